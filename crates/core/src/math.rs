@@ -1,0 +1,344 @@
+//! Scalar, vector, rotation and transform types shared by the whole engine.
+//!
+//! | build            | [`Real`] | [`Vec2`]          |
+//! |------------------|----------|-------------------|
+//! | default          | `f32`    | `glam::Vec2`      |
+//! | feature `f64`    | `f64`    | `glam::DVec2`     |
+//!
+//! Conventions (the same as `../shared/spec/portal.md`):
+//! - 2D cross product `a × b = a.x*b.y - a.y*b.x` is [`cross`] (glam: `perp_dot`);
+//! - `perp(v) = (-v.y, v.x)`, so `ω × v = ω * perp(v)` is [`cross_sv`];
+//! - a [`Rot`] stores cosine and sine, never the angle.
+
+/// The engine's one scalar type: `f32`, or `f64` with the `f64` feature.
+#[cfg(not(feature = "f64"))]
+pub type Real = f32;
+/// The engine's one scalar type: `f32`, or `f64` with the `f64` feature.
+#[cfg(feature = "f64")]
+pub type Real = f64;
+
+/// The engine's 2D vector: `glam::Vec2`, or `glam::DVec2` with the `f64` feature.
+#[cfg(not(feature = "f64"))]
+pub type Vec2 = glam::Vec2;
+/// The engine's 2D vector: `glam::Vec2`, or `glam::DVec2` with the `f64` feature.
+#[cfg(feature = "f64")]
+pub type Vec2 = glam::DVec2;
+
+/// π in the engine's precision.
+#[cfg(not(feature = "f64"))]
+pub const PI: Real = std::f32::consts::PI;
+/// π in the engine's precision.
+#[cfg(feature = "f64")]
+pub const PI: Real = std::f64::consts::PI;
+
+/// 2π in the engine's precision.
+pub const TAU: Real = 2.0 * PI;
+
+/// Machine epsilon of [`Real`].
+pub const EPSILON: Real = Real::EPSILON;
+
+/// 2D cross product of two vectors, `a.x*b.y - a.y*b.x` (a scalar).
+#[inline(always)]
+pub fn cross(a: Vec2, b: Vec2) -> Real {
+    a.x * b.y - a.y * b.x
+}
+
+/// Cross product of a scalar (an angular velocity) and a vector: `s * perp(v)`.
+#[inline(always)]
+pub fn cross_sv(s: Real, v: Vec2) -> Vec2 {
+    Vec2::new(-s * v.y, s * v.x)
+}
+
+/// Cross product of a vector and a scalar: `-s * perp(v)`.
+#[inline(always)]
+pub fn cross_vs(v: Vec2, s: Real) -> Vec2 {
+    Vec2::new(s * v.y, -s * v.x)
+}
+
+/// Wraps an angle into `[-π, π]`: `x - 2π round(x / 2π)`.
+#[inline]
+pub fn wrap_angle(x: Real) -> Real {
+    x - TAU * (x / TAU).round()
+}
+
+/// True when every component is finite.
+#[inline]
+pub fn vec_is_finite(v: Vec2) -> bool {
+    v.x.is_finite() && v.y.is_finite()
+}
+
+/// A rotation stored as cosine and sine (unit length).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rot {
+    /// Cosine of the angle.
+    pub c: Real,
+    /// Sine of the angle.
+    pub s: Real,
+}
+
+impl Default for Rot {
+    fn default() -> Self {
+        Self::IDENTITY
+    }
+}
+
+impl Rot {
+    /// No rotation.
+    pub const IDENTITY: Rot = Rot { c: 1.0, s: 0.0 };
+
+    /// The rotation by `angle` radians.
+    #[inline]
+    pub fn from_angle(angle: Real) -> Self {
+        let (s, c) = angle.sin_cos();
+        Rot { c, s }
+    }
+
+    /// The angle in `[-π, π]`.
+    #[inline]
+    pub fn angle(self) -> Real {
+        self.s.atan2(self.c)
+    }
+
+    /// Rotates a vector.
+    #[inline(always)]
+    pub fn rotate(self, v: Vec2) -> Vec2 {
+        Vec2::new(self.c * v.x - self.s * v.y, self.s * v.x + self.c * v.y)
+    }
+
+    /// Rotates a vector by the inverse rotation.
+    #[inline(always)]
+    pub fn inv_rotate(self, v: Vec2) -> Vec2 {
+        Vec2::new(self.c * v.x + self.s * v.y, -self.s * v.x + self.c * v.y)
+    }
+
+    /// `self * other`: apply `other`, then `self`.
+    #[inline(always)]
+    pub fn mul(self, other: Rot) -> Rot {
+        Rot {
+            c: self.c * other.c - self.s * other.s,
+            s: self.s * other.c + self.c * other.s,
+        }
+    }
+
+    /// `self⁻¹ * other`: the rotation from `self` to `other`.
+    #[inline(always)]
+    pub fn inv_mul(self, other: Rot) -> Rot {
+        Rot {
+            c: self.c * other.c + self.s * other.s,
+            s: self.c * other.s - self.s * other.c,
+        }
+    }
+
+    /// The relative angle from `self` to `other`, in `[-π, π]`.
+    #[inline]
+    pub fn relative_angle(self, other: Rot) -> Real {
+        self.inv_mul(other).angle()
+    }
+
+    /// Normalises to unit length (identity if degenerate).
+    #[inline]
+    pub fn normalize(self) -> Rot {
+        let mag = (self.c * self.c + self.s * self.s).sqrt();
+        if mag > EPSILON {
+            let inv = 1.0 / mag;
+            Rot {
+                c: self.c * inv,
+                s: self.s * inv,
+            }
+        } else {
+            Rot::IDENTITY
+        }
+    }
+
+    /// Advances the rotation by an angle increment `h * w` (first-order, then
+    /// normalised), as Box2D v3 integrates rotations.
+    #[inline(always)]
+    pub fn integrate(self, delta_angle: Real) -> Rot {
+        Rot {
+            c: self.c - delta_angle * self.s,
+            s: self.s + delta_angle * self.c,
+        }
+        .normalize()
+    }
+
+    /// The unit x axis of the rotated frame.
+    #[inline]
+    pub fn x_axis(self) -> Vec2 {
+        Vec2::new(self.c, self.s)
+    }
+
+    /// True when both components are finite.
+    #[inline]
+    pub fn is_finite(self) -> bool {
+        self.c.is_finite() && self.s.is_finite()
+    }
+}
+
+/// A rigid transform: rotation then translation.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Transform {
+    /// Translation (the body origin in world space).
+    pub p: Vec2,
+    /// Rotation.
+    pub q: Rot,
+}
+
+impl Transform {
+    /// The identity transform.
+    pub const IDENTITY: Transform = Transform {
+        p: Vec2::ZERO,
+        q: Rot::IDENTITY,
+    };
+
+    /// A transform from a position and an angle.
+    pub fn new(p: Vec2, angle: Real) -> Self {
+        Transform {
+            p,
+            q: Rot::from_angle(angle),
+        }
+    }
+
+    /// Maps a local point to world space.
+    #[inline(always)]
+    pub fn apply(&self, v: Vec2) -> Vec2 {
+        self.q.rotate(v) + self.p
+    }
+
+    /// Maps a world point to local space.
+    #[inline(always)]
+    pub fn apply_inv(&self, v: Vec2) -> Vec2 {
+        self.q.inv_rotate(v - self.p)
+    }
+
+    /// `self * other` (apply `other`, then `self`).
+    #[inline]
+    pub fn mul(&self, other: &Transform) -> Transform {
+        Transform {
+            q: self.q.mul(other.q),
+            p: self.q.rotate(other.p) + self.p,
+        }
+    }
+
+    /// `self⁻¹ * other`: `other` expressed in the frame of `self`.
+    #[inline]
+    pub fn inv_mul(&self, other: &Transform) -> Transform {
+        Transform {
+            q: self.q.inv_mul(other.q),
+            p: self.q.inv_rotate(other.p - self.p),
+        }
+    }
+}
+
+/// Solves the symmetric 2×2 system `[k11 k12; k12 k22] x = b`, returning zero
+/// for a singular matrix (never NaN).
+#[inline]
+pub fn solve22(k11: Real, k12: Real, k22: Real, b: Vec2) -> Vec2 {
+    let det = k11 * k22 - k12 * k12;
+    if det.abs() <= EPSILON * (k11.abs() * k22.abs()).max(EPSILON) || det == 0.0 {
+        return Vec2::ZERO;
+    }
+    let inv_det = 1.0 / det;
+    Vec2::new(
+        inv_det * (k22 * b.x - k12 * b.y),
+        inv_det * (k11 * b.y - k12 * b.x),
+    )
+}
+
+/// A 3×3 matrix in row-major order, used for coupled constraint blocks.
+pub type Mat3 = [[Real; 3]; 3];
+
+/// Solves `k x = b` for a symmetric positive semi-definite 3×3 `k`.
+///
+/// Uses an LDLᵀ factorisation with pivots below a relative tolerance treated
+/// as zero (the corresponding component of `x` is set to zero): the result is
+/// a least-norm-like solution of the well-posed part and never NaN.
+pub fn solve33_psd(k: &Mat3, b: [Real; 3]) -> [Real; 3] {
+    let scale = k[0][0].abs().max(k[1][1].abs()).max(k[2][2].abs());
+    if scale == 0.0 || !scale.is_finite() {
+        return [0.0; 3];
+    }
+    let tol = scale * 1e3 * EPSILON;
+    // LDLᵀ with a lower unit-triangular L.
+    let mut l = [[0.0 as Real; 3]; 3];
+    let mut d = [0.0 as Real; 3];
+    for j in 0..3 {
+        let mut dj = k[j][j];
+        for m in 0..j {
+            dj -= l[j][m] * l[j][m] * d[m];
+        }
+        d[j] = dj;
+        l[j][j] = 1.0;
+        for i in (j + 1)..3 {
+            let mut v = k[i][j];
+            for m in 0..j {
+                v -= l[i][m] * l[j][m] * d[m];
+            }
+            l[i][j] = if dj > tol { v / dj } else { 0.0 };
+        }
+    }
+    // Forward: L y = b.
+    let mut y = [0.0 as Real; 3];
+    for i in 0..3 {
+        let mut v = b[i];
+        for m in 0..i {
+            v -= l[i][m] * y[m];
+        }
+        y[i] = v;
+    }
+    // Diagonal.
+    let mut z = [0.0 as Real; 3];
+    for i in 0..3 {
+        z[i] = if d[i] > tol { y[i] / d[i] } else { 0.0 };
+    }
+    // Backward: Lᵀ x = z.
+    let mut x = [0.0 as Real; 3];
+    for i in (0..3).rev() {
+        let mut v = z[i];
+        for m in (i + 1)..3 {
+            v -= l[m][i] * x[m];
+        }
+        x[i] = v;
+    }
+    x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rot_inverse_roundtrip() {
+        let q = Rot::from_angle(0.7);
+        let v = Vec2::new(1.5, -2.0);
+        let back = q.inv_rotate(q.rotate(v));
+        assert!((back - v).length() < 1e-5);
+        assert!((q.relative_angle(Rot::from_angle(1.0)) - 0.3).abs() < 1e-5);
+    }
+
+    #[test]
+    fn wrap_angle_maps_two_pi_to_zero() {
+        assert!(wrap_angle(TAU).abs() < 1e-5);
+        assert!(wrap_angle(-TAU).abs() < 1e-5);
+        assert!((wrap_angle(3.0 * PI / 2.0) + PI / 2.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn solve33_matches_direct_solution() {
+        let k: Mat3 = [[4.0, 1.0, 0.5], [1.0, 3.0, 0.2], [0.5, 0.2, 2.0]];
+        let b = [1.0, 2.0, 3.0];
+        let x = solve33_psd(&k, b);
+        for i in 0..3 {
+            let r = k[i][0] * x[0] + k[i][1] * x[1] + k[i][2] * x[2];
+            assert!((r - b[i]).abs() < 1e-5, "row {i}: {r} vs {}", b[i]);
+        }
+    }
+
+    #[test]
+    fn solve33_singular_is_finite() {
+        let k: Mat3 = [[1.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 0.0, 0.0]];
+        let x = solve33_psd(&k, [1.0, 1.0, 1.0]);
+        assert!(x.iter().all(|v| v.is_finite()));
+        assert!(((x[0] + x[1]) - 1.0).abs() < 1e-5);
+        assert_eq!(x[2], 0.0);
+    }
+}
