@@ -1,1 +1,44 @@
+//! # janus2d-constraints
+//!
+//! Constraint types built on [`janus2d_core::constraint::Constraint`]:
+//!
+//! | type                          | rows | bodies | built from              |
+//! |-------------------------------|------|--------|-------------------------|
+//! | [`revolute::RevoluteJoint`]   | 2–6  | 2      | point + angle parts     |
+//!
+//! Every type follows the same stages (prepare, warm start, solve with or
+//! without bias) and reports its rows through `Constraint::rows`.
 
+pub mod parts;
+pub mod revolute;
+
+pub use revolute::{RevoluteJoint, RevoluteJointDef};
+
+/// Invalid joint input at the API boundary.
+#[derive(Clone, Debug, PartialEq)]
+pub enum JointError {
+    /// Both ends name the same body.
+    SameBody,
+    /// A value that must be finite is not.
+    NonFinite,
+    /// A value that must be ≥ 0 is negative.
+    Negative,
+    /// The lower limit exceeds the upper limit.
+    InvalidLimits,
+}
+
+impl std::fmt::Display for JointError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            JointError::SameBody => write!(f, "a joint needs two different bodies"),
+            JointError::NonFinite => write!(f, "joint definition has a non-finite value"),
+            JointError::Negative => write!(
+                f,
+                "joint definition has a negative torque, hertz or damping"
+            ),
+            JointError::InvalidLimits => write!(f, "joint lower limit exceeds upper limit"),
+        }
+    }
+}
+
+impl std::error::Error for JointError {}

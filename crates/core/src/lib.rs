@@ -2,9 +2,27 @@
 //!
 //! Bodies, integration, the sequential-impulse solver and the constraint
 //! trait that reports J, K and bias.
-#![doc = "See `docs/architecture.md` for the crate graph and the step pipeline."]
+//!
+//! | module         | what                                                        |
+//! |----------------|-------------------------------------------------------------|
+//! | [`math`]       | the scalar alias, vectors, rotations, transforms, small solves |
+//! | [`body`]       | body definitions, generational handles, hot/cold storage    |
+//! | [`softness`]   | the one softness type of every soft row                    |
+//! | [`constraint`] | the constraint trait, rows, blocks, the step context        |
+//! | [`solver`]     | the soft step and the PGS baseline                          |
+//! | [`geometry`]   | shapes, mass properties, bounding boxes, manifolds          |
+//!
+//! See `docs/architecture.md` for the crate graph and the step pipeline.
 
+pub mod body;
+pub mod constraint;
 pub mod geometry;
 pub mod math;
+pub mod softness;
+pub mod solver;
 
+pub use body::{BodyDef, BodyHandle, BodyMass, BodySet, BodyState, BodyType};
+pub use constraint::{Constraint, ConstraintBatch, ConstraintRows, SolverMode, StepContext};
 pub use math::{Real, Rot, Transform, Vec2};
+pub use softness::Softness;
+pub use solver::SolverSettings;

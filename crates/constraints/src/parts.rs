@@ -1,0 +1,279 @@
+//! Reusable constraint parts: point, axis and angle.
+//!
+//! Joints and contacts are assembled from these parts, in the spirit of
+//! Jolt's constraint parts. Each part owns its accumulated impulse and
+//! implements the same stages (warm start, solve with or without bias).
+//!
+//! | part          | rows | C                                         | J (body a │ body b)                          |
+//! |---------------|------|-------------------------------------------|----------------------------------------------|
+//! | [`PointPart`] | 2    | `(x_b + r_b) − (x_a + r_a)`               | `−I, −perp(r_a) │ I, perp(r_b)`                |
+//! | [`AxisPart`]  | 1    | `n · ((x_b + r_b) − (x_a + r_a))`         | `−n, −r_a × n │ n, r_b × n`                    |
+//! | [`AnglePart`] | 1    | `θ_b − θ_a − θ_ref`                       | `0, −1 │ 0, 1`                                |
+//!
+//! Positions during a step are tracked as deltas: `r = dq · r₀`, and the
+//! centre offset is `Δc + dp_b − dp_a`, so `C` is refreshed every substep
+//! without recomputing transforms.
+//!
+//! All parts read velocities and inverse masses from the hot
+//! [`BodyState`] only. A static body is the shared identity state (slot 0),
+//! whose zero inverse mass makes every impulse on it vanish without a branch.
+
+use janus2d_core::body::BodyState;
+use janus2d_core::math::{Real, Vec2, cross, cross_sv, solve22};
+use janus2d_core::softness::Softness;
+
+/// Reads the velocity part of two states.
+#[inline(always)]
+pub fn load_pair(states: &[BodyState], a: u32, b: u32) -> (BodyState, BodyState) {
+    (states[a as usize], states[b as usize])
+}
+
+/// Writes back the velocities of two states (positions are untouched).
+#[inline(always)]
+pub fn store_pair(states: &mut [BodyState], a: u32, b: u32, sa: &BodyState, sb: &BodyState) {
+    let ta = &mut states[a as usize];
+    ta.v = sa.v;
+    ta.w = sa.w;
+    let tb = &mut states[b as usize];
+    tb.v = sb.v;
+    tb.w = sb.w;
+}
+
+/// Applies a linear impulse `p` at arms `r_a`, `r_b` (equal and opposite)
+/// plus an angular impulse `l` (positive on b).
+#[inline(always)]
+pub fn apply_pair(sa: &mut BodyState, sb: &mut BodyState, r_a: Vec2, r_b: Vec2, p: Vec2, l: Real) {
+    sa.v -= sa.inv_mass * p;
+    sa.w -= sa.inv_inertia * (cross(r_a, p) + l);
+    sb.v += sb.inv_mass * p;
+    sb.w += sb.inv_inertia * (cross(r_b, p) + l);
+}
+
+/// Clamps the length of a bias velocity to `max` (m/s).
+#[inline(always)]
+pub fn clamp_length(v: Vec2, max: Real) -> Vec2 {
+    let len2 = v.length_squared();
+    if len2 > max * max {
+        v * (max / len2.sqrt())
+    } else {
+        v
+    }
+}
+
+/// Two rows that hold an anchor on body a at an anchor on body b.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PointPart {
+    /// Anchor on a relative to a's centre at the start of the step (world frame), m.
+    pub frame_a: Vec2,
+    /// Anchor on b relative to b's centre at the start of the step (world frame), m.
+    pub frame_b: Vec2,
+    /// `c_b − c_a` at the start of the step, m.
+    pub delta_center: Vec2,
+    /// Accumulated impulse, N·s.
+    pub impulse: Vec2,
+}
+
+impl PointPart {
+    /// Current arms and separation `C` (m) from the states' deltas.
+    #[inline(always)]
+    pub fn arms(&self, sa: &BodyState, sb: &BodyState) -> (Vec2, Vec2, Vec2) {
+        let r_a = sa.dq.rotate(self.frame_a);
+        let r_b = sb.dq.rotate(self.frame_b);
+        let c = (sb.dp - sa.dp) + (r_b - r_a) + self.delta_center;
+        (r_a, r_b, c)
+    }
+
+    /// Applies the accumulated impulse.
+    #[inline(always)]
+    pub fn warm_start(&self, sa: &mut BodyState, sb: &mut BodyState) {
+        let r_a = sa.dq.rotate(self.frame_a);
+        let r_b = sb.dq.rotate(self.frame_b);
+        apply_pair(sa, sb, r_a, r_b, self.impulse, 0.0);
+    }
+
+    /// The 2×2 effective mass `K = J M⁻¹ Jᵀ` as `(k11, k12, k22)`.
+    #[inline(always)]
+    pub fn effective_mass(
+        sa: &BodyState,
+        sb: &BodyState,
+        r_a: Vec2,
+        r_b: Vec2,
+    ) -> (Real, Real, Real) {
+        let (m_a, m_b, i_a, i_b) = (sa.inv_mass, sb.inv_mass, sa.inv_inertia, sb.inv_inertia);
+        let k11 = m_a + m_b + r_a.y * r_a.y * i_a + r_b.y * r_b.y * i_b;
+        let k12 = -r_a.y * r_a.x * i_a - r_b.y * r_b.x * i_b;
+        let k22 = m_a + m_b + r_a.x * r_a.x * i_a + r_b.x * r_b.x * i_b;
+        (k11, k12, k22)
+    }
+
+    /// One soft iteration. With `use_bias` the position error is fed back
+    /// at `softness.bias_rate`, its speed capped at `max_correction` (m/s).
+    #[inline(always)]
+    pub fn solve(
+        &mut self,
+        sa: &mut BodyState,
+        sb: &mut BodyState,
+        softness: Softness,
+        max_correction: Real,
+        use_bias: bool,
+    ) {
+        let (r_a, r_b, c) = self.arms(sa, sb);
+        let c_dot = (sb.v + cross_sv(sb.w, r_b)) - (sa.v + cross_sv(sa.w, r_a));
+        let (bias, mass_scale, impulse_scale) = if use_bias {
+            (
+                clamp_length(softness.bias_rate * c, max_correction),
+                softness.mass_scale,
+                softness.impulse_scale,
+            )
+        } else {
+            (Vec2::ZERO, 1.0, 0.0)
+        };
+        let (k11, k12, k22) = Self::effective_mass(sa, sb, r_a, r_b);
+        let b = solve22(k11, k12, k22, c_dot + bias);
+        let impulse = -mass_scale * b - impulse_scale * self.impulse;
+        self.impulse += impulse;
+        apply_pair(sa, sb, r_a, r_b, impulse, 0.0);
+    }
+}
+
+/// One row along a direction `n` between two anchors (contact normals,
+/// friction, prismatic axes). The caller keeps the arms and direction.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AxisPart {
+    /// Effective mass `1 / (J M⁻¹ Jᵀ)`, kg.
+    pub mass: Real,
+    /// Accumulated impulse, N·s.
+    pub impulse: Real,
+}
+
+impl AxisPart {
+    /// `J M⁻¹ Jᵀ` of the row along `n` with arms `r_a`, `r_b`.
+    #[inline(always)]
+    pub fn k(sa: &BodyState, sb: &BodyState, r_a: Vec2, r_b: Vec2, n: Vec2) -> Real {
+        let rn_a = cross(r_a, n);
+        let rn_b = cross(r_b, n);
+        sa.inv_mass + sb.inv_mass + sa.inv_inertia * rn_a * rn_a + sb.inv_inertia * rn_b * rn_b
+    }
+
+    /// Sets the effective mass from `K` (zero when `K` is zero).
+    #[inline(always)]
+    pub fn set_mass(&mut self, k: Real) {
+        self.mass = if k > 0.0 { 1.0 / k } else { 0.0 };
+    }
+
+    /// Relative velocity along `n` at the arms.
+    #[inline(always)]
+    pub fn c_dot(sa: &BodyState, sb: &BodyState, r_a: Vec2, r_b: Vec2, n: Vec2) -> Real {
+        let dv = (sb.v + cross_sv(sb.w, r_b)) - (sa.v + cross_sv(sa.w, r_a));
+        dv.dot(n)
+    }
+
+    /// Applies an impulse `lambda` along `n`.
+    #[inline(always)]
+    pub fn apply(
+        sa: &mut BodyState,
+        sb: &mut BodyState,
+        r_a: Vec2,
+        r_b: Vec2,
+        n: Vec2,
+        lambda: Real,
+    ) {
+        apply_pair(sa, sb, r_a, r_b, lambda * n, 0.0);
+    }
+}
+
+/// One row on the relative angle of two bodies (springs, motors, limits).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AnglePart {
+    /// Effective mass `1 / (1/I_a + 1/I_b)`, kg·m².
+    pub mass: Real,
+    /// Accumulated impulse, N·m·s.
+    pub impulse: Real,
+}
+
+impl AnglePart {
+    /// Sets the effective mass from the two states.
+    #[inline(always)]
+    pub fn prepare(&mut self, sa: &BodyState, sb: &BodyState) {
+        let k = sa.inv_inertia + sb.inv_inertia;
+        self.mass = if k > 0.0 { 1.0 / k } else { 0.0 };
+    }
+
+    /// Relative angular velocity `ω_b − ω_a`.
+    #[inline(always)]
+    pub fn c_dot(sa: &BodyState, sb: &BodyState) -> Real {
+        sb.w - sa.w
+    }
+
+    /// Applies an angular impulse (positive on b).
+    #[inline(always)]
+    pub fn apply(sa: &mut BodyState, sb: &mut BodyState, lambda: Real) {
+        sa.w -= sa.inv_inertia * lambda;
+        sb.w += sb.inv_inertia * lambda;
+    }
+
+    /// A soft equality row: drives `c` to zero with `softness`.
+    #[inline(always)]
+    pub fn solve_soft(
+        &mut self,
+        sa: &mut BodyState,
+        sb: &mut BodyState,
+        c: Real,
+        softness: Softness,
+    ) {
+        let c_dot = Self::c_dot(sa, sb);
+        let bias = softness.bias_rate * c;
+        let lambda = -softness.mass_scale * self.mass * (c_dot + bias)
+            - softness.impulse_scale * self.impulse;
+        self.impulse += lambda;
+        Self::apply(sa, sb, lambda);
+    }
+
+    /// A velocity row driving `ω_b − ω_a` to `target`, with the accumulated
+    /// impulse clamped to `±max_impulse`.
+    #[inline(always)]
+    pub fn solve_motor(
+        &mut self,
+        sa: &mut BodyState,
+        sb: &mut BodyState,
+        target: Real,
+        max_impulse: Real,
+    ) {
+        let c_dot = Self::c_dot(sa, sb) - target;
+        let lambda = -self.mass * c_dot;
+        let old = self.impulse;
+        self.impulse = (old + lambda).clamp(-max_impulse, max_impulse);
+        Self::apply(sa, sb, self.impulse - old);
+    }
+
+    /// A one-sided row `sign · c ≥ 0` (a limit): speculative when apart,
+    /// soft when violated (only with `use_bias`).
+    #[inline(always)]
+    pub fn solve_limit(
+        &mut self,
+        sa: &mut BodyState,
+        sb: &mut BodyState,
+        c: Real,
+        sign: Real,
+        softness: Softness,
+        inv_h: Real,
+        use_bias: bool,
+    ) {
+        let (bias, mass_scale, impulse_scale) = if c > 0.0 {
+            (c * inv_h, 1.0, 0.0)
+        } else if use_bias {
+            (
+                softness.bias_rate * c,
+                softness.mass_scale,
+                softness.impulse_scale,
+            )
+        } else {
+            (0.0, 1.0, 0.0)
+        };
+        let c_dot = sign * Self::c_dot(sa, sb);
+        let lambda = -self.mass * mass_scale * (c_dot + bias) - impulse_scale * self.impulse;
+        let old = self.impulse;
+        self.impulse = (old + lambda).max(0.0);
+        Self::apply(sa, sb, sign * (self.impulse - old));
+    }
+}

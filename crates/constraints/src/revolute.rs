@@ -1,0 +1,430 @@
+//! The revolute joint: a shared point, with optional angle limits, a motor
+//! and an angular spring.
+//!
+//! # Derivation
+//!
+//! Bodies `a` and `b` with centres `x_a`, `x_b`, angles `θ_a`, `θ_b`, and
+//! anchors `r_a = R(θ_a)(l_a − c_a)`, `r_b = R(θ_b)(l_b − c_b)` measured from
+//! the centres of mass.
+//!
+//! **Point (2 rows).** `C = (x_b + r_b) − (x_a + r_a)`, so
+//! `Ċ = v_b + ω_b × r_b − v_a − ω_a × r_a = J v` with
+//!
+//! ```text
+//! J = [ −I  −perp(r_a)   I  perp(r_b) ]
+//! K = J M⁻¹ Jᵀ = (m_a⁻¹ + m_b⁻¹) I + i_a⁻¹ perp(r_a) perp(r_a)ᵀ + i_b⁻¹ perp(r_b) perp(r_b)ᵀ
+//! ```
+//!
+//! solved as a 2×2 block: `λ = −s_m K⁻¹ (Ċ + β C) − s_i λ_acc` with the soft
+//! coefficients `β, s_m, s_i` of [`Softness`](janus2d_core::softness::Softness)
+//! and the bias `β C` capped at the joint correction speed so that a large
+//! initial error recovers gently instead of flinging the bodies.
+//!
+//! **Angle (1 row each).** `C = θ_b − θ_a − θ_ref`, `J = [0 −1 0 1]`,
+//! `K = i_a⁻¹ + i_b⁻¹`. The spring drives `C` to zero with its own softness;
+//! the motor drives `Ċ` to the target speed with the impulse clamped to
+//! `max_motor_torque · h`; the limits are the one-sided rows
+//! `C − lower ≥ 0` and `upper − C ≥ 0`, speculative while apart.
+
+use janus2d_core::body::{BodyHandle, BodySet, BodyState};
+use janus2d_core::constraint::{Block, BodyJacobian, Constraint, ConstraintRows, Row, StepContext};
+use janus2d_core::math::{Real, Vec2, cross, vec_is_finite};
+use janus2d_core::softness::Softness;
+use smallvec::smallvec;
+
+use crate::JointError;
+use crate::parts::{AnglePart, PointPart, load_pair, store_pair};
+
+/// Everything needed to create a revolute joint.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RevoluteJointDef {
+    /// First body.
+    pub body_a: BodyHandle,
+    /// Second body.
+    pub body_b: BodyHandle,
+    /// Anchor in body a's frame (relative to its origin), m.
+    pub local_anchor_a: Vec2,
+    /// Anchor in body b's frame (relative to its origin), m.
+    pub local_anchor_b: Vec2,
+    /// `θ_b − θ_a` at which the joint angle is zero, rad.
+    pub reference_angle: Real,
+    /// Enables the angle limits.
+    pub enable_limit: bool,
+    /// Lower angle limit, rad.
+    pub lower_angle: Real,
+    /// Upper angle limit, rad.
+    pub upper_angle: Real,
+    /// Enables the motor.
+    pub enable_motor: bool,
+    /// Motor target speed, rad/s.
+    pub motor_speed: Real,
+    /// Maximum motor torque, N·m.
+    pub max_motor_torque: Real,
+    /// Enables the angular spring.
+    pub enable_spring: bool,
+    /// Spring stiffness, Hz.
+    pub hertz: Real,
+    /// Spring damping ratio (dimensionless).
+    pub damping_ratio: Real,
+    /// Whether the two bodies collide with each other (usual false).
+    pub collide_connected: bool,
+}
+
+impl RevoluteJointDef {
+    /// A plain hinge between two bodies at the given local anchors.
+    pub fn new(
+        body_a: BodyHandle,
+        body_b: BodyHandle,
+        local_anchor_a: Vec2,
+        local_anchor_b: Vec2,
+    ) -> Self {
+        RevoluteJointDef {
+            body_a,
+            body_b,
+            local_anchor_a,
+            local_anchor_b,
+            reference_angle: 0.0,
+            enable_limit: false,
+            lower_angle: 0.0,
+            upper_angle: 0.0,
+            enable_motor: false,
+            motor_speed: 0.0,
+            max_motor_torque: 0.0,
+            enable_spring: false,
+            hertz: 0.0,
+            damping_ratio: 0.0,
+            collide_connected: false,
+        }
+    }
+
+    /// Enables limits (builder style).
+    pub fn with_limits(mut self, lower: Real, upper: Real) -> Self {
+        self.enable_limit = true;
+        self.lower_angle = lower;
+        self.upper_angle = upper;
+        self
+    }
+
+    /// Enables the motor (builder style).
+    pub fn with_motor(mut self, speed: Real, max_torque: Real) -> Self {
+        self.enable_motor = true;
+        self.motor_speed = speed;
+        self.max_motor_torque = max_torque;
+        self
+    }
+
+    /// Enables the spring (builder style).
+    pub fn with_spring(mut self, hertz: Real, damping_ratio: Real) -> Self {
+        self.enable_spring = true;
+        self.hertz = hertz;
+        self.damping_ratio = damping_ratio;
+        self
+    }
+
+    /// Checks the definition's own values (not the handles).
+    pub fn validate(&self) -> Result<(), JointError> {
+        if self.body_a == self.body_b {
+            return Err(JointError::SameBody);
+        }
+        let finite = vec_is_finite(self.local_anchor_a)
+            && vec_is_finite(self.local_anchor_b)
+            && self.reference_angle.is_finite()
+            && self.lower_angle.is_finite()
+            && self.upper_angle.is_finite()
+            && self.motor_speed.is_finite()
+            && !self.max_motor_torque.is_nan()
+            && self.hertz.is_finite()
+            && self.damping_ratio.is_finite();
+        if !finite {
+            return Err(JointError::NonFinite);
+        }
+        if self.enable_limit && self.lower_angle > self.upper_angle {
+            return Err(JointError::InvalidLimits);
+        }
+        if self.max_motor_torque < 0.0 || self.hertz < 0.0 || self.damping_ratio < 0.0 {
+            return Err(JointError::Negative);
+        }
+        Ok(())
+    }
+}
+
+/// A revolute joint in solver form.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RevoluteJoint {
+    /// The definition it was made from (limits, motor and spring settings).
+    pub def: RevoluteJointDef,
+    /// False when the joint is disabled (skipped by the solver).
+    pub enabled: bool,
+    state_a: u32,
+    state_b: u32,
+    point: PointPart,
+    /// `θ_b − θ_a − θ_ref` at the start of the step, rad.
+    delta_angle: Real,
+    spring: AnglePart,
+    motor: AnglePart,
+    lower: AnglePart,
+    upper: AnglePart,
+    spring_softness: Softness,
+}
+
+impl RevoluteJoint {
+    /// A joint from a definition (validate it first).
+    pub fn new(def: RevoluteJointDef) -> Self {
+        RevoluteJoint {
+            def,
+            enabled: true,
+            state_a: 0,
+            state_b: 0,
+            point: PointPart::default(),
+            delta_angle: 0.0,
+            spring: AnglePart::default(),
+            motor: AnglePart::default(),
+            lower: AnglePart::default(),
+            upper: AnglePart::default(),
+            spring_softness: Softness::RIGID,
+        }
+    }
+
+    /// The world anchors on a and b (their distance is the joint gap).
+    pub fn world_anchors(&self, bodies: &BodySet) -> (Vec2, Vec2) {
+        let a = bodies.solver_body(self.def.body_a).sim;
+        let b = bodies.solver_body(self.def.body_b).sim;
+        (
+            a.transform.apply(self.def.local_anchor_a),
+            b.transform.apply(self.def.local_anchor_b),
+        )
+    }
+
+    /// Distance between the two world anchors, m.
+    pub fn gap(&self, bodies: &BodySet) -> Real {
+        let (pa, pb) = self.world_anchors(bodies);
+        (pb - pa).length()
+    }
+
+    /// The joint angle `θ_b − θ_a − θ_ref`, rad.
+    pub fn angle(&self, bodies: &BodySet) -> Real {
+        let a = bodies.solver_body(self.def.body_a).sim;
+        let b = bodies.solver_body(self.def.body_b).sim;
+        janus2d_core::math::wrap_angle(
+            a.transform.q.relative_angle(b.transform.q) - self.def.reference_angle,
+        )
+    }
+
+    /// Accumulated point impulse of the last step, N·s.
+    pub fn linear_impulse(&self) -> Vec2 {
+        self.point.impulse
+    }
+
+    /// Accumulated motor impulse of the last step, N·m·s.
+    pub fn motor_impulse(&self) -> Real {
+        self.motor.impulse
+    }
+
+    fn current_angle(&self, sa: &BodyState, sb: &BodyState) -> Real {
+        janus2d_core::math::wrap_angle(self.delta_angle + sa.dq.relative_angle(sb.dq))
+    }
+}
+
+impl Constraint for RevoluteJoint {
+    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
+        let a = bodies.solver_body(self.def.body_a);
+        let b = bodies.solver_body(self.def.body_b);
+        self.state_a = a.state_index;
+        self.state_b = b.state_index;
+        let q_a = a.sim.transform.q;
+        let q_b = b.sim.transform.q;
+        self.point.frame_a = q_a.rotate(self.def.local_anchor_a - a.sim.local_center);
+        self.point.frame_b = q_b.rotate(self.def.local_anchor_b - b.sim.local_center);
+        self.point.delta_center = b.sim.center - a.sim.center;
+        self.delta_angle =
+            janus2d_core::math::wrap_angle(q_a.relative_angle(q_b) - self.def.reference_angle);
+        let (sa, sb) = (a.state, b.state);
+        for part in [
+            &mut self.spring,
+            &mut self.motor,
+            &mut self.lower,
+            &mut self.upper,
+        ] {
+            part.prepare(sa, sb);
+        }
+        self.spring_softness = Softness::new(self.def.hertz, self.def.damping_ratio, ctx.h);
+        if !ctx.warm_starting {
+            self.point.impulse = Vec2::ZERO;
+            self.spring.impulse = 0.0;
+            self.motor.impulse = 0.0;
+            self.lower.impulse = 0.0;
+            self.upper.impulse = 0.0;
+        }
+        if !self.def.enable_spring {
+            self.spring.impulse = 0.0;
+        }
+        if !self.def.enable_motor {
+            self.motor.impulse = 0.0;
+        }
+        if !self.def.enable_limit {
+            self.lower.impulse = 0.0;
+            self.upper.impulse = 0.0;
+        }
+    }
+
+    fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
+        let (mut sa, mut sb) = load_pair(states, self.state_a, self.state_b);
+        let axial =
+            self.spring.impulse + self.motor.impulse + self.lower.impulse - self.upper.impulse;
+        AnglePart::apply(&mut sa, &mut sb, axial);
+        self.point.warm_start(&mut sa, &mut sb);
+        store_pair(states, self.state_a, self.state_b, &sa, &sb);
+    }
+
+    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
+        let (mut sa, mut sb) = load_pair(states, self.state_a, self.state_b);
+        if self.def.enable_spring && sa.inv_inertia + sb.inv_inertia > 0.0 {
+            let c = self.current_angle(&sa, &sb);
+            self.spring
+                .solve_soft(&mut sa, &mut sb, c, self.spring_softness);
+        }
+        if self.def.enable_motor {
+            let max_impulse = ctx.h * self.def.max_motor_torque;
+            self.motor
+                .solve_motor(&mut sa, &mut sb, self.def.motor_speed, max_impulse);
+        }
+        if self.def.enable_limit {
+            let angle = self.current_angle(&sa, &sb);
+            let soft = ctx.joint_softness;
+            self.lower.solve_limit(
+                &mut sa,
+                &mut sb,
+                angle - self.def.lower_angle,
+                1.0,
+                soft,
+                ctx.inv_h,
+                use_bias,
+            );
+            self.upper.solve_limit(
+                &mut sa,
+                &mut sb,
+                self.def.upper_angle - angle,
+                -1.0,
+                soft,
+                ctx.inv_h,
+                use_bias,
+            );
+        }
+        self.point.solve(
+            &mut sa,
+            &mut sb,
+            ctx.joint_softness,
+            ctx.joint_max_correction_speed,
+            use_bias,
+        );
+        store_pair(states, self.state_a, self.state_b, &sa, &sb);
+    }
+
+    fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
+        let a = bodies.solver_body(self.def.body_a);
+        let b = bodies.solver_body(self.def.body_b);
+        let r_a = a
+            .sim
+            .transform
+            .q
+            .rotate(self.def.local_anchor_a - a.sim.local_center);
+        let r_b = b
+            .sim
+            .transform
+            .q
+            .rotate(self.def.local_anchor_b - b.sim.local_center);
+        let c = (b.sim.center + r_b) - (a.sim.center + r_a);
+        let (ima, iia, imb, iib) = (
+            a.state.inv_mass,
+            a.state.inv_inertia,
+            b.state.inv_mass,
+            b.state.inv_inertia,
+        );
+        let entry = |body, linear: Vec2, angular, im, ii| BodyJacobian {
+            body,
+            linear,
+            angular,
+            inv_mass: im,
+            inv_inertia: ii,
+        };
+        let point_row = |axis: Vec2, c: Real, impulse: Real| Row {
+            jacobian: smallvec![
+                entry(self.def.body_a, -axis, -cross(r_a, axis), ima, iia),
+                entry(self.def.body_b, axis, cross(r_b, axis), imb, iib),
+            ],
+            c,
+            softness: ctx.joint_softness,
+            lower: Real::NEG_INFINITY,
+            upper: Real::INFINITY,
+            impulse,
+        };
+        let mut out = ConstraintRows::default();
+        out.rows.push(point_row(Vec2::X, c.x, self.point.impulse.x));
+        out.rows.push(point_row(Vec2::Y, c.y, self.point.impulse.y));
+        let (k11, k12, k22) = PointPart::effective_mass(a.state, b.state, r_a, r_b);
+        out.blocks.push(Block {
+            first_row: 0,
+            len: 2,
+            k: [[k11, k12, 0.0], [k12, k22, 0.0], [0.0; 3]],
+        });
+        let angle = self.angle(bodies);
+        let k_angle = a.state.inv_inertia + b.state.inv_inertia;
+        let mut angle_row =
+            |sign: Real, c: Real, softness: Softness, lower: Real, upper: Real, impulse: Real| {
+                let first_row = out.rows.len();
+                out.rows.push(Row {
+                    jacobian: smallvec![
+                        entry(self.def.body_a, Vec2::ZERO, -sign, ima, iia),
+                        entry(self.def.body_b, Vec2::ZERO, sign, imb, iib),
+                    ],
+                    c,
+                    softness,
+                    lower,
+                    upper,
+                    impulse,
+                });
+                out.blocks.push(Block {
+                    first_row,
+                    len: 1,
+                    k: [[k_angle, 0.0, 0.0], [0.0; 3], [0.0; 3]],
+                });
+            };
+        if self.def.enable_spring {
+            angle_row(
+                1.0,
+                angle,
+                Softness::new(self.def.hertz, self.def.damping_ratio, ctx.h),
+                Real::NEG_INFINITY,
+                Real::INFINITY,
+                self.spring.impulse,
+            );
+        }
+        if self.def.enable_motor {
+            let m = ctx.h * self.def.max_motor_torque;
+            angle_row(1.0, 0.0, Softness::RIGID, -m, m, self.motor.impulse);
+        }
+        if self.def.enable_limit {
+            angle_row(
+                1.0,
+                angle - self.def.lower_angle,
+                ctx.joint_softness,
+                0.0,
+                Real::INFINITY,
+                self.lower.impulse,
+            );
+            angle_row(
+                -1.0,
+                self.def.upper_angle - angle,
+                ctx.joint_softness,
+                0.0,
+                Real::INFINITY,
+                self.upper.impulse,
+            );
+        }
+        out
+    }
+
+    fn is_enabled(&self) -> bool {
+        self.enabled
+    }
+}

@@ -1,0 +1,755 @@
+//! Rigid bodies and their storage, split by how often the solver touches them.
+//!
+//! ```text
+//!                 handle (index, generation)
+//!                          │
+//!                          ▼
+//!   records: Vec<BodyRecord>   ── bookkeeping: type, generation, where the body lives
+//!                          │
+//!          ┌───────────────┴────────────────┐
+//!          ▼ moving (dynamic, kinematic)     ▼ static
+//!   states[i]: BodyState   (hot)       static_sims[j]: BodySim
+//!   sims[i]:   BodySim     (per step)  (state index 0: the shared
+//!   i = 0 is the static sentinel        identity state)
+//! ```
+//!
+//! | array          | touched                    | contents                                      |
+//! |----------------|----------------------------|-----------------------------------------------|
+//! | `states`       | every solver iteration     | v, ω, position delta, rotation delta, 1/m, 1/I |
+//! | `sims`         | once per (sub)step         | transform, centre, forces, damping, limits   |
+//! | `records`      | on API calls               | generation, type, location, user data         |
+//!
+//! Slot 0 of `states` and `sims` is a sentinel with zero inverse mass and
+//! zero velocity: every static body maps to it, so constraints read a static
+//! body's state through the same code path as a moving body's, with no branch;
+//! impulses written to it are multiplied by zero inverse mass.
+
+use crate::math::{Real, Rot, Transform, Vec2, vec_is_finite};
+
+/// Default maximum linear speed of a body, m/s (usual value 400 m/s, Box2D's
+/// `4 m × 100` at unit length scale).
+pub const DEFAULT_MAX_LINEAR_SPEED: Real = 400.0;
+
+/// Default maximum rotation of a body per substep, radians (usual value
+/// 0.25 π, as in Box2D).
+pub const DEFAULT_MAX_ROTATION: Real = 0.25 * crate::math::PI;
+
+/// How a body moves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum BodyType {
+    /// Never moves; infinite mass.
+    #[default]
+    Static,
+    /// Moves with a velocity set by the user; infinite mass; unaffected by forces.
+    Kinematic,
+    /// Moves under forces, gravity and constraints.
+    Dynamic,
+}
+
+/// A generational handle to a body. A handle to a destroyed body is stale
+/// and is rejected with a typed error.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct BodyHandle {
+    /// Slot index.
+    pub index: u32,
+    /// Generation of the slot when the handle was issued.
+    pub generation: u32,
+}
+
+/// Mass properties set directly on a body.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyMass {
+    /// Mass, kg (> 0 for a dynamic body).
+    pub mass: Real,
+    /// Rotational inertia about the centre of mass, kg·m² (> 0 for a dynamic body
+    /// unless `fixed_rotation`).
+    pub rotational_inertia: Real,
+    /// Centre of mass in the body frame, m.
+    pub center: Vec2,
+}
+
+impl BodyMass {
+    /// Mass properties with the centre of mass at the body origin.
+    pub fn new(mass: Real, rotational_inertia: Real) -> Self {
+        BodyMass {
+            mass,
+            rotational_inertia,
+            center: Vec2::ZERO,
+        }
+    }
+}
+
+/// Everything needed to create a body. Start from `BodyDef::default()` or a
+/// constructor and change fields.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodyDef {
+    /// Static, kinematic or dynamic.
+    pub body_type: BodyType,
+    /// World position of the body origin, m.
+    pub position: Vec2,
+    /// World angle, rad.
+    pub angle: Real,
+    /// Linear velocity of the body origin, m/s.
+    pub linear_velocity: Vec2,
+    /// Angular velocity, rad/s.
+    pub angular_velocity: Real,
+    /// Linear damping, 1/s (usual 0).
+    pub linear_damping: Real,
+    /// Angular damping, 1/s (usual 0).
+    pub angular_damping: Real,
+    /// Multiplier of world gravity (usual 1).
+    pub gravity_scale: Real,
+    /// Maximum linear speed, m/s (usual 400).
+    pub max_linear_speed: Real,
+    /// Maximum rotation per substep, rad (usual π/4).
+    pub max_rotation: Real,
+    /// Mass set directly; `None` computes it from the body's shapes (a body
+    /// without shapes then has 1 kg and 1 kg·m² about its origin).
+    pub mass: Option<BodyMass>,
+    /// Prevents rotation (infinite rotational inertia).
+    pub fixed_rotation: bool,
+    /// Opaque user value.
+    pub user_data: u64,
+}
+
+impl Default for BodyDef {
+    fn default() -> Self {
+        BodyDef {
+            body_type: BodyType::Static,
+            position: Vec2::ZERO,
+            angle: 0.0,
+            linear_velocity: Vec2::ZERO,
+            angular_velocity: 0.0,
+            linear_damping: 0.0,
+            angular_damping: 0.0,
+            gravity_scale: 1.0,
+            max_linear_speed: DEFAULT_MAX_LINEAR_SPEED,
+            max_rotation: DEFAULT_MAX_ROTATION,
+            mass: None,
+            fixed_rotation: false,
+            user_data: 0,
+        }
+    }
+}
+
+impl BodyDef {
+    /// A dynamic body at `position`.
+    pub fn dynamic(position: Vec2) -> Self {
+        BodyDef {
+            body_type: BodyType::Dynamic,
+            position,
+            ..Default::default()
+        }
+    }
+
+    /// A static body at `position`.
+    pub fn fixed(position: Vec2) -> Self {
+        BodyDef {
+            body_type: BodyType::Static,
+            position,
+            ..Default::default()
+        }
+    }
+
+    /// A kinematic body at `position`.
+    pub fn kinematic(position: Vec2) -> Self {
+        BodyDef {
+            body_type: BodyType::Kinematic,
+            position,
+            ..Default::default()
+        }
+    }
+
+    /// Sets the mass properties directly (builder style).
+    pub fn with_mass(mut self, mass: Real, rotational_inertia: Real) -> Self {
+        self.mass = Some(BodyMass::new(mass, rotational_inertia));
+        self
+    }
+
+    /// Sets the angle (builder style).
+    pub fn with_angle(mut self, angle: Real) -> Self {
+        self.angle = angle;
+        self
+    }
+
+    /// Sets the linear velocity (builder style).
+    pub fn with_velocity(mut self, v: Vec2) -> Self {
+        self.linear_velocity = v;
+        self
+    }
+
+    /// Sets the angular velocity (builder style).
+    pub fn with_angular_velocity(mut self, w: Real) -> Self {
+        self.angular_velocity = w;
+        self
+    }
+}
+
+/// Invalid input at the body API boundary.
+#[derive(Clone, Debug, PartialEq)]
+pub enum BodyError {
+    /// A value that must be finite is NaN or infinite (names the field).
+    NonFinite(&'static str),
+    /// A dynamic body with mass ≤ 0.
+    NonPositiveMass,
+    /// A dynamic, rotating body with rotational inertia ≤ 0.
+    NonPositiveInertia,
+    /// A value that must be ≥ 0 is negative (names the field).
+    Negative(&'static str),
+    /// The handle refers to a destroyed body or was never issued.
+    StaleHandle,
+}
+
+impl std::fmt::Display for BodyError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BodyError::NonFinite(field) => write!(f, "body field `{field}` is not finite"),
+            BodyError::NonPositiveMass => write!(f, "dynamic body needs mass > 0"),
+            BodyError::NonPositiveInertia => {
+                write!(f, "dynamic rotating body needs rotational inertia > 0")
+            }
+            BodyError::Negative(field) => write!(f, "body field `{field}` is negative"),
+            BodyError::StaleHandle => write!(f, "stale or foreign body handle"),
+        }
+    }
+}
+
+impl std::error::Error for BodyError {}
+
+/// The solver's hot per-body state: everything a constraint reads or writes
+/// in every iteration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyState {
+    /// Linear velocity of the centre of mass, m/s.
+    pub v: Vec2,
+    /// Angular velocity, rad/s.
+    pub w: Real,
+    /// Inverse mass, 1/kg (0 for static and kinematic bodies).
+    pub inv_mass: Real,
+    /// Inverse rotational inertia, 1/(kg·m²).
+    pub inv_inertia: Real,
+    /// Displacement of the centre of mass since the step began, m.
+    pub dp: Vec2,
+    /// Rotation since the step began.
+    pub dq: Rot,
+}
+
+impl BodyState {
+    /// The state every static body reads: at rest, infinite mass, not moved.
+    pub const IDENTITY: BodyState = BodyState {
+        v: Vec2::ZERO,
+        w: 0.0,
+        inv_mass: 0.0,
+        inv_inertia: 0.0,
+        dp: Vec2::ZERO,
+        dq: Rot::IDENTITY,
+    };
+}
+
+/// Per-body data the solver touches once per step or substep.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodySim {
+    /// Body origin and rotation.
+    pub transform: Transform,
+    /// World centre of mass, m.
+    pub center: Vec2,
+    /// World centre of mass at the start of the step, m.
+    pub center0: Vec2,
+    /// Rotation at the start of the step.
+    pub rotation0: Rot,
+    /// Centre of mass in the body frame, m.
+    pub local_center: Vec2,
+    /// Accumulated force for this step, N.
+    pub force: Vec2,
+    /// Accumulated torque for this step, N·m.
+    pub torque: Real,
+    /// Mass, kg (0 for static and kinematic).
+    pub mass: Real,
+    /// Rotational inertia about the centre, kg·m².
+    pub inertia: Real,
+    /// Inverse mass, 1/kg.
+    pub inv_mass: Real,
+    /// Inverse rotational inertia.
+    pub inv_inertia: Real,
+    /// Multiplier of world gravity.
+    pub gravity_scale: Real,
+    /// Linear damping, 1/s.
+    pub linear_damping: Real,
+    /// Angular damping, 1/s.
+    pub angular_damping: Real,
+    /// Maximum linear speed, m/s.
+    pub max_linear_speed: Real,
+    /// Maximum rotation per substep, rad.
+    pub max_rotation: Real,
+    /// The handle of the body this belongs to.
+    pub handle: BodyHandle,
+    /// Static, kinematic or dynamic.
+    pub body_type: BodyType,
+}
+
+impl BodySim {
+    fn sentinel() -> BodySim {
+        BodySim {
+            transform: Transform::IDENTITY,
+            center: Vec2::ZERO,
+            center0: Vec2::ZERO,
+            rotation0: Rot::IDENTITY,
+            local_center: Vec2::ZERO,
+            force: Vec2::ZERO,
+            torque: 0.0,
+            mass: 0.0,
+            inertia: 0.0,
+            inv_mass: 0.0,
+            inv_inertia: 0.0,
+            gravity_scale: 0.0,
+            linear_damping: 0.0,
+            angular_damping: 0.0,
+            max_linear_speed: 0.0,
+            max_rotation: 0.0,
+            handle: BodyHandle {
+                index: u32::MAX,
+                generation: 0,
+            },
+            body_type: BodyType::Static,
+        }
+    }
+}
+
+/// Where a live body's data sits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BodyLocation {
+    /// Index into `sims`/`states` (≥ 1).
+    Moving(u32),
+    /// Index into `static_sims`.
+    Static(u32),
+}
+
+/// Bookkeeping for one body slot.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodyRecord {
+    /// Current generation of the slot.
+    pub generation: u32,
+    /// Where the body lives, or `None` for a free slot.
+    pub location: Option<BodyLocation>,
+    /// Opaque user value.
+    pub user_data: u64,
+    /// True when the mass was set directly rather than from shapes.
+    pub mass_override: bool,
+    /// True when rotation is locked.
+    pub fixed_rotation: bool,
+}
+
+/// A body as the solver sees it during prepare: its state slot and its data.
+#[derive(Clone, Copy, Debug)]
+pub struct SolverBody<'a> {
+    /// Index into the state array (0 for static bodies).
+    pub state_index: u32,
+    /// The body's per-step data.
+    pub sim: &'a BodySim,
+    /// The body's current state (velocities, inverse mass).
+    pub state: &'a BodyState,
+}
+
+/// Storage of every body, with generational handles.
+#[derive(Clone, Debug)]
+pub struct BodySet {
+    records: Vec<BodyRecord>,
+    free: Vec<u32>,
+    /// Per-step data of moving bodies; index 0 is the static sentinel.
+    pub sims: Vec<BodySim>,
+    /// Hot state of moving bodies; index 0 is [`BodyState::IDENTITY`].
+    pub states: Vec<BodyState>,
+    /// Per-step data of static bodies.
+    pub static_sims: Vec<BodySim>,
+    identity_sim: BodySim,
+}
+
+impl Default for BodySet {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+fn check_finite(v: Real, field: &'static str) -> Result<(), BodyError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(BodyError::NonFinite(field))
+    }
+}
+
+fn check_finite_vec(v: Vec2, field: &'static str) -> Result<(), BodyError> {
+    if vec_is_finite(v) {
+        Ok(())
+    } else {
+        Err(BodyError::NonFinite(field))
+    }
+}
+
+/// Validates a body definition without creating anything.
+pub fn validate_body_def(def: &BodyDef) -> Result<(), BodyError> {
+    check_finite_vec(def.position, "position")?;
+    check_finite(def.angle, "angle")?;
+    check_finite_vec(def.linear_velocity, "linear_velocity")?;
+    check_finite(def.angular_velocity, "angular_velocity")?;
+    check_finite(def.linear_damping, "linear_damping")?;
+    check_finite(def.angular_damping, "angular_damping")?;
+    check_finite(def.gravity_scale, "gravity_scale")?;
+    check_finite(def.max_linear_speed, "max_linear_speed")?;
+    check_finite(def.max_rotation, "max_rotation")?;
+    if def.linear_damping < 0.0 {
+        return Err(BodyError::Negative("linear_damping"));
+    }
+    if def.angular_damping < 0.0 {
+        return Err(BodyError::Negative("angular_damping"));
+    }
+    if def.max_linear_speed < 0.0 {
+        return Err(BodyError::Negative("max_linear_speed"));
+    }
+    if def.max_rotation < 0.0 {
+        return Err(BodyError::Negative("max_rotation"));
+    }
+    if let Some(m) = def.mass {
+        validate_mass(def.body_type, &m, def.fixed_rotation)?;
+    }
+    Ok(())
+}
+
+/// Validates mass properties for a body of the given type.
+pub fn validate_mass(
+    body_type: BodyType,
+    m: &BodyMass,
+    fixed_rotation: bool,
+) -> Result<(), BodyError> {
+    check_finite(m.mass, "mass")?;
+    check_finite(m.rotational_inertia, "rotational_inertia")?;
+    check_finite_vec(m.center, "center")?;
+    if body_type == BodyType::Dynamic {
+        if m.mass <= 0.0 {
+            return Err(BodyError::NonPositiveMass);
+        }
+        if !fixed_rotation && m.rotational_inertia <= 0.0 {
+            return Err(BodyError::NonPositiveInertia);
+        }
+    }
+    Ok(())
+}
+
+impl BodySet {
+    /// An empty set (holding only the static sentinel).
+    pub fn new() -> Self {
+        BodySet {
+            records: Vec::new(),
+            free: Vec::new(),
+            sims: vec![BodySim::sentinel()],
+            states: vec![BodyState::IDENTITY],
+            static_sims: Vec::new(),
+            identity_sim: BodySim::sentinel(),
+        }
+    }
+
+    /// Number of live bodies.
+    pub fn len(&self) -> usize {
+        self.sims.len() - 1 + self.static_sims.len()
+    }
+
+    /// True when there are no bodies.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Number of moving (dynamic or kinematic) bodies.
+    pub fn moving_count(&self) -> usize {
+        self.sims.len() - 1
+    }
+
+    /// Creates a body. Bad input returns an error and changes nothing.
+    pub fn create(&mut self, def: &BodyDef) -> Result<BodyHandle, BodyError> {
+        validate_body_def(def)?;
+        let index = match self.free.pop() {
+            Some(i) => i,
+            None => {
+                self.records.push(BodyRecord {
+                    generation: 0,
+                    location: None,
+                    user_data: 0,
+                    mass_override: false,
+                    fixed_rotation: false,
+                });
+                (self.records.len() - 1) as u32
+            }
+        };
+        let record = &mut self.records[index as usize];
+        record.generation = record.generation.wrapping_add(1);
+        record.user_data = def.user_data;
+        record.mass_override = def.mass.is_some();
+        record.fixed_rotation = def.fixed_rotation;
+        let handle = BodyHandle {
+            index,
+            generation: record.generation,
+        };
+        let transform = Transform::new(def.position, def.angle);
+        let mass = def.mass.unwrap_or(BodyMass::new(1.0, 1.0));
+        let mut sim = BodySim {
+            transform,
+            center: transform.p,
+            center0: transform.p,
+            rotation0: transform.q,
+            local_center: Vec2::ZERO,
+            force: Vec2::ZERO,
+            torque: 0.0,
+            mass: 0.0,
+            inertia: 0.0,
+            inv_mass: 0.0,
+            inv_inertia: 0.0,
+            gravity_scale: def.gravity_scale,
+            linear_damping: def.linear_damping,
+            angular_damping: def.angular_damping,
+            max_linear_speed: def.max_linear_speed,
+            max_rotation: def.max_rotation,
+            handle,
+            body_type: def.body_type,
+        };
+        let location = if def.body_type == BodyType::Static {
+            self.static_sims.push(sim);
+            BodyLocation::Static((self.static_sims.len() - 1) as u32)
+        } else {
+            let state = BodyState {
+                v: def.linear_velocity,
+                w: def.angular_velocity,
+                ..BodyState::IDENTITY
+            };
+            sim.center = transform.p;
+            self.sims.push(sim);
+            self.states.push(state);
+            BodyLocation::Moving((self.sims.len() - 1) as u32)
+        };
+        self.records[index as usize].location = Some(location);
+        if def.body_type == BodyType::Dynamic {
+            self.apply_mass(handle, mass, def.fixed_rotation);
+            // Velocity given for the origin: keep it for the centre (same when
+            // the centre is at the origin; otherwise add ω × r).
+            if let Some(BodyLocation::Moving(i)) = self.records[index as usize].location {
+                let sim = &self.sims[i as usize];
+                let r = sim.center - sim.transform.p;
+                let st = &mut self.states[i as usize];
+                st.v += crate::math::cross_sv(st.w, r);
+            }
+        }
+        Ok(handle)
+    }
+
+    /// Sets mass properties on a live body (no validation: call
+    /// [`validate_mass`] first). Keeps the origin fixed and moves the centre.
+    pub fn apply_mass(&mut self, handle: BodyHandle, m: BodyMass, fixed_rotation: bool) {
+        let Some(loc) = self.location(handle) else {
+            return;
+        };
+        let BodyLocation::Moving(i) = loc else {
+            return;
+        };
+        let sim = &mut self.sims[i as usize];
+        if sim.body_type != BodyType::Dynamic {
+            return;
+        }
+        sim.mass = m.mass;
+        sim.inv_mass = 1.0 / m.mass;
+        sim.inertia = if fixed_rotation {
+            0.0
+        } else {
+            m.rotational_inertia
+        };
+        sim.inv_inertia = if fixed_rotation || m.rotational_inertia <= 0.0 {
+            0.0
+        } else {
+            1.0 / m.rotational_inertia
+        };
+        sim.local_center = m.center;
+        sim.center = sim.transform.apply(m.center);
+        sim.center0 = sim.center;
+        let st = &mut self.states[i as usize];
+        st.inv_mass = sim.inv_mass;
+        st.inv_inertia = sim.inv_inertia;
+    }
+
+    /// Destroys a body; its slot's generation makes old handles stale.
+    pub fn destroy(&mut self, handle: BodyHandle) -> Result<(), BodyError> {
+        let loc = self.location(handle).ok_or(BodyError::StaleHandle)?;
+        match loc {
+            BodyLocation::Moving(i) => {
+                let i = i as usize;
+                self.sims.swap_remove(i);
+                self.states.swap_remove(i);
+                if i < self.sims.len() {
+                    let moved = self.sims[i].handle;
+                    self.records[moved.index as usize].location =
+                        Some(BodyLocation::Moving(i as u32));
+                }
+            }
+            BodyLocation::Static(j) => {
+                let j = j as usize;
+                self.static_sims.swap_remove(j);
+                if j < self.static_sims.len() {
+                    let moved = self.static_sims[j].handle;
+                    self.records[moved.index as usize].location =
+                        Some(BodyLocation::Static(j as u32));
+                }
+            }
+        }
+        let rec = &mut self.records[handle.index as usize];
+        rec.location = None;
+        self.free.push(handle.index);
+        Ok(())
+    }
+
+    /// Where a live body lives, or `None` for a stale handle.
+    #[inline]
+    pub fn location(&self, handle: BodyHandle) -> Option<BodyLocation> {
+        let rec = self.records.get(handle.index as usize)?;
+        if rec.generation != handle.generation {
+            return None;
+        }
+        rec.location
+    }
+
+    /// True when the handle refers to a live body.
+    pub fn contains(&self, handle: BodyHandle) -> bool {
+        self.location(handle).is_some()
+    }
+
+    /// The record of a live body.
+    pub fn record(&self, handle: BodyHandle) -> Option<&BodyRecord> {
+        self.location(handle)?;
+        self.records.get(handle.index as usize)
+    }
+
+    /// The per-step data of a live body.
+    pub fn sim(&self, handle: BodyHandle) -> Option<&BodySim> {
+        match self.location(handle)? {
+            BodyLocation::Moving(i) => self.sims.get(i as usize),
+            BodyLocation::Static(j) => self.static_sims.get(j as usize),
+        }
+    }
+
+    /// Mutable per-step data of a live body.
+    pub fn sim_mut(&mut self, handle: BodyHandle) -> Option<&mut BodySim> {
+        match self.location(handle)? {
+            BodyLocation::Moving(i) => self.sims.get_mut(i as usize),
+            BodyLocation::Static(j) => self.static_sims.get_mut(j as usize),
+        }
+    }
+
+    /// The hot state of a body (the identity state for a static body).
+    pub fn state(&self, handle: BodyHandle) -> Option<&BodyState> {
+        match self.location(handle)? {
+            BodyLocation::Moving(i) => self.states.get(i as usize),
+            BodyLocation::Static(_) => Some(&self.states[0]),
+        }
+    }
+
+    /// Mutable hot state of a moving body (`None` for static bodies).
+    pub fn state_mut(&mut self, handle: BodyHandle) -> Option<&mut BodyState> {
+        match self.location(handle)? {
+            BodyLocation::Moving(i) => self.states.get_mut(i as usize),
+            BodyLocation::Static(_) => None,
+        }
+    }
+
+    /// The state index (0 for static bodies) of a live body.
+    pub fn state_index(&self, handle: BodyHandle) -> Option<u32> {
+        match self.location(handle)? {
+            BodyLocation::Moving(i) => Some(i),
+            BodyLocation::Static(_) => Some(0),
+        }
+    }
+
+    /// A body as the solver sees it, or the static identity for a stale handle.
+    pub fn solver_body(&self, handle: BodyHandle) -> SolverBody<'_> {
+        match self.location(handle) {
+            Some(BodyLocation::Moving(i)) => SolverBody {
+                state_index: i,
+                sim: &self.sims[i as usize],
+                state: &self.states[i as usize],
+            },
+            Some(BodyLocation::Static(j)) => SolverBody {
+                state_index: 0,
+                sim: &self.static_sims[j as usize],
+                state: &self.states[0],
+            },
+            None => SolverBody {
+                state_index: 0,
+                sim: &self.identity_sim,
+                state: &self.states[0],
+            },
+        }
+    }
+
+    /// Handles of all live bodies in slot order (deterministic).
+    pub fn handles(&self) -> impl Iterator<Item = BodyHandle> + '_ {
+        self.records.iter().enumerate().filter_map(|(i, r)| {
+            r.location.map(|_| BodyHandle {
+                index: i as u32,
+                generation: r.generation,
+            })
+        })
+    }
+
+    /// The body type of a live body.
+    pub fn body_type(&self, handle: BodyHandle) -> Option<BodyType> {
+        self.sim(handle).map(|s| s.body_type)
+    }
+
+    /// Linear velocity of the centre of mass.
+    pub fn linear_velocity(&self, handle: BodyHandle) -> Option<Vec2> {
+        self.state(handle).map(|s| s.v)
+    }
+
+    /// Angular velocity.
+    pub fn angular_velocity(&self, handle: BodyHandle) -> Option<Real> {
+        self.state(handle).map(|s| s.w)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stale_handle_is_rejected_after_slot_reuse() {
+        let mut set = BodySet::new();
+        let a = set.create(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+        set.destroy(a).unwrap();
+        let b = set.create(&BodyDef::dynamic(Vec2::ONE)).unwrap();
+        assert_eq!(a.index, b.index);
+        assert!(set.sim(a).is_none());
+        assert_eq!(set.destroy(a), Err(BodyError::StaleHandle));
+        assert_eq!(set.sim(b).unwrap().transform.p, Vec2::ONE);
+    }
+
+    #[test]
+    fn swap_remove_keeps_locations_consistent() {
+        let mut set = BodySet::new();
+        let hs: Vec<_> = (0..5)
+            .map(|i| {
+                set.create(&BodyDef::dynamic(Vec2::new(i as Real, 0.0)))
+                    .unwrap()
+            })
+            .collect();
+        set.destroy(hs[1]).unwrap();
+        for (i, h) in hs.iter().enumerate() {
+            if i == 1 {
+                continue;
+            }
+            assert_eq!(set.sim(*h).unwrap().transform.p.x, i as Real);
+        }
+        assert_eq!(set.moving_count(), 4);
+    }
+
+    #[test]
+    fn bad_mass_is_rejected() {
+        let mut set = BodySet::new();
+        let def = BodyDef::dynamic(Vec2::ZERO).with_mass(-1.0, 1.0);
+        assert_eq!(set.create(&def), Err(BodyError::NonPositiveMass));
+        assert!(set.is_empty());
+    }
+}

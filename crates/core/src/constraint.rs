@@ -1,0 +1,251 @@
+//! The constraint trait: the place where rows are built.
+//!
+//! A constraint is a set of rows `C(x) = 0` (or `≥ 0`, or bounded impulses
+//! for friction and motors). For each row it reports a Jacobian with a
+//! **separate** linear and angular part for each body it touches (the
+//! portal's linear parts are not negatives of each other, and it touches up
+//! to four bodies), its position error `C`, its impulse bounds and its
+//! accumulated impulse; rows that couple are grouped into blocks with their
+//! effective mass `K = J M⁻¹ Jᵀ`, solved as one small system.
+//!
+//! Every constraint has the same stages:
+//!
+//! | stage                | when                      | what                                          |
+//! |----------------------|---------------------------|-----------------------------------------------|
+//! | `prepare`            | once per step             | anchors, K, softness from body data           |
+//! | `warm_start`         | each substep              | apply last impulses                           |
+//! | `solve(use_bias)`    | each substep              | velocity solve with position feedback         |
+//! | `solve(!use_bias)`   | each substep ("relax")    | velocity solve without feedback               |
+//! | `apply_restitution`  | once per step             | bounce (contacts only)                        |
+//! | `store_impulses`     | once per step             | keep impulses for the next step's warm start  |
+//!
+//! The solver never calls a constraint through `dyn` per row: each
+//! constraint type lives in its own `Vec`, and the [`ConstraintBatch`]
+//! implementation for `Vec<C>` runs a monomorphic loop over it. `dyn` is used
+//! once per type per stage.
+
+use smallvec::SmallVec;
+
+use crate::body::{BodyHandle, BodySet, BodyState};
+use crate::math::{Real, Vec2};
+use crate::softness::Softness;
+
+/// How the velocity solver treats position error.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SolverMode {
+    /// Box2D v3's soft step: substeps, soft constraints, relax iterations.
+    #[default]
+    SoftStep,
+    /// Plain projected Gauss–Seidel with Baumgarte bias: one step, a number
+    /// of velocity iterations, rigid rows. The cheap baseline.
+    PgsBaumgarte,
+}
+
+/// Everything a constraint needs to know about the current step.
+#[derive(Clone, Debug)]
+pub struct StepContext {
+    /// Step length, s.
+    pub dt: Real,
+    /// 1 / dt, 1/s.
+    pub inv_dt: Real,
+    /// Substep length, s.
+    pub h: Real,
+    /// 1 / h, 1/s.
+    pub inv_h: Real,
+    /// Number of substeps.
+    pub substeps: u32,
+    /// World gravity, m/s².
+    pub gravity: Vec2,
+    /// Softness of joint point rows.
+    pub joint_softness: Softness,
+    /// Softness of contact rows between two moving bodies.
+    pub contact_softness: Softness,
+    /// Softness of contact rows against a static body.
+    pub static_softness: Softness,
+    /// Maximum contact push-out speed, m/s (usual 3).
+    pub contact_push_max_velocity: Real,
+    /// Maximum joint correction speed, m/s (usual 5 m/s; `Real::MAX` disables).
+    pub joint_max_correction_speed: Real,
+    /// Restitution is applied only above this approach speed, m/s (usual 1).
+    pub restitution_threshold: Real,
+    /// Contact hertz, used where a constraint builds its own softness.
+    pub contact_hertz: Real,
+    /// Contact damping ratio.
+    pub contact_damping_ratio: Real,
+    /// Joint hertz.
+    pub joint_hertz: Real,
+    /// Joint damping ratio.
+    pub joint_damping_ratio: Real,
+    /// Warm starting on or off.
+    pub warm_starting: bool,
+    /// Soft step or PGS baseline.
+    pub mode: SolverMode,
+}
+
+/// One body's part of one Jacobian row.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyJacobian {
+    /// The body.
+    pub body: BodyHandle,
+    /// Linear part, multiplies the centre-of-mass velocity.
+    pub linear: Vec2,
+    /// Angular part, multiplies the angular velocity.
+    pub angular: Real,
+    /// Inverse mass used by the constraint (0 for static or kinematic).
+    pub inv_mass: Real,
+    /// Inverse rotational inertia used by the constraint.
+    pub inv_inertia: Real,
+}
+
+/// One row of a constraint.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    /// The Jacobian, one entry per body the row touches.
+    pub jacobian: SmallVec<[BodyJacobian; 4]>,
+    /// Position error `C` (0 for pure velocity rows like friction or motors).
+    pub c: Real,
+    /// The row's softness for the current substep.
+    pub softness: Softness,
+    /// Lower impulse bound (`-∞` for an equality).
+    pub lower: Real,
+    /// Upper impulse bound (`+∞` for an equality).
+    pub upper: Real,
+    /// Impulse accumulated this step (used to warm start the next).
+    pub impulse: Real,
+}
+
+/// A group of coupled rows solved together, with its effective mass.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Block {
+    /// Index of the first row of the block in [`ConstraintRows::rows`].
+    pub first_row: usize,
+    /// Number of rows (1 to 3).
+    pub len: usize,
+    /// Effective mass `K = J M⁻¹ Jᵀ` of the block, row-major, `len × len`
+    /// used.
+    pub k: [[Real; 3]; 3],
+}
+
+/// What a constraint reports about itself: rows, blocks and their K.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ConstraintRows {
+    /// All rows.
+    pub rows: SmallVec<[Row; 4]>,
+    /// Blocks of coupled rows, covering the rows in order.
+    pub blocks: SmallVec<[Block; 4]>,
+}
+
+impl ConstraintRows {
+    /// Computes `J M⁻¹ Jᵀ` for rows `i` and `j` from the reported Jacobians,
+    /// merging entries that refer to the same body.
+    pub fn jmj(&self, i: usize, j: usize) -> Real {
+        let mut sum = 0.0;
+        for a in &self.rows[i].jacobian {
+            for b in &self.rows[j].jacobian {
+                if a.body == b.body {
+                    sum += a.inv_mass * a.linear.dot(b.linear) + a.inv_inertia * a.angular * b.angular;
+                }
+            }
+        }
+        sum
+    }
+
+    /// `J v` of row `i` given a velocity lookup.
+    pub fn row_velocity(&self, i: usize, vel: impl Fn(BodyHandle) -> (Vec2, Real)) -> Real {
+        self.rows[i]
+            .jacobian
+            .iter()
+            .map(|e| {
+                let (v, w) = vel(e.body);
+                e.linear.dot(v) + e.angular * w
+            })
+            .sum()
+    }
+}
+
+/// A constraint type. Implemented by contacts, joints and portals.
+pub trait Constraint {
+    /// Computes anchors, effective masses and softness for the step. Reads
+    /// body data through `bodies`; stores state indices for the solve.
+    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet);
+
+    /// Applies the impulses kept from the last step.
+    fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]);
+
+    /// One velocity iteration; `use_bias` selects position feedback (the
+    /// main solve) or none (relax).
+    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool);
+
+    /// Applies restitution once after the substeps (contacts only).
+    fn apply_restitution(&mut self, _ctx: &StepContext, _states: &mut [BodyState]) {}
+
+    /// Keeps impulses for the next step's warm start.
+    fn store_impulses(&mut self) {}
+
+    /// Reports rows, Jacobians, K, C and impulses at the bodies' current
+    /// positions (for tests, diagnostics and error metrics).
+    fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows;
+
+    /// False for a disabled constraint: the batch skips it.
+    fn is_enabled(&self) -> bool {
+        true
+    }
+}
+
+/// A homogeneous collection of constraints driven by the solver: one
+/// dynamic call per stage, a monomorphic loop inside.
+pub trait ConstraintBatch {
+    /// Number of constraints.
+    fn count(&self) -> usize;
+    /// Prepare every constraint.
+    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet);
+    /// Warm start every constraint.
+    fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]);
+    /// Solve every constraint once.
+    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool);
+    /// Restitution for every constraint.
+    fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]);
+    /// Store impulses of every constraint.
+    fn store_impulses(&mut self);
+}
+
+impl<C: Constraint> ConstraintBatch for Vec<C> {
+    fn count(&self) -> usize {
+        self.len()
+    }
+    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
+        for c in self.iter_mut() {
+            if c.is_enabled() {
+                c.prepare(ctx, bodies);
+            }
+        }
+    }
+    fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+        for c in self.iter_mut() {
+            if c.is_enabled() {
+                c.warm_start(ctx, states);
+            }
+        }
+    }
+    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
+        for c in self.iter_mut() {
+            if c.is_enabled() {
+                c.solve(ctx, states, use_bias);
+            }
+        }
+    }
+    fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+        for c in self.iter_mut() {
+            if c.is_enabled() {
+                c.apply_restitution(ctx, states);
+            }
+        }
+    }
+    fn store_impulses(&mut self) {
+        for c in self.iter_mut() {
+            if c.is_enabled() {
+                c.store_impulses();
+            }
+        }
+    }
+}

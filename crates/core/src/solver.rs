@@ -1,0 +1,302 @@
+//! The step solver: Box2D v3's soft step, and a plain PGS baseline.
+//!
+//! ```text
+//! soft step (SolverMode::SoftStep), h = dt / substeps
+//!
+//!   prepare bodies ─ prepare constraints (anchors, K, softness)
+//!   repeat substeps times:
+//!   │   integrate velocities   v += h (g + F/m), damping, speed caps
+//!   │   warm start             apply the accumulated impulses
+//!   │   solve (bias)           soft rows: push towards C = 0
+//!   │   integrate positions    dp += h v, dq ← dq ⊕ h ω
+//!   │   relax × n (no bias)    remove the velocity the bias added
+//!   restitution ─ store impulses ─ finalize transforms
+//!
+//! PGS baseline (SolverMode::PgsBaumgarte), one step of length dt
+//!
+//!   prepare ─ integrate velocities ─ warm start
+//!   ─ solve (Baumgarte bias β C / dt) × velocity_iterations
+//!   ─ integrate positions ─ restitution ─ store ─ finalize
+//! ```
+//!
+//! The constraints only see [`BodyState`]s (hot data): slot 0 is the static
+//! identity state, which the solver resets after every step.
+
+use std::time::Instant;
+
+use crate::body::{BodyHandle, BodySet, BodyState, BodyType};
+use crate::constraint::{ConstraintBatch, SolverMode, StepContext};
+use crate::math::{Real, Vec2, vec_is_finite};
+use crate::softness::Softness;
+
+/// Accuracy and softness settings of the solver. Every knob that trades
+/// accuracy for time lives here.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SolverSettings {
+    /// Soft step (default) or the PGS-with-Baumgarte baseline.
+    pub mode: SolverMode,
+    /// Substeps per step (soft step), usual 4.
+    pub substeps: u32,
+    /// Relax iterations per substep (soft step), usual 1.
+    pub relax_iterations: u32,
+    /// Velocity iterations (PGS baseline), usual 8.
+    pub velocity_iterations: u32,
+    /// Baumgarte factor β of the PGS baseline (dimensionless), usual 0.2.
+    pub baumgarte: Real,
+    /// Contact stiffness, Hz (usual 30).
+    pub contact_hertz: Real,
+    /// Contact damping ratio (usual 10).
+    pub contact_damping_ratio: Real,
+    /// Maximum contact push-out speed, m/s (usual 3).
+    pub contact_push_max_velocity: Real,
+    /// Joint stiffness, Hz (usual 60).
+    pub joint_hertz: Real,
+    /// Joint damping ratio (usual 2).
+    pub joint_damping_ratio: Real,
+    /// Maximum joint correction speed, m/s (usual 5): large initial joint
+    /// errors recover at this speed at most.
+    pub joint_max_correction_speed: Real,
+    /// Restitution threshold, m/s (usual 1).
+    pub restitution_threshold: Real,
+    /// Warm starting on (default) or off.
+    pub warm_starting: bool,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        SolverSettings {
+            mode: SolverMode::SoftStep,
+            substeps: 4,
+            relax_iterations: 1,
+            velocity_iterations: 8,
+            baumgarte: 0.2,
+            contact_hertz: 30.0,
+            contact_damping_ratio: 10.0,
+            contact_push_max_velocity: 3.0,
+            joint_hertz: 60.0,
+            joint_damping_ratio: 2.0,
+            joint_max_correction_speed: 5.0,
+            restitution_threshold: 1.0,
+            warm_starting: true,
+        }
+    }
+}
+
+impl SolverSettings {
+    /// Builds the per-step context.
+    pub fn context(&self, dt: Real, gravity: Vec2) -> StepContext {
+        let (substeps, h) = match self.mode {
+            SolverMode::SoftStep => {
+                let n = self.substeps.max(1);
+                (n, dt / n as Real)
+            }
+            SolverMode::PgsBaumgarte => (1, dt),
+        };
+        let (joint_softness, contact_softness, static_softness) = match self.mode {
+            SolverMode::SoftStep => (
+                Softness::new(self.joint_hertz, self.joint_damping_ratio, h),
+                Softness::new(self.contact_hertz, self.contact_damping_ratio, h),
+                Softness::new(2.0 * self.contact_hertz, self.contact_damping_ratio, h),
+            ),
+            SolverMode::PgsBaumgarte => {
+                let s = Softness::baumgarte(self.baumgarte, dt);
+                (s, s, s)
+            }
+        };
+        StepContext {
+            dt,
+            inv_dt: if dt > 0.0 { 1.0 / dt } else { 0.0 },
+            h,
+            inv_h: if h > 0.0 { 1.0 / h } else { 0.0 },
+            substeps,
+            gravity,
+            joint_softness,
+            contact_softness,
+            static_softness,
+            contact_push_max_velocity: self.contact_push_max_velocity,
+            joint_max_correction_speed: self.joint_max_correction_speed,
+            restitution_threshold: self.restitution_threshold,
+            contact_hertz: self.contact_hertz,
+            contact_damping_ratio: self.contact_damping_ratio,
+            joint_hertz: self.joint_hertz,
+            joint_damping_ratio: self.joint_damping_ratio,
+            warm_starting: self.warm_starting,
+            mode: self.mode,
+        }
+    }
+}
+
+/// Time spent in each solver stage during the last step, seconds.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SolverProfile {
+    /// Preparing bodies and constraints.
+    pub prepare: f64,
+    /// Integrating velocities and positions.
+    pub integrate: f64,
+    /// Warm starting.
+    pub warm_start: f64,
+    /// Solving with bias.
+    pub solve: f64,
+    /// Relaxing (solving without bias).
+    pub relax: f64,
+    /// Restitution.
+    pub restitution: f64,
+    /// Storing impulses and finalizing transforms.
+    pub finalize: f64,
+}
+
+/// What happened in a solve besides the new state.
+#[derive(Clone, Debug, Default)]
+pub struct SolveReport {
+    /// Bodies whose state went non-finite; they were reset to their
+    /// start-of-step pose at rest.
+    pub non_finite: Vec<BodyHandle>,
+    /// Stage timings.
+    pub profile: SolverProfile,
+}
+
+#[inline]
+fn lap(t: &mut Instant) -> f64 {
+    let now = Instant::now();
+    let d = now.duration_since(*t).as_secs_f64();
+    *t = now;
+    d
+}
+
+fn prepare_bodies(bodies: &mut BodySet) {
+    let BodySet { sims, states, .. } = bodies;
+    for (sim, state) in sims.iter_mut().zip(states.iter_mut()).skip(1) {
+        sim.center0 = sim.center;
+        sim.rotation0 = sim.transform.q;
+        state.dp = Vec2::ZERO;
+        state.dq = crate::math::Rot::IDENTITY;
+        state.inv_mass = sim.inv_mass;
+        state.inv_inertia = sim.inv_inertia;
+    }
+}
+
+/// Integrates velocities of moving bodies over one substep `h`: gravity,
+/// forces, damping, the maximum linear speed and the rotation limit.
+pub fn integrate_velocities(ctx: &StepContext, bodies: &mut BodySet) {
+    let h = ctx.h;
+    let gravity = ctx.gravity;
+    let has_gravity = gravity != Vec2::ZERO;
+    let BodySet { sims, states, .. } = bodies;
+    for (sim, state) in sims.iter().zip(states.iter_mut()).skip(1) {
+        if sim.body_type != BodyType::Dynamic {
+            continue;
+        }
+        let linear_damping = 1.0 / (1.0 + h * sim.linear_damping);
+        let angular_damping = 1.0 / (1.0 + h * sim.angular_damping);
+        let mut accel = sim.inv_mass * sim.force;
+        if has_gravity {
+            accel += sim.gravity_scale * gravity;
+        }
+        let mut v = linear_damping * (state.v + h * accel);
+        let mut w = angular_damping * (state.w + h * sim.inv_inertia * sim.torque);
+        let max_v = sim.max_linear_speed;
+        let v2 = v.length_squared();
+        if v2 > max_v * max_v {
+            v *= max_v / v2.sqrt();
+        }
+        let max_w = sim.max_rotation * ctx.inv_h;
+        if w * w > max_w * max_w {
+            w = w.clamp(-max_w, max_w);
+        }
+        state.v = v;
+        state.w = w;
+    }
+}
+
+/// Integrates positions of moving bodies over one substep (into the deltas).
+pub fn integrate_positions(ctx: &StepContext, bodies: &mut BodySet) {
+    let h = ctx.h;
+    for state in bodies.states.iter_mut().skip(1) {
+        state.dq = state.dq.integrate(h * state.w);
+        state.dp += h * state.v;
+    }
+}
+
+fn finalize_bodies(bodies: &mut BodySet, report: &mut SolveReport) {
+    let BodySet { sims, states, .. } = bodies;
+    for (sim, state) in sims.iter_mut().zip(states.iter_mut()).skip(1) {
+        let ok = vec_is_finite(state.v)
+            && state.w.is_finite()
+            && vec_is_finite(state.dp)
+            && state.dq.is_finite();
+        if !ok {
+            report.non_finite.push(sim.handle);
+            state.v = Vec2::ZERO;
+            state.w = 0.0;
+            state.dp = Vec2::ZERO;
+            state.dq = crate::math::Rot::IDENTITY;
+            continue;
+        }
+        sim.center = sim.center0 + state.dp;
+        sim.transform.q = state.dq.mul(sim.rotation0).normalize();
+        sim.transform.p = sim.center - sim.transform.q.rotate(sim.local_center);
+        sim.force = Vec2::ZERO;
+        sim.torque = 0.0;
+    }
+    states[0] = BodyState::IDENTITY;
+}
+
+/// Advances the bodies by one step, solving every batch of constraints.
+///
+/// `batches` holds one entry per constraint type (each a `Vec<C>`).
+pub fn solve_step(
+    settings: &SolverSettings,
+    ctx: &StepContext,
+    bodies: &mut BodySet,
+    batches: &mut [&mut dyn ConstraintBatch],
+) -> SolveReport {
+    let mut report = SolveReport::default();
+    let mut t = Instant::now();
+    prepare_bodies(bodies);
+    for b in batches.iter_mut() {
+        b.prepare(ctx, bodies);
+    }
+    report.profile.prepare += lap(&mut t);
+
+    let (substeps, solve_iterations, relax_iterations) = match ctx.mode {
+        SolverMode::SoftStep => (ctx.substeps, 1, settings.relax_iterations),
+        SolverMode::PgsBaumgarte => (1, settings.velocity_iterations.max(1), 0),
+    };
+    let active: Vec<usize> = (0..batches.len())
+        .filter(|&i| batches[i].count() > 0)
+        .collect();
+    for _ in 0..substeps {
+        integrate_velocities(ctx, bodies);
+        report.profile.integrate += lap(&mut t);
+        if ctx.warm_starting {
+            for &i in &active {
+                batches[i].warm_start(ctx, &mut bodies.states);
+            }
+        }
+        report.profile.warm_start += lap(&mut t);
+        for _ in 0..solve_iterations {
+            for &i in &active {
+                batches[i].solve(ctx, &mut bodies.states, true);
+            }
+        }
+        report.profile.solve += lap(&mut t);
+        integrate_positions(ctx, bodies);
+        report.profile.integrate += lap(&mut t);
+        for _ in 0..relax_iterations {
+            for &i in &active {
+                batches[i].solve(ctx, &mut bodies.states, false);
+            }
+        }
+        report.profile.relax += lap(&mut t);
+    }
+    for &i in &active {
+        batches[i].apply_restitution(ctx, &mut bodies.states);
+    }
+    report.profile.restitution += lap(&mut t);
+    for &i in &active {
+        batches[i].store_impulses();
+    }
+    finalize_bodies(bodies, &mut report);
+    report.profile.finalize += lap(&mut t);
+    report
+}
