@@ -1,1 +1,40 @@
+//! # janus2d
+//!
+//! A 2D rigid-body physics engine whose signature is the portal. This facade
+//! re-exports the three crates:
+//!
+//! | crate                 | contents                                                   |
+//! |-----------------------|------------------------------------------------------------|
+//! | [`base`] (janus2d-core) | bodies, integration, the solver, the constraint trait      |
+//! | [`constraints`]       | contact, revolute and portal constraints                   |
+//! | [`world`]             | the stepping loop, collision pipeline, portals            |
+//!
+//! ```
+//! use janus2d::prelude::*;
+//! let mut world = World::new(WorldDef::default()).unwrap();
+//! let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+//! let bob = world
+//!     .create_body(&BodyDef::dynamic(Vec2::new(1.0, 0.0)).with_mass(1.0, 0.01))
+//!     .unwrap();
+//! world
+//!     .create_revolute_joint(&RevoluteJointDef::new(ground, bob, Vec2::ZERO, Vec2::new(-1.0, 0.0)))
+//!     .unwrap();
+//! for _ in 0..60 {
+//!     world.step(1.0 / 60.0).unwrap();
+//! }
+//! assert!(world.position(bob).unwrap().y < -0.5);
+//! ```
 
+pub use janus2d_constraints as constraints;
+pub use janus2d_core as base;
+pub use janus2d_world as world;
+
+/// The names most programs need.
+pub mod prelude {
+    pub use janus2d_constraints::{RevoluteJoint, RevoluteJointDef};
+    pub use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
+    pub use janus2d_core::constraint::SolverMode;
+    pub use janus2d_core::math::{Real, Rot, Transform, Vec2};
+    pub use janus2d_core::solver::SolverSettings;
+    pub use janus2d_world::{JointHandle, StepEvents, World, WorldDef, WorldError};
+}

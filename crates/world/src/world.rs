@@ -1,0 +1,518 @@
+//! The world: bodies, joints and the stepping loop.
+//!
+//! ```text
+//! World::step(dt)
+//!   ├─ validate dt
+//!   ├─ solve_step (janus2d-core): prepare ─ substeps ─ restitution ─ store ─ finalize
+//!   └─ events: non-finite bodies (reset and reported)
+//! ```
+//!
+//! Everything is created from definition structs with defaults and returns
+//! a generational handle; every call that rejects its input leaves the world
+//! unchanged.
+
+use janus2d_constraints::{RevoluteJoint, RevoluteJointDef};
+use janus2d_core::body::{BodyDef, BodyHandle, BodyLocation, BodySet, BodyType, validate_mass};
+use janus2d_core::constraint::{ConstraintBatch, StepContext};
+use janus2d_core::math::{Real, Rot, Transform, Vec2, cross, vec_is_finite};
+use janus2d_core::solver::{SolverProfile, SolverSettings, solve_step};
+use janus2d_core::BodyMass;
+
+use crate::error::WorldError;
+
+/// Default gravity, m/s² (usual (0, −10)).
+pub const DEFAULT_GRAVITY: Vec2 = Vec2::new(0.0, -10.0);
+
+/// Everything needed to create a world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldDef {
+    /// Gravity, m/s² (usual (0, −10)).
+    pub gravity: Vec2,
+    /// Solver accuracy and softness settings.
+    pub solver: SolverSettings,
+}
+
+impl Default for WorldDef {
+    fn default() -> Self {
+        WorldDef {
+            gravity: DEFAULT_GRAVITY,
+            solver: SolverSettings::default(),
+        }
+    }
+}
+
+/// A generational handle to a joint.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct JointHandle {
+    /// Slot index.
+    pub index: u32,
+    /// Generation of the slot when issued.
+    pub generation: u32,
+}
+
+#[derive(Clone, Debug)]
+struct JointSlot {
+    generation: u32,
+    /// Index into `World::revolute`, or `None` when free.
+    index: Option<u32>,
+}
+
+/// Events of the last step, read after `step`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StepEvents {
+    /// Bodies whose state went non-finite during the step. Each was put back
+    /// at its start-of-step pose, at rest, instead of spreading NaN.
+    pub non_finite_bodies: Vec<BodyHandle>,
+}
+
+/// The simulation world.
+pub struct World {
+    gravity: Vec2,
+    settings: SolverSettings,
+    bodies: BodySet,
+    revolute: Vec<RevoluteJoint>,
+    revolute_handles: Vec<JointHandle>,
+    joint_slots: Vec<JointSlot>,
+    joint_free: Vec<u32>,
+    events: StepEvents,
+    profile: SolverProfile,
+    step_count: u64,
+}
+
+impl World {
+    /// A new empty world. Rejects non-finite gravity.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// let world = World::new(WorldDef::default()).unwrap();
+    /// assert_eq!(world.body_count(), 0);
+    /// ```
+    pub fn new(def: WorldDef) -> Result<World, WorldError> {
+        if !vec_is_finite(def.gravity) {
+            return Err(WorldError::NonFinite("gravity"));
+        }
+        validate_settings(&def.solver)?;
+        Ok(World {
+            gravity: def.gravity,
+            settings: def.solver,
+            bodies: BodySet::new(),
+            revolute: Vec::new(),
+            revolute_handles: Vec::new(),
+            joint_slots: Vec::new(),
+            joint_free: Vec::new(),
+            events: StepEvents::default(),
+            profile: SolverProfile::default(),
+            step_count: 0,
+        })
+    }
+
+    /// Gravity, m/s².
+    pub fn gravity(&self) -> Vec2 {
+        self.gravity
+    }
+
+    /// Sets gravity (rejects non-finite values).
+    pub fn set_gravity(&mut self, gravity: Vec2) -> Result<(), WorldError> {
+        if !vec_is_finite(gravity) {
+            return Err(WorldError::NonFinite("gravity"));
+        }
+        self.gravity = gravity;
+        Ok(())
+    }
+
+    /// The solver settings.
+    pub fn settings(&self) -> &SolverSettings {
+        &self.settings
+    }
+
+    /// Replaces the solver settings (validated).
+    pub fn set_settings(&mut self, settings: SolverSettings) -> Result<(), WorldError> {
+        validate_settings(&settings)?;
+        self.settings = settings;
+        Ok(())
+    }
+
+    /// Read access to the body storage (for metrics and tests).
+    pub fn bodies(&self) -> &BodySet {
+        &self.bodies
+    }
+
+    /// Number of live bodies.
+    pub fn body_count(&self) -> usize {
+        self.bodies.len()
+    }
+
+    /// Number of live joints.
+    pub fn joint_count(&self) -> usize {
+        self.revolute.len()
+    }
+
+    /// Steps taken so far.
+    pub fn step_count(&self) -> u64 {
+        self.step_count
+    }
+
+    /// Events of the last step.
+    pub fn events(&self) -> &StepEvents {
+        &self.events
+    }
+
+    /// Stage timings of the last step.
+    pub fn solver_profile(&self) -> &SolverProfile {
+        &self.profile
+    }
+
+    // ----- bodies -----------------------------------------------------------
+
+    /// Creates a body.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let ball = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 4.0)).with_mass(1.0, 0.1)).unwrap();
+    /// world.step(1.0 / 60.0).unwrap();
+    /// assert!(world.position(ball).unwrap().y < 4.0);
+    /// ```
+    pub fn create_body(&mut self, def: &BodyDef) -> Result<BodyHandle, WorldError> {
+        Ok(self.bodies.create(def)?)
+    }
+
+    /// Destroys a body and every joint attached to it.
+    pub fn destroy_body(&mut self, body: BodyHandle) -> Result<(), WorldError> {
+        if !self.bodies.contains(body) {
+            return Err(WorldError::StaleBody);
+        }
+        let attached: Vec<JointHandle> = self
+            .revolute
+            .iter()
+            .zip(&self.revolute_handles)
+            .filter(|(j, _)| j.def.body_a == body || j.def.body_b == body)
+            .map(|(_, h)| *h)
+            .collect();
+        for h in attached {
+            self.destroy_joint(h)?;
+        }
+        self.bodies.destroy(body)?;
+        Ok(())
+    }
+
+    fn check_body(&self, body: BodyHandle) -> Result<(), WorldError> {
+        if self.bodies.contains(body) {
+            Ok(())
+        } else {
+            Err(WorldError::StaleBody)
+        }
+    }
+
+    /// Body origin and rotation.
+    pub fn transform(&self, body: BodyHandle) -> Result<Transform, WorldError> {
+        self.bodies.sim(body).map(|s| s.transform).ok_or(WorldError::StaleBody)
+    }
+
+    /// Body origin, m.
+    pub fn position(&self, body: BodyHandle) -> Result<Vec2, WorldError> {
+        self.transform(body).map(|t| t.p)
+    }
+
+    /// Body angle, rad, in `[-π, π]`.
+    pub fn angle(&self, body: BodyHandle) -> Result<Real, WorldError> {
+        self.transform(body).map(|t| t.q.angle())
+    }
+
+    /// World centre of mass, m.
+    pub fn center_of_mass(&self, body: BodyHandle) -> Result<Vec2, WorldError> {
+        self.bodies.sim(body).map(|s| s.center).ok_or(WorldError::StaleBody)
+    }
+
+    /// Linear velocity of the centre of mass, m/s.
+    pub fn linear_velocity(&self, body: BodyHandle) -> Result<Vec2, WorldError> {
+        self.bodies.linear_velocity(body).ok_or(WorldError::StaleBody)
+    }
+
+    /// Angular velocity, rad/s.
+    pub fn angular_velocity(&self, body: BodyHandle) -> Result<Real, WorldError> {
+        self.bodies.angular_velocity(body).ok_or(WorldError::StaleBody)
+    }
+
+    /// Mass, kg (0 for static and kinematic bodies).
+    pub fn mass(&self, body: BodyHandle) -> Result<Real, WorldError> {
+        self.bodies.sim(body).map(|s| s.mass).ok_or(WorldError::StaleBody)
+    }
+
+    /// Rotational inertia about the centre of mass, kg·m².
+    pub fn rotational_inertia(&self, body: BodyHandle) -> Result<Real, WorldError> {
+        self.bodies.sim(body).map(|s| s.inertia).ok_or(WorldError::StaleBody)
+    }
+
+    /// Body type.
+    pub fn body_type(&self, body: BodyHandle) -> Result<BodyType, WorldError> {
+        self.bodies.body_type(body).ok_or(WorldError::StaleBody)
+    }
+
+    /// Sets the linear velocity of a moving body's centre of mass.
+    pub fn set_linear_velocity(&mut self, body: BodyHandle, v: Vec2) -> Result<(), WorldError> {
+        if !vec_is_finite(v) {
+            return Err(WorldError::NonFinite("linear_velocity"));
+        }
+        self.check_body(body)?;
+        if let Some(s) = self.bodies.state_mut(body) {
+            s.v = v;
+        }
+        Ok(())
+    }
+
+    /// Sets the angular velocity of a moving body.
+    pub fn set_angular_velocity(&mut self, body: BodyHandle, w: Real) -> Result<(), WorldError> {
+        if !w.is_finite() {
+            return Err(WorldError::NonFinite("angular_velocity"));
+        }
+        self.check_body(body)?;
+        if let Some(s) = self.bodies.state_mut(body) {
+            s.w = w;
+        }
+        Ok(())
+    }
+
+    /// Moves a body (teleport): origin and angle.
+    pub fn set_transform(&mut self, body: BodyHandle, position: Vec2, angle: Real) -> Result<(), WorldError> {
+        if !vec_is_finite(position) || !angle.is_finite() {
+            return Err(WorldError::NonFinite("transform"));
+        }
+        let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
+        sim.transform = Transform { p: position, q: Rot::from_angle(angle) };
+        sim.center = sim.transform.apply(sim.local_center);
+        sim.center0 = sim.center;
+        sim.rotation0 = sim.transform.q;
+        Ok(())
+    }
+
+    /// Sets the mass properties of a dynamic body directly.
+    pub fn set_mass(&mut self, body: BodyHandle, mass: BodyMass) -> Result<(), WorldError> {
+        let ty = self.body_type(body)?;
+        let fixed = self.bodies.record(body).map(|r| r.fixed_rotation).unwrap_or(false);
+        validate_mass(ty, &mass, fixed)?;
+        if ty != BodyType::Dynamic {
+            return Err(WorldError::NotDynamic);
+        }
+        self.bodies.apply_mass(body, mass, fixed);
+        Ok(())
+    }
+
+    /// Adds a force (N) at a world point for the next step.
+    pub fn apply_force(&mut self, body: BodyHandle, force: Vec2, point: Vec2) -> Result<(), WorldError> {
+        if !vec_is_finite(force) || !vec_is_finite(point) {
+            return Err(WorldError::NonFinite("force"));
+        }
+        let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
+        if sim.body_type == BodyType::Dynamic {
+            sim.force += force;
+            sim.torque += cross(point - sim.center, force);
+        }
+        Ok(())
+    }
+
+    /// Adds a force (N) at the centre of mass for the next step.
+    pub fn apply_force_to_center(&mut self, body: BodyHandle, force: Vec2) -> Result<(), WorldError> {
+        let c = self.center_of_mass(body)?;
+        self.apply_force(body, force, c)
+    }
+
+    /// Adds a torque (N·m) for the next step.
+    pub fn apply_torque(&mut self, body: BodyHandle, torque: Real) -> Result<(), WorldError> {
+        if !torque.is_finite() {
+            return Err(WorldError::NonFinite("torque"));
+        }
+        let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
+        if sim.body_type == BodyType::Dynamic {
+            sim.torque += torque;
+        }
+        Ok(())
+    }
+
+    /// Applies a linear impulse (N·s) at a world point, changing velocity now.
+    pub fn apply_linear_impulse(&mut self, body: BodyHandle, impulse: Vec2, point: Vec2) -> Result<(), WorldError> {
+        if !vec_is_finite(impulse) || !vec_is_finite(point) {
+            return Err(WorldError::NonFinite("impulse"));
+        }
+        let loc = self.bodies.location(body).ok_or(WorldError::StaleBody)?;
+        if let BodyLocation::Moving(i) = loc {
+            let sim = &self.bodies.sims[i as usize];
+            if sim.body_type == BodyType::Dynamic {
+                let (im, ii, c) = (sim.inv_mass, sim.inv_inertia, sim.center);
+                let st = &mut self.bodies.states[i as usize];
+                st.v += im * impulse;
+                st.w += ii * cross(point - c, impulse);
+            }
+        }
+        Ok(())
+    }
+
+    /// Applies an angular impulse (N·m·s), changing angular velocity now.
+    pub fn apply_angular_impulse(&mut self, body: BodyHandle, impulse: Real) -> Result<(), WorldError> {
+        if !impulse.is_finite() {
+            return Err(WorldError::NonFinite("impulse"));
+        }
+        let loc = self.bodies.location(body).ok_or(WorldError::StaleBody)?;
+        if let BodyLocation::Moving(i) = loc {
+            let ii = self.bodies.sims[i as usize].inv_inertia;
+            self.bodies.states[i as usize].w += ii * impulse;
+        }
+        Ok(())
+    }
+
+    // ----- joints -----------------------------------------------------------
+
+    /// Creates a revolute joint.
+    pub fn create_revolute_joint(&mut self, def: &RevoluteJointDef) -> Result<JointHandle, WorldError> {
+        def.validate()?;
+        self.check_body(def.body_a)?;
+        self.check_body(def.body_b)?;
+        let index = match self.joint_free.pop() {
+            Some(i) => i,
+            None => {
+                self.joint_slots.push(JointSlot { generation: 0, index: None });
+                (self.joint_slots.len() - 1) as u32
+            }
+        };
+        let slot = &mut self.joint_slots[index as usize];
+        slot.generation = slot.generation.wrapping_add(1);
+        slot.index = Some(self.revolute.len() as u32);
+        let handle = JointHandle { index, generation: slot.generation };
+        self.revolute.push(RevoluteJoint::new(def.clone()));
+        self.revolute_handles.push(handle);
+        Ok(handle)
+    }
+
+    fn joint_index(&self, joint: JointHandle) -> Result<usize, WorldError> {
+        let slot = self.joint_slots.get(joint.index as usize).ok_or(WorldError::StaleJoint)?;
+        if slot.generation != joint.generation {
+            return Err(WorldError::StaleJoint);
+        }
+        slot.index.map(|i| i as usize).ok_or(WorldError::StaleJoint)
+    }
+
+    /// Destroys a joint.
+    pub fn destroy_joint(&mut self, joint: JointHandle) -> Result<(), WorldError> {
+        let i = self.joint_index(joint)?;
+        self.revolute.swap_remove(i);
+        self.revolute_handles.swap_remove(i);
+        if i < self.revolute.len() {
+            let moved = self.revolute_handles[i];
+            self.joint_slots[moved.index as usize].index = Some(i as u32);
+        }
+        self.joint_slots[joint.index as usize].index = None;
+        self.joint_free.push(joint.index);
+        Ok(())
+    }
+
+    /// A revolute joint.
+    pub fn revolute_joint(&self, joint: JointHandle) -> Result<&RevoluteJoint, WorldError> {
+        let i = self.joint_index(joint)?;
+        Ok(&self.revolute[i])
+    }
+
+    /// Mutable access to a revolute joint's settings (motor speed, limits, …).
+    pub fn revolute_joint_def_mut(&mut self, joint: JointHandle) -> Result<&mut RevoluteJointDef, WorldError> {
+        let i = self.joint_index(joint)?;
+        Ok(&mut self.revolute[i].def)
+    }
+
+    /// Distance between a joint's two world anchors, m.
+    pub fn joint_gap(&self, joint: JointHandle) -> Result<Real, WorldError> {
+        Ok(self.revolute_joint(joint)?.gap(&self.bodies))
+    }
+
+    /// Handles of every joint, in storage order.
+    pub fn joint_handles(&self) -> &[JointHandle] {
+        &self.revolute_handles
+    }
+
+    /// The largest joint gap in the world, m.
+    pub fn max_joint_gap(&self) -> Real {
+        self.revolute.iter().map(|j| j.gap(&self.bodies)).fold(0.0, Real::max)
+    }
+
+    // ----- stepping ---------------------------------------------------------
+
+    /// The step context the solver uses for a step of `dt`.
+    pub fn step_context(&self, dt: Real) -> StepContext {
+        self.settings.context(dt, self.gravity)
+    }
+
+    /// Advances the world by `dt` seconds (finite, > 0).
+    pub fn step(&mut self, dt: Real) -> Result<(), WorldError> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(WorldError::InvalidTimeStep);
+        }
+        let ctx = self.step_context(dt);
+        let mut batches: [&mut dyn ConstraintBatch; 1] = [&mut self.revolute];
+        let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
+        self.events = StepEvents { non_finite_bodies: report.non_finite };
+        self.profile = report.profile;
+        self.step_count += 1;
+        Ok(())
+    }
+
+    /// A hash of every body's transform and velocity bits, in handle order:
+    /// equal hashes mean bit-identical states.
+    pub fn state_hash(&self) -> u64 {
+        let mut h = Fnv::new();
+        for handle in self.bodies.handles() {
+            let sim = self.bodies.sim(handle).expect("live handle");
+            let st = self.bodies.state(handle).expect("live handle");
+            h.write_u32(handle.index);
+            for x in [sim.transform.p.x, sim.transform.p.y, sim.transform.q.c, sim.transform.q.s, st.v.x, st.v.y, st.w] {
+                h.write_real(x);
+            }
+        }
+        h.finish()
+    }
+}
+
+fn validate_settings(s: &SolverSettings) -> Result<(), WorldError> {
+    let reals = [
+        s.baumgarte,
+        s.contact_hertz,
+        s.contact_damping_ratio,
+        s.contact_push_max_velocity,
+        s.joint_hertz,
+        s.joint_damping_ratio,
+        s.joint_max_correction_speed,
+        s.restitution_threshold,
+    ];
+    if reals.iter().any(|x| x.is_nan()) {
+        return Err(WorldError::NonFinite("solver settings"));
+    }
+    if reals.iter().any(|x| *x < 0.0) {
+        return Err(WorldError::OutOfRange("solver settings"));
+    }
+    if s.substeps == 0 || s.substeps > 1024 || s.velocity_iterations > 1024 || s.relax_iterations > 1024 {
+        return Err(WorldError::OutOfRange("iteration counts"));
+    }
+    Ok(())
+}
+
+/// FNV-1a, 64 bit: a small, stable hash for determinism checks.
+struct Fnv(u64);
+
+impl Fnv {
+    fn new() -> Self {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+    fn write_bytes(&mut self, bytes: &[u8]) {
+        for b in bytes {
+            self.0 ^= *b as u64;
+            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+    fn write_u32(&mut self, v: u32) {
+        self.write_bytes(&v.to_le_bytes());
+    }
+    fn write_real(&mut self, v: Real) {
+        self.write_bytes(&v.to_bits().to_le_bytes());
+    }
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
