@@ -45,7 +45,11 @@ fn measured_period(world: &mut World, bob: BodyHandle, dt: Real, seconds: Real) 
         }
         prev_x = x;
     }
-    assert!(crossings.len() >= 3, "too few crossings: {}", crossings.len());
+    assert!(
+        crossings.len() >= 3,
+        "too few crossings: {}",
+        crossings.len()
+    );
     (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as Real
 }
 
@@ -56,7 +60,10 @@ fn pendulum_small_angle_period_within_one_percent() {
     let expected = 2.0 * janus2d::base::math::PI * (L / G).sqrt();
     let err = (period - expected).abs() / expected;
     if std::env::var("JANUS2D_REPORT").is_ok() {
-        eprintln!("pendulum period {period:.5} s, expected {expected:.5} s, error {:.4}%", err * 100.0);
+        eprintln!(
+            "pendulum period {period:.5} s, expected {expected:.5} s, error {:.4}%",
+            err * 100.0
+        );
     }
     assert!(err < 0.01, "period {period} vs {expected}: error {err}");
 }
@@ -84,9 +91,14 @@ fn pendulum_energy_does_not_grow_over_60_seconds() {
         assert!(e - e0 <= 0.01 * swing, "step {k}: energy {e} vs start {e0}");
     }
     if std::env::var("JANUS2D_REPORT").is_ok() {
-        eprintln!("pendulum energy: start {e0:.5}, peak first 10 s {first_peak:.5}, peak last 10 s {last_peak:.5}");
+        eprintln!(
+            "pendulum energy: start {e0:.5}, peak first 10 s {first_peak:.5}, peak last 10 s {last_peak:.5}"
+        );
     }
-    assert!(last_peak <= first_peak + 1e-4 * swing, "energy grew: {first_peak} -> {last_peak}");
+    assert!(
+        last_peak <= first_peak + 1e-4 * swing,
+        "energy grew: {first_peak} -> {last_peak}"
+    );
     let gap = world.max_joint_gap();
     assert!(gap < 1e-3, "joint gap {gap}");
 }

@@ -54,6 +54,16 @@ pub struct BodyHandle {
     pub index: u32,
     /// Generation of the slot when the handle was issued.
     pub generation: u32,
+    /// Id of the body set (world) that issued the handle: a handle from
+    /// another world is rejected as foreign.
+    pub owner: u32,
+}
+
+static NEXT_OWNER_ID: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(1);
+
+/// A fresh id for a new body set or world (never 0).
+pub fn next_owner_id() -> u32 {
+    NEXT_OWNER_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 /// Mass properties set directly on a body.
@@ -309,6 +319,7 @@ impl BodySim {
             handle: BodyHandle {
                 index: u32::MAX,
                 generation: 0,
+                owner: 0,
             },
             body_type: BodyType::Static,
         }
@@ -353,6 +364,7 @@ pub struct SolverBody<'a> {
 /// Storage of every body, with generational handles.
 #[derive(Clone, Debug)]
 pub struct BodySet {
+    owner: u32,
     records: Vec<BodyRecord>,
     free: Vec<u32>,
     /// Per-step data of moving bodies; index 0 is the static sentinel.
@@ -439,6 +451,7 @@ impl BodySet {
     /// An empty set (holding only the static sentinel).
     pub fn new() -> Self {
         BodySet {
+            owner: next_owner_id(),
             records: Vec::new(),
             free: Vec::new(),
             sims: vec![BodySim::sentinel()],
@@ -446,6 +459,11 @@ impl BodySet {
             static_sims: Vec::new(),
             identity_sim: BodySim::sentinel(),
         }
+    }
+
+    /// The id stamped on every handle this set issues.
+    pub fn owner(&self) -> u32 {
+        self.owner
     }
 
     /// Number of live bodies.
@@ -487,6 +505,7 @@ impl BodySet {
         let handle = BodyHandle {
             index,
             generation: record.generation,
+            owner: self.owner,
         };
         let transform = Transform::new(def.position, def.angle);
         let mass = def.mass.unwrap_or(BodyMass::new(1.0, 1.0));
@@ -606,7 +625,7 @@ impl BodySet {
     #[inline]
     pub fn location(&self, handle: BodyHandle) -> Option<BodyLocation> {
         let rec = self.records.get(handle.index as usize)?;
-        if rec.generation != handle.generation {
+        if rec.generation != handle.generation || handle.owner != self.owner {
             return None;
         }
         rec.location
@@ -690,6 +709,7 @@ impl BodySet {
             r.location.map(|_| BodyHandle {
                 index: i as u32,
                 generation: r.generation,
+                owner: self.owner,
             })
         })
     }
@@ -743,6 +763,17 @@ mod tests {
             assert_eq!(set.sim(*h).unwrap().transform.p.x, i as Real);
         }
         assert_eq!(set.moving_count(), 4);
+    }
+
+    #[test]
+    fn foreign_handle_is_rejected() {
+        let mut a = BodySet::new();
+        let mut b = BodySet::new();
+        let ha = a.create(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+        let _hb = b.create(&BodyDef::dynamic(Vec2::ONE)).unwrap();
+        assert!(b.sim(ha).is_none());
+        assert_eq!(b.destroy(ha), Err(BodyError::StaleHandle));
+        assert_eq!(b.len(), 1);
     }
 
     #[test]

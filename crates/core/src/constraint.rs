@@ -143,7 +143,8 @@ impl ConstraintRows {
         for a in &self.rows[i].jacobian {
             for b in &self.rows[j].jacobian {
                 if a.body == b.body {
-                    sum += a.inv_mass * a.linear.dot(b.linear) + a.inv_inertia * a.angular * b.angular;
+                    sum +=
+                        a.inv_mass * a.linear.dot(b.linear) + a.inv_inertia * a.angular * b.angular;
                 }
             }
         }

@@ -12,11 +12,11 @@
 //! unchanged.
 
 use janus2d_constraints::{RevoluteJoint, RevoluteJointDef};
+use janus2d_core::BodyMass;
 use janus2d_core::body::{BodyDef, BodyHandle, BodyLocation, BodySet, BodyType, validate_mass};
 use janus2d_core::constraint::{ConstraintBatch, StepContext};
 use janus2d_core::math::{Real, Rot, Transform, Vec2, cross, vec_is_finite};
 use janus2d_core::solver::{SolverProfile, SolverSettings, solve_step};
-use janus2d_core::BodyMass;
 
 use crate::error::WorldError;
 
@@ -48,6 +48,8 @@ pub struct JointHandle {
     pub index: u32,
     /// Generation of the slot when issued.
     pub generation: u32,
+    /// Id of the world that issued it (a foreign handle is rejected).
+    pub owner: u32,
 }
 
 #[derive(Clone, Debug)]
@@ -207,7 +209,10 @@ impl World {
 
     /// Body origin and rotation.
     pub fn transform(&self, body: BodyHandle) -> Result<Transform, WorldError> {
-        self.bodies.sim(body).map(|s| s.transform).ok_or(WorldError::StaleBody)
+        self.bodies
+            .sim(body)
+            .map(|s| s.transform)
+            .ok_or(WorldError::StaleBody)
     }
 
     /// Body origin, m.
@@ -222,27 +227,40 @@ impl World {
 
     /// World centre of mass, m.
     pub fn center_of_mass(&self, body: BodyHandle) -> Result<Vec2, WorldError> {
-        self.bodies.sim(body).map(|s| s.center).ok_or(WorldError::StaleBody)
+        self.bodies
+            .sim(body)
+            .map(|s| s.center)
+            .ok_or(WorldError::StaleBody)
     }
 
     /// Linear velocity of the centre of mass, m/s.
     pub fn linear_velocity(&self, body: BodyHandle) -> Result<Vec2, WorldError> {
-        self.bodies.linear_velocity(body).ok_or(WorldError::StaleBody)
+        self.bodies
+            .linear_velocity(body)
+            .ok_or(WorldError::StaleBody)
     }
 
     /// Angular velocity, rad/s.
     pub fn angular_velocity(&self, body: BodyHandle) -> Result<Real, WorldError> {
-        self.bodies.angular_velocity(body).ok_or(WorldError::StaleBody)
+        self.bodies
+            .angular_velocity(body)
+            .ok_or(WorldError::StaleBody)
     }
 
     /// Mass, kg (0 for static and kinematic bodies).
     pub fn mass(&self, body: BodyHandle) -> Result<Real, WorldError> {
-        self.bodies.sim(body).map(|s| s.mass).ok_or(WorldError::StaleBody)
+        self.bodies
+            .sim(body)
+            .map(|s| s.mass)
+            .ok_or(WorldError::StaleBody)
     }
 
     /// Rotational inertia about the centre of mass, kg·m².
     pub fn rotational_inertia(&self, body: BodyHandle) -> Result<Real, WorldError> {
-        self.bodies.sim(body).map(|s| s.inertia).ok_or(WorldError::StaleBody)
+        self.bodies
+            .sim(body)
+            .map(|s| s.inertia)
+            .ok_or(WorldError::StaleBody)
     }
 
     /// Body type.
@@ -275,12 +293,20 @@ impl World {
     }
 
     /// Moves a body (teleport): origin and angle.
-    pub fn set_transform(&mut self, body: BodyHandle, position: Vec2, angle: Real) -> Result<(), WorldError> {
+    pub fn set_transform(
+        &mut self,
+        body: BodyHandle,
+        position: Vec2,
+        angle: Real,
+    ) -> Result<(), WorldError> {
         if !vec_is_finite(position) || !angle.is_finite() {
             return Err(WorldError::NonFinite("transform"));
         }
         let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
-        sim.transform = Transform { p: position, q: Rot::from_angle(angle) };
+        sim.transform = Transform {
+            p: position,
+            q: Rot::from_angle(angle),
+        };
         sim.center = sim.transform.apply(sim.local_center);
         sim.center0 = sim.center;
         sim.rotation0 = sim.transform.q;
@@ -290,7 +316,11 @@ impl World {
     /// Sets the mass properties of a dynamic body directly.
     pub fn set_mass(&mut self, body: BodyHandle, mass: BodyMass) -> Result<(), WorldError> {
         let ty = self.body_type(body)?;
-        let fixed = self.bodies.record(body).map(|r| r.fixed_rotation).unwrap_or(false);
+        let fixed = self
+            .bodies
+            .record(body)
+            .map(|r| r.fixed_rotation)
+            .unwrap_or(false);
         validate_mass(ty, &mass, fixed)?;
         if ty != BodyType::Dynamic {
             return Err(WorldError::NotDynamic);
@@ -300,7 +330,12 @@ impl World {
     }
 
     /// Adds a force (N) at a world point for the next step.
-    pub fn apply_force(&mut self, body: BodyHandle, force: Vec2, point: Vec2) -> Result<(), WorldError> {
+    pub fn apply_force(
+        &mut self,
+        body: BodyHandle,
+        force: Vec2,
+        point: Vec2,
+    ) -> Result<(), WorldError> {
         if !vec_is_finite(force) || !vec_is_finite(point) {
             return Err(WorldError::NonFinite("force"));
         }
@@ -313,7 +348,11 @@ impl World {
     }
 
     /// Adds a force (N) at the centre of mass for the next step.
-    pub fn apply_force_to_center(&mut self, body: BodyHandle, force: Vec2) -> Result<(), WorldError> {
+    pub fn apply_force_to_center(
+        &mut self,
+        body: BodyHandle,
+        force: Vec2,
+    ) -> Result<(), WorldError> {
         let c = self.center_of_mass(body)?;
         self.apply_force(body, force, c)
     }
@@ -331,7 +370,12 @@ impl World {
     }
 
     /// Applies a linear impulse (N·s) at a world point, changing velocity now.
-    pub fn apply_linear_impulse(&mut self, body: BodyHandle, impulse: Vec2, point: Vec2) -> Result<(), WorldError> {
+    pub fn apply_linear_impulse(
+        &mut self,
+        body: BodyHandle,
+        impulse: Vec2,
+        point: Vec2,
+    ) -> Result<(), WorldError> {
         if !vec_is_finite(impulse) || !vec_is_finite(point) {
             return Err(WorldError::NonFinite("impulse"));
         }
@@ -349,7 +393,11 @@ impl World {
     }
 
     /// Applies an angular impulse (N·m·s), changing angular velocity now.
-    pub fn apply_angular_impulse(&mut self, body: BodyHandle, impulse: Real) -> Result<(), WorldError> {
+    pub fn apply_angular_impulse(
+        &mut self,
+        body: BodyHandle,
+        impulse: Real,
+    ) -> Result<(), WorldError> {
         if !impulse.is_finite() {
             return Err(WorldError::NonFinite("impulse"));
         }
@@ -364,29 +412,42 @@ impl World {
     // ----- joints -----------------------------------------------------------
 
     /// Creates a revolute joint.
-    pub fn create_revolute_joint(&mut self, def: &RevoluteJointDef) -> Result<JointHandle, WorldError> {
+    pub fn create_revolute_joint(
+        &mut self,
+        def: &RevoluteJointDef,
+    ) -> Result<JointHandle, WorldError> {
         def.validate()?;
         self.check_body(def.body_a)?;
         self.check_body(def.body_b)?;
         let index = match self.joint_free.pop() {
             Some(i) => i,
             None => {
-                self.joint_slots.push(JointSlot { generation: 0, index: None });
+                self.joint_slots.push(JointSlot {
+                    generation: 0,
+                    index: None,
+                });
                 (self.joint_slots.len() - 1) as u32
             }
         };
         let slot = &mut self.joint_slots[index as usize];
         slot.generation = slot.generation.wrapping_add(1);
         slot.index = Some(self.revolute.len() as u32);
-        let handle = JointHandle { index, generation: slot.generation };
+        let handle = JointHandle {
+            index,
+            generation: slot.generation,
+            owner: self.bodies.owner(),
+        };
         self.revolute.push(RevoluteJoint::new(def.clone()));
         self.revolute_handles.push(handle);
         Ok(handle)
     }
 
     fn joint_index(&self, joint: JointHandle) -> Result<usize, WorldError> {
-        let slot = self.joint_slots.get(joint.index as usize).ok_or(WorldError::StaleJoint)?;
-        if slot.generation != joint.generation {
+        let slot = self
+            .joint_slots
+            .get(joint.index as usize)
+            .ok_or(WorldError::StaleJoint)?;
+        if slot.generation != joint.generation || joint.owner != self.bodies.owner() {
             return Err(WorldError::StaleJoint);
         }
         slot.index.map(|i| i as usize).ok_or(WorldError::StaleJoint)
@@ -413,7 +474,10 @@ impl World {
     }
 
     /// Mutable access to a revolute joint's settings (motor speed, limits, …).
-    pub fn revolute_joint_def_mut(&mut self, joint: JointHandle) -> Result<&mut RevoluteJointDef, WorldError> {
+    pub fn revolute_joint_def_mut(
+        &mut self,
+        joint: JointHandle,
+    ) -> Result<&mut RevoluteJointDef, WorldError> {
         let i = self.joint_index(joint)?;
         Ok(&mut self.revolute[i].def)
     }
@@ -430,7 +494,10 @@ impl World {
 
     /// The largest joint gap in the world, m.
     pub fn max_joint_gap(&self) -> Real {
-        self.revolute.iter().map(|j| j.gap(&self.bodies)).fold(0.0, Real::max)
+        self.revolute
+            .iter()
+            .map(|j| j.gap(&self.bodies))
+            .fold(0.0, Real::max)
     }
 
     // ----- stepping ---------------------------------------------------------
@@ -448,7 +515,9 @@ impl World {
         let ctx = self.step_context(dt);
         let mut batches: [&mut dyn ConstraintBatch; 1] = [&mut self.revolute];
         let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
-        self.events = StepEvents { non_finite_bodies: report.non_finite };
+        self.events = StepEvents {
+            non_finite_bodies: report.non_finite,
+        };
         self.profile = report.profile;
         self.step_count += 1;
         Ok(())
@@ -462,7 +531,15 @@ impl World {
             let sim = self.bodies.sim(handle).expect("live handle");
             let st = self.bodies.state(handle).expect("live handle");
             h.write_u32(handle.index);
-            for x in [sim.transform.p.x, sim.transform.p.y, sim.transform.q.c, sim.transform.q.s, st.v.x, st.v.y, st.w] {
+            for x in [
+                sim.transform.p.x,
+                sim.transform.p.y,
+                sim.transform.q.c,
+                sim.transform.q.s,
+                st.v.x,
+                st.v.y,
+                st.w,
+            ] {
                 h.write_real(x);
             }
         }
@@ -487,7 +564,11 @@ fn validate_settings(s: &SolverSettings) -> Result<(), WorldError> {
     if reals.iter().any(|x| *x < 0.0) {
         return Err(WorldError::OutOfRange("solver settings"));
     }
-    if s.substeps == 0 || s.substeps > 1024 || s.velocity_iterations > 1024 || s.relax_iterations > 1024 {
+    if s.substeps == 0
+        || s.substeps > 1024
+        || s.velocity_iterations > 1024
+        || s.relax_iterations > 1024
+    {
         return Err(WorldError::OutOfRange("iteration counts"));
     }
     Ok(())
