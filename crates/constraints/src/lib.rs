@@ -5,13 +5,21 @@
 //! | type                          | rows | bodies | built from              |
 //! |-------------------------------|------|--------|-------------------------|
 //! | [`revolute::RevoluteJoint`]   | 2–6  | 2      | point + angle parts     |
+//! | [`portal::PortalConstraint`]  | 3    | 4      | portal part + portal map |
+//! | [`contact::ContactConstraint`]| 2–4  | 2      | axis parts              |
 //!
 //! Every type follows the same stages (prepare, warm start, solve with or
 //! without bias) and reports its rows through `Constraint::rows`.
 
+pub mod contact;
 pub mod parts;
+pub mod portal;
+pub mod portal_map;
 pub mod revolute;
 
+pub use contact::{ContactConstraint, ContactPointInput};
+pub use portal::{PortalConstraint, PortalConstraintDef};
+pub use portal_map::{Portal, PortalError, PortalMap, PortalPair};
 pub use revolute::{RevoluteJoint, RevoluteJointDef};
 
 /// Invalid joint input at the API boundary.

@@ -1,0 +1,310 @@
+//! The contact constraint: a non-penetration row per manifold point, with
+//! Coulomb friction and restitution.
+//!
+//! # Derivation
+//!
+//! For a manifold with unit normal `n` (from a to b), tangent
+//! `t = (n.y, −n.x)` and points with anchors `r_a`, `r_b` measured from the
+//! centres of mass (fixed on the bodies for the whole step):
+//!
+//! **Normal row.** `C = s ≥ 0`, the separation along `n`. Its rate is
+//! `Ċ = n · (v_b + ω_b × r_b − v_a − ω_a × r_a)`, so
+//!
+//! ```text
+//! J = [ −n  −(r_a × n)   n  (r_b × n) ]
+//! k = m_a⁻¹ + m_b⁻¹ + i_a⁻¹ (r_a × n)² + i_b⁻¹ (r_b × n)²
+//! ```
+//!
+//! The separation is refreshed every substep from the position deltas
+//! without recomputing the manifold:
+//! `s = s₀ + n · ((dp_b − dp_a) + (dq_b r_b − dq_a r_a) − (r_b − r_a))`.
+//!
+//! - `s > 0` (speculative): `bias = s / h`, rigid — the row only stops the
+//!   bodies from closing the gap within the substep.
+//! - `s ≤ 0`, with bias: soft push-out `bias = max(β s, −v_push)` with the
+//!   contact [`Softness`](janus2d_core::softness::Softness) (twice the hertz
+//!   against static bodies) and the push-out speed cap `v_push`.
+//! - relax: no bias, rigid.
+//!
+//! `λ = −k⁻¹ s_m (Ċ + bias) − s_i λ_acc`, accumulated impulse clamped `≥ 0`.
+//!
+//! **Friction row.** `J` as above with `t` for `n`, no position error;
+//! the accumulated impulse is clamped to `±μ λ_n` (Coulomb), with
+//! `μ = √(μ_a μ_b)`.
+//!
+//! **Restitution.** Once after the substeps, for points that approached
+//! faster than the threshold: drive `Ċ` to `−e · Ċ_before`, `e = max(e_a, e_b)`.
+
+use janus2d_core::body::{BodyHandle, BodySet, BodyState};
+use janus2d_core::constraint::{Block, BodyJacobian, Constraint, ConstraintRows, Row, StepContext};
+use janus2d_core::math::{Real, Vec2, cross};
+use janus2d_core::softness::Softness;
+use smallvec::smallvec;
+
+use crate::parts::{AxisPart, load_pair, store_pair};
+
+/// Maximum points per manifold.
+pub const MAX_MANIFOLD_POINTS: usize = 2;
+
+/// One point of a contact, as the collision pipeline hands it over.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactPointInput {
+    /// Anchor on a relative to a's centre of mass (world frame), m.
+    pub anchor_a: Vec2,
+    /// Anchor on b relative to b's centre of mass (world frame), m.
+    pub anchor_b: Vec2,
+    /// Separation along the normal when the manifold was computed, m.
+    pub separation: Real,
+    /// Normal impulse kept from the last step (warm start), N·s.
+    pub normal_impulse: Real,
+    /// Tangent impulse kept from the last step (warm start), N·s.
+    pub tangent_impulse: Real,
+}
+
+/// One solver point.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct ContactPoint {
+    r_a: Vec2,
+    r_b: Vec2,
+    base_separation: Real,
+    normal: AxisPart,
+    tangent: AxisPart,
+    /// Largest normal impulse applied in one iteration (restitution gate).
+    max_normal_impulse: Real,
+    /// Normal velocity before the solve (for restitution), m/s.
+    relative_velocity: Real,
+}
+
+/// A contact constraint between two bodies (one manifold, 1–2 points).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactConstraint {
+    /// Body a.
+    pub body_a: BodyHandle,
+    /// Body b.
+    pub body_b: BodyHandle,
+    /// Unit normal from a to b (world).
+    pub normal: Vec2,
+    /// Mixed friction coefficient `√(μ_a μ_b)`.
+    pub friction: Real,
+    /// Mixed restitution `max(e_a, e_b)`.
+    pub restitution: Real,
+    /// Index of the contact in the world's contact list (for storing impulses).
+    pub contact_index: u32,
+    state_a: u32,
+    state_b: u32,
+    point_count: usize,
+    points: [ContactPoint; MAX_MANIFOLD_POINTS],
+    softness: Softness,
+}
+
+impl ContactConstraint {
+    /// A constraint from the pipeline's manifold data.
+    pub fn new(
+        body_a: BodyHandle,
+        body_b: BodyHandle,
+        normal: Vec2,
+        points: &[ContactPointInput],
+        friction: Real,
+        restitution: Real,
+        contact_index: u32,
+    ) -> Self {
+        let mut c = ContactConstraint {
+            body_a,
+            body_b,
+            normal,
+            friction,
+            restitution,
+            contact_index,
+            state_a: 0,
+            state_b: 0,
+            point_count: points.len().min(MAX_MANIFOLD_POINTS),
+            points: [ContactPoint::default(); MAX_MANIFOLD_POINTS],
+            softness: Softness::RIGID,
+        };
+        for (cp, input) in c.points.iter_mut().zip(points) {
+            cp.r_a = input.anchor_a;
+            cp.r_b = input.anchor_b;
+            cp.base_separation = input.separation - (input.anchor_b - input.anchor_a).dot(normal);
+            cp.normal.impulse = input.normal_impulse;
+            cp.tangent.impulse = input.tangent_impulse;
+        }
+        c
+    }
+
+    /// Number of points.
+    pub fn point_count(&self) -> usize {
+        self.point_count
+    }
+
+    /// Accumulated (normal, tangent) impulses of point `i`, N·s.
+    pub fn impulses(&self, i: usize) -> (Real, Real) {
+        (self.points[i].normal.impulse, self.points[i].tangent.impulse)
+    }
+
+    /// Total normal impulse of the last step, N·s.
+    pub fn total_normal_impulse(&self) -> Real {
+        self.points[..self.point_count].iter().map(|p| p.normal.impulse).sum()
+    }
+
+    #[inline(always)]
+    fn tangent(&self) -> Vec2 {
+        Vec2::new(self.normal.y, -self.normal.x)
+    }
+}
+
+impl Constraint for ContactConstraint {
+    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
+        let a = bodies.solver_body(self.body_a);
+        let b = bodies.solver_body(self.body_b);
+        self.state_a = a.state_index;
+        self.state_b = b.state_index;
+        let (sa, sb) = (a.state, b.state);
+        let static_pair = sa.inv_mass == 0.0 || sb.inv_mass == 0.0;
+        self.softness = if static_pair { ctx.static_softness } else { ctx.contact_softness };
+        let n = self.normal;
+        let t = self.tangent();
+        for cp in &mut self.points[..self.point_count] {
+            cp.normal.set_mass(AxisPart::k(sa, sb, cp.r_a, cp.r_b, n));
+            cp.tangent.set_mass(AxisPart::k(sa, sb, cp.r_a, cp.r_b, t));
+            cp.relative_velocity = AxisPart::c_dot(sa, sb, cp.r_a, cp.r_b, n);
+            cp.max_normal_impulse = 0.0;
+            if !ctx.warm_starting {
+                cp.normal.impulse = 0.0;
+                cp.tangent.impulse = 0.0;
+            }
+        }
+    }
+
+    fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
+        let (mut sa, mut sb) = load_pair(states, self.state_a, self.state_b);
+        let (n, t) = (self.normal, self.tangent());
+        for cp in &self.points[..self.point_count] {
+            let p = cp.normal.impulse * n + cp.tangent.impulse * t;
+            AxisPart::apply(&mut sa, &mut sb, cp.r_a, cp.r_b, p, 1.0);
+        }
+        store_pair(states, self.state_a, self.state_b, &sa, &sb);
+    }
+
+    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
+        let (mut sa, mut sb) = load_pair(states, self.state_a, self.state_b);
+        let n = self.normal;
+        let dp = sb.dp - sa.dp;
+        let softness = self.softness;
+        for cp in &mut self.points[..self.point_count] {
+            // Current separation from the deltas, anchors fixed on the bodies.
+            let pr_a = sa.dq.rotate(cp.r_a);
+            let pr_b = sb.dq.rotate(cp.r_b);
+            let s = cp.base_separation + (dp + pr_b - pr_a).dot(n);
+            let (bias, mass_scale, impulse_scale) = if s > 0.0 {
+                (s * ctx.inv_h, 1.0, 0.0)
+            } else if use_bias {
+                (
+                    (softness.bias_rate * s).max(-ctx.contact_push_max_velocity),
+                    softness.mass_scale,
+                    softness.impulse_scale,
+                )
+            } else {
+                (0.0, 1.0, 0.0)
+            };
+            let c_dot = AxisPart::c_dot(&sa, &sb, cp.r_a, cp.r_b, n);
+            let lambda = -cp.normal.mass * mass_scale * (c_dot + bias) - impulse_scale * cp.normal.impulse;
+            let new_impulse = (cp.normal.impulse + lambda).max(0.0);
+            let applied = new_impulse - cp.normal.impulse;
+            cp.normal.impulse = new_impulse;
+            cp.max_normal_impulse = cp.max_normal_impulse.max(applied);
+            AxisPart::apply(&mut sa, &mut sb, cp.r_a, cp.r_b, n, applied);
+        }
+        let t = self.tangent();
+        let friction = self.friction;
+        for cp in &mut self.points[..self.point_count] {
+            let c_dot = AxisPart::c_dot(&sa, &sb, cp.r_a, cp.r_b, t);
+            let lambda = -cp.tangent.mass * c_dot;
+            let max_friction = friction * cp.normal.impulse;
+            let new_impulse = (cp.tangent.impulse + lambda).clamp(-max_friction, max_friction);
+            let applied = new_impulse - cp.tangent.impulse;
+            cp.tangent.impulse = new_impulse;
+            AxisPart::apply(&mut sa, &mut sb, cp.r_a, cp.r_b, t, applied);
+        }
+        store_pair(states, self.state_a, self.state_b, &sa, &sb);
+    }
+
+    fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+        if self.restitution == 0.0 {
+            return;
+        }
+        let (mut sa, mut sb) = load_pair(states, self.state_a, self.state_b);
+        let n = self.normal;
+        let e = self.restitution;
+        for cp in &mut self.points[..self.point_count] {
+            if cp.relative_velocity > -ctx.restitution_threshold || cp.max_normal_impulse == 0.0 {
+                continue;
+            }
+            let c_dot = AxisPart::c_dot(&sa, &sb, cp.r_a, cp.r_b, n);
+            let lambda = -cp.normal.mass * (c_dot + e * cp.relative_velocity);
+            let new_impulse = (cp.normal.impulse + lambda).max(0.0);
+            let applied = new_impulse - cp.normal.impulse;
+            cp.normal.impulse = new_impulse;
+            cp.max_normal_impulse = cp.max_normal_impulse.max(applied);
+            AxisPart::apply(&mut sa, &mut sb, cp.r_a, cp.r_b, n, applied);
+        }
+        store_pair(states, self.state_a, self.state_b, &sa, &sb);
+    }
+
+    fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
+        let a = bodies.solver_body(self.body_a);
+        let b = bodies.solver_body(self.body_b);
+        let (sa, sb) = (a.state, b.state);
+        let static_pair = sa.inv_mass == 0.0 || sb.inv_mass == 0.0;
+        let softness = if static_pair { ctx.static_softness } else { ctx.contact_softness };
+        let mut out = ConstraintRows::default();
+        let entry = |body, linear: Vec2, angular, s: &BodyState| BodyJacobian {
+            body,
+            linear,
+            angular,
+            inv_mass: s.inv_mass,
+            inv_inertia: s.inv_inertia,
+        };
+        for (axis, is_normal) in [(self.normal, true), (self.tangent(), false)] {
+            for cp in &self.points[..self.point_count] {
+                let first_row = out.rows.len();
+                let (c, softness, lower, upper, impulse) = if is_normal {
+                    let s = cp.base_separation + (cp.r_b - cp.r_a).dot(self.normal);
+                    (s, softness, 0.0, Real::INFINITY, cp.normal.impulse)
+                } else {
+                    let m = self.friction * cp.normal.impulse;
+                    (0.0, Softness::RIGID, -m, m, cp.tangent.impulse)
+                };
+                out.rows.push(Row {
+                    jacobian: smallvec![
+                        entry(self.body_a, -axis, -cross(cp.r_a, axis), sa),
+                        entry(self.body_b, axis, cross(cp.r_b, axis), sb),
+                    ],
+                    c,
+                    softness,
+                    lower,
+                    upper,
+                    impulse,
+                });
+                let k = AxisPart::k(sa, sb, cp.r_a, cp.r_b, axis);
+                out.blocks.push(Block {
+                    first_row,
+                    len: 1,
+                    k: [[k, 0.0, 0.0], [0.0; 3], [0.0; 3]],
+                });
+            }
+        }
+        out
+    }
+}
+
+/// Mixes two friction coefficients: `√(μ_a μ_b)`.
+#[inline]
+pub fn mix_friction(a: Real, b: Real) -> Real {
+    (a * b).sqrt()
+}
+
+/// Mixes two restitution coefficients: `max(e_a, e_b)`.
+#[inline]
+pub fn mix_restitution(a: Real, b: Real) -> Real {
+    a.max(b)
+}

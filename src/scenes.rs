@@ -1,0 +1,251 @@
+//! The standard scenes of `../shared/spec/scenes.md`, built exactly as
+//! specified, for benchmarks, hard-case tests, examples and the accuracy
+//! sweep.
+//!
+//! | scene                | bodies  | what it stresses                        |
+//! |----------------------|---------|-----------------------------------------|
+//! | [`large_pyramid`]    | 5,051   | deep stacking, solver convergence       |
+//! | [`many_pyramids`]    | 22,001  | many islands, broadphase, cache         |
+//! | [`joint_grid`]       | 10,000  | 19,800 joints                           |
+//! | [`tumbler`]          | 2,027   | a motor-driven drum, constant motion    |
+//! | [`smash`]            | 9,601   | a fast projectile into a block, g = 0   |
+//! | [`spinner`]          | 6,078   | a paddle in a one-sided loop, mixed shapes |
+//!
+//! Every builder returns a [`Scene`]: the world plus a probe body (the one a
+//! benchmark's sanity line and the tests track).
+
+use janus2d_constraints::RevoluteJointDef;
+use janus2d_core::body::{BodyDef, BodyHandle};
+use janus2d_core::geometry::{Capsule, Circle, Polygon, Segment, make_chain};
+use janus2d_core::math::{PI, Real, Vec2};
+use janus2d_world::{Filter, ShapeDef, World, WorldDef};
+
+/// Shared step length of every scene, s (1/60).
+pub const DT: Real = 1.0 / 60.0;
+
+/// A built scene.
+pub struct Scene {
+    /// The world.
+    pub world: World,
+    /// The body whose motion the scene reports.
+    pub probe: BodyHandle,
+    /// What the probe is.
+    pub probe_label: &'static str,
+    /// Steps Box2D's benchmark runs for this scene.
+    pub steps: usize,
+}
+
+fn new_world(def: &WorldDef) -> World {
+    World::new(def.clone()).expect("valid world definition")
+}
+
+fn box_def() -> ShapeDef {
+    ShapeDef::default().with_density(1.0).with_friction(0.6)
+}
+
+/// A pyramid of `base` rows of unit boxes on a static ground box of half
+/// extents (100, 1) at (0, −1). `base = 100` is `large_pyramid`, `base = 20`
+/// the hard case "pyramid 20".
+pub fn large_pyramid(def: &WorldDef, base: usize) -> Scene {
+    let mut world = new_world(def);
+    let ground = world.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
+    world.create_shape(ground, &ShapeDef::default(), Polygon::make_box(100.0, 1.0)).unwrap();
+    let square = Polygon::make_box(0.5, 0.5);
+    let sd = box_def();
+    let mut top = ground;
+    for i in 0..base {
+        let y = (2 * i + 1) as Real * 0.5;
+        for j in i..base {
+            let x = (i + 1) as Real * 0.5 + (j - i) as Real - 0.5 * base as Real;
+            let b = world.create_body(&BodyDef::dynamic(Vec2::new(x, y))).unwrap();
+            world.create_shape(b, &sd, square).unwrap();
+            top = b;
+        }
+    }
+    Scene { world, probe: top, probe_label: "top box", steps: 500 }
+}
+
+/// 20 × 20 pyramids of base 10 on 20 two-sided ground segments.
+pub fn many_pyramids(def: &WorldDef) -> Scene {
+    let (rows, cols, base) = (20, 20, 10);
+    let mut world = new_world(def);
+    let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    for r in 0..rows {
+        let y = 11.0 * r as Real;
+        let seg = Segment::new(Vec2::new(-110.0, y), Vec2::new(110.0, y)).unwrap();
+        world.create_shape(ground, &ShapeDef::default(), seg).unwrap();
+    }
+    let square = Polygon::make_box(0.5, 0.5);
+    let sd = box_def();
+    let mut probe = None;
+    for r in 0..rows {
+        let base_y = 11.0 * r as Real;
+        for c in 0..cols {
+            let center_x = -110.0 + 11.0 * c as Real + 1.0;
+            let mut last = ground;
+            for i in 0..base {
+                let y = (2 * i + 1) as Real * 0.5 + base_y;
+                for j in i..base {
+                    let x = (i + 1) as Real * 0.5 + (j - i) as Real + center_x - 0.5;
+                    let b = world.create_body(&BodyDef::dynamic(Vec2::new(x, y))).unwrap();
+                    world.create_shape(b, &sd, square).unwrap();
+                    last = b;
+                }
+            }
+            probe.get_or_insert(last);
+        }
+    }
+    Scene { world, probe: probe.unwrap(), probe_label: "top box of the first pyramid", steps: 200 }
+}
+
+/// `n × n` circles r 0.4 linked by revolute joints, hanging from 7 static
+/// ones; the circles never collide with each other. `n = 100` is the
+/// benchmark; the hard case uses `n = 40` with doubled gravity.
+pub fn joint_grid(def: &WorldDef, n: usize) -> Scene {
+    let mut world = new_world(def);
+    let sd = ShapeDef {
+        filter: Filter { category_bits: 2, mask_bits: !2u64, group_index: 0 },
+        ..ShapeDef::default()
+    };
+    let circle = Circle::new(Vec2::ZERO, 0.4).unwrap();
+    let mut grid: Vec<BodyHandle> = Vec::with_capacity(n * n);
+    let mid = n / 2;
+    for k in 0..n {
+        for i in 0..n {
+            let pos = Vec2::new(k as Real, -(i as Real));
+            let is_static = i == 0 && k + 3 >= mid && k <= mid + 3;
+            let body_def = if is_static { BodyDef::fixed(pos) } else { BodyDef::dynamic(pos) };
+            let b = world.create_body(&body_def).unwrap();
+            world.create_shape(b, &sd, circle).unwrap();
+            if i > 0 {
+                let above = grid[grid.len() - 1];
+                world
+                    .create_revolute_joint(&RevoluteJointDef::new(above, b, Vec2::new(0.0, -0.5), Vec2::new(0.0, 0.5)))
+                    .unwrap();
+            }
+            if k > 0 {
+                let left = grid[grid.len() - n];
+                world
+                    .create_revolute_joint(&RevoluteJointDef::new(left, b, Vec2::new(0.5, 0.0), Vec2::new(-0.5, 0.0)))
+                    .unwrap();
+            }
+            grid.push(b);
+        }
+    }
+    Scene { world, probe: grid[n - 1], probe_label: "bottom-left circle", steps: 500 }
+}
+
+/// A motor-driven hollow drum turning 45 × 45 small boxes.
+pub fn tumbler(def: &WorldDef) -> Scene {
+    let mut world = new_world(def);
+    let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    let drum = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 10.0))).unwrap();
+    let wall = ShapeDef::default().with_density(50.0);
+    for (hx, hy, cx, cy) in [(0.5, 10.0, 10.0, 0.0), (0.5, 10.0, -10.0, 0.0), (10.0, 0.5, 0.0, 10.0), (10.0, 0.5, 0.0, -10.0)] {
+        world
+            .create_shape(drum, &wall, Polygon::make_offset_box(hx, hy, Vec2::new(cx, cy), 0.0))
+            .unwrap();
+    }
+    let motor = RevoluteJointDef::new(ground, drum, Vec2::new(0.0, 10.0), Vec2::ZERO).with_motor(25.0 * PI / 180.0, 1e8);
+    world.create_revolute_joint(&motor).unwrap();
+    let small = Polygon::make_box(0.125, 0.125);
+    let sd = box_def();
+    for i in 0..45 {
+        for j in 0..45 {
+            let b = world
+                .create_body(&BodyDef::dynamic(Vec2::new(-9.0 + 0.4 * j as Real, 1.0 + 0.4 * i as Real)))
+                .unwrap();
+            world.create_shape(b, &sd, small).unwrap();
+        }
+    }
+    Scene { world, probe: drum, probe_label: "drum (motor 25 deg/s)", steps: 750 }
+}
+
+/// A heavy fast box smashing into a block of 120 × 80 small boxes, g = 0.
+pub fn smash(def: &WorldDef) -> Scene {
+    let mut def = def.clone();
+    def.gravity = Vec2::ZERO;
+    let mut world = new_world(&def);
+    let projectile = world
+        .create_body(&BodyDef::dynamic(Vec2::new(-20.0, 0.0)).with_velocity(Vec2::new(40.0, 0.0)))
+        .unwrap();
+    world
+        .create_shape(projectile, &ShapeDef::default().with_density(8.0), Polygon::make_box(4.0, 4.0))
+        .unwrap();
+    let small = Polygon::make_box(0.2, 0.2);
+    let sd = box_def();
+    for i in 0..120 {
+        for j in 0..80 {
+            let b = world
+                .create_body(&BodyDef::dynamic(Vec2::new(30.0 + 0.4 * i as Real, 0.4 * (j as Real - 40.0))))
+                .unwrap();
+            world.create_shape(b, &sd, small).unwrap();
+        }
+    }
+    Scene { world, probe: projectile, probe_label: "projectile", steps: 300 }
+}
+
+/// A motorised paddle stirring 6,076 mixed shapes inside a one-sided loop.
+pub fn spinner(def: &WorldDef) -> Scene {
+    let mut world = new_world(def);
+    let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    let points: Vec<Vec2> = (0..360)
+        .map(|i| {
+            // Clockwise, so each segment's front normal (to the right of
+            // its direction, the side that collides) points inwards.
+            let a = -(i as Real) * 2.0 * PI / 360.0;
+            Vec2::new(40.0 * a.cos(), 32.0 + 40.0 * a.sin())
+        })
+        .collect();
+    let loop_def = ShapeDef::default().with_friction(0.1);
+    for seg in make_chain(&points, true).unwrap() {
+        world.create_shape(ground, &loop_def, seg).unwrap();
+    }
+    let paddle = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 12.0))).unwrap();
+    world
+        .create_shape(paddle, &ShapeDef::default().with_friction(0.0), Polygon::make_rounded_box(0.4, 20.0, 0.2))
+        .unwrap();
+    let motor = RevoluteJointDef::new(ground, paddle, Vec2::new(0.0, 12.0), Vec2::ZERO).with_motor(5.0, Real::MAX);
+    world.create_revolute_joint(&motor).unwrap();
+    let sd = ShapeDef { density: 0.25, friction: 0.1, restitution: 0.1, ..ShapeDef::default() };
+    let capsule = Capsule::new(Vec2::new(-0.25, 0.0), Vec2::new(0.25, 0.0), 0.25).unwrap();
+    let circle = Circle::new(Vec2::ZERO, 0.35).unwrap();
+    let square = Polygon::make_box(0.35, 0.35);
+    let (mut x, mut y) = (-23.0, 2.0);
+    for i in 0..6076 {
+        let b = world.create_body(&BodyDef::dynamic(Vec2::new(x, y))).unwrap();
+        match i % 3 {
+            0 => world.create_shape(b, &sd, capsule),
+            1 => world.create_shape(b, &sd, circle),
+            _ => world.create_shape(b, &sd, square),
+        }
+        .unwrap();
+        x += 0.5;
+        if x >= 23.0 {
+            x = -23.0;
+            y += 0.5;
+        }
+    }
+    Scene { world, probe: paddle, probe_label: "paddle", steps: 500 }
+}
+
+/// Builds a benchmark scene by name.
+pub fn by_name(name: &str, def: &WorldDef) -> Option<Scene> {
+    Some(match name {
+        "large_pyramid" => large_pyramid(def, 100),
+        "pyramid20" => {
+            let mut s = large_pyramid(def, 20);
+            s.steps = 600;
+            s
+        }
+        "many_pyramids" => many_pyramids(def),
+        "joint_grid" => joint_grid(def, 100),
+        "tumbler" => tumbler(def),
+        "smash" => smash(def),
+        "spinner" => spinner(def),
+        _ => return None,
+    })
+}
+
+/// Names of the benchmark scenes, in the order `all` runs them.
+pub const NAMES: [&str; 7] = ["large_pyramid", "pyramid20", "many_pyramids", "joint_grid", "tumbler", "smash", "spinner"];
