@@ -25,6 +25,8 @@
 //! assert!(world.position(bob).unwrap().y < -0.5);
 //! ```
 
+pub mod scenes;
+
 pub use janus2d_constraints as constraints;
 pub use janus2d_core as base;
 pub use janus2d_world as world;
@@ -36,5 +38,6 @@ pub mod prelude {
     pub use janus2d_core::constraint::SolverMode;
     pub use janus2d_core::math::{Real, Rot, Transform, Vec2};
     pub use janus2d_core::solver::SolverSettings;
-    pub use janus2d_world::{JointHandle, StepEvents, World, WorldDef, WorldError};
+    pub use janus2d_core::geometry::{Capsule, ChainSegment, Circle, Polygon, Segment, Shape, make_chain};
+    pub use janus2d_world::{Filter, JointHandle, ShapeDef, ShapeHandle, StepEvents, World, WorldDef, WorldError};
 }

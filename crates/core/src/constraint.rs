@@ -229,9 +229,20 @@ impl<C: Constraint> ConstraintBatch for Vec<C> {
         }
     }
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        for c in self.iter_mut() {
-            if c.is_enabled() {
-                c.solve(ctx, states, use_bias);
+        // Symmetric Gauss–Seidel: the biased solve sweeps forwards, the
+        // relax sweep backwards, so information travels both ways along
+        // chains within one substep.
+        if use_bias {
+            for c in self.iter_mut() {
+                if c.is_enabled() {
+                    c.solve(ctx, states, true);
+                }
+            }
+        } else {
+            for c in self.iter_mut().rev() {
+                if c.is_enabled() {
+                    c.solve(ctx, states, false);
+                }
             }
         }
     }

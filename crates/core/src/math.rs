@@ -113,6 +113,7 @@ impl Rot {
 
     /// `self * other`: apply `other`, then `self`.
     #[inline(always)]
+    #[allow(clippy::should_implement_trait)]
     pub fn mul(self, other: Rot) -> Rot {
         Rot {
             c: self.c * other.c - self.s * other.s,
@@ -212,6 +213,7 @@ impl Transform {
 
     /// `self * other` (apply `other`, then `self`).
     #[inline]
+    #[allow(clippy::should_implement_trait)]
     pub fn mul(&self, other: &Transform) -> Transform {
         Transform {
             q: self.q.mul(other.q),

@@ -75,7 +75,7 @@ impl Default for SolverSettings {
             contact_push_max_velocity: 3.0,
             joint_hertz: 60.0,
             joint_damping_ratio: 2.0,
-            joint_max_correction_speed: 5.0,
+            joint_max_correction_speed: Real::MAX,
             restitution_threshold: 1.0,
             warm_starting: true,
         }

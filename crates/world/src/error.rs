@@ -3,6 +3,7 @@
 
 use janus2d_constraints::JointError;
 use janus2d_core::body::BodyError;
+use janus2d_core::geometry::GeometryError;
 
 /// Anything the world API can reject.
 #[derive(Clone, Debug, PartialEq)]
@@ -11,6 +12,8 @@ pub enum WorldError {
     Body(BodyError),
     /// Invalid joint input (same body twice, non-finite values, bad limits).
     Joint(JointError),
+    /// Invalid shape input (degenerate polygon, non-positive radius, …).
+    Geometry(GeometryError),
     /// A body handle that is stale (destroyed) or was never issued by this world.
     StaleBody,
     /// A joint handle that is stale or foreign.
@@ -32,6 +35,7 @@ impl std::fmt::Display for WorldError {
         match self {
             WorldError::Body(e) => write!(f, "body: {e}"),
             WorldError::Joint(e) => write!(f, "joint: {e}"),
+            WorldError::Geometry(e) => write!(f, "shape: {e}"),
             WorldError::StaleBody => write!(f, "stale or foreign body handle"),
             WorldError::StaleJoint => write!(f, "stale or foreign joint handle"),
             WorldError::StaleShape => write!(f, "stale or foreign shape handle"),
@@ -57,5 +61,11 @@ impl From<BodyError> for WorldError {
 impl From<JointError> for WorldError {
     fn from(e: JointError) -> Self {
         WorldError::Joint(e)
+    }
+}
+
+impl From<GeometryError> for WorldError {
+    fn from(e: GeometryError) -> Self {
+        WorldError::Geometry(e)
     }
 }

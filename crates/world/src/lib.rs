@@ -7,9 +7,14 @@
 //! |---------------|---------------------------------------------------|
 //! | [`world`]     | [`World`], [`WorldDef`], handles, the step        |
 //! | [`error`]     | [`WorldError`], the typed errors of the API        |
+//! | [`collision`] | shapes, contacts, events                          |
+//! | [`broadphase`]| the dynamic AABB tree and pair finding            |
 
+pub mod broadphase;
+pub mod collision;
 pub mod error;
 pub mod world;
 
+pub use collision::{CollisionEvents, Filter, ShapeDef, ShapeHandle};
 pub use error::WorldError;
 pub use world::{JointHandle, StepEvents, World, WorldDef};

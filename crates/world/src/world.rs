@@ -11,13 +11,15 @@
 //! a generational handle; every call that rejects its input leaves the world
 //! unchanged.
 
-use janus2d_constraints::{RevoluteJoint, RevoluteJointDef};
+use janus2d_constraints::{ContactConstraint, RevoluteJoint, RevoluteJointDef};
+use janus2d_core::geometry::{MassData, Shape};
 use janus2d_core::BodyMass;
 use janus2d_core::body::{BodyDef, BodyHandle, BodyLocation, BodySet, BodyType, validate_mass};
 use janus2d_core::constraint::{ConstraintBatch, StepContext};
 use janus2d_core::math::{Real, Rot, Transform, Vec2, cross, vec_is_finite};
 use janus2d_core::solver::{SolverProfile, SolverSettings, solve_step};
 
+use crate::collision::{Collision, CollisionCounters, CollisionEvents, ShapeDef, ShapeHandle};
 use crate::error::WorldError;
 
 /// Default gravity, m/s² (usual (0, −10)).
@@ -65,6 +67,8 @@ pub struct StepEvents {
     /// Bodies whose state went non-finite during the step. Each was put back
     /// at its start-of-step pose, at rest, instead of spreading NaN.
     pub non_finite_bodies: Vec<BodyHandle>,
+    /// Contact and sensor begin/end events.
+    pub collision: CollisionEvents,
 }
 
 /// The simulation world.
@@ -76,6 +80,8 @@ pub struct World {
     revolute_handles: Vec<JointHandle>,
     joint_slots: Vec<JointSlot>,
     joint_free: Vec<u32>,
+    collision: Collision,
+    contact_constraints: Vec<ContactConstraint>,
     events: StepEvents,
     profile: SolverProfile,
     step_count: u64,
@@ -94,10 +100,13 @@ impl World {
             return Err(WorldError::NonFinite("gravity"));
         }
         validate_settings(&def.solver)?;
+        let bodies = BodySet::new();
         Ok(World {
             gravity: def.gravity,
             settings: def.solver,
-            bodies: BodySet::new(),
+            collision: Collision::new(bodies.owner()),
+            contact_constraints: Vec::new(),
+            bodies,
             revolute: Vec::new(),
             revolute_handles: Vec::new(),
             joint_slots: Vec::new(),
@@ -194,6 +203,10 @@ impl World {
             .collect();
         for h in attached {
             self.destroy_joint(h)?;
+        }
+        let shapes = self.collision.body_shapes.get(body.index as usize).cloned().unwrap_or_default();
+        for s in shapes {
+            self.collision.remove_shape(s);
         }
         self.bodies.destroy(body)?;
         Ok(())
@@ -310,6 +323,8 @@ impl World {
         sim.center = sim.transform.apply(sim.local_center);
         sim.center0 = sim.center;
         sim.rotation0 = sim.transform.q;
+        let xf = sim.transform;
+        self.collision.refresh_body(body, &xf);
         Ok(())
     }
 
@@ -439,6 +454,11 @@ impl World {
         };
         self.revolute.push(RevoluteJoint::new(def.clone()));
         self.revolute_handles.push(handle);
+        if !def.collide_connected {
+            let key = body_pair_key(def.body_a, def.body_b);
+            *self.collision.no_collide_pairs.entry(key).or_insert(0) += 1;
+            self.collision.remove_contacts_between(def.body_a, def.body_b);
+        }
         Ok(handle)
     }
 
@@ -456,6 +476,16 @@ impl World {
     /// Destroys a joint.
     pub fn destroy_joint(&mut self, joint: JointHandle) -> Result<(), WorldError> {
         let i = self.joint_index(joint)?;
+        let def = &self.revolute[i].def;
+        if !def.collide_connected {
+            let key = body_pair_key(def.body_a, def.body_b);
+            if let Some(n) = self.collision.no_collide_pairs.get_mut(&key) {
+                *n -= 1;
+                if *n == 0 {
+                    self.collision.no_collide_pairs.remove(&key);
+                }
+            }
+        }
         self.revolute.swap_remove(i);
         self.revolute_handles.swap_remove(i);
         if i < self.revolute.len() {
@@ -500,6 +530,128 @@ impl World {
             .fold(0.0, Real::max)
     }
 
+    // ----- shapes -----------------------------------------------------------
+
+    /// Attaches a shape to a body. A dynamic body without directly set mass
+    /// gets its mass, centre and inertia from its shapes.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Polygon;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    /// world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    /// assert!((world.mass(b).unwrap() - 1.0).abs() < 1e-6);
+    /// ```
+    pub fn create_shape(
+        &mut self,
+        body: BodyHandle,
+        def: &ShapeDef,
+        geometry: impl Into<Shape>,
+    ) -> Result<ShapeHandle, WorldError> {
+        let geometry = geometry.into();
+        let ty = self.body_type(body)?;
+        validate_shape_def(def)?;
+        crate::collision::validate_geometry(&geometry)?;
+        let mass_override = self.bodies.record(body).map(|r| r.mass_override).unwrap_or(true);
+        let has_area = geometry.area() > 0.0;
+        if ty == BodyType::Dynamic && !mass_override && has_area && def.density <= 0.0 && !self.has_mass_from_shapes(body) {
+            return Err(WorldError::OutOfRange("density"));
+        }
+        let handle = self.collision.add_shape(&self.bodies, body, geometry, def.clone());
+        if ty == BodyType::Dynamic && !mass_override {
+            self.update_mass_from_shapes(body);
+        }
+        Ok(handle)
+    }
+
+    /// Removes a shape (its contacts end; the body's mass is recomputed).
+    pub fn destroy_shape(&mut self, shape: ShapeHandle) -> Result<(), WorldError> {
+        let slot = self.collision.slot(shape).ok_or(WorldError::StaleShape)?;
+        let body = self.collision.shapes[slot as usize].body;
+        self.collision.remove_shape(slot);
+        let mass_override = self.bodies.record(body).map(|r| r.mass_override).unwrap_or(true);
+        if self.body_type(body)? == BodyType::Dynamic && !mass_override {
+            self.update_mass_from_shapes(body);
+        }
+        Ok(())
+    }
+
+    fn has_mass_from_shapes(&self, body: BodyHandle) -> bool {
+        self.shape_mass(body).mass > 0.0
+    }
+
+    fn shape_mass(&self, body: BodyHandle) -> MassData {
+        let mut total = MassData::default();
+        let mut first = Vec2::ZERO;
+        let mut second: Real = 0.0;
+        if let Some(list) = self.collision.body_shapes.get(body.index as usize) {
+            for &s in list {
+                let shape = &self.collision.shapes[s as usize];
+                if shape.def.density <= 0.0 {
+                    continue;
+                }
+                let md = shape.geometry.compute_mass(shape.def.density);
+                total.mass += md.mass;
+                first += md.mass * md.center;
+                second += md.rotational_inertia + md.mass * md.center.length_squared();
+            }
+        }
+        if total.mass > 0.0 {
+            total.center = first / total.mass;
+            total.rotational_inertia = (second - total.mass * total.center.length_squared()).max(0.0);
+        }
+        total
+    }
+
+    fn update_mass_from_shapes(&mut self, body: BodyHandle) {
+        let md = self.shape_mass(body);
+        let fixed = self.bodies.record(body).map(|r| r.fixed_rotation).unwrap_or(false);
+        let mass = if md.mass > 0.0 {
+            BodyMass { mass: md.mass, rotational_inertia: md.rotational_inertia, center: md.center }
+        } else {
+            BodyMass::new(1.0, 1.0)
+        };
+        let inertia_ok = fixed || mass.rotational_inertia > 0.0;
+        let mass = if inertia_ok { mass } else { BodyMass { rotational_inertia: mass.mass * 1e-3, ..mass } };
+        self.bodies.apply_mass(body, mass, fixed);
+    }
+
+    /// Number of live shapes.
+    pub fn shape_count(&self) -> usize {
+        self.collision.shape_count()
+    }
+
+    /// The collision pipeline (shapes, contacts) for reading.
+    pub fn collision(&self) -> &Collision {
+        &self.collision
+    }
+
+    /// Counters of the last collision pass.
+    pub fn collision_counters(&self) -> CollisionCounters {
+        self.collision.counters
+    }
+
+    /// Number of touching solid contacts after the last step.
+    pub fn touching_contact_count(&self) -> usize {
+        self.contact_constraints.len()
+    }
+
+    /// The most negative separation of any touching contact point, m
+    /// (0 when nothing penetrates).
+    pub fn max_penetration(&self) -> Real {
+        let mut worst: Real = 0.0;
+        for c in &self.collision.contacts {
+            if c.touching && !c.sensor && c.enabled {
+                for p in &c.points[..c.point_count] {
+                    worst = worst.max(-p.separation);
+                }
+            }
+        }
+        worst
+    }
+
     // ----- stepping ---------------------------------------------------------
 
     /// The step context the solver uses for a step of `dt`.
@@ -513,10 +665,24 @@ impl World {
             return Err(WorldError::InvalidTimeStep);
         }
         let ctx = self.step_context(dt);
-        let mut batches: [&mut dyn ConstraintBatch; 1] = [&mut self.revolute];
+        self.collision.events = CollisionEvents::default();
+        let has_shapes = self.collision.shape_count() > 0;
+        if has_shapes {
+            self.collision.update_pairs(&self.bodies);
+            self.collision.narrowphase(&self.bodies);
+            self.collision.build_constraints(&mut self.contact_constraints);
+        } else {
+            self.contact_constraints.clear();
+        }
+        let mut batches: [&mut dyn ConstraintBatch; 2] = [&mut self.revolute, &mut self.contact_constraints];
         let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
+        if has_shapes {
+            self.collision.store_impulses(&self.contact_constraints);
+            self.collision.update_proxies(&self.bodies);
+        }
         self.events = StepEvents {
             non_finite_bodies: report.non_finite,
+            collision: std::mem::take(&mut self.collision.events),
         };
         self.profile = report.profile;
         self.step_count += 1;
@@ -545,6 +711,22 @@ impl World {
         }
         h.finish()
     }
+}
+
+fn body_pair_key(a: BodyHandle, b: BodyHandle) -> (u32, u32) {
+    if a.index < b.index { (a.index, b.index) } else { (b.index, a.index) }
+}
+
+fn validate_shape_def(def: &ShapeDef) -> Result<(), WorldError> {
+    for (v, name) in [(def.density, "density"), (def.friction, "friction"), (def.restitution, "restitution")] {
+        if !v.is_finite() {
+            return Err(WorldError::NonFinite(name));
+        }
+        if v < 0.0 {
+            return Err(WorldError::OutOfRange(name));
+        }
+    }
+    Ok(())
 }
 
 fn validate_settings(s: &SolverSettings) -> Result<(), WorldError> {
