@@ -48,9 +48,9 @@ fn determinism_hash_is_stable_across_runs() {
 fn determinism_hash_matches_golden_value() {
     let hash = build_and_run();
     #[cfg(not(feature = "f64"))]
-    let golden: u64 = 0x38a3_b270_4ef8_e70b;
+    let golden: u64 = 0xf407_9776_2b31_4c44;
     #[cfg(feature = "f64")]
-    let golden: u64 = 0x0da4_a04b_e521_6efe;
+    let golden: u64 = 0x4bc1_4df6_e86b_1ce4;
     assert_eq!(
         hash, golden,
         "state hash {hash:#018x} differs from the golden value"

@@ -202,8 +202,9 @@ pub trait ConstraintBatch {
     fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet);
     /// Warm start every constraint.
     fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]);
-    /// Solve every constraint once.
-    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool);
+    /// Solve every constraint once, in storage order or (`reverse`) the
+    /// opposite order.
+    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, reverse: bool);
     /// Restitution for every constraint.
     fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]);
     /// Store impulses of every constraint.
@@ -228,20 +229,17 @@ impl<C: Constraint> ConstraintBatch for Vec<C> {
             }
         }
     }
-    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        // Symmetric Gauss–Seidel: the biased solve sweeps forwards, the
-        // relax sweep backwards, so information travels both ways along
-        // chains within one substep.
-        if use_bias {
-            for c in self.iter_mut() {
+    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, reverse: bool) {
+        if reverse {
+            for c in self.iter_mut().rev() {
                 if c.is_enabled() {
-                    c.solve(ctx, states, true);
+                    c.solve(ctx, states, use_bias);
                 }
             }
         } else {
-            for c in self.iter_mut().rev() {
+            for c in self.iter_mut() {
                 if c.is_enabled() {
-                    c.solve(ctx, states, false);
+                    c.solve(ctx, states, use_bias);
                 }
             }
         }

@@ -265,7 +265,12 @@ pub fn solve_step(
     let active: Vec<usize> = (0..batches.len())
         .filter(|&i| batches[i].count() > 0)
         .collect();
-    for _ in 0..substeps {
+    // Symmetric Gauss–Seidel: sweeps alternate direction (solve forwards,
+    // relax backwards, and the other way round on the next substep), so
+    // information travels both ways along chains and stacks, and the order
+    // of creation leaves no sideways bias.
+    for substep in 0..substeps {
+        let flip = substep % 2 == 1;
         integrate_velocities(ctx, bodies);
         report.profile.integrate += lap(&mut t);
         if ctx.warm_starting {
@@ -276,7 +281,7 @@ pub fn solve_step(
         report.profile.warm_start += lap(&mut t);
         for _ in 0..solve_iterations {
             for &i in &active {
-                batches[i].solve(ctx, &mut bodies.states, true);
+                batches[i].solve(ctx, &mut bodies.states, true, flip);
             }
         }
         report.profile.solve += lap(&mut t);
@@ -284,7 +289,7 @@ pub fn solve_step(
         report.profile.integrate += lap(&mut t);
         for _ in 0..relax_iterations {
             for &i in &active {
-                batches[i].solve(ctx, &mut bodies.states, false);
+                batches[i].solve(ctx, &mut bodies.states, false, !flip);
             }
         }
         report.profile.relax += lap(&mut t);

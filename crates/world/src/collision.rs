@@ -453,7 +453,12 @@ impl Collision {
 
     /// Updates every contact's manifold; destroys contacts whose fat boxes
     /// separated; records begin/end events.
-    pub fn narrowphase(&mut self, bodies: &BodySet) {
+    ///
+    /// The speculative distance of a pair grows with how far the two bodies
+    /// can approach within `dt`: `d = d₀ + dt (|v_b − v_a| + |ω_a| R_a + |ω_b| R_b)`
+    /// with `R` the reach of a shape's box from its body's centre, so a
+    /// fast body gets its contact points before it would overshoot.
+    pub fn narrowphase(&mut self, bodies: &BodySet, dt: Real) {
         let mut k = 0;
         let mut tested = 0;
         let mut touching_count = 0;
@@ -470,9 +475,17 @@ impl Collision {
             let c = &self.contacts[k];
             let sa = &self.shapes[c.shape_a as usize];
             let sb = &self.shapes[c.shape_b as usize];
-            let sim_a = bodies.solver_body(sa.body).sim;
-            let sim_b = bodies.solver_body(sb.body).sim;
-            let manifold = collide(&sa.geometry, &sim_a.transform, &sb.geometry, &sim_b.transform, SPECULATIVE_DISTANCE);
+            let body_a = bodies.solver_body(sa.body);
+            let body_b = bodies.solver_body(sb.body);
+            let (sim_a, sim_b) = (body_a.sim, body_b.sim);
+            let reach = |aabb: &Aabb, center: Vec2| {
+                (aabb.lower - center).abs().max((aabb.upper - center).abs()).length()
+            };
+            let approach = (body_b.state.v - body_a.state.v).length()
+                + body_a.state.w.abs() * reach(&sa.aabb, sim_a.center)
+                + body_b.state.w.abs() * reach(&sb.aabb, sim_b.center);
+            let speculative = SPECULATIVE_DISTANCE + dt * approach;
+            let manifold = collide(&sa.geometry, &sim_a.transform, &sb.geometry, &sim_b.transform, speculative);
             let was_touching = c.touching;
             let c = &mut self.contacts[k];
             update_manifold(c, &manifold, &sim_a.transform, sim_a.center, &sim_b.transform, sim_b.center);
@@ -501,10 +514,25 @@ impl Collision {
     }
 
     /// Builds the contact constraints of touching solid contacts.
-    pub fn build_constraints(&self, out: &mut Vec<ContactConstraint>) {
+    ///
+    /// Contacts between two moving bodies come first and contacts with a
+    /// static body last, so each Gauss–Seidel sweep ends on the ground: the
+    /// support a stack stands on has the last word (as Box2D v3 keeps
+    /// static contacts out of its first graph color).
+    pub fn build_constraints(&self, bodies: &BodySet, out: &mut Vec<ContactConstraint>) {
         out.clear();
+        let is_static = |b: BodyHandle| bodies.state_index(b) == Some(0);
+        for pass in [false, true] {
+            self.build_pass(pass, &is_static, out);
+        }
+    }
+
+    fn build_pass(&self, static_pass: bool, is_static: &dyn Fn(BodyHandle) -> bool, out: &mut Vec<ContactConstraint>) {
         for (k, c) in self.contacts.iter().enumerate() {
             if !c.touching || c.sensor || !c.enabled {
+                continue;
+            }
+            if (is_static(c.body_a) || is_static(c.body_b)) != static_pass {
                 continue;
             }
             let mut inputs = [ContactPointInput::default(); 2];
@@ -543,17 +571,22 @@ impl Collision {
 
     /// Recomputes the boxes of the shapes of moving bodies and moves their
     /// proxies when they left their fat boxes.
-    pub fn update_proxies(&mut self, bodies: &BodySet) {
+    ///
+    /// A proxy's box covers the shape now and where its body's velocity
+    /// takes it within `dt`, so pairs exist before a fast body arrives.
+    pub fn update_proxies(&mut self, bodies: &BodySet, dt: Real) {
         let mut moved = 0;
-        for sim in bodies.sims.iter().skip(1) {
+        for (sim, state) in bodies.sims.iter().zip(&bodies.states).skip(1) {
             let b = sim.handle.index as usize;
             let Some(list) = self.body_shapes.get(b) else {
                 continue;
             };
+            let sweep = dt * state.v;
             for &s in list {
                 let shape = &mut self.shapes[s as usize];
                 let aabb = shape.geometry.compute_aabb(&sim.transform);
                 shape.aabb = aabb;
+                let aabb = Aabb::new(aabb.lower + sweep.min(Vec2::ZERO), aabb.upper + sweep.max(Vec2::ZERO));
                 if self.broadphase.move_proxy(shape.proxy, aabb) {
                     moved += 1;
                 }

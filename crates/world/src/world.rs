@@ -669,8 +669,8 @@ impl World {
         let has_shapes = self.collision.shape_count() > 0;
         if has_shapes {
             self.collision.update_pairs(&self.bodies);
-            self.collision.narrowphase(&self.bodies);
-            self.collision.build_constraints(&mut self.contact_constraints);
+            self.collision.narrowphase(&self.bodies, dt);
+            self.collision.build_constraints(&self.bodies, &mut self.contact_constraints);
         } else {
             self.contact_constraints.clear();
         }
@@ -678,7 +678,7 @@ impl World {
         let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
         if has_shapes {
             self.collision.store_impulses(&self.contact_constraints);
-            self.collision.update_proxies(&self.bodies);
+            self.collision.update_proxies(&self.bodies, dt);
         }
         self.events = StepEvents {
             non_finite_bodies: report.non_finite,
