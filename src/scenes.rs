@@ -249,3 +249,21 @@ pub fn by_name(name: &str, def: &WorldDef) -> Option<Scene> {
 
 /// Names of the benchmark scenes, in the order `all` runs them.
 pub const NAMES: [&str; 7] = ["large_pyramid", "pyramid20", "many_pyramids", "joint_grid", "tumbler", "smash", "spinner"];
+
+/// The portal "drop" scene: a 1 m box falls 5 m onto a floor portal (2 m
+/// aperture, facing up); the partner sits on a wall to the left, facing +x.
+/// Returns the scene (probe: the box) and the pair.
+pub fn portal_drop(def: &WorldDef) -> (Scene, janus2d_world::PortalPairHandle) {
+    use janus2d_world::{PortalDef, PortalPairDef};
+    let mut world = new_world(def);
+    let floor = world.create_body(&BodyDef::fixed(Vec2::new(0.0, -0.5))).unwrap();
+    world.create_shape(floor, &ShapeDef::default(), Polygon::make_box(10.0, 0.5)).unwrap();
+    let wall = world.create_body(&BodyDef::fixed(Vec2::new(-20.0, 5.0))).unwrap();
+    world.create_shape(wall, &ShapeDef::default(), Polygon::make_box(0.5, 5.0)).unwrap();
+    let entry = PortalDef { body: floor, anchor: Vec2::new(0.0, 0.5), direction: Vec2::Y, half_width: 1.0 };
+    let exit = PortalDef { body: wall, anchor: Vec2::new(0.5, 0.0), direction: Vec2::X, half_width: 1.0 };
+    let pair = world.create_portal_pair(&PortalPairDef::new(entry, exit)).unwrap();
+    let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 5.5))).unwrap();
+    world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    (Scene { world, probe: b, probe_label: "box", steps: 120 }, pair)
+}

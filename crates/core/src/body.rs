@@ -621,6 +621,33 @@ impl BodySet {
         Ok(())
     }
 
+    /// Exchanges the identities of two live bodies: afterwards handle `a`
+    /// refers to what was body `b` (its pose, velocity, mass, user data) and
+    /// `b` to what was `a`. Used when an object hands over through a portal,
+    /// so the user's handle follows the object.
+    pub fn swap_identity(&mut self, a: BodyHandle, b: BodyHandle) -> Result<(), BodyError> {
+        let la = self.location(a).ok_or(BodyError::StaleHandle)?;
+        let lb = self.location(b).ok_or(BodyError::StaleHandle)?;
+        let (ia, ib) = (a.index as usize, b.index as usize);
+        let ra = self.records[ia].clone();
+        let rb = self.records[ib].clone();
+        self.records[ia].location = Some(lb);
+        self.records[ia].user_data = rb.user_data;
+        self.records[ia].mass_override = rb.mass_override;
+        self.records[ia].fixed_rotation = rb.fixed_rotation;
+        self.records[ib].location = Some(la);
+        self.records[ib].user_data = ra.user_data;
+        self.records[ib].mass_override = ra.mass_override;
+        self.records[ib].fixed_rotation = ra.fixed_rotation;
+        let set_handle = |set: &mut BodySet, loc: BodyLocation, h: BodyHandle| match loc {
+            BodyLocation::Moving(i) => set.sims[i as usize].handle = h,
+            BodyLocation::Static(j) => set.static_sims[j as usize].handle = h,
+        };
+        set_handle(self, lb, a);
+        set_handle(self, la, b);
+        Ok(())
+    }
+
     /// Where a live body lives, or `None` for a stale handle.
     #[inline]
     pub fn location(&self, handle: BodyHandle) -> Option<BodyLocation> {
@@ -774,6 +801,20 @@ mod tests {
         assert!(b.sim(ha).is_none());
         assert_eq!(b.destroy(ha), Err(BodyError::StaleHandle));
         assert_eq!(b.len(), 1);
+    }
+
+    #[test]
+    fn swap_identity_moves_the_handle_to_the_other_body() {
+        let mut set = BodySet::new();
+        let a = set.create(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+        let b = set.create(&BodyDef::dynamic(Vec2::new(3.0, 0.0))).unwrap();
+        set.swap_identity(a, b).unwrap();
+        assert_eq!(set.sim(a).unwrap().transform.p, Vec2::new(3.0, 0.0));
+        assert_eq!(set.sim(b).unwrap().transform.p, Vec2::ZERO);
+        assert_eq!(set.sim(a).unwrap().handle, a);
+        set.destroy(b).unwrap();
+        assert_eq!(set.sim(a).unwrap().transform.p, Vec2::new(3.0, 0.0));
+        assert_eq!(set.len(), 1);
     }
 
     #[test]

@@ -229,6 +229,96 @@ pub struct CollisionCounters {
     pub proxies_moved: usize,
 }
 
+/// A region where contact points are dropped: a portal's aperture.
+///
+/// ```text
+///        lip        aperture (|t| < w)       lip
+///   ─────────────●━━━━━━━━━━━━━━━━━━━━━●─────────────  wall surface, normal n
+///                 points here are dropped
+/// ```
+///
+/// - `Hole`: the aperture is a hole in the wall body that carries the portal:
+///   contact points between that body and anything else are dropped when
+///   they lie in the aperture's span (|t| < w), from in front of the surface
+///   down to a depth of 2w behind it; the lips (|t| ≥ w) still collide.
+/// - `Behind`: a crossing copy's points that lie behind its own portal
+///   plane within the aperture are dropped (that part of the object is on
+///   the other side).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ApertureClip {
+    /// The body whose contacts are clipped (the wall, or the crossing copy).
+    pub body: BodyHandle,
+    /// Aperture centre, world, m.
+    pub point: Vec2,
+    /// Outward unit normal, world.
+    pub normal: Vec2,
+    /// Half-width, m.
+    pub half_width: Real,
+    /// True for a hole in a wall, false for a crossing copy.
+    pub hole: bool,
+}
+
+impl ApertureClip {
+    #[inline]
+    fn drops(&self, p: Vec2) -> bool {
+        let d = p - self.point;
+        let s = d.dot(self.normal);
+        let t = janus2d_core::math::cross(self.normal, d);
+        if t.abs() >= self.half_width {
+            return false;
+        }
+        if self.hole {
+            // The hole runs from the aperture surface into the wall, as
+            // deep as the aperture is wide; speculative points in front of
+            // the surface belong to it too.
+            s > -2.0 * self.half_width
+        } else {
+            s < 0.0
+        }
+    }
+}
+
+/// What the portal stage asks the narrowphase to drop.
+#[derive(Clone, Debug, Default)]
+pub struct ContactClipping {
+    /// Aperture regions.
+    pub clips: Vec<ApertureClip>,
+    /// Pairs of bodies that never touch (a crossing copy and its twin).
+    pub ignored_pairs: Vec<(BodyHandle, BodyHandle)>,
+}
+
+impl ContactClipping {
+    /// True when nothing is clipped (the narrowphase then skips the check).
+    pub fn is_empty(&self) -> bool {
+        self.clips.is_empty() && self.ignored_pairs.is_empty()
+    }
+
+    fn apply(&self, c: &mut Contact) {
+        if self
+            .ignored_pairs
+            .iter()
+            .any(|&(x, y)| (c.body_a == x && c.body_b == y) || (c.body_a == y && c.body_b == x))
+        {
+            c.point_count = 0;
+            return;
+        }
+        let mut k = 0;
+        while k < c.point_count {
+            let p = c.points[k].point;
+            let dropped = self.clips.iter().any(|clip| {
+                let involved = c.body_a == clip.body || c.body_b == clip.body;
+                involved && clip.drops(p)
+            });
+            if dropped {
+                c.points[k] = c.points[c.point_count - 1];
+                c.point_count -= 1;
+            } else {
+                k += 1;
+            }
+        }
+    }
+}
+
 /// Shapes, broadphase and contacts of a world.
 pub struct Collision {
     owner: u32,
@@ -387,6 +477,40 @@ impl Collision {
         }
     }
 
+    /// Removes every contact of a body (end events for touching ones).
+    pub fn remove_contacts_of(&mut self, body: BodyHandle) {
+        let mut k = 0;
+        while k < self.contacts.len() {
+            let c = &self.contacts[k];
+            if c.body_a == body || c.body_b == body {
+                self.destroy_contact(k);
+            } else {
+                k += 1;
+            }
+        }
+    }
+
+    /// Exchanges the shape lists of two bodies whose identities were swapped
+    /// (their contacts must be gone already).
+    pub fn swap_body_shapes(&mut self, a: BodyHandle, b: BodyHandle) {
+        let (ia, ib) = (a.index as usize, b.index as usize);
+        let n = ia.max(ib) + 1;
+        if self.body_shapes.len() < n {
+            self.body_shapes.resize(n, Vec::new());
+        }
+        self.body_shapes.swap(ia, ib);
+        for &s in &self.body_shapes[ia] {
+            self.shapes[s as usize].body = a;
+        }
+        for &s in &self.body_shapes[ib] {
+            self.shapes[s as usize].body = b;
+        }
+        // Proxies must report their pairs again under the new owners.
+        for &s in self.body_shapes[ia].iter().chain(&self.body_shapes[ib]) {
+            self.broadphase.touch_proxy(self.shapes[s as usize].proxy);
+        }
+    }
+
     fn should_pair(&self, bodies: &BodySet, a: u32, b: u32) -> bool {
         let (sa, sb) = (&self.shapes[a as usize], &self.shapes[b as usize]);
         if sa.body == sb.body {
@@ -458,7 +582,8 @@ impl Collision {
     /// can approach within `dt`: `d = d₀ + dt (|v_b − v_a| + |ω_a| R_a + |ω_b| R_b)`
     /// with `R` the reach of a shape's box from its body's centre, so a
     /// fast body gets its contact points before it would overshoot.
-    pub fn narrowphase(&mut self, bodies: &BodySet, dt: Real) {
+    pub fn narrowphase(&mut self, bodies: &BodySet, dt: Real, clipping: &ContactClipping) {
+        let clip = !clipping.is_empty();
         let mut k = 0;
         let mut tested = 0;
         let mut touching_count = 0;
@@ -489,6 +614,9 @@ impl Collision {
             let was_touching = c.touching;
             let c = &mut self.contacts[k];
             update_manifold(c, &manifold, &sim_a.transform, sim_a.center, &sim_b.transform, sim_b.center);
+            if clip {
+                clipping.apply(c);
+            }
             let touching = c.point_count > 0;
             c.touching = touching;
             if touching {

@@ -2,6 +2,7 @@
 //! world exactly as it was.
 
 use janus2d_constraints::JointError;
+use janus2d_constraints::PortalError;
 use janus2d_core::body::BodyError;
 use janus2d_core::geometry::GeometryError;
 
@@ -20,6 +21,10 @@ pub enum WorldError {
     StaleJoint,
     /// A shape handle that is stale or foreign.
     StaleShape,
+    /// A portal pair handle that is stale or foreign.
+    StalePortal,
+    /// Invalid portal input (η ≤ 0, zero direction, non-positive half-width).
+    Portal(PortalError),
     /// A time step that is not finite or not positive.
     InvalidTimeStep,
     /// A non-finite value in a world-level input (names it).
@@ -39,6 +44,8 @@ impl std::fmt::Display for WorldError {
             WorldError::StaleBody => write!(f, "stale or foreign body handle"),
             WorldError::StaleJoint => write!(f, "stale or foreign joint handle"),
             WorldError::StaleShape => write!(f, "stale or foreign shape handle"),
+            WorldError::StalePortal => write!(f, "stale or foreign portal pair handle"),
+            WorldError::Portal(e) => write!(f, "portal: {e}"),
             WorldError::InvalidTimeStep => write!(f, "time step must be finite and > 0"),
             WorldError::NonFinite(what) => write!(f, "`{what}` is not finite"),
             WorldError::OutOfRange(what) => write!(f, "`{what}` is out of range"),

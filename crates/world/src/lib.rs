@@ -9,12 +9,15 @@
 //! | [`error`]     | [`WorldError`], the typed errors of the API        |
 //! | [`collision`] | shapes, contacts, events                          |
 //! | [`broadphase`]| the dynamic AABB tree and pair finding            |
+//! | [`portals`]   | portal pairs, crossings, clones, handover         |
 
 pub mod broadphase;
 pub mod collision;
 pub mod error;
+pub mod portals;
 pub mod world;
 
 pub use collision::{CollisionEvents, Filter, ShapeDef, ShapeHandle};
 pub use error::WorldError;
+pub use portals::{MassModel, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle};
 pub use world::{JointHandle, StepEvents, World, WorldDef};

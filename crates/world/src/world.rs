@@ -82,6 +82,7 @@ pub struct World {
     joint_free: Vec<u32>,
     collision: Collision,
     contact_constraints: Vec<ContactConstraint>,
+    pub(crate) portals: crate::portals::Portals,
     events: StepEvents,
     profile: SolverProfile,
     step_count: u64,
@@ -106,6 +107,7 @@ impl World {
             settings: def.solver,
             collision: Collision::new(bodies.owner()),
             contact_constraints: Vec::new(),
+            portals: crate::portals::Portals::default(),
             bodies,
             revolute: Vec::new(),
             revolute_handles: Vec::new(),
@@ -194,6 +196,7 @@ impl World {
         if !self.bodies.contains(body) {
             return Err(WorldError::StaleBody);
         }
+        self.portals_forget_body(body);
         let attached: Vec<JointHandle> = self
             .revolute
             .iter()
@@ -652,6 +655,41 @@ impl World {
         worst
     }
 
+    // ----- helpers for the portal stage -------------------------------------
+
+    /// Sets a dynamic body's mass properties without touching its velocity.
+    pub(crate) fn apply_mass_keep_velocity(&mut self, body: BodyHandle, mass: BodyMass) {
+        let fixed = self.bodies.record(body).map(|r| r.fixed_rotation).unwrap_or(false);
+        self.bodies.apply_mass(body, mass, fixed);
+    }
+
+    /// Joints attached to a body, in storage order.
+    pub(crate) fn joints_attached_to(&self, body: BodyHandle) -> Vec<JointHandle> {
+        self.revolute
+            .iter()
+            .zip(&self.revolute_handles)
+            .filter(|(j, _)| j.enabled && (j.def.body_a == body || j.def.body_b == body))
+            .map(|(_, h)| *h)
+            .collect()
+    }
+
+    /// Disables a joint (the solver skips it; it stays until destroyed).
+    pub(crate) fn disable_joint(&mut self, joint: JointHandle) {
+        if let Ok(i) = self.joint_index(joint) {
+            self.revolute[i].enabled = false;
+        }
+    }
+
+    /// Exchanges two bodies' identities (see `BodySet::swap_identity`),
+    /// moving their shapes along and dropping their contacts.
+    pub(crate) fn swap_body_identity(&mut self, a: BodyHandle, b: BodyHandle) {
+        self.collision.remove_contacts_of(a);
+        self.collision.remove_contacts_of(b);
+        if self.bodies.swap_identity(a, b).is_ok() {
+            self.collision.swap_body_shapes(a, b);
+        }
+    }
+
     // ----- stepping ---------------------------------------------------------
 
     /// The step context the solver uses for a step of `dt`.
@@ -667,18 +705,31 @@ impl World {
         let ctx = self.step_context(dt);
         self.collision.events = CollisionEvents::default();
         let has_shapes = self.collision.shape_count() > 0;
+        let has_portals = self.portals.is_active();
+        if has_portals {
+            self.portal_clipping();
+        }
         if has_shapes {
             self.collision.update_pairs(&self.bodies);
-            self.collision.narrowphase(&self.bodies, dt);
+            self.collision.narrowphase(&self.bodies, dt, &self.portals.clipping);
             self.collision.build_constraints(&self.bodies, &mut self.contact_constraints);
         } else {
             self.contact_constraints.clear();
         }
-        let mut batches: [&mut dyn ConstraintBatch; 2] = [&mut self.revolute, &mut self.contact_constraints];
+        let mut batches: [&mut dyn ConstraintBatch; 3] = [
+            &mut self.revolute,
+            &mut self.contact_constraints,
+            &mut self.portals.constraints,
+        ];
         let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
         if has_shapes {
             self.collision.store_impulses(&self.contact_constraints);
             self.collision.update_proxies(&self.bodies, dt);
+        }
+        if has_portals {
+            self.portal_stage();
+        } else {
+            self.portals.events.clear();
         }
         self.events = StepEvents {
             non_finite_bodies: report.non_finite,

@@ -1,0 +1,679 @@
+//! Portals in the world: bodies cross, clones appear and hand over.
+//!
+//! A linked pair of portals sits on two bodies (static, kinematic or
+//! dynamic). A body whose shapes enter an aperture gets a **clone** at the
+//! partner portal, placed by the exact clone state of the portal map
+//! (`../shared/spec/portal.md`) and scaled by `η` (`1/η` the other way); a
+//! [`PortalConstraint`] makes the two copies move as one object.
+//!
+//! ```text
+//!   entry portal (normal n₁)                  exit portal (normal n₂)
+//!        │  original ░░│                        │▓▓ clone
+//!        │   moving  ░░│ ──── T(x) = P₂ + ηQ(x − P₁) ───▶ │▓▓ emerging
+//!        │   along −n₁░│                        │▓▓ along +n₂
+//!   f₁ = area in front of entry  +  f₂ = area in front of exit  = 1
+//! ```
+//!
+//! Life of a crossing:
+//!
+//! | stage     | when                                                        | effect |
+//! |-----------|-------------------------------------------------------------|--------|
+//! | start     | a body's shapes straddle an aperture and fit its width, or its centre swept through the aperture during the step | clone created, constraint linked, [`PortalEvent::CrossingStarted`] |
+//! | straddle  | every step                                                  | masses and inertias weighted by `f₁`, `f₂` (clamped to `[F_MIN, 1 − F_MIN]`) |
+//! | handover  | the original is entirely behind the entry plane            | the handle moves to the clone's body, the original's body is removed, [`PortalEvent::CrossingCompleted`] |
+//! | cancel    | the clone is entirely behind the exit plane (backed out)   | clone removed, [`PortalEvent::CrossingCancelled`] |
+//!
+//! Contacts: the aperture is a hole in the body that carries the portal
+//! (the lips still collide); a crossing copy drops its contact points that
+//! lie behind its own portal plane within the aperture; a copy never touches
+//! its twin. A body takes part in at most one crossing: while it crosses it
+//! ignores every other portal. A joint attached to a body that hands over
+//! would span the portal: it is disabled and reported
+//! ([`PortalEvent::JointDisabled`]).
+//!
+//! The whole stage is skipped when the world has no portal pair.
+
+use janus2d_constraints::portal_map::{BodyMotion, PortalBodyMotion, PortalFrame, PortalMap};
+use janus2d_constraints::{Portal, PortalConstraint, PortalConstraintDef};
+use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
+use janus2d_core::geometry::Aabb;
+use janus2d_core::math::{Real, Rot, Vec2, cross};
+
+use crate::collision::{ApertureClip, ContactClipping};
+use crate::error::WorldError;
+use crate::world::{JointHandle, World};
+
+/// Smallest mass fraction a straddling copy keeps (dimensionless, usual
+/// 0.1): a copy that has barely appeared is never thousands of times
+/// lighter than what it touches.
+pub const F_MIN: Real = 0.1;
+
+/// How a clone's mass follows from the original's.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum MassModel {
+    /// Density unchanged: `m₂ = η² m₁`, `I₂ = η⁴ I₁` (what a game expects).
+    #[default]
+    SameMaterial,
+    /// Density times `η⁻⁴`: `m₂ = m₁ / η²`, `I₂ = I₁`; a full pass keeps
+    /// kinetic energy.
+    EnergyPreserving,
+}
+
+impl MassModel {
+    /// The clone's mass properties for an original of `m` scaled by `eta`
+    /// (centre in the original's local frame; scaling is about it).
+    pub fn clone_mass(self, m: BodyMass, eta: Real) -> BodyMass {
+        match self {
+            MassModel::SameMaterial => BodyMass {
+                mass: eta * eta * m.mass,
+                rotational_inertia: eta.powi(4) * m.rotational_inertia,
+                center: m.center,
+            },
+            MassModel::EnergyPreserving => BodyMass {
+                mass: m.mass / (eta * eta),
+                rotational_inertia: m.rotational_inertia,
+                center: m.center,
+            },
+        }
+    }
+}
+
+/// One portal: an aperture on a body.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PortalDef {
+    /// The body carrying the portal.
+    pub body: BodyHandle,
+    /// Aperture centre in the body frame, m.
+    pub anchor: Vec2,
+    /// Outward face normal in the body frame (normalised on creation).
+    pub direction: Vec2,
+    /// Half the aperture width, m (> 0).
+    pub half_width: Real,
+}
+
+/// A linked pair of portals.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PortalPairDef {
+    /// Portal a (bodies entering it come out of b scaled by `η`).
+    pub portal_a: PortalDef,
+    /// Portal b (bodies entering it come out of a scaled by `1/η`).
+    pub portal_b: PortalDef,
+    /// Scale from a to b; `None` gives `w_b / w_a`.
+    pub eta: Option<Real>,
+    /// How clones' masses follow from the originals'.
+    pub mass_model: MassModel,
+}
+
+impl PortalPairDef {
+    /// A pair with `η = w_b / w_a` and the same-material mass model.
+    pub fn new(portal_a: PortalDef, portal_b: PortalDef) -> Self {
+        PortalPairDef {
+            portal_a,
+            portal_b,
+            eta: None,
+            mass_model: MassModel::SameMaterial,
+        }
+    }
+}
+
+/// A generational handle to a portal pair.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct PortalPairHandle {
+    /// Slot index.
+    pub index: u32,
+    /// Generation of the slot when issued.
+    pub generation: u32,
+    /// Id of the issuing world.
+    pub owner: u32,
+}
+
+/// What happened at the portals during the last step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PortalEvent {
+    /// A body entered a portal: its clone was created.
+    CrossingStarted {
+        /// The original.
+        body: BodyHandle,
+        /// Its clone.
+        clone: BodyHandle,
+        /// The pair.
+        pair: PortalPairHandle,
+    },
+    /// A body went through: `body` now refers to the object on the exit side.
+    CrossingCompleted {
+        /// The object (its handle followed it).
+        body: BodyHandle,
+        /// The pair.
+        pair: PortalPairHandle,
+    },
+    /// A body backed out: its clone was removed.
+    CrossingCancelled {
+        /// The original.
+        body: BodyHandle,
+        /// The pair.
+        pair: PortalPairHandle,
+    },
+    /// A joint would have spanned the portal: it is disabled.
+    JointDisabled {
+        /// The joint.
+        joint: JointHandle,
+        /// The pair.
+        pair: PortalPairHandle,
+    },
+}
+
+/// Counters of the last portal stage.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PortalCounters {
+    /// Crossings in progress after the step.
+    pub active_crossings: usize,
+    /// Crossings started this step.
+    pub started: usize,
+    /// Crossings completed this step.
+    pub completed: usize,
+    /// Crossings cancelled this step.
+    pub cancelled: usize,
+    /// Bodies tested against apertures this step.
+    pub bodies_tested: usize,
+}
+
+#[derive(Clone, Debug)]
+pub(crate) struct PairData {
+    pub(crate) portals: [PortalDef; 2],
+    pub(crate) local: [Portal; 2],
+    pub(crate) eta: Real,
+    pub(crate) mass_model: MassModel,
+}
+
+#[derive(Clone, Debug)]
+pub(crate) struct PairSlot {
+    generation: u32,
+    pub(crate) data: Option<PairData>,
+}
+
+/// A crossing in progress.
+#[derive(Clone, Debug)]
+pub(crate) struct Crossing {
+    pub(crate) pair: u32,
+    /// 0: entered portal a; 1: entered portal b.
+    pub(crate) entry: usize,
+    pub(crate) original: BodyHandle,
+    pub(crate) clone: BodyHandle,
+    pub(crate) mass_original: BodyMass,
+    pub(crate) mass_clone: BodyMass,
+}
+
+/// Portal pairs, crossings and their constraints.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Portals {
+    pub(crate) slots: Vec<PairSlot>,
+    free: Vec<u32>,
+    pub(crate) crossings: Vec<Crossing>,
+    /// One constraint per crossing, same order.
+    pub(crate) constraints: Vec<PortalConstraint>,
+    pub(crate) events: Vec<PortalEvent>,
+    pub(crate) counters: PortalCounters,
+    pub(crate) clipping: ContactClipping,
+    live_pairs: usize,
+}
+
+impl Portals {
+    pub(crate) fn is_active(&self) -> bool {
+        self.live_pairs > 0
+    }
+
+    pub(crate) fn crossing_of(&self, body: BodyHandle) -> Option<usize> {
+        self.crossings.iter().position(|c| c.original == body || c.clone == body)
+    }
+}
+
+fn frame_of(world: &World, def: &PortalDef, local: &Portal) -> PortalFrame {
+    let sim = world.bodies().solver_body(def.body).sim;
+    PortalFrame::new(&sim.transform, local)
+}
+
+fn motion_of(world: &World, body: BodyHandle) -> PortalBodyMotion {
+    let b = world.bodies().solver_body(body);
+    PortalBodyMotion {
+        center: b.sim.center,
+        linear_velocity: b.state.v,
+        angular_velocity: b.state.w,
+    }
+}
+
+impl World {
+    /// Creates a linked pair of portals.
+    ///
+    /// Rejects stale body handles, non-finite values, a zero direction, a
+    /// non-positive half-width and `η ≤ 0`.
+    pub fn create_portal_pair(&mut self, def: &PortalPairDef) -> Result<PortalPairHandle, WorldError> {
+        let mut local = Vec::with_capacity(2);
+        for p in [def.portal_a, def.portal_b] {
+            if !self.bodies().contains(p.body) {
+                return Err(WorldError::StaleBody);
+            }
+            local.push(Portal::new(p.anchor, p.direction, p.half_width).map_err(WorldError::Portal)?.normalized());
+        }
+        let local = [local[0], local[1]];
+        let eta = def.eta.unwrap_or(local[1].half_width / local[0].half_width);
+        janus2d_constraints::portal_map::validate_eta(eta).map_err(WorldError::Portal)?;
+        let data = PairData {
+            portals: [def.portal_a, def.portal_b],
+            local,
+            eta,
+            mass_model: def.mass_model,
+        };
+        let p = &mut self.portals;
+        let index = match p.free.pop() {
+            Some(i) => i,
+            None => {
+                p.slots.push(PairSlot { generation: 0, data: None });
+                (p.slots.len() - 1) as u32
+            }
+        };
+        let slot = &mut p.slots[index as usize];
+        slot.generation = slot.generation.wrapping_add(1);
+        slot.data = Some(data);
+        p.live_pairs += 1;
+        Ok(PortalPairHandle {
+            index,
+            generation: slot.generation,
+            owner: self.bodies().owner(),
+        })
+    }
+
+    fn pair_slot(&self, pair: PortalPairHandle) -> Result<u32, WorldError> {
+        let slot = self.portals.slots.get(pair.index as usize).ok_or(WorldError::StalePortal)?;
+        if slot.generation != pair.generation || slot.data.is_none() || pair.owner != self.bodies().owner() {
+            return Err(WorldError::StalePortal);
+        }
+        Ok(pair.index)
+    }
+
+    fn pair_handle(&self, index: u32) -> PortalPairHandle {
+        PortalPairHandle {
+            index,
+            generation: self.portals.slots[index as usize].generation,
+            owner: self.bodies().owner(),
+        }
+    }
+
+    /// Destroys a portal pair, cancelling every crossing in progress through it.
+    pub fn destroy_portal_pair(&mut self, pair: PortalPairHandle) -> Result<(), WorldError> {
+        let index = self.pair_slot(pair)?;
+        while let Some(k) = self.portals.crossings.iter().position(|c| c.pair == index) {
+            self.cancel_crossing(k);
+        }
+        self.portals.slots[index as usize].data = None;
+        self.portals.free.push(index);
+        self.portals.live_pairs -= 1;
+        Ok(())
+    }
+
+    /// Number of live portal pairs.
+    pub fn portal_pair_count(&self) -> usize {
+        self.portals.live_pairs
+    }
+
+    /// Number of crossings in progress (each has one clone and one constraint).
+    pub fn crossing_count(&self) -> usize {
+        self.portals.crossings.len()
+    }
+
+    /// Portal events of the last step.
+    pub fn portal_events(&self) -> &[PortalEvent] {
+        &self.portals.events
+    }
+
+    /// Portal counters of the last step.
+    pub fn portal_counters(&self) -> PortalCounters {
+        self.portals.counters
+    }
+
+    /// The portal constraints of the crossings in progress.
+    pub fn portal_constraints(&self) -> &[PortalConstraint] {
+        &self.portals.constraints
+    }
+
+    /// The clone of `body` while it crosses, if any.
+    pub fn clone_of(&self, body: BodyHandle) -> Option<BodyHandle> {
+        self.portals.crossings.iter().find(|c| c.original == body).map(|c| c.clone)
+    }
+
+    /// Largest portal constraint error `|x₂ − T(x₁)|` over crossings, m.
+    pub fn max_portal_error(&self) -> Real {
+        self.portals
+            .constraints
+            .iter()
+            .map(|c| c.position_error(self.bodies()))
+            .fold(0.0, Real::max)
+    }
+
+    /// Called when a body is about to be destroyed: ends the crossings it
+    /// takes part in and destroys the portal pairs it carries.
+    pub(crate) fn portals_forget_body(&mut self, body: BodyHandle) {
+        if self.portals.slots.is_empty() {
+            return;
+        }
+        for index in 0..self.portals.slots.len() as u32 {
+            let on_body = self.portals.slots[index as usize]
+                .data
+                .as_ref()
+                .is_some_and(|d| d.portals.iter().any(|p| p.body == body));
+            if on_body {
+                let h = self.pair_handle(index);
+                let _ = self.destroy_portal_pair(h);
+            }
+        }
+        while let Some(k) = self.portals.crossing_of(body) {
+            self.cancel_crossing(k);
+        }
+    }
+
+    /// Builds the contact clipping for this step's narrowphase.
+    pub(crate) fn portal_clipping(&mut self) {
+        let mut clipping = std::mem::take(&mut self.portals.clipping);
+        clipping.clips.clear();
+        clipping.ignored_pairs.clear();
+        for slot in &self.portals.slots {
+            let Some(d) = &slot.data else { continue };
+            for k in 0..2 {
+                let f = frame_of(self, &d.portals[k], &d.local[k]);
+                clipping.clips.push(ApertureClip {
+                    body: d.portals[k].body,
+                    point: f.point,
+                    normal: f.normal,
+                    half_width: d.local[k].half_width,
+                    hole: true,
+                });
+            }
+        }
+        for c in &self.portals.crossings {
+            let d = self.portals.slots[c.pair as usize].data.as_ref().expect("live pair");
+            let (entry, exit) = (c.entry, 1 - c.entry);
+            for (body, side) in [(c.original, entry), (c.clone, exit)] {
+                let f = frame_of(self, &d.portals[side], &d.local[side]);
+                clipping.clips.push(ApertureClip {
+                    body,
+                    point: f.point,
+                    normal: f.normal,
+                    half_width: d.local[side].half_width,
+                    hole: false,
+                });
+            }
+            clipping.ignored_pairs.push((c.original, c.clone));
+        }
+        self.portals.clipping = clipping;
+    }
+
+    /// Extents `(min_n, max_n, min_t, max_t)` of a body's shapes in a portal frame.
+    fn extents_in(&self, body: BodyHandle, f: &PortalFrame) -> Option<(Real, Real, Real, Real)> {
+        let xf = self.bodies().sim(body)?.transform;
+        let list = self.collision().body_shapes.get(body.index as usize)?;
+        if list.is_empty() {
+            return None;
+        }
+        let (mut n0, mut n1, mut t0, mut t1) = (Real::MAX, Real::MIN, Real::MAX, Real::MIN);
+        let offset_n = f.point.dot(f.normal);
+        let offset_t = f.point.dot(f.tangent);
+        for &s in list {
+            let shape = &self.collision().shapes[s as usize].geometry;
+            let (a, b) = shape.support_extent(&xf, f.normal);
+            n0 = n0.min(a - offset_n);
+            n1 = n1.max(b - offset_n);
+            let (a, b) = shape.support_extent(&xf, f.tangent);
+            t0 = t0.min(a - offset_t);
+            t1 = t1.max(b - offset_t);
+        }
+        Some((n0, n1, t0, t1))
+    }
+
+    /// Fraction of a body's shape area in front of a portal plane.
+    fn front_fraction(&self, body: BodyHandle, f: &PortalFrame) -> Real {
+        let Some(sim) = self.bodies().sim(body) else { return 0.0 };
+        let xf = sim.transform;
+        let Some(list) = self.collision().body_shapes.get(body.index as usize) else {
+            return 0.0;
+        };
+        let (mut front, mut total) = (0.0, 0.0);
+        for &s in list {
+            let shape = &self.collision().shapes[s as usize].geometry;
+            front += shape.area_in_front(&xf, f.point, f.normal);
+            total += shape.area();
+        }
+        if total > 0.0 { front / total } else { 0.0 }
+    }
+
+    /// The portal stage: handovers, cancellations, new crossings, weights.
+    pub(crate) fn portal_stage(&mut self) {
+        self.portals.events.clear();
+        let mut counters = PortalCounters::default();
+        let mut crossed_this_step: Vec<BodyHandle> = Vec::new();
+
+        // 1. Crossings in progress: hand over, cancel, or re-weight.
+        let mut k = 0;
+        while k < self.portals.crossings.len() {
+            let c = self.portals.crossings[k].clone();
+            let d = self.portals.slots[c.pair as usize].data.clone().expect("live pair");
+            let f_entry = frame_of(self, &d.portals[c.entry], &d.local[c.entry]);
+            let f_exit = frame_of(self, &d.portals[1 - c.entry], &d.local[1 - c.entry]);
+            let orig_ext = self.extents_in(c.original, &f_entry);
+            let clone_ext = self.extents_in(c.clone, &f_exit);
+            if orig_ext.is_some_and(|e| e.1 < 0.0) {
+                self.complete_crossing(k);
+                counters.completed += 1;
+                crossed_this_step.push(c.original);
+                continue;
+            }
+            if clone_ext.is_some_and(|e| e.1 < 0.0) {
+                self.cancel_crossing(k);
+                counters.cancelled += 1;
+                crossed_this_step.push(c.original);
+                continue;
+            }
+            self.weigh_crossing(k, &f_entry, &f_exit);
+            k += 1;
+        }
+
+        // 2. New crossings: bodies whose shapes straddle an aperture and fit
+        //    its width, or whose centre swept through it during the step.
+        for index in 0..self.portals.slots.len() as u32 {
+            let Some(d) = self.portals.slots[index as usize].data.clone() else { continue };
+            for entry in 0..2 {
+                let f = frame_of(self, &d.portals[entry], &d.local[entry]);
+                let w = d.local[entry].half_width;
+                let candidates = self.aperture_candidates(&f, w, &d);
+                counters.bodies_tested += candidates.len();
+                for body in candidates {
+                    if crossed_this_step.contains(&body) || self.portals.crossing_of(body).is_some() {
+                        continue;
+                    }
+                    let Some((n0, n1, t0, t1)) = self.extents_in(body, &f) else { continue };
+                    let straddles = n0 < 0.0 && n1 > 0.0 && t0 >= -w && t1 <= w;
+                    let sim = self.bodies().sim(body).expect("live");
+                    let s0 = (sim.center0 - f.point).dot(f.normal);
+                    let s1 = (sim.center - f.point).dot(f.normal);
+                    let swept = s0 > 0.0 && s1 <= 0.0 && {
+                        let x = sim.center0 + (sim.center - sim.center0) * (s0 / (s0 - s1));
+                        cross(f.normal, x - f.point).abs() < w
+                    };
+                    if !(straddles || swept) {
+                        continue;
+                    }
+                    if self.start_crossing(index, entry, body).is_some() {
+                        counters.started += 1;
+                        crossed_this_step.push(body);
+                        // A fast body may already be entirely through.
+                        let k = self.portals.crossings.len() - 1;
+                        if self.extents_in(body, &f).is_some_and(|e| e.1 < 0.0) {
+                            self.complete_crossing(k);
+                            counters.completed += 1;
+                        } else {
+                            let f_exit = frame_of(self, &d.portals[1 - entry], &d.local[1 - entry]);
+                            self.weigh_crossing(k, &f, &f_exit);
+                        }
+                    }
+                }
+            }
+        }
+        counters.active_crossings = self.portals.crossings.len();
+        self.portals.counters = counters;
+    }
+
+    /// Dynamic bodies whose shapes' boxes touch an aperture region (both
+    /// sides of the segment), sorted by handle for a deterministic order.
+    fn aperture_candidates(&self, f: &PortalFrame, w: Real, d: &PairData) -> Vec<BodyHandle> {
+        let a = f.point - w * f.tangent;
+        let b = f.point + w * f.tangent;
+        let region = Aabb::new(a.min(b), a.max(b)).fattened(crate::collision::AABB_MARGIN);
+        let mut out = Vec::new();
+        let collision = self.collision();
+        collision.broadphase.query(&region, |_, payload| {
+            let body = collision.shapes[payload as usize].body;
+            out.push(body);
+            true
+        });
+        out.sort();
+        out.dedup();
+        out.retain(|b| {
+            self.bodies().body_type(*b) == Some(BodyType::Dynamic) && d.portals.iter().all(|p| p.body != *b)
+        });
+        out
+    }
+
+    /// Creates the clone of `body` entering portal `entry` of pair `index`.
+    fn start_crossing(&mut self, index: u32, entry: usize, body: BodyHandle) -> Option<()> {
+        let d = self.portals.slots[index as usize].data.clone()?;
+        let exit = 1 - entry;
+        let eta = if entry == 0 { d.eta } else { 1.0 / d.eta };
+        let f1 = frame_of(self, &d.portals[entry], &d.local[entry]);
+        let f2 = frame_of(self, &d.portals[exit], &d.local[exit]);
+        let map = PortalMap::new(f1, f2, eta).ok()?;
+        let (sim, state) = {
+            let b = self.bodies().solver_body(body);
+            (*b.sim, *b.state)
+        };
+        let record = self.bodies().record(body)?.clone();
+        let motion = BodyMotion {
+            center: sim.center,
+            angle: sim.transform.q.angle(),
+            linear_velocity: state.v,
+            angular_velocity: state.w,
+        };
+        let clone_motion = map.clone_state(
+            &motion,
+            &motion_of(self, d.portals[entry].body),
+            &motion_of(self, d.portals[exit].body),
+        );
+        let full = BodyMass {
+            mass: sim.mass,
+            rotational_inertia: sim.inertia,
+            center: sim.local_center,
+        };
+        let mass_clone = d.mass_model.clone_mass(full, eta);
+        let q2 = Rot::from_angle(clone_motion.angle);
+        let origin = clone_motion.center - q2.rotate(sim.local_center);
+        let clone_def = BodyDef {
+            body_type: BodyType::Dynamic,
+            position: origin,
+            angle: clone_motion.angle,
+            linear_damping: sim.linear_damping,
+            angular_damping: sim.angular_damping,
+            gravity_scale: sim.gravity_scale,
+            max_linear_speed: sim.max_linear_speed,
+            max_rotation: sim.max_rotation,
+            mass: Some(mass_clone),
+            fixed_rotation: record.fixed_rotation,
+            user_data: record.user_data,
+            ..BodyDef::default()
+        };
+        let clone = self.create_body(&clone_def).ok()?;
+        let shapes: Vec<_> = self.collision().body_shapes.get(body.index as usize)?.clone();
+        for s in shapes {
+            let data = &self.collision().shapes[s as usize];
+            let geometry = data.geometry.scaled(eta, sim.local_center);
+            let mut def = data.def.clone();
+            if d.mass_model == MassModel::EnergyPreserving {
+                def.density /= eta.powi(4);
+            }
+            let _ = self.create_shape(clone, &def, geometry);
+        }
+        self.set_mass(clone, mass_clone).ok()?;
+        let _ = self.set_linear_velocity(clone, clone_motion.linear_velocity);
+        let _ = self.set_angular_velocity(clone, clone_motion.angular_velocity);
+        let constraint = PortalConstraint::new(PortalConstraintDef {
+            body,
+            clone,
+            portal_body_a: d.portals[entry].body,
+            portal_body_b: d.portals[exit].body,
+            portal_a: d.local[entry],
+            portal_b: d.local[exit],
+            eta,
+        })
+        .ok()?;
+        self.portals.crossings.push(Crossing {
+            pair: index,
+            entry,
+            original: body,
+            clone,
+            mass_original: full,
+            mass_clone,
+        });
+        self.portals.constraints.push(constraint);
+        let pair = self.pair_handle(index);
+        self.portals.events.push(PortalEvent::CrossingStarted { body, clone, pair });
+        Some(())
+    }
+
+    /// Weighs the two copies of crossing `k` by their area fractions.
+    fn weigh_crossing(&mut self, k: usize, f_entry: &PortalFrame, f_exit: &PortalFrame) {
+        let c = self.portals.crossings[k].clone();
+        let a = self.front_fraction(c.original, f_entry);
+        let b = self.front_fraction(c.clone, f_exit);
+        let f = if a + b > 0.0 { a / (a + b) } else { 0.5 };
+        let f = f.clamp(F_MIN, 1.0 - F_MIN);
+        let scale = |m: BodyMass, f: Real| BodyMass {
+            mass: f * m.mass,
+            rotational_inertia: f * m.rotational_inertia,
+            center: m.center,
+        };
+        self.apply_mass_keep_velocity(c.original, scale(c.mass_original, f));
+        self.apply_mass_keep_velocity(c.clone, scale(c.mass_clone, 1.0 - f));
+    }
+
+    /// Removes crossing `k` and its constraint, returning it.
+    fn take_crossing(&mut self, k: usize) -> Crossing {
+        self.portals.constraints.remove(k);
+        self.portals.crossings.remove(k)
+    }
+
+    /// The original went through: the handle follows the object to the
+    /// exit side; the original's old body is removed.
+    fn complete_crossing(&mut self, k: usize) {
+        let c = self.take_crossing(k);
+        self.apply_mass_keep_velocity(c.clone, c.mass_clone);
+        let pair = self.pair_handle(c.pair);
+        // Joints on the original would now span the portal.
+        for joint in self.joints_attached_to(c.original) {
+            self.disable_joint(joint);
+            self.portals.events.push(PortalEvent::JointDisabled { joint, pair });
+        }
+        self.swap_body_identity(c.original, c.clone);
+        let _ = self.destroy_body(c.clone);
+        self.portals.events.push(PortalEvent::CrossingCompleted { body: c.original, pair });
+    }
+
+    /// The body backed out (or the crossing is ended): remove the clone and
+    /// restore the original's full mass.
+    fn cancel_crossing(&mut self, k: usize) {
+        let c = self.take_crossing(k);
+        if self.bodies().contains(c.original) {
+            self.apply_mass_keep_velocity(c.original, c.mass_original);
+        }
+        if self.bodies().contains(c.clone) {
+            let _ = self.destroy_body(c.clone);
+        }
+        let pair = self.pair_handle(c.pair);
+        self.portals.events.push(PortalEvent::CrossingCancelled { body: c.original, pair });
+    }
+}
