@@ -243,12 +243,24 @@ pub fn by_name(name: &str, def: &WorldDef) -> Option<Scene> {
         "tumbler" => tumbler(def),
         "smash" => smash(def),
         "spinner" => spinner(def),
+        "portal_stream" => portal_stream(def, true),
+        "hole_stream" => portal_stream(def, false),
         _ => return None,
     })
 }
 
 /// Names of the benchmark scenes, in the order `all` runs them.
-pub const NAMES: [&str; 7] = ["large_pyramid", "pyramid20", "many_pyramids", "joint_grid", "tumbler", "smash", "spinner"];
+pub const NAMES: [&str; 9] = [
+    "large_pyramid",
+    "pyramid20",
+    "many_pyramids",
+    "joint_grid",
+    "tumbler",
+    "smash",
+    "spinner",
+    "portal_stream",
+    "hole_stream",
+];
 
 /// The portal "drop" scene: a 1 m box falls 5 m onto a floor portal (2 m
 /// aperture, facing up); the partner sits on a wall to the left, facing +x.
@@ -266,4 +278,61 @@ pub fn portal_drop(def: &WorldDef) -> (Scene, janus2d_world::PortalPairHandle) {
     let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 5.5))).unwrap();
     world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
     (Scene { world, probe: b, probe_label: "box", steps: 120 }, pair)
+}
+
+/// The portal "stream" scene: 200 mixed shapes (boxes, circles, capsules)
+/// pour down a funnel into a floor portal and come out of a wall portal
+/// into a second room below. With `with_portal == false` the portal is
+/// replaced by a plain 2 m hole in the funnel's floor (the bodies fall
+/// straight through to the room below), for the cost comparison.
+pub fn portal_stream(def: &WorldDef, with_portal: bool) -> Scene {
+    use janus2d_world::{PortalDef, PortalPairDef};
+    let mut world = new_world(def);
+    let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    let sd = ShapeDef::default();
+    let solid = |world: &mut World, hx: Real, hy: Real, c: Vec2, a: Real| {
+        world.create_shape(ground, &sd, Polygon::make_offset_box(hx, hy, c, a)).unwrap();
+    };
+    // Funnel: two slopes down to a 2 m opening at (0, 0), side walls.
+    let slope = (8.0 as Real).atan2(8.8);
+    solid(&mut world, 5.95, 0.25, Vec2::new(-5.4, 4.0), -slope);
+    solid(&mut world, 5.95, 0.25, Vec2::new(5.4, 4.0), slope);
+    solid(&mut world, 0.25, 12.0, Vec2::new(-10.25, 12.0), 0.0);
+    solid(&mut world, 0.25, 12.0, Vec2::new(10.25, 12.0), 0.0);
+    // Room below: floor, side walls.
+    solid(&mut world, 40.0, 0.5, Vec2::new(0.0, -30.5), 0.0);
+    solid(&mut world, 0.5, 10.0, Vec2::new(40.5, -20.0), 0.0);
+    if with_portal {
+        // The funnel's floor carries the entry portal; the exit is on a
+        // wall of the room below, facing +x.
+        let floor = world.create_body(&BodyDef::fixed(Vec2::new(0.0, -0.5))).unwrap();
+        world.create_shape(floor, &sd, Polygon::make_box(1.5, 0.5)).unwrap();
+        let exit_wall = world.create_body(&BodyDef::fixed(Vec2::new(-40.5, -25.0))).unwrap();
+        world.create_shape(exit_wall, &sd, Polygon::make_box(0.5, 5.0)).unwrap();
+        let entry = PortalDef { body: floor, anchor: Vec2::new(0.0, 0.5), direction: Vec2::Y, half_width: 1.0 };
+        let exit = PortalDef { body: exit_wall, anchor: Vec2::new(0.5, 0.0), direction: Vec2::X, half_width: 1.0 };
+        world.create_portal_pair(&PortalPairDef::new(entry, exit)).unwrap();
+    } else {
+        // The same floor with a 2 m hole; the exit wall is kept as scenery.
+        solid(&mut world, 0.25, 0.5, Vec2::new(-1.25, -0.5), 0.0);
+        solid(&mut world, 0.25, 0.5, Vec2::new(1.25, -0.5), 0.0);
+        solid(&mut world, 0.5, 5.0, Vec2::new(-40.5, -25.0), 0.0);
+    }
+    let capsule = Capsule::new(Vec2::new(-0.1, 0.0), Vec2::new(0.1, 0.0), 0.12).unwrap();
+    let circle = Circle::new(Vec2::ZERO, 0.15).unwrap();
+    let square = Polygon::make_box(0.15, 0.15);
+    let mut probe = ground;
+    for i in 0..200 {
+        let (row, col) = (i / 20, i % 20);
+        let pos = Vec2::new(-8.55 + 0.9 * col as Real, 10.0 + 0.6 * row as Real);
+        let b = world.create_body(&BodyDef::dynamic(pos)).unwrap();
+        match i % 3 {
+            0 => world.create_shape(b, &sd, square),
+            1 => world.create_shape(b, &sd, circle),
+            _ => world.create_shape(b, &sd, capsule),
+        }
+        .unwrap();
+        probe = b;
+    }
+    Scene { world, probe, probe_label: "last shape", steps: 1800 }
 }

@@ -601,6 +601,9 @@ impl World {
         self.set_mass(clone, mass_clone).ok()?;
         let _ = self.set_linear_velocity(clone, clone_motion.linear_velocity);
         let _ = self.set_angular_velocity(clone, clone_motion.angular_velocity);
+        // The clone's momentum comes out of the exit portal's body.
+        let clone_full = (mass_clone.mass, mass_clone.rotational_inertia);
+        self.exchange_with_portal(clone, (0.0, 0.0), clone_full, d.portals[exit].body);
         let constraint = PortalConstraint::new(PortalConstraintDef {
             body,
             clone,
@@ -637,8 +640,55 @@ impl World {
             rotational_inertia: f * m.rotational_inertia,
             center: m.center,
         };
-        self.apply_mass_keep_velocity(c.original, scale(c.mass_original, f));
-        self.apply_mass_keep_velocity(c.clone, scale(c.mass_clone, 1.0 - f));
+        let (entry_body, exit_body) = self.crossing_portal_bodies(&c);
+        self.set_copy_mass(c.original, scale(c.mass_original, f), entry_body);
+        self.set_copy_mass(c.clone, scale(c.mass_clone, 1.0 - f), exit_body);
+    }
+
+    fn crossing_portal_bodies(&self, c: &Crossing) -> (BodyHandle, BodyHandle) {
+        let d = self.portals.slots[c.pair as usize].data.as_ref().expect("live pair");
+        (d.portals[c.entry].body, d.portals[1 - c.entry].body)
+    }
+
+    /// Sets a crossing copy's (weighted) mass, velocity unchanged. The mass
+    /// that leaves (or enters) through the portal carries its momentum to
+    /// (or from) the portal body, so with a dynamic portal body the total
+    /// linear and angular momentum is unchanged:
+    ///
+    /// ```text
+    /// Δm = m_old − m_new,  ΔI = I_old − I_new
+    /// portal body:  linear impulse Δm v at the copy's centre x,
+    ///               angular impulse ΔI ω
+    /// ```
+    ///
+    /// Static and kinematic portal bodies absorb it (infinite mass).
+    fn set_copy_mass(&mut self, body: BodyHandle, new: BodyMass, portal_body: BodyHandle) {
+        let Some(b) = self.bodies().sim(body).copied() else { return };
+        if self.bodies().body_type(portal_body) == Some(BodyType::Dynamic) {
+            let st = *self.bodies().state(body).expect("live");
+            let dm = b.mass - new.mass;
+            let di = b.inertia - new.rotational_inertia;
+            let _ = self.apply_linear_impulse(portal_body, dm * st.v, b.center);
+            let _ = self.apply_angular_impulse(portal_body, di * st.w);
+        }
+        if new.mass > 0.0 {
+            self.apply_mass_keep_velocity(body, new);
+        }
+    }
+
+    /// The momentum of `body` as if its mass went from `from` to `to`
+    /// (velocity fixed) is exchanged with the portal body: the portal body
+    /// receives `(m_from − m_to) v` at the copy's centre and
+    /// `(I_from − I_to) ω`. Used when a copy appears (`from` = 0) or
+    /// disappears (`to` = 0) as a whole.
+    fn exchange_with_portal(&mut self, body: BodyHandle, from: (Real, Real), to: (Real, Real), portal_body: BodyHandle) {
+        if self.bodies().body_type(portal_body) != Some(BodyType::Dynamic) {
+            return;
+        }
+        let Some(b) = self.bodies().sim(body).copied() else { return };
+        let st = *self.bodies().state(body).expect("live");
+        let _ = self.apply_linear_impulse(portal_body, (from.0 - to.0) * st.v, b.center);
+        let _ = self.apply_angular_impulse(portal_body, (from.1 - to.1) * st.w);
     }
 
     /// Removes crossing `k` and its constraint, returning it.
@@ -651,7 +701,12 @@ impl World {
     /// exit side; the original's old body is removed.
     fn complete_crossing(&mut self, k: usize) {
         let c = self.take_crossing(k);
-        self.apply_mass_keep_velocity(c.clone, c.mass_clone);
+        let (entry_body, exit_body) = self.crossing_portal_bodies(&c);
+        self.set_copy_mass(c.clone, c.mass_clone, exit_body);
+        // What is left of the original goes into the entry portal's body.
+        if let Some(b) = self.bodies().sim(c.original).copied() {
+            self.exchange_with_portal(c.original, (b.mass, b.inertia), (0.0, 0.0), entry_body);
+        }
         let pair = self.pair_handle(c.pair);
         // Joints on the original would now span the portal.
         for joint in self.joints_attached_to(c.original) {
@@ -666,11 +721,18 @@ impl World {
     /// The body backed out (or the crossing is ended): remove the clone and
     /// restore the original's full mass.
     fn cancel_crossing(&mut self, k: usize) {
+        let (entry_body, exit_body) = {
+            let c = &self.portals.crossings[k];
+            self.crossing_portal_bodies(c)
+        };
         let c = self.take_crossing(k);
         if self.bodies().contains(c.original) {
-            self.apply_mass_keep_velocity(c.original, c.mass_original);
+            self.set_copy_mass(c.original, c.mass_original, entry_body);
         }
         if self.bodies().contains(c.clone) {
+            if let Some(b) = self.bodies().sim(c.clone).copied() {
+                self.exchange_with_portal(c.clone, (b.mass, b.inertia), (0.0, 0.0), exit_body);
+            }
             let _ = self.destroy_body(c.clone);
         }
         let pair = self.pair_handle(c.pair);
