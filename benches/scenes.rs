@@ -6,6 +6,7 @@
 //! cargo bench --bench scenes -- large_pyramid            # 3 repeats
 //! cargo bench --bench scenes -- all -r 1 --csv           # every scene, CSV
 //! cargo bench --bench scenes -- pyramid20 -s 100         # other step count
+//! cargo bench --bench scenes -- large_pyramid --sleep --warmup 600 -s 120   # settled, asleep
 //! ```
 //!
 //! Put the numbers beside Box2D's from the same run:
@@ -22,10 +23,12 @@ struct Args {
     repeats: usize,
     csv: bool,
     substeps: Option<u32>,
+    sleep: Option<bool>,
+    warmup: usize,
 }
 
 fn parse_args() -> Args {
-    let mut args = Args { scenes: Vec::new(), steps: 0, repeats: 3, csv: false, substeps: None };
+    let mut args = Args { scenes: Vec::new(), steps: 0, repeats: 3, csv: false, substeps: None, sleep: None, warmup: 0 };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
         match a.as_str() {
@@ -33,6 +36,9 @@ fn parse_args() -> Args {
             "-r" | "--repeats" => args.repeats = it.next().and_then(|v| v.parse().ok()).expect("--repeats N"),
             "--substeps" => args.substeps = it.next().and_then(|v| v.parse().ok()),
             "--csv" => args.csv = true,
+            "--sleep" => args.sleep = Some(true),
+            "--no-sleep" => args.sleep = Some(false),
+            "--warmup" => args.warmup = it.next().and_then(|v| v.parse().ok()).expect("--warmup N"),
             "--bench" => {}
             "all" => args.scenes.extend(scenes::NAMES.iter().map(|s| s.to_string())),
             name if !name.starts_with('-') => args.scenes.push(name.to_string()),
@@ -57,6 +63,10 @@ fn main() {
         println!("janus2d scenes: single thread, dt=1/60, {} substeps", def.solver.substeps);
     }
     for name in &args.scenes {
+        // Sleep as scenes.md says: off except in `tumbler` and `spinner`,
+        // unless the command line says otherwise.
+        let mut def = def.clone();
+        def.sleep.enabled = args.sleep.unwrap_or(matches!(name.as_str(), "tumbler" | "spinner"));
         let mut best = f64::MAX;
         let mut runs = Vec::new();
         let mut summary = String::new();
@@ -67,6 +77,9 @@ fn main() {
             let mut scene = scenes::by_name(name, &def).unwrap_or_else(|| panic!("unknown scene {name}"));
             steps = if args.steps > 1 { args.steps } else { scene.steps };
             let start = scene.world.position(scene.probe).unwrap();
+            for _ in 0..args.warmup {
+                scene.world.step(DT).unwrap();
+            }
             scene.world.step(DT).unwrap();
             let t0 = Instant::now();
             for _ in 1..steps {
@@ -80,7 +93,8 @@ fn main() {
             let end = scene.world.position(scene.probe).unwrap();
             let angle = scene.world.angle(scene.probe).unwrap();
             summary = format!(
-                "  sanity {name}: bodies={bodies} contacts={contacts} {}: ({:.4}, {:.4}) -> ({:.4}, {:.4}) angle={:.4} rad",
+                "  sanity {name}: bodies={bodies} contacts={contacts} sleeping={} {}: ({:.4}, {:.4}) -> ({:.4}, {:.4}) angle={:.4} rad",
+                scene.world.sleeping_body_count(),
                 scene.probe_label, start.x, start.y, end.x, end.y, angle
             );
         }

@@ -291,6 +291,8 @@ pub struct BodySim {
     pub max_linear_speed: Real,
     /// Maximum rotation per substep, rad.
     pub max_rotation: Real,
+    /// How long the body has been slow enough to sleep, s.
+    pub sleep_time: Real,
     /// The handle of the body this belongs to.
     pub handle: BodyHandle,
     /// Static, kinematic or dynamic.
@@ -316,6 +318,7 @@ impl BodySim {
             angular_damping: 0.0,
             max_linear_speed: 0.0,
             max_rotation: 0.0,
+            sleep_time: 0.0,
             handle: BodyHandle {
                 index: u32::MAX,
                 generation: 0,
@@ -333,6 +336,10 @@ pub enum BodyLocation {
     Moving(u32),
     /// Index into `static_sims`.
     Static(u32),
+    /// Index into `sleeping_sims`/`sleeping_states`: a dynamic or kinematic
+    /// body whose island sleeps. The solver never sees it; constraints that
+    /// reach it read the static identity state.
+    Sleeping(u32),
 }
 
 /// Bookkeeping for one body slot.
@@ -373,6 +380,10 @@ pub struct BodySet {
     pub states: Vec<BodyState>,
     /// Per-step data of static bodies.
     pub static_sims: Vec<BodySim>,
+    /// Per-step data of sleeping bodies.
+    pub sleeping_sims: Vec<BodySim>,
+    /// States of sleeping bodies (kept for when they wake).
+    pub sleeping_states: Vec<BodyState>,
     identity_sim: BodySim,
 }
 
@@ -457,6 +468,8 @@ impl BodySet {
             sims: vec![BodySim::sentinel()],
             states: vec![BodyState::IDENTITY],
             static_sims: Vec::new(),
+            sleeping_sims: Vec::new(),
+            sleeping_states: Vec::new(),
             identity_sim: BodySim::sentinel(),
         }
     }
@@ -468,7 +481,60 @@ impl BodySet {
 
     /// Number of live bodies.
     pub fn len(&self) -> usize {
-        self.sims.len() - 1 + self.static_sims.len()
+        self.sims.len() - 1 + self.static_sims.len() + self.sleeping_sims.len()
+    }
+
+    /// Number of sleeping bodies.
+    pub fn sleeping_count(&self) -> usize {
+        self.sleeping_sims.len()
+    }
+
+    /// Puts a moving body to sleep: it leaves the solver's arrays (at rest)
+    /// until [`BodySet::wake`]. No effect on static or sleeping bodies.
+    pub fn sleep(&mut self, handle: BodyHandle) {
+        let Some(BodyLocation::Moving(i)) = self.location(handle) else {
+            return;
+        };
+        let i = i as usize;
+        let sim = self.sims.swap_remove(i);
+        let mut state = self.states.swap_remove(i);
+        if i < self.sims.len() {
+            let moved = self.sims[i].handle;
+            self.records[moved.index as usize].location = Some(BodyLocation::Moving(i as u32));
+        }
+        state.v = Vec2::ZERO;
+        state.w = 0.0;
+        state.dp = Vec2::ZERO;
+        state.dq = Rot::IDENTITY;
+        self.sleeping_sims.push(sim);
+        self.sleeping_states.push(state);
+        self.records[handle.index as usize].location =
+            Some(BodyLocation::Sleeping((self.sleeping_sims.len() - 1) as u32));
+    }
+
+    /// Wakes a sleeping body (back into the solver's arrays, timer reset).
+    /// No effect on other bodies.
+    pub fn wake(&mut self, handle: BodyHandle) {
+        let Some(BodyLocation::Sleeping(j)) = self.location(handle) else {
+            return;
+        };
+        let j = j as usize;
+        let mut sim = self.sleeping_sims.swap_remove(j);
+        let state = self.sleeping_states.swap_remove(j);
+        if j < self.sleeping_sims.len() {
+            let moved = self.sleeping_sims[j].handle;
+            self.records[moved.index as usize].location = Some(BodyLocation::Sleeping(j as u32));
+        }
+        sim.sleep_time = 0.0;
+        self.sims.push(sim);
+        self.states.push(state);
+        self.records[handle.index as usize].location =
+            Some(BodyLocation::Moving((self.sims.len() - 1) as u32));
+    }
+
+    /// True when the body sleeps.
+    pub fn is_sleeping(&self, handle: BodyHandle) -> bool {
+        matches!(self.location(handle), Some(BodyLocation::Sleeping(_)))
     }
 
     /// True when there are no bodies.
@@ -526,6 +592,7 @@ impl BodySet {
             angular_damping: def.angular_damping,
             max_linear_speed: def.max_linear_speed,
             max_rotation: def.max_rotation,
+            sleep_time: 0.0,
             handle,
             body_type: def.body_type,
         };
@@ -614,6 +681,16 @@ impl BodySet {
                         Some(BodyLocation::Static(j as u32));
                 }
             }
+            BodyLocation::Sleeping(j) => {
+                let j = j as usize;
+                self.sleeping_sims.swap_remove(j);
+                self.sleeping_states.swap_remove(j);
+                if j < self.sleeping_sims.len() {
+                    let moved = self.sleeping_sims[j].handle;
+                    self.records[moved.index as usize].location =
+                        Some(BodyLocation::Sleeping(j as u32));
+                }
+            }
         }
         let rec = &mut self.records[handle.index as usize];
         rec.location = None;
@@ -642,6 +719,7 @@ impl BodySet {
         let set_handle = |set: &mut BodySet, loc: BodyLocation, h: BodyHandle| match loc {
             BodyLocation::Moving(i) => set.sims[i as usize].handle = h,
             BodyLocation::Static(j) => set.static_sims[j as usize].handle = h,
+            BodyLocation::Sleeping(j) => set.sleeping_sims[j as usize].handle = h,
         };
         set_handle(self, lb, a);
         set_handle(self, la, b);
@@ -674,6 +752,7 @@ impl BodySet {
         match self.location(handle)? {
             BodyLocation::Moving(i) => self.sims.get(i as usize),
             BodyLocation::Static(j) => self.static_sims.get(j as usize),
+            BodyLocation::Sleeping(j) => self.sleeping_sims.get(j as usize),
         }
     }
 
@@ -682,6 +761,7 @@ impl BodySet {
         match self.location(handle)? {
             BodyLocation::Moving(i) => self.sims.get_mut(i as usize),
             BodyLocation::Static(j) => self.static_sims.get_mut(j as usize),
+            BodyLocation::Sleeping(j) => self.sleeping_sims.get_mut(j as usize),
         }
     }
 
@@ -690,6 +770,7 @@ impl BodySet {
         match self.location(handle)? {
             BodyLocation::Moving(i) => self.states.get(i as usize),
             BodyLocation::Static(_) => Some(&self.states[0]),
+            BodyLocation::Sleeping(j) => self.sleeping_states.get(j as usize),
         }
     }
 
@@ -698,6 +779,7 @@ impl BodySet {
         match self.location(handle)? {
             BodyLocation::Moving(i) => self.states.get_mut(i as usize),
             BodyLocation::Static(_) => None,
+            BodyLocation::Sleeping(j) => self.sleeping_states.get_mut(j as usize),
         }
     }
 
@@ -705,7 +787,7 @@ impl BodySet {
     pub fn state_index(&self, handle: BodyHandle) -> Option<u32> {
         match self.location(handle)? {
             BodyLocation::Moving(i) => Some(i),
-            BodyLocation::Static(_) => Some(0),
+            BodyLocation::Static(_) | BodyLocation::Sleeping(_) => Some(0),
         }
     }
 
@@ -720,6 +802,11 @@ impl BodySet {
             Some(BodyLocation::Static(j)) => SolverBody {
                 state_index: 0,
                 sim: &self.static_sims[j as usize],
+                state: &self.states[0],
+            },
+            Some(BodyLocation::Sleeping(j)) => SolverBody {
+                state_index: 0,
+                sim: &self.sleeping_sims[j as usize],
                 state: &self.states[0],
             },
             None => SolverBody {
@@ -815,6 +902,24 @@ mod tests {
         set.destroy(b).unwrap();
         assert_eq!(set.sim(a).unwrap().transform.p, Vec2::new(3.0, 0.0));
         assert_eq!(set.len(), 1);
+    }
+
+    #[test]
+    fn sleep_and_wake_round_trip() {
+        let mut set = BodySet::new();
+        let a = set.create(&BodyDef::dynamic(Vec2::ZERO).with_mass(2.0, 1.0)).unwrap();
+        let b = set.create(&BodyDef::dynamic(Vec2::ONE)).unwrap();
+        set.sleep(a);
+        assert!(set.is_sleeping(a));
+        assert_eq!(set.moving_count(), 1);
+        assert_eq!(set.len(), 2);
+        assert_eq!(set.solver_body(a).state_index, 0);
+        assert_eq!(set.sim(b).unwrap().transform.p, Vec2::ONE);
+        set.wake(a);
+        assert!(!set.is_sleeping(a));
+        assert_eq!(set.sim(a).unwrap().mass, 2.0);
+        assert_eq!(set.state(a).unwrap().inv_mass, 0.5);
+        assert_eq!(set.moving_count(), 2);
     }
 
     #[test]

@@ -582,12 +582,25 @@ impl Collision {
     /// can approach within `dt`: `d = d₀ + dt (|v_b − v_a| + |ω_a| R_a + |ω_b| R_b)`
     /// with `R` the reach of a shape's box from its body's centre, so a
     /// fast body gets its contact points before it would overshoot.
-    pub fn narrowphase(&mut self, bodies: &BodySet, dt: Real, clipping: &ContactClipping) {
+    ///
+    /// Contacts between two bodies that are both static or asleep are
+    /// skipped; a touching contact between a sleeping body and an awake one
+    /// lists the sleeping body in `wake`.
+    pub fn narrowphase(&mut self, bodies: &BodySet, dt: Real, clipping: &ContactClipping, wake: &mut Vec<BodyHandle>) {
         let clip = !clipping.is_empty();
         let mut k = 0;
         let mut tested = 0;
         let mut touching_count = 0;
         while k < self.contacts.len() {
+            let (body_a, body_b) = {
+                let c = &self.contacts[k];
+                (bodies.solver_body(c.body_a), bodies.solver_body(c.body_b))
+            };
+            if body_a.state_index == 0 && body_b.state_index == 0 {
+                // Both asleep (or asleep and static): nothing moves.
+                k += 1;
+                continue;
+            }
             let (pa, pb) = {
                 let c = &self.contacts[k];
                 (self.shapes[c.shape_a as usize].proxy, self.shapes[c.shape_b as usize].proxy)
@@ -600,8 +613,6 @@ impl Collision {
             let c = &self.contacts[k];
             let sa = &self.shapes[c.shape_a as usize];
             let sb = &self.shapes[c.shape_b as usize];
-            let body_a = bodies.solver_body(sa.body);
-            let body_b = bodies.solver_body(sb.body);
             let (sim_a, sim_b) = (body_a.sim, body_b.sim);
             let reach = |aabb: &Aabb, center: Vec2| {
                 (aabb.lower - center).abs().max((aabb.upper - center).abs()).length()
@@ -619,6 +630,12 @@ impl Collision {
             }
             let touching = c.point_count > 0;
             c.touching = touching;
+            if touching && (body_a.state_index == 0 || body_b.state_index == 0) {
+                let other = if body_a.state_index == 0 { c.body_a } else { c.body_b };
+                if bodies.is_sleeping(other) {
+                    wake.push(other);
+                }
+            }
             if touching {
                 touching_count += 1;
             }
@@ -660,7 +677,8 @@ impl Collision {
             if !c.touching || c.sensor || !c.enabled {
                 continue;
             }
-            if (is_static(c.body_a) || is_static(c.body_b)) != static_pass {
+            let (sa, sb) = (is_static(c.body_a), is_static(c.body_b));
+            if (sa && sb) || (sa || sb) != static_pass {
                 continue;
             }
             let mut inputs = [ContactPointInput::default(); 2];

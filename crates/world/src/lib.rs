@@ -10,14 +10,20 @@
 //! | [`collision`] | shapes, contacts, events                          |
 //! | [`broadphase`]| the dynamic AABB tree and pair finding            |
 //! | [`portals`]   | portal pairs, crossings, clones, handover         |
+//! | [`sleep`]     | resting islands leave the solver                  |
+//! | [`profile`]   | per-stage timings and work counters               |
 
 pub mod broadphase;
 pub mod collision;
 pub mod error;
 pub mod portals;
+pub mod profile;
+pub mod sleep;
 pub mod world;
 
 pub use collision::{CollisionEvents, Filter, ShapeDef, ShapeHandle};
 pub use error::WorldError;
+pub use profile::{StepCounters, StepProfile};
+pub use sleep::SleepSettings;
 pub use portals::{MassModel, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle};
 pub use world::{JointHandle, StepEvents, World, WorldDef};

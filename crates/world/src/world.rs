@@ -32,6 +32,8 @@ pub struct WorldDef {
     pub gravity: Vec2,
     /// Solver accuracy and softness settings.
     pub solver: SolverSettings,
+    /// When bodies fall asleep (on by default, as in Box2D and Rapier).
+    pub sleep: crate::sleep::SleepSettings,
 }
 
 impl Default for WorldDef {
@@ -39,6 +41,7 @@ impl Default for WorldDef {
         WorldDef {
             gravity: DEFAULT_GRAVITY,
             solver: SolverSettings::default(),
+            sleep: crate::sleep::SleepSettings::default(),
         }
     }
 }
@@ -83,8 +86,13 @@ pub struct World {
     collision: Collision,
     contact_constraints: Vec<ContactConstraint>,
     pub(crate) portals: crate::portals::Portals,
+    pub(crate) islands: crate::sleep::Islands,
+    pub(crate) sleep_settings: crate::sleep::SleepSettings,
+    wake_list: Vec<BodyHandle>,
     events: StepEvents,
     profile: SolverProfile,
+    step_profile: crate::profile::StepProfile,
+    counters: crate::profile::StepCounters,
     step_count: u64,
 }
 
@@ -108,6 +116,9 @@ impl World {
             collision: Collision::new(bodies.owner()),
             contact_constraints: Vec::new(),
             portals: crate::portals::Portals::default(),
+            islands: crate::sleep::Islands::default(),
+            sleep_settings: def.sleep,
+            wake_list: Vec::new(),
             bodies,
             revolute: Vec::new(),
             revolute_handles: Vec::new(),
@@ -115,6 +126,8 @@ impl World {
             joint_free: Vec::new(),
             events: StepEvents::default(),
             profile: SolverProfile::default(),
+            step_profile: crate::profile::StepProfile::default(),
+            counters: crate::profile::StepCounters::default(),
             step_count: 0,
         })
     }
@@ -170,9 +183,19 @@ impl World {
         &self.events
     }
 
-    /// Stage timings of the last step.
+    /// Stage timings of the solver in the last step.
     pub fn solver_profile(&self) -> &SolverProfile {
         &self.profile
+    }
+
+    /// Stage timings of the last step (every pipeline stage).
+    pub fn profile(&self) -> &crate::profile::StepProfile {
+        &self.step_profile
+    }
+
+    /// Work counters of the last step.
+    pub fn counters(&self) -> crate::profile::StepCounters {
+        self.counters
     }
 
     // ----- bodies -----------------------------------------------------------
@@ -197,6 +220,15 @@ impl World {
             return Err(WorldError::StaleBody);
         }
         self.portals_forget_body(body);
+        let touching: Vec<BodyHandle> = self
+            .collision
+            .contacts
+            .iter()
+            .filter(|c| c.body_a == body || c.body_b == body)
+            .map(|c| if c.body_a == body { c.body_b } else { c.body_a })
+            .collect();
+        self.wake_all(&touching);
+        self.wake_body(body);
         let attached: Vec<JointHandle> = self
             .revolute
             .iter()
@@ -286,6 +318,7 @@ impl World {
 
     /// Sets the linear velocity of a moving body's centre of mass.
     pub fn set_linear_velocity(&mut self, body: BodyHandle, v: Vec2) -> Result<(), WorldError> {
+        self.wake_body(body);
         if !vec_is_finite(v) {
             return Err(WorldError::NonFinite("linear_velocity"));
         }
@@ -298,6 +331,7 @@ impl World {
 
     /// Sets the angular velocity of a moving body.
     pub fn set_angular_velocity(&mut self, body: BodyHandle, w: Real) -> Result<(), WorldError> {
+        self.wake_body(body);
         if !w.is_finite() {
             return Err(WorldError::NonFinite("angular_velocity"));
         }
@@ -315,6 +349,7 @@ impl World {
         position: Vec2,
         angle: Real,
     ) -> Result<(), WorldError> {
+        self.wake_body(body);
         if !vec_is_finite(position) || !angle.is_finite() {
             return Err(WorldError::NonFinite("transform"));
         }
@@ -333,6 +368,7 @@ impl World {
 
     /// Sets the mass properties of a dynamic body directly.
     pub fn set_mass(&mut self, body: BodyHandle, mass: BodyMass) -> Result<(), WorldError> {
+        self.wake_body(body);
         let ty = self.body_type(body)?;
         let fixed = self
             .bodies
@@ -354,6 +390,7 @@ impl World {
         force: Vec2,
         point: Vec2,
     ) -> Result<(), WorldError> {
+        self.wake_body(body);
         if !vec_is_finite(force) || !vec_is_finite(point) {
             return Err(WorldError::NonFinite("force"));
         }
@@ -377,6 +414,7 @@ impl World {
 
     /// Adds a torque (N·m) for the next step.
     pub fn apply_torque(&mut self, body: BodyHandle, torque: Real) -> Result<(), WorldError> {
+        self.wake_body(body);
         if !torque.is_finite() {
             return Err(WorldError::NonFinite("torque"));
         }
@@ -394,6 +432,7 @@ impl World {
         impulse: Vec2,
         point: Vec2,
     ) -> Result<(), WorldError> {
+        self.wake_body(body);
         if !vec_is_finite(impulse) || !vec_is_finite(point) {
             return Err(WorldError::NonFinite("impulse"));
         }
@@ -416,6 +455,7 @@ impl World {
         body: BodyHandle,
         impulse: Real,
     ) -> Result<(), WorldError> {
+        self.wake_body(body);
         if !impulse.is_finite() {
             return Err(WorldError::NonFinite("impulse"));
         }
@@ -434,6 +474,8 @@ impl World {
         &mut self,
         def: &RevoluteJointDef,
     ) -> Result<JointHandle, WorldError> {
+        self.wake_body(def.body_a);
+        self.wake_body(def.body_b);
         def.validate()?;
         self.check_body(def.body_a)?;
         self.check_body(def.body_b)?;
@@ -479,6 +521,9 @@ impl World {
     /// Destroys a joint.
     pub fn destroy_joint(&mut self, joint: JointHandle) -> Result<(), WorldError> {
         let i = self.joint_index(joint)?;
+        let (a, b) = (self.revolute[i].def.body_a, self.revolute[i].def.body_b);
+        self.wake_body(a);
+        self.wake_body(b);
         let def = &self.revolute[i].def;
         if !def.collide_connected {
             let key = body_pair_key(def.body_a, def.body_b);
@@ -512,6 +557,9 @@ impl World {
         joint: JointHandle,
     ) -> Result<&mut RevoluteJointDef, WorldError> {
         let i = self.joint_index(joint)?;
+        let (a, b) = (self.revolute[i].def.body_a, self.revolute[i].def.body_b);
+        self.wake_body(a);
+        self.wake_body(b);
         Ok(&mut self.revolute[i].def)
     }
 
@@ -562,6 +610,7 @@ impl World {
         if ty == BodyType::Dynamic && !mass_override && has_area && def.density <= 0.0 && !self.has_mass_from_shapes(body) {
             return Err(WorldError::OutOfRange("density"));
         }
+        self.wake_body(body);
         let handle = self.collision.add_shape(&self.bodies, body, geometry, def.clone());
         if ty == BodyType::Dynamic && !mass_override {
             self.update_mass_from_shapes(body);
@@ -573,6 +622,7 @@ impl World {
     pub fn destroy_shape(&mut self, shape: ShapeHandle) -> Result<(), WorldError> {
         let slot = self.collision.slot(shape).ok_or(WorldError::StaleShape)?;
         let body = self.collision.shapes[slot as usize].body;
+        self.wake_body(body);
         self.collision.remove_shape(slot);
         let mass_override = self.bodies.record(body).map(|r| r.mass_override).unwrap_or(true);
         if self.body_type(body)? == BodyType::Dynamic && !mass_override {
@@ -655,7 +705,53 @@ impl World {
         worst
     }
 
-    // ----- helpers for the portal stage -------------------------------------
+    // ----- helpers for the portal and sleep stages ----------------------------
+
+    /// Mutable body storage (crate-internal).
+    pub(crate) fn bodies_mut(&mut self) -> &mut BodySet {
+        &mut self.bodies
+    }
+
+    /// The sleep settings.
+    pub fn sleep_settings(&self) -> crate::sleep::SleepSettings {
+        self.sleep_settings
+    }
+
+    /// Changes the sleep settings; turning sleep off wakes every body.
+    pub fn set_sleep_settings(&mut self, settings: crate::sleep::SleepSettings) {
+        if !settings.enabled {
+            let sleeping: Vec<BodyHandle> = self.bodies.sleeping_sims.iter().map(|s| s.handle).collect();
+            self.wake_all(&sleeping);
+        }
+        self.sleep_settings = settings;
+    }
+
+    /// How far a body's shapes reach from its centre of mass, m.
+    pub(crate) fn body_reach(&self, body: BodyHandle) -> Real {
+        let Some(sim) = self.bodies.sim(body) else { return 0.0 };
+        let Some(list) = self.collision.body_shapes.get(body.index as usize) else {
+            return 0.0;
+        };
+        list.iter()
+            .map(|&s| {
+                let a = &self.collision.shapes[s as usize].aabb;
+                (a.lower - sim.center).abs().max((a.upper - sim.center).abs()).length()
+            })
+            .fold(0.0, Real::max)
+    }
+
+    /// Pairs of bodies held together by enabled joints or touching solid
+    /// contacts (the edges of the island graph).
+    pub(crate) fn constraint_edges(&self) -> Vec<(BodyHandle, BodyHandle)> {
+        let joints = self.revolute.iter().filter(|j| j.enabled).map(|j| (j.def.body_a, j.def.body_b));
+        let contacts = self
+            .collision
+            .contacts
+            .iter()
+            .filter(|c| c.touching && !c.sensor && c.enabled)
+            .map(|c| (c.body_a, c.body_b));
+        joints.chain(contacts).collect()
+    }
 
     /// Sets a dynamic body's mass properties without touching its velocity.
     pub(crate) fn apply_mass_keep_velocity(&mut self, body: BodyHandle, mass: BodyMass) {
@@ -703,16 +799,33 @@ impl World {
             return Err(WorldError::InvalidTimeStep);
         }
         let ctx = self.step_context(dt);
+        let start = std::time::Instant::now();
+        let mut t = start;
+        let mut lap = || {
+            let now = std::time::Instant::now();
+            let d = now.duration_since(t).as_secs_f64();
+            t = now;
+            d
+        };
+        let mut sp = crate::profile::StepProfile::default();
+        let mut counters = crate::profile::StepCounters::default();
         self.collision.events = CollisionEvents::default();
         let has_shapes = self.collision.shape_count() > 0;
         let has_portals = self.portals.is_active();
         if has_portals {
             self.portal_clipping();
         }
+        sp.portals += lap();
         if has_shapes {
             self.collision.update_pairs(&self.bodies);
-            self.collision.narrowphase(&self.bodies, dt, &self.portals.clipping);
+            sp.broadphase += lap();
+            let mut wake = std::mem::take(&mut self.wake_list);
+            wake.clear();
+            self.collision.narrowphase(&self.bodies, dt, &self.portals.clipping, &mut wake);
+            self.wake_all(&wake);
+            self.wake_list = wake;
             self.collision.build_constraints(&self.bodies, &mut self.contact_constraints);
+            sp.narrowphase += lap();
         } else {
             self.contact_constraints.clear();
         }
@@ -722,15 +835,55 @@ impl World {
             &mut self.portals.constraints,
         ];
         let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
+        lap();
         if has_shapes {
             self.collision.store_impulses(&self.contact_constraints);
             self.collision.update_proxies(&self.bodies, dt);
+            sp.broadphase += lap();
         }
         if has_portals {
             self.portal_stage();
+            sp.portals += lap();
         } else {
             self.portals.events.clear();
         }
+        if self.sleep_settings.enabled {
+            self.update_sleep(dt);
+            sp.sleep += lap();
+        }
+        let p = &report.profile;
+        sp.prepare = p.prepare;
+        sp.integrate = p.integrate;
+        sp.warm_start = p.warm_start;
+        sp.solve = p.solve;
+        sp.relax = p.relax;
+        sp.restitution = p.restitution;
+        sp.finalize = p.finalize;
+        sp.total = start.elapsed().as_secs_f64();
+        // Counters.
+        let cc = self.collision.counters;
+        counters.collision_ran = has_shapes;
+        counters.pairs_tested = cc.pairs_tested;
+        counters.pairs_created = cc.pairs_created;
+        counters.proxies_moved = cc.proxies_moved;
+        counters.contacts = self.contact_constraints.len();
+        counters.contact_rows = self.contact_constraints.iter().map(|c| 2 * c.point_count()).sum();
+        counters.restitution_contacts = self.contact_constraints.iter().filter(|c| c.restitution > 0.0).count();
+        counters.joint_rows = self
+            .revolute
+            .iter()
+            .filter(|j| j.enabled)
+            .map(|j| 2 + 2 * j.def.enable_limit as usize + j.def.enable_motor as usize + j.def.enable_spring as usize)
+            .sum();
+        counters.portal_rows = 3 * self.portals.constraints.len();
+        counters.portal_stage_ran = has_portals;
+        counters.portal_bodies_tested = if has_portals { self.portals.counters.bodies_tested } else { 0 };
+        counters.portal_crossings = self.portals.crossings.len();
+        counters.gravity_bodies = if self.gravity == Vec2::ZERO { 0 } else { self.bodies.moving_count() };
+        counters.awake_bodies = self.bodies.moving_count();
+        counters.sleeping_bodies = self.bodies.sleeping_count();
+        self.counters = counters;
+        self.step_profile = sp;
         self.events = StepEvents {
             non_finite_bodies: report.non_finite,
             collision: std::mem::take(&mut self.collision.events),

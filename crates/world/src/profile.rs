@@ -1,0 +1,83 @@
+//! Per-step profile: the time of each pipeline stage and counters that show
+//! which stages did work.
+//!
+//! | field (time, s)  | stage                                              |
+//! |------------------|----------------------------------------------------|
+//! | `broadphase`     | new pairs from moved proxies; proxy updates        |
+//! | `narrowphase`    | manifolds of every awake contact                   |
+//! | `portals`        | clipping, crossings, handovers, weights            |
+//! | `prepare`        | body and constraint preparation                    |
+//! | `integrate`      | velocity and position integration                  |
+//! | `warm_start`     | warm starting                                      |
+//! | `solve`          | solve with bias                                    |
+//! | `relax`          | relax (solve without bias)                         |
+//! | `restitution`    | restitution                                        |
+//! | `finalize`       | storing impulses, transforms                       |
+//! | `sleep`          | sleep timers and islands                           |
+//!
+//! A stage whose feature the scene lacks is not entered: its time is zero
+//! and its counters stay zero (see [`StepCounters`]).
+
+/// Stage timings of the last step, seconds.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StepProfile {
+    /// Broadphase (pair finding and proxy updates).
+    pub broadphase: f64,
+    /// Narrowphase (manifolds).
+    pub narrowphase: f64,
+    /// Portal stage.
+    pub portals: f64,
+    /// Constraint and body preparation.
+    pub prepare: f64,
+    /// Integration of velocities and positions.
+    pub integrate: f64,
+    /// Warm starting.
+    pub warm_start: f64,
+    /// Solve with bias.
+    pub solve: f64,
+    /// Relax.
+    pub relax: f64,
+    /// Restitution.
+    pub restitution: f64,
+    /// Storing impulses and finalizing transforms.
+    pub finalize: f64,
+    /// Sleep.
+    pub sleep: f64,
+    /// Whole step.
+    pub total: f64,
+}
+
+/// Work counters of the last step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StepCounters {
+    /// The collision stages ran (the world has shapes).
+    pub collision_ran: bool,
+    /// Shape pairs whose manifolds were computed.
+    pub pairs_tested: usize,
+    /// New pairs found by the broadphase.
+    pub pairs_created: usize,
+    /// Broadphase proxies re-inserted.
+    pub proxies_moved: usize,
+    /// Touching solid contacts solved.
+    pub contacts: usize,
+    /// Contact rows (normal + friction per point).
+    pub contact_rows: usize,
+    /// Joint rows (revolute: 2 point rows plus limit, motor, spring rows).
+    pub joint_rows: usize,
+    /// Portal constraint rows (3 per crossing).
+    pub portal_rows: usize,
+    /// The portal stage ran (the world has a portal pair).
+    pub portal_stage_ran: bool,
+    /// Bodies tested against apertures.
+    pub portal_bodies_tested: usize,
+    /// Crossings in progress.
+    pub portal_crossings: usize,
+    /// Contacts with restitution > 0 (the restitution pass runs only if > 0).
+    pub restitution_contacts: usize,
+    /// Bodies integrated with gravity (0 when gravity is zero).
+    pub gravity_bodies: usize,
+    /// Awake dynamic and kinematic bodies.
+    pub awake_bodies: usize,
+    /// Sleeping bodies.
+    pub sleeping_bodies: usize,
+}
