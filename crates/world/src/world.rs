@@ -814,8 +814,8 @@ impl World {
         let has_portals = self.portals.is_active();
         if has_portals {
             self.portal_clipping();
+            sp.portals += lap();
         }
-        sp.portals += lap();
         if has_shapes {
             self.collision.update_pairs(&self.bodies);
             sp.broadphase += lap();
