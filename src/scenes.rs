@@ -243,6 +243,7 @@ pub fn by_name(name: &str, def: &WorldDef) -> Option<Scene> {
         "tumbler" => tumbler(def),
         "smash" => smash(def),
         "spinner" => spinner(def),
+        #[cfg(feature = "portals")]
         "portal_stream" => portal_stream(def, true),
         "hole_stream" => portal_stream(def, false),
         _ => return None,
@@ -262,6 +263,7 @@ pub const NAMES: [&str; 9] = [
     "hole_stream",
 ];
 
+#[cfg(feature = "portals")]
 /// The portal "drop" scene: a 1 m box falls 5 m onto a floor portal (2 m
 /// aperture, facing up); the partner sits on a wall to the left, facing +x.
 /// Returns the scene (probe: the box) and the pair.
@@ -286,7 +288,6 @@ pub fn portal_drop(def: &WorldDef) -> (Scene, janus2d_world::PortalPairHandle) {
 /// replaced by a plain 2 m hole in the funnel's floor (the bodies fall
 /// straight through to the room below), for the cost comparison.
 pub fn portal_stream(def: &WorldDef, with_portal: bool) -> Scene {
-    use janus2d_world::{PortalDef, PortalPairDef};
     let mut world = new_world(def);
     let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
     let sd = ShapeDef::default();
@@ -303,8 +304,13 @@ pub fn portal_stream(def: &WorldDef, with_portal: bool) -> Scene {
     solid(&mut world, 40.0, 0.5, Vec2::new(0.0, -30.5), 0.0);
     solid(&mut world, 0.5, 10.0, Vec2::new(40.5, -20.0), 0.0);
     if with_portal {
+        #[cfg(not(feature = "portals"))]
+        panic!("the portal stream needs the `portals` feature");
         // The funnel's floor carries the entry portal; the exit is on a
         // wall of the room below, facing +x.
+        #[cfg(feature = "portals")]
+        {
+        use janus2d_world::{PortalDef, PortalPairDef};
         let floor = world.create_body(&BodyDef::fixed(Vec2::new(0.0, -0.5))).unwrap();
         world.create_shape(floor, &sd, Polygon::make_box(1.5, 0.5)).unwrap();
         let exit_wall = world.create_body(&BodyDef::fixed(Vec2::new(-40.5, -25.0))).unwrap();
@@ -312,6 +318,7 @@ pub fn portal_stream(def: &WorldDef, with_portal: bool) -> Scene {
         let entry = PortalDef { body: floor, anchor: Vec2::new(0.0, 0.5), direction: Vec2::Y, half_width: 1.0 };
         let exit = PortalDef { body: exit_wall, anchor: Vec2::new(0.5, 0.0), direction: Vec2::X, half_width: 1.0 };
         world.create_portal_pair(&PortalPairDef::new(entry, exit)).unwrap();
+        }
     } else {
         // The same floor with a 2 m hole; the exit wall is kept as scenery.
         solid(&mut world, 0.25, 0.5, Vec2::new(-1.25, -0.5), 0.0);

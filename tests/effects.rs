@@ -47,6 +47,7 @@ fn no_portals_means_no_portal_stage() {
     assert_eq!(world.profile().portals, 0.0);
 }
 
+#[cfg(feature = "portals")]
 #[test]
 fn portals_present_means_portal_stage_runs() {
     let (mut scene, _) = janus2d::scenes::portal_drop(&WorldDef::default());
@@ -146,6 +147,7 @@ fn joint_change_wakes_both_bodies() {
     assert!(!world.is_sleeping(bodies[3]) && !world.is_sleeping(bodies[4]));
 }
 
+#[cfg(feature = "portals")]
 #[test]
 fn portal_crossing_keeps_bodies_awake() {
     let (mut scene, _) = janus2d::scenes::portal_drop(&WorldDef::default());

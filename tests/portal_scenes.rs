@@ -1,5 +1,6 @@
 //! The portal scenes of `../shared/spec/scenes.md`, each with its bound.
 //! Set `JANUS2D_REPORT=1` to print the measured figures.
+#![cfg(feature = "portals")]
 
 use janus2d::prelude::*;
 use janus2d::scenes::{self, DT};

@@ -278,6 +278,12 @@ impl ApertureClip {
     }
 }
 
+/// Clipping that drops nothing (the narrowphase's input without portals).
+pub static NO_CLIPPING: ContactClipping = ContactClipping {
+    clips: Vec::new(),
+    ignored_pairs: Vec::new(),
+};
+
 /// What the portal stage asks the narrowphase to drop.
 #[derive(Clone, Debug, Default)]
 pub struct ContactClipping {

@@ -16,6 +16,7 @@
 pub mod broadphase;
 pub mod collision;
 pub mod error;
+#[cfg(feature = "portals")]
 pub mod portals;
 pub mod profile;
 pub mod sleep;
@@ -25,5 +26,6 @@ pub use collision::{CollisionEvents, Filter, ShapeDef, ShapeHandle};
 pub use error::WorldError;
 pub use profile::{StepCounters, StepProfile};
 pub use sleep::SleepSettings;
+#[cfg(feature = "portals")]
 pub use portals::{MassModel, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle};
 pub use world::{JointHandle, StepEvents, World, WorldDef};

@@ -158,7 +158,9 @@ impl World {
                 union(&mut parent, ia, ib);
             }
         }
-        for c in self.portals.crossings.clone() {
+        #[cfg(feature = "portals")]
+        for k in 0..self.portals.crossings.len() {
+            let c = &self.portals.crossings[k];
             for b in [c.original, c.clone] {
                 if let Some(i) = index(self, b) {
                     self.bodies_mut().sims[i as usize].sleep_time = 0.0;

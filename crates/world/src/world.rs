@@ -85,6 +85,7 @@ pub struct World {
     joint_free: Vec<u32>,
     collision: Collision,
     contact_constraints: Vec<ContactConstraint>,
+    #[cfg(feature = "portals")]
     pub(crate) portals: crate::portals::Portals,
     pub(crate) islands: crate::sleep::Islands,
     pub(crate) sleep_settings: crate::sleep::SleepSettings,
@@ -115,6 +116,7 @@ impl World {
             settings: def.solver,
             collision: Collision::new(bodies.owner()),
             contact_constraints: Vec::new(),
+            #[cfg(feature = "portals")]
             portals: crate::portals::Portals::default(),
             islands: crate::sleep::Islands::default(),
             sleep_settings: def.sleep,
@@ -219,6 +221,7 @@ impl World {
         if !self.bodies.contains(body) {
             return Err(WorldError::StaleBody);
         }
+        #[cfg(feature = "portals")]
         self.portals_forget_body(body);
         let touching: Vec<BodyHandle> = self
             .collision
@@ -753,12 +756,14 @@ impl World {
         joints.chain(contacts).collect()
     }
 
+    #[cfg(feature = "portals")]
     /// Sets a dynamic body's mass properties without touching its velocity.
     pub(crate) fn apply_mass_keep_velocity(&mut self, body: BodyHandle, mass: BodyMass) {
         let fixed = self.bodies.record(body).map(|r| r.fixed_rotation).unwrap_or(false);
         self.bodies.apply_mass(body, mass, fixed);
     }
 
+    #[cfg(feature = "portals")]
     /// Joints attached to a body, in storage order.
     pub(crate) fn joints_attached_to(&self, body: BodyHandle) -> Vec<JointHandle> {
         self.revolute
@@ -769,6 +774,7 @@ impl World {
             .collect()
     }
 
+    #[cfg(feature = "portals")]
     /// Disables a joint (the solver skips it; it stays until destroyed).
     pub(crate) fn disable_joint(&mut self, joint: JointHandle) {
         if let Ok(i) = self.joint_index(joint) {
@@ -776,6 +782,7 @@ impl World {
         }
     }
 
+    #[cfg(feature = "portals")]
     /// Exchanges two bodies' identities (see `BodySet::swap_identity`),
     /// moving their shapes along and dropping their contacts.
     pub(crate) fn swap_body_identity(&mut self, a: BodyHandle, b: BodyHandle) {
@@ -811,7 +818,11 @@ impl World {
         let mut counters = crate::profile::StepCounters::default();
         self.collision.events = CollisionEvents::default();
         let has_shapes = self.collision.shape_count() > 0;
+        #[cfg(feature = "portals")]
         let has_portals = self.portals.is_active();
+        #[cfg(not(feature = "portals"))]
+        let has_portals = false;
+        #[cfg(feature = "portals")]
         if has_portals {
             self.portal_clipping();
             sp.portals += lap();
@@ -821,7 +832,11 @@ impl World {
             sp.broadphase += lap();
             let mut wake = std::mem::take(&mut self.wake_list);
             wake.clear();
-            self.collision.narrowphase(&self.bodies, dt, &self.portals.clipping, &mut wake);
+            #[cfg(feature = "portals")]
+            let clipping = &self.portals.clipping;
+            #[cfg(not(feature = "portals"))]
+            let clipping = &crate::collision::NO_CLIPPING;
+            self.collision.narrowphase(&self.bodies, dt, clipping, &mut wake);
             self.wake_all(&wake);
             self.wake_list = wake;
             self.collision.build_constraints(&self.bodies, &mut self.contact_constraints);
@@ -829,11 +844,14 @@ impl World {
         } else {
             self.contact_constraints.clear();
         }
+        #[cfg(feature = "portals")]
         let mut batches: [&mut dyn ConstraintBatch; 3] = [
             &mut self.revolute,
             &mut self.contact_constraints,
             &mut self.portals.constraints,
         ];
+        #[cfg(not(feature = "portals"))]
+        let mut batches: [&mut dyn ConstraintBatch; 2] = [&mut self.revolute, &mut self.contact_constraints];
         let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
         lap();
         if has_shapes {
@@ -841,6 +859,7 @@ impl World {
             self.collision.update_proxies(&self.bodies, dt);
             sp.broadphase += lap();
         }
+        #[cfg(feature = "portals")]
         if has_portals {
             self.portal_stage();
             sp.portals += lap();
@@ -875,10 +894,13 @@ impl World {
             .filter(|j| j.enabled)
             .map(|j| 2 + 2 * j.def.enable_limit as usize + j.def.enable_motor as usize + j.def.enable_spring as usize)
             .sum();
-        counters.portal_rows = 3 * self.portals.constraints.len();
         counters.portal_stage_ran = has_portals;
-        counters.portal_bodies_tested = if has_portals { self.portals.counters.bodies_tested } else { 0 };
-        counters.portal_crossings = self.portals.crossings.len();
+        #[cfg(feature = "portals")]
+        {
+            counters.portal_rows = 3 * self.portals.constraints.len();
+            counters.portal_bodies_tested = if has_portals { self.portals.counters.bodies_tested } else { 0 };
+            counters.portal_crossings = self.portals.crossings.len();
+        }
         counters.gravity_bodies = if self.gravity == Vec2::ZERO { 0 } else { self.bodies.moving_count() };
         counters.awake_bodies = self.bodies.moving_count();
         counters.sleeping_bodies = self.bodies.sleeping_count();
