@@ -251,15 +251,16 @@ pub type Mat3 = [[Real; 3]; 3];
 
 /// Solves `k x = b` for a symmetric positive semi-definite 3×3 `k`.
 ///
-/// Uses an LDLᵀ factorisation with pivots below a relative tolerance treated
-/// as zero (the corresponding component of `x` is set to zero): the result is
-/// a least-norm-like solution of the well-posed part and never NaN.
+/// Uses an LDLᵀ factorisation; a pivot below `16 ε` times its own diagonal
+/// entry is treated as zero (the corresponding component of `x` is set to
+/// zero): badly conditioned but regular matrices are solved, singular ones
+/// give a solution of the well-posed part, and the result is never NaN.
 pub fn solve33_psd(k: &Mat3, b: [Real; 3]) -> [Real; 3] {
     let scale = k[0][0].abs().max(k[1][1].abs()).max(k[2][2].abs());
     if scale == 0.0 || !scale.is_finite() {
         return [0.0; 3];
     }
-    let tol = scale * 1e3 * EPSILON;
+    let tol = |j: usize| 16.0 * EPSILON * k[j][j].abs().max(scale * EPSILON);
     // LDLᵀ with a lower unit-triangular L.
     let mut l = [[0.0 as Real; 3]; 3];
     let mut d = [0.0 as Real; 3];
@@ -275,7 +276,7 @@ pub fn solve33_psd(k: &Mat3, b: [Real; 3]) -> [Real; 3] {
             for m in 0..j {
                 v -= l[i][m] * l[j][m] * d[m];
             }
-            l[i][j] = if dj > tol { v / dj } else { 0.0 };
+            l[i][j] = if dj > tol(j) { v / dj } else { 0.0 };
         }
     }
     // Forward: L y = b.
@@ -290,7 +291,7 @@ pub fn solve33_psd(k: &Mat3, b: [Real; 3]) -> [Real; 3] {
     // Diagonal.
     let mut z = [0.0 as Real; 3];
     for i in 0..3 {
-        z[i] = if d[i] > tol { y[i] / d[i] } else { 0.0 };
+        z[i] = if d[i] > tol(i) { y[i] / d[i] } else { 0.0 };
     }
     // Backward: Lᵀ x = z.
     let mut x = [0.0 as Real; 3];

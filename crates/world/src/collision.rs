@@ -346,6 +346,18 @@ pub struct Collision {
     /// Counters of the last step.
     pub counters: CollisionCounters,
     new_pairs: Vec<(u32, u32)>,
+    scratch: Vec<ContactUpdate>,
+}
+
+/// Phase-1 result of the narrowphase for one contact.
+#[derive(Clone, Debug)]
+enum ContactUpdate {
+    /// Both bodies asleep or static: keep the contact as it is.
+    Asleep,
+    /// The fat boxes separated: destroy the contact.
+    Separated,
+    /// The new manifold.
+    Manifold(Manifold),
 }
 
 fn pair_key(a: u32, b: u32) -> (u32, u32) {
@@ -367,6 +379,7 @@ impl Collision {
             events: CollisionEvents::default(),
             counters: CollisionCounters::default(),
             new_pairs: Vec::new(),
+            scratch: Vec::new(),
         }
     }
 
@@ -593,44 +606,49 @@ impl Collision {
     /// skipped; a touching contact between a sleeping body and an awake one
     /// lists the sleeping body in `wake`.
     pub fn narrowphase(&mut self, bodies: &BodySet, dt: Real, clipping: &ContactClipping, wake: &mut Vec<BodyHandle>) {
+        // Phase 1: every contact's new manifold, independently (in parallel
+        // with the `parallel` feature: the results do not depend on the
+        // thread count, since each contact is computed alone).
+        let mut results = std::mem::take(&mut self.scratch);
+        results.clear();
+        {
+            let this = &*self;
+            let compute = |c: &Contact| this.update_of(c, bodies, dt);
+            #[cfg(feature = "parallel")]
+            {
+                use rayon::prelude::*;
+                self.contacts.par_iter().map(compute).collect_into_vec(&mut results);
+            }
+            #[cfg(not(feature = "parallel"))]
+            results.extend(self.contacts.iter().map(compute));
+        }
+        // Phase 2, in contact order: destroy, store, events.
         let clip = !clipping.is_empty();
         let mut k = 0;
         let mut tested = 0;
         let mut touching_count = 0;
         while k < self.contacts.len() {
+            let update = match results[k] {
+                ContactUpdate::Asleep => {
+                    k += 1;
+                    continue;
+                }
+                ContactUpdate::Separated => {
+                    self.destroy_contact(k);
+                    results.swap_remove(k);
+                    continue;
+                }
+                ContactUpdate::Manifold(ref m) => m,
+            };
+            tested += 1;
             let (body_a, body_b) = {
                 let c = &self.contacts[k];
                 (bodies.solver_body(c.body_a), bodies.solver_body(c.body_b))
             };
-            if body_a.state_index == 0 && body_b.state_index == 0 {
-                // Both asleep (or asleep and static): nothing moves.
-                k += 1;
-                continue;
-            }
-            let (pa, pb) = {
-                let c = &self.contacts[k];
-                (self.shapes[c.shape_a as usize].proxy, self.shapes[c.shape_b as usize].proxy)
-            };
-            if !self.broadphase.test_overlap(pa, pb) {
-                self.destroy_contact(k);
-                continue;
-            }
-            tested += 1;
-            let c = &self.contacts[k];
-            let sa = &self.shapes[c.shape_a as usize];
-            let sb = &self.shapes[c.shape_b as usize];
             let (sim_a, sim_b) = (body_a.sim, body_b.sim);
-            let reach = |aabb: &Aabb, center: Vec2| {
-                (aabb.lower - center).abs().max((aabb.upper - center).abs()).length()
-            };
-            let approach = (body_b.state.v - body_a.state.v).length()
-                + body_a.state.w.abs() * reach(&sa.aabb, sim_a.center)
-                + body_b.state.w.abs() * reach(&sb.aabb, sim_b.center);
-            let speculative = SPECULATIVE_DISTANCE + dt * approach;
-            let manifold = collide(&sa.geometry, &sim_a.transform, &sb.geometry, &sim_b.transform, speculative);
-            let was_touching = c.touching;
             let c = &mut self.contacts[k];
-            update_manifold(c, &manifold, &sim_a.transform, sim_a.center, &sim_b.transform, sim_b.center);
+            let was_touching = c.touching;
+            update_manifold(c, update, &sim_a.transform, sim_a.center, &sim_b.transform, sim_b.center);
             if clip {
                 clipping.apply(c);
             }
@@ -660,8 +678,31 @@ impl Collision {
             }
             k += 1;
         }
+        self.scratch = results;
         self.counters.pairs_tested = tested;
         self.counters.touching = touching_count;
+    }
+
+    /// The new manifold of one contact (phase 1 of the narrowphase).
+    fn update_of(&self, c: &Contact, bodies: &BodySet, dt: Real) -> ContactUpdate {
+        let body_a = bodies.solver_body(c.body_a);
+        let body_b = bodies.solver_body(c.body_b);
+        if body_a.state_index == 0 && body_b.state_index == 0 {
+            // Both asleep (or asleep and static): nothing moves.
+            return ContactUpdate::Asleep;
+        }
+        let sa = &self.shapes[c.shape_a as usize];
+        let sb = &self.shapes[c.shape_b as usize];
+        if !self.broadphase.test_overlap(sa.proxy, sb.proxy) {
+            return ContactUpdate::Separated;
+        }
+        let (sim_a, sim_b) = (body_a.sim, body_b.sim);
+        let reach = |aabb: &Aabb, center: Vec2| (aabb.lower - center).abs().max((aabb.upper - center).abs()).length();
+        let approach = (body_b.state.v - body_a.state.v).length()
+            + body_a.state.w.abs() * reach(&sa.aabb, sim_a.center)
+            + body_b.state.w.abs() * reach(&sb.aabb, sim_b.center);
+        let speculative = SPECULATIVE_DISTANCE + dt * approach;
+        ContactUpdate::Manifold(collide(&sa.geometry, &sim_a.transform, &sb.geometry, &sim_b.transform, speculative))
     }
 
     /// Builds the contact constraints of touching solid contacts.

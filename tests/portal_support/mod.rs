@@ -1,0 +1,449 @@
+//! Helpers shared by the portal test suites: body specifications built into
+//! a `BodySet`, random strategies, and momentum sums in f64.
+#![allow(dead_code)]
+
+use janus2d_constraints::portal::{PortalConstraint, PortalConstraintDef};
+use janus2d_constraints::portal_map::{
+    BodyMotion, Portal, PortalBodyMotion, PortalFrame, PortalMap,
+};
+use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodySet, BodyType};
+use janus2d_core::math::{Real, Rot, Transform, Vec2, cross_sv};
+use proptest::prelude::*;
+
+/// Widens to f64 (identity under the `f64` feature).
+#[allow(clippy::useless_conversion)] // `Real` is f64 with the feature
+pub fn d(x: Real) -> f64 {
+    f64::from(x)
+}
+
+/// A 2D vector widened to f64.
+pub fn dv(v: Vec2) -> [f64; 2] {
+    [d(v.x), d(v.y)]
+}
+
+/// Everything needed to create one body, about its centre of mass.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodySpec {
+    /// Static, kinematic or dynamic.
+    pub ty: BodyType,
+    /// Centre of mass, m.
+    pub center: Vec2,
+    /// Angle, rad.
+    pub angle: Real,
+    /// Velocity of the centre of mass, m/s (ignored for static bodies).
+    pub v: Vec2,
+    /// Angular velocity, rad/s (ignored for static bodies).
+    pub w: Real,
+    /// Mass, kg (dynamic only).
+    pub mass: Real,
+    /// Rotational inertia about the centre, kg·m² (dynamic only).
+    pub inertia: Real,
+    /// Centre of mass in the body frame (dynamic only; other types rotate
+    /// about their origin).
+    pub local_center: Vec2,
+    /// Locks rotation (dynamic only).
+    pub fixed_rotation: bool,
+}
+
+impl BodySpec {
+    /// A dynamic body with its centre at its origin.
+    pub fn dynamic(center: Vec2, mass: Real, inertia: Real) -> BodySpec {
+        BodySpec {
+            ty: BodyType::Dynamic,
+            center,
+            angle: 0.0,
+            v: Vec2::ZERO,
+            w: 0.0,
+            mass,
+            inertia,
+            local_center: Vec2::ZERO,
+            fixed_rotation: false,
+        }
+    }
+
+    /// A static body.
+    pub fn fixed(center: Vec2, angle: Real) -> BodySpec {
+        BodySpec {
+            ty: BodyType::Static,
+            angle,
+            ..BodySpec::dynamic(center, 1.0, 1.0)
+        }
+    }
+
+    /// A kinematic body.
+    pub fn kinematic(center: Vec2, angle: Real, v: Vec2, w: Real) -> BodySpec {
+        BodySpec {
+            ty: BodyType::Kinematic,
+            angle,
+            v,
+            w,
+            ..BodySpec::dynamic(center, 1.0, 1.0)
+        }
+    }
+
+    /// The local centre the engine will use (zero unless dynamic).
+    pub fn effective_local_center(&self) -> Vec2 {
+        if self.ty == BodyType::Dynamic {
+            self.local_center
+        } else {
+            Vec2::ZERO
+        }
+    }
+
+    /// The body transform (origin and rotation).
+    pub fn transform(&self) -> Transform {
+        let q = Rot::from_angle(self.angle);
+        Transform {
+            p: self.center - q.rotate(self.effective_local_center()),
+            q,
+        }
+    }
+
+    /// The velocity field the body carries (zero for a static body).
+    pub fn motion(&self) -> PortalBodyMotion {
+        if self.ty == BodyType::Static {
+            PortalBodyMotion {
+                center: self.center,
+                ..PortalBodyMotion::AT_REST
+            }
+        } else {
+            PortalBodyMotion {
+                center: self.center,
+                linear_velocity: self.v,
+                angular_velocity: self.w,
+            }
+        }
+    }
+
+    /// Position, angle and velocities about the centre.
+    pub fn body_motion(&self) -> BodyMotion {
+        BodyMotion {
+            center: self.center,
+            angle: self.angle,
+            linear_velocity: self.v,
+            angular_velocity: self.w,
+        }
+    }
+
+    /// The pose moved along a direction `(dir_v, dir_w)` for a time `t`
+    /// (velocities unchanged).
+    pub fn moved(&self, dir_v: Vec2, dir_w: Real, t: Real) -> BodySpec {
+        BodySpec {
+            center: self.center + t * dir_v,
+            angle: self.angle + t * dir_w,
+            ..self.clone()
+        }
+    }
+
+    /// Creates the body.
+    pub fn create(&self, set: &mut BodySet) -> BodyHandle {
+        let tf = self.transform();
+        let moving = self.ty != BodyType::Static;
+        let (v, w) = if moving {
+            (self.v, self.w)
+        } else {
+            (Vec2::ZERO, 0.0)
+        };
+        // BodyDef takes the origin's velocity; the engine adds ω × (c − o).
+        let v_origin = v - cross_sv(w, self.center - tf.p);
+        let def = BodyDef {
+            body_type: self.ty,
+            position: tf.p,
+            angle: self.angle,
+            linear_velocity: v_origin,
+            angular_velocity: w,
+            mass: (self.ty == BodyType::Dynamic).then_some(BodyMass {
+                mass: self.mass,
+                rotational_inertia: self.inertia,
+                center: self.local_center,
+            }),
+            fixed_rotation: self.ty == BodyType::Dynamic && self.fixed_rotation,
+            max_linear_speed: 1.0e9,
+            max_rotation: 1.0e9,
+            ..BodyDef::default()
+        };
+        set.create(&def).expect("valid body")
+    }
+}
+
+/// A portal constraint case: four bodies (A and B may be one), two portals
+/// and a scale.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PortalCase {
+    /// Body 1.
+    pub body: BodySpec,
+    /// Body 2, the clone.
+    pub clone: BodySpec,
+    /// Portal body A.
+    pub a: BodySpec,
+    /// Portal body B (ignored when `same_ab`).
+    pub b: BodySpec,
+    /// A and B are one body (`a`).
+    pub same_ab: bool,
+    /// Portal 1 on A.
+    pub portal_a: Portal,
+    /// Portal 2 on B.
+    pub portal_b: Portal,
+    /// Scale.
+    pub eta: Real,
+}
+
+/// A case built into bodies.
+pub struct Built {
+    /// The bodies.
+    pub set: BodySet,
+    /// Handles: body, clone, A, B.
+    pub handles: [BodyHandle; 4],
+    /// The constraint.
+    pub constraint: PortalConstraint,
+}
+
+impl PortalCase {
+    /// The spec of portal body B (A's when `same_ab`).
+    pub fn b_spec(&self) -> &BodySpec {
+        if self.same_ab { &self.a } else { &self.b }
+    }
+
+    /// The world map at the current poses.
+    pub fn map(&self) -> PortalMap {
+        PortalMap::new(
+            PortalFrame::new(&self.a.transform(), &self.portal_a),
+            PortalFrame::new(&self.b_spec().transform(), &self.portal_b),
+            self.eta,
+        )
+        .expect("valid eta")
+    }
+
+    /// Puts the clone at the exact clone state of the body.
+    pub fn place_clone_exactly(&mut self) {
+        let state = self.map().clone_state(
+            &self.body.body_motion(),
+            &self.a.motion(),
+            &self.b_spec().motion(),
+        );
+        self.clone.center = state.center;
+        self.clone.angle = state.angle;
+        self.clone.v = state.linear_velocity;
+        self.clone.w = state.angular_velocity;
+    }
+
+    /// Puts the clone's angle so that the angle row's error is `c2`.
+    pub fn set_angle_error(&mut self, c2: Real) {
+        let map = self.map();
+        // c2 = (θ1 − α1) − (θ2 − α2) − π
+        self.clone.angle =
+            self.body.angle - map.frame1.angle + map.frame2.angle - janus2d_core::math::PI - c2;
+    }
+
+    /// Creates the bodies and the constraint.
+    pub fn build(&self) -> Built {
+        let mut set = BodySet::new();
+        let a = self.a.create(&mut set);
+        let b = if self.same_ab {
+            a
+        } else {
+            self.b.create(&mut set)
+        };
+        let body = self.body.create(&mut set);
+        let clone = self.clone.create(&mut set);
+        let constraint = PortalConstraint::new(PortalConstraintDef {
+            body,
+            clone,
+            portal_body_a: a,
+            portal_body_b: b,
+            portal_a: self.portal_a,
+            portal_b: self.portal_b,
+            eta: self.eta,
+        })
+        .expect("valid portal definition");
+        Built {
+            set,
+            handles: [body, clone, a, b],
+            constraint,
+        }
+    }
+
+    /// The case with every body moved along its direction for time `t`
+    /// (`dirs` in the order body, clone, A, B).
+    pub fn moved(&self, dirs: &[(Vec2, Real); 4], t: Real) -> PortalCase {
+        PortalCase {
+            body: self.body.moved(dirs[0].0, dirs[0].1, t),
+            clone: self.clone.moved(dirs[1].0, dirs[1].1, t),
+            a: self.a.moved(dirs[2].0, dirs[2].1, t),
+            b: self.b.moved(dirs[3].0, dirs[3].1, t),
+            ..self.clone()
+        }
+    }
+}
+
+/// Total linear momentum and angular momentum about the origin of the
+/// given bodies (each once), in f64, plus the sum of the magnitudes of the
+/// terms (the scale round-off is relative to).
+pub fn total_momentum(set: &BodySet, handles: &[BodyHandle]) -> ([f64; 3], f64) {
+    let mut seen: Vec<BodyHandle> = Vec::new();
+    let mut p = [0.0f64; 3];
+    let mut scale = 0.0f64;
+    for &h in handles {
+        if seen.contains(&h) {
+            continue;
+        }
+        seen.push(h);
+        let sim = set.sim(h).unwrap();
+        if sim.body_type != BodyType::Dynamic {
+            continue;
+        }
+        let st = set.state(h).unwrap();
+        let m = d(sim.mass);
+        let i = d(sim.inertia);
+        let [x, y] = dv(sim.center);
+        let [vx, vy] = dv(st.v);
+        let w = d(st.w);
+        p[0] += m * vx;
+        p[1] += m * vy;
+        let l = m * (x * vy - y * vx) + i * w;
+        p[2] += l;
+        scale += m * (vx.abs() + vy.abs())
+            + m * (x.abs() * vy.abs() + y.abs() * vx.abs())
+            + (i * w).abs();
+    }
+    (p, scale)
+}
+
+/// `p1 + η Qᵀ p2` and `I1 ω1 + I2 ω2` in f64, plus the scale of the terms.
+pub fn scaled_momentum(
+    set: &BodySet,
+    body: BodyHandle,
+    clone: BodyHandle,
+    map: &PortalMap,
+) -> ([f64; 3], f64) {
+    let q = map.rotation();
+    let (qc, qs) = (d(q.c), d(q.s));
+    let eta = d(map.eta);
+    let part = |h: BodyHandle| {
+        let sim = set.sim(h).unwrap();
+        let st = set.state(h).unwrap();
+        let m = d(sim.mass);
+        let [vx, vy] = dv(st.v);
+        (m * vx, m * vy, d(sim.inertia) * d(st.w))
+    };
+    let (p1x, p1y, l1) = part(body);
+    let (p2x, p2y, l2) = part(clone);
+    // Qᵀ p2
+    let (qx, qy) = (qc * p2x + qs * p2y, -qs * p2x + qc * p2y);
+    let value = [p1x + eta * qx, p1y + eta * qy, l1 + l2];
+    let scale = p1x.abs() + p1y.abs() + eta * (p2x.abs() + p2y.abs()) + l1.abs() + l2.abs();
+    (value, scale)
+}
+
+/// Log-uniform values between `10^lo` and `10^hi`.
+pub fn log_uniform(lo: f64, hi: f64) -> impl Strategy<Value = Real> + Clone {
+    (lo..hi).prop_map(|u| 10f64.powf(u) as Real)
+}
+
+/// Uniform reals.
+pub fn real(lo: f64, hi: f64) -> impl Strategy<Value = Real> + Clone {
+    (lo..hi).prop_map(|u| u as Real)
+}
+
+/// Vectors with components in `[-r, r]`.
+pub fn vec2(r: f64) -> impl Strategy<Value = Vec2> + Clone {
+    (-r..r, -r..r).prop_map(|(x, y)| Vec2::new(x as Real, y as Real))
+}
+
+/// A random body of a type drawn from `ty`: centre in ±5 m, any angle,
+/// speed components ±2 m/s, ω ±1.5 rad/s, mass and inertia in
+/// `[1e-3, 1e3]` (six orders of magnitude), local centre ±0.5 m.
+pub fn body_spec(
+    ty: impl Strategy<Value = BodyType> + Clone,
+) -> impl Strategy<Value = BodySpec> + Clone {
+    (
+        ty,
+        vec2(5.0),
+        real(-std::f64::consts::PI, std::f64::consts::PI),
+        vec2(2.0),
+        real(-1.5, 1.5),
+        log_uniform(-3.0, 3.0),
+        log_uniform(-3.0, 3.0),
+        vec2(0.5),
+    )
+        .prop_map(
+            |(ty, center, angle, v, w, mass, inertia, local_center)| BodySpec {
+                ty,
+                center,
+                angle,
+                v: if ty == BodyType::Static {
+                    Vec2::ZERO
+                } else {
+                    v
+                },
+                w: if ty == BodyType::Static { 0.0 } else { w },
+                mass,
+                inertia,
+                local_center,
+                fixed_rotation: false,
+            },
+        )
+}
+
+/// A random portal: anchor ±2 m, any direction (given at a random length),
+/// half-width 0.1–3 m.
+pub fn portal() -> impl Strategy<Value = Portal> + Clone {
+    (
+        vec2(2.0),
+        real(-std::f64::consts::PI, std::f64::consts::PI),
+        real(0.2, 5.0),
+        real(0.1, 3.0),
+    )
+        .prop_map(|(anchor, a, len, w)| {
+            Portal::new(anchor, len * Vec2::new(a.cos(), a.sin()), w).expect("valid portal")
+        })
+}
+
+/// Any portal body type.
+pub fn any_type() -> impl Strategy<Value = BodyType> + Clone {
+    prop_oneof![
+        Just(BodyType::Static),
+        Just(BodyType::Kinematic),
+        Just(BodyType::Dynamic)
+    ]
+}
+
+/// Static or kinematic (zero inverse mass).
+pub fn massless_type() -> impl Strategy<Value = BodyType> + Clone {
+    prop_oneof![Just(BodyType::Static), Just(BodyType::Kinematic)]
+}
+
+/// A random case: the body and its clone dynamic, the portal bodies of
+/// the given types (A and B one body with probability 1/4), η in [0.1, 10]
+/// (log-uniform), the clone anywhere and its angle error `c2` in ±3 rad.
+pub fn portal_case(
+    portal_type: impl Strategy<Value = BodyType> + Clone,
+) -> impl Strategy<Value = PortalCase> + Clone {
+    (
+        body_spec(Just(BodyType::Dynamic)),
+        body_spec(Just(BodyType::Dynamic)),
+        body_spec(portal_type.clone()),
+        body_spec(portal_type),
+        prop::bool::weighted(0.25),
+        portal(),
+        portal(),
+        log_uniform(-1.0, 1.0),
+        real(-3.0, 3.0),
+    )
+        .prop_map(
+            |(body, clone, a, b, same_ab, portal_a, portal_b, eta, c2)| {
+                let mut case = PortalCase {
+                    body,
+                    clone,
+                    a,
+                    b,
+                    same_ab,
+                    portal_a,
+                    portal_b,
+                    eta,
+                };
+                case.set_angle_error(c2);
+                case
+            },
+        )
+}
