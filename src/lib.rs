@@ -19,12 +19,14 @@
 //! world
 //!     .create_revolute_joint(&RevoluteJointDef::new(ground, bob, Vec2::ZERO, Vec2::new(-1.0, 0.0)))
 //!     .unwrap();
-//! for _ in 0..60 {
+//! // Half a second later the bob swings through the bottom of its arc.
+//! for _ in 0..30 {
 //!     world.step(1.0 / 60.0).unwrap();
 //! }
 //! assert!(world.position(bob).unwrap().y < -0.5);
 //! ```
 
+pub mod metrics;
 pub mod scenes;
 
 pub use janus2d_constraints as constraints;

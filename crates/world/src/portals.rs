@@ -544,6 +544,9 @@ impl World {
     /// Creates the clone of `body` entering portal `entry` of pair `index`.
     fn start_crossing(&mut self, index: u32, entry: usize, body: BodyHandle) -> Option<()> {
         let d = self.portals.slots[index as usize].data.clone()?;
+        // A crossing wakes the portal bodies (their constraint rows act now).
+        self.wake_body(d.portals[0].body);
+        self.wake_body(d.portals[1].body);
         let exit = 1 - entry;
         let eta = if entry == 0 { d.eta } else { 1.0 / d.eta };
         let f1 = frame_of(self, &d.portals[entry], &d.local[entry]);
@@ -645,7 +648,7 @@ impl World {
         self.set_copy_mass(c.clone, scale(c.mass_clone, 1.0 - f), exit_body);
     }
 
-    fn crossing_portal_bodies(&self, c: &Crossing) -> (BodyHandle, BodyHandle) {
+    pub(crate) fn crossing_portal_bodies(&self, c: &Crossing) -> (BodyHandle, BodyHandle) {
         let d = self.portals.slots[c.pair as usize].data.as_ref().expect("live pair");
         (d.portals[c.entry].body, d.portals[1 - c.entry].body)
     }

@@ -158,10 +158,12 @@ impl World {
                 union(&mut parent, ia, ib);
             }
         }
+        // A crossing keeps the object and its portal bodies awake.
         #[cfg(feature = "portals")]
         for k in 0..self.portals.crossings.len() {
             let c = &self.portals.crossings[k];
-            for b in [c.original, c.clone] {
+            let (entry, exit) = self.crossing_portal_bodies(c);
+            for b in [c.original, c.clone, entry, exit] {
                 if let Some(i) = index(self, b) {
                     self.bodies_mut().sims[i as usize].sleep_time = 0.0;
                 }

@@ -965,6 +965,8 @@ fn validate_settings(s: &SolverSettings) -> Result<(), WorldError> {
         s.joint_damping_ratio,
         s.joint_max_correction_speed,
         s.restitution_threshold,
+        s.contact_mass_ratio_cap,
+        s.joint_mass_ratio_cap,
     ];
     if reals.iter().any(|x| x.is_nan()) {
         return Err(WorldError::NonFinite("solver settings"));
