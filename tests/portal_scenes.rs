@@ -441,3 +441,112 @@ fn portal_stream_conserves_bodies() {
     assert!(all_finite);
     assert!(passes >= 100, "only {passes} passes");
 }
+
+/// Destroying the pair mid-crossing removes the clone and its constraint;
+/// destroying a portal's body ends the pair and its crossings too.
+#[test]
+fn destroying_a_portal_ends_crossings_cleanly() {
+    for destroy_body in [false, true] {
+        let (mut scene, pair) = scenes::portal_drop(&WorldDef::default());
+        let world = &mut scene.world;
+        let mut steps = 0;
+        while world.crossing_count() == 0 {
+            world.step(DT).unwrap();
+            steps += 1;
+            assert!(steps < 200, "never started crossing");
+        }
+        let clone = world.clone_of(scene.probe).unwrap();
+        if destroy_body {
+            let floor = world.bodies().handles().next().unwrap();
+            world.destroy_body(floor).unwrap();
+        } else {
+            world.destroy_portal_pair(pair).unwrap();
+        }
+        assert_eq!(world.crossing_count(), 0);
+        assert_eq!(world.portal_constraints().len(), 0);
+        assert_eq!(world.portal_pair_count(), 0);
+        assert!(world.position(clone).is_err(), "clone leaked");
+        assert_eq!(dynamic_count(world), 1);
+        assert!(world.destroy_portal_pair(pair).is_err(), "stale pair handle accepted");
+        for _ in 0..10 {
+            world.step(DT).unwrap();
+        }
+        assert!(world.position(scene.probe).unwrap().is_finite());
+    }
+}
+
+/// A joint on a body that goes through would span the portal: it is
+/// disabled and reported; the body's handle follows it to the exit.
+#[test]
+fn joint_spanning_a_portal_is_disabled_and_reported() {
+    let (mut scene, _) = scenes::portal_drop(&WorldDef::default());
+    let world = &mut scene.world;
+    // A second box hinged on top of the falling one: once the first is
+    // through, the joint would span the portal.
+    let buddy = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 7.0))).unwrap();
+    world.create_shape(buddy, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    let joint = world
+        .create_revolute_joint(&RevoluteJointDef::new(scene.probe, buddy, Vec2::new(0.0, 0.75), Vec2::new(0.0, -0.75)))
+        .unwrap();
+    let mut disabled = false;
+    let mut completed_body = None;
+    for _ in 0..150 {
+        world.step(DT).unwrap();
+        for e in world.portal_events() {
+            match e {
+                PortalEvent::JointDisabled { joint: j, .. } => {
+                    assert_eq!(*j, joint);
+                    disabled = true;
+                }
+                PortalEvent::CrossingCompleted { body, .. } if *body == scene.probe => completed_body = Some(*body),
+                _ => {}
+            }
+        }
+        if completed_body.is_some() {
+            break;
+        }
+    }
+    assert!(completed_body.is_some(), "the box never went through");
+    assert!(disabled, "no joint-disabled event");
+    assert!(!world.revolute_joint(joint).unwrap().enabled);
+    // The handle now refers to the object on the exit side (the wall at x = -20).
+    assert!(world.position(scene.probe).unwrap().x < -15.0);
+}
+
+/// Fast bodies: a box at 150 m/s straight at a wall portal crosses within a
+/// step or two and never shows up behind the entry wall; it crosses once.
+#[test]
+fn fast_body_crosses_without_tunnelling() {
+    let def = WorldDef { gravity: Vec2::ZERO, ..Default::default() };
+    let mut world = World::new(def).unwrap();
+    let a = wall(&mut world, Vec2::new(0.5, 0.0), 0.5, 5.0);
+    let b = wall(&mut world, Vec2::new(-0.5, 50.0), 0.5, 5.0);
+    world
+        .create_portal_pair(&PortalPairDef::new(
+            PortalDef { body: a, anchor: Vec2::new(-0.5, 0.0), direction: -Vec2::X, half_width: 1.0 },
+            PortalDef { body: b, anchor: Vec2::new(0.5, 0.0), direction: Vec2::X, half_width: 1.0 },
+        ))
+        .unwrap();
+    let body = world
+        .create_body(&BodyDef::dynamic(Vec2::new(-10.0, 0.0)).with_velocity(Vec2::new(150.0, 0.0)))
+        .unwrap();
+    world.create_shape(body, &ShapeDef::default(), Polygon::make_box(0.25, 0.25)).unwrap();
+    let mut completions = 0;
+    for _ in 0..30 {
+        world.step(DT).unwrap();
+        completions += world
+            .portal_events()
+            .iter()
+            .filter(|e| matches!(e, PortalEvent::CrossingCompleted { .. }))
+            .count();
+        let p = world.position(body).unwrap();
+        // Entirely behind the entry plane (centre deeper than its half size)
+        // would mean it tunnelled into the wall instead of crossing.
+        assert!(!(p.x > 0.25 && p.y.abs() < 10.0), "behind the entry wall at {p}");
+    }
+    let p = world.position(body).unwrap();
+    let v = world.linear_velocity(body).unwrap();
+    assert_eq!(completions, 1);
+    assert!((p.y - 50.0).abs() < 0.5 && p.x > 10.0, "not on the exit side: {p}");
+    assert!((v.x - 150.0).abs() < 1.5, "speed changed: {v}");
+}
