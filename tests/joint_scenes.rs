@@ -5,6 +5,19 @@ use janus2d::prelude::*;
 
 const DT: Real = 1.0 / 60.0;
 
+/// The shared settings of the hard cases: the default world with sleep off
+/// (scenes.md: "stability tests, sleep off"), so a stack that would fall is
+/// never frozen by sleeping.
+fn sleep_off() -> WorldDef {
+    WorldDef {
+        sleep: janus2d::world::SleepSettings {
+            enabled: false,
+            ..Default::default()
+        },
+        ..WorldDef::default()
+    }
+}
+
 fn report() -> bool {
     std::env::var("JANUS2D_REPORT").is_ok()
 }
@@ -60,7 +73,7 @@ fn unstretched_chain_whip_reference() {
 /// Runs the chain with link spacing `spacing` for 10 s; returns the peak
 /// speed, the first time every gap is ≤ 1 cm, and the largest gap at 10 s.
 fn run_chain(spacing: Real) -> (Real, Option<Real>, Real) {
-    let mut world = World::new(WorldDef::default()).unwrap();
+    let mut world = World::new(sleep_off()).unwrap();
     let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
     let r: Real = 0.25;
     let m = janus2d::base::math::PI * r * r;
@@ -105,7 +118,7 @@ fn run_chain(spacing: Real) -> (Real, Option<Real>, Real) {
 /// end, both ends pinned.
 #[test]
 fn bridge_joint_gap_over_last_second() {
-    let mut world = World::new(WorldDef::default()).unwrap();
+    let mut world = World::new(sleep_off()).unwrap();
     let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
     let (hx, hy): (Real, Real) = (0.5, 0.125);
     let density: Real = 20.0;

@@ -28,6 +28,14 @@
 //!
 //! `λ = −k⁻¹ s_m (Ċ + bias) − s_i λ_acc`, accumulated impulse clamped `≥ 0`.
 //!
+//! **Mass-ratio-aware softness.** Between two moving bodies the spring of a
+//! point is built on the heavier side's effective mass at that point
+//! (Softness::with_mass_ratio): with `k_a = m_a⁻¹ + i_a⁻¹ (r_a × n)²` and
+//! `k_b` likewise, `k = k_a + k_b` and
+//! `ρ = min(k / min(k_a, k_b), ρ_max)`, so `s_m`, `s_i` are per point,
+//! computed once in `prepare`. Against a static body `ρ = 1` (that pair
+//! already uses the stiffer static softness).
+//!
 //! **Friction row.** `J` as above with `t` for `n`, no position error;
 //! the accumulated impulse is clamped to `±μ λ_n` (Coulomb), with
 //! `μ = √(μ_a μ_b)`.
@@ -73,6 +81,16 @@ struct ContactPoint {
     max_normal_impulse: Real,
     /// Normal velocity before the solve (for restitution), m/s.
     relative_velocity: Real,
+    /// Soft mass scale `s_m` of this point's normal row (dimensionless).
+    mass_scale: Real,
+    /// Soft impulse scale `s_i` of this point's normal row (dimensionless).
+    impulse_scale: Real,
+    /// Angular Jacobian parts `r_a × n`, `r_b × n`, `r_a × t`, `r_b × t`
+    /// (the anchors are fixed for the step), m.
+    rn_a: Real,
+    rn_b: Real,
+    rt_a: Real,
+    rt_b: Real,
 }
 
 /// A contact constraint between two bodies (one manifold, 1–2 points).
@@ -138,12 +156,18 @@ impl ContactConstraint {
 
     /// Accumulated (normal, tangent) impulses of point `i`, N·s.
     pub fn impulses(&self, i: usize) -> (Real, Real) {
-        (self.points[i].normal.impulse, self.points[i].tangent.impulse)
+        (
+            self.points[i].normal.impulse,
+            self.points[i].tangent.impulse,
+        )
     }
 
     /// Total normal impulse of the last step, N·s.
     pub fn total_normal_impulse(&self) -> Real {
-        self.points[..self.point_count].iter().map(|p| p.normal.impulse).sum()
+        self.points[..self.point_count]
+            .iter()
+            .map(|p| p.normal.impulse)
+            .sum()
     }
 
     #[inline(always)]
@@ -160,11 +184,35 @@ impl Constraint for ContactConstraint {
         self.state_b = b.state_index;
         let (sa, sb) = (a.state, b.state);
         let static_pair = sa.inv_mass == 0.0 || sb.inv_mass == 0.0;
-        self.softness = if static_pair { ctx.static_softness } else { ctx.contact_softness };
+        self.softness = if static_pair {
+            ctx.static_softness
+        } else {
+            ctx.contact_softness
+        };
+        let moving_pair = !static_pair;
+        let rho_max = ctx.contact_mass_ratio_cap;
         let n = self.normal;
         let t = self.tangent();
         for cp in &mut self.points[..self.point_count] {
-            cp.normal.set_mass(AxisPart::k(sa, sb, cp.r_a, cp.r_b, n));
+            let rn_a = cross(cp.r_a, n);
+            let rn_b = cross(cp.r_b, n);
+            let k_a = sa.inv_mass + sa.inv_inertia * rn_a * rn_a;
+            let k_b = sb.inv_mass + sb.inv_inertia * rn_b * rn_b;
+            let k = k_a + k_b;
+            let k_heavy = k_a.min(k_b);
+            let rho = if moving_pair && rho_max > 1.0 && k_heavy > 0.0 {
+                (k / k_heavy).min(rho_max)
+            } else {
+                1.0
+            };
+            let soft = self.softness.with_mass_ratio(rho);
+            cp.mass_scale = soft.mass_scale;
+            cp.impulse_scale = soft.impulse_scale;
+            cp.rn_a = rn_a;
+            cp.rn_b = rn_b;
+            cp.rt_a = cross(cp.r_a, t);
+            cp.rt_b = cross(cp.r_b, t);
+            cp.normal.set_mass(k);
             cp.tangent.set_mass(AxisPart::k(sa, sb, cp.r_a, cp.r_b, t));
             cp.relative_velocity = AxisPart::c_dot(sa, sb, cp.r_a, cp.r_b, n);
             cp.max_normal_impulse = 0.0;
@@ -178,54 +226,78 @@ impl Constraint for ContactConstraint {
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
         let (mut sa, mut sb) = load_pair(states, self.state_a, self.state_b);
         let (n, t) = (self.normal, self.tangent());
+        let (m_a, i_a, m_b, i_b) = (sa.inv_mass, sa.inv_inertia, sb.inv_mass, sb.inv_inertia);
         for cp in &self.points[..self.point_count] {
-            let p = cp.normal.impulse * n + cp.tangent.impulse * t;
-            AxisPart::apply(&mut sa, &mut sb, cp.r_a, cp.r_b, p, 1.0);
+            let (lambda_n, lambda_t) = (cp.normal.impulse, cp.tangent.impulse);
+            let p = lambda_n * n + lambda_t * t;
+            sa.v -= m_a * p;
+            sa.w -= i_a * (lambda_n * cp.rn_a + lambda_t * cp.rt_a);
+            sb.v += m_b * p;
+            sb.w += i_b * (lambda_n * cp.rn_b + lambda_t * cp.rt_b);
         }
         store_pair(states, self.state_a, self.state_b, &sa, &sb);
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        let (mut sa, mut sb) = load_pair(states, self.state_a, self.state_b);
+        let (sa, sb) = load_pair(states, self.state_a, self.state_b);
+        let (m_a, i_a, m_b, i_b) = (sa.inv_mass, sa.inv_inertia, sb.inv_mass, sb.inv_inertia);
+        let (mut v_a, mut w_a, mut v_b, mut w_b) = (sa.v, sa.w, sb.v, sb.w);
         let n = self.normal;
         let dp = sb.dp - sa.dp;
-        let softness = self.softness;
-        for cp in &mut self.points[..self.point_count] {
+        let bias_rate = self.softness.bias_rate;
+        let push_max = ctx.contact_push_max_velocity;
+        let inv_h = ctx.inv_h;
+        let count = self.point_count;
+        for cp in &mut self.points[..count] {
             // Current separation from the deltas, anchors fixed on the bodies.
-            let pr_a = sa.dq.rotate(cp.r_a);
-            let pr_b = sb.dq.rotate(cp.r_b);
-            let s = cp.base_separation + (dp + pr_b - pr_a).dot(n);
+            let ds = dp + sb.dq.rotate(cp.r_b) - sa.dq.rotate(cp.r_a);
+            let s = cp.base_separation + ds.dot(n);
             let (bias, mass_scale, impulse_scale) = if s > 0.0 {
-                (s * ctx.inv_h, 1.0, 0.0)
+                (s * inv_h, 1.0, 0.0)
             } else if use_bias {
                 (
-                    (softness.bias_rate * s).max(-ctx.contact_push_max_velocity),
-                    softness.mass_scale,
-                    softness.impulse_scale,
+                    (bias_rate * s).max(-push_max),
+                    cp.mass_scale,
+                    cp.impulse_scale,
                 )
             } else {
                 (0.0, 1.0, 0.0)
             };
-            let c_dot = AxisPart::c_dot(&sa, &sb, cp.r_a, cp.r_b, n);
-            let lambda = -cp.normal.mass * mass_scale * (c_dot + bias) - impulse_scale * cp.normal.impulse;
-            let new_impulse = (cp.normal.impulse + lambda).max(0.0);
-            let applied = new_impulse - cp.normal.impulse;
+            // Ċ = n · (v_b − v_a) + ω_b (r_b × n) − ω_a (r_a × n).
+            let c_dot = (v_b - v_a).dot(n) + w_b * cp.rn_b - w_a * cp.rn_a;
+            let old = cp.normal.impulse;
+            let lambda = -cp.normal.mass * mass_scale * (c_dot + bias) - impulse_scale * old;
+            let new_impulse = (old + lambda).max(0.0);
+            let applied = new_impulse - old;
             cp.normal.impulse = new_impulse;
             cp.max_normal_impulse = cp.max_normal_impulse.max(applied);
-            AxisPart::apply(&mut sa, &mut sb, cp.r_a, cp.r_b, n, applied);
+            let p = applied * n;
+            v_a -= m_a * p;
+            w_a -= i_a * applied * cp.rn_a;
+            v_b += m_b * p;
+            w_b += i_b * applied * cp.rn_b;
         }
         let t = self.tangent();
         let friction = self.friction;
-        for cp in &mut self.points[..self.point_count] {
-            let c_dot = AxisPart::c_dot(&sa, &sb, cp.r_a, cp.r_b, t);
-            let lambda = -cp.tangent.mass * c_dot;
+        for cp in &mut self.points[..count] {
+            let c_dot = (v_b - v_a).dot(t) + w_b * cp.rt_b - w_a * cp.rt_a;
+            let old = cp.tangent.impulse;
             let max_friction = friction * cp.normal.impulse;
-            let new_impulse = (cp.tangent.impulse + lambda).clamp(-max_friction, max_friction);
-            let applied = new_impulse - cp.tangent.impulse;
+            let new_impulse = (old - cp.tangent.mass * c_dot).clamp(-max_friction, max_friction);
+            let applied = new_impulse - old;
             cp.tangent.impulse = new_impulse;
-            AxisPart::apply(&mut sa, &mut sb, cp.r_a, cp.r_b, t, applied);
+            let p = applied * t;
+            v_a -= m_a * p;
+            w_a -= i_a * applied * cp.rt_a;
+            v_b += m_b * p;
+            w_b += i_b * applied * cp.rt_b;
         }
-        store_pair(states, self.state_a, self.state_b, &sa, &sb);
+        let ta = &mut states[self.state_a as usize];
+        ta.v = v_a;
+        ta.w = w_a;
+        let tb = &mut states[self.state_b as usize];
+        tb.v = v_b;
+        tb.w = w_b;
     }
 
     fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
@@ -255,7 +327,11 @@ impl Constraint for ContactConstraint {
         let b = bodies.solver_body(self.body_b);
         let (sa, sb) = (a.state, b.state);
         let static_pair = sa.inv_mass == 0.0 || sb.inv_mass == 0.0;
-        let softness = if static_pair { ctx.static_softness } else { ctx.contact_softness };
+        let softness = if static_pair {
+            ctx.static_softness
+        } else {
+            ctx.contact_softness
+        };
         let mut out = ConstraintRows::default();
         let entry = |body, linear: Vec2, angular, s: &BodyState| BodyJacobian {
             body,

@@ -20,6 +20,12 @@
 //! and the bias `β C` capped at the joint correction speed so that a large
 //! initial error recovers gently instead of flinging the bodies.
 //!
+//! The point rows' spring is built on the heavier body's mass
+//! (Softness::with_mass_ratio): `ρ = min((m_a⁻¹ + m_b⁻¹) / min(m_a⁻¹, m_b⁻¹), ρ_max)`,
+//! `ρ = ρ_max` against a static or kinematic body, so a light link under a
+//! heavy load stretches `ρ` times less; `ρ_max` keeps one Gauss–Seidel
+//! iteration per substep stable.
+//!
 //! **Angle (1 row each).** `C = θ_b − θ_a − θ_ref`, `J = [0 −1 0 1]`,
 //! `K = i_a⁻¹ + i_b⁻¹`. The spring drives `C` to zero with its own softness;
 //! the motor drives `Ċ` to the target speed with the impulse clamped to
@@ -165,6 +171,8 @@ pub struct RevoluteJoint {
     lower: AnglePart,
     upper: AnglePart,
     spring_softness: Softness,
+    /// Softness of the point rows for this step (mass-ratio aware).
+    point_softness: Softness,
 }
 
 impl RevoluteJoint {
@@ -182,6 +190,7 @@ impl RevoluteJoint {
             lower: AnglePart::default(),
             upper: AnglePart::default(),
             spring_softness: Softness::RIGID,
+            point_softness: Softness::RIGID,
         }
     }
 
@@ -248,6 +257,14 @@ impl Constraint for RevoluteJoint {
             part.prepare(sa, sb);
         }
         self.spring_softness = Softness::new(self.def.hertz, self.def.damping_ratio, ctx.h);
+        let inv_mass_sum = sa.inv_mass + sb.inv_mass;
+        let inv_mass_heavy = sa.inv_mass.min(sb.inv_mass);
+        let rho = if inv_mass_heavy > 0.0 {
+            (inv_mass_sum / inv_mass_heavy).min(ctx.joint_mass_ratio_cap)
+        } else {
+            ctx.joint_mass_ratio_cap
+        };
+        self.point_softness = ctx.joint_softness.with_mass_ratio(rho);
         if !ctx.warm_starting {
             self.point.impulse = Vec2::ZERO;
             self.spring.impulse = 0.0;
@@ -313,7 +330,7 @@ impl Constraint for RevoluteJoint {
         self.point.solve(
             &mut sa,
             &mut sb,
-            ctx.joint_softness,
+            self.point_softness,
             ctx.joint_max_correction_speed,
             use_bias,
         );

@@ -80,6 +80,14 @@ pub struct StepContext {
     pub warm_starting: bool,
     /// Soft step or PGS baseline.
     pub mode: SolverMode,
+    /// Largest stiffening factor of a contact between moving bodies
+    /// (dimensionless, `≥ 1`; 1 in the PGS baseline), see
+    /// [`SolverSettings::contact_mass_ratio_cap`](crate::solver::SolverSettings::contact_mass_ratio_cap).
+    pub contact_mass_ratio_cap: Real,
+    /// Largest stiffening factor of a joint's point rows (dimensionless,
+    /// `≥ 1`), see
+    /// [`SolverSettings::joint_mass_ratio_cap`](crate::solver::SolverSettings::joint_mass_ratio_cap).
+    pub joint_mass_ratio_cap: Real,
 }
 
 /// One body's part of one Jacobian row.
@@ -229,7 +237,13 @@ impl<C: Constraint> ConstraintBatch for Vec<C> {
             }
         }
     }
-    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, reverse: bool) {
+    fn solve(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+    ) {
         if reverse {
             for c in self.iter_mut().rev() {
                 if c.is_enabled() {

@@ -29,6 +29,16 @@ use crate::constraint::{ConstraintBatch, SolverMode, StepContext};
 use crate::math::{Real, Vec2, vec_is_finite};
 use crate::softness::Softness;
 
+/// Default largest stiffening factor of a contact between two moving
+/// bodies (dimensionless, usual 1.3; 1 gives Box2D v3's contacts). See
+/// [`SolverSettings::contact_mass_ratio_cap`].
+pub const DEFAULT_CONTACT_MASS_RATIO_CAP: Real = 1.3;
+
+/// Default largest stiffening factor of a joint's point rows
+/// (dimensionless, usual 1.3; 1 gives Box2D v3's joints). See
+/// [`SolverSettings::joint_mass_ratio_cap`].
+pub const DEFAULT_JOINT_MASS_RATIO_CAP: Real = 1.3;
+
 /// Accuracy and softness settings of the solver. Every knob that trades
 /// accuracy for time lives here.
 #[derive(Clone, Debug, PartialEq)]
@@ -60,6 +70,22 @@ pub struct SolverSettings {
     pub restitution_threshold: Real,
     /// Warm starting on (default) or off.
     pub warm_starting: bool,
+    /// Mass-ratio-aware contact stiffness (dimensionless, usual 1.3, `≤ 1`
+    /// switches it off). A contact between two moving bodies builds its
+    /// soft spring on the effective mass of the *heavier* side at the point
+    /// (`1 / min(k_a, k_b)`, `k = 1/m + (r × n)²/I` of one body) instead of
+    /// the pair's (`1 / (k_a + k_b)`), so a light body under a heavy one
+    /// deflects as if on the ground. The factor `ρ = (k_a + k_b) / min(k_a,
+    /// k_b)` is capped here: with one iteration per substep stiffer rows
+    /// make deep pyramids jitter and heavy-topped ones collapse. Contacts
+    /// with a static body keep their own (twice as stiff) softness.
+    pub contact_mass_ratio_cap: Real,
+    /// Mass-ratio-aware joint stiffness (dimensionless, usual 1.3, `≤ 1`
+    /// switches it off): a joint's point rows build their spring on the
+    /// heavier body's mass, `ρ = (1/m_a + 1/m_b) / min(1/m_a, 1/m_b)`
+    /// (the cap itself against a static or kinematic body), capped here for
+    /// the same stability reason (a cloth-like joint grid diverges near 2).
+    pub joint_mass_ratio_cap: Real,
 }
 
 impl Default for SolverSettings {
@@ -78,6 +104,8 @@ impl Default for SolverSettings {
             joint_max_correction_speed: Real::MAX,
             restitution_threshold: 1.0,
             warm_starting: true,
+            contact_mass_ratio_cap: DEFAULT_CONTACT_MASS_RATIO_CAP,
+            joint_mass_ratio_cap: DEFAULT_JOINT_MASS_RATIO_CAP,
         }
     }
 }
@@ -122,6 +150,14 @@ impl SolverSettings {
             joint_damping_ratio: self.joint_damping_ratio,
             warm_starting: self.warm_starting,
             mode: self.mode,
+            contact_mass_ratio_cap: match self.mode {
+                SolverMode::SoftStep => self.contact_mass_ratio_cap.max(1.0),
+                SolverMode::PgsBaumgarte => 1.0,
+            },
+            joint_mass_ratio_cap: match self.mode {
+                SolverMode::SoftStep => self.joint_mass_ratio_cap.max(1.0),
+                SolverMode::PgsBaumgarte => 1.0,
+            },
         }
     }
 }
