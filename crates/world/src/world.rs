@@ -840,6 +840,12 @@ impl World {
             self.wake_all(&wake);
             self.wake_list = wake;
             self.collision.build_constraints(&self.bodies, &mut self.contact_constraints);
+            #[cfg(feature = "portals")]
+            if has_portals {
+                let mut cs = std::mem::take(&mut self.contact_constraints);
+                self.apply_object_masses(&mut cs);
+                self.contact_constraints = cs;
+            }
             sp.narrowphase += lap();
         } else {
             self.contact_constraints.clear();
