@@ -192,6 +192,9 @@ pub struct Contact {
     pub sensor: bool,
     /// False when a filter (portal clipping, a disabled pair) suppresses it.
     pub enabled: bool,
+    /// Whether each body read as static (static or asleep) at the last
+    /// narrowphase; both true: the contact sleeps and is not solved.
+    pub still: [bool; 2],
 }
 
 /// Two shapes that began or stopped touching.
@@ -351,13 +354,24 @@ pub struct Collision {
 
 /// Phase-1 result of the narrowphase for one contact.
 #[derive(Clone, Debug)]
+#[allow(clippy::large_enum_variant)] // one per contact in a reused buffer; no boxing
 enum ContactUpdate {
     /// Both bodies asleep or static: keep the contact as it is.
     Asleep,
     /// The fat boxes separated: destroy the contact.
     Separated,
-    /// The new manifold.
-    Manifold(Manifold),
+    /// The new manifold, with what phase 2 needs of the two bodies.
+    Manifold(Computed),
+}
+
+/// A computed manifold and the body data phase 2 needs.
+#[derive(Clone, Debug)]
+struct Computed {
+    manifold: Manifold,
+    /// Body origin minus centre of mass, per body (world frame), m.
+    offset: [Vec2; 2],
+    /// Whether each body reads as static (static or asleep).
+    still: [bool; 2],
 }
 
 fn pair_key(a: u32, b: u32) -> (u32, u32) {
@@ -587,6 +601,7 @@ impl Collision {
                 touching: false,
                 sensor: sa.def.is_sensor || sb.def.is_sensor,
                 enabled: true,
+                still: [false, false],
             };
             self.pair_index.insert((a, b), self.contacts.len() as u32);
             self.contacts.push(contact);
@@ -630,6 +645,7 @@ impl Collision {
         while k < self.contacts.len() {
             let update = match results[k] {
                 ContactUpdate::Asleep => {
+                    self.contacts[k].still = [true, true];
                     k += 1;
                     continue;
                 }
@@ -641,23 +657,21 @@ impl Collision {
                 ContactUpdate::Manifold(ref m) => m,
             };
             tested += 1;
-            let (body_a, body_b) = {
-                let c = &self.contacts[k];
-                (bodies.solver_body(c.body_a), bodies.solver_body(c.body_b))
-            };
-            let (sim_a, sim_b) = (body_a.sim, body_b.sim);
             let c = &mut self.contacts[k];
             let was_touching = c.touching;
-            update_manifold(c, update, &sim_a.transform, sim_a.center, &sim_b.transform, sim_b.center);
+            update_manifold(c, &update.manifold, update.offset);
+            c.still = update.still;
             if clip {
                 clipping.apply(c);
             }
             let touching = c.point_count > 0;
             c.touching = touching;
-            if touching && (body_a.state_index == 0 || body_b.state_index == 0) {
-                let other = if body_a.state_index == 0 { c.body_a } else { c.body_b };
+            if touching && (update.still[0] || update.still[1]) {
+                let other = if update.still[0] { c.body_a } else { c.body_b };
                 if bodies.is_sleeping(other) {
                     wake.push(other);
+                    // Woken before the solve: it moves this step.
+                    c.still = [false, false];
                 }
             }
             if touching {
@@ -702,7 +716,11 @@ impl Collision {
             + body_a.state.w.abs() * reach(&sa.aabb, sim_a.center)
             + body_b.state.w.abs() * reach(&sb.aabb, sim_b.center);
         let speculative = SPECULATIVE_DISTANCE + dt * approach;
-        ContactUpdate::Manifold(collide(&sa.geometry, &sim_a.transform, &sb.geometry, &sim_b.transform, speculative))
+        ContactUpdate::Manifold(Computed {
+            manifold: collide(&sa.geometry, &sim_a.transform, &sb.geometry, &sim_b.transform, speculative),
+            offset: [sim_a.transform.p - sim_a.center, sim_b.transform.p - sim_b.center],
+            still: [body_a.state_index == 0, body_b.state_index == 0],
+        })
     }
 
     /// Builds the contact constraints of touching solid contacts.
@@ -711,20 +729,29 @@ impl Collision {
     /// static body last, so each Gauss–Seidel sweep ends on the ground: the
     /// support a stack stands on has the last word (as Box2D v3 keeps
     /// static contacts out of its first graph color).
-    pub fn build_constraints(&self, bodies: &BodySet, out: &mut Vec<ContactConstraint>) {
+    ///
+    /// Whether a body reads as static was noted by the narrowphase
+    /// ([`Contact::still`]); a contact whose two bodies are still sleeps.
+    /// When islands were woken after the narrowphase (`woke`), contacts
+    /// that slept are checked again.
+    pub fn build_constraints(&mut self, bodies: &BodySet, woke: bool, out: &mut Vec<ContactConstraint>) {
         out.clear();
-        let is_static = |b: BodyHandle| bodies.state_index(b) == Some(0);
+        if woke {
+            for c in self.contacts.iter_mut().filter(|c| c.still == [true, true]) {
+                c.still = [bodies.state_index(c.body_a) == Some(0), bodies.state_index(c.body_b) == Some(0)];
+            }
+        }
         for pass in [false, true] {
-            self.build_pass(pass, &is_static, out);
+            self.build_pass(pass, out);
         }
     }
 
-    fn build_pass(&self, static_pass: bool, is_static: &dyn Fn(BodyHandle) -> bool, out: &mut Vec<ContactConstraint>) {
+    fn build_pass(&self, static_pass: bool, out: &mut Vec<ContactConstraint>) {
         for (k, c) in self.contacts.iter().enumerate() {
             if !c.touching || c.sensor || !c.enabled {
                 continue;
             }
-            let (sa, sb) = (is_static(c.body_a), is_static(c.body_b));
+            let [sa, sb] = c.still;
             if (sa && sb) || (sa || sb) != static_pass {
                 continue;
             }
@@ -804,13 +831,12 @@ impl Collision {
 
 /// Replaces a contact's manifold, carrying impulses over by feature id and
 /// converting anchors from body origins to centres of mass.
-fn update_manifold(c: &mut Contact, m: &Manifold, xf_a: &Transform, center_a: Vec2, xf_b: &Transform, center_b: Vec2) {
+fn update_manifold(c: &mut Contact, m: &Manifold, offset: [Vec2; 2]) {
     let old = c.points;
     let old_count = c.point_count;
     c.normal = m.normal;
     c.point_count = m.point_count;
-    let off_a = xf_a.p - center_a;
-    let off_b = xf_b.p - center_b;
+    let [off_a, off_b] = offset;
     for i in 0..m.point_count {
         let mp = &m.points[i];
         let mut p = ContactPointData {

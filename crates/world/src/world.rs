@@ -838,8 +838,10 @@ impl World {
             let clipping = &crate::collision::NO_CLIPPING;
             self.collision.narrowphase(&self.bodies, dt, clipping, &mut wake);
             self.wake_all(&wake);
+            let woke = !wake.is_empty();
             self.wake_list = wake;
-            self.collision.build_constraints(&self.bodies, &mut self.contact_constraints);
+            self.collision
+                .build_constraints(&self.bodies, woke, &mut self.contact_constraints);
             #[cfg(feature = "portals")]
             if has_portals {
                 let mut cs = std::mem::take(&mut self.contact_constraints);
