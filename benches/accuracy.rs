@@ -899,7 +899,7 @@ fn draw_plot(path: &Path, spec: &SceneSpec, p: &PlotSpec, rows: &[Row], runs: &[
     // The legend, beside the plot: knob, colour, the values it takes.
     let font = ("sans-serif", 13).into_font();
     let small = ("sans-serif", 11).into_font().color(&RGBColor(90, 90, 90));
-    let mut y = 60;
+    let mut y = 52;
     for (name, color, pts) in &curves {
         let color = *color;
         legend_area.draw(&PathElement::new(
@@ -909,7 +909,7 @@ fn draw_plot(path: &Path, spec: &SceneSpec, p: &PlotSpec, rows: &[Row], runs: &[
         legend_area.draw(&Text::new(name.to_string(), (34, y - 8), font.clone()))?;
         let values: Vec<&str> = pts.iter().map(|p| p.2.as_str()).collect();
         legend_area.draw(&Text::new(values.join(", "), (34, y + 8), small.clone()))?;
-        y += 40;
+        y += 37;
     }
     legend_area.draw(&Circle::new((16, y), 7, BLACK.stroke_width(2)))?;
     legend_area.draw(&Text::new("defaults", (34, y - 8), font.clone()))?;
