@@ -503,11 +503,9 @@ pub fn free_fall_energy_loss(mass: f64, gravity: f64, h: f64, substeps: u64) -> 
 /// `tests/joint_scenes.rs` build them, with the probe and tracker settings
 /// that measure them.
 pub mod cases {
-    use janus2d_constraints::RevoluteJointDef;
-    use janus2d_core::body::{BodyDef, BodyHandle};
-    use janus2d_core::geometry::{Capsule, Circle, Polygon};
+    use janus2d_core::body::BodyHandle;
     use janus2d_core::math::{Real, Vec2};
-    use janus2d_world::{ShapeDef, World, WorldDef};
+    use janus2d_world::{World, WorldDef};
 
     use super::{Tracker, TrackerConfig};
     use crate::scenes::{self, DT};
@@ -539,10 +537,6 @@ pub mod cases {
             self.config.late_from = late_from_last_second(steps);
             self
         }
-    }
-
-    fn new_world(def: &WorldDef) -> World {
-        World::new(def.clone()).expect("valid world definition")
     }
 
     /// A probe that swings freely has no collapse box.
@@ -581,35 +575,16 @@ pub mod cases {
     /// collapse: its origin more than 0.5 m from (0, rest height) after a 2 s
     /// grace, as in `tests/hard_cases.rs`.
     pub fn vertical_stack(def: &WorldDef, rows: usize, seconds: usize) -> Case {
-        let mut world = new_world(def);
-        let ground = world
-            .create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0)))
-            .unwrap();
-        let ground_def = ShapeDef::default().with_friction(0.3);
-        world
-            .create_shape(ground, &ground_def, Polygon::make_box(50.0, 1.0))
-            .unwrap();
-        let sd = ShapeDef::default().with_friction(0.3);
-        let mut top = ground;
-        for i in 0..rows {
-            let x = if i % 2 == 0 { 0.01 } else { -0.01 };
-            let b = world
-                .create_body(&BodyDef::dynamic(Vec2::new(x, 0.55 + 1.1 * i as Real)))
-                .unwrap();
-            world
-                .create_shape(b, &sd, Polygon::make_box(0.5, 0.5))
-                .unwrap();
-            top = b;
-        }
+        let scene = scenes::vertical_stack(def, rows);
         let steps = seconds * 60;
         let rest = Vec2::new(0.0, 0.5 + (rows - 1) as Real);
-        let config = TrackerConfig::probe(top)
+        let config = TrackerConfig::probe(scene.probe)
             .with_collapse_box(rest, Vec2::new(0.5, 0.5), 2.0)
             .with_late_from(late_from_last_second(steps));
         Case {
-            world,
-            probe: top,
-            probe_label: "top box",
+            world: scene.world,
+            probe: scene.probe,
+            probe_label: scene.probe_label,
             steps,
             config,
         }
@@ -620,51 +595,14 @@ pub mod cases {
     /// to the last link, released horizontally; 10 s. Probe: the ball (no
     /// collapse box: it swings).
     pub fn ball_and_chain(def: &WorldDef) -> Case {
-        let mut world = new_world(def);
-        let pin = world
-            .create_body(&BodyDef::fixed(Vec2::new(0.0, 40.0)))
-            .unwrap();
-        let sd = ShapeDef::default().with_density(20.0);
-        let link = Capsule::new(Vec2::new(-0.5, 0.0), Vec2::new(0.5, 0.0), 0.125).unwrap();
-        let mut prev = pin;
-        let mut prev_anchor = Vec2::ZERO;
-        for i in 0..40 {
-            let b = world
-                .create_body(&BodyDef::dynamic(Vec2::new(0.5 + i as Real, 40.0)))
-                .unwrap();
-            world.create_shape(b, &sd, link).unwrap();
-            world
-                .create_revolute_joint(&RevoluteJointDef::new(
-                    prev,
-                    b,
-                    prev_anchor,
-                    Vec2::new(-0.5, 0.0),
-                ))
-                .unwrap();
-            prev = b;
-            prev_anchor = Vec2::new(0.5, 0.0);
-        }
-        let ball = world
-            .create_body(&BodyDef::dynamic(Vec2::new(48.0, 40.0)))
-            .unwrap();
-        world
-            .create_shape(ball, &sd, Circle::new(Vec2::ZERO, 8.0).unwrap())
-            .unwrap();
-        world
-            .create_revolute_joint(&RevoluteJointDef::new(
-                prev,
-                ball,
-                prev_anchor,
-                Vec2::new(-8.0, 0.0),
-            ))
-            .unwrap();
-        let steps = 600;
+        let scene = scenes::ball_and_chain(def);
+        let steps = scene.steps;
         Case {
-            world,
-            probe: ball,
-            probe_label: "ball",
+            world: scene.world,
+            probe: scene.probe,
+            probe_label: scene.probe_label,
             steps,
-            config: no_collapse(TrackerConfig::probe(ball))
+            config: no_collapse(TrackerConfig::probe(scene.probe))
                 .with_late_from(late_from_last_second(steps)),
         }
     }
@@ -673,54 +611,14 @@ pub mod cases {
     /// linear damping 0.1, no shapes) hinged end to end, both ends pinned;
     /// 10 s. Probe: the middle plank (its sink is the sag; no collapse box).
     pub fn bridge(def: &WorldDef) -> Case {
-        let mut world = new_world(def);
-        let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
-        let (hx, hy): (Real, Real) = (0.5, 0.125);
-        let density: Real = 20.0;
-        let m = density * 4.0 * hx * hy;
-        let inertia = m * (4.0 * hx * hx + 4.0 * hy * hy) / 12.0;
-        let n = 160;
-        let x0 = -(n as Real) * hx;
-        let mut prev = ground;
-        let mut middle = ground;
-        for i in 0..n {
-            let mut body = BodyDef::dynamic(Vec2::new(x0 + hx + 2.0 * hx * i as Real, 0.0))
-                .with_mass(m, inertia);
-            body.linear_damping = 0.1;
-            let b = world.create_body(&body).unwrap();
-            let anchor_a = if i == 0 {
-                Vec2::new(x0, 0.0)
-            } else {
-                Vec2::new(hx, 0.0)
-            };
-            world
-                .create_revolute_joint(&RevoluteJointDef::new(
-                    prev,
-                    b,
-                    anchor_a,
-                    Vec2::new(-hx, 0.0),
-                ))
-                .unwrap();
-            if i == n / 2 {
-                middle = b;
-            }
-            prev = b;
-        }
-        world
-            .create_revolute_joint(&RevoluteJointDef::new(
-                prev,
-                ground,
-                Vec2::new(hx, 0.0),
-                Vec2::new(-x0, 0.0),
-            ))
-            .unwrap();
-        let steps = 600;
+        let scene = scenes::bridge(def);
+        let steps = scene.steps;
         Case {
-            world,
-            probe: middle,
-            probe_label: "middle plank",
+            world: scene.world,
+            probe: scene.probe,
+            probe_label: scene.probe_label,
             steps,
-            config: no_collapse(TrackerConfig::probe(middle))
+            config: no_collapse(TrackerConfig::probe(scene.probe))
                 .with_late_from(late_from_last_second(steps)),
         }
     }

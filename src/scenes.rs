@@ -35,6 +35,16 @@ pub struct Scene {
     pub steps: usize,
 }
 
+/// The shared settings of `../shared/spec/scenes.md`: the default world
+/// (gravity (0, −10), 4 substeps, contacts 30 Hz / ζ 10, joints 60 Hz / ζ 2,
+/// push-out 3 m/s) with **sleep off**, as the hard cases and the benchmark
+/// scenes (but `tumbler` and `spinner`) require.
+pub fn shared_settings() -> WorldDef {
+    let mut def = WorldDef::default();
+    def.sleep.enabled = false;
+    def
+}
+
 fn new_world(def: &WorldDef) -> World {
     World::new(def.clone()).expect("valid world definition")
 }
@@ -342,4 +352,85 @@ pub fn portal_stream(def: &WorldDef, with_portal: bool) -> Scene {
         probe = b;
     }
     Scene { world, probe, probe_label: "last shape", steps: 1800 }
+}
+
+/// The hard case "vertical stack": `rows` 1 m boxes in a column with 0.1 m
+/// gaps, x alternating ±0.01, μ 0.3, on a ground box (top at y = 0).
+/// Probe: the top box; it rests at (0, rows − 0.5) while the stack stands.
+pub fn vertical_stack(def: &WorldDef, rows: usize) -> Scene {
+    let mut world = new_world(def);
+    let ground = world.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
+    let sd = ShapeDef::default().with_friction(0.3);
+    world.create_shape(ground, &sd, Polygon::make_box(50.0, 1.0)).unwrap();
+    let mut top = ground;
+    for i in 0..rows {
+        let x = if i % 2 == 0 { 0.01 } else { -0.01 };
+        let b = world
+            .create_body(&BodyDef::dynamic(Vec2::new(x, 0.55 + 1.1 * i as Real)))
+            .unwrap();
+        world.create_shape(b, &sd, Polygon::make_box(0.5, 0.5)).unwrap();
+        top = b;
+    }
+    Scene { world, probe: top, probe_label: "top box", steps: 3600 }
+}
+
+/// The hard case "ball and chain": 40 capsule links (half-length 0.5,
+/// r 0.125, density 20) in a horizontal line from a static pin at (0, 40),
+/// jointed end to end, and a ball r 8 (density 20, ≈ 670:1) jointed to the
+/// last link. Probe: the ball.
+pub fn ball_and_chain(def: &WorldDef) -> Scene {
+    let mut world = new_world(def);
+    let pin = world.create_body(&BodyDef::fixed(Vec2::new(0.0, 40.0))).unwrap();
+    let sd = ShapeDef::default().with_density(20.0);
+    let link = Capsule::new(Vec2::new(-0.5, 0.0), Vec2::new(0.5, 0.0), 0.125).unwrap();
+    let mut prev = pin;
+    let mut prev_anchor = Vec2::ZERO;
+    for i in 0..40 {
+        let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.5 + i as Real, 40.0))).unwrap();
+        world.create_shape(b, &sd, link).unwrap();
+        world
+            .create_revolute_joint(&RevoluteJointDef::new(prev, b, prev_anchor, Vec2::new(-0.5, 0.0)))
+            .unwrap();
+        prev = b;
+        prev_anchor = Vec2::new(0.5, 0.0);
+    }
+    let ball = world.create_body(&BodyDef::dynamic(Vec2::new(48.0, 40.0))).unwrap();
+    world.create_shape(ball, &sd, Circle::new(Vec2::ZERO, 8.0).unwrap()).unwrap();
+    world
+        .create_revolute_joint(&RevoluteJointDef::new(prev, ball, prev_anchor, Vec2::new(-8.0, 0.0)))
+        .unwrap();
+    Scene { world, probe: ball, probe_label: "ball", steps: 600 }
+}
+
+/// The hard case "bridge": 160 planks half 0.5×0.125 (density 20, mass set
+/// directly, linear damping 0.1; joints only, no shapes) hinged end to end,
+/// both ends pinned. Probe: the middle plank.
+pub fn bridge(def: &WorldDef) -> Scene {
+    let mut world = new_world(def);
+    let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    let (hx, hy): (Real, Real) = (0.5, 0.125);
+    let density: Real = 20.0;
+    let m = density * 4.0 * hx * hy;
+    let inertia = m * (4.0 * hx * hx + 4.0 * hy * hy) / 12.0;
+    let n = 160;
+    let x0 = -(n as Real) * hx;
+    let mut prev = ground;
+    let mut middle = ground;
+    for i in 0..n {
+        let mut body = BodyDef::dynamic(Vec2::new(x0 + hx + 2.0 * hx * i as Real, 0.0)).with_mass(m, inertia);
+        body.linear_damping = 0.1;
+        let b = world.create_body(&body).unwrap();
+        let anchor_a = if i == 0 { Vec2::new(x0, 0.0) } else { Vec2::new(hx, 0.0) };
+        world
+            .create_revolute_joint(&RevoluteJointDef::new(prev, b, anchor_a, Vec2::new(-hx, 0.0)))
+            .unwrap();
+        if i == n / 2 {
+            middle = b;
+        }
+        prev = b;
+    }
+    world
+        .create_revolute_joint(&RevoluteJointDef::new(prev, ground, Vec2::new(hx, 0.0), Vec2::new(-x0, 0.0)))
+        .unwrap();
+    Scene { world, probe: middle, probe_label: "middle plank", steps: 600 }
 }

@@ -6,18 +6,6 @@
 use janus2d::prelude::*;
 use janus2d::scenes::{self, DT};
 
-/// The shared settings of the hard cases: the default world with sleep off
-/// (scenes.md: "stability tests, sleep off"), so a stack that would fall is
-/// never frozen by sleeping.
-fn sleep_off() -> WorldDef {
-    WorldDef {
-        sleep: janus2d::world::SleepSettings {
-            enabled: false,
-            ..Default::default()
-        },
-        ..WorldDef::default()
-    }
-}
 
 fn report() -> bool {
     std::env::var("JANUS2D_REPORT").is_ok()
@@ -61,7 +49,7 @@ fn assert_sane(world: &World, floor: Real) {
 /// 2×2 box dropped from y = 4, μ 0.5: after 90 steps |x|, |y − 1|, |angle| < 0.01.
 #[test]
 fn single_box_comes_to_rest_on_the_ground() {
-    let mut world = World::new(sleep_off()).unwrap();
+    let mut world = World::new(scenes::shared_settings()).unwrap();
     ground_box(&mut world, 0.5);
     let b = dynamic_box(
         &mut world,
@@ -97,7 +85,7 @@ struct PyramidFigures {
 }
 
 fn run_pyramid(base: usize, seconds: usize) -> PyramidFigures {
-    let mut scene = scenes::large_pyramid(&sleep_off(), base);
+    let mut scene = scenes::large_pyramid(&scenes::shared_settings(), base);
     let top0 = scene.world.position(scene.probe).unwrap();
     let steps = seconds * 60;
     let mut f = PyramidFigures {
@@ -167,21 +155,8 @@ fn large_pyramid_stands_for_10_seconds() {
 /// ±0.01, μ 0.3) and returns the time at which it fell (top box more than
 /// 0.5 m from its start sideways or down), or `None` if it stood `seconds`.
 fn vertical_stack(rows: usize, seconds: usize) -> Option<Real> {
-    let mut world = World::new(sleep_off()).unwrap();
-    ground_box(&mut world, 0.3);
-    let sd = ShapeDef::default().with_friction(0.3);
-    let mut top = None;
-    for i in 0..rows {
-        let x = if i % 2 == 0 { 0.01 } else { -0.01 };
-        top = Some(dynamic_box(
-            &mut world,
-            Vec2::new(x, 0.55 + 1.1 * i as Real),
-            0.5,
-            0.5,
-            &sd,
-        ));
-    }
-    let top = top.unwrap();
+    let scene = scenes::vertical_stack(&scenes::shared_settings(), rows);
+    let (mut world, top) = (scene.world, scene.probe);
     let expected_y = 0.5 + (rows - 1) as Real;
     for k in 0..seconds * 60 {
         world.step(DT).unwrap();
@@ -226,7 +201,7 @@ fn vertical_stack_of_15_and_20_meet_box2d() {
 /// top with an impulse (0.2, 0): all 15 topple.
 #[test]
 fn double_domino_all_topple() {
-    let mut world = World::new(sleep_off()).unwrap();
+    let mut world = World::new(scenes::shared_settings()).unwrap();
     ground_box(&mut world, 0.6);
     let sd = ShapeDef::default().with_friction(0.6);
     let dominoes: Vec<_> = (0..15)
@@ -255,7 +230,7 @@ fn double_domino_all_topple() {
 fn confined_circles_stay_inside_and_settle() {
     let def = WorldDef {
         gravity: Vec2::ZERO,
-        ..sleep_off()
+        ..scenes::shared_settings()
     };
     let mut world = World::new(def).unwrap();
     let walls = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
@@ -318,7 +293,7 @@ fn confined_circles_stay_inside_and_settle() {
 /// settled figure.
 #[test]
 fn high_mass_ratio_1_pyramids_hold_heavy_tops() {
-    let mut world = World::new(sleep_off()).unwrap();
+    let mut world = World::new(scenes::shared_settings()).unwrap();
     ground_box(&mut world, 0.5);
     let mut tops = Vec::new();
     let mut bottoms = Vec::new();
@@ -366,7 +341,7 @@ fn high_mass_ratio_1_pyramids_hold_heavy_tops() {
 }
 
 fn high_mass_ratio_drop(thick_ground: bool) -> Real {
-    let mut world = World::new(sleep_off()).unwrap();
+    let mut world = World::new(scenes::shared_settings()).unwrap();
     let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
     if thick_ground {
         world
@@ -446,47 +421,9 @@ fn high_mass_ratio_3_big_box_on_small_boxes_box_ground() {
 /// 0.074 m) or an exact (tree) solve of the chain.
 #[test]
 fn ball_and_chain_peak_gap() {
-    let mut world = World::new(sleep_off()).unwrap();
-    let pin = world
-        .create_body(&BodyDef::fixed(Vec2::new(0.0, 40.0)))
-        .unwrap();
-    let sd = ShapeDef::default().with_density(20.0);
-    let link = Capsule::new(Vec2::new(-0.5, 0.0), Vec2::new(0.5, 0.0), 0.125).unwrap();
-    let mut prev = pin;
-    let mut prev_anchor = Vec2::ZERO;
-    let mut bodies = Vec::new();
-    for i in 0..40 {
-        let b = world
-            .create_body(&BodyDef::dynamic(Vec2::new(0.5 + i as Real, 40.0)))
-            .unwrap();
-        world.create_shape(b, &sd, link).unwrap();
-        world
-            .create_revolute_joint(&RevoluteJointDef::new(
-                prev,
-                b,
-                prev_anchor,
-                Vec2::new(-0.5, 0.0),
-            ))
-            .unwrap();
-        prev = b;
-        prev_anchor = Vec2::new(0.5, 0.0);
-        bodies.push(b);
-    }
-    let ball = world
-        .create_body(&BodyDef::dynamic(Vec2::new(40.0 + 8.0, 40.0)))
-        .unwrap();
-    world
-        .create_shape(ball, &sd, Circle::new(Vec2::ZERO, 8.0).unwrap())
-        .unwrap();
-    world
-        .create_revolute_joint(&RevoluteJointDef::new(
-            prev,
-            ball,
-            prev_anchor,
-            Vec2::new(-8.0, 0.0),
-        ))
-        .unwrap();
-    bodies.push(ball);
+    let scene = scenes::ball_and_chain(&scenes::shared_settings());
+    let mut world = scene.world;
+    let bodies: Vec<BodyHandle> = world.bodies().handles().collect();
     let mut peak_gap: Real = 0.0;
     for _ in 0..600 {
         world.step(DT).unwrap();
@@ -508,7 +445,7 @@ fn ball_and_chain_peak_gap() {
 fn joint_grid_40_peak_gap() {
     let def = WorldDef {
         gravity: Vec2::new(0.0, -20.0),
-        ..sleep_off()
+        ..scenes::shared_settings()
     };
     let mut scene = scenes::joint_grid(&def, 40);
     let mut peak_gap: Real = 0.0;

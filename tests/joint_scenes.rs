@@ -2,21 +2,10 @@
 //! and the 160-plank bridge (planks need no collision here).
 
 use janus2d::prelude::*;
+use janus2d::scenes;
 
 const DT: Real = 1.0 / 60.0;
 
-/// The shared settings of the hard cases: the default world with sleep off
-/// (scenes.md: "stability tests, sleep off"), so a stack that would fall is
-/// never frozen by sleeping.
-fn sleep_off() -> WorldDef {
-    WorldDef {
-        sleep: janus2d::world::SleepSettings {
-            enabled: false,
-            ..Default::default()
-        },
-        ..WorldDef::default()
-    }
-}
 
 fn report() -> bool {
     std::env::var("JANUS2D_REPORT").is_ok()
@@ -73,7 +62,7 @@ fn unstretched_chain_whip_reference() {
 /// Runs the chain with link spacing `spacing` for 10 s; returns the peak
 /// speed, the first time every gap is ≤ 1 cm, and the largest gap at 10 s.
 fn run_chain(spacing: Real) -> (Real, Option<Real>, Real) {
-    let mut world = World::new(sleep_off()).unwrap();
+    let mut world = World::new(scenes::shared_settings()).unwrap();
     let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
     let r: Real = 0.25;
     let m = janus2d::base::math::PI * r * r;
@@ -118,45 +107,12 @@ fn run_chain(spacing: Real) -> (Real, Option<Real>, Real) {
 /// end, both ends pinned.
 #[test]
 fn bridge_joint_gap_over_last_second() {
-    let mut world = World::new(sleep_off()).unwrap();
-    let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
-    let (hx, hy): (Real, Real) = (0.5, 0.125);
-    let density: Real = 20.0;
-    let m = density * 4.0 * hx * hy;
-    let inertia = m * (4.0 * hx * hx + 4.0 * hy * hy) / 12.0;
-    let n = 160;
-    let x0 = -(n as Real) * hx;
-    let mut prev = ground;
-    let mut planks = Vec::new();
-    for i in 0..n {
-        let mut def =
-            BodyDef::dynamic(Vec2::new(x0 + hx + 2.0 * hx * i as Real, 0.0)).with_mass(m, inertia);
-        def.linear_damping = 0.1;
-        let b = world.create_body(&def).unwrap();
-        let anchor_a = if i == 0 {
-            Vec2::new(x0, 0.0)
-        } else {
-            Vec2::new(hx, 0.0)
-        };
-        world
-            .create_revolute_joint(&RevoluteJointDef::new(
-                prev,
-                b,
-                anchor_a,
-                Vec2::new(-hx, 0.0),
-            ))
-            .unwrap();
-        planks.push(b);
-        prev = b;
-    }
-    world
-        .create_revolute_joint(&RevoluteJointDef::new(
-            prev,
-            ground,
-            Vec2::new(hx, 0.0),
-            Vec2::new(-x0, 0.0),
-        ))
-        .unwrap();
+    let mut world = scenes::bridge(&scenes::shared_settings()).world;
+    let planks: Vec<BodyHandle> = world
+        .bodies()
+        .handles()
+        .filter(|h| world.body_type(*h) == Ok(BodyType::Dynamic))
+        .collect();
     let mut peak_gap_last: Real = 0.0;
     let mut peak_speed: Real = 0.0;
     for k in 0..600 {
