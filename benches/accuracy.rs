@@ -245,6 +245,25 @@ fn scene_specs(args: &Args) -> Vec<SceneSpec> {
                 plot("peak_speed", "peak speed (m/s)", 1e-2, |m| m.peak_speed),
             ],
         },
+        #[cfg(feature = "portals")]
+        SceneSpec {
+            name: "portal_stream",
+            title: format!("portal stream (200 shapes, {} s)", joints / 60),
+            build: Box::new(move |d| cases::portal_stream(d, joints)),
+            repeats: reps(3),
+            clock: Clock::Wall,
+            plots: vec![
+                plot("portal_c", "peak portal error |C| (m)", 1e-7, |m| {
+                    m.extras
+                        .iter()
+                        .find(|e| e.name == "portal_c")
+                        .and_then(|e| e.peak)
+                        .unwrap_or(0.0)
+                })
+                .bound(1e-3),
+                pen(),
+            ],
+        },
         SceneSpec {
             name: "bridge",
             title: format!("bridge (160 planks, {} s)", joints / 60),

@@ -144,6 +144,24 @@ pub trait ExtraMetric {
     fn measure(&mut self, world: &World) -> Option<f64>;
 }
 
+/// Portal constraint error `max |x₂ − T(x₁)|` over the crossings in
+/// progress, m (`None` while nothing crosses).
+#[cfg(feature = "portals")]
+pub struct PortalError;
+
+#[cfg(feature = "portals")]
+impl ExtraMetric for PortalError {
+    fn name(&self) -> &'static str {
+        "portal_c"
+    }
+    fn unit(&self) -> &'static str {
+        "m"
+    }
+    fn measure(&mut self, world: &World) -> Option<f64> {
+        (world.crossing_count() > 0).then(|| world.max_portal_error() as f64)
+    }
+}
+
 /// The peak and last value of an [`ExtraMetric`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct ExtraValue {
@@ -525,9 +543,15 @@ pub mod cases {
     }
 
     impl Case {
-        /// A tracker for this case, started now.
+        /// A tracker for this case, started now (with the portal error
+        /// metric when the world has portals).
         pub fn tracker(&self) -> Tracker {
-            Tracker::new(&self.world, self.config.clone()).expect("the probe is live")
+            let tracker = Tracker::new(&self.world, self.config.clone()).expect("the probe is live");
+            #[cfg(feature = "portals")]
+            if self.world.portal_pair_count() > 0 {
+                return tracker.with_extra(Box::new(super::PortalError));
+            }
+            tracker
         }
 
         /// Runs `steps` steps instead, with the late window moved to the
@@ -604,6 +628,22 @@ pub mod cases {
             steps,
             config: no_collapse(TrackerConfig::probe(scene.probe))
                 .with_late_from(late_from_last_second(steps)),
+        }
+    }
+
+    /// Portal stream ([`scenes::portal_stream`]): 200 mixed shapes pour
+    /// through a floor portal and out of a wall portal; `steps` steps.
+    /// Probe: the last shape (no collapse box). The tracker adds
+    /// [`PortalError`](super::PortalError).
+    #[cfg(feature = "portals")]
+    pub fn portal_stream(def: &WorldDef, steps: usize) -> Case {
+        let scene = scenes::portal_stream(def, true);
+        Case {
+            world: scene.world,
+            probe: scene.probe,
+            probe_label: scene.probe_label,
+            steps,
+            config: no_collapse(TrackerConfig::probe(scene.probe)).with_late_from(late_from_last_second(steps)),
         }
     }
 
