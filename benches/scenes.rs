@@ -28,19 +28,33 @@ struct Args {
 }
 
 fn parse_args() -> Args {
-    let mut args = Args { scenes: Vec::new(), steps: 0, repeats: 3, csv: false, substeps: None, sleep: None, warmup: 0 };
+    let mut args = Args {
+        scenes: Vec::new(),
+        steps: 0,
+        repeats: 3,
+        csv: false,
+        substeps: None,
+        sleep: None,
+        warmup: 0,
+    };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
         match a.as_str() {
-            "-s" | "--steps" => args.steps = it.next().and_then(|v| v.parse().ok()).expect("--steps N"),
-            "-r" | "--repeats" => args.repeats = it.next().and_then(|v| v.parse().ok()).expect("--repeats N"),
+            "-s" | "--steps" => {
+                args.steps = it.next().and_then(|v| v.parse().ok()).expect("--steps N")
+            }
+            "-r" | "--repeats" => {
+                args.repeats = it.next().and_then(|v| v.parse().ok()).expect("--repeats N")
+            }
             "--substeps" => args.substeps = it.next().and_then(|v| v.parse().ok()),
             "--csv" => args.csv = true,
             "--sleep" => args.sleep = Some(true),
             "--no-sleep" => args.sleep = Some(false),
             "--warmup" => args.warmup = it.next().and_then(|v| v.parse().ok()).expect("--warmup N"),
             "--bench" => {}
-            "all" => args.scenes.extend(scenes::NAMES.iter().map(|s| s.to_string())),
+            "all" => args
+                .scenes
+                .extend(scenes::NAMES.iter().map(|s| s.to_string())),
             name if !name.starts_with('-') => args.scenes.push(name.to_string()),
             other => panic!("unknown option {other}"),
         }
@@ -60,13 +74,18 @@ fn main() {
     if args.csv {
         println!("scene,bodies,contacts,steps,repeats,min_total_ms,ms_per_step");
     } else {
-        println!("janus2d scenes: single thread, dt=1/60, {} substeps", def.solver.substeps);
+        println!(
+            "janus2d scenes: single thread, dt=1/60, {} substeps",
+            def.solver.substeps
+        );
     }
     for name in &args.scenes {
         // Sleep as scenes.md says: off except in `tumbler` and `spinner`,
         // unless the command line says otherwise.
         let mut def = def.clone();
-        def.sleep.enabled = args.sleep.unwrap_or(matches!(name.as_str(), "tumbler" | "spinner"));
+        def.sleep.enabled = args
+            .sleep
+            .unwrap_or(matches!(name.as_str(), "tumbler" | "spinner"));
         let mut best = f64::MAX;
         let mut runs = Vec::new();
         let mut summary = String::new();
@@ -74,8 +93,13 @@ fn main() {
         let mut contacts = 0;
         let mut steps = 0;
         for _ in 0..args.repeats.max(1) {
-            let mut scene = scenes::by_name(name, &def).unwrap_or_else(|| panic!("unknown scene {name}"));
-            steps = if args.steps > 1 { args.steps } else { scene.steps };
+            let mut scene =
+                scenes::by_name(name, &def).unwrap_or_else(|| panic!("unknown scene {name}"));
+            steps = if args.steps > 1 {
+                args.steps
+            } else {
+                scene.steps
+            };
             let start = scene.world.position(scene.probe).unwrap();
             for _ in 0..args.warmup {
                 scene.world.step(DT).unwrap();
@@ -95,12 +119,20 @@ fn main() {
             summary = format!(
                 "  sanity {name}: bodies={bodies} contacts={contacts} sleeping={} {}: ({:.4}, {:.4}) -> ({:.4}, {:.4}) angle={:.4} rad",
                 scene.world.sleeping_body_count(),
-                scene.probe_label, start.x, start.y, end.x, end.y, angle
+                scene.probe_label,
+                start.x,
+                start.y,
+                end.x,
+                end.y,
+                angle
             );
         }
         let per_step = best / (steps - 1) as f64;
         if args.csv {
-            println!("{name},{bodies},{contacts},{steps},{},{best:.1},{per_step:.3}", args.repeats);
+            println!(
+                "{name},{bodies},{contacts},{steps},{},{best:.1},{per_step:.3}",
+                args.repeats
+            );
         } else {
             let runs: Vec<String> = runs.iter().map(|r| format!("{r:.1}")).collect();
             println!(

@@ -25,7 +25,11 @@ fn main() -> Result<(), WorldError> {
         penetration = penetration.max(s.world.max_penetration());
     }
     let top = s.world.position(s.probe)?;
-    println!("1. pyramid of {} boxes, 5 s simulated in {:.0} ms", s.world.body_count() - 1, t0.elapsed().as_secs_f64() * 1e3);
+    println!(
+        "1. pyramid of {} boxes, 5 s simulated in {:.0} ms",
+        s.world.body_count() - 1,
+        t0.elapsed().as_secs_f64() * 1e3
+    );
     println!(
         "   top box {:.3} m -> {:.3} m (sank {:.1} mm, drifted {:.2} mm); {} contacts; worst penetration {:.2} mm",
         top0.y,
@@ -56,7 +60,9 @@ fn main() -> Result<(), WorldError> {
     {
         use janus2d::world::PortalEvent;
         let (mut s, _) = scenes::portal_drop(&WorldDef::default());
-        println!("3. portal drop: a 1 m box falls 5 m onto a floor portal; the partner is on a wall facing +x");
+        println!(
+            "3. portal drop: a 1 m box falls 5 m onto a floor portal; the partner is on a wall facing +x"
+        );
         for step in 1..=90 {
             let v_before = s.world.linear_velocity(s.probe)?;
             s.world.step(DT)?;
@@ -64,7 +70,10 @@ fn main() -> Result<(), WorldError> {
                 let t = step as Real * DT;
                 match e {
                     PortalEvent::CrossingStarted { .. } => {
-                        println!("   t = {t:.3} s: enters the floor portal at {:.2} m/s; clone created", v_before.length())
+                        println!(
+                            "   t = {t:.3} s: enters the floor portal at {:.2} m/s; clone created",
+                            v_before.length()
+                        )
                     }
                     PortalEvent::CrossingCompleted { body, .. } => {
                         let v = s.world.linear_velocity(*body)?;

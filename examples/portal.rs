@@ -12,19 +12,32 @@ fn main() -> Result<(), WorldError> {
     let (mut scene, _pair) = scenes::portal_drop(&WorldDef::default());
     let world = &mut scene.world;
     let body = scene.probe;
-    println!("janus2d portal drop: 1 m box falls 5 m onto a floor portal; the partner is on a wall facing +x");
-    println!("{:>6} {:>9} {:>9} {:>9} {:>9} {:>7} {:>8}  events", "t [s]", "x", "y", "vx", "vy", "bodies", "|C| mm");
+    println!(
+        "janus2d portal drop: 1 m box falls 5 m onto a floor portal; the partner is on a wall facing +x"
+    );
+    println!(
+        "{:>6} {:>9} {:>9} {:>9} {:>9} {:>7} {:>8}  events",
+        "t [s]", "x", "y", "vx", "vy", "bodies", "|C| mm"
+    );
     for step in 1..=150 {
         world.step(DT)?;
         let p = world.position(body)?;
         let v = world.linear_velocity(body)?;
-        let dynamic = world.bodies().handles().filter(|h| world.body_type(*h) == Ok(BodyType::Dynamic)).count();
+        let dynamic = world
+            .bodies()
+            .handles()
+            .filter(|h| world.body_type(*h) == Ok(BodyType::Dynamic))
+            .count();
         let events: Vec<String> = world
             .portal_events()
             .iter()
             .map(|e| match e {
-                PortalEvent::CrossingStarted { .. } => "crossing started (clone created)".to_string(),
-                PortalEvent::CrossingCompleted { .. } => "crossing completed (handover)".to_string(),
+                PortalEvent::CrossingStarted { .. } => {
+                    "crossing started (clone created)".to_string()
+                }
+                PortalEvent::CrossingCompleted { .. } => {
+                    "crossing completed (handover)".to_string()
+                }
                 PortalEvent::CrossingCancelled { .. } => "crossing cancelled".to_string(),
                 PortalEvent::JointDisabled { .. } => "joint disabled".to_string(),
             })

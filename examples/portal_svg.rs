@@ -40,21 +40,39 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .x_label_area_size(30)
         .y_label_area_size(40)
         .build_cartesian_2d(-22.0f64..3.0f64, -1.5f64..7.0f64)?;
-    chart.configure_mesh().x_desc("x [m]").y_desc("y [m]").draw()?;
-    let statics: Vec<BodyHandle> = world.bodies().handles().filter(|h| *h != scene.probe).collect();
+    chart
+        .configure_mesh()
+        .x_desc("x [m]")
+        .y_desc("y [m]")
+        .draw()?;
+    let statics: Vec<BodyHandle> = world
+        .bodies()
+        .handles()
+        .filter(|h| *h != scene.probe)
+        .collect();
     for b in &statics {
         for o in outlines(world, *b) {
-            chart.draw_series(std::iter::once(plotters::element::Polygon::new(o, RGBColor(200, 200, 200).filled())))?;
+            chart.draw_series(std::iter::once(plotters::element::Polygon::new(
+                o,
+                RGBColor(200, 200, 200).filled(),
+            )))?;
         }
     }
     // The two apertures.
-    chart.draw_series(LineSeries::new(vec![(-1.0, 0.0), (1.0, 0.0)], RED.stroke_width(4)))?;
-    chart.draw_series(LineSeries::new(vec![(-19.5, 4.0), (-19.5, 6.0)], RED.stroke_width(4)))?;
+    chart.draw_series(LineSeries::new(
+        vec![(-1.0, 0.0), (1.0, 0.0)],
+        RED.stroke_width(4),
+    ))?;
+    chart.draw_series(LineSeries::new(
+        vec![(-19.5, 4.0), (-19.5, 6.0)],
+        RED.stroke_width(4),
+    ))?;
     let mut frame = 0;
     for step in 1..=120 {
         world.step(DT)?;
         let crossing = world.crossing_count() > 0;
-        let keep = matches!(step, 30 | 50) || (crossing && step % 2 == 0) || matches!(step, 75 | 90);
+        let keep =
+            matches!(step, 30 | 50) || (crossing && step % 2 == 0) || matches!(step, 75 | 90);
         if !keep {
             continue;
         }
@@ -64,7 +82,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         if let Some(clone) = world.clone_of(scene.probe) {
             for o in outlines(world, clone) {
-                chart.draw_series(std::iter::once(PathElement::new(o, RGBColor(230, 120, 0).stroke_width(2))))?;
+                chart.draw_series(std::iter::once(PathElement::new(
+                    o,
+                    RGBColor(230, 120, 0).stroke_width(2),
+                )))?;
             }
         }
     }

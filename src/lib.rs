@@ -38,8 +38,12 @@ pub mod prelude {
     pub use janus2d_constraints::{RevoluteJoint, RevoluteJointDef};
     pub use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
     pub use janus2d_core::constraint::SolverMode;
+    pub use janus2d_core::geometry::{
+        Capsule, ChainSegment, Circle, Polygon, Segment, Shape, make_chain,
+    };
     pub use janus2d_core::math::{Real, Rot, Transform, Vec2};
     pub use janus2d_core::solver::SolverSettings;
-    pub use janus2d_core::geometry::{Capsule, ChainSegment, Circle, Polygon, Segment, Shape, make_chain};
-    pub use janus2d_world::{Filter, JointHandle, ShapeDef, ShapeHandle, StepEvents, World, WorldDef, WorldError};
+    pub use janus2d_world::{
+        Filter, JointHandle, ShapeDef, ShapeHandle, StepEvents, World, WorldDef, WorldError,
+    };
 }

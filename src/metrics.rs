@@ -546,7 +546,8 @@ pub mod cases {
         /// A tracker for this case, started now (with the portal error
         /// metric when the world has portals).
         pub fn tracker(&self) -> Tracker {
-            let tracker = Tracker::new(&self.world, self.config.clone()).expect("the probe is live");
+            let tracker =
+                Tracker::new(&self.world, self.config.clone()).expect("the probe is live");
             #[cfg(feature = "portals")]
             if self.world.portal_pair_count() > 0 {
                 return tracker.with_extra(Box::new(super::PortalError));
@@ -643,7 +644,8 @@ pub mod cases {
             probe: scene.probe,
             probe_label: scene.probe_label,
             steps,
-            config: no_collapse(TrackerConfig::probe(scene.probe)).with_late_from(late_from_last_second(steps)),
+            config: no_collapse(TrackerConfig::probe(scene.probe))
+                .with_late_from(late_from_last_second(steps)),
         }
     }
 

@@ -58,8 +58,12 @@ fn box_def() -> ShapeDef {
 /// the hard case "pyramid 20".
 pub fn large_pyramid(def: &WorldDef, base: usize) -> Scene {
     let mut world = new_world(def);
-    let ground = world.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
-    world.create_shape(ground, &ShapeDef::default(), Polygon::make_box(100.0, 1.0)).unwrap();
+    let ground = world
+        .create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0)))
+        .unwrap();
+    world
+        .create_shape(ground, &ShapeDef::default(), Polygon::make_box(100.0, 1.0))
+        .unwrap();
     let square = Polygon::make_box(0.5, 0.5);
     let sd = box_def();
     let mut top = ground;
@@ -67,12 +71,19 @@ pub fn large_pyramid(def: &WorldDef, base: usize) -> Scene {
         let y = (2 * i + 1) as Real * 0.5;
         for j in i..base {
             let x = (i + 1) as Real * 0.5 + (j - i) as Real - 0.5 * base as Real;
-            let b = world.create_body(&BodyDef::dynamic(Vec2::new(x, y))).unwrap();
+            let b = world
+                .create_body(&BodyDef::dynamic(Vec2::new(x, y)))
+                .unwrap();
             world.create_shape(b, &sd, square).unwrap();
             top = b;
         }
     }
-    Scene { world, probe: top, probe_label: "top box", steps: 500 }
+    Scene {
+        world,
+        probe: top,
+        probe_label: "top box",
+        steps: 500,
+    }
 }
 
 /// 20 × 20 pyramids of base 10 on 20 two-sided ground segments.
@@ -83,7 +94,9 @@ pub fn many_pyramids(def: &WorldDef) -> Scene {
     for r in 0..rows {
         let y = 11.0 * r as Real;
         let seg = Segment::new(Vec2::new(-110.0, y), Vec2::new(110.0, y)).unwrap();
-        world.create_shape(ground, &ShapeDef::default(), seg).unwrap();
+        world
+            .create_shape(ground, &ShapeDef::default(), seg)
+            .unwrap();
     }
     let square = Polygon::make_box(0.5, 0.5);
     let sd = box_def();
@@ -97,7 +110,9 @@ pub fn many_pyramids(def: &WorldDef) -> Scene {
                 let y = (2 * i + 1) as Real * 0.5 + base_y;
                 for j in i..base {
                     let x = (i + 1) as Real * 0.5 + (j - i) as Real + center_x - 0.5;
-                    let b = world.create_body(&BodyDef::dynamic(Vec2::new(x, y))).unwrap();
+                    let b = world
+                        .create_body(&BodyDef::dynamic(Vec2::new(x, y)))
+                        .unwrap();
                     world.create_shape(b, &sd, square).unwrap();
                     last = b;
                 }
@@ -105,7 +120,12 @@ pub fn many_pyramids(def: &WorldDef) -> Scene {
             probe.get_or_insert(last);
         }
     }
-    Scene { world, probe: probe.unwrap(), probe_label: "top box of the first pyramid", steps: 200 }
+    Scene {
+        world,
+        probe: probe.unwrap(),
+        probe_label: "top box of the first pyramid",
+        steps: 200,
+    }
 }
 
 /// `n × n` circles r 0.4 linked by revolute joints, hanging from 7 static
@@ -114,7 +134,11 @@ pub fn many_pyramids(def: &WorldDef) -> Scene {
 pub fn joint_grid(def: &WorldDef, n: usize) -> Scene {
     let mut world = new_world(def);
     let sd = ShapeDef {
-        filter: Filter { category_bits: 2, mask_bits: !2u64, group_index: 0 },
+        filter: Filter {
+            category_bits: 2,
+            mask_bits: !2u64,
+            group_index: 0,
+        },
         ..ShapeDef::default()
     };
     let circle = Circle::new(Vec2::ZERO, 0.4).unwrap();
@@ -124,51 +148,90 @@ pub fn joint_grid(def: &WorldDef, n: usize) -> Scene {
         for i in 0..n {
             let pos = Vec2::new(k as Real, -(i as Real));
             let is_static = i == 0 && k + 3 >= mid && k <= mid + 3;
-            let body_def = if is_static { BodyDef::fixed(pos) } else { BodyDef::dynamic(pos) };
+            let body_def = if is_static {
+                BodyDef::fixed(pos)
+            } else {
+                BodyDef::dynamic(pos)
+            };
             let b = world.create_body(&body_def).unwrap();
             world.create_shape(b, &sd, circle).unwrap();
             if i > 0 {
                 let above = grid[grid.len() - 1];
                 world
-                    .create_revolute_joint(&RevoluteJointDef::new(above, b, Vec2::new(0.0, -0.5), Vec2::new(0.0, 0.5)))
+                    .create_revolute_joint(&RevoluteJointDef::new(
+                        above,
+                        b,
+                        Vec2::new(0.0, -0.5),
+                        Vec2::new(0.0, 0.5),
+                    ))
                     .unwrap();
             }
             if k > 0 {
                 let left = grid[grid.len() - n];
                 world
-                    .create_revolute_joint(&RevoluteJointDef::new(left, b, Vec2::new(0.5, 0.0), Vec2::new(-0.5, 0.0)))
+                    .create_revolute_joint(&RevoluteJointDef::new(
+                        left,
+                        b,
+                        Vec2::new(0.5, 0.0),
+                        Vec2::new(-0.5, 0.0),
+                    ))
                     .unwrap();
             }
             grid.push(b);
         }
     }
-    Scene { world, probe: grid[n - 1], probe_label: "bottom-left circle", steps: 500 }
+    Scene {
+        world,
+        probe: grid[n - 1],
+        probe_label: "bottom-left circle",
+        steps: 500,
+    }
 }
 
 /// A motor-driven hollow drum turning 45 × 45 small boxes.
 pub fn tumbler(def: &WorldDef) -> Scene {
     let mut world = new_world(def);
     let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
-    let drum = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 10.0))).unwrap();
+    let drum = world
+        .create_body(&BodyDef::dynamic(Vec2::new(0.0, 10.0)))
+        .unwrap();
     let wall = ShapeDef::default().with_density(50.0);
-    for (hx, hy, cx, cy) in [(0.5, 10.0, 10.0, 0.0), (0.5, 10.0, -10.0, 0.0), (10.0, 0.5, 0.0, 10.0), (10.0, 0.5, 0.0, -10.0)] {
+    for (hx, hy, cx, cy) in [
+        (0.5, 10.0, 10.0, 0.0),
+        (0.5, 10.0, -10.0, 0.0),
+        (10.0, 0.5, 0.0, 10.0),
+        (10.0, 0.5, 0.0, -10.0),
+    ] {
         world
-            .create_shape(drum, &wall, Polygon::make_offset_box(hx, hy, Vec2::new(cx, cy), 0.0))
+            .create_shape(
+                drum,
+                &wall,
+                Polygon::make_offset_box(hx, hy, Vec2::new(cx, cy), 0.0),
+            )
             .unwrap();
     }
-    let motor = RevoluteJointDef::new(ground, drum, Vec2::new(0.0, 10.0), Vec2::ZERO).with_motor(25.0 * PI / 180.0, 1e8);
+    let motor = RevoluteJointDef::new(ground, drum, Vec2::new(0.0, 10.0), Vec2::ZERO)
+        .with_motor(25.0 * PI / 180.0, 1e8);
     world.create_revolute_joint(&motor).unwrap();
     let small = Polygon::make_box(0.125, 0.125);
     let sd = box_def();
     for i in 0..45 {
         for j in 0..45 {
             let b = world
-                .create_body(&BodyDef::dynamic(Vec2::new(-9.0 + 0.4 * j as Real, 1.0 + 0.4 * i as Real)))
+                .create_body(&BodyDef::dynamic(Vec2::new(
+                    -9.0 + 0.4 * j as Real,
+                    1.0 + 0.4 * i as Real,
+                )))
                 .unwrap();
             world.create_shape(b, &sd, small).unwrap();
         }
     }
-    Scene { world, probe: drum, probe_label: "drum (motor 25 deg/s)", steps: 750 }
+    Scene {
+        world,
+        probe: drum,
+        probe_label: "drum (motor 25 deg/s)",
+        steps: 750,
+    }
 }
 
 /// A heavy fast box smashing into a block of 120 × 80 small boxes, g = 0.
@@ -180,19 +243,31 @@ pub fn smash(def: &WorldDef) -> Scene {
         .create_body(&BodyDef::dynamic(Vec2::new(-20.0, 0.0)).with_velocity(Vec2::new(40.0, 0.0)))
         .unwrap();
     world
-        .create_shape(projectile, &ShapeDef::default().with_density(8.0), Polygon::make_box(4.0, 4.0))
+        .create_shape(
+            projectile,
+            &ShapeDef::default().with_density(8.0),
+            Polygon::make_box(4.0, 4.0),
+        )
         .unwrap();
     let small = Polygon::make_box(0.2, 0.2);
     let sd = box_def();
     for i in 0..120 {
         for j in 0..80 {
             let b = world
-                .create_body(&BodyDef::dynamic(Vec2::new(30.0 + 0.4 * i as Real, 0.4 * (j as Real - 40.0))))
+                .create_body(&BodyDef::dynamic(Vec2::new(
+                    30.0 + 0.4 * i as Real,
+                    0.4 * (j as Real - 40.0),
+                )))
                 .unwrap();
             world.create_shape(b, &sd, small).unwrap();
         }
     }
-    Scene { world, probe: projectile, probe_label: "projectile", steps: 300 }
+    Scene {
+        world,
+        probe: projectile,
+        probe_label: "projectile",
+        steps: 300,
+    }
 }
 
 /// A motorised paddle stirring 6,076 mixed shapes inside a one-sided loop.
@@ -211,19 +286,33 @@ pub fn spinner(def: &WorldDef) -> Scene {
     for seg in make_chain(&points, true).unwrap() {
         world.create_shape(ground, &loop_def, seg).unwrap();
     }
-    let paddle = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 12.0))).unwrap();
-    world
-        .create_shape(paddle, &ShapeDef::default().with_friction(0.0), Polygon::make_rounded_box(0.4, 20.0, 0.2))
+    let paddle = world
+        .create_body(&BodyDef::dynamic(Vec2::new(0.0, 12.0)))
         .unwrap();
-    let motor = RevoluteJointDef::new(ground, paddle, Vec2::new(0.0, 12.0), Vec2::ZERO).with_motor(5.0, Real::MAX);
+    world
+        .create_shape(
+            paddle,
+            &ShapeDef::default().with_friction(0.0),
+            Polygon::make_rounded_box(0.4, 20.0, 0.2),
+        )
+        .unwrap();
+    let motor = RevoluteJointDef::new(ground, paddle, Vec2::new(0.0, 12.0), Vec2::ZERO)
+        .with_motor(5.0, Real::MAX);
     world.create_revolute_joint(&motor).unwrap();
-    let sd = ShapeDef { density: 0.25, friction: 0.1, restitution: 0.1, ..ShapeDef::default() };
+    let sd = ShapeDef {
+        density: 0.25,
+        friction: 0.1,
+        restitution: 0.1,
+        ..ShapeDef::default()
+    };
     let capsule = Capsule::new(Vec2::new(-0.25, 0.0), Vec2::new(0.25, 0.0), 0.25).unwrap();
     let circle = Circle::new(Vec2::ZERO, 0.35).unwrap();
     let square = Polygon::make_box(0.35, 0.35);
     let (mut x, mut y) = (-23.0, 2.0);
     for i in 0..6076 {
-        let b = world.create_body(&BodyDef::dynamic(Vec2::new(x, y))).unwrap();
+        let b = world
+            .create_body(&BodyDef::dynamic(Vec2::new(x, y)))
+            .unwrap();
         match i % 3 {
             0 => world.create_shape(b, &sd, capsule),
             1 => world.create_shape(b, &sd, circle),
@@ -236,7 +325,12 @@ pub fn spinner(def: &WorldDef) -> Scene {
             y += 0.5;
         }
     }
-    Scene { world, probe: paddle, probe_label: "paddle", steps: 500 }
+    Scene {
+        world,
+        probe: paddle,
+        probe_label: "paddle",
+        steps: 500,
+    }
 }
 
 /// Builds a benchmark scene by name.
@@ -280,16 +374,48 @@ pub const NAMES: [&str; 9] = [
 pub fn portal_drop(def: &WorldDef) -> (Scene, janus2d_world::PortalPairHandle) {
     use janus2d_world::{PortalDef, PortalPairDef};
     let mut world = new_world(def);
-    let floor = world.create_body(&BodyDef::fixed(Vec2::new(0.0, -0.5))).unwrap();
-    world.create_shape(floor, &ShapeDef::default(), Polygon::make_box(10.0, 0.5)).unwrap();
-    let wall = world.create_body(&BodyDef::fixed(Vec2::new(-20.0, 5.0))).unwrap();
-    world.create_shape(wall, &ShapeDef::default(), Polygon::make_box(0.5, 5.0)).unwrap();
-    let entry = PortalDef { body: floor, anchor: Vec2::new(0.0, 0.5), direction: Vec2::Y, half_width: 1.0 };
-    let exit = PortalDef { body: wall, anchor: Vec2::new(0.5, 0.0), direction: Vec2::X, half_width: 1.0 };
-    let pair = world.create_portal_pair(&PortalPairDef::new(entry, exit)).unwrap();
-    let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 5.5))).unwrap();
-    world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
-    (Scene { world, probe: b, probe_label: "box", steps: 120 }, pair)
+    let floor = world
+        .create_body(&BodyDef::fixed(Vec2::new(0.0, -0.5)))
+        .unwrap();
+    world
+        .create_shape(floor, &ShapeDef::default(), Polygon::make_box(10.0, 0.5))
+        .unwrap();
+    let wall = world
+        .create_body(&BodyDef::fixed(Vec2::new(-20.0, 5.0)))
+        .unwrap();
+    world
+        .create_shape(wall, &ShapeDef::default(), Polygon::make_box(0.5, 5.0))
+        .unwrap();
+    let entry = PortalDef {
+        body: floor,
+        anchor: Vec2::new(0.0, 0.5),
+        direction: Vec2::Y,
+        half_width: 1.0,
+    };
+    let exit = PortalDef {
+        body: wall,
+        anchor: Vec2::new(0.5, 0.0),
+        direction: Vec2::X,
+        half_width: 1.0,
+    };
+    let pair = world
+        .create_portal_pair(&PortalPairDef::new(entry, exit))
+        .unwrap();
+    let b = world
+        .create_body(&BodyDef::dynamic(Vec2::new(0.0, 5.5)))
+        .unwrap();
+    world
+        .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    (
+        Scene {
+            world,
+            probe: b,
+            probe_label: "box",
+            steps: 120,
+        },
+        pair,
+    )
 }
 
 /// The portal "stream" scene: 200 mixed shapes (boxes, circles, capsules)
@@ -302,7 +428,9 @@ pub fn portal_stream(def: &WorldDef, with_portal: bool) -> Scene {
     let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
     let sd = ShapeDef::default();
     let solid = |world: &mut World, hx: Real, hy: Real, c: Vec2, a: Real| {
-        world.create_shape(ground, &sd, Polygon::make_offset_box(hx, hy, c, a)).unwrap();
+        world
+            .create_shape(ground, &sd, Polygon::make_offset_box(hx, hy, c, a))
+            .unwrap();
     };
     // Funnel: two slopes down to a 2 m opening at (0, 0), side walls.
     let slope = (8.0 as Real).atan2(8.8);
@@ -320,14 +448,34 @@ pub fn portal_stream(def: &WorldDef, with_portal: bool) -> Scene {
         // wall of the room below, facing +x.
         #[cfg(feature = "portals")]
         {
-        use janus2d_world::{PortalDef, PortalPairDef};
-        let floor = world.create_body(&BodyDef::fixed(Vec2::new(0.0, -0.5))).unwrap();
-        world.create_shape(floor, &sd, Polygon::make_box(1.5, 0.5)).unwrap();
-        let exit_wall = world.create_body(&BodyDef::fixed(Vec2::new(-40.5, -25.0))).unwrap();
-        world.create_shape(exit_wall, &sd, Polygon::make_box(0.5, 5.0)).unwrap();
-        let entry = PortalDef { body: floor, anchor: Vec2::new(0.0, 0.5), direction: Vec2::Y, half_width: 1.0 };
-        let exit = PortalDef { body: exit_wall, anchor: Vec2::new(0.5, 0.0), direction: Vec2::X, half_width: 1.0 };
-        world.create_portal_pair(&PortalPairDef::new(entry, exit)).unwrap();
+            use janus2d_world::{PortalDef, PortalPairDef};
+            let floor = world
+                .create_body(&BodyDef::fixed(Vec2::new(0.0, -0.5)))
+                .unwrap();
+            world
+                .create_shape(floor, &sd, Polygon::make_box(1.5, 0.5))
+                .unwrap();
+            let exit_wall = world
+                .create_body(&BodyDef::fixed(Vec2::new(-40.5, -25.0)))
+                .unwrap();
+            world
+                .create_shape(exit_wall, &sd, Polygon::make_box(0.5, 5.0))
+                .unwrap();
+            let entry = PortalDef {
+                body: floor,
+                anchor: Vec2::new(0.0, 0.5),
+                direction: Vec2::Y,
+                half_width: 1.0,
+            };
+            let exit = PortalDef {
+                body: exit_wall,
+                anchor: Vec2::new(0.5, 0.0),
+                direction: Vec2::X,
+                half_width: 1.0,
+            };
+            world
+                .create_portal_pair(&PortalPairDef::new(entry, exit))
+                .unwrap();
         }
     } else {
         // The same floor with a 2 m hole; the exit wall is kept as scenery.
@@ -351,7 +499,12 @@ pub fn portal_stream(def: &WorldDef, with_portal: bool) -> Scene {
         .unwrap();
         probe = b;
     }
-    Scene { world, probe, probe_label: "last shape", steps: 1800 }
+    Scene {
+        world,
+        probe,
+        probe_label: "last shape",
+        steps: 1800,
+    }
 }
 
 /// The hard case "vertical stack": `rows` 1 m boxes in a column with 0.1 m
@@ -359,19 +512,30 @@ pub fn portal_stream(def: &WorldDef, with_portal: bool) -> Scene {
 /// Probe: the top box; it rests at (0, rows − 0.5) while the stack stands.
 pub fn vertical_stack(def: &WorldDef, rows: usize) -> Scene {
     let mut world = new_world(def);
-    let ground = world.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
+    let ground = world
+        .create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0)))
+        .unwrap();
     let sd = ShapeDef::default().with_friction(0.3);
-    world.create_shape(ground, &sd, Polygon::make_box(50.0, 1.0)).unwrap();
+    world
+        .create_shape(ground, &sd, Polygon::make_box(50.0, 1.0))
+        .unwrap();
     let mut top = ground;
     for i in 0..rows {
         let x = if i % 2 == 0 { 0.01 } else { -0.01 };
         let b = world
             .create_body(&BodyDef::dynamic(Vec2::new(x, 0.55 + 1.1 * i as Real)))
             .unwrap();
-        world.create_shape(b, &sd, Polygon::make_box(0.5, 0.5)).unwrap();
+        world
+            .create_shape(b, &sd, Polygon::make_box(0.5, 0.5))
+            .unwrap();
         top = b;
     }
-    Scene { world, probe: top, probe_label: "top box", steps: 3600 }
+    Scene {
+        world,
+        probe: top,
+        probe_label: "top box",
+        steps: 3600,
+    }
 }
 
 /// The hard case "ball and chain": 40 capsule links (half-length 0.5,
@@ -380,26 +544,49 @@ pub fn vertical_stack(def: &WorldDef, rows: usize) -> Scene {
 /// last link. Probe: the ball.
 pub fn ball_and_chain(def: &WorldDef) -> Scene {
     let mut world = new_world(def);
-    let pin = world.create_body(&BodyDef::fixed(Vec2::new(0.0, 40.0))).unwrap();
+    let pin = world
+        .create_body(&BodyDef::fixed(Vec2::new(0.0, 40.0)))
+        .unwrap();
     let sd = ShapeDef::default().with_density(20.0);
     let link = Capsule::new(Vec2::new(-0.5, 0.0), Vec2::new(0.5, 0.0), 0.125).unwrap();
     let mut prev = pin;
     let mut prev_anchor = Vec2::ZERO;
     for i in 0..40 {
-        let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.5 + i as Real, 40.0))).unwrap();
+        let b = world
+            .create_body(&BodyDef::dynamic(Vec2::new(0.5 + i as Real, 40.0)))
+            .unwrap();
         world.create_shape(b, &sd, link).unwrap();
         world
-            .create_revolute_joint(&RevoluteJointDef::new(prev, b, prev_anchor, Vec2::new(-0.5, 0.0)))
+            .create_revolute_joint(&RevoluteJointDef::new(
+                prev,
+                b,
+                prev_anchor,
+                Vec2::new(-0.5, 0.0),
+            ))
             .unwrap();
         prev = b;
         prev_anchor = Vec2::new(0.5, 0.0);
     }
-    let ball = world.create_body(&BodyDef::dynamic(Vec2::new(48.0, 40.0))).unwrap();
-    world.create_shape(ball, &sd, Circle::new(Vec2::ZERO, 8.0).unwrap()).unwrap();
-    world
-        .create_revolute_joint(&RevoluteJointDef::new(prev, ball, prev_anchor, Vec2::new(-8.0, 0.0)))
+    let ball = world
+        .create_body(&BodyDef::dynamic(Vec2::new(48.0, 40.0)))
         .unwrap();
-    Scene { world, probe: ball, probe_label: "ball", steps: 600 }
+    world
+        .create_shape(ball, &sd, Circle::new(Vec2::ZERO, 8.0).unwrap())
+        .unwrap();
+    world
+        .create_revolute_joint(&RevoluteJointDef::new(
+            prev,
+            ball,
+            prev_anchor,
+            Vec2::new(-8.0, 0.0),
+        ))
+        .unwrap();
+    Scene {
+        world,
+        probe: ball,
+        probe_label: "ball",
+        steps: 600,
+    }
 }
 
 /// The hard case "bridge": 160 planks half 0.5×0.125 (density 20, mass set
@@ -417,12 +604,22 @@ pub fn bridge(def: &WorldDef) -> Scene {
     let mut prev = ground;
     let mut middle = ground;
     for i in 0..n {
-        let mut body = BodyDef::dynamic(Vec2::new(x0 + hx + 2.0 * hx * i as Real, 0.0)).with_mass(m, inertia);
+        let mut body =
+            BodyDef::dynamic(Vec2::new(x0 + hx + 2.0 * hx * i as Real, 0.0)).with_mass(m, inertia);
         body.linear_damping = 0.1;
         let b = world.create_body(&body).unwrap();
-        let anchor_a = if i == 0 { Vec2::new(x0, 0.0) } else { Vec2::new(hx, 0.0) };
+        let anchor_a = if i == 0 {
+            Vec2::new(x0, 0.0)
+        } else {
+            Vec2::new(hx, 0.0)
+        };
         world
-            .create_revolute_joint(&RevoluteJointDef::new(prev, b, anchor_a, Vec2::new(-hx, 0.0)))
+            .create_revolute_joint(&RevoluteJointDef::new(
+                prev,
+                b,
+                anchor_a,
+                Vec2::new(-hx, 0.0),
+            ))
             .unwrap();
         if i == n / 2 {
             middle = b;
@@ -430,7 +627,17 @@ pub fn bridge(def: &WorldDef) -> Scene {
         prev = b;
     }
     world
-        .create_revolute_joint(&RevoluteJointDef::new(prev, ground, Vec2::new(hx, 0.0), Vec2::new(-x0, 0.0)))
+        .create_revolute_joint(&RevoluteJointDef::new(
+            prev,
+            ground,
+            Vec2::new(hx, 0.0),
+            Vec2::new(-x0, 0.0),
+        ))
         .unwrap();
-    Scene { world, probe: middle, probe_label: "middle plank", steps: 600 }
+    Scene {
+        world,
+        probe: middle,
+        probe_label: "middle plank",
+        steps: 600,
+    }
 }

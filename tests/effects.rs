@@ -7,13 +7,21 @@ use janus2d::world::SleepSettings;
 
 fn boxes_on_ground(def: WorldDef, restitution: Real) -> (World, Vec<BodyHandle>) {
     let mut world = World::new(def).unwrap();
-    let g = world.create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0))).unwrap();
-    world.create_shape(g, &ShapeDef::default(), Polygon::make_box(20.0, 1.0)).unwrap();
+    let g = world
+        .create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0)))
+        .unwrap();
+    world
+        .create_shape(g, &ShapeDef::default(), Polygon::make_box(20.0, 1.0))
+        .unwrap();
     let sd = ShapeDef::default().with_restitution(restitution);
     let bodies = (0..5)
         .map(|i| {
-            let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 0.5 + 1.0 * i as Real))).unwrap();
-            world.create_shape(b, &sd, Polygon::make_box(0.5, 0.5)).unwrap();
+            let b = world
+                .create_body(&BodyDef::dynamic(Vec2::new(0.0, 0.5 + 1.0 * i as Real)))
+                .unwrap();
+            world
+                .create_shape(b, &sd, Polygon::make_box(0.5, 0.5))
+                .unwrap();
             b
         })
         .collect();
@@ -24,26 +32,40 @@ fn boxes_on_ground(def: WorldDef, restitution: Real) -> (World, Vec<BodyHandle>)
 fn no_shapes_means_no_collision_work() {
     let mut world = World::new(WorldDef::default()).unwrap();
     for i in 0..10 {
-        world.create_body(&BodyDef::dynamic(Vec2::new(i as Real, 0.0))).unwrap();
+        world
+            .create_body(&BodyDef::dynamic(Vec2::new(i as Real, 0.0)))
+            .unwrap();
     }
     world.step(DT).unwrap();
     let c = world.counters();
     assert!(!c.collision_ran);
-    assert_eq!((c.pairs_tested, c.pairs_created, c.proxies_moved, c.contacts), (0, 0, 0, 0));
+    assert_eq!(
+        (c.pairs_tested, c.pairs_created, c.proxies_moved, c.contacts),
+        (0, 0, 0, 0)
+    );
     assert_eq!(world.profile().broadphase, 0.0);
     assert_eq!(world.profile().narrowphase, 0.0);
 }
 
 #[test]
 fn no_portals_means_no_portal_stage() {
-    let def = WorldDef { sleep: SleepSettings { enabled: false, ..Default::default() }, ..Default::default() };
+    let def = WorldDef {
+        sleep: SleepSettings {
+            enabled: false,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
     let (mut world, _) = boxes_on_ground(def, 0.0);
     for _ in 0..10 {
         world.step(DT).unwrap();
     }
     let c = world.counters();
     assert!(!c.portal_stage_ran);
-    assert_eq!((c.portal_bodies_tested, c.portal_crossings, c.portal_rows), (0, 0, 0));
+    assert_eq!(
+        (c.portal_bodies_tested, c.portal_crossings, c.portal_rows),
+        (0, 0, 0)
+    );
     assert_eq!(world.profile().portals, 0.0);
 }
 
@@ -57,7 +79,13 @@ fn portals_present_means_portal_stage_runs() {
 
 #[test]
 fn no_restitution_means_no_restitution_contacts() {
-    let def = WorldDef { sleep: SleepSettings { enabled: false, ..Default::default() }, ..Default::default() };
+    let def = WorldDef {
+        sleep: SleepSettings {
+            enabled: false,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
     let (mut world, _) = boxes_on_ground(def.clone(), 0.0);
     for _ in 0..10 {
         world.step(DT).unwrap();
@@ -73,14 +101,22 @@ fn no_restitution_means_no_restitution_contacts() {
 
 #[test]
 fn zero_gravity_means_no_gravity_work_and_no_joints_no_joint_rows() {
-    let def = WorldDef { gravity: Vec2::ZERO, ..Default::default() };
+    let def = WorldDef {
+        gravity: Vec2::ZERO,
+        ..Default::default()
+    };
     let (mut world, _) = boxes_on_ground(def, 0.0);
     world.step(DT).unwrap();
     assert_eq!(world.counters().gravity_bodies, 0);
     assert_eq!(world.counters().joint_rows, 0);
     let (mut heavy, bodies) = boxes_on_ground(WorldDef::default(), 0.0);
     heavy
-        .create_revolute_joint(&RevoluteJointDef::new(bodies[0], bodies[1], Vec2::new(0.0, 0.5), Vec2::new(0.0, -0.5)))
+        .create_revolute_joint(&RevoluteJointDef::new(
+            bodies[0],
+            bodies[1],
+            Vec2::new(0.0, 0.5),
+            Vec2::new(0.0, -0.5),
+        ))
         .unwrap();
     heavy.step(DT).unwrap();
     assert_eq!(heavy.counters().gravity_bodies, 5);
@@ -109,7 +145,13 @@ fn api_change_wakes_the_whole_island() {
         world.step(DT).unwrap();
     }
     assert!(world.is_sleeping(bodies[4]));
-    world.apply_linear_impulse(bodies[4], Vec2::new(0.1, 0.0), world.center_of_mass(bodies[4]).unwrap()).unwrap();
+    world
+        .apply_linear_impulse(
+            bodies[4],
+            Vec2::new(0.1, 0.0),
+            world.center_of_mass(bodies[4]).unwrap(),
+        )
+        .unwrap();
     for b in &bodies {
         assert!(!world.is_sleeping(*b), "island member still asleep");
     }
@@ -123,8 +165,16 @@ fn contact_from_an_awake_body_wakes_the_island() {
         world.step(DT).unwrap();
     }
     assert_eq!(world.sleeping_body_count(), 5);
-    let ball = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 8.0))).unwrap();
-    world.create_shape(ball, &ShapeDef::default(), Circle::new(Vec2::ZERO, 0.25).unwrap()).unwrap();
+    let ball = world
+        .create_body(&BodyDef::dynamic(Vec2::new(0.0, 8.0)))
+        .unwrap();
+    world
+        .create_shape(
+            ball,
+            &ShapeDef::default(),
+            Circle::new(Vec2::ZERO, 0.25).unwrap(),
+        )
+        .unwrap();
     let mut woke = false;
     for _ in 0..120 {
         world.step(DT).unwrap();
@@ -137,7 +187,12 @@ fn contact_from_an_awake_body_wakes_the_island() {
 fn joint_change_wakes_both_bodies() {
     let (mut world, bodies) = boxes_on_ground(WorldDef::default(), 0.0);
     let j = world
-        .create_revolute_joint(&RevoluteJointDef::new(bodies[3], bodies[4], Vec2::new(0.0, 0.5), Vec2::new(0.0, -0.5)))
+        .create_revolute_joint(&RevoluteJointDef::new(
+            bodies[3],
+            bodies[4],
+            Vec2::new(0.0, 0.5),
+            Vec2::new(0.0, -0.5),
+        ))
         .unwrap();
     for _ in 0..240 {
         world.step(DT).unwrap();
@@ -156,7 +211,8 @@ fn portal_crossing_keeps_bodies_awake() {
         scene.world.step(DT).unwrap();
         if scene.world.crossing_count() > 0 {
             let clone = scene.world.clone_of(scene.probe).unwrap();
-            asleep_while_crossing |= scene.world.is_sleeping(scene.probe) || scene.world.is_sleeping(clone);
+            asleep_while_crossing |=
+                scene.world.is_sleeping(scene.probe) || scene.world.is_sleeping(clone);
         }
     }
     assert!(!asleep_while_crossing);

@@ -6,7 +6,6 @@
 use janus2d::prelude::*;
 use janus2d::scenes::{self, DT};
 
-
 fn report() -> bool {
     std::env::var("JANUS2D_REPORT").is_ok()
 }

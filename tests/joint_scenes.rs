@@ -6,7 +6,6 @@ use janus2d::scenes;
 
 const DT: Real = 1.0 / 60.0;
 
-
 fn report() -> bool {
     std::env::var("JANUS2D_REPORT").is_ok()
 }

@@ -21,7 +21,8 @@ fn dynamic_count(world: &World) -> usize {
 fn kinetic_energy(world: &World, b: BodyHandle) -> Real {
     let v = world.linear_velocity(b).unwrap();
     let w = world.angular_velocity(b).unwrap();
-    0.5 * world.mass(b).unwrap() * v.length_squared() + 0.5 * world.rotational_inertia(b).unwrap() * w * w
+    0.5 * world.mass(b).unwrap() * v.length_squared()
+        + 0.5 * world.rotational_inertia(b).unwrap() * w * w
 }
 
 /// Width of a body's shapes along a world direction, m.
@@ -39,7 +40,9 @@ fn extent(world: &World, b: BodyHandle, dir: Vec2) -> Real {
 
 fn wall(world: &mut World, center: Vec2, hx: Real, hy: Real) -> BodyHandle {
     let b = world.create_body(&BodyDef::fixed(center)).unwrap();
-    world.create_shape(b, &ShapeDef::default(), Polygon::make_box(hx, hy)).unwrap();
+    world
+        .create_shape(b, &ShapeDef::default(), Polygon::make_box(hx, hy))
+        .unwrap();
     b
 }
 
@@ -77,9 +80,16 @@ fn portal_drop_exits_sideways_at_impact_speed() {
         if world.crossing_count() > 0 {
             let clone = world.clone_of(body).unwrap();
             for c in &world.collision().contacts {
-                let copy = [body, clone].iter().any(|b| c.body_a == *b || c.body_b == *b);
-                let wall = portal_bodies.iter().any(|b| c.body_a == *b || c.body_b == *b);
-                assert!(!(copy && wall && c.touching), "a copy touched a portal wall");
+                let copy = [body, clone]
+                    .iter()
+                    .any(|b| c.body_a == *b || c.body_b == *b);
+                let wall = portal_bodies
+                    .iter()
+                    .any(|b| c.body_a == *b || c.body_b == *b);
+                assert!(
+                    !(copy && wall && c.touching),
+                    "a copy touched a portal wall"
+                );
             }
         }
         if exit_velocity.is_some() {
@@ -107,13 +117,26 @@ fn portal_drop_exits_sideways_at_impact_speed() {
 /// Gravity 0: a 1 m box launched at 5 m/s through a pair whose exit is η
 /// times wider. Returns (size ratio, speed ratio, KE ratio).
 fn scale_pass(eta: Real, model: MassModel) -> (Real, Real, Real) {
-    let def = WorldDef { gravity: Vec2::ZERO, ..Default::default() };
+    let def = WorldDef {
+        gravity: Vec2::ZERO,
+        ..Default::default()
+    };
     let mut world = World::new(def).unwrap();
     let a = wall(&mut world, Vec2::new(0.5, 0.0), 0.5, 5.0);
     let b = wall(&mut world, Vec2::new(50.0, 50.0), 0.5, 10.0);
     let pair = PortalPairDef {
-        portal_a: PortalDef { body: a, anchor: Vec2::new(-0.5, 0.0), direction: -Vec2::X, half_width: 1.0 },
-        portal_b: PortalDef { body: b, anchor: Vec2::new(0.5, 0.0), direction: Vec2::X, half_width: eta },
+        portal_a: PortalDef {
+            body: a,
+            anchor: Vec2::new(-0.5, 0.0),
+            direction: -Vec2::X,
+            half_width: 1.0,
+        },
+        portal_b: PortalDef {
+            body: b,
+            anchor: Vec2::new(0.5, 0.0),
+            direction: Vec2::X,
+            half_width: eta,
+        },
         eta: None,
         mass_model: model,
     };
@@ -121,7 +144,9 @@ fn scale_pass(eta: Real, model: MassModel) -> (Real, Real, Real) {
     let body = world
         .create_body(&BodyDef::dynamic(Vec2::new(-3.0, 0.0)).with_velocity(Vec2::new(5.0, 0.0)))
         .unwrap();
-    world.create_shape(body, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    world
+        .create_shape(body, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
     let (size0, ke0) = (extent(&world, body, Vec2::Y), kinetic_energy(&world, body));
     let mut done = false;
     for _ in 0..600 {
@@ -134,7 +159,11 @@ fn scale_pass(eta: Real, model: MassModel) -> (Real, Real, Real) {
     assert!(done, "never went through");
     assert_eq!(dynamic_count(&world), 1);
     let speed = world.linear_velocity(body).unwrap().length();
-    (extent(&world, body, Vec2::Y) / size0, speed / 5.0, kinetic_energy(&world, body) / ke0)
+    (
+        extent(&world, body, Vec2::Y) / size0,
+        speed / 5.0,
+        kinetic_energy(&world, body) / ke0,
+    )
 }
 
 /// Scale: clone size and speed are η×; kinetic energy after a full pass is
@@ -142,14 +171,28 @@ fn scale_pass(eta: Real, model: MassModel) -> (Real, Real, Real) {
 #[test]
 fn portal_scale_size_speed_and_energy() {
     for eta in [2.0 as Real, 0.5] {
-        for (model, ke_expected) in [(MassModel::SameMaterial, eta.powi(4)), (MassModel::EnergyPreserving, 1.0)] {
+        for (model, ke_expected) in [
+            (MassModel::SameMaterial, eta.powi(4)),
+            (MassModel::EnergyPreserving, 1.0),
+        ] {
             let (size, speed, ke) = scale_pass(eta, model);
             if report() {
-                eprintln!("scale η {eta} {model:?}: size ×{size:.4}, speed ×{speed:.4}, KE ×{ke:.4} (expected ×{ke_expected})");
+                eprintln!(
+                    "scale η {eta} {model:?}: size ×{size:.4}, speed ×{speed:.4}, KE ×{ke:.4} (expected ×{ke_expected})"
+                );
             }
-            assert!((size / eta - 1.0).abs() < 0.02, "size ratio {size} for η {eta}");
-            assert!((speed / eta - 1.0).abs() < 0.02, "speed ratio {speed} for η {eta}");
-            assert!((ke / ke_expected - 1.0).abs() < 0.02, "KE ratio {ke} vs {ke_expected}");
+            assert!(
+                (size / eta - 1.0).abs() < 0.02,
+                "size ratio {size} for η {eta}"
+            );
+            assert!(
+                (speed / eta - 1.0).abs() < 0.02,
+                "speed ratio {speed} for η {eta}"
+            );
+            assert!(
+                (ke / ke_expected - 1.0).abs() < 0.02,
+                "KE ratio {ke} vs {ke_expected}"
+            );
         }
     }
 }
@@ -159,13 +202,21 @@ fn portal_scale_size_speed_and_energy() {
 #[test]
 fn portal_round_trip_restores_energy_and_size() {
     let eta = 2.0;
-    let def = WorldDef { gravity: Vec2::ZERO, ..Default::default() };
+    let def = WorldDef {
+        gravity: Vec2::ZERO,
+        ..Default::default()
+    };
     let mut world = World::new(def).unwrap();
     let a = wall(&mut world, Vec2::new(0.5, 0.0), 0.5, 5.0);
     let b = wall(&mut world, Vec2::new(-0.5, 50.0), 0.5, 10.0);
     let c = wall(&mut world, Vec2::new(40.5, 50.0), 0.5, 10.0);
     let d = wall(&mut world, Vec2::new(-0.5, 100.0), 0.5, 5.0);
-    let p = |body, anchor, direction, half_width| PortalDef { body, anchor, direction, half_width };
+    let p = |body, anchor, direction, half_width| PortalDef {
+        body,
+        anchor,
+        direction,
+        half_width,
+    };
     world
         .create_portal_pair(&PortalPairDef::new(
             p(a, Vec2::new(-0.5, 0.0), -Vec2::X, 1.0),
@@ -181,7 +232,9 @@ fn portal_round_trip_restores_energy_and_size() {
     let body = world
         .create_body(&BodyDef::dynamic(Vec2::new(-3.0, 0.0)).with_velocity(Vec2::new(5.0, 0.0)))
         .unwrap();
-    world.create_shape(body, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    world
+        .create_shape(body, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
     let (size0, ke0) = (extent(&world, body, Vec2::Y), kinetic_energy(&world, body));
     let mut passes = 0;
     for _ in 0..1200 {
@@ -194,13 +247,22 @@ fn portal_round_trip_restores_energy_and_size() {
         }
     }
     assert_eq!(passes, 2, "did not make both passes");
-    let (size, ke) = (extent(&world, body, Vec2::Y) / size0, kinetic_energy(&world, body) / ke0);
+    let (size, ke) = (
+        extent(&world, body, Vec2::Y) / size0,
+        kinetic_energy(&world, body) / ke0,
+    );
     if report() {
-        eprintln!("round trip: size ×{size:.4}, KE ×{ke:.4}, position {}", world.position(body).unwrap());
+        eprintln!(
+            "round trip: size ×{size:.4}, KE ×{ke:.4}, position {}",
+            world.position(body).unwrap()
+        );
     }
     assert!((size - 1.0).abs() < 0.01, "size ratio {size}");
     assert!((ke - 1.0).abs() < 0.01, "KE ratio {ke}");
-    assert!(world.position(body).unwrap().y > 90.0, "not at the second exit");
+    assert!(
+        world.position(body).unwrap().y > 90.0,
+        "not at the second exit"
+    );
 }
 
 /// Loop: a floor portal straight below its partner on the ceiling (endless
@@ -213,12 +275,26 @@ fn portal_loop_speed_grows_only_by_gravity() {
     let ceiling = wall(&mut world, Vec2::new(0.0, 10.5), 5.0, 0.5);
     world
         .create_portal_pair(&PortalPairDef::new(
-            PortalDef { body: floor, anchor: Vec2::new(0.0, 0.5), direction: Vec2::Y, half_width: 1.0 },
-            PortalDef { body: ceiling, anchor: Vec2::new(0.0, -0.5), direction: -Vec2::Y, half_width: 1.0 },
+            PortalDef {
+                body: floor,
+                anchor: Vec2::new(0.0, 0.5),
+                direction: Vec2::Y,
+                half_width: 1.0,
+            },
+            PortalDef {
+                body: ceiling,
+                anchor: Vec2::new(0.0, -0.5),
+                direction: -Vec2::Y,
+                half_width: 1.0,
+            },
         ))
         .unwrap();
-    let body = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 5.0))).unwrap();
-    world.create_shape(body, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    let body = world
+        .create_body(&BodyDef::dynamic(Vec2::new(0.0, 5.0)))
+        .unwrap();
+    world
+        .create_shape(body, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
     let mut max_excess: Real = 0.0;
     let mut passes = 0;
     let (mut max_bodies, mut max_constraints) = (0, 0);
@@ -240,10 +316,15 @@ fn portal_loop_speed_grows_only_by_gravity() {
     }
     let speed = world.linear_velocity(body).unwrap().length();
     if report() {
-        eprintln!("loop: {passes} passes, final speed {speed:.2} m/s (g t = 200), max excess over g t {max_excess:.4} m/s, max bodies {max_bodies}, max constraints {max_constraints}");
+        eprintln!(
+            "loop: {passes} passes, final speed {speed:.2} m/s (g t = 200), max excess over g t {max_excess:.4} m/s, max bodies {max_bodies}, max constraints {max_constraints}"
+        );
     }
     assert!(passes > 10, "only {passes} passes");
-    assert!(max_excess <= 0.05 * 10.0, "gained more than gravity: {max_excess} m/s");
+    assert!(
+        max_excess <= 0.05 * 10.0,
+        "gained more than gravity: {max_excess} m/s"
+    );
     assert!(speed >= 0.95 * 200.0, "lost speed: {speed}");
     assert!(max_bodies <= 2 && max_constraints <= 1);
     assert_eq!(dynamic_count(&world), 1 + world.crossing_count());
@@ -253,25 +334,44 @@ fn portal_loop_speed_grows_only_by_gravity() {
 /// rad/s; a body pushed through: |C| ≤ 1 mm throughout.
 #[test]
 fn portal_turning_bodies_keep_error_below_a_millimetre() {
-    let def = WorldDef { gravity: Vec2::ZERO, ..Default::default() };
+    let def = WorldDef {
+        gravity: Vec2::ZERO,
+        ..Default::default()
+    };
     let mut world = World::new(def).unwrap();
     let mk = |world: &mut World, p: Vec2, w: Real| {
-        let b = world.create_body(&BodyDef::kinematic(p).with_angular_velocity(w)).unwrap();
-        world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.25, 1.5)).unwrap();
+        let b = world
+            .create_body(&BodyDef::kinematic(p).with_angular_velocity(w))
+            .unwrap();
+        world
+            .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.25, 1.5))
+            .unwrap();
         b
     };
     let a = mk(&mut world, Vec2::ZERO, 1.0);
     let b = mk(&mut world, Vec2::new(20.0, 0.0), -0.5);
     world
         .create_portal_pair(&PortalPairDef::new(
-            PortalDef { body: a, anchor: Vec2::new(-0.25, 0.0), direction: -Vec2::X, half_width: 1.0 },
-            PortalDef { body: b, anchor: Vec2::new(0.25, 0.0), direction: Vec2::X, half_width: 1.0 },
+            PortalDef {
+                body: a,
+                anchor: Vec2::new(-0.25, 0.0),
+                direction: -Vec2::X,
+                half_width: 1.0,
+            },
+            PortalDef {
+                body: b,
+                anchor: Vec2::new(0.25, 0.0),
+                direction: Vec2::X,
+                half_width: 1.0,
+            },
         ))
         .unwrap();
     let body = world
         .create_body(&BodyDef::dynamic(Vec2::new(-0.9, 0.0)).with_velocity(Vec2::new(6.0, 0.0)))
         .unwrap();
-    world.create_shape(body, &ShapeDef::default(), Polygon::make_box(0.3, 0.3)).unwrap();
+    world
+        .create_shape(body, &ShapeDef::default(), Polygon::make_box(0.3, 0.3))
+        .unwrap();
     let (mut worst, mut steps_crossing) = (0.0 as Real, 0);
     for _ in 0..120 {
         world.step(DT).unwrap();
@@ -281,7 +381,10 @@ fn portal_turning_bodies_keep_error_below_a_millimetre() {
         worst = worst.max(world.max_portal_error());
     }
     if report() {
-        eprintln!("turning: worst |C| {:.4} mm over {steps_crossing} straddling steps", worst * 1000.0);
+        eprintln!(
+            "turning: worst |C| {:.4} mm over {steps_crossing} straddling steps",
+            worst * 1000.0
+        );
     }
     assert!(steps_crossing > 0, "never crossed");
     assert!(worst <= 1e-3, "|C| {worst} m");
@@ -293,13 +396,20 @@ fn portal_turning_bodies_keep_error_below_a_millimetre() {
 fn portal_dynamic_bodies_conserve_momentum() {
     // Sleep off: a sleeping island is put at rest, which is a deliberate
     // loss of its (tiny) momentum; this test measures the constraints.
-    let mut def = WorldDef { gravity: Vec2::ZERO, ..Default::default() };
+    let mut def = WorldDef {
+        gravity: Vec2::ZERO,
+        ..Default::default()
+    };
     def.sleep.enabled = false;
     let mut world = World::new(def).unwrap();
     let mk = |world: &mut World, p: Vec2| {
         let b = world.create_body(&BodyDef::dynamic(p)).unwrap();
         world
-            .create_shape(b, &ShapeDef::default().with_density(20.0), Polygon::make_box(0.25, 1.5))
+            .create_shape(
+                b,
+                &ShapeDef::default().with_density(20.0),
+                Polygon::make_box(0.25, 1.5),
+            )
             .unwrap();
         b
     };
@@ -307,14 +417,26 @@ fn portal_dynamic_bodies_conserve_momentum() {
     let b = mk(&mut world, Vec2::new(20.0, 5.0));
     world
         .create_portal_pair(&PortalPairDef::new(
-            PortalDef { body: a, anchor: Vec2::new(-0.25, 0.0), direction: -Vec2::X, half_width: 1.0 },
-            PortalDef { body: b, anchor: Vec2::new(0.25, 0.0), direction: Vec2::X, half_width: 1.0 },
+            PortalDef {
+                body: a,
+                anchor: Vec2::new(-0.25, 0.0),
+                direction: -Vec2::X,
+                half_width: 1.0,
+            },
+            PortalDef {
+                body: b,
+                anchor: Vec2::new(0.25, 0.0),
+                direction: Vec2::X,
+                half_width: 1.0,
+            },
         ))
         .unwrap();
     let body = world
         .create_body(&BodyDef::dynamic(Vec2::new(-1.0, 0.1)).with_velocity(Vec2::new(4.0, 0.0)))
         .unwrap();
-    world.create_shape(body, &ShapeDef::default(), Polygon::make_box(0.3, 0.3)).unwrap();
+    world
+        .create_shape(body, &ShapeDef::default(), Polygon::make_box(0.3, 0.3))
+        .unwrap();
     let momentum = |world: &World| {
         let (mut p, mut l) = (Vec2::ZERO, 0.0 as Real);
         for h in world.bodies().handles() {
@@ -325,7 +447,8 @@ fn portal_dynamic_bodies_conserve_momentum() {
             let v = world.linear_velocity(h).unwrap();
             let x = world.center_of_mass(h).unwrap();
             p += m * v;
-            l += m * janus2d::base::math::cross(x, v) + world.rotational_inertia(h).unwrap() * world.angular_velocity(h).unwrap();
+            l += m * janus2d::base::math::cross(x, v)
+                + world.rotational_inertia(h).unwrap() * world.angular_velocity(h).unwrap();
         }
         (p, l)
     };
@@ -342,7 +465,9 @@ fn portal_dynamic_bodies_conserve_momentum() {
         worst_l = worst_l.max((l - l0).abs() / scale_l);
     }
     if report() {
-        eprintln!("dynamic portals: worst relative momentum error linear {worst_p:.3e}, angular {worst_l:.3e}");
+        eprintln!(
+            "dynamic portals: worst relative momentum error linear {worst_p:.3e}, angular {worst_l:.3e}"
+        );
     }
     assert!(crossed, "never crossed");
     #[cfg(not(feature = "f64"))]
@@ -360,15 +485,22 @@ fn portal_too_wide_box_rests_on_the_lips() {
     let (mut scene, _) = scenes::portal_drop(&WorldDef::default());
     let world = &mut scene.world;
     world.destroy_body(scene.probe).unwrap();
-    let body = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 3.0))).unwrap();
-    world.create_shape(body, &ShapeDef::default(), Polygon::make_box(1.5, 1.5)).unwrap();
+    let body = world
+        .create_body(&BodyDef::dynamic(Vec2::new(0.0, 3.0)))
+        .unwrap();
+    world
+        .create_shape(body, &ShapeDef::default(), Polygon::make_box(1.5, 1.5))
+        .unwrap();
     for _ in 0..300 {
         world.step(DT).unwrap();
     }
     let p = world.position(body).unwrap();
     let v = world.linear_velocity(body).unwrap().length();
     if report() {
-        eprintln!("too wide: rests at {p}, speed {v:.5}, crossings {}", world.crossing_count());
+        eprintln!(
+            "too wide: rests at {p}, speed {v:.5}, crossings {}",
+            world.crossing_count()
+        );
     }
     assert_eq!(world.crossing_count(), 0);
     assert_eq!(dynamic_count(world), 1);
@@ -389,12 +521,26 @@ fn portal_blocked_exit_stops_the_body() {
     wall(&mut world, Vec2::new(30.0, 1.0), 3.0, 0.5); // lower face at y = 0.5
     world
         .create_portal_pair(&PortalPairDef::new(
-            PortalDef { body: entry_floor, anchor: Vec2::new(0.0, 0.5), direction: Vec2::Y, half_width: 1.0 },
-            PortalDef { body: exit_floor, anchor: Vec2::new(0.0, 0.5), direction: Vec2::Y, half_width: 1.0 },
+            PortalDef {
+                body: entry_floor,
+                anchor: Vec2::new(0.0, 0.5),
+                direction: Vec2::Y,
+                half_width: 1.0,
+            },
+            PortalDef {
+                body: exit_floor,
+                anchor: Vec2::new(0.0, 0.5),
+                direction: Vec2::Y,
+                half_width: 1.0,
+            },
         ))
         .unwrap();
-    let body = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 3.5))).unwrap();
-    world.create_shape(body, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    let body = world
+        .create_body(&BodyDef::dynamic(Vec2::new(0.0, 3.5)))
+        .unwrap();
+    world
+        .create_shape(body, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
     let mut pen: Real = 0.0;
     for _ in 0..300 {
         world.step(DT).unwrap();
@@ -408,12 +554,17 @@ fn portal_blocked_exit_stops_the_body() {
     let clone = world.clone_of(body).expect("still straddling");
     let clone_p = world.position(clone).unwrap();
     if report() {
-        eprintln!("blocked: original at {p} (clone at {clone_p}), velocity {v}, max penetration {pen:.5} m");
+        eprintln!(
+            "blocked: original at {p} (clone at {clone_p}), velocity {v}, max penetration {pen:.5} m"
+        );
     }
     assert!(v.y.abs() < 0.01, "still moving through at {}", v.y);
     // The clone's top rests on the slab: its centre at y = 0, so the
     // original is half way into its floor.
-    assert!(clone_p.y.abs() < 0.02 && p.y.abs() < 0.02, "original {p}, clone {clone_p}");
+    assert!(
+        clone_p.y.abs() < 0.02 && p.y.abs() < 0.02,
+        "original {p}, clone {clone_p}"
+    );
     assert!(pen <= 0.005 + 1e-3, "penetration {pen}");
 }
 
@@ -432,13 +583,23 @@ fn portal_stream_conserves_bodies() {
             .iter()
             .filter(|e| matches!(e, PortalEvent::CrossingCompleted { .. }))
             .count();
-        assert_eq!(dynamic_count(world), n0 + world.crossing_count(), "body leaked");
+        assert_eq!(
+            dynamic_count(world),
+            n0 + world.crossing_count(),
+            "body leaked"
+        );
         assert_eq!(world.portal_constraints().len(), world.crossing_count());
         assert!(world.events().non_finite_bodies.is_empty());
     }
-    let all_finite = world.bodies().handles().all(|h| world.position(h).unwrap().is_finite());
+    let all_finite = world
+        .bodies()
+        .handles()
+        .all(|h| world.position(h).unwrap().is_finite());
     if report() {
-        eprintln!("stream: {n0} bodies, {passes} passes in 30 s, {} crossing at the end", world.crossing_count());
+        eprintln!(
+            "stream: {n0} bodies, {passes} passes in 30 s, {} crossing at the end",
+            world.crossing_count()
+        );
     }
     assert!(all_finite);
     assert!(passes >= 100, "only {passes} passes");
@@ -469,7 +630,10 @@ fn destroying_a_portal_ends_crossings_cleanly() {
         assert_eq!(world.portal_pair_count(), 0);
         assert!(world.position(clone).is_err(), "clone leaked");
         assert_eq!(dynamic_count(world), 1);
-        assert!(world.destroy_portal_pair(pair).is_err(), "stale pair handle accepted");
+        assert!(
+            world.destroy_portal_pair(pair).is_err(),
+            "stale pair handle accepted"
+        );
         for _ in 0..10 {
             world.step(DT).unwrap();
         }
@@ -485,10 +649,19 @@ fn joint_spanning_a_portal_is_disabled_and_reported() {
     let world = &mut scene.world;
     // A second box hinged on top of the falling one: once the first is
     // through, the joint would span the portal.
-    let buddy = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 7.0))).unwrap();
-    world.create_shape(buddy, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    let buddy = world
+        .create_body(&BodyDef::dynamic(Vec2::new(0.0, 7.0)))
+        .unwrap();
+    world
+        .create_shape(buddy, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
     let joint = world
-        .create_revolute_joint(&RevoluteJointDef::new(scene.probe, buddy, Vec2::new(0.0, 0.75), Vec2::new(0.0, -0.75)))
+        .create_revolute_joint(&RevoluteJointDef::new(
+            scene.probe,
+            buddy,
+            Vec2::new(0.0, 0.75),
+            Vec2::new(0.0, -0.75),
+        ))
         .unwrap();
     let mut disabled = false;
     let mut completed_body = None;
@@ -500,7 +673,9 @@ fn joint_spanning_a_portal_is_disabled_and_reported() {
                     assert_eq!(*j, joint);
                     disabled = true;
                 }
-                PortalEvent::CrossingCompleted { body, .. } if *body == scene.probe => completed_body = Some(*body),
+                PortalEvent::CrossingCompleted { body, .. } if *body == scene.probe => {
+                    completed_body = Some(*body)
+                }
                 _ => {}
             }
         }
@@ -519,20 +694,35 @@ fn joint_spanning_a_portal_is_disabled_and_reported() {
 /// step or two and never shows up behind the entry wall; it crosses once.
 #[test]
 fn fast_body_crosses_without_tunnelling() {
-    let def = WorldDef { gravity: Vec2::ZERO, ..Default::default() };
+    let def = WorldDef {
+        gravity: Vec2::ZERO,
+        ..Default::default()
+    };
     let mut world = World::new(def).unwrap();
     let a = wall(&mut world, Vec2::new(0.5, 0.0), 0.5, 5.0);
     let b = wall(&mut world, Vec2::new(-0.5, 50.0), 0.5, 5.0);
     world
         .create_portal_pair(&PortalPairDef::new(
-            PortalDef { body: a, anchor: Vec2::new(-0.5, 0.0), direction: -Vec2::X, half_width: 1.0 },
-            PortalDef { body: b, anchor: Vec2::new(0.5, 0.0), direction: Vec2::X, half_width: 1.0 },
+            PortalDef {
+                body: a,
+                anchor: Vec2::new(-0.5, 0.0),
+                direction: -Vec2::X,
+                half_width: 1.0,
+            },
+            PortalDef {
+                body: b,
+                anchor: Vec2::new(0.5, 0.0),
+                direction: Vec2::X,
+                half_width: 1.0,
+            },
         ))
         .unwrap();
     let body = world
         .create_body(&BodyDef::dynamic(Vec2::new(-10.0, 0.0)).with_velocity(Vec2::new(150.0, 0.0)))
         .unwrap();
-    world.create_shape(body, &ShapeDef::default(), Polygon::make_box(0.25, 0.25)).unwrap();
+    world
+        .create_shape(body, &ShapeDef::default(), Polygon::make_box(0.25, 0.25))
+        .unwrap();
     let mut completions = 0;
     for _ in 0..30 {
         world.step(DT).unwrap();
@@ -544,11 +734,17 @@ fn fast_body_crosses_without_tunnelling() {
         let p = world.position(body).unwrap();
         // Entirely behind the entry plane (centre deeper than its half size)
         // would mean it tunnelled into the wall instead of crossing.
-        assert!(!(p.x > 0.25 && p.y.abs() < 10.0), "behind the entry wall at {p}");
+        assert!(
+            !(p.x > 0.25 && p.y.abs() < 10.0),
+            "behind the entry wall at {p}"
+        );
     }
     let p = world.position(body).unwrap();
     let v = world.linear_velocity(body).unwrap();
     assert_eq!(completions, 1);
-    assert!((p.y - 50.0).abs() < 0.5 && p.x > 10.0, "not on the exit side: {p}");
+    assert!(
+        (p.y - 50.0).abs() < 0.5 && p.x > 10.0,
+        "not on the exit side: {p}"
+    );
     assert!((v.x - 150.0).abs() < 1.5, "speed changed: {v}");
 }

@@ -508,8 +508,9 @@ impl BodySet {
         state.dq = Rot::IDENTITY;
         self.sleeping_sims.push(sim);
         self.sleeping_states.push(state);
-        self.records[handle.index as usize].location =
-            Some(BodyLocation::Sleeping((self.sleeping_sims.len() - 1) as u32));
+        self.records[handle.index as usize].location = Some(BodyLocation::Sleeping(
+            (self.sleeping_sims.len() - 1) as u32,
+        ));
     }
 
     /// Wakes a sleeping body (back into the solver's arrays, timer reset).
@@ -907,7 +908,9 @@ mod tests {
     #[test]
     fn sleep_and_wake_round_trip() {
         let mut set = BodySet::new();
-        let a = set.create(&BodyDef::dynamic(Vec2::ZERO).with_mass(2.0, 1.0)).unwrap();
+        let a = set
+            .create(&BodyDef::dynamic(Vec2::ZERO).with_mass(2.0, 1.0))
+            .unwrap();
         let b = set.create(&BodyDef::dynamic(Vec2::ONE)).unwrap();
         set.sleep(a);
         assert!(set.is_sleeping(a));

@@ -414,11 +414,18 @@ impl Collision {
     /// The slot of a live shape.
     pub fn slot(&self, handle: ShapeHandle) -> Option<u32> {
         let s = self.shapes.get(handle.index as usize)?;
-        (s.alive && s.generation == handle.generation && handle.owner == self.owner).then_some(handle.index)
+        (s.alive && s.generation == handle.generation && handle.owner == self.owner)
+            .then_some(handle.index)
     }
 
     /// Adds a shape (already validated) to a live body.
-    pub fn add_shape(&mut self, bodies: &BodySet, body: BodyHandle, geometry: Shape, def: ShapeDef) -> ShapeHandle {
+    pub fn add_shape(
+        &mut self,
+        bodies: &BodySet,
+        body: BodyHandle,
+        geometry: Shape,
+        def: ShapeDef,
+    ) -> ShapeHandle {
         let sim = bodies.sim(body).expect("live body");
         let aabb = geometry.compute_aabb(&sim.transform);
         let is_static = sim.body_type == BodyType::Static;
@@ -481,7 +488,8 @@ impl Collision {
         self.pair_index.remove(&pair_key(c.shape_a, c.shape_b));
         if k < self.contacts.len() {
             let moved = &self.contacts[k];
-            self.pair_index.insert(pair_key(moved.shape_a, moved.shape_b), k as u32);
+            self.pair_index
+                .insert(pair_key(moved.shape_a, moved.shape_b), k as u32);
         }
         if c.touching {
             let ev = ShapePairEvent {
@@ -558,7 +566,9 @@ impl Collision {
             return false;
         }
         if !self.no_collide_pairs.is_empty()
-            && self.no_collide_pairs.contains_key(&pair_key(sa.body.index, sb.body.index))
+            && self
+                .no_collide_pairs
+                .contains_key(&pair_key(sa.body.index, sb.body.index))
         {
             return false;
         }
@@ -620,7 +630,13 @@ impl Collision {
     /// Contacts between two bodies that are both static or asleep are
     /// skipped; a touching contact between a sleeping body and an awake one
     /// lists the sleeping body in `wake`.
-    pub fn narrowphase(&mut self, bodies: &BodySet, dt: Real, clipping: &ContactClipping, wake: &mut Vec<BodyHandle>) {
+    pub fn narrowphase(
+        &mut self,
+        bodies: &BodySet,
+        dt: Real,
+        clipping: &ContactClipping,
+        wake: &mut Vec<BodyHandle>,
+    ) {
         // Phase 1: every contact's new manifold, independently (in parallel
         // with the `parallel` feature: the results do not depend on the
         // thread count, since each contact is computed alone).
@@ -632,7 +648,10 @@ impl Collision {
             #[cfg(feature = "parallel")]
             {
                 use rayon::prelude::*;
-                self.contacts.par_iter().map(compute).collect_into_vec(&mut results);
+                self.contacts
+                    .par_iter()
+                    .map(compute)
+                    .collect_into_vec(&mut results);
             }
             #[cfg(not(feature = "parallel"))]
             results.extend(self.contacts.iter().map(compute));
@@ -711,14 +730,28 @@ impl Collision {
             return ContactUpdate::Separated;
         }
         let (sim_a, sim_b) = (body_a.sim, body_b.sim);
-        let reach = |aabb: &Aabb, center: Vec2| (aabb.lower - center).abs().max((aabb.upper - center).abs()).length();
+        let reach = |aabb: &Aabb, center: Vec2| {
+            (aabb.lower - center)
+                .abs()
+                .max((aabb.upper - center).abs())
+                .length()
+        };
         let approach = (body_b.state.v - body_a.state.v).length()
             + body_a.state.w.abs() * reach(&sa.aabb, sim_a.center)
             + body_b.state.w.abs() * reach(&sb.aabb, sim_b.center);
         let speculative = SPECULATIVE_DISTANCE + dt * approach;
         ContactUpdate::Manifold(Computed {
-            manifold: collide(&sa.geometry, &sim_a.transform, &sb.geometry, &sim_b.transform, speculative),
-            offset: [sim_a.transform.p - sim_a.center, sim_b.transform.p - sim_b.center],
+            manifold: collide(
+                &sa.geometry,
+                &sim_a.transform,
+                &sb.geometry,
+                &sim_b.transform,
+                speculative,
+            ),
+            offset: [
+                sim_a.transform.p - sim_a.center,
+                sim_b.transform.p - sim_b.center,
+            ],
             still: [body_a.state_index == 0, body_b.state_index == 0],
         })
     }
@@ -734,11 +767,19 @@ impl Collision {
     /// ([`Contact::still`]); a contact whose two bodies are still sleeps.
     /// When islands were woken after the narrowphase (`woke`), contacts
     /// that slept are checked again.
-    pub fn build_constraints(&mut self, bodies: &BodySet, woke: bool, out: &mut Vec<ContactConstraint>) {
+    pub fn build_constraints(
+        &mut self,
+        bodies: &BodySet,
+        woke: bool,
+        out: &mut Vec<ContactConstraint>,
+    ) {
         out.clear();
         if woke {
             for c in self.contacts.iter_mut().filter(|c| c.still == [true, true]) {
-                c.still = [bodies.state_index(c.body_a) == Some(0), bodies.state_index(c.body_b) == Some(0)];
+                c.still = [
+                    bodies.state_index(c.body_a) == Some(0),
+                    bodies.state_index(c.body_b) == Some(0),
+                ];
             }
         }
         for pass in [false, true] {
@@ -806,7 +847,10 @@ impl Collision {
                 let shape = &mut self.shapes[s as usize];
                 let aabb = shape.geometry.compute_aabb(&sim.transform);
                 shape.aabb = aabb;
-                let aabb = Aabb::new(aabb.lower + sweep.min(Vec2::ZERO), aabb.upper + sweep.max(Vec2::ZERO));
+                let aabb = Aabb::new(
+                    aabb.lower + sweep.min(Vec2::ZERO),
+                    aabb.upper + sweep.max(Vec2::ZERO),
+                );
                 if self.broadphase.move_proxy(shape.proxy, aabb) {
                     moved += 1;
                 }
@@ -891,7 +935,9 @@ pub fn validate_geometry(shape: &Shape) -> Result<(), janus2d_core::geometry::Ge
             if !finite(&[c.ghost1, c.segment.point1, c.segment.point2, c.ghost2]) {
                 return Err(E::NonFinite);
             }
-            if (c.segment.point2 - c.segment.point1).length() <= janus2d_core::geometry::shapes::WELD_DISTANCE {
+            if (c.segment.point2 - c.segment.point1).length()
+                <= janus2d_core::geometry::shapes::WELD_DISTANCE
+            {
                 return Err(E::DegenerateSegment);
             }
         }
@@ -914,7 +960,10 @@ pub fn validate_geometry(shape: &Shape) -> Result<(), janus2d_core::geometry::Ge
                 return Ok(());
             }
             if n < 3 {
-                return Err(E::TooFewPoints { found: n, needed: 3 });
+                return Err(E::TooFewPoints {
+                    found: n,
+                    needed: 3,
+                });
             }
             let mut area2 = 0.0;
             for i in 0..n {

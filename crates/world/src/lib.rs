@@ -24,8 +24,8 @@ pub mod world;
 
 pub use collision::{CollisionEvents, Filter, ShapeDef, ShapeHandle};
 pub use error::WorldError;
-pub use profile::{StepCounters, StepProfile};
-pub use sleep::SleepSettings;
 #[cfg(feature = "portals")]
 pub use portals::{MassModel, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle};
+pub use profile::{StepCounters, StepProfile};
+pub use sleep::SleepSettings;
 pub use world::{JointHandle, StepEvents, World, WorldDef};

@@ -223,7 +223,9 @@ impl Portals {
     }
 
     pub(crate) fn crossing_of(&self, body: BodyHandle) -> Option<usize> {
-        self.crossings.iter().position(|c| c.original == body || c.clone == body)
+        self.crossings
+            .iter()
+            .position(|c| c.original == body || c.clone == body)
     }
 }
 
@@ -246,13 +248,20 @@ impl World {
     ///
     /// Rejects stale body handles, non-finite values, a zero direction, a
     /// non-positive half-width and `η ≤ 0`.
-    pub fn create_portal_pair(&mut self, def: &PortalPairDef) -> Result<PortalPairHandle, WorldError> {
+    pub fn create_portal_pair(
+        &mut self,
+        def: &PortalPairDef,
+    ) -> Result<PortalPairHandle, WorldError> {
         let mut local = Vec::with_capacity(2);
         for p in [def.portal_a, def.portal_b] {
             if !self.bodies().contains(p.body) {
                 return Err(WorldError::StaleBody);
             }
-            local.push(Portal::new(p.anchor, p.direction, p.half_width).map_err(WorldError::Portal)?.normalized());
+            local.push(
+                Portal::new(p.anchor, p.direction, p.half_width)
+                    .map_err(WorldError::Portal)?
+                    .normalized(),
+            );
         }
         let local = [local[0], local[1]];
         let eta = def.eta.unwrap_or(local[1].half_width / local[0].half_width);
@@ -267,7 +276,10 @@ impl World {
         let index = match p.free.pop() {
             Some(i) => i,
             None => {
-                p.slots.push(PairSlot { generation: 0, data: None });
+                p.slots.push(PairSlot {
+                    generation: 0,
+                    data: None,
+                });
                 (p.slots.len() - 1) as u32
             }
         };
@@ -283,8 +295,15 @@ impl World {
     }
 
     fn pair_slot(&self, pair: PortalPairHandle) -> Result<u32, WorldError> {
-        let slot = self.portals.slots.get(pair.index as usize).ok_or(WorldError::StalePortal)?;
-        if slot.generation != pair.generation || slot.data.is_none() || pair.owner != self.bodies().owner() {
+        let slot = self
+            .portals
+            .slots
+            .get(pair.index as usize)
+            .ok_or(WorldError::StalePortal)?;
+        if slot.generation != pair.generation
+            || slot.data.is_none()
+            || pair.owner != self.bodies().owner()
+        {
             return Err(WorldError::StalePortal);
         }
         Ok(pair.index)
@@ -337,7 +356,11 @@ impl World {
 
     /// The clone of `body` while it crosses, if any.
     pub fn clone_of(&self, body: BodyHandle) -> Option<BodyHandle> {
-        self.portals.crossings.iter().find(|c| c.original == body).map(|c| c.clone)
+        self.portals
+            .crossings
+            .iter()
+            .find(|c| c.original == body)
+            .map(|c| c.clone)
     }
 
     /// Largest portal constraint error `|x₂ − T(x₁)|` over crossings, m.
@@ -389,7 +412,10 @@ impl World {
             }
         }
         for c in &self.portals.crossings {
-            let d = self.portals.slots[c.pair as usize].data.as_ref().expect("live pair");
+            let d = self.portals.slots[c.pair as usize]
+                .data
+                .as_ref()
+                .expect("live pair");
             let (entry, exit) = (c.entry, 1 - c.entry);
             for (body, side) in [(c.original, entry), (c.clone, exit)] {
                 let f = frame_of(self, &d.portals[side], &d.local[side]);
@@ -430,7 +456,9 @@ impl World {
 
     /// Fraction of a body's shape area in front of a portal plane.
     fn front_fraction(&self, body: BodyHandle, f: &PortalFrame) -> Real {
-        let Some(sim) = self.bodies().sim(body) else { return 0.0 };
+        let Some(sim) = self.bodies().sim(body) else {
+            return 0.0;
+        };
         let xf = sim.transform;
         let Some(list) = self.collision().body_shapes.get(body.index as usize) else {
             return 0.0;
@@ -454,7 +482,10 @@ impl World {
         let mut k = 0;
         while k < self.portals.crossings.len() {
             let c = self.portals.crossings[k].clone();
-            let d = self.portals.slots[c.pair as usize].data.clone().expect("live pair");
+            let d = self.portals.slots[c.pair as usize]
+                .data
+                .clone()
+                .expect("live pair");
             let f_entry = frame_of(self, &d.portals[c.entry], &d.local[c.entry]);
             let f_exit = frame_of(self, &d.portals[1 - c.entry], &d.local[1 - c.entry]);
             let orig_ext = self.extents_in(c.original, &f_entry);
@@ -478,17 +509,22 @@ impl World {
         // 2. New crossings: bodies whose shapes straddle an aperture and fit
         //    its width, or whose centre swept through it during the step.
         for index in 0..self.portals.slots.len() as u32 {
-            let Some(d) = self.portals.slots[index as usize].data.clone() else { continue };
+            let Some(d) = self.portals.slots[index as usize].data.clone() else {
+                continue;
+            };
             for entry in 0..2 {
                 let f = frame_of(self, &d.portals[entry], &d.local[entry]);
                 let w = d.local[entry].half_width;
                 let candidates = self.aperture_candidates(&f, w, &d);
                 counters.bodies_tested += candidates.len();
                 for body in candidates {
-                    if crossed_this_step.contains(&body) || self.portals.crossing_of(body).is_some() {
+                    if crossed_this_step.contains(&body) || self.portals.crossing_of(body).is_some()
+                    {
                         continue;
                     }
-                    let Some((n0, n1, t0, t1)) = self.extents_in(body, &f) else { continue };
+                    let Some((n0, n1, t0, t1)) = self.extents_in(body, &f) else {
+                        continue;
+                    };
                     let straddles = n0 < 0.0 && n1 > 0.0 && t0 >= -w && t1 <= w;
                     let sim = self.bodies().sim(body).expect("live");
                     let s0 = (sim.center0 - f.point).dot(f.normal);
@@ -536,7 +572,8 @@ impl World {
         out.sort();
         out.dedup();
         out.retain(|b| {
-            self.bodies().body_type(*b) == Some(BodyType::Dynamic) && d.portals.iter().all(|p| p.body != *b)
+            self.bodies().body_type(*b) == Some(BodyType::Dynamic)
+                && d.portals.iter().all(|p| p.body != *b)
         });
         out
     }
@@ -591,7 +628,11 @@ impl World {
             ..BodyDef::default()
         };
         let clone = self.create_body(&clone_def).ok()?;
-        let shapes: Vec<_> = self.collision().body_shapes.get(body.index as usize)?.clone();
+        let shapes: Vec<_> = self
+            .collision()
+            .body_shapes
+            .get(body.index as usize)?
+            .clone();
         for s in shapes {
             let data = &self.collision().shapes[s as usize];
             let geometry = data.geometry.scaled(eta, sim.local_center);
@@ -627,7 +668,9 @@ impl World {
         });
         self.portals.constraints.push(constraint);
         let pair = self.pair_handle(index);
-        self.portals.events.push(PortalEvent::CrossingStarted { body, clone, pair });
+        self.portals
+            .events
+            .push(PortalEvent::CrossingStarted { body, clone, pair });
         Some(())
     }
 
@@ -636,18 +679,27 @@ impl World {
     /// clone moves the object as if its mass were `m₂ + m₁/η²` (and
     /// `m₁ + η² m₂` seen from the original); rotation is shared, so the
     /// inertia is `I₁ + I₂`.
-    pub(crate) fn apply_object_masses(&self, constraints: &mut [janus2d_constraints::ContactConstraint]) {
+    pub(crate) fn apply_object_masses(
+        &self,
+        constraints: &mut [janus2d_constraints::ContactConstraint],
+    ) {
         if self.portals.crossings.is_empty() {
             return;
         }
-        let mut objects: Vec<(BodyHandle, Real, Real)> = Vec::with_capacity(2 * self.portals.crossings.len());
+        let mut objects: Vec<(BodyHandle, Real, Real)> =
+            Vec::with_capacity(2 * self.portals.crossings.len());
         for (c, pc) in self.portals.crossings.iter().zip(&self.portals.constraints) {
             let eta = pc.def().eta;
-            let (Some(s1), Some(s2)) = (self.bodies().sim(c.original), self.bodies().sim(c.clone)) else {
+            let (Some(s1), Some(s2)) = (self.bodies().sim(c.original), self.bodies().sim(c.clone))
+            else {
                 continue;
             };
             let inertia = s1.inertia + s2.inertia;
-            let inv_i = if inertia > 0.0 && s1.inv_inertia > 0.0 { 1.0 / inertia } else { 0.0 };
+            let inv_i = if inertia > 0.0 && s1.inv_inertia > 0.0 {
+                1.0 / inertia
+            } else {
+                0.0
+            };
             let m_orig = s1.mass + eta * eta * s2.mass;
             let m_clone = s2.mass + s1.mass / (eta * eta);
             objects.push((c.original, 1.0 / m_orig, inv_i));
@@ -683,7 +735,10 @@ impl World {
     }
 
     pub(crate) fn crossing_portal_bodies(&self, c: &Crossing) -> (BodyHandle, BodyHandle) {
-        let d = self.portals.slots[c.pair as usize].data.as_ref().expect("live pair");
+        let d = self.portals.slots[c.pair as usize]
+            .data
+            .as_ref()
+            .expect("live pair");
         (d.portals[c.entry].body, d.portals[1 - c.entry].body)
     }
 
@@ -700,7 +755,9 @@ impl World {
     ///
     /// Static and kinematic portal bodies absorb it (infinite mass).
     fn set_copy_mass(&mut self, body: BodyHandle, new: BodyMass, portal_body: BodyHandle) {
-        let Some(b) = self.bodies().sim(body).copied() else { return };
+        let Some(b) = self.bodies().sim(body).copied() else {
+            return;
+        };
         if self.bodies().body_type(portal_body) == Some(BodyType::Dynamic) {
             let st = *self.bodies().state(body).expect("live");
             let dm = b.mass - new.mass;
@@ -718,11 +775,19 @@ impl World {
     /// receives `(m_from − m_to) v` at the copy's centre and
     /// `(I_from − I_to) ω`. Used when a copy appears (`from` = 0) or
     /// disappears (`to` = 0) as a whole.
-    fn exchange_with_portal(&mut self, body: BodyHandle, from: (Real, Real), to: (Real, Real), portal_body: BodyHandle) {
+    fn exchange_with_portal(
+        &mut self,
+        body: BodyHandle,
+        from: (Real, Real),
+        to: (Real, Real),
+        portal_body: BodyHandle,
+    ) {
         if self.bodies().body_type(portal_body) != Some(BodyType::Dynamic) {
             return;
         }
-        let Some(b) = self.bodies().sim(body).copied() else { return };
+        let Some(b) = self.bodies().sim(body).copied() else {
+            return;
+        };
         let st = *self.bodies().state(body).expect("live");
         let _ = self.apply_linear_impulse(portal_body, (from.0 - to.0) * st.v, b.center);
         let _ = self.apply_angular_impulse(portal_body, (from.1 - to.1) * st.w);
@@ -748,11 +813,16 @@ impl World {
         // Joints on the original would now span the portal.
         for joint in self.joints_attached_to(c.original) {
             self.disable_joint(joint);
-            self.portals.events.push(PortalEvent::JointDisabled { joint, pair });
+            self.portals
+                .events
+                .push(PortalEvent::JointDisabled { joint, pair });
         }
         self.swap_body_identity(c.original, c.clone);
         let _ = self.destroy_body(c.clone);
-        self.portals.events.push(PortalEvent::CrossingCompleted { body: c.original, pair });
+        self.portals.events.push(PortalEvent::CrossingCompleted {
+            body: c.original,
+            pair,
+        });
     }
 
     /// The body backed out (or the crossing is ended): remove the clone and
@@ -773,6 +843,9 @@ impl World {
             let _ = self.destroy_body(c.clone);
         }
         let pair = self.pair_handle(c.pair);
-        self.portals.events.push(PortalEvent::CrossingCancelled { body: c.original, pair });
+        self.portals.events.push(PortalEvent::CrossingCancelled {
+            body: c.original,
+            pair,
+        });
     }
 }

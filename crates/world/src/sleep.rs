@@ -177,14 +177,19 @@ impl World {
         for i in 1..n {
             let r = find(&mut parent, i as u32) as usize;
             let sim = &self.bodies().sims[i];
-            let t = if sim.body_type == BodyType::Dynamic { sim.sleep_time } else { 0.0 };
+            let t = if sim.body_type == BodyType::Dynamic {
+                sim.sleep_time
+            } else {
+                0.0
+            };
             min_time[r] = min_time[r].min(t);
         }
         let mut groups: Vec<(u32, BodyHandle)> = Vec::new();
         for i in 1..n {
             let r = find(&mut parent, i as u32);
             let sim = &self.bodies().sims[i];
-            if sim.body_type == BodyType::Dynamic && min_time[r as usize] >= settings.time_to_sleep {
+            if sim.body_type == BodyType::Dynamic && min_time[r as usize] >= settings.time_to_sleep
+            {
                 groups.push((r, sim.handle));
             }
         }

@@ -12,10 +12,10 @@
 //! unchanged.
 
 use janus2d_constraints::{ContactConstraint, RevoluteJoint, RevoluteJointDef};
-use janus2d_core::geometry::{MassData, Shape};
 use janus2d_core::BodyMass;
 use janus2d_core::body::{BodyDef, BodyHandle, BodyLocation, BodySet, BodyType, validate_mass};
 use janus2d_core::constraint::{ConstraintBatch, StepContext};
+use janus2d_core::geometry::{MassData, Shape};
 use janus2d_core::math::{Real, Rot, Transform, Vec2, cross, vec_is_finite};
 use janus2d_core::solver::{SolverProfile, SolverSettings, solve_step};
 
@@ -242,7 +242,12 @@ impl World {
         for h in attached {
             self.destroy_joint(h)?;
         }
-        let shapes = self.collision.body_shapes.get(body.index as usize).cloned().unwrap_or_default();
+        let shapes = self
+            .collision
+            .body_shapes
+            .get(body.index as usize)
+            .cloned()
+            .unwrap_or_default();
         for s in shapes {
             self.collision.remove_shape(s);
         }
@@ -505,7 +510,8 @@ impl World {
         if !def.collide_connected {
             let key = body_pair_key(def.body_a, def.body_b);
             *self.collision.no_collide_pairs.entry(key).or_insert(0) += 1;
-            self.collision.remove_contacts_between(def.body_a, def.body_b);
+            self.collision
+                .remove_contacts_between(def.body_a, def.body_b);
         }
         Ok(handle)
     }
@@ -608,13 +614,24 @@ impl World {
         let ty = self.body_type(body)?;
         validate_shape_def(def)?;
         crate::collision::validate_geometry(&geometry)?;
-        let mass_override = self.bodies.record(body).map(|r| r.mass_override).unwrap_or(true);
+        let mass_override = self
+            .bodies
+            .record(body)
+            .map(|r| r.mass_override)
+            .unwrap_or(true);
         let has_area = geometry.area() > 0.0;
-        if ty == BodyType::Dynamic && !mass_override && has_area && def.density <= 0.0 && !self.has_mass_from_shapes(body) {
+        if ty == BodyType::Dynamic
+            && !mass_override
+            && has_area
+            && def.density <= 0.0
+            && !self.has_mass_from_shapes(body)
+        {
             return Err(WorldError::OutOfRange("density"));
         }
         self.wake_body(body);
-        let handle = self.collision.add_shape(&self.bodies, body, geometry, def.clone());
+        let handle = self
+            .collision
+            .add_shape(&self.bodies, body, geometry, def.clone());
         if ty == BodyType::Dynamic && !mass_override {
             self.update_mass_from_shapes(body);
         }
@@ -627,7 +644,11 @@ impl World {
         let body = self.collision.shapes[slot as usize].body;
         self.wake_body(body);
         self.collision.remove_shape(slot);
-        let mass_override = self.bodies.record(body).map(|r| r.mass_override).unwrap_or(true);
+        let mass_override = self
+            .bodies
+            .record(body)
+            .map(|r| r.mass_override)
+            .unwrap_or(true);
         if self.body_type(body)? == BodyType::Dynamic && !mass_override {
             self.update_mass_from_shapes(body);
         }
@@ -656,21 +677,37 @@ impl World {
         }
         if total.mass > 0.0 {
             total.center = first / total.mass;
-            total.rotational_inertia = (second - total.mass * total.center.length_squared()).max(0.0);
+            total.rotational_inertia =
+                (second - total.mass * total.center.length_squared()).max(0.0);
         }
         total
     }
 
     fn update_mass_from_shapes(&mut self, body: BodyHandle) {
         let md = self.shape_mass(body);
-        let fixed = self.bodies.record(body).map(|r| r.fixed_rotation).unwrap_or(false);
+        let fixed = self
+            .bodies
+            .record(body)
+            .map(|r| r.fixed_rotation)
+            .unwrap_or(false);
         let mass = if md.mass > 0.0 {
-            BodyMass { mass: md.mass, rotational_inertia: md.rotational_inertia, center: md.center }
+            BodyMass {
+                mass: md.mass,
+                rotational_inertia: md.rotational_inertia,
+                center: md.center,
+            }
         } else {
             BodyMass::new(1.0, 1.0)
         };
         let inertia_ok = fixed || mass.rotational_inertia > 0.0;
-        let mass = if inertia_ok { mass } else { BodyMass { rotational_inertia: mass.mass * 1e-3, ..mass } };
+        let mass = if inertia_ok {
+            mass
+        } else {
+            BodyMass {
+                rotational_inertia: mass.mass * 1e-3,
+                ..mass
+            }
+        };
         self.bodies.apply_mass(body, mass, fixed);
     }
 
@@ -723,7 +760,8 @@ impl World {
     /// Changes the sleep settings; turning sleep off wakes every body.
     pub fn set_sleep_settings(&mut self, settings: crate::sleep::SleepSettings) {
         if !settings.enabled {
-            let sleeping: Vec<BodyHandle> = self.bodies.sleeping_sims.iter().map(|s| s.handle).collect();
+            let sleeping: Vec<BodyHandle> =
+                self.bodies.sleeping_sims.iter().map(|s| s.handle).collect();
             self.wake_all(&sleeping);
         }
         self.sleep_settings = settings;
@@ -731,14 +769,19 @@ impl World {
 
     /// How far a body's shapes reach from its centre of mass, m.
     pub(crate) fn body_reach(&self, body: BodyHandle) -> Real {
-        let Some(sim) = self.bodies.sim(body) else { return 0.0 };
+        let Some(sim) = self.bodies.sim(body) else {
+            return 0.0;
+        };
         let Some(list) = self.collision.body_shapes.get(body.index as usize) else {
             return 0.0;
         };
         list.iter()
             .map(|&s| {
                 let a = &self.collision.shapes[s as usize].aabb;
-                (a.lower - sim.center).abs().max((a.upper - sim.center).abs()).length()
+                (a.lower - sim.center)
+                    .abs()
+                    .max((a.upper - sim.center).abs())
+                    .length()
             })
             .fold(0.0, Real::max)
     }
@@ -746,7 +789,11 @@ impl World {
     /// Pairs of bodies held together by enabled joints or touching solid
     /// contacts (the edges of the island graph).
     pub(crate) fn constraint_edges(&self) -> Vec<(BodyHandle, BodyHandle)> {
-        let joints = self.revolute.iter().filter(|j| j.enabled).map(|j| (j.def.body_a, j.def.body_b));
+        let joints = self
+            .revolute
+            .iter()
+            .filter(|j| j.enabled)
+            .map(|j| (j.def.body_a, j.def.body_b));
         let contacts = self
             .collision
             .contacts
@@ -759,7 +806,11 @@ impl World {
     #[cfg(feature = "portals")]
     /// Sets a dynamic body's mass properties without touching its velocity.
     pub(crate) fn apply_mass_keep_velocity(&mut self, body: BodyHandle, mass: BodyMass) {
-        let fixed = self.bodies.record(body).map(|r| r.fixed_rotation).unwrap_or(false);
+        let fixed = self
+            .bodies
+            .record(body)
+            .map(|r| r.fixed_rotation)
+            .unwrap_or(false);
         self.bodies.apply_mass(body, mass, fixed);
     }
 
@@ -836,7 +887,8 @@ impl World {
             let clipping = &self.portals.clipping;
             #[cfg(not(feature = "portals"))]
             let clipping = &crate::collision::NO_CLIPPING;
-            self.collision.narrowphase(&self.bodies, dt, clipping, &mut wake);
+            self.collision
+                .narrowphase(&self.bodies, dt, clipping, &mut wake);
             self.wake_all(&wake);
             let woke = !wake.is_empty();
             self.wake_list = wake;
@@ -859,7 +911,8 @@ impl World {
             &mut self.portals.constraints,
         ];
         #[cfg(not(feature = "portals"))]
-        let mut batches: [&mut dyn ConstraintBatch; 2] = [&mut self.revolute, &mut self.contact_constraints];
+        let mut batches: [&mut dyn ConstraintBatch; 2] =
+            [&mut self.revolute, &mut self.contact_constraints];
         let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
         lap();
         if has_shapes {
@@ -894,22 +947,42 @@ impl World {
         counters.pairs_created = cc.pairs_created;
         counters.proxies_moved = cc.proxies_moved;
         counters.contacts = self.contact_constraints.len();
-        counters.contact_rows = self.contact_constraints.iter().map(|c| 2 * c.point_count()).sum();
-        counters.restitution_contacts = self.contact_constraints.iter().filter(|c| c.restitution > 0.0).count();
+        counters.contact_rows = self
+            .contact_constraints
+            .iter()
+            .map(|c| 2 * c.point_count())
+            .sum();
+        counters.restitution_contacts = self
+            .contact_constraints
+            .iter()
+            .filter(|c| c.restitution > 0.0)
+            .count();
         counters.joint_rows = self
             .revolute
             .iter()
             .filter(|j| j.enabled)
-            .map(|j| 2 + 2 * j.def.enable_limit as usize + j.def.enable_motor as usize + j.def.enable_spring as usize)
+            .map(|j| {
+                2 + 2 * j.def.enable_limit as usize
+                    + j.def.enable_motor as usize
+                    + j.def.enable_spring as usize
+            })
             .sum();
         counters.portal_stage_ran = has_portals;
         #[cfg(feature = "portals")]
         {
             counters.portal_rows = 3 * self.portals.constraints.len();
-            counters.portal_bodies_tested = if has_portals { self.portals.counters.bodies_tested } else { 0 };
+            counters.portal_bodies_tested = if has_portals {
+                self.portals.counters.bodies_tested
+            } else {
+                0
+            };
             counters.portal_crossings = self.portals.crossings.len();
         }
-        counters.gravity_bodies = if self.gravity == Vec2::ZERO { 0 } else { self.bodies.moving_count() };
+        counters.gravity_bodies = if self.gravity == Vec2::ZERO {
+            0
+        } else {
+            self.bodies.moving_count()
+        };
         counters.awake_bodies = self.bodies.moving_count();
         counters.sleeping_bodies = self.bodies.sleeping_count();
         self.counters = counters;
@@ -948,11 +1021,19 @@ impl World {
 }
 
 fn body_pair_key(a: BodyHandle, b: BodyHandle) -> (u32, u32) {
-    if a.index < b.index { (a.index, b.index) } else { (b.index, a.index) }
+    if a.index < b.index {
+        (a.index, b.index)
+    } else {
+        (b.index, a.index)
+    }
 }
 
 fn validate_shape_def(def: &ShapeDef) -> Result<(), WorldError> {
-    for (v, name) in [(def.density, "density"), (def.friction, "friction"), (def.restitution, "restitution")] {
+    for (v, name) in [
+        (def.density, "density"),
+        (def.friction, "friction"),
+        (def.restitution, "restitution"),
+    ] {
         if !v.is_finite() {
             return Err(WorldError::NonFinite(name));
         }
