@@ -8,6 +8,8 @@ use janus2d::scenes::{self, DT};
 use plotters::prelude::*;
 
 /// World outlines of every shape of a body (polygons as vertex loops).
+// `Real` is f32 or f64 by feature: the cast is the identity in f64.
+#[allow(clippy::unnecessary_cast)]
 fn outlines(world: &World, body: BodyHandle) -> Vec<Vec<(f64, f64)>> {
     let xf = world.transform(body).unwrap();
     let c = world.collision();

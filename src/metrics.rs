@@ -157,8 +157,10 @@ impl ExtraMetric for PortalError {
     fn unit(&self) -> &'static str {
         "m"
     }
+    // `Real` is f32 or f64 by feature: the conversion is the identity in f64.
+    #[allow(clippy::useless_conversion)]
     fn measure(&mut self, world: &World) -> Option<f64> {
-        (world.crossing_count() > 0).then(|| world.max_portal_error() as f64)
+        (world.crossing_count() > 0).then(|| f64::from(world.max_portal_error()))
     }
 }
 
