@@ -22,7 +22,7 @@
 //! - `s > 0` (speculative): `bias = s / h`, rigid — the row only stops the
 //!   bodies from closing the gap within the substep.
 //! - `s ≤ 0`, with bias: soft push-out `bias = max(β s, −v_push)` with the
-//!   contact [`Softness`](janus2d_core::softness::Softness) (twice the hertz
+//!   contact [`Softness`] (twice the hertz
 //!   against static bodies) and the push-out speed cap `v_push`.
 //! - relax: no bias, rigid.
 //!
@@ -42,17 +42,45 @@
 //!
 //! **Restitution.** Once after the substeps, for points that approached
 //! faster than the threshold: drive `Ċ` to `−e · Ċ_before`, `e = max(e_a, e_b)`.
+//!
+//! # Evaluation
+//!
+//! The anchors are kept only through the Jacobian's angular parts
+//! `r × n` and `r × t` (computed once, in [`ContactConstraint::new`]):
+//! `r · n = −(r × t)`, and for a rotation `dq = (cos, sin)`
+//! `n · (dq r) = (r × n) sin − (r × t) cos`, so the separation is
+//!
+//! ```text
+//! s = base + n · (dp_b − dp_a) + ((r_b × n) sin_b − (r_b × t) cos_b)
+//!                              − ((r_a × n) sin_a − (r_a × t) cos_a)
+//! base = s₀ + (r_b × t) − (r_a × t)
+//! ```
+//!
+//! One iteration solves the rows in the order normal 0, normal 1,
+//! friction 0, friction 1 (projected Gauss–Seidel). It forms every row's
+//! `Ċ = J v` once from the loaded velocities and, after row `i`'s
+//! increment `Δλ_i`, advances each later row `j` by `K_ij Δλ_i` with
+//! `K_ij = J_j M⁻¹ J_iᵀ` (exact in real arithmetic: the velocities move by
+//! `M⁻¹ J_iᵀ Δλ_i`); the velocities are written once at the end. The
+//! results equal a row-by-row velocity update up to round-off, with a much
+//! shorter dependency chain from one row to the next.
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState};
 use janus2d_core::constraint::{Block, BodyJacobian, Constraint, ConstraintRows, Row, StepContext};
-use janus2d_core::math::{Real, Vec2, cross};
+use janus2d_core::math::{Real, Rot, Vec2, cross};
 use janus2d_core::softness::Softness;
 use smallvec::smallvec;
 
-use crate::parts::{AxisPart, load_pair, store_pair};
-
 /// Maximum points per manifold.
 pub const MAX_MANIFOLD_POINTS: usize = 2;
+
+/// Rows of a constraint: the normal rows of points 0 and 1, then their
+/// friction rows. A one-point manifold leaves rows 1 and 3 at zero (zero
+/// Jacobian, mass and impulse), which the solve passes through exactly.
+const ROWS: usize = 2 * MAX_MANIFOLD_POINTS;
+
+// The solve is written out for two points (four rows).
+const _: () = assert!(MAX_MANIFOLD_POINTS == 2);
 
 /// One point of a contact, as the collision pipeline hands it over.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -69,54 +97,83 @@ pub struct ContactPointInput {
     pub tangent_impulse: Real,
 }
 
-/// One solver point.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct ContactPoint {
-    r_a: Vec2,
-    r_b: Vec2,
-    base_separation: Real,
-    normal: AxisPart,
-    tangent: AxisPart,
-    /// Largest normal impulse applied in one iteration (restitution gate).
-    max_normal_impulse: Real,
-    /// Normal velocity before the solve (for restitution), m/s.
-    relative_velocity: Real,
-    /// Soft mass scale `s_m` of this point's normal row (dimensionless).
-    mass_scale: Real,
-    /// Soft impulse scale `s_i` of this point's normal row (dimensionless).
-    impulse_scale: Real,
-    /// Angular Jacobian parts `r_a × n`, `r_b × n`, `r_a × t`, `r_b × t`
-    /// (the anchors are fixed for the step), m.
-    rn_a: Real,
-    rn_b: Real,
-    rt_a: Real,
-    rt_b: Real,
-}
-
 /// A contact constraint between two bodies (one manifold, 1–2 points).
+///
+/// The data is stored by row (normal 0, normal 1, friction 0, friction 1)
+/// in a fixed, cache-line aligned layout (`repr(C)`): what the warm start
+/// reads (Jacobians, impulses, state indices, normal) fills the first cache
+/// line (f32), the rest of what the velocity iterations read the second,
+/// and the fields they never touch (handles, restitution data, portal
+/// masses) the third. The anchors themselves are not kept: the Jacobian's
+/// angular parts determine them, `r = (r × n) t − (r × t) n`.
 #[derive(Clone, Debug, PartialEq)]
+#[repr(C, align(64))]
 pub struct ContactConstraint {
-    /// Body a.
-    pub body_a: BodyHandle,
-    /// Body b.
-    pub body_b: BodyHandle,
+    /// Angular Jacobian parts on a per row: `r_a × n` (rows 0, 1) and
+    /// `r_a × t` (rows 2, 3), m.
+    ja: [Real; ROWS],
+    /// Angular Jacobian parts on b per row: `r_b × n`, `r_b × t`, m.
+    jb: [Real; ROWS],
+    /// Accumulated impulse per row, N·s.
+    impulse: [Real; ROWS],
+    /// State index of body a (0: static, sleeping or stale).
+    state_a: u32,
+    /// State index of body b.
+    state_b: u32,
     /// Unit normal from a to b (world).
     pub normal: Vec2,
+    /// Rigid effective mass `1 / k` per row, kg.
+    mass: [Real; ROWS],
     /// Mixed friction coefficient `√(μ_a μ_b)`.
     pub friction: Real,
+    /// Bias rate of the contact softness (static or moving pair), 1/s.
+    bias_rate: Real,
+    /// `s₀ − n · (r_b − r_a)` per point: the separation at zero position
+    /// deltas is `base + (r_a × t) − (r_b × t)`, m.
+    base_separation: [Real; MAX_MANIFOLD_POINTS],
+    /// Soft effective mass `s_m / k` of each normal row, kg.
+    soft_mass: [Real; MAX_MANIFOLD_POINTS],
+    /// Soft impulse scale `s_i` of each normal row (dimensionless).
+    impulse_scale: [Real; MAX_MANIFOLD_POINTS],
+    /// Largest normal impulse applied in one iteration (restitution gate).
+    max_normal_impulse: [Real; MAX_MANIFOLD_POINTS],
+    /// Number of points (0 to 2).
+    point_count: u32,
+    /// Normal velocity before the solve (for restitution), m/s.
+    relative_velocity: [Real; MAX_MANIFOLD_POINTS],
     /// Mixed restitution `max(e_a, e_b)`.
     pub restitution: Real,
     /// Index of the contact in the world's contact list (for storing impulses).
     pub contact_index: u32,
-    state_a: u32,
-    state_b: u32,
-    point_count: usize,
-    points: [ContactPoint; MAX_MANIFOLD_POINTS],
-    softness: Softness,
+    /// Body a.
+    pub body_a: BodyHandle,
+    /// Body b.
+    pub body_b: BodyHandle,
     /// Inverse mass and inertia of the whole object a body belongs to, when
     /// it is one copy of an object crossing a portal (see
     /// [`ContactConstraint::set_object_mass`]).
     object_mass: [Option<(Real, Real)>; 2],
+}
+
+/// `max(x, floor)` that returns `floor` when `x` is NaN (as `Real::max`),
+/// in one instruction.
+#[inline(always)]
+fn max_or(x: Real, floor: Real) -> Real {
+    if x > floor { x } else { floor }
+}
+
+/// `x` clamped to `[lo, hi]` (NaN passes through, as `Real::clamp`),
+/// without `Real::clamp`'s `lo ≤ hi` assertion.
+#[inline(always)]
+fn clamp_to(x: Real, lo: Real, hi: Real) -> Real {
+    let x = if x < lo { lo } else { x };
+    if x > hi { hi } else { x }
+}
+
+/// `Σ x_k y_k` over the rows, as `(x₀y₀ + x₁y₁) + (x₂y₂ + x₃y₃)`.
+#[inline(always)]
+fn dot_rows(x: &[Real; ROWS], y: &[Real; ROWS]) -> Real {
+    (x[0] * y[0] + x[1] * y[1]) + (x[2] * y[2] + x[3] * y[3])
 }
 
 impl ContactConstraint {
@@ -130,26 +187,39 @@ impl ContactConstraint {
         restitution: Real,
         contact_index: u32,
     ) -> Self {
+        let t = Vec2::new(normal.y, -normal.x);
         let mut c = ContactConstraint {
-            body_a,
-            body_b,
-            normal,
-            friction,
-            restitution,
-            contact_index,
+            ja: [0.0; ROWS],
+            jb: [0.0; ROWS],
+            mass: [0.0; ROWS],
+            impulse: [0.0; ROWS],
             state_a: 0,
             state_b: 0,
-            point_count: points.len().min(MAX_MANIFOLD_POINTS),
-            points: [ContactPoint::default(); MAX_MANIFOLD_POINTS],
-            softness: Softness::RIGID,
+            normal,
+            friction,
+            bias_rate: 0.0,
+            base_separation: [0.0; MAX_MANIFOLD_POINTS],
+            soft_mass: [0.0; MAX_MANIFOLD_POINTS],
+            impulse_scale: [0.0; MAX_MANIFOLD_POINTS],
+            max_normal_impulse: [0.0; MAX_MANIFOLD_POINTS],
+            point_count: points.len().min(MAX_MANIFOLD_POINTS) as u32,
+            relative_velocity: [0.0; MAX_MANIFOLD_POINTS],
+            restitution,
+            contact_index,
+            body_a,
+            body_b,
             object_mass: [None, None],
         };
-        for (cp, input) in c.points.iter_mut().zip(points) {
-            cp.r_a = input.anchor_a;
-            cp.r_b = input.anchor_b;
-            cp.base_separation = input.separation - (input.anchor_b - input.anchor_a).dot(normal);
-            cp.normal.impulse = input.normal_impulse;
-            cp.tangent.impulse = input.tangent_impulse;
+        for (i, p) in points.iter().take(MAX_MANIFOLD_POINTS).enumerate() {
+            let (r_a, r_b) = (p.anchor_a, p.anchor_b);
+            c.ja[i] = cross(r_a, normal);
+            c.jb[i] = cross(r_b, normal);
+            c.ja[i + 2] = cross(r_a, t);
+            c.jb[i + 2] = cross(r_b, t);
+            // r · n = −(r × t).
+            c.base_separation[i] = p.separation + (c.jb[i + 2] - c.ja[i + 2]);
+            c.impulse[i] = p.normal_impulse;
+            c.impulse[i + 2] = p.tangent_impulse;
         }
         c
     }
@@ -166,61 +236,193 @@ impl ContactConstraint {
 
     /// Number of points.
     pub fn point_count(&self) -> usize {
-        self.point_count
+        self.point_count as usize
     }
 
     /// Accumulated (normal, tangent) impulses of point `i`, N·s.
     pub fn impulses(&self, i: usize) -> (Real, Real) {
-        (
-            self.points[i].normal.impulse,
-            self.points[i].tangent.impulse,
-        )
+        (self.impulse[i], self.impulse[i + MAX_MANIFOLD_POINTS])
     }
 
     /// Total normal impulse of the last step, N·s.
     pub fn total_normal_impulse(&self) -> Real {
-        self.points[..self.point_count]
-            .iter()
-            .map(|p| p.normal.impulse)
-            .sum()
+        self.impulse[..self.point_count()].iter().sum()
     }
 
     #[inline(always)]
     fn tangent(&self) -> Vec2 {
         Vec2::new(self.normal.y, -self.normal.x)
     }
+
+    /// One velocity iteration: the normal rows, then the friction rows,
+    /// each a projected Gauss–Seidel step.
+    ///
+    /// The rows' velocities `Ċ = J v` are formed once from the loaded
+    /// velocities; after row `i`'s impulse `Δλ_i` each later row `j`
+    /// advances by `K_ij Δλ_i` (`K_ij = J_j M⁻¹ J_iᵀ`: exact in real
+    /// arithmetic), and the bodies' velocities are written once,
+    /// `Δv = M⁻¹ Jᵀ Δλ`. The Gauss–Seidel dependency chain from one row to
+    /// the next is then one multiply-add instead of a velocity update and a
+    /// Jacobian product. The parts that do not depend on the velocities
+    /// (separation, bias, the feedback `s_i λ`) are formed aside, and the
+    /// normal clamp works on the increment, `Δλ = max(λ, −λ_acc)`, so that
+    /// `λ_acc + Δλ ≥ 0`.
+    #[inline(always)]
+    fn solve_rows<const USE_BIAS: bool>(
+        &mut self,
+        states: &mut [BodyState],
+        inv_h: Real,
+        push_max: Real,
+    ) {
+        let (ia, ib) = (self.state_a as usize, self.state_b as usize);
+        let (sa, sb) = (&states[ia], &states[ib]);
+        let (m_a, i_a, m_b, i_b) = (sa.inv_mass, sa.inv_inertia, sb.inv_mass, sb.inv_inertia);
+        let (v_a, w_a, v_b, w_b) = (sa.v, sa.w, sb.v, sb.w);
+        let (qa, qb) = (sa.dq, sb.dq);
+        let n = self.normal;
+        let t = Vec2::new(n.y, -n.x);
+        let dpn = (sb.dp - sa.dp).dot(n);
+        let (ja, jb) = (self.ja, self.jb);
+
+        // Ċ of every row at the loaded velocities.
+        let dv = v_b - v_a;
+        let (dvn, dvt) = (dv.x * n.x + dv.y * n.y, dv.x * t.x + dv.y * t.y);
+        let c0 = dvn + (w_b * jb[0] - w_a * ja[0]);
+        let c1 = dvn + (w_b * jb[1] - w_a * ja[1]);
+        let c2 = dvt + (w_b * jb[2] - w_a * ja[2]);
+        let c3 = dvt + (w_b * jb[3] - w_a * ja[3]);
+
+        // K_ij = J_j M⁻¹ J_iᵀ for i < j (n · t = 0).
+        let m_sum = m_a + m_b;
+        let (ka0, ka1, ka2) = (i_a * ja[0], i_a * ja[1], i_a * ja[2]);
+        let (kb0, kb1, kb2) = (i_b * jb[0], i_b * jb[1], i_b * jb[2]);
+        let k01 = m_sum + (ka0 * ja[1] + kb0 * jb[1]);
+        let k02 = ka0 * ja[2] + kb0 * jb[2];
+        let k03 = ka0 * ja[3] + kb0 * jb[3];
+        let k12 = ka1 * ja[2] + kb1 * jb[2];
+        let k13 = ka1 * ja[3] + kb1 * jb[3];
+        let k23 = m_sum + (ka2 * ja[3] + kb2 * jb[3]);
+
+        // Normal rows.
+        let d0 = self.normal_row::<USE_BIAS>(0, c0, dpn, qa, qb, inv_h, push_max);
+        let c1 = c1 + k01 * d0;
+        let d1 = self.normal_row::<USE_BIAS>(1, c1, dpn, qa, qb, inv_h, push_max);
+        // Friction rows.
+        let c2 = (c2 + k02 * d0) + k12 * d1;
+        let d2 = self.friction_row(2, c2);
+        let c3 = ((c3 + k03 * d0) + k13 * d1) + k23 * d2;
+        let d3 = self.friction_row(3, c3);
+
+        // The velocities, once: Δv = M⁻¹ Jᵀ Δλ summed over the rows.
+        let d = [d0, d1, d2, d3];
+        let p = (d0 + d1) * n + (d2 + d3) * t;
+        let (l_a, l_b) = (dot_rows(&d, &ja), dot_rows(&d, &jb));
+        let ta = &mut states[ia];
+        ta.v = v_a - m_a * p;
+        ta.w = w_a - i_a * l_a;
+        let tb = &mut states[ib];
+        tb.v = v_b + m_b * p;
+        tb.w = w_b + i_b * l_b;
+    }
+
+    /// The normal row of point `i` given its `Ċ`: accumulates the impulse
+    /// and returns the increment.
+    #[inline(always)]
+    fn normal_row<const USE_BIAS: bool>(
+        &mut self,
+        i: usize,
+        c_dot: Real,
+        dpn: Real,
+        qa: Rot,
+        qb: Rot,
+        inv_h: Real,
+        push_max: Real,
+    ) -> Real {
+        let (ja, jb) = (&self.ja, &self.jb);
+        // Current separation from the deltas, anchors fixed on the bodies:
+        // n · (dq r) = (r × n) sin − (r × t) cos.
+        let s = self.base_separation[i]
+            + dpn
+            + (qb.s * jb[i] - qb.c * jb[i + 2])
+            + (qa.c * ja[i + 2] - qa.s * ja[i]);
+        let old = self.impulse[i];
+        let rigid = self.mass[i];
+        // λ = offset − mass · Ċ.
+        let (mass, offset) = if USE_BIAS {
+            if s > 0.0 {
+                (rigid, -(rigid * (s * inv_h)))
+            } else {
+                let soft = self.soft_mass[i];
+                let bias = max_or(self.bias_rate * s, -push_max);
+                (soft, -(soft * bias) - self.impulse_scale[i] * old)
+            }
+        } else {
+            (rigid, -(rigid * max_or(s * inv_h, 0.0)))
+        };
+        let d = max_or(offset - mass * c_dot, -old);
+        self.impulse[i] = old + d;
+        self.max_normal_impulse[i] = max_or(d, self.max_normal_impulse[i]);
+        d
+    }
+
+    /// Friction row `i` (2 or 3) given its `Ċ`: accumulates the impulse,
+    /// bounded by `±μ λ_n` of its point, and returns the increment.
+    #[inline(always)]
+    fn friction_row(&mut self, i: usize, c_dot: Real) -> Real {
+        let old = self.impulse[i];
+        let max_friction = self.friction * self.impulse[i - MAX_MANIFOLD_POINTS];
+        let neg_mass = -self.mass[i];
+        let d = clamp_to(neg_mass * c_dot, -max_friction - old, max_friction - old);
+        self.impulse[i] = clamp_to(old + d, -max_friction, max_friction);
+        d
+    }
+}
+
+/// Solves every constraint of a sweep once.
+#[inline(always)]
+fn sweep<'a, const USE_BIAS: bool>(
+    items: impl Iterator<Item = &'a mut ContactConstraint>,
+    states: &mut [BodyState],
+    ctx: &StepContext,
+) {
+    let (inv_h, push_max) = (ctx.inv_h, ctx.contact_push_max_velocity);
+    for c in items {
+        c.solve_rows::<USE_BIAS>(states, inv_h, push_max);
+    }
 }
 
 impl Constraint for ContactConstraint {
     fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
-        let a = bodies.solver_body(self.body_a);
-        let b = bodies.solver_body(self.body_b);
-        self.state_a = a.state_index;
-        self.state_b = b.state_index;
-        let (mut sa, mut sb) = (*a.state, *b.state);
-        let static_pair = sa.inv_mass == 0.0 || sb.inv_mass == 0.0;
+        // Static, sleeping and stale bodies read the identity state 0.
+        self.state_a = bodies.state_index(self.body_a).unwrap_or(0);
+        self.state_b = bodies.state_index(self.body_b).unwrap_or(0);
+        let sa = &bodies.states[self.state_a as usize];
+        let sb = &bodies.states[self.state_b as usize];
+        let (mut m_a, mut i_a) = (sa.inv_mass, sa.inv_inertia);
+        let (mut m_b, mut i_b) = (sb.inv_mass, sb.inv_inertia);
+        let static_pair = m_a == 0.0 || m_b == 0.0;
         // Crossing copies respond as their whole object (K only).
         if let Some((m, i)) = self.object_mass[0] {
-            (sa.inv_mass, sa.inv_inertia) = (m, i);
+            (m_a, i_a) = (m, i);
         }
         if let Some((m, i)) = self.object_mass[1] {
-            (sb.inv_mass, sb.inv_inertia) = (m, i);
+            (m_b, i_b) = (m, i);
         }
-        let (sa, sb) = (&sa, &sb);
-        self.softness = if static_pair {
+        let softness = if static_pair {
             ctx.static_softness
         } else {
             ctx.contact_softness
         };
+        self.bias_rate = softness.bias_rate;
         let moving_pair = !static_pair;
         let rho_max = ctx.contact_mass_ratio_cap;
-        let n = self.normal;
-        let t = self.tangent();
-        for cp in &mut self.points[..self.point_count] {
-            let rn_a = cross(cp.r_a, n);
-            let rn_b = cross(cp.r_b, n);
-            let k_a = sa.inv_mass + sa.inv_inertia * rn_a * rn_a;
-            let k_b = sb.inv_mass + sb.inv_inertia * rn_b * rn_b;
+        let dv = sb.v - sa.v;
+        let dvn = dv.dot(self.normal);
+        for i in 0..self.point_count() {
+            let (rn_a, rn_b) = (self.ja[i], self.jb[i]);
+            let (rt_a, rt_b) = (self.ja[i + 2], self.jb[i + 2]);
+            let k_a = m_a + i_a * rn_a * rn_a;
+            let k_b = m_b + i_b * rn_b * rn_b;
             let k = k_a + k_b;
             let k_heavy = k_a.min(k_b);
             let rho = if moving_pair && rho_max > 1.0 && k_heavy > 0.0 {
@@ -228,121 +430,93 @@ impl Constraint for ContactConstraint {
             } else {
                 1.0
             };
-            let soft = self.softness.with_mass_ratio(rho);
-            cp.mass_scale = soft.mass_scale;
-            cp.impulse_scale = soft.impulse_scale;
-            cp.rn_a = rn_a;
-            cp.rn_b = rn_b;
-            cp.rt_a = cross(cp.r_a, t);
-            cp.rt_b = cross(cp.r_b, t);
-            cp.normal.set_mass(k);
-            cp.tangent.set_mass(AxisPart::k(sa, sb, cp.r_a, cp.r_b, t));
-            cp.relative_velocity = AxisPart::c_dot(sa, sb, cp.r_a, cp.r_b, n);
-            cp.max_normal_impulse = 0.0;
-            if !ctx.warm_starting {
-                cp.normal.impulse = 0.0;
-                cp.tangent.impulse = 0.0;
-            }
+            let soft = softness.with_mass_ratio(rho);
+            let normal_mass = if k > 0.0 { 1.0 / k } else { 0.0 };
+            self.mass[i] = normal_mass;
+            self.soft_mass[i] = normal_mass * soft.mass_scale;
+            self.impulse_scale[i] = soft.impulse_scale;
+            let k_t = m_a + m_b + i_a * rt_a * rt_a + i_b * rt_b * rt_b;
+            self.mass[i + 2] = if k_t > 0.0 { 1.0 / k_t } else { 0.0 };
+            self.relative_velocity[i] = dvn + (sb.w * rn_b - sa.w * rn_a);
+            self.max_normal_impulse[i] = 0.0;
+        }
+        if !ctx.warm_starting {
+            self.impulse = [0.0; ROWS];
         }
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        let (mut sa, mut sb) = load_pair(states, self.state_a, self.state_b);
-        let (n, t) = (self.normal, self.tangent());
-        let (m_a, i_a, m_b, i_b) = (sa.inv_mass, sa.inv_inertia, sb.inv_mass, sb.inv_inertia);
-        for cp in &self.points[..self.point_count] {
-            let (lambda_n, lambda_t) = (cp.normal.impulse, cp.tangent.impulse);
-            let p = lambda_n * n + lambda_t * t;
-            sa.v -= m_a * p;
-            sa.w -= i_a * (lambda_n * cp.rn_a + lambda_t * cp.rt_a);
-            sb.v += m_b * p;
-            sb.w += i_b * (lambda_n * cp.rn_b + lambda_t * cp.rt_b);
-        }
-        store_pair(states, self.state_a, self.state_b, &sa, &sb);
+        let (ia, ib) = (self.state_a as usize, self.state_b as usize);
+        let lambda = &self.impulse;
+        let p = (lambda[0] + lambda[1]) * self.normal + (lambda[2] + lambda[3]) * self.tangent();
+        let (l_a, l_b) = (dot_rows(lambda, &self.ja), dot_rows(lambda, &self.jb));
+        let sa = &mut states[ia];
+        sa.v -= sa.inv_mass * p;
+        sa.w -= sa.inv_inertia * l_a;
+        let sb = &mut states[ib];
+        sb.v += sb.inv_mass * p;
+        sb.w += sb.inv_inertia * l_b;
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        let (sa, sb) = load_pair(states, self.state_a, self.state_b);
-        let (m_a, i_a, m_b, i_b) = (sa.inv_mass, sa.inv_inertia, sb.inv_mass, sb.inv_inertia);
-        let (mut v_a, mut w_a, mut v_b, mut w_b) = (sa.v, sa.w, sb.v, sb.w);
-        let n = self.normal;
-        let dp = sb.dp - sa.dp;
-        let bias_rate = self.softness.bias_rate;
-        let push_max = ctx.contact_push_max_velocity;
-        let inv_h = ctx.inv_h;
-        let count = self.point_count;
-        for cp in &mut self.points[..count] {
-            // Current separation from the deltas, anchors fixed on the bodies.
-            let ds = dp + sb.dq.rotate(cp.r_b) - sa.dq.rotate(cp.r_a);
-            let s = cp.base_separation + ds.dot(n);
-            let (bias, mass_scale, impulse_scale) = if s > 0.0 {
-                (s * inv_h, 1.0, 0.0)
-            } else if use_bias {
-                (
-                    (bias_rate * s).max(-push_max),
-                    cp.mass_scale,
-                    cp.impulse_scale,
-                )
-            } else {
-                (0.0, 1.0, 0.0)
-            };
-            // Ċ = n · (v_b − v_a) + ω_b (r_b × n) − ω_a (r_a × n).
-            let c_dot = (v_b - v_a).dot(n) + w_b * cp.rn_b - w_a * cp.rn_a;
-            let old = cp.normal.impulse;
-            let lambda = -cp.normal.mass * mass_scale * (c_dot + bias) - impulse_scale * old;
-            let new_impulse = (old + lambda).max(0.0);
-            let applied = new_impulse - old;
-            cp.normal.impulse = new_impulse;
-            cp.max_normal_impulse = cp.max_normal_impulse.max(applied);
-            let p = applied * n;
-            v_a -= m_a * p;
-            w_a -= i_a * applied * cp.rn_a;
-            v_b += m_b * p;
-            w_b += i_b * applied * cp.rn_b;
+        let (inv_h, push_max) = (ctx.inv_h, ctx.contact_push_max_velocity);
+        if use_bias {
+            self.solve_rows::<true>(states, inv_h, push_max);
+        } else {
+            self.solve_rows::<false>(states, inv_h, push_max);
         }
-        let t = self.tangent();
-        let friction = self.friction;
-        for cp in &mut self.points[..count] {
-            let c_dot = (v_b - v_a).dot(t) + w_b * cp.rt_b - w_a * cp.rt_a;
-            let old = cp.tangent.impulse;
-            let max_friction = friction * cp.normal.impulse;
-            let new_impulse = (old - cp.tangent.mass * c_dot).clamp(-max_friction, max_friction);
-            let applied = new_impulse - old;
-            cp.tangent.impulse = new_impulse;
-            let p = applied * t;
-            v_a -= m_a * p;
-            w_a -= i_a * applied * cp.rt_a;
-            v_b += m_b * p;
-            w_b += i_b * applied * cp.rt_b;
+    }
+
+    fn solve_all(
+        items: &mut [Self],
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+    ) {
+        match (use_bias, reverse) {
+            (true, false) => sweep::<true>(items.iter_mut(), states, ctx),
+            (true, true) => sweep::<true>(items.iter_mut().rev(), states, ctx),
+            (false, false) => sweep::<false>(items.iter_mut(), states, ctx),
+            (false, true) => sweep::<false>(items.iter_mut().rev(), states, ctx),
         }
-        let ta = &mut states[self.state_a as usize];
-        ta.v = v_a;
-        ta.w = w_a;
-        let tb = &mut states[self.state_b as usize];
-        tb.v = v_b;
-        tb.w = w_b;
     }
 
     fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
         if self.restitution == 0.0 {
             return;
         }
-        let (mut sa, mut sb) = load_pair(states, self.state_a, self.state_b);
+        let (ia, ib) = (self.state_a as usize, self.state_b as usize);
+        let (sa, sb) = (&states[ia], &states[ib]);
+        let (m_a, i_a, m_b, i_b) = (sa.inv_mass, sa.inv_inertia, sb.inv_mass, sb.inv_inertia);
+        let (mut v_a, mut w_a, mut v_b, mut w_b) = (sa.v, sa.w, sb.v, sb.w);
         let n = self.normal;
         let e = self.restitution;
-        for cp in &mut self.points[..self.point_count] {
-            if cp.relative_velocity > -ctx.restitution_threshold || cp.max_normal_impulse == 0.0 {
+        for i in 0..self.point_count() {
+            let rv = self.relative_velocity[i];
+            if rv > -ctx.restitution_threshold || self.max_normal_impulse[i] == 0.0 {
                 continue;
             }
-            let c_dot = AxisPart::c_dot(&sa, &sb, cp.r_a, cp.r_b, n);
-            let lambda = -cp.normal.mass * (c_dot + e * cp.relative_velocity);
-            let new_impulse = (cp.normal.impulse + lambda).max(0.0);
-            let applied = new_impulse - cp.normal.impulse;
-            cp.normal.impulse = new_impulse;
-            cp.max_normal_impulse = cp.max_normal_impulse.max(applied);
-            AxisPart::apply(&mut sa, &mut sb, cp.r_a, cp.r_b, n, applied);
+            let (rn_a, rn_b) = (self.ja[i], self.jb[i]);
+            let c_dot = (v_b - v_a).dot(n) + (w_b * rn_b - w_a * rn_a);
+            let lambda = -self.mass[i] * (c_dot + e * rv);
+            let old = self.impulse[i];
+            let new_impulse = (old + lambda).max(0.0);
+            let applied = new_impulse - old;
+            self.impulse[i] = new_impulse;
+            self.max_normal_impulse[i] = self.max_normal_impulse[i].max(applied);
+            let p = applied * n;
+            v_a -= m_a * p;
+            w_a -= i_a * applied * rn_a;
+            v_b += m_b * p;
+            w_b += i_b * applied * rn_b;
         }
-        store_pair(states, self.state_a, self.state_b, &sa, &sb);
+        let ta = &mut states[ia];
+        ta.v = v_a;
+        ta.w = w_a;
+        let tb = &mut states[ib];
+        tb.v = v_b;
+        tb.w = w_b;
     }
 
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
@@ -363,28 +537,35 @@ impl Constraint for ContactConstraint {
             inv_mass: s.inv_mass,
             inv_inertia: s.inv_inertia,
         };
-        for (axis, is_normal) in [(self.normal, true), (self.tangent(), false)] {
-            for cp in &self.points[..self.point_count] {
+        let count = self.point_count();
+        for (axis, first) in [(self.normal, 0), (self.tangent(), MAX_MANIFOLD_POINTS)] {
+            for i in 0..count {
+                let row = first + i;
                 let first_row = out.rows.len();
-                let (c, softness, lower, upper, impulse) = if is_normal {
-                    let s = cp.base_separation + (cp.r_b - cp.r_a).dot(self.normal);
-                    (s, softness, 0.0, Real::INFINITY, cp.normal.impulse)
+                let (j_a, j_b) = (self.ja[row], self.jb[row]);
+                let (c, softness, lower, upper) = if first == 0 {
+                    // At the start of the step: r · n = −(r × t).
+                    let s = self.base_separation[i] - (self.jb[i + 2] - self.ja[i + 2]);
+                    (s, softness, 0.0, Real::INFINITY)
                 } else {
-                    let m = self.friction * cp.normal.impulse;
-                    (0.0, Softness::RIGID, -m, m, cp.tangent.impulse)
+                    let m = self.friction * self.impulse[i];
+                    (0.0, Softness::RIGID, -m, m)
                 };
                 out.rows.push(Row {
                     jacobian: smallvec![
-                        entry(self.body_a, -axis, -cross(cp.r_a, axis), sa),
-                        entry(self.body_b, axis, cross(cp.r_b, axis), sb),
+                        entry(self.body_a, -axis, -j_a, sa),
+                        entry(self.body_b, axis, j_b, sb),
                     ],
                     c,
                     softness,
                     lower,
                     upper,
-                    impulse,
+                    impulse: self.impulse[row],
                 });
-                let k = AxisPart::k(sa, sb, cp.r_a, cp.r_b, axis);
+                let k = sa.inv_mass
+                    + sb.inv_mass
+                    + sa.inv_inertia * j_a * j_a
+                    + sb.inv_inertia * j_b * j_b;
                 out.blocks.push(Block {
                     first_row,
                     len: 1,

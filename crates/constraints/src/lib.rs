@@ -6,7 +6,7 @@
 //! |-------------------------------|------|--------|-------------------------|
 //! | [`revolute::RevoluteJoint`]   | 2–6  | 2      | point + angle parts     |
 //! | [`portal::PortalConstraint`]  | 3    | 4      | portal part + portal map |
-//! | [`contact::ContactConstraint`]| 2–4  | 2      | axis parts              |
+//! | [`contact::ContactConstraint`]| 2–4  | 2      | compact rows (normal, friction) |
 //!
 //! Every type follows the same stages (prepare, warm start, solve with or
 //! without bias) and reports its rows through `Constraint::rows`.

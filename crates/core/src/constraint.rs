@@ -22,7 +22,8 @@
 //! The solver never calls a constraint through `dyn` per row: each
 //! constraint type lives in its own `Vec`, and the [`ConstraintBatch`]
 //! implementation for `Vec<C>` runs a monomorphic loop over it. `dyn` is used
-//! once per type per stage.
+//! once per type per stage. A type may replace its solve loop
+//! ([`Constraint::solve_all`]), as contacts do.
 
 use smallvec::SmallVec;
 
@@ -199,6 +200,34 @@ pub trait Constraint {
     fn is_enabled(&self) -> bool {
         true
     }
+
+    /// Solves every enabled constraint of `items` once, in storage order or
+    /// (`reverse`) the opposite order: the batch's solve stage. A type may
+    /// override it with a loop of its own (contacts do, to hoist `use_bias`
+    /// and the step constants out of the loop).
+    fn solve_all(
+        items: &mut [Self],
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+    ) where
+        Self: Sized,
+    {
+        if reverse {
+            for c in items.iter_mut().rev() {
+                if c.is_enabled() {
+                    c.solve(ctx, states, use_bias);
+                }
+            }
+        } else {
+            for c in items.iter_mut() {
+                if c.is_enabled() {
+                    c.solve(ctx, states, use_bias);
+                }
+            }
+        }
+    }
 }
 
 /// A homogeneous collection of constraints driven by the solver: one
@@ -244,19 +273,7 @@ impl<C: Constraint> ConstraintBatch for Vec<C> {
         use_bias: bool,
         reverse: bool,
     ) {
-        if reverse {
-            for c in self.iter_mut().rev() {
-                if c.is_enabled() {
-                    c.solve(ctx, states, use_bias);
-                }
-            }
-        } else {
-            for c in self.iter_mut() {
-                if c.is_enabled() {
-                    c.solve(ctx, states, use_bias);
-                }
-            }
-        }
+        C::solve_all(self, ctx, states, use_bias, reverse);
     }
     fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
         for c in self.iter_mut() {

@@ -244,6 +244,73 @@ pub fn integrate_velocities(ctx: &StepContext, bodies: &mut BodySet) {
     }
 }
 
+/// The velocity integration of one dynamic body over a substep, with
+/// everything that is fixed for the step (forces, gravity, damping, limits)
+/// evaluated once: [`integrate_velocities`] on a compact array instead of
+/// the bodies' per-step data. Same arithmetic, same results.
+#[derive(Clone, Copy, Debug)]
+struct VelocityTerms {
+    /// Index of the body's state.
+    state: u32,
+    /// `h (F/m + s g)`, m/s.
+    dv: Vec2,
+    /// `h τ / I`, rad/s.
+    dw: Real,
+    /// `1 / (1 + h c_lin)`.
+    linear_damping: Real,
+    /// `1 / (1 + h c_ang)`.
+    angular_damping: Real,
+    /// Maximum linear speed, m/s.
+    max_v: Real,
+    /// Maximum angular speed over the substep, rad/s.
+    max_w: Real,
+}
+
+/// The [`VelocityTerms`] of every dynamic body, in state order.
+fn velocity_terms(ctx: &StepContext, bodies: &BodySet) -> Vec<VelocityTerms> {
+    let h = ctx.h;
+    let gravity = ctx.gravity;
+    let has_gravity = gravity != Vec2::ZERO;
+    let mut terms = Vec::with_capacity(bodies.sims.len());
+    for (i, sim) in bodies.sims.iter().enumerate().skip(1) {
+        if sim.body_type != BodyType::Dynamic {
+            continue;
+        }
+        let mut accel = sim.inv_mass * sim.force;
+        if has_gravity {
+            accel += sim.gravity_scale * gravity;
+        }
+        terms.push(VelocityTerms {
+            state: i as u32,
+            dv: h * accel,
+            dw: h * sim.inv_inertia * sim.torque,
+            linear_damping: 1.0 / (1.0 + h * sim.linear_damping),
+            angular_damping: 1.0 / (1.0 + h * sim.angular_damping),
+            max_v: sim.max_linear_speed,
+            max_w: sim.max_rotation * ctx.inv_h,
+        });
+    }
+    terms
+}
+
+/// [`integrate_velocities`] from precomputed terms.
+fn integrate_velocity_terms(terms: &[VelocityTerms], states: &mut [BodyState]) {
+    for t in terms {
+        let state = &mut states[t.state as usize];
+        let mut v = t.linear_damping * (state.v + t.dv);
+        let mut w = t.angular_damping * (state.w + t.dw);
+        let v2 = v.length_squared();
+        if v2 > t.max_v * t.max_v {
+            v *= t.max_v / v2.sqrt();
+        }
+        if w * w > t.max_w * t.max_w {
+            w = w.clamp(-t.max_w, t.max_w);
+        }
+        state.v = v;
+        state.w = w;
+    }
+}
+
 /// Integrates positions of moving bodies over one substep (into the deltas).
 pub fn integrate_positions(ctx: &StepContext, bodies: &mut BodySet) {
     let h = ctx.h;
@@ -289,6 +356,7 @@ pub fn solve_step(
     let mut report = SolveReport::default();
     let mut t = Instant::now();
     prepare_bodies(bodies);
+    let terms = velocity_terms(ctx, bodies);
     for b in batches.iter_mut() {
         b.prepare(ctx, bodies);
     }
@@ -307,7 +375,7 @@ pub fn solve_step(
     // of creation leaves no sideways bias.
     for substep in 0..substeps {
         let flip = substep % 2 == 1;
-        integrate_velocities(ctx, bodies);
+        integrate_velocity_terms(&terms, &mut bodies.states);
         report.profile.integrate += lap(&mut t);
         if ctx.warm_starting {
             for &i in &active {
