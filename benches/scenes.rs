@@ -80,12 +80,12 @@ fn main() {
         );
     }
     for name in &args.scenes {
-        // Sleep as scenes.md says: off except in `tumbler` and `spinner`,
+        // Sleep as scenes.md says: off except in `tumbler`, `spinner` and `smash`,
         // unless the command line says otherwise.
         let mut def = def.clone();
         def.sleep.enabled = args
             .sleep
-            .unwrap_or(matches!(name.as_str(), "tumbler" | "spinner"));
+            .unwrap_or(matches!(name.as_str(), "tumbler" | "spinner" | "smash"));
         let mut best = f64::MAX;
         let mut runs = Vec::new();
         let mut summary = String::new();

@@ -234,7 +234,8 @@ pub fn tumbler(def: &WorldDef) -> Scene {
     }
 }
 
-/// A heavy fast box smashing into a block of 120 × 80 small boxes, g = 0.
+/// A heavy fast box smashing into a block of 120 × 80 small boxes, g = 0;
+/// the block is created asleep (run it with sleep on, as Box2D does).
 pub fn smash(def: &WorldDef) -> Scene {
     let mut def = def.clone();
     def.gravity = Vec2::ZERO;
@@ -253,12 +254,12 @@ pub fn smash(def: &WorldDef) -> Scene {
     let sd = box_def();
     for i in 0..120 {
         for j in 0..80 {
-            let b = world
-                .create_body(&BodyDef::dynamic(Vec2::new(
-                    30.0 + 0.4 * i as Real,
-                    0.4 * (j as Real - 40.0),
-                )))
-                .unwrap();
+            let pos = Vec2::new(30.0 + 0.4 * i as Real, 0.4 * (j as Real - 40.0));
+            let asleep = BodyDef {
+                awake: false,
+                ..BodyDef::dynamic(pos)
+            };
+            let b = world.create_body(&asleep).unwrap();
             world.create_shape(b, &sd, small).unwrap();
         }
     }

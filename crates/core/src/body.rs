@@ -118,6 +118,11 @@ pub struct BodyDef {
     pub mass: Option<BodyMass>,
     /// Prevents rotation (infinite rotational inertia).
     pub fixed_rotation: bool,
+    /// Starts awake (usual true); `false` creates the body asleep, as Box2D's
+    /// `isAwake = false`: the world puts it to sleep before its next step
+    /// (after its shapes are attached), and it costs nothing until something
+    /// wakes it.
+    pub awake: bool,
     /// Opaque user value.
     pub user_data: u64,
 }
@@ -137,6 +142,7 @@ impl Default for BodyDef {
             max_rotation: DEFAULT_MAX_ROTATION,
             mass: None,
             fixed_rotation: false,
+            awake: true,
             user_data: 0,
         }
     }

@@ -80,6 +80,9 @@ fn union(parent: &mut [u32], a: u32, b: u32) {
 impl World {
     /// Wakes the island of `body` (no effect on awake or static bodies).
     pub fn wake_body(&mut self, body: BodyHandle) {
+        if !self.pending_sleep_is_empty() {
+            self.cancel_pending_sleep(body);
+        }
         if !self.bodies().is_sleeping(body) {
             return;
         }

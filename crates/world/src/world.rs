@@ -90,6 +90,8 @@ pub struct World {
     pub(crate) islands: crate::sleep::Islands,
     pub(crate) sleep_settings: crate::sleep::SleepSettings,
     wake_list: Vec<BodyHandle>,
+    /// Bodies created with `awake = false`, put to sleep at the next step.
+    pending_sleep: Vec<BodyHandle>,
     events: StepEvents,
     profile: SolverProfile,
     step_profile: crate::profile::StepProfile,
@@ -121,6 +123,7 @@ impl World {
             islands: crate::sleep::Islands::default(),
             sleep_settings: def.sleep,
             wake_list: Vec::new(),
+            pending_sleep: Vec::new(),
             bodies,
             revolute: Vec::new(),
             revolute_handles: Vec::new(),
@@ -213,7 +216,11 @@ impl World {
     /// assert!(world.position(ball).unwrap().y < 4.0);
     /// ```
     pub fn create_body(&mut self, def: &BodyDef) -> Result<BodyHandle, WorldError> {
-        Ok(self.bodies.create(def)?)
+        let handle = self.bodies.create(def)?;
+        if !def.awake && def.body_type != BodyType::Static {
+            self.pending_sleep.push(handle);
+        }
+        Ok(handle)
     }
 
     /// Destroys a body and every joint attached to it.
@@ -628,7 +635,10 @@ impl World {
         {
             return Err(WorldError::OutOfRange("density"));
         }
-        self.wake_body(body);
+        // Wakes a sleeping island; a body created asleep stays pending.
+        if self.bodies.is_sleeping(body) {
+            self.wake_body(body);
+        }
         let handle = self
             .collision
             .add_shape(&self.bodies, body, geometry, def.clone());
@@ -746,6 +756,16 @@ impl World {
     }
 
     // ----- helpers for the portal and sleep stages ----------------------------
+
+    pub(crate) fn pending_sleep_is_empty(&self) -> bool {
+        self.pending_sleep.is_empty()
+    }
+
+    /// A body created asleep that the user touched before the first step
+    /// stays awake.
+    pub(crate) fn cancel_pending_sleep(&mut self, body: BodyHandle) {
+        self.pending_sleep.retain(|b| *b != body);
+    }
 
     /// Mutable body storage (crate-internal).
     pub(crate) fn bodies_mut(&mut self) -> &mut BodySet {
@@ -868,6 +888,14 @@ impl World {
         let mut sp = crate::profile::StepProfile::default();
         let mut counters = crate::profile::StepCounters::default();
         self.collision.events = CollisionEvents::default();
+        if !self.pending_sleep.is_empty() {
+            let pending = std::mem::take(&mut self.pending_sleep);
+            if self.sleep_settings.enabled {
+                for b in pending {
+                    self.bodies.sleep(b);
+                }
+            }
+        }
         let has_shapes = self.collision.shape_count() > 0;
         #[cfg(feature = "portals")]
         let has_portals = self.portals.is_active();
