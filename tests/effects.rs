@@ -217,3 +217,47 @@ fn portal_crossing_keeps_bodies_awake() {
     }
     assert!(!asleep_while_crossing);
 }
+
+#[test]
+fn bodies_created_asleep_cost_nothing_until_touched() {
+    let mut world = World::new(WorldDef {
+        gravity: Vec2::ZERO,
+        ..Default::default()
+    })
+    .unwrap();
+    let asleep: Vec<BodyHandle> = (0..10)
+        .map(|i| {
+            let def = BodyDef {
+                awake: false,
+                ..BodyDef::dynamic(Vec2::new(i as Real * 0.4, 0.0))
+            };
+            let b = world.create_body(&def).unwrap();
+            world
+                .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.2, 0.2))
+                .unwrap();
+            b
+        })
+        .collect();
+    world.step(DT).unwrap();
+    assert_eq!(world.sleeping_body_count(), 10);
+    assert_eq!(
+        world.counters().pairs_tested,
+        0,
+        "touching sleeping boxes were tested"
+    );
+    let ball = world
+        .create_body(&BodyDef::dynamic(Vec2::new(-3.0, 0.0)).with_velocity(Vec2::new(10.0, 0.0)))
+        .unwrap();
+    world
+        .create_shape(
+            ball,
+            &ShapeDef::default(),
+            Circle::new(Vec2::ZERO, 0.2).unwrap(),
+        )
+        .unwrap();
+    for _ in 0..60 {
+        world.step(DT).unwrap();
+    }
+    assert!(!world.is_sleeping(asleep[0]), "the hit box is still asleep");
+    assert!(world.linear_velocity(asleep[0]).unwrap().x > 0.0);
+}
