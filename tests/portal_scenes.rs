@@ -46,6 +46,26 @@ fn wall(world: &mut World, center: Vec2, hx: Real, hy: Real) -> BodyHandle {
     b
 }
 
+fn portal(body: BodyHandle, anchor: Vec2, direction: Vec2, half_width: Real) -> PortalDef {
+    PortalDef {
+        body,
+        anchor,
+        direction,
+        half_width,
+    }
+}
+
+/// A square box of half size `half` at `pos` moving at `velocity`.
+fn launched_box(world: &mut World, pos: Vec2, velocity: Vec2, half: Real) -> BodyHandle {
+    let b = world
+        .create_body(&BodyDef::dynamic(pos).with_velocity(velocity))
+        .unwrap();
+    world
+        .create_shape(b, &ShapeDef::default(), Polygon::make_box(half, half))
+        .unwrap();
+    b
+}
+
 fn completed(world: &World) -> bool {
     world
         .portal_events()
@@ -125,28 +145,13 @@ fn scale_pass(eta: Real, model: MassModel) -> (Real, Real, Real) {
     let a = wall(&mut world, Vec2::new(0.5, 0.0), 0.5, 5.0);
     let b = wall(&mut world, Vec2::new(50.0, 50.0), 0.5, 10.0);
     let pair = PortalPairDef {
-        portal_a: PortalDef {
-            body: a,
-            anchor: Vec2::new(-0.5, 0.0),
-            direction: -Vec2::X,
-            half_width: 1.0,
-        },
-        portal_b: PortalDef {
-            body: b,
-            anchor: Vec2::new(0.5, 0.0),
-            direction: Vec2::X,
-            half_width: eta,
-        },
+        portal_a: portal(a, Vec2::new(-0.5, 0.0), -Vec2::X, 1.0),
+        portal_b: portal(b, Vec2::new(0.5, 0.0), Vec2::X, eta),
         eta: None,
         mass_model: model,
     };
     world.create_portal_pair(&pair).unwrap();
-    let body = world
-        .create_body(&BodyDef::dynamic(Vec2::new(-3.0, 0.0)).with_velocity(Vec2::new(5.0, 0.0)))
-        .unwrap();
-    world
-        .create_shape(body, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
-        .unwrap();
+    let body = launched_box(&mut world, Vec2::new(-3.0, 0.0), Vec2::new(5.0, 0.0), 0.5);
     let (size0, ke0) = (extent(&world, body, Vec2::Y), kinetic_energy(&world, body));
     let mut done = false;
     for _ in 0..600 {
@@ -211,30 +216,19 @@ fn portal_round_trip_restores_energy_and_size() {
     let b = wall(&mut world, Vec2::new(-0.5, 50.0), 0.5, 10.0);
     let c = wall(&mut world, Vec2::new(40.5, 50.0), 0.5, 10.0);
     let d = wall(&mut world, Vec2::new(-0.5, 100.0), 0.5, 5.0);
-    let p = |body, anchor, direction, half_width| PortalDef {
-        body,
-        anchor,
-        direction,
-        half_width,
-    };
     world
         .create_portal_pair(&PortalPairDef::new(
-            p(a, Vec2::new(-0.5, 0.0), -Vec2::X, 1.0),
-            p(b, Vec2::new(0.5, 0.0), Vec2::X, eta),
+            portal(a, Vec2::new(-0.5, 0.0), -Vec2::X, 1.0),
+            portal(b, Vec2::new(0.5, 0.0), Vec2::X, eta),
         ))
         .unwrap();
     world
         .create_portal_pair(&PortalPairDef::new(
-            p(c, Vec2::new(-0.5, 0.0), -Vec2::X, eta),
-            p(d, Vec2::new(0.5, 0.0), Vec2::X, 1.0),
+            portal(c, Vec2::new(-0.5, 0.0), -Vec2::X, eta),
+            portal(d, Vec2::new(0.5, 0.0), Vec2::X, 1.0),
         ))
         .unwrap();
-    let body = world
-        .create_body(&BodyDef::dynamic(Vec2::new(-3.0, 0.0)).with_velocity(Vec2::new(5.0, 0.0)))
-        .unwrap();
-    world
-        .create_shape(body, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
-        .unwrap();
+    let body = launched_box(&mut world, Vec2::new(-3.0, 0.0), Vec2::new(5.0, 0.0), 0.5);
     let (size0, ke0) = (extent(&world, body, Vec2::Y), kinetic_energy(&world, body));
     let mut passes = 0;
     for _ in 0..1200 {
@@ -275,18 +269,8 @@ fn portal_loop_speed_grows_only_by_gravity() {
     let ceiling = wall(&mut world, Vec2::new(0.0, 10.5), 5.0, 0.5);
     world
         .create_portal_pair(&PortalPairDef::new(
-            PortalDef {
-                body: floor,
-                anchor: Vec2::new(0.0, 0.5),
-                direction: Vec2::Y,
-                half_width: 1.0,
-            },
-            PortalDef {
-                body: ceiling,
-                anchor: Vec2::new(0.0, -0.5),
-                direction: -Vec2::Y,
-                half_width: 1.0,
-            },
+            portal(floor, Vec2::new(0.0, 0.5), Vec2::Y, 1.0),
+            portal(ceiling, Vec2::new(0.0, -0.5), -Vec2::Y, 1.0),
         ))
         .unwrap();
     let body = world
@@ -352,26 +336,11 @@ fn portal_turning_bodies_keep_error_below_a_millimetre() {
     let b = mk(&mut world, Vec2::new(20.0, 0.0), -0.5);
     world
         .create_portal_pair(&PortalPairDef::new(
-            PortalDef {
-                body: a,
-                anchor: Vec2::new(-0.25, 0.0),
-                direction: -Vec2::X,
-                half_width: 1.0,
-            },
-            PortalDef {
-                body: b,
-                anchor: Vec2::new(0.25, 0.0),
-                direction: Vec2::X,
-                half_width: 1.0,
-            },
+            portal(a, Vec2::new(-0.25, 0.0), -Vec2::X, 1.0),
+            portal(b, Vec2::new(0.25, 0.0), Vec2::X, 1.0),
         ))
         .unwrap();
-    let body = world
-        .create_body(&BodyDef::dynamic(Vec2::new(-0.9, 0.0)).with_velocity(Vec2::new(6.0, 0.0)))
-        .unwrap();
-    world
-        .create_shape(body, &ShapeDef::default(), Polygon::make_box(0.3, 0.3))
-        .unwrap();
+    launched_box(&mut world, Vec2::new(-0.9, 0.0), Vec2::new(6.0, 0.0), 0.3);
     let (mut worst, mut steps_crossing) = (0.0 as Real, 0);
     for _ in 0..120 {
         world.step(DT).unwrap();
@@ -417,26 +386,11 @@ fn portal_dynamic_bodies_conserve_momentum() {
     let b = mk(&mut world, Vec2::new(20.0, 5.0));
     world
         .create_portal_pair(&PortalPairDef::new(
-            PortalDef {
-                body: a,
-                anchor: Vec2::new(-0.25, 0.0),
-                direction: -Vec2::X,
-                half_width: 1.0,
-            },
-            PortalDef {
-                body: b,
-                anchor: Vec2::new(0.25, 0.0),
-                direction: Vec2::X,
-                half_width: 1.0,
-            },
+            portal(a, Vec2::new(-0.25, 0.0), -Vec2::X, 1.0),
+            portal(b, Vec2::new(0.25, 0.0), Vec2::X, 1.0),
         ))
         .unwrap();
-    let body = world
-        .create_body(&BodyDef::dynamic(Vec2::new(-1.0, 0.1)).with_velocity(Vec2::new(4.0, 0.0)))
-        .unwrap();
-    world
-        .create_shape(body, &ShapeDef::default(), Polygon::make_box(0.3, 0.3))
-        .unwrap();
+    launched_box(&mut world, Vec2::new(-1.0, 0.1), Vec2::new(4.0, 0.0), 0.3);
     let momentum = |world: &World| {
         let (mut p, mut l) = (Vec2::ZERO, 0.0 as Real);
         for h in world.bodies().handles() {
@@ -521,18 +475,8 @@ fn portal_blocked_exit_stops_the_body() {
     wall(&mut world, Vec2::new(30.0, 1.0), 3.0, 0.5); // lower face at y = 0.5
     world
         .create_portal_pair(&PortalPairDef::new(
-            PortalDef {
-                body: entry_floor,
-                anchor: Vec2::new(0.0, 0.5),
-                direction: Vec2::Y,
-                half_width: 1.0,
-            },
-            PortalDef {
-                body: exit_floor,
-                anchor: Vec2::new(0.0, 0.5),
-                direction: Vec2::Y,
-                half_width: 1.0,
-            },
+            portal(entry_floor, Vec2::new(0.0, 0.5), Vec2::Y, 1.0),
+            portal(exit_floor, Vec2::new(0.0, 0.5), Vec2::Y, 1.0),
         ))
         .unwrap();
     let body = world
@@ -703,26 +647,16 @@ fn fast_body_crosses_without_tunnelling() {
     let b = wall(&mut world, Vec2::new(-0.5, 50.0), 0.5, 5.0);
     world
         .create_portal_pair(&PortalPairDef::new(
-            PortalDef {
-                body: a,
-                anchor: Vec2::new(-0.5, 0.0),
-                direction: -Vec2::X,
-                half_width: 1.0,
-            },
-            PortalDef {
-                body: b,
-                anchor: Vec2::new(0.5, 0.0),
-                direction: Vec2::X,
-                half_width: 1.0,
-            },
+            portal(a, Vec2::new(-0.5, 0.0), -Vec2::X, 1.0),
+            portal(b, Vec2::new(0.5, 0.0), Vec2::X, 1.0),
         ))
         .unwrap();
-    let body = world
-        .create_body(&BodyDef::dynamic(Vec2::new(-10.0, 0.0)).with_velocity(Vec2::new(150.0, 0.0)))
-        .unwrap();
-    world
-        .create_shape(body, &ShapeDef::default(), Polygon::make_box(0.25, 0.25))
-        .unwrap();
+    let body = launched_box(
+        &mut world,
+        Vec2::new(-10.0, 0.0),
+        Vec2::new(150.0, 0.0),
+        0.25,
+    );
     let mut completions = 0;
     for _ in 0..30 {
         world.step(DT).unwrap();
