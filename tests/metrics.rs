@@ -389,3 +389,60 @@ fn short_stack_stands_and_loses_energy() {
     );
     assert_eq!(m.non_finite_steps, 0);
 }
+
+/// The portal metrics: a box pushed through an η = 1 pair of static portals
+/// with gravity off keeps its η-scaled momentum (to f32 round-off) and the
+/// constraint error stays below a millimetre.
+#[cfg(feature = "portals")]
+#[test]
+fn portal_metrics_measure_a_passive_crossing() {
+    use janus2d::metrics::{ExtraMetric, PortalError, PortalMomentumError};
+    use janus2d::world::{PortalDef, PortalPairDef};
+    let mut world = zero_gravity();
+    let wall = |world: &mut World, p: Vec2| {
+        let b = world.create_body(&BodyDef::fixed(p)).unwrap();
+        world
+            .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 3.0))
+            .unwrap();
+        b
+    };
+    let (a, b) = (
+        wall(&mut world, Vec2::new(0.5, 0.0)),
+        wall(&mut world, Vec2::new(-0.5, 20.0)),
+    );
+    let portal = |body, anchor, direction| PortalDef {
+        body,
+        anchor,
+        direction,
+        half_width: 1.0,
+    };
+    world
+        .create_portal_pair(&PortalPairDef::new(
+            portal(a, Vec2::new(-0.5, 0.0), -Vec2::X),
+            portal(b, Vec2::new(0.5, 0.0), Vec2::X),
+        ))
+        .unwrap();
+    let body = world
+        .create_body(&BodyDef::dynamic(Vec2::new(-2.0, 0.2)).with_velocity(Vec2::new(3.0, 0.0)))
+        .unwrap();
+    world
+        .create_shape(body, &ShapeDef::default(), Polygon::make_box(0.3, 0.3))
+        .unwrap();
+    let (mut c, mut p) = (PortalError, PortalMomentumError::default());
+    let (mut worst_c, mut worst_p, mut seen) = (0.0f64, 0.0f64, 0);
+    for _ in 0..90 {
+        world.step(1.0 / 60.0).unwrap();
+        if let (Some(ec), Some(ep)) = (c.measure(&world), p.measure(&world)) {
+            worst_c = worst_c.max(ec);
+            worst_p = worst_p.max(ep);
+            seen += 1;
+        }
+    }
+    assert!(seen > 3, "the box never straddled");
+    assert!(worst_c < 1e-3, "|C| {worst_c}");
+    #[cfg(not(feature = "f64"))]
+    let tol = 1e-5;
+    #[cfg(feature = "f64")]
+    let tol = 1e-12;
+    assert!(worst_p < tol, "η-momentum error {worst_p}");
+}
