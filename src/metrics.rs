@@ -189,6 +189,8 @@ impl ExtraMetric for PortalMomentumError {
     fn unit(&self) -> &'static str {
         "1"
     }
+    // `Real` is f32 or f64 by feature: the cast is the identity in f64.
+    #[allow(clippy::unnecessary_cast)]
     fn measure(&mut self, world: &World) -> Option<f64> {
         let mut worst: Option<f64> = None;
         for c in world.portal_constraints() {
