@@ -81,6 +81,9 @@ pub struct StepContext {
     pub warm_starting: bool,
     /// Soft step or PGS baseline.
     pub mode: SolverMode,
+    /// False when no constraint of the step has restitution: the restitution
+    /// stage is skipped (the world sets it from its contacts; usual true).
+    pub restitution: bool,
     /// Largest stiffening factor of a contact between moving bodies
     /// (dimensionless, `≥ 1`; 1 in the PGS baseline), see
     /// [`SolverSettings::contact_mass_ratio_cap`](crate::solver::SolverSettings::contact_mass_ratio_cap).

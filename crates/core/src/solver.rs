@@ -150,6 +150,7 @@ impl SolverSettings {
             joint_damping_ratio: self.joint_damping_ratio,
             warm_starting: self.warm_starting,
             mode: self.mode,
+            restitution: true,
             contact_mass_ratio_cap: match self.mode {
                 SolverMode::SoftStep => self.contact_mass_ratio_cap.max(1.0),
                 SolverMode::PgsBaumgarte => 1.0,
@@ -398,10 +399,12 @@ pub fn solve_step(
         }
         report.profile.relax += lap(&mut t);
     }
-    for &i in &active {
-        batches[i].apply_restitution(ctx, &mut bodies.states);
+    if ctx.restitution {
+        for &i in &active {
+            batches[i].apply_restitution(ctx, &mut bodies.states);
+        }
+        report.profile.restitution += lap(&mut t);
     }
-    report.profile.restitution += lap(&mut t);
     for &i in &active {
         batches[i].store_impulses();
     }

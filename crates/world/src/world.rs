@@ -876,7 +876,7 @@ impl World {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(WorldError::InvalidTimeStep);
         }
-        let ctx = self.step_context(dt);
+        let mut ctx = self.step_context(dt);
         let start = std::time::Instant::now();
         let mut t = start;
         let mut lap = || {
@@ -932,6 +932,8 @@ impl World {
         } else {
             self.contact_constraints.clear();
         }
+        // No restitution anywhere: no restitution pass.
+        ctx.restitution = self.contact_constraints.iter().any(|c| c.restitution > 0.0);
         #[cfg(feature = "portals")]
         let mut batches: [&mut dyn ConstraintBatch; 3] = [
             &mut self.revolute,
