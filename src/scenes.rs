@@ -434,9 +434,24 @@ pub fn portal_stream(def: &WorldDef, with_portal: bool) -> Scene {
             .unwrap();
     };
     // Funnel: two slopes down to a 2 m opening at (0, 0), side walls.
-    let slope = (8.0 as Real).atan2(8.8);
-    solid(&mut world, 5.95, 0.25, Vec2::new(-5.4, 4.0), -slope);
-    solid(&mut world, 5.95, 0.25, Vec2::new(5.4, 4.0), slope);
+    // 45° slopes whose upper faces run from (±10, 9) down to the aperture's
+    // edges (±1, 0), so nothing can rest beside the opening.
+    let slope = PI / 4.0;
+    let normal_out = Vec2::new(-0.25 * (0.5 as Real).sqrt(), 0.25 * (0.5 as Real).sqrt());
+    solid(
+        &mut world,
+        6.5,
+        0.25,
+        Vec2::new(5.5, 4.5) - normal_out,
+        slope,
+    );
+    solid(
+        &mut world,
+        6.5,
+        0.25,
+        Vec2::new(-5.5, 4.5) - Vec2::new(-normal_out.x, normal_out.y),
+        -slope,
+    );
     solid(&mut world, 0.25, 12.0, Vec2::new(-10.25, 12.0), 0.0);
     solid(&mut world, 0.25, 12.0, Vec2::new(10.25, 12.0), 0.0);
     // Room below: floor, side walls.
