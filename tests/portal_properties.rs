@@ -15,7 +15,6 @@
 
 mod portal_support;
 
-use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use janus2d_constraints::parts::clamp_length;
@@ -23,53 +22,11 @@ use janus2d_constraints::portal::PIVOT_TOLERANCE;
 use janus2d_constraints::portal_map::{PortalFrame, PortalMap};
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::constraint::{Constraint, ConstraintRows, SolverMode, StepContext};
-use janus2d_core::math::{EPSILON, Real, Rot, Vec2, vec_is_finite, wrap_angle};
+use janus2d_core::math::{Real, Rot, Vec2, vec_is_finite, wrap_angle};
 use janus2d_core::solver::{SolverSettings, solve_step};
 use portal_support::*;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestCaseError, TestError, TestRunner};
-
-#[allow(clippy::unnecessary_cast)] // `Real` is f64 with the feature
-const EPS: f64 = EPSILON as f64;
-
-fn report() -> bool {
-    std::env::var("JANUS2D_REPORT").is_ok()
-}
-
-/// Runs a property over at least 256 cases; the closure returns the
-/// measured error as a fraction of its bound (≤ 1 passes), and the worst
-/// fraction is printed under `JANUS2D_REPORT`.
-fn check<S: Strategy>(name: &str, strategy: S, f: impl Fn(S::Value) -> Result<f64, TestCaseError>)
-where
-    S::Value: std::fmt::Debug,
-{
-    let mut config = Config::default();
-    config.cases = config.cases.max(256);
-    config.failure_persistence = None;
-    let cases = config.cases;
-    let mut runner = TestRunner::new(config);
-    let worst = Cell::new(0.0f64);
-    let result = runner.run(&strategy, |v| {
-        let r = f(v)?;
-        if r > worst.get() {
-            worst.set(r);
-        }
-        Ok(())
-    });
-    match result {
-        Ok(()) => {}
-        Err(TestError::Fail(why, value)) => {
-            panic!("{name}: {why}\nminimal failing input: {value:#?}")
-        }
-        Err(e) => panic!("{name}: {e}"),
-    }
-    if report() {
-        eprintln!(
-            "{name}: {cases} cases, worst error / bound = {:.3e}",
-            worst.get()
-        );
-    }
-}
+use proptest::test_runner::TestCaseError;
 
 fn ctx_soft() -> StepContext {
     SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO)

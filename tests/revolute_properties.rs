@@ -14,55 +14,14 @@
 
 mod portal_support;
 
-use std::cell::Cell;
-
 use janus2d_constraints::revolute::{RevoluteJoint, RevoluteJointDef};
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::constraint::{Constraint, ConstraintRows, StepContext};
-use janus2d_core::math::{EPSILON, Real, Vec2, wrap_angle};
+use janus2d_core::math::{Real, Vec2, wrap_angle};
 use janus2d_core::solver::SolverSettings;
 use portal_support::*;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestCaseError, TestError, TestRunner};
-
-#[allow(clippy::unnecessary_cast)] // `Real` is f64 with the feature
-const EPS: f64 = EPSILON as f64;
-
-fn report() -> bool {
-    std::env::var("JANUS2D_REPORT").is_ok()
-}
-
-/// Runs a property over at least 256 cases; the closure returns its error
-/// as a fraction of the bound.
-fn check<S: Strategy>(name: &str, strategy: S, f: impl Fn(S::Value) -> Result<f64, TestCaseError>)
-where
-    S::Value: std::fmt::Debug,
-{
-    let mut config = Config::default();
-    config.cases = config.cases.max(256);
-    config.failure_persistence = None;
-    let cases = config.cases;
-    let mut runner = TestRunner::new(config);
-    let worst = Cell::new(0.0f64);
-    let result = runner.run(&strategy, |v| {
-        let r = f(v)?;
-        worst.set(worst.get().max(r));
-        Ok(())
-    });
-    match result {
-        Ok(()) => {}
-        Err(TestError::Fail(why, value)) => {
-            panic!("{name}: {why}\nminimal failing input: {value:#?}")
-        }
-        Err(e) => panic!("{name}: {e}"),
-    }
-    if report() {
-        eprintln!(
-            "{name}: {cases} cases, worst error / bound = {:.3e}",
-            worst.get()
-        );
-    }
-}
+use proptest::test_runner::TestCaseError;
 
 /// A joint case: two bodies, local anchors, a reference angle and limits
 /// around the current joint angle, with spring and motor on (all rows).

@@ -7,8 +7,11 @@ use janus2d_constraints::portal_map::{
     BodyMotion, Portal, PortalBodyMotion, PortalFrame, PortalMap,
 };
 use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodySet, BodyType};
-use janus2d_core::math::{Real, Rot, Transform, Vec2, cross_sv};
+use std::cell::Cell;
+
+use janus2d_core::math::{EPSILON, Real, Rot, Transform, Vec2, cross_sv};
 use proptest::prelude::*;
+use proptest::test_runner::{Config, TestCaseError, TestError, TestRunner};
 
 /// Widens to f64 (identity under the `f64` feature).
 #[allow(clippy::useless_conversion)] // `Real` is f64 with the feature
@@ -446,4 +449,50 @@ pub fn portal_case(
                 case
             },
         )
+}
+
+/// Machine epsilon of `Real`, as f64.
+#[allow(clippy::unnecessary_cast)] // `Real` is f64 with the feature
+pub const EPS: f64 = EPSILON as f64;
+
+pub fn report() -> bool {
+    std::env::var("JANUS2D_REPORT").is_ok()
+}
+
+/// Runs a property (shared by the portal and revolute property tests) over at least 256 cases; the closure returns the
+/// measured error as a fraction of its bound (≤ 1 passes), and the worst
+/// fraction is printed under `JANUS2D_REPORT`.
+pub fn check<S: Strategy>(
+    name: &str,
+    strategy: S,
+    f: impl Fn(S::Value) -> Result<f64, TestCaseError>,
+) where
+    S::Value: std::fmt::Debug,
+{
+    let mut config = Config::default();
+    config.cases = config.cases.max(256);
+    config.failure_persistence = None;
+    let cases = config.cases;
+    let mut runner = TestRunner::new(config);
+    let worst = Cell::new(0.0f64);
+    let result = runner.run(&strategy, |v| {
+        let r = f(v)?;
+        if r > worst.get() {
+            worst.set(r);
+        }
+        Ok(())
+    });
+    match result {
+        Ok(()) => {}
+        Err(TestError::Fail(why, value)) => {
+            panic!("{name}: {why}\nminimal failing input: {value:#?}")
+        }
+        Err(e) => panic!("{name}: {e}"),
+    }
+    if report() {
+        eprintln!(
+            "{name}: {cases} cases, worst error / bound = {:.3e}",
+            worst.get()
+        );
+    }
 }
