@@ -16,7 +16,7 @@
 //! ```
 //!
 //! solved as a 2×2 block: `λ = −s_m K⁻¹ (Ċ + β C) − s_i λ_acc` with the soft
-//! coefficients `β, s_m, s_i` of [`Softness`](janus2d_core::softness::Softness)
+//! coefficients `β, s_m, s_i` of [`Softness`]
 //! and the bias `β C` capped at the joint correction speed so that a large
 //! initial error recovers gently instead of flinging the bodies.
 //!
