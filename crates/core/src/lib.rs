@@ -11,6 +11,7 @@
 //! | [`constraint`] | the constraint trait, rows, blocks, the step context        |
 //! | [`solver`]     | the soft step and the PGS baseline                          |
 //! | [`geometry`]   | shapes, mass properties, bounding boxes, manifolds          |
+//! | [`slots`]      | generational slots behind handles                           |
 //!
 //! See `docs/architecture.md` for the crate graph and the step pipeline.
 
@@ -18,6 +19,7 @@ pub mod body;
 pub mod constraint;
 pub mod geometry;
 pub mod math;
+pub mod slots;
 pub mod softness;
 pub mod solver;
 

@@ -38,6 +38,7 @@ use janus2d_constraints::{Portal, PortalConstraint, PortalConstraintDef};
 use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
 use janus2d_core::geometry::Aabb;
 use janus2d_core::math::{Real, Rot, Vec2, cross};
+use janus2d_core::slots::Slots;
 
 use crate::collision::{ApertureClip, ContactClipping};
 use crate::error::WorldError;
@@ -185,12 +186,6 @@ pub(crate) struct PairData {
     pub(crate) mass_model: MassModel,
 }
 
-#[derive(Clone, Debug)]
-pub(crate) struct PairSlot {
-    generation: u32,
-    pub(crate) data: Option<PairData>,
-}
-
 /// A crossing in progress.
 #[derive(Clone, Debug)]
 pub(crate) struct Crossing {
@@ -206,20 +201,19 @@ pub(crate) struct Crossing {
 /// Portal pairs, crossings and their constraints.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Portals {
-    pub(crate) slots: Vec<PairSlot>,
-    free: Vec<u32>,
+    /// Portal pair handle slots.
+    pub(crate) pairs: Slots<PairData>,
     pub(crate) crossings: Vec<Crossing>,
     /// One constraint per crossing, same order.
     pub(crate) constraints: Vec<PortalConstraint>,
     pub(crate) events: Vec<PortalEvent>,
     pub(crate) counters: PortalCounters,
     pub(crate) clipping: ContactClipping,
-    live_pairs: usize,
 }
 
 impl Portals {
     pub(crate) fn is_active(&self) -> bool {
-        self.live_pairs > 0
+        !self.pairs.is_empty()
     }
 
     pub(crate) fn crossing_of(&self, body: BodyHandle) -> Option<usize> {
@@ -272,38 +266,21 @@ impl World {
             eta,
             mass_model: def.mass_model,
         };
-        let p = &mut self.portals;
-        let index = match p.free.pop() {
-            Some(i) => i,
-            None => {
-                p.slots.push(PairSlot {
-                    generation: 0,
-                    data: None,
-                });
-                (p.slots.len() - 1) as u32
-            }
-        };
-        let slot = &mut p.slots[index as usize];
-        slot.generation = slot.generation.wrapping_add(1);
-        slot.data = Some(data);
-        p.live_pairs += 1;
+        let (index, generation) = self.portals.pairs.insert(data);
         Ok(PortalPairHandle {
             index,
-            generation: slot.generation,
+            generation,
             owner: self.bodies().owner(),
         })
     }
 
     fn pair_slot(&self, pair: PortalPairHandle) -> Result<u32, WorldError> {
-        let slot = self
+        let live = self
             .portals
-            .slots
-            .get(pair.index as usize)
-            .ok_or(WorldError::StalePortal)?;
-        if slot.generation != pair.generation
-            || slot.data.is_none()
-            || pair.owner != self.bodies().owner()
-        {
+            .pairs
+            .get(pair.index, pair.generation)
+            .is_some();
+        if !live || pair.owner != self.bodies().owner() {
             return Err(WorldError::StalePortal);
         }
         Ok(pair.index)
@@ -312,7 +289,7 @@ impl World {
     fn pair_handle(&self, index: u32) -> PortalPairHandle {
         PortalPairHandle {
             index,
-            generation: self.portals.slots[index as usize].generation,
+            generation: self.portals.pairs.generation(index),
             owner: self.bodies().owner(),
         }
     }
@@ -323,15 +300,13 @@ impl World {
         while let Some(k) = self.portals.crossings.iter().position(|c| c.pair == index) {
             self.cancel_crossing(k);
         }
-        self.portals.slots[index as usize].data = None;
-        self.portals.free.push(index);
-        self.portals.live_pairs -= 1;
+        self.portals.pairs.remove(pair.index, pair.generation);
         Ok(())
     }
 
     /// Number of live portal pairs.
     pub fn portal_pair_count(&self) -> usize {
-        self.portals.live_pairs
+        self.portals.pairs.len()
     }
 
     /// Number of crossings in progress (each has one clone and one constraint).
@@ -375,18 +350,16 @@ impl World {
     /// Called when a body is about to be destroyed: ends the crossings it
     /// takes part in and destroys the portal pairs it carries.
     pub(crate) fn portals_forget_body(&mut self, body: BodyHandle) {
-        if self.portals.slots.is_empty() {
-            return;
-        }
-        for index in 0..self.portals.slots.len() as u32 {
-            let on_body = self.portals.slots[index as usize]
-                .data
-                .as_ref()
-                .is_some_and(|d| d.portals.iter().any(|p| p.body == body));
-            if on_body {
-                let h = self.pair_handle(index);
-                let _ = self.destroy_portal_pair(h);
-            }
+        let carried: Vec<u32> = self
+            .portals
+            .pairs
+            .iter()
+            .filter(|(_, d)| d.portals.iter().any(|p| p.body == body))
+            .map(|(i, _)| i)
+            .collect();
+        for index in carried {
+            let h = self.pair_handle(index);
+            let _ = self.destroy_portal_pair(h);
         }
         while let Some(k) = self.portals.crossing_of(body) {
             self.cancel_crossing(k);
@@ -398,8 +371,7 @@ impl World {
         let mut clipping = std::mem::take(&mut self.portals.clipping);
         clipping.clips.clear();
         clipping.ignored_pairs.clear();
-        for slot in &self.portals.slots {
-            let Some(d) = &slot.data else { continue };
+        for (_, d) in self.portals.pairs.iter() {
             for k in 0..2 {
                 let f = frame_of(self, &d.portals[k], &d.local[k]);
                 clipping.clips.push(ApertureClip {
@@ -412,10 +384,7 @@ impl World {
             }
         }
         for c in &self.portals.crossings {
-            let d = self.portals.slots[c.pair as usize]
-                .data
-                .as_ref()
-                .expect("live pair");
+            let d = self.portals.pairs.at(c.pair).expect("live pair");
             let (entry, exit) = (c.entry, 1 - c.entry);
             for (body, side) in [(c.original, entry), (c.clone, exit)] {
                 let f = frame_of(self, &d.portals[side], &d.local[side]);
@@ -482,10 +451,7 @@ impl World {
         let mut k = 0;
         while k < self.portals.crossings.len() {
             let c = self.portals.crossings[k].clone();
-            let d = self.portals.slots[c.pair as usize]
-                .data
-                .clone()
-                .expect("live pair");
+            let d = self.portals.pairs.at(c.pair).cloned().expect("live pair");
             let f_entry = frame_of(self, &d.portals[c.entry], &d.local[c.entry]);
             let f_exit = frame_of(self, &d.portals[1 - c.entry], &d.local[1 - c.entry]);
             let orig_ext = self.extents_in(c.original, &f_entry);
@@ -508,8 +474,8 @@ impl World {
 
         // 2. New crossings: bodies whose shapes straddle an aperture and fit
         //    its width, or whose centre swept through it during the step.
-        for index in 0..self.portals.slots.len() as u32 {
-            let Some(d) = self.portals.slots[index as usize].data.clone() else {
+        for index in 0..self.portals.pairs.capacity() {
+            let Some(d) = self.portals.pairs.at(index).cloned() else {
                 continue;
             };
             for entry in 0..2 {
@@ -580,7 +546,7 @@ impl World {
 
     /// Creates the clone of `body` entering portal `entry` of pair `index`.
     fn start_crossing(&mut self, index: u32, entry: usize, body: BodyHandle) -> Option<()> {
-        let d = self.portals.slots[index as usize].data.clone()?;
+        let d = self.portals.pairs.at(index).cloned()?;
         // A crossing wakes the portal bodies (their constraint rows act now).
         self.wake_body(d.portals[0].body);
         self.wake_body(d.portals[1].body);
@@ -735,10 +701,7 @@ impl World {
     }
 
     pub(crate) fn crossing_portal_bodies(&self, c: &Crossing) -> (BodyHandle, BodyHandle) {
-        let d = self.portals.slots[c.pair as usize]
-            .data
-            .as_ref()
-            .expect("live pair");
+        let d = self.portals.pairs.at(c.pair).expect("live pair");
         (d.portals[c.entry].body, d.portals[1 - c.entry].body)
     }
 

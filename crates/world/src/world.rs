@@ -57,13 +57,6 @@ pub struct JointHandle {
     pub owner: u32,
 }
 
-#[derive(Clone, Debug)]
-struct JointSlot {
-    generation: u32,
-    /// Index into `World::revolute`, or `None` when free.
-    index: Option<u32>,
-}
-
 /// Events of the last step, read after `step`.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StepEvents {
@@ -81,8 +74,8 @@ pub struct World {
     bodies: BodySet,
     revolute: Vec<RevoluteJoint>,
     revolute_handles: Vec<JointHandle>,
-    joint_slots: Vec<JointSlot>,
-    joint_free: Vec<u32>,
+    /// Joint handle slots → index into `revolute`.
+    joint_slots: janus2d_core::slots::Slots<u32>,
     collision: Collision,
     contact_constraints: Vec<ContactConstraint>,
     #[cfg(feature = "portals")]
@@ -127,8 +120,7 @@ impl World {
             bodies,
             revolute: Vec::new(),
             revolute_handles: Vec::new(),
-            joint_slots: Vec::new(),
-            joint_free: Vec::new(),
+            joint_slots: janus2d_core::slots::Slots::default(),
             events: StepEvents::default(),
             profile: SolverProfile::default(),
             step_profile: crate::profile::StepProfile::default(),
@@ -333,10 +325,10 @@ impl World {
 
     /// Sets the linear velocity of a moving body's centre of mass.
     pub fn set_linear_velocity(&mut self, body: BodyHandle, v: Vec2) -> Result<(), WorldError> {
-        self.wake_body(body);
         if !vec_is_finite(v) {
             return Err(WorldError::NonFinite("linear_velocity"));
         }
+        self.wake_body(body);
         self.check_body(body)?;
         if let Some(s) = self.bodies.state_mut(body) {
             s.v = v;
@@ -346,10 +338,10 @@ impl World {
 
     /// Sets the angular velocity of a moving body.
     pub fn set_angular_velocity(&mut self, body: BodyHandle, w: Real) -> Result<(), WorldError> {
-        self.wake_body(body);
         if !w.is_finite() {
             return Err(WorldError::NonFinite("angular_velocity"));
         }
+        self.wake_body(body);
         self.check_body(body)?;
         if let Some(s) = self.bodies.state_mut(body) {
             s.w = w;
@@ -364,10 +356,10 @@ impl World {
         position: Vec2,
         angle: Real,
     ) -> Result<(), WorldError> {
-        self.wake_body(body);
         if !vec_is_finite(position) || !angle.is_finite() {
             return Err(WorldError::NonFinite("transform"));
         }
+        self.wake_body(body);
         let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
         sim.transform = Transform {
             p: position,
@@ -383,7 +375,6 @@ impl World {
 
     /// Sets the mass properties of a dynamic body directly.
     pub fn set_mass(&mut self, body: BodyHandle, mass: BodyMass) -> Result<(), WorldError> {
-        self.wake_body(body);
         let ty = self.body_type(body)?;
         let fixed = self
             .bodies
@@ -394,6 +385,7 @@ impl World {
         if ty != BodyType::Dynamic {
             return Err(WorldError::NotDynamic);
         }
+        self.wake_body(body);
         self.bodies.apply_mass(body, mass, fixed);
         Ok(())
     }
@@ -405,10 +397,10 @@ impl World {
         force: Vec2,
         point: Vec2,
     ) -> Result<(), WorldError> {
-        self.wake_body(body);
         if !vec_is_finite(force) || !vec_is_finite(point) {
             return Err(WorldError::NonFinite("force"));
         }
+        self.wake_body(body);
         let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
         if sim.body_type == BodyType::Dynamic {
             sim.force += force;
@@ -429,10 +421,10 @@ impl World {
 
     /// Adds a torque (N·m) for the next step.
     pub fn apply_torque(&mut self, body: BodyHandle, torque: Real) -> Result<(), WorldError> {
-        self.wake_body(body);
         if !torque.is_finite() {
             return Err(WorldError::NonFinite("torque"));
         }
+        self.wake_body(body);
         let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
         if sim.body_type == BodyType::Dynamic {
             sim.torque += torque;
@@ -447,10 +439,10 @@ impl World {
         impulse: Vec2,
         point: Vec2,
     ) -> Result<(), WorldError> {
-        self.wake_body(body);
         if !vec_is_finite(impulse) || !vec_is_finite(point) {
             return Err(WorldError::NonFinite("impulse"));
         }
+        self.wake_body(body);
         let loc = self.bodies.location(body).ok_or(WorldError::StaleBody)?;
         if let BodyLocation::Moving(i) = loc {
             let sim = &self.bodies.sims[i as usize];
@@ -470,10 +462,10 @@ impl World {
         body: BodyHandle,
         impulse: Real,
     ) -> Result<(), WorldError> {
-        self.wake_body(body);
         if !impulse.is_finite() {
             return Err(WorldError::NonFinite("impulse"));
         }
+        self.wake_body(body);
         let loc = self.bodies.location(body).ok_or(WorldError::StaleBody)?;
         if let BodyLocation::Moving(i) = loc {
             let ii = self.bodies.sims[i as usize].inv_inertia;
@@ -489,27 +481,15 @@ impl World {
         &mut self,
         def: &RevoluteJointDef,
     ) -> Result<JointHandle, WorldError> {
-        self.wake_body(def.body_a);
-        self.wake_body(def.body_b);
         def.validate()?;
         self.check_body(def.body_a)?;
         self.check_body(def.body_b)?;
-        let index = match self.joint_free.pop() {
-            Some(i) => i,
-            None => {
-                self.joint_slots.push(JointSlot {
-                    generation: 0,
-                    index: None,
-                });
-                (self.joint_slots.len() - 1) as u32
-            }
-        };
-        let slot = &mut self.joint_slots[index as usize];
-        slot.generation = slot.generation.wrapping_add(1);
-        slot.index = Some(self.revolute.len() as u32);
+        self.wake_body(def.body_a);
+        self.wake_body(def.body_b);
+        let (index, generation) = self.joint_slots.insert(self.revolute.len() as u32);
         let handle = JointHandle {
             index,
-            generation: slot.generation,
+            generation,
             owner: self.bodies.owner(),
         };
         self.revolute.push(RevoluteJoint::new(def.clone()));
@@ -524,14 +504,13 @@ impl World {
     }
 
     fn joint_index(&self, joint: JointHandle) -> Result<usize, WorldError> {
-        let slot = self
-            .joint_slots
-            .get(joint.index as usize)
-            .ok_or(WorldError::StaleJoint)?;
-        if slot.generation != joint.generation || joint.owner != self.bodies.owner() {
+        if joint.owner != self.bodies.owner() {
             return Err(WorldError::StaleJoint);
         }
-        slot.index.map(|i| i as usize).ok_or(WorldError::StaleJoint)
+        self.joint_slots
+            .get(joint.index, joint.generation)
+            .map(|&i| i as usize)
+            .ok_or(WorldError::StaleJoint)
     }
 
     /// Destroys a joint.
@@ -554,10 +533,11 @@ impl World {
         self.revolute_handles.swap_remove(i);
         if i < self.revolute.len() {
             let moved = self.revolute_handles[i];
-            self.joint_slots[moved.index as usize].index = Some(i as u32);
+            if let Some(slot) = self.joint_slots.at_mut(moved.index) {
+                *slot = i as u32;
+            }
         }
-        self.joint_slots[joint.index as usize].index = None;
-        self.joint_free.push(joint.index);
+        self.joint_slots.remove(joint.index, joint.generation);
         Ok(())
     }
 

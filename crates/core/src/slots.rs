@@ -1,0 +1,124 @@
+//! Generational slots: the storage behind handles.
+//!
+//! ```text
+//! insert ─▶ (index, generation)       remove ─▶ slot freed, generation kept
+//! get(index, generation) ─▶ Some only while the generation matches
+//! ```
+//!
+//! A removed slot is reused by the next insert with its generation bumped,
+//! so a handle to what was removed is stale, never aliased. Slots are
+//! visited in index order (deterministic).
+
+/// Values in generational slots.
+#[derive(Clone, Debug)]
+pub struct Slots<T> {
+    entries: Vec<(u32, Option<T>)>,
+    free: Vec<u32>,
+    live: usize,
+}
+
+impl<T> Default for Slots<T> {
+    fn default() -> Self {
+        Slots {
+            entries: Vec::new(),
+            free: Vec::new(),
+            live: 0,
+        }
+    }
+}
+
+impl<T> Slots<T> {
+    /// Stores a value; returns its `(index, generation)`.
+    ///
+    /// ```
+    /// use janus2d_core::slots::Slots;
+    /// let mut s = Slots::default();
+    /// let (i, g) = s.insert("a");
+    /// assert_eq!(s.remove(i, g), Some("a"));
+    /// let (j, h) = s.insert("b");
+    /// assert_eq!(j, i);
+    /// assert!(s.get(i, g).is_none() && s.get(j, h) == Some(&"b"));
+    /// ```
+    pub fn insert(&mut self, value: T) -> (u32, u32) {
+        self.live += 1;
+        match self.free.pop() {
+            Some(i) => {
+                let e = &mut self.entries[i as usize];
+                e.0 = e.0.wrapping_add(1);
+                e.1 = Some(value);
+                (i, e.0)
+            }
+            None => {
+                self.entries.push((1, Some(value)));
+                ((self.entries.len() - 1) as u32, 1)
+            }
+        }
+    }
+
+    /// The value in a live slot whose generation matches.
+    pub fn get(&self, index: u32, generation: u32) -> Option<&T> {
+        match self.entries.get(index as usize) {
+            Some((g, Some(v))) if *g == generation => Some(v),
+            _ => None,
+        }
+    }
+
+    /// Mutable access to a live slot whose generation matches.
+    pub fn get_mut(&mut self, index: u32, generation: u32) -> Option<&mut T> {
+        match self.entries.get_mut(index as usize) {
+            Some((g, Some(v))) if *g == generation => Some(v),
+            _ => None,
+        }
+    }
+
+    /// The value in slot `index` if it is live (any generation).
+    pub fn at(&self, index: u32) -> Option<&T> {
+        self.entries.get(index as usize).and_then(|e| e.1.as_ref())
+    }
+
+    /// Mutable access to slot `index` if it is live (any generation).
+    pub fn at_mut(&mut self, index: u32) -> Option<&mut T> {
+        self.entries
+            .get_mut(index as usize)
+            .and_then(|e| e.1.as_mut())
+    }
+
+    /// The current generation of slot `index` (0 if never used).
+    pub fn generation(&self, index: u32) -> u32 {
+        self.entries.get(index as usize).map_or(0, |e| e.0)
+    }
+
+    /// Frees a slot whose generation matches; returns its value.
+    pub fn remove(&mut self, index: u32, generation: u32) -> Option<T> {
+        let e = self.entries.get_mut(index as usize)?;
+        if e.0 != generation || e.1.is_none() {
+            return None;
+        }
+        self.free.push(index);
+        self.live -= 1;
+        e.1.take()
+    }
+
+    /// Number of live values.
+    pub fn len(&self) -> usize {
+        self.live
+    }
+
+    /// True when no value is stored.
+    pub fn is_empty(&self) -> bool {
+        self.live == 0
+    }
+
+    /// One past the largest index ever used.
+    pub fn capacity(&self) -> u32 {
+        self.entries.len() as u32
+    }
+
+    /// Live values with their index, in index order.
+    pub fn iter(&self) -> impl Iterator<Item = (u32, &T)> {
+        self.entries
+            .iter()
+            .enumerate()
+            .filter_map(|(i, e)| e.1.as_ref().map(|v| (i as u32, v)))
+    }
+}
