@@ -143,7 +143,7 @@
 
 use janus2d_core::body::{BodyHandle, BodySet, BodySim, BodyState, BodyType};
 use janus2d_core::constraint::{Block, BodyJacobian, Constraint, ConstraintRows, Row, StepContext};
-use janus2d_core::math::{EPSILON, Mat3, PI, Real, Vec2, cross, cross_sv, wrap_angle};
+use janus2d_core::math::{Mat3, PI, Real, Vec2, cross, cross_sv, wrap_angle};
 use janus2d_core::softness::Softness;
 use smallvec::SmallVec;
 
@@ -449,75 +449,17 @@ impl PortalGeometry {
     }
 }
 
-/// Relative pivot tolerance of [`solve_block`] (dimensionless, usual
-/// `16 ε`): a pivot of the Jacobi-scaled `K` (unit diagonal) below this is
-/// round-off of an exactly singular `K` and its component is set to zero.
-pub const PIVOT_TOLERANCE: Real = 16.0 * EPSILON;
+/// Relative pivot tolerance of the block solve (dimensionless, usual
+/// `16 ε`): see [`janus2d_core::math::PIVOT_TOLERANCE`].
+pub const PIVOT_TOLERANCE: Real = janus2d_core::math::PIVOT_TOLERANCE;
 
 /// Solves `k x = b` for the symmetric positive semi-definite portal block,
-/// never NaN.
-///
-/// `K` is Jacobi-scaled to a unit diagonal (a zero diagonal, a row with no
-/// mass at all, gives a zero row and `x_i = 0`), then factored as `L D Lᵀ`
-/// with pivots below [`PIVOT_TOLERANCE`] treated as zero. The tolerance is
-/// relative to each row's own diagonal, so masses spanning many orders of
-/// magnitude stay solvable: a light, turning portal body makes `K` badly
-/// conditioned (pivot ratios around `1e-5` in the property tests) but
-/// regular, and dropping such a pivot would break `J v = −bias`. (This is
-/// why the block does not call [`janus2d_core::math::solve33_psd`], whose
-/// tolerance `1e3 ε · max K_ii` drops them.)
+/// never NaN: [`janus2d_core::math::solve33_psd`] (Jacobi-scaled `L D Lᵀ`
+/// with a pivot tolerance relative to each row's own diagonal, so a light,
+/// turning portal body — a badly conditioned but regular `K`, pivot ratios
+/// around `1e-5` in the property tests — stays solvable).
 pub fn solve_block(k: &Mat3, b: [Real; 3]) -> [Real; 3] {
-    let mut d = [0.0 as Real; 3];
-    for i in 0..3 {
-        if k[i][i] > 0.0 && k[i][i].is_finite() {
-            d[i] = 1.0 / k[i][i].sqrt();
-        }
-    }
-    // The scaled matrix `D K D` (unit diagonal) and right-hand side `D b`.
-    let mut a: Mat3 = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            a[i][j] = d[i] * k[i][j] * d[j];
-        }
-    }
-    let rhs = [d[0] * b[0], d[1] * b[1], d[2] * b[2]];
-    // L D Lᵀ, L unit lower-triangular.
-    let mut l: Mat3 = [[0.0; 3]; 3];
-    let mut pivot = [0.0 as Real; 3];
-    let mut live = [false; 3];
-    for j in 0..3 {
-        let mut p = a[j][j];
-        for m in 0..j {
-            p -= l[j][m] * l[j][m] * pivot[m];
-        }
-        pivot[j] = p;
-        live[j] = a[j][j] > 0.0 && p > PIVOT_TOLERANCE;
-        for i in (j + 1)..3 {
-            let mut v = a[i][j];
-            for m in 0..j {
-                v -= l[i][m] * l[j][m] * pivot[m];
-            }
-            l[i][j] = if live[j] { v / p } else { 0.0 };
-        }
-    }
-    // L y = rhs, z = D⁻¹ y, Lᵀ x = z.
-    let mut y = [0.0 as Real; 3];
-    for i in 0..3 {
-        let mut v = rhs[i];
-        for m in 0..i {
-            v -= l[i][m] * y[m];
-        }
-        y[i] = v;
-    }
-    let mut x = [0.0 as Real; 3];
-    for i in (0..3).rev() {
-        let mut v = if live[i] { y[i] / pivot[i] } else { 0.0 };
-        for m in (i + 1)..3 {
-            v -= l[m][i] * x[m];
-        }
-        x[i] = v;
-    }
-    [d[0] * x[0], d[1] * x[1], d[2] * x[2]]
+    janus2d_core::math::solve33_psd(k, b)
 }
 
 /// The portal rows as a part: start-of-step geometry, the scale and the

@@ -249,60 +249,73 @@ pub fn solve22(k11: Real, k12: Real, k22: Real, b: Vec2) -> Vec2 {
 /// A 3×3 matrix in row-major order, used for coupled constraint blocks.
 pub type Mat3 = [[Real; 3]; 3];
 
-/// Solves `k x = b` for a symmetric positive semi-definite 3×3 `k`.
+/// Relative pivot tolerance of [`solve33_psd`] (dimensionless, usual
+/// `16 ε`): a pivot of the Jacobi-scaled matrix (unit diagonal) below this
+/// is round-off of an exactly singular matrix and its component is set to
+/// zero.
+pub const PIVOT_TOLERANCE: Real = 16.0 * EPSILON;
+
+/// Solves `k x = b` for a symmetric positive semi-definite 3×3 `k`, never
+/// NaN.
 ///
-/// Uses an LDLᵀ factorisation; a pivot below `16 ε` times its own diagonal
-/// entry is treated as zero (the corresponding component of `x` is set to
-/// zero): badly conditioned but regular matrices are solved, singular ones
-/// give a solution of the well-posed part, and the result is never NaN.
+/// `k` is Jacobi-scaled to a unit diagonal (a zero diagonal gives a zero
+/// row and `x_i = 0`), then factored as `L D Lᵀ` with pivots below
+/// [`PIVOT_TOLERANCE`] treated as zero. The tolerance is relative to each
+/// row's own diagonal, so badly conditioned but regular matrices (masses
+/// spanning many orders of magnitude) are solved, and singular ones give a
+/// solution of their well-posed part.
 pub fn solve33_psd(k: &Mat3, b: [Real; 3]) -> [Real; 3] {
-    let scale = k[0][0].abs().max(k[1][1].abs()).max(k[2][2].abs());
-    if scale == 0.0 || !scale.is_finite() {
-        return [0.0; 3];
-    }
-    let tol = |j: usize| 16.0 * EPSILON * k[j][j].abs().max(scale * EPSILON);
-    // LDLᵀ with a lower unit-triangular L.
-    let mut l = [[0.0 as Real; 3]; 3];
     let mut d = [0.0 as Real; 3];
-    for j in 0..3 {
-        let mut dj = k[j][j];
-        for m in 0..j {
-            dj -= l[j][m] * l[j][m] * d[m];
-        }
-        d[j] = dj;
-        l[j][j] = 1.0;
-        for i in (j + 1)..3 {
-            let mut v = k[i][j];
-            for m in 0..j {
-                v -= l[i][m] * l[j][m] * d[m];
-            }
-            l[i][j] = if dj > tol(j) { v / dj } else { 0.0 };
+    for i in 0..3 {
+        if k[i][i] > 0.0 && k[i][i].is_finite() {
+            d[i] = 1.0 / k[i][i].sqrt();
         }
     }
-    // Forward: L y = b.
+    // The scaled matrix `D K D` (unit diagonal) and right-hand side `D b`.
+    let mut a: Mat3 = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            a[i][j] = d[i] * k[i][j] * d[j];
+        }
+    }
+    let rhs = [d[0] * b[0], d[1] * b[1], d[2] * b[2]];
+    // L D Lᵀ, L unit lower-triangular.
+    let mut l: Mat3 = [[0.0; 3]; 3];
+    let mut pivot = [0.0 as Real; 3];
+    let mut live = [false; 3];
+    for j in 0..3 {
+        let mut p = a[j][j];
+        for m in 0..j {
+            p -= l[j][m] * l[j][m] * pivot[m];
+        }
+        pivot[j] = p;
+        live[j] = a[j][j] > 0.0 && p > PIVOT_TOLERANCE;
+        for i in (j + 1)..3 {
+            let mut v = a[i][j];
+            for m in 0..j {
+                v -= l[i][m] * l[j][m] * pivot[m];
+            }
+            l[i][j] = if live[j] { v / p } else { 0.0 };
+        }
+    }
+    // L y = rhs, z = D⁻¹ y, Lᵀ x = z.
     let mut y = [0.0 as Real; 3];
     for i in 0..3 {
-        let mut v = b[i];
+        let mut v = rhs[i];
         for m in 0..i {
             v -= l[i][m] * y[m];
         }
         y[i] = v;
     }
-    // Diagonal.
-    let mut z = [0.0 as Real; 3];
-    for i in 0..3 {
-        z[i] = if d[i] > tol(i) { y[i] / d[i] } else { 0.0 };
-    }
-    // Backward: Lᵀ x = z.
     let mut x = [0.0 as Real; 3];
     for i in (0..3).rev() {
-        let mut v = z[i];
+        let mut v = if live[i] { y[i] / pivot[i] } else { 0.0 };
         for m in (i + 1)..3 {
             v -= l[m][i] * x[m];
         }
         x[i] = v;
     }
-    x
+    [d[0] * x[0], d[1] * x[1], d[2] * x[2]]
 }
 
 #[cfg(test)]
