@@ -833,8 +833,8 @@ impl Collision {
     /// Recomputes the boxes of the shapes of moving bodies and moves their
     /// proxies when they left their fat boxes.
     ///
-    /// A proxy's box covers the shape now and where its body's velocity
-    /// takes it within `dt`, so pairs exist before a fast body arrives.
+    /// A fast body's proxy box covers the shape now and where its velocity
+    /// takes it within `dt`, so pairs exist before it arrives.
     pub fn update_proxies(&mut self, bodies: &BodySet, dt: Real) {
         let mut moved = 0;
         for (sim, state) in bodies.sims.iter().zip(&bodies.states).skip(1) {
@@ -842,15 +842,21 @@ impl Collision {
             let Some(list) = self.body_shapes.get(b) else {
                 continue;
             };
+            // Only a body that travels more than half the fat margin in a
+            // step gets a swept box: slower ones stay inside their fat box
+            // as in Box2D, so they are not re-inserted more often.
             let sweep = dt * state.v;
+            let fast = sweep.length_squared() > (0.5 * AABB_MARGIN) * (0.5 * AABB_MARGIN);
             for &s in list {
                 let shape = &mut self.shapes[s as usize];
-                let aabb = shape.geometry.compute_aabb(&sim.transform);
+                let mut aabb = shape.geometry.compute_aabb(&sim.transform);
                 shape.aabb = aabb;
-                let aabb = Aabb::new(
-                    aabb.lower + sweep.min(Vec2::ZERO),
-                    aabb.upper + sweep.max(Vec2::ZERO),
-                );
+                if fast {
+                    aabb = Aabb::new(
+                        aabb.lower + sweep.min(Vec2::ZERO),
+                        aabb.upper + sweep.max(Vec2::ZERO),
+                    );
+                }
                 if self.broadphase.move_proxy(shape.proxy, aabb) {
                     moved += 1;
                 }
