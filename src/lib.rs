@@ -47,3 +47,8 @@ pub mod prelude {
         Filter, JointHandle, ShapeDef, ShapeHandle, StepEvents, World, WorldDef, WorldError,
     };
 }
+
+/// The README's code blocks run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
