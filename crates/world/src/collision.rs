@@ -230,6 +230,10 @@ pub struct CollisionCounters {
     pub touching: usize,
     /// Proxies re-inserted in the broadphase.
     pub proxies_moved: usize,
+    /// Contact rows built (normal + friction per point).
+    pub contact_rows: usize,
+    /// Contact constraints built with restitution > 0.
+    pub restitution_contacts: usize,
 }
 
 /// A region where contact points are dropped: a portal's aperture.
@@ -782,12 +786,21 @@ impl Collision {
                 ];
             }
         }
+        let (mut rows, mut bouncy) = (0, 0);
         for pass in [false, true] {
-            self.build_pass(pass, out);
+            self.build_pass(pass, out, &mut rows, &mut bouncy);
         }
+        self.counters.contact_rows = rows;
+        self.counters.restitution_contacts = bouncy;
     }
 
-    fn build_pass(&self, static_pass: bool, out: &mut Vec<ContactConstraint>) {
+    fn build_pass(
+        &self,
+        static_pass: bool,
+        out: &mut Vec<ContactConstraint>,
+        rows: &mut usize,
+        bouncy: &mut usize,
+    ) {
         for (k, c) in self.contacts.iter().enumerate() {
             if !c.touching || c.sensor || !c.enabled {
                 continue;
@@ -796,6 +809,8 @@ impl Collision {
             if (sa && sb) || (sa || sb) != static_pass {
                 continue;
             }
+            *rows += 2 * c.point_count;
+            *bouncy += usize::from(c.restitution > 0.0);
             let mut inputs = [ContactPointInput::default(); 2];
             for (input, p) in inputs.iter_mut().zip(&c.points[..c.point_count]) {
                 *input = ContactPointInput {

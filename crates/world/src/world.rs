@@ -913,7 +913,7 @@ impl World {
             self.contact_constraints.clear();
         }
         // No restitution anywhere: no restitution pass.
-        ctx.restitution = self.contact_constraints.iter().any(|c| c.restitution > 0.0);
+        ctx.restitution = has_shapes && self.collision.counters.restitution_contacts > 0;
         #[cfg(feature = "portals")]
         let mut batches: [&mut dyn ConstraintBatch; 3] = [
             &mut self.revolute,
@@ -957,16 +957,12 @@ impl World {
         counters.pairs_created = cc.pairs_created;
         counters.proxies_moved = cc.proxies_moved;
         counters.contacts = self.contact_constraints.len();
-        counters.contact_rows = self
-            .contact_constraints
-            .iter()
-            .map(|c| 2 * c.point_count())
-            .sum();
-        counters.restitution_contacts = self
-            .contact_constraints
-            .iter()
-            .filter(|c| c.restitution > 0.0)
-            .count();
+        counters.contact_rows = if has_shapes { cc.contact_rows } else { 0 };
+        counters.restitution_contacts = if has_shapes {
+            cc.restitution_contacts
+        } else {
+            0
+        };
         counters.joint_rows = self
             .revolute
             .iter()
