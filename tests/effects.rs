@@ -92,7 +92,11 @@ fn no_restitution_means_no_restitution_contacts() {
     }
     assert!(world.counters().contacts > 0);
     assert_eq!(world.counters().restitution_contacts, 0);
-    assert_eq!(world.profile().restitution, 0.0, "the restitution pass ran");
+    assert_eq!(
+        world.profile().solver.restitution,
+        0.0,
+        "the restitution pass ran"
+    );
     let (mut bouncy, _) = boxes_on_ground(def, 0.5);
     for _ in 0..10 {
         bouncy.step(DT).unwrap();

@@ -6,17 +6,13 @@
 //! | `broadphase`     | new pairs from moved proxies; proxy updates        |
 //! | `narrowphase`    | manifolds of every awake contact                   |
 //! | `portals`        | clipping, crossings, handovers, weights            |
-//! | `prepare`        | body and constraint preparation                    |
-//! | `integrate`      | velocity and position integration                  |
-//! | `warm_start`     | warm starting                                      |
-//! | `solve`          | solve with bias                                    |
-//! | `relax`          | relax (solve without bias)                         |
-//! | `restitution`    | restitution                                        |
-//! | `finalize`       | storing impulses, transforms                       |
+//! | `solver.*`       | the solver's stages ([`SolverProfile`]): prepare, integrate, warm start, solve, relax, restitution, finalize |
 //! | `sleep`          | sleep timers and islands                           |
 //!
 //! A stage whose feature the scene lacks is not entered: its time is zero
 //! and its counters stay zero (see [`StepCounters`]).
+
+use janus2d_core::solver::SolverProfile;
 
 /// Stage timings of the last step, seconds.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -27,20 +23,9 @@ pub struct StepProfile {
     pub narrowphase: f64,
     /// Portal stage.
     pub portals: f64,
-    /// Constraint and body preparation.
-    pub prepare: f64,
-    /// Integration of velocities and positions.
-    pub integrate: f64,
-    /// Warm starting.
-    pub warm_start: f64,
-    /// Solve with bias.
-    pub solve: f64,
-    /// Relax.
-    pub relax: f64,
-    /// Restitution.
-    pub restitution: f64,
-    /// Storing impulses and finalizing transforms.
-    pub finalize: f64,
+    /// The solver's stages (prepare, integrate, warm start, solve, relax,
+    /// restitution, finalize).
+    pub solver: SolverProfile,
     /// Sleep.
     pub sleep: f64,
     /// Whole step.

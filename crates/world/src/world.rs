@@ -86,7 +86,6 @@ pub struct World {
     /// Bodies created with `awake = false`, put to sleep at the next step.
     pending_sleep: Vec<BodyHandle>,
     events: StepEvents,
-    profile: SolverProfile,
     step_profile: crate::profile::StepProfile,
     counters: crate::profile::StepCounters,
     step_count: u64,
@@ -122,7 +121,6 @@ impl World {
             revolute_handles: Vec::new(),
             joint_slots: janus2d_core::slots::Slots::default(),
             events: StepEvents::default(),
-            profile: SolverProfile::default(),
             step_profile: crate::profile::StepProfile::default(),
             counters: crate::profile::StepCounters::default(),
             step_count: 0,
@@ -182,7 +180,7 @@ impl World {
 
     /// Stage timings of the solver in the last step.
     pub fn solver_profile(&self) -> &SolverProfile {
-        &self.profile
+        &self.step_profile.solver
     }
 
     /// Stage timings of the last step (every pipeline stage).
@@ -788,7 +786,7 @@ impl World {
 
     /// Pairs of bodies held together by enabled joints or touching solid
     /// contacts (the edges of the island graph).
-    pub(crate) fn constraint_edges(&self) -> Vec<(BodyHandle, BodyHandle)> {
+    pub(crate) fn constraint_edges(&self) -> impl Iterator<Item = (BodyHandle, BodyHandle)> + '_ {
         let joints = self
             .revolute
             .iter()
@@ -800,7 +798,7 @@ impl World {
             .iter()
             .filter(|c| c.touching && !c.sensor && c.enabled)
             .map(|c| (c.body_a, c.body_b));
-        joints.chain(contacts).collect()
+        joints.chain(contacts)
     }
 
     #[cfg(feature = "portals")]
@@ -941,14 +939,7 @@ impl World {
             self.update_sleep(dt);
             sp.sleep += lap();
         }
-        let p = &report.profile;
-        sp.prepare = p.prepare;
-        sp.integrate = p.integrate;
-        sp.warm_start = p.warm_start;
-        sp.solve = p.solve;
-        sp.relax = p.relax;
-        sp.restitution = p.restitution;
-        sp.finalize = p.finalize;
+        sp.solver = report.profile;
         sp.total = start.elapsed().as_secs_f64();
         // Counters.
         let cc = self.collision.counters;
@@ -997,7 +988,6 @@ impl World {
             non_finite_bodies: report.non_finite,
             collision: std::mem::take(&mut self.collision.events),
         };
-        self.profile = report.profile;
         self.step_count += 1;
         Ok(())
     }
