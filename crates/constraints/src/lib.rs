@@ -8,16 +8,21 @@
 //! | [`portal::PortalConstraint`]  | 3    | 4      | portal part + portal map |
 //! | [`contact::ContactConstraint`]| 2–4  | 2      | compact rows (normal, friction) |
 //!
+//! The point rows of joints that form a tree are solved exactly, the
+//! whole tree at once ([`joint_tree`]); the rest is Gauss–Seidel.
+//!
 //! Every type follows the same stages (prepare, warm start, solve with or
 //! without bias) and reports its rows through `Constraint::rows`.
 
 pub mod contact;
+pub mod joint_tree;
 pub mod parts;
 pub mod portal;
 pub mod portal_map;
 pub mod revolute;
 
 pub use contact::{ContactConstraint, ContactPointInput};
+pub use joint_tree::{JointForest, RevoluteBatch};
 pub use portal::{PortalConstraint, PortalConstraintDef};
 pub use portal_map::{Portal, PortalError, PortalMap, PortalPair};
 pub use revolute::{RevoluteJoint, RevoluteJointDef};

@@ -161,9 +161,12 @@ pub struct RevoluteJoint {
     pub def: RevoluteJointDef,
     /// False when the joint is disabled (skipped by the solver).
     pub enabled: bool,
-    state_a: u32,
-    state_b: u32,
-    point: PointPart,
+    pub(crate) state_a: u32,
+    pub(crate) state_b: u32,
+    pub(crate) point: PointPart,
+    /// True while the point rows belong to the direct solve of a joint tree
+    /// (set every step by [`JointForest`](crate::joint_tree::JointForest)).
+    pub(crate) in_tree: bool,
     /// `θ_b − θ_a − θ_ref` at the start of the step, rad.
     delta_angle: Real,
     spring: AnglePart,
@@ -184,6 +187,7 @@ impl RevoluteJoint {
             state_a: 0,
             state_b: 0,
             point: PointPart::default(),
+            in_tree: false,
             delta_angle: 0.0,
             spring: AnglePart::default(),
             motor: AnglePart::default(),
@@ -217,6 +221,12 @@ impl RevoluteJoint {
         janus2d_core::math::wrap_angle(
             a.transform.q.relative_angle(b.transform.q) - self.def.reference_angle,
         )
+    }
+
+    /// True when the last step solved the point rows directly (the joint
+    /// is part of a tree of joints, see [`crate::joint_tree`]).
+    pub fn in_tree(&self) -> bool {
+        self.in_tree
     }
 
     /// Accumulated point impulse of the last step, N·s.
@@ -327,13 +337,15 @@ impl Constraint for RevoluteJoint {
                 use_bias,
             );
         }
-        self.point.solve(
-            &mut sa,
-            &mut sb,
-            self.point_softness,
-            ctx.joint_max_correction_speed,
-            use_bias,
-        );
+        if !self.in_tree {
+            self.point.solve(
+                &mut sa,
+                &mut sb,
+                self.point_softness,
+                ctx.joint_max_correction_speed,
+                use_bias,
+            );
+        }
         store_pair(states, self.state_a, self.state_b, &sa, &sb);
     }
 

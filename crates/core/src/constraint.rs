@@ -92,6 +92,14 @@ pub struct StepContext {
     /// `≥ 1`), see
     /// [`SolverSettings::joint_mass_ratio_cap`](crate::solver::SolverSettings::joint_mass_ratio_cap).
     pub joint_mass_ratio_cap: Real,
+    /// Joints forming a tree get their point rows solved directly (false in
+    /// the PGS baseline), see
+    /// [`SolverSettings::direct_joints`](crate::solver::SolverSettings::direct_joints).
+    pub direct_joints: bool,
+    /// Softness of the point rows solved directly.
+    pub direct_joint_softness: Softness,
+    /// Largest correction speed of a directly solved joint, m/s (usual 5).
+    pub direct_joint_max_correction_speed: Real,
 }
 
 /// One body's part of one Jacobian row.

@@ -73,6 +73,8 @@ pub struct World {
     settings: SolverSettings,
     bodies: BodySet,
     revolute: Vec<RevoluteJoint>,
+    /// The joint forest of the last step (direct point-row solve).
+    joint_forest: janus2d_constraints::JointForest,
     revolute_handles: Vec<JointHandle>,
     /// Joint handle slots → index into `revolute`.
     joint_slots: janus2d_core::slots::Slots<u32>,
@@ -118,6 +120,7 @@ impl World {
             pending_sleep: Vec::new(),
             bodies,
             revolute: Vec::new(),
+            joint_forest: Default::default(),
             revolute_handles: Vec::new(),
             joint_slots: janus2d_core::slots::Slots::default(),
             events: StepEvents::default(),
@@ -912,15 +915,19 @@ impl World {
         }
         // No restitution anywhere: no restitution pass.
         ctx.restitution = has_shapes && self.collision.counters.restitution_contacts > 0;
+        let mut revolute = janus2d_constraints::RevoluteBatch {
+            joints: &mut self.revolute,
+            forest: &mut self.joint_forest,
+        };
         #[cfg(feature = "portals")]
         let mut batches: [&mut dyn ConstraintBatch; 3] = [
-            &mut self.revolute,
+            &mut revolute,
             &mut self.contact_constraints,
             &mut self.portals.constraints,
         ];
         #[cfg(not(feature = "portals"))]
         let mut batches: [&mut dyn ConstraintBatch; 2] =
-            [&mut self.revolute, &mut self.contact_constraints];
+            [&mut revolute, &mut self.contact_constraints];
         let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
         lap();
         if has_shapes {
@@ -1052,6 +1059,8 @@ fn validate_settings(s: &SolverSettings) -> Result<(), WorldError> {
         s.restitution_threshold,
         s.contact_mass_ratio_cap,
         s.joint_mass_ratio_cap,
+        s.direct_joint_hertz,
+        s.direct_joint_max_correction_speed,
     ];
     if reals.iter().any(|x| x.is_nan()) {
         return Err(WorldError::NonFinite("solver settings"));

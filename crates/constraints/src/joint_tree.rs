@@ -1,0 +1,476 @@
+//! Direct solve of the joints' point rows where the joints form a tree.
+//!
+//! Gauss–Seidel moves information one joint per iteration and builds a soft
+//! joint's spring on the *light* body's effective mass, so a heavy load on a
+//! chain of light links (the "ball and chain", 670:1) stretches every joint
+//! by about `F K / ω²`. Where the joints form a tree, the point rows of the
+//! whole tree can instead be solved exactly in time linear in its size
+//! (the idea of Baraff, *Linear-time dynamics using Lagrange multipliers*,
+//! 1996), and an exact solve stays stable at any stiffness.
+//!
+//! # Derivation
+//!
+//! Unknowns: the velocity change `Δv_i = (Δv_x, Δv_y, Δω)` of every moving
+//! body in the tree and the impulse change `Δλ_j` (2 rows) of every joint.
+//! With `J_ji` the 2×3 block of joint `j` on body `i`
+//!
+//! ```text
+//! J_jb = [ 1 0 −r_b.y ]      J_ja = −[ 1 0 −r_a.y ]      (Ċ = v_b + ω_b × r_b − v_a − ω_a × r_a)
+//!        [ 0 1  r_b.x ]              [ 0 1  r_a.x ]
+//! ```
+//!
+//! the soft rows of [`Softness`](janus2d_core::softness::Softness) solved
+//! to convergence are
+//!
+//! ```text
+//! M_i Δv_i = Σ_j J_jiᵀ Δλ_j                                  (bodies)
+//! Σ_i J_ji Δv_i + Γ_j Δλ_j = −(Ċ_j + β C_j + Γ_j λ_j)        (joints, with bias)
+//! Σ_i J_ji Δv_i + Γ_j Δλ_j = −Ċ_j                            (joints, relax)
+//! Γ_j = K_j / a2,   K_j = Σ_i J_ji M_i⁻¹ J_jiᵀ,   a2 = mass_scale / impulse_scale
+//! ```
+//!
+//! (for one joint alone this is exactly the soft row `Δλ = −s_m K⁻¹(Ċ + βC) −
+//! s_i λ`). With `μ_j = −Δλ_j` the system is symmetric:
+//!
+//! ```text
+//! H x = b,   H = [ M   Jᵀ ]    x = [ Δv ]    b = [ 0 ]
+//!                [ J  −Γ  ]        [ μ  ]        [ r ]
+//! ```
+//!
+//! The graph of `H` has a node per moving body and per joint and an edge per
+//! (joint, body) pair; static and kinematic bodies are not nodes (a joint to
+//! one has a single edge). When the joints form a forest, so does this
+//! graph, and block elimination from the leaves up creates no fill:
+//!
+//! ```text
+//!           body ── joint ── body ── joint ── body      eliminate leaves first:
+//!  root ─┤                                              D_k  = H_kk − Σ_children L_c E_cᵀ
+//!           joint (to a static pin)                     L_k  = E_k D_k⁻¹   (E_k = H_parent,k)
+//!                                                       b_p −= L_k b_k
+//!  back substitution, root first:   x_k = D_k⁻¹ b_k − L_kᵀ x_parent
+//! ```
+//!
+//! Body pivots stay positive definite and joint pivots negative definite,
+//! so the 3×3 block inverses need no pivoting. A joint block has 2 rows; it
+//! is padded to 3×3 with `−1` on the unused diagonal. A body that cannot
+//! translate (or rotate) gets the placeholder mass 1 on that axis and a zero
+//! Jacobian column, so its `Δv` there is exactly zero.
+//!
+//! Only joint components without a loop are solved directly (found by
+//! union–find over the moving bodies; a static, kinematic or sleeping body
+//! is a fixed end, so a bridge pinned at both ends is still a tree). A
+//! component with a loop (a joint grid, a cloth) stays wholly iterative:
+//! mixing a stiff exact tree with soft Gauss–Seidel rows that close its loops
+//! measured unstable (the 40×40 joint grid diverged at 240 Hz). Every
+//! joint's angle rows (springs, motors, limits) stay iterative too; the tree
+//! solve runs after them in the same batch, a block Gauss–Seidel with one
+//! exact block.
+
+use janus2d_core::body::BodySet;
+use janus2d_core::body::BodyState;
+use janus2d_core::constraint::{ConstraintBatch, StepContext};
+use janus2d_core::math::{Matrix3, PIVOT_TOLERANCE, Real, Vec2, Vec3, cross_sv};
+
+use crate::parts::clamp_length;
+use crate::revolute::RevoluteJoint;
+
+const NONE: u32 = u32::MAX;
+
+/// One node of the elimination tree: a moving body or a joint.
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    /// Body: its state index. Joint: its index in the joint slice.
+    index: u32,
+    /// Parent node (`NONE` for a root). Parents come before children.
+    parent: u32,
+    /// True for a joint node.
+    is_joint: bool,
+    /// Which side of the joint the body is: +1 for body b, −1 for body a.
+    /// A body node: its side in its parent joint. A joint node: the side of
+    /// its parent body.
+    side: Real,
+}
+
+/// The joint forest of one step and the scratch space of its solve.
+///
+/// Built in `prepare` from the joints' state indices (so sleeping, static
+/// and kinematic bodies are the fixed ends), solved in every solve and relax
+/// iteration. Deterministic: joints are visited in storage order.
+#[derive(Clone, Debug, Default)]
+pub struct JointForest {
+    /// Nodes, parents first (breadth-first from each root).
+    nodes: Vec<Node>,
+    /// Per node: the pivot `D_k` while eliminating, then `D_k⁻¹`.
+    d: Vec<Matrix3>,
+    /// Per node: `L_k = E_k D_k⁻¹`.
+    l: Vec<Matrix3>,
+    /// Per node: the right-hand side, then the solution.
+    b: Vec<Vec3>,
+    /// Per joint node: the arms `r_a`, `r_b` of this iteration.
+    arms: Vec<(Vec2, Vec2)>,
+    // Build scratch.
+    union: Vec<u32>,
+    cyclic: Vec<bool>,
+    adjacency_start: Vec<u32>,
+    adjacency: Vec<u32>,
+    visited: Vec<bool>,
+    tree_joints: Vec<u32>,
+}
+
+fn find(union: &mut [u32], mut i: u32) -> u32 {
+    while union[i as usize] != i {
+        let up = union[union[i as usize] as usize];
+        union[i as usize] = up;
+        i = up;
+    }
+    i
+}
+
+/// A body that the tree moves: dynamic (some inverse mass or inertia).
+#[inline]
+fn is_moving(states: &[BodyState], s: u32) -> bool {
+    s != 0 && {
+        let st = &states[s as usize];
+        st.inv_mass > 0.0 || st.inv_inertia > 0.0
+    }
+}
+
+/// The 2×3 block `J_ji` (rows 0 and 1 of a 3×3) of a joint on one body,
+/// with `side` ±1 and the body's axis masks (`lin`, `ang`: 1 or 0).
+#[inline(always)]
+fn jacobian(side: Real, r: Vec2, lin: Real, ang: Real) -> Matrix3 {
+    let s_l = side * lin;
+    let s_a = side * ang;
+    Matrix3::from_cols(
+        Vec3::new(s_l, 0.0, 0.0),
+        Vec3::new(0.0, s_l, 0.0),
+        Vec3::new(-s_a * r.y, s_a * r.x, 0.0),
+    )
+}
+
+/// Mass matrix and axis masks of a moving body: `(diag(m, m, I), lin, ang)`
+/// with placeholder 1 on an axis it cannot move along.
+#[inline(always)]
+fn body_mass(st: &BodyState) -> (Matrix3, Real, Real) {
+    let (m, lin) = if st.inv_mass > 0.0 {
+        (1.0 / st.inv_mass, 1.0)
+    } else {
+        (1.0, 0.0)
+    };
+    let (i, ang) = if st.inv_inertia > 0.0 {
+        (1.0 / st.inv_inertia, 1.0)
+    } else {
+        (1.0, 0.0)
+    };
+    (Matrix3::from_diagonal(Vec3::new(m, m, i)), lin, ang)
+}
+
+/// `D⁻¹` of a definite pivot; zero when it is singular or not finite (the
+/// node then takes no impulse this iteration).
+#[inline(always)]
+fn pivot_inverse(d: &Matrix3) -> Matrix3 {
+    let det = d.determinant();
+    let scale = (d.x_axis.x * d.y_axis.y * d.z_axis.z).abs();
+    if !det.is_finite() || det.abs() <= PIVOT_TOLERANCE * scale || det == 0.0 {
+        return Matrix3::ZERO;
+    }
+    d.inverse()
+}
+
+impl JointForest {
+    /// Number of joints whose point rows the last build put in a tree.
+    pub fn tree_joint_count(&self) -> usize {
+        self.tree_joints.len()
+    }
+
+    /// Finds the joint forest among the enabled joints and marks its joints
+    /// (`in_tree`). With `enabled` false every joint stays iterative.
+    pub fn build(&mut self, joints: &mut [RevoluteJoint], states: &[BodyState], enabled: bool) {
+        self.nodes.clear();
+        self.tree_joints.clear();
+        for j in joints.iter_mut() {
+            j.in_tree = false;
+        }
+        if !enabled || joints.is_empty() {
+            return;
+        }
+        let n = states.len();
+        self.union.clear();
+        self.union.extend(0..n as u32);
+        self.adjacency_start.clear();
+        self.adjacency_start.resize(n + 1, 0);
+        // Pass 1: components of moving bodies; mark those with a loop.
+        self.cyclic.clear();
+        self.cyclic.resize(n, false);
+        for j in joints.iter() {
+            let (a, b) = (j.state_a, j.state_b);
+            if !j.enabled || !is_moving(states, a) || !is_moving(states, b) {
+                continue;
+            }
+            let (ra, rb) = (find(&mut self.union, a), find(&mut self.union, b));
+            if ra == rb {
+                self.cyclic[ra as usize] = true;
+            } else {
+                self.union[ra as usize] = rb;
+                self.cyclic[rb as usize] |= self.cyclic[ra as usize];
+            }
+        }
+        // Pass 2: the joints of loop-free components form the forest.
+        for (i, j) in joints.iter_mut().enumerate() {
+            if !j.enabled {
+                continue;
+            }
+            let (a, b) = (j.state_a, j.state_b);
+            let (ma, mb) = (is_moving(states, a), is_moving(states, b));
+            if !ma && !mb {
+                continue;
+            }
+            let root = find(&mut self.union, if ma { a } else { b });
+            if self.cyclic[root as usize] {
+                continue;
+            }
+            j.in_tree = true;
+            self.tree_joints.push(i as u32);
+            if ma {
+                self.adjacency_start[a as usize + 1] += 1;
+            }
+            if mb {
+                self.adjacency_start[b as usize + 1] += 1;
+            }
+        }
+        for s in 0..n {
+            self.adjacency_start[s + 1] += self.adjacency_start[s];
+        }
+        self.adjacency.clear();
+        self.adjacency.resize(self.adjacency_start[n] as usize, 0);
+        {
+            let mut fill: Vec<u32> = self.adjacency_start[..n].to_vec();
+            for &i in &self.tree_joints {
+                let j = &joints[i as usize];
+                for s in [j.state_a, j.state_b] {
+                    if is_moving(states, s) {
+                        self.adjacency[fill[s as usize] as usize] = i;
+                        fill[s as usize] += 1;
+                    }
+                }
+            }
+        }
+        self.visited.clear();
+        self.visited.resize(n, false);
+        for t in 0..self.tree_joints.len() {
+            let j = &joints[self.tree_joints[t] as usize];
+            for root in [j.state_a, j.state_b] {
+                if is_moving(states, root) && !self.visited[root as usize] {
+                    self.grow(joints, states, root);
+                }
+            }
+        }
+        let count = self.nodes.len();
+        self.d.resize(count, Matrix3::ZERO);
+        self.l.resize(count, Matrix3::ZERO);
+        self.b.resize(count, Vec3::ZERO);
+        self.arms.resize(count, (Vec2::ZERO, Vec2::ZERO));
+    }
+
+    /// Breadth-first from `root`, appending nodes parents first.
+    fn grow(&mut self, joints: &[RevoluteJoint], states: &[BodyState], root: u32) {
+        self.visited[root as usize] = true;
+        let mut next = self.nodes.len();
+        self.nodes.push(Node {
+            index: root,
+            parent: NONE,
+            is_joint: false,
+            side: 1.0,
+        });
+        while next < self.nodes.len() {
+            let node = self.nodes[next];
+            let body_node = next as u32;
+            next += 1;
+            if node.is_joint {
+                continue;
+            }
+            let parent_joint = if node.parent == NONE {
+                NONE
+            } else {
+                self.nodes[node.parent as usize].index
+            };
+            let s = node.index;
+            let (lo, hi) = (
+                self.adjacency_start[s as usize] as usize,
+                self.adjacency_start[s as usize + 1] as usize,
+            );
+            for k in lo..hi {
+                let ji = self.adjacency[k];
+                if ji == parent_joint {
+                    continue;
+                }
+                let j = &joints[ji as usize];
+                let (side, other, other_side) = if j.state_b == s {
+                    (1.0, j.state_a, -1.0)
+                } else {
+                    (-1.0, j.state_b, 1.0)
+                };
+                let joint_node = self.nodes.len() as u32;
+                self.nodes.push(Node {
+                    index: ji,
+                    parent: body_node,
+                    is_joint: true,
+                    side,
+                });
+                if is_moving(states, other) && !self.visited[other as usize] {
+                    self.visited[other as usize] = true;
+                    self.nodes.push(Node {
+                        index: other,
+                        parent: joint_node,
+                        is_joint: false,
+                        side: other_side,
+                    });
+                }
+            }
+        }
+    }
+
+    /// One exact solve of every tree's point rows (see the module docs):
+    /// with `use_bias` the soft rows with position feedback, without it the
+    /// relax rows.
+    pub fn solve(
+        &mut self,
+        ctx: &StepContext,
+        joints: &mut [RevoluteJoint],
+        states: &mut [BodyState],
+        use_bias: bool,
+    ) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let softness = ctx.direct_joint_softness;
+        let compliance = if softness.mass_scale > 0.0 {
+            softness.impulse_scale / softness.mass_scale
+        } else {
+            0.0
+        };
+        // Right-hand sides and initial pivots.
+        for (k, node) in self.nodes.iter().enumerate() {
+            if node.is_joint {
+                let j = &joints[node.index as usize];
+                let (sa, sb) = (&states[j.state_a as usize], &states[j.state_b as usize]);
+                let (r_a, r_b, c) = j.point.arms(sa, sb);
+                let c_dot = (sb.v + cross_sv(sb.w, r_b)) - (sa.v + cross_sv(sa.w, r_a));
+                let (k11, k12, k22) = crate::parts::PointPart::effective_mass(sa, sb, r_a, r_b);
+                let gamma = Matrix3::from_cols(
+                    Vec3::new(k11, k12, 0.0) * compliance,
+                    Vec3::new(k12, k22, 0.0) * compliance,
+                    Vec3::new(0.0, 0.0, 1.0),
+                );
+                let rhs = if use_bias {
+                    let bias = clamp_length(
+                        softness.bias_rate * c,
+                        ctx.direct_joint_max_correction_speed,
+                    );
+                    let held = Vec2::new(
+                        k11 * j.point.impulse.x + k12 * j.point.impulse.y,
+                        k12 * j.point.impulse.x + k22 * j.point.impulse.y,
+                    ) * compliance;
+                    -(c_dot + bias + held)
+                } else {
+                    -c_dot
+                };
+                self.arms[k] = (r_a, r_b);
+                self.d[k] = -gamma;
+                self.b[k] = Vec3::new(rhs.x, rhs.y, 0.0);
+            } else {
+                self.d[k] = body_mass(&states[node.index as usize]).0;
+                self.b[k] = Vec3::ZERO;
+            }
+        }
+        // Eliminate leaves first.
+        for k in (0..self.nodes.len()).rev() {
+            let node = self.nodes[k];
+            let d_inv = pivot_inverse(&self.d[k]);
+            self.d[k] = d_inv;
+            if node.parent == NONE {
+                continue;
+            }
+            let p = node.parent as usize;
+            // E_k = H_parent,k.
+            let e = if node.is_joint {
+                let (lin, ang) = {
+                    let (_, lin, ang) = body_mass(&states[self.nodes[p].index as usize]);
+                    (lin, ang)
+                };
+                let (r_a, r_b) = self.arms[k];
+                let r = if node.side > 0.0 { r_b } else { r_a };
+                jacobian(node.side, r, lin, ang).transpose()
+            } else {
+                let (_, lin, ang) = body_mass(&states[node.index as usize]);
+                let (r_a, r_b) = self.arms[p];
+                let r = if node.side > 0.0 { r_b } else { r_a };
+                jacobian(node.side, r, lin, ang)
+            };
+            let l = e * d_inv;
+            self.l[k] = l;
+            self.d[p] -= l * e.transpose();
+            let b_k = self.b[k];
+            self.b[p] -= l * b_k;
+        }
+        // Back substitution, parents first.
+        for k in 0..self.nodes.len() {
+            let node = self.nodes[k];
+            let mut x = self.d[k] * self.b[k];
+            if node.parent != NONE {
+                x -= self.l[k].transpose() * self.b[node.parent as usize];
+            }
+            self.b[k] = x;
+        }
+        // Apply: bodies take Δv, joints accumulate Δλ = −μ.
+        for (k, node) in self.nodes.iter().enumerate() {
+            let x = self.b[k];
+            if node.is_joint {
+                joints[node.index as usize].point.impulse -= Vec2::new(x.x, x.y);
+            } else {
+                let st = &mut states[node.index as usize];
+                st.v += Vec2::new(x.x, x.y);
+                st.w += x.z;
+            }
+        }
+    }
+}
+
+/// The revolute joints of a world and their forest, driven by the solver as
+/// one batch: the iterative rows first, then the direct tree solve.
+pub struct RevoluteBatch<'a> {
+    /// The joints, in storage order.
+    pub joints: &'a mut Vec<RevoluteJoint>,
+    /// The forest found at `prepare`.
+    pub forest: &'a mut JointForest,
+}
+
+impl ConstraintBatch for RevoluteBatch<'_> {
+    fn count(&self) -> usize {
+        self.joints.len()
+    }
+    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
+        self.joints.prepare(ctx, bodies);
+        self.forest
+            .build(self.joints, &bodies.states, ctx.direct_joints);
+    }
+    fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+        self.joints.warm_start(ctx, states);
+    }
+    fn solve(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+    ) {
+        self.joints.solve(ctx, states, use_bias, reverse);
+        self.forest.solve(ctx, self.joints, states, use_bias);
+    }
+    fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+        self.joints.apply_restitution(ctx, states);
+    }
+    fn store_impulses(&mut self) {
+        self.joints.store_impulses();
+    }
+}
