@@ -24,24 +24,6 @@ pub type Vec2 = glam::Vec2;
 #[cfg(feature = "f64")]
 pub type Vec2 = glam::DVec2;
 
-/// A 3-vector in the engine's precision (`glam::Vec3` / `glam::DVec3`):
-/// the velocity `(v_x, v_y, ω)` of one body in the direct joint solve.
-#[cfg(not(feature = "f64"))]
-pub type Vec3 = glam::Vec3;
-/// A 3-vector in the engine's precision (`glam::Vec3` / `glam::DVec3`):
-/// the velocity `(v_x, v_y, ω)` of one body in the direct joint solve.
-#[cfg(feature = "f64")]
-pub type Vec3 = glam::DVec3;
-
-/// A 3×3 matrix in the engine's precision (`glam::Mat3` / `glam::DMat3`,
-/// column-major): the blocks of the direct joint solve.
-#[cfg(not(feature = "f64"))]
-pub type Matrix3 = glam::Mat3;
-/// A 3×3 matrix in the engine's precision (`glam::Mat3` / `glam::DMat3`,
-/// column-major): the blocks of the direct joint solve.
-#[cfg(feature = "f64")]
-pub type Matrix3 = glam::DMat3;
-
 /// π in the engine's precision.
 #[cfg(not(feature = "f64"))]
 pub const PI: Real = std::f32::consts::PI;

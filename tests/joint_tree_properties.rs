@@ -1,0 +1,278 @@
+//! Property tests of the direct joint-tree solve
+//! (`janus2d_constraints::joint_tree`): on random trees of revolute joints
+//! (2–10 dynamic bodies, each hinged to an earlier one or to a static pin,
+//! some also pinned a second time; masses and inertias in [0.1, 1e3]) one
+//! solve
+//!
+//! - satisfies every joint's soft row exactly: `J v' + β C + Γ Δλ = 0`
+//!   (with bias) or `J v' + Γ Δλ = 0` (relax), `Γ = K / a2`;
+//! - changes the bodies' total linear momentum by exactly the impulses the
+//!   static pin takes.
+//!
+//! At least 256 cases each, f32 and f64. Bounds: the residual is
+//! `8 n ε s (1 + a2)` of the size of the velocity terms, with `n` joints,
+//! `s` the spread (max / min) of the bodies' masses and inertias and
+//! `1 + a2` the softness's regularisation, which together bound the
+//! system's condition (the elimination runs in f64 in both builds, so the
+//! f32 build keeps a wide margin); momentum is `64 n ε` of the largest
+//! `m (|v| + |Δv|)`, since every impulse is applied equal and opposite
+//! through its joint. `JANUS2D_REPORT=1` prints the
+//! worst error as a fraction of its bound.
+
+mod portal_support;
+
+use janus2d_constraints::JointForest;
+use janus2d_constraints::revolute::{RevoluteJoint, RevoluteJointDef};
+use janus2d_core::body::{BodyHandle, BodySet, BodyType};
+use janus2d_core::constraint::{Constraint, StepContext};
+use janus2d_core::math::{Real, Vec2};
+use janus2d_core::solver::SolverSettings;
+use portal_support::*;
+use proptest::prelude::*;
+use proptest::test_runner::TestCaseError;
+
+/// One joint of a tree case: its parent (0 = the static pin, k = body k−1)
+/// and its two local anchors.
+#[derive(Clone, Debug)]
+struct Link {
+    parent: usize,
+    anchor_parent: Vec2,
+    anchor_child: Vec2,
+}
+
+#[derive(Clone, Debug)]
+struct TreeCase {
+    bodies: Vec<BodySpec>,
+    links: Vec<Link>,
+    /// Bodies hinged to the pin a second time (index, local anchor).
+    extra_pins: Vec<(usize, Vec2)>,
+    use_bias: bool,
+}
+
+fn tree_case() -> impl Strategy<Value = TreeCase> {
+    (2usize..=10)
+        .prop_flat_map(|n| {
+            let body = body_spec(Just(BodyType::Dynamic))
+                .prop_flat_map(|b| (Just(b), log_uniform(-1.0, 3.0), log_uniform(-1.0, 3.0)));
+            let link = (0usize..1000, vec2(1.5), vec2(1.5));
+            (
+                prop::collection::vec(body, n),
+                prop::collection::vec(link, n),
+                prop::collection::vec((0usize..1000, vec2(1.5)), 0..3),
+                any::<bool>(),
+            )
+        })
+        .prop_map(|(bodies, links, extra, use_bias)| {
+            let n = bodies.len();
+            let bodies = bodies
+                .into_iter()
+                .map(|(mut b, m, i)| {
+                    b.mass = m;
+                    b.inertia = i;
+                    b
+                })
+                .collect();
+            let links = links
+                .into_iter()
+                .enumerate()
+                .map(|(k, (p, anchor_parent, anchor_child))| Link {
+                    parent: p % (k + 1),
+                    anchor_parent,
+                    anchor_child,
+                })
+                .collect();
+            let extra_pins = extra.into_iter().map(|(i, a)| (i % n, a)).collect();
+            TreeCase {
+                bodies,
+                links,
+                extra_pins,
+                use_bias,
+            }
+        })
+}
+
+struct Built {
+    set: BodySet,
+    bodies: Vec<BodyHandle>,
+    joints: Vec<RevoluteJoint>,
+    /// Per joint: true when body a is the static pin.
+    pinned: Vec<bool>,
+}
+
+fn build(case: &TreeCase, ctx: &StepContext) -> Built {
+    let mut set = BodySet::new();
+    let pin = BodySpec::fixed(Vec2::new(0.5, -0.5), 0.3).create(&mut set);
+    let bodies: Vec<BodyHandle> = case.bodies.iter().map(|b| b.create(&mut set)).collect();
+    let mut joints = Vec::new();
+    let mut pinned = Vec::new();
+    for (k, link) in case.links.iter().enumerate() {
+        let parent = if link.parent == 0 {
+            pin
+        } else {
+            bodies[link.parent - 1]
+        };
+        let def = RevoluteJointDef::new(parent, bodies[k], link.anchor_parent, link.anchor_child);
+        joints.push(RevoluteJoint::new(def));
+        pinned.push(link.parent == 0);
+    }
+    for &(i, anchor) in &case.extra_pins {
+        let def = RevoluteJointDef::new(pin, bodies[i], Vec2::ZERO, anchor);
+        joints.push(RevoluteJoint::new(def));
+        pinned.push(true);
+    }
+    for j in joints.iter_mut() {
+        j.prepare(ctx, &set);
+    }
+    Built {
+        set,
+        bodies,
+        joints,
+        pinned,
+    }
+}
+
+fn velocity(set: &BodySet, h: BodyHandle) -> (Vec2, Real) {
+    let s = set.solver_body(h).state;
+    (s.v, s.w)
+}
+
+#[test]
+fn tree_solve_satisfies_every_soft_row() {
+    let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
+    let soft = ctx.direct_joint_softness;
+    let compliance = d(soft.impulse_scale / soft.mass_scale);
+    check("tree solve residual", tree_case(), |case| {
+        let mut b = build(&case, &ctx);
+        let mut forest = JointForest::default();
+        forest.build(&mut b.joints, &b.set.states, true);
+        prop_assert_eq!(forest.tree_joint_count(), b.joints.len());
+        let before: Vec<_> = b.joints.iter().map(|j| j.rows(&ctx, &b.set)).collect();
+        // Size of the terms whose rounding enters the residual.
+        let mut scale: f64 = case
+            .bodies
+            .iter()
+            .map(|s| d(s.v.length()) + 4.0 * d(s.w.abs()))
+            .fold(0.0, f64::max);
+        for rows in &before {
+            for i in 0..2 {
+                scale = scale.max(d(rows.row_velocity(i, |h| velocity(&b.set, h))).abs());
+                if case.use_bias {
+                    scale = scale.max(d(soft.bias_rate * rows.rows[i].c).abs());
+                }
+            }
+        }
+        forest.solve(&ctx, &mut b.joints, &mut b.set.states, case.use_bias);
+        let mut worst: f64 = 0.0;
+        for (j, rows) in b.joints.iter().zip(&before) {
+            let after = j.rows(&ctx, &b.set);
+            let lambda = j.linear_impulse();
+            let k = &rows.blocks[0].k;
+            for i in 0..2 {
+                let c_dot = d(after.row_velocity(i, |h| velocity(&b.set, h)));
+                let bias = if case.use_bias {
+                    let c = Vec2::new(rows.rows[0].c, rows.rows[1].c);
+                    let bias = soft.bias_rate * c;
+                    let len = bias.length();
+                    let cap = ctx.direct_joint_max_correction_speed;
+                    let bias = if len > cap { bias * (cap / len) } else { bias };
+                    d(bias[i])
+                } else {
+                    0.0
+                };
+                let held = compliance * (d(k[i][0]) * d(lambda.x) + d(k[i][1]) * d(lambda.y));
+                worst = worst.max((c_dot + bias + held).abs());
+            }
+        }
+        // Rounding in the elimination grows with the spread of the masses
+        // and inertias (the pivots' condition) and the number of joints.
+        let spread = case
+            .bodies
+            .iter()
+            .flat_map(|b| [d(b.mass), d(b.inertia)])
+            .fold((f64::MAX, 0.0f64), |(lo, hi), x| (lo.min(x), hi.max(x)));
+        let n = b.joints.len() as f64;
+        // The regularised system's condition is at most the spread times
+        // (1 + a2): Γ = K / a2 keeps its smallest eigenvalue off zero.
+        let a2 = d(soft.mass_scale / soft.impulse_scale);
+        let bound = 8.0 * n * EPS * (spread.1 / spread.0) * (1.0 + a2) * scale;
+        prop_assert!(worst <= bound, "residual {worst:e} > {bound:e}");
+        Ok(worst / bound)
+    });
+}
+
+#[test]
+fn tree_solve_changes_momentum_only_through_the_pin() {
+    let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
+    check("tree solve momentum", tree_case(), |case| {
+        let mut b = build(&case, &ctx);
+        let v0: Vec<(Vec2, Real)> = b.bodies.iter().map(|h| velocity(&b.set, *h)).collect();
+        let mut forest = JointForest::default();
+        forest.build(&mut b.joints, &b.set.states, true);
+        forest.solve(&ctx, &mut b.joints, &mut b.set.states, case.use_bias);
+        let (mut p, mut scale) = ([0.0f64; 2], 1e-12f64);
+        for (h, (v, _)) in b.bodies.iter().zip(&v0) {
+            let m = d(case.bodies[b.bodies.iter().position(|x| x == h).unwrap()].mass);
+            let dv = velocity(&b.set, *h).0 - *v;
+            p[0] += m * d(dv.x);
+            p[1] += m * d(dv.y);
+            // Rounding of v + Δv: relative to the velocity, not the change.
+            scale = scale.max(m * (d(v.length()) + d(dv.length())));
+        }
+        // The pin is body a of its joints: it takes −λ, the bodies +λ.
+        for (j, &pinned) in b.joints.iter().zip(&b.pinned) {
+            if pinned {
+                p[0] -= d(j.linear_impulse().x);
+                p[1] -= d(j.linear_impulse().y);
+            }
+        }
+        let err = p[0].hypot(p[1]);
+        let bound = 64.0 * EPS * scale * (b.joints.len() as f64);
+        prop_assert!(err <= bound, "momentum error {err:e} > {bound:e}");
+        Ok(err / bound)
+    });
+}
+
+/// A joint that closes a loop between moving bodies leaves the whole
+/// component to Gauss–Seidel; one more pin to a static body does not.
+#[test]
+fn joint_loops_stay_gauss_seidel() -> Result<(), TestCaseError> {
+    let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
+    let spec = |x: Real| BodySpec::dynamic(Vec2::new(x, 0.0), 1.0, 0.1);
+    let case = TreeCase {
+        bodies: vec![spec(1.0), spec(2.0), spec(3.0)],
+        links: vec![
+            Link {
+                parent: 0,
+                anchor_parent: Vec2::ZERO,
+                anchor_child: Vec2::new(-0.5, 0.0),
+            },
+            Link {
+                parent: 1,
+                anchor_parent: Vec2::new(0.5, 0.0),
+                anchor_child: Vec2::new(-0.5, 0.0),
+            },
+            Link {
+                parent: 2,
+                anchor_parent: Vec2::new(0.5, 0.0),
+                anchor_child: Vec2::new(-0.5, 0.0),
+            },
+        ],
+        extra_pins: vec![(2, Vec2::new(0.5, 0.0))],
+        use_bias: true,
+    };
+    let mut b = build(&case, &ctx);
+    let mut forest = JointForest::default();
+    forest.build(&mut b.joints, &b.set.states, true);
+    assert_eq!(forest.tree_joint_count(), 4, "a second pin keeps a tree");
+    // Close a loop: body 3 back to body 1.
+    let extra = RevoluteJointDef::new(b.bodies[2], b.bodies[0], Vec2::ZERO, Vec2::ZERO);
+    let mut loop_joint = RevoluteJoint::new(extra);
+    loop_joint.prepare(&ctx, &b.set);
+    b.joints.push(loop_joint);
+    forest.build(&mut b.joints, &b.set.states, true);
+    assert_eq!(forest.tree_joint_count(), 0);
+    assert!(b.joints.iter().all(|j| !j.in_tree()));
+    forest.build(&mut b.joints, &b.set.states, false);
+    assert_eq!(forest.tree_joint_count(), 0, "switched off");
+    Ok(())
+}
