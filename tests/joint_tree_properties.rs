@@ -276,3 +276,45 @@ fn joint_loops_stay_gauss_seidel() -> Result<(), TestCaseError> {
     assert_eq!(forest.tree_joint_count(), 0, "switched off");
     Ok(())
 }
+
+/// The forest is kept between steps while the joints' ends do not change;
+/// a joint destroyed and made again with the same ends (same storage slot)
+/// must still join the tree, and one that closes a loop must leave it.
+#[test]
+fn forest_follows_joints_made_and_destroyed_between_steps() {
+    use janus2d::prelude::{BodyDef, World, WorldDef};
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let pin = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    let a = world
+        .create_body(&BodyDef::dynamic(Vec2::new(0.5, 0.0)).with_mass(1.0, 0.1))
+        .unwrap();
+    let b = world
+        .create_body(&BodyDef::dynamic(Vec2::new(1.5, 0.0)).with_mass(1.0, 0.1))
+        .unwrap();
+    let half = Vec2::new(0.5, 0.0);
+    let j0 = world
+        .create_revolute_joint(&RevoluteJointDef::new(pin, a, Vec2::ZERO, -half))
+        .unwrap();
+    let j1 = world
+        .create_revolute_joint(&RevoluteJointDef::new(a, b, half, -half))
+        .unwrap();
+    world.step(1.0 / 60.0).unwrap();
+    let in_tree = |w: &World, j| w.revolute_joint(j).unwrap().in_tree();
+    assert!(in_tree(&world, j0) && in_tree(&world, j1));
+    world.destroy_joint(j1).unwrap();
+    let j1 = world
+        .create_revolute_joint(&RevoluteJointDef::new(a, b, half, -half))
+        .unwrap();
+    world.step(1.0 / 60.0).unwrap();
+    assert!(in_tree(&world, j0) && in_tree(&world, j1), "re-made joint");
+    let gap = world.max_joint_gap();
+    let closing = world
+        .create_revolute_joint(&RevoluteJointDef::new(b, a, -half, half))
+        .unwrap();
+    world.step(1.0 / 60.0).unwrap();
+    assert!(!in_tree(&world, j0) && !in_tree(&world, j1) && !in_tree(&world, closing));
+    world.destroy_joint(closing).unwrap();
+    world.step(1.0 / 60.0).unwrap();
+    assert!(in_tree(&world, j0) && in_tree(&world, j1), "loop removed");
+    assert!(gap < 1e-3, "gap {gap}");
+}

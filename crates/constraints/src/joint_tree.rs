@@ -73,7 +73,7 @@
 use glam::{DMat3 as Matrix3, DVec2, DVec3 as Vec3};
 use janus2d_core::body::BodySet;
 use janus2d_core::body::BodyState;
-use janus2d_core::constraint::{ConstraintBatch, StepContext};
+use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
 use janus2d_core::math::{Real, Vec2, cross_sv};
 
 use crate::parts::{apply_pair, clamp_length, load_pair, store_pair};
@@ -113,6 +113,11 @@ pub struct JointForest {
     b: Vec<Vec3>,
     /// Per joint node: the arms `r_a`, `r_b` of this iteration.
     arms: Vec<(Vec2, Vec2)>,
+    /// Per joint: its moving ends this step (see `moving_pair`).
+    pairs: Vec<[u32; 3]>,
+    /// The pairs and switch the forest was last built from.
+    built_pairs: Vec<[u32; 3]>,
+    built_enabled: bool,
     // Build scratch.
     union: Vec<u32>,
     cyclic: Vec<bool>,
@@ -138,6 +143,20 @@ fn is_moving(states: &[BodyState], s: u32) -> bool {
         let st = &states[s as usize];
         st.inv_mass > 0.0 || st.inv_inertia > 0.0
     }
+}
+
+/// A joint's two state indices, 0 for an end the tree does not move
+/// (static, kinematic, sleeping), `[0, 0]` for a disabled joint; and its
+/// `in_tree` flag, so that a joint created since the last build (flag
+/// unset) forces a rebuild even where the ends repeat.
+#[inline]
+fn moving_pair(j: &RevoluteJoint, states: &[BodyState]) -> [u32; 3] {
+    let flag = u32::from(j.in_tree);
+    if !j.enabled {
+        return [0, 0, flag];
+    }
+    let end = |s: u32| if is_moving(states, s) { s } else { 0 };
+    [end(j.state_a), end(j.state_b), flag]
 }
 
 /// The 2×3 block `J_ji` (rows 0 and 1 of a 3×3) of a joint on one body,
@@ -208,6 +227,42 @@ impl JointForest {
     /// Finds the joint forest among the enabled joints and marks its joints
     /// (`in_tree`). With `enabled` false every joint stays iterative.
     pub fn build(&mut self, joints: &mut [RevoluteJoint], states: &[BodyState], enabled: bool) {
+        self.pairs.clear();
+        for j in joints.iter() {
+            self.pairs.push(moving_pair(j, states));
+        }
+        self.update(joints, states.len(), enabled);
+    }
+
+    /// Prepares every enabled joint and finds the forest in the same pass
+    /// over the joints (the batch's `prepare`).
+    pub fn prepare(&mut self, joints: &mut [RevoluteJoint], ctx: &StepContext, bodies: &BodySet) {
+        self.pairs.clear();
+        for j in joints.iter_mut() {
+            if j.enabled {
+                j.prepare(ctx, bodies);
+            }
+            self.pairs.push(moving_pair(j, &bodies.states));
+        }
+        self.update(joints, bodies.states.len(), ctx.direct_joints);
+    }
+
+    /// Rebuilds the forest when the joints' moving ends changed since the
+    /// last build (joints created, destroyed, enabled or disabled, bodies
+    /// woken, put to sleep or re-indexed); otherwise keeps it.
+    fn update(&mut self, joints: &mut [RevoluteJoint], n: usize, enabled: bool) {
+        if enabled == self.built_enabled && self.pairs == self.built_pairs {
+            return;
+        }
+        self.rebuild(joints, n, enabled);
+        self.built_enabled = enabled;
+        self.built_pairs.clone_from(&self.pairs);
+        for (pair, j) in self.built_pairs.iter_mut().zip(joints.iter()) {
+            pair[2] = u32::from(j.in_tree);
+        }
+    }
+
+    fn rebuild(&mut self, joints: &mut [RevoluteJoint], n: usize, enabled: bool) {
         self.nodes.clear();
         self.tree_joints.clear();
         for j in joints.iter_mut() {
@@ -216,7 +271,6 @@ impl JointForest {
         if !enabled || joints.is_empty() {
             return;
         }
-        let n = states.len();
         self.union.clear();
         self.union.extend(0..n as u32);
         self.adjacency_start.clear();
@@ -224,9 +278,8 @@ impl JointForest {
         // Pass 1: components of moving bodies; mark those with a loop.
         self.cyclic.clear();
         self.cyclic.resize(n, false);
-        for j in joints.iter() {
-            let (a, b) = (j.state_a, j.state_b);
-            if !j.enabled || !is_moving(states, a) || !is_moving(states, b) {
+        for &[a, b, _] in &self.pairs {
+            if a == 0 || b == 0 {
                 continue;
             }
             let (ra, rb) = (find(&mut self.union, a), find(&mut self.union, b));
@@ -238,26 +291,20 @@ impl JointForest {
             }
         }
         // Pass 2: the joints of loop-free components form the forest.
-        for (i, j) in joints.iter_mut().enumerate() {
-            if !j.enabled {
+        for (i, &[a, b, _]) in self.pairs.iter().enumerate() {
+            if a == 0 && b == 0 {
                 continue;
             }
-            let (a, b) = (j.state_a, j.state_b);
-            let (ma, mb) = (is_moving(states, a), is_moving(states, b));
-            if !ma && !mb {
-                continue;
-            }
-            let root = find(&mut self.union, if ma { a } else { b });
+            let root = find(&mut self.union, if a != 0 { a } else { b });
             if self.cyclic[root as usize] {
                 continue;
             }
-            j.in_tree = true;
+            joints[i].in_tree = true;
             self.tree_joints.push(i as u32);
-            if ma {
-                self.adjacency_start[a as usize + 1] += 1;
-            }
-            if mb {
-                self.adjacency_start[b as usize + 1] += 1;
+            for s in [a, b] {
+                if s != 0 {
+                    self.adjacency_start[s as usize + 1] += 1;
+                }
             }
         }
         for s in 0..n {
@@ -268,9 +315,8 @@ impl JointForest {
         {
             let mut fill: Vec<u32> = self.adjacency_start[..n].to_vec();
             for &i in &self.tree_joints {
-                let j = &joints[i as usize];
-                for s in [j.state_a, j.state_b] {
-                    if is_moving(states, s) {
+                for &s in &self.pairs[i as usize][..2] {
+                    if s != 0 {
                         self.adjacency[fill[s as usize] as usize] = i;
                         fill[s as usize] += 1;
                     }
@@ -280,10 +326,10 @@ impl JointForest {
         self.visited.clear();
         self.visited.resize(n, false);
         for t in 0..self.tree_joints.len() {
-            let j = &joints[self.tree_joints[t] as usize];
-            for root in [j.state_a, j.state_b] {
-                if is_moving(states, root) && !self.visited[root as usize] {
-                    self.grow(joints, states, root);
+            let [a, b, _] = self.pairs[self.tree_joints[t] as usize];
+            for root in [a, b] {
+                if root != 0 && !self.visited[root as usize] {
+                    self.grow(root);
                 }
             }
         }
@@ -295,7 +341,7 @@ impl JointForest {
     }
 
     /// Breadth-first from `root`, appending nodes parents first.
-    fn grow(&mut self, joints: &[RevoluteJoint], states: &[BodyState], root: u32) {
+    fn grow(&mut self, root: u32) {
         self.visited[root as usize] = true;
         let mut next = self.nodes.len();
         self.nodes.push(Node {
@@ -326,11 +372,11 @@ impl JointForest {
                 if ji == parent_joint {
                     continue;
                 }
-                let j = &joints[ji as usize];
-                let (side, other, other_side) = if j.state_b == s {
-                    (1.0, j.state_a, -1.0)
+                let [a, b, _] = self.pairs[ji as usize];
+                let (side, other, other_side) = if b == s {
+                    (1.0, a, -1.0)
                 } else {
-                    (-1.0, j.state_b, 1.0)
+                    (-1.0, b, 1.0)
                 };
                 let joint_node = self.nodes.len() as u32;
                 self.nodes.push(Node {
@@ -339,7 +385,7 @@ impl JointForest {
                     is_joint: true,
                     side,
                 });
-                if is_moving(states, other) && !self.visited[other as usize] {
+                if other != 0 && !self.visited[other as usize] {
                     self.visited[other as usize] = true;
                     self.nodes.push(Node {
                         index: other,
@@ -479,9 +525,7 @@ impl ConstraintBatch for RevoluteBatch<'_> {
         self.joints.len()
     }
     fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
-        self.joints.prepare(ctx, bodies);
-        self.forest
-            .build(self.joints, &bodies.states, ctx.direct_joints);
+        self.forest.prepare(self.joints, ctx, bodies);
     }
     fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
         self.joints.warm_start(ctx, states);
