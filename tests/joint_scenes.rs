@@ -25,7 +25,7 @@ fn max_speed(world: &World, bodies: &[BodyHandle]) -> Real {
 /// peaks at 273 m/s. What this test holds: every joint is back within 1 cm
 /// before 10 s, and the peak speed beats Box2D's 273 m/s. Measured (f32,
 /// the chain solved directly with its correction capped at 5 m/s per
-/// joint): back at 0.50 s, peak 115 m/s. The 20 m/s goal is not met: the
+/// joint): back at 0.52 s, peak 111 m/s. The 20 m/s goal is not met: the
 /// same chain built *without* stretch already whips its free end to about
 /// 69 m/s under gravity (a physical whip of a 40 m chain released
 /// horizontally), see `unstretched_chain_whip_reference`.

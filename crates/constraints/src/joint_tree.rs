@@ -178,22 +178,29 @@ fn jacobian(side: f64, r: Vec2, lin: f64, ang: f64) -> Matrix3 {
 #[inline(always)]
 fn body_mass(st: &BodyState) -> (Matrix3, f64, f64) {
     let (m, lin) = if st.inv_mass > 0.0 {
-        (1.0 / f64::from(st.inv_mass), 1.0)
+        (1.0 / widen(st.inv_mass), 1.0)
     } else {
         (1.0, 0.0)
     };
     let (i, ang) = if st.inv_inertia > 0.0 {
-        (1.0 / f64::from(st.inv_inertia), 1.0)
+        (1.0 / widen(st.inv_inertia), 1.0)
     } else {
         (1.0, 0.0)
     };
     (Matrix3::from_diagonal(Vec3::new(m, m, i)), lin, ang)
 }
 
+/// Widens a [`Real`] to f64 (a no-op with the `f64` feature).
+#[inline(always)]
+#[allow(clippy::useless_conversion)]
+fn widen(x: Real) -> f64 {
+    f64::from(x)
+}
+
 /// Widens a vector to f64.
 #[inline(always)]
 fn wide(v: Vec2) -> DVec2 {
-    DVec2::new(f64::from(v.x), f64::from(v.y))
+    DVec2::new(widen(v.x), widen(v.y))
 }
 
 /// Rounds an f64 to [`Real`] (a no-op with the `f64` feature).
@@ -413,7 +420,7 @@ impl JointForest {
         }
         let softness = ctx.direct_joint_softness;
         let compliance = if softness.mass_scale > 0.0 {
-            f64::from(softness.impulse_scale) / f64::from(softness.mass_scale)
+            widen(softness.impulse_scale) / widen(softness.mass_scale)
         } else {
             0.0
         };
@@ -425,7 +432,7 @@ impl JointForest {
                 let (r_a, r_b, c) = j.point.arms(sa, sb);
                 let c_dot = (sb.v + cross_sv(sb.w, r_b)) - (sa.v + cross_sv(sa.w, r_a));
                 let (k11, k12, k22) = crate::parts::PointPart::effective_mass(sa, sb, r_a, r_b);
-                let (k11, k12, k22) = (f64::from(k11), f64::from(k12), f64::from(k22));
+                let (k11, k12, k22) = (widen(k11), widen(k12), widen(k22));
                 let gamma = Matrix3::from_cols(
                     Vec3::new(k11, k12, 0.0) * compliance,
                     Vec3::new(k12, k22, 0.0) * compliance,
