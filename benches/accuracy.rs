@@ -317,6 +317,17 @@ fn knobs() -> Vec<Knob> {
             })
             .collect::<Vec<_>>()
     };
+    // A switch: off (0) and on (1).
+    let on_off = |set: &dyn Fn(&mut SolverSettings, bool)| {
+        [(0.0, false), (1.0, true)]
+            .into_iter()
+            .map(|(v, on)| {
+                let mut s = base.clone();
+                set(&mut s, on);
+                (v, if on { "on" } else { "off" }.to_string(), s)
+            })
+            .collect::<Vec<_>>()
+    };
     vec![
         Knob {
             name: "substeps",
@@ -381,16 +392,7 @@ fn knobs() -> Vec<Knob> {
             name: "direct_joints",
             needs: Needs::Joints,
             color: RGBColor(0, 0, 0),
-            values: [(0.0, false), (1.0, true)]
-                .into_iter()
-                .map(|(v, on)| {
-                    let s = SolverSettings {
-                        direct_joints: on,
-                        ..base.clone()
-                    };
-                    (v, if on { "on" } else { "off" }.to_string(), s)
-                })
-                .collect(),
+            values: on_off(&|s, on| s.direct_joints = on),
         },
         Knob {
             name: "direct_joint_hertz",
@@ -404,16 +406,7 @@ fn knobs() -> Vec<Knob> {
             name: "warm_starting",
             needs: Needs::Anything,
             color: RGBColor(127, 127, 127),
-            values: [(0.0, false), (1.0, true)]
-                .into_iter()
-                .map(|(v, on)| {
-                    let s = SolverSettings {
-                        warm_starting: on,
-                        ..base.clone()
-                    };
-                    (v, if on { "on" } else { "off" }.to_string(), s)
-                })
-                .collect(),
+            values: on_off(&|s, on| s.warm_starting = on),
         },
     ]
 }

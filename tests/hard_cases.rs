@@ -414,14 +414,8 @@ fn high_mass_ratio_3_big_box_on_small_boxes_box_ground() {
 /// keeps that figure honest.
 #[test]
 fn ball_and_chain_peak_gap() {
-    let scene = scenes::ball_and_chain(&scenes::shared_settings());
-    let mut world = scene.world;
+    let (world, peak_gap) = run_ball_and_chain(&scenes::shared_settings());
     let bodies: Vec<BodyHandle> = world.bodies().handles().collect();
-    let mut peak_gap: Real = 0.0;
-    for _ in 0..600 {
-        world.step(DT).unwrap();
-        peak_gap = peak_gap.max(world.max_joint_gap());
-    }
     if report() {
         eprintln!("ball and chain: peak joint gap {peak_gap:.4} m");
     }
@@ -442,6 +436,17 @@ fn ball_and_chain_peak_gap() {
     );
 }
 
+/// Runs the ball and chain for 10 s; returns the world and the peak gap.
+fn run_ball_and_chain(def: &WorldDef) -> (World, Real) {
+    let mut world = scenes::ball_and_chain(def).world;
+    let mut peak_gap: Real = 0.0;
+    for _ in 0..600 {
+        world.step(DT).unwrap();
+        peak_gap = peak_gap.max(world.max_joint_gap());
+    }
+    (world, peak_gap)
+}
+
 /// The same scene with every joint left to Gauss–Seidel: the gap the direct
 /// solve removes. Holds the iterative path at Box2D's 0.24 m and shows it
 /// cannot meet 0.1 m (if it ever does, the tree solve's reason to exist
@@ -450,12 +455,7 @@ fn ball_and_chain_peak_gap() {
 fn ball_and_chain_gauss_seidel_reference() {
     let mut def = scenes::shared_settings();
     def.solver.direct_joints = false;
-    let mut world = scenes::ball_and_chain(&def).world;
-    let mut peak_gap: Real = 0.0;
-    for _ in 0..600 {
-        world.step(DT).unwrap();
-        peak_gap = peak_gap.max(world.max_joint_gap());
-    }
+    let (world, peak_gap) = run_ball_and_chain(&def);
     if report() {
         eprintln!("ball and chain, Gauss–Seidel joints: peak joint gap {peak_gap:.4} m");
     }
