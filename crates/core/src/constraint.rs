@@ -65,7 +65,8 @@ pub struct StepContext {
     pub static_softness: Softness,
     /// Maximum contact push-out speed, m/s (usual 3).
     pub contact_push_max_velocity: Real,
-    /// Maximum joint correction speed, m/s (usual 5 m/s; `Real::MAX` disables).
+    /// Maximum correction speed of a Gauss–Seidel joint, m/s (usual
+    /// `Real::MAX`: no cap).
     pub joint_max_correction_speed: Real,
     /// Restitution is applied only above this approach speed, m/s (usual 1).
     pub restitution_threshold: Real,

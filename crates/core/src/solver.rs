@@ -67,8 +67,10 @@ pub struct SolverSettings {
     pub joint_hertz: Real,
     /// Joint damping ratio (usual 2).
     pub joint_damping_ratio: Real,
-    /// Maximum joint correction speed, m/s (usual 5): large initial joint
-    /// errors recover at this speed at most.
+    /// Maximum correction speed of a joint solved by Gauss–Seidel, m/s
+    /// (usual `Real::MAX`, no cap: 5 m/s raised the 40×40 joint grid's peak
+    /// gap from 0.17 to 0.32 m). Joint trees use
+    /// `direct_joint_max_correction_speed` instead.
     pub joint_max_correction_speed: Real,
     /// Restitution threshold, m/s (usual 1).
     pub restitution_threshold: Real,
