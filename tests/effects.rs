@@ -126,6 +126,38 @@ fn zero_gravity_means_no_gravity_work_and_no_joints_no_joint_rows() {
     heavy.step(DT).unwrap();
     assert_eq!(heavy.counters().gravity_bodies, 5);
     assert_eq!(heavy.counters().joint_rows, 2);
+    assert_eq!(heavy.counters().direct_joint_rows, 2, "a one-joint tree");
+    assert_eq!(world.counters().direct_joint_rows, 0, "no joints, no tree");
+}
+
+#[test]
+fn joint_loops_and_the_switch_leave_the_tree_solve_idle() {
+    let mut settings = WorldDef::default();
+    settings.sleep.enabled = false;
+    let (mut world, bodies) = boxes_on_ground(settings.clone(), 0.0);
+    let hinge = |a, b| RevoluteJointDef::new(a, b, Vec2::new(0.0, 0.5), Vec2::new(0.0, -0.5));
+    world
+        .create_revolute_joint(&hinge(bodies[0], bodies[1]))
+        .unwrap();
+    world
+        .create_revolute_joint(&hinge(bodies[1], bodies[2]))
+        .unwrap();
+    world.step(DT).unwrap();
+    assert_eq!(world.counters().direct_joint_rows, 4);
+    // Closing a loop sends the whole component back to Gauss–Seidel.
+    world
+        .create_revolute_joint(&hinge(bodies[2], bodies[0]))
+        .unwrap();
+    world.step(DT).unwrap();
+    assert_eq!(world.counters().direct_joint_rows, 0);
+    assert_eq!(world.counters().joint_rows, 6);
+    settings.solver.direct_joints = false;
+    let (mut off, bodies) = boxes_on_ground(settings, 0.0);
+    off.create_revolute_joint(&hinge(bodies[0], bodies[1]))
+        .unwrap();
+    off.step(DT).unwrap();
+    assert_eq!(off.counters().direct_joint_rows, 0);
+    assert_eq!(off.counters().joint_rows, 2);
 }
 
 #[test]

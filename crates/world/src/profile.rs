@@ -49,6 +49,9 @@ pub struct StepCounters {
     pub contact_rows: usize,
     /// Joint rows (revolute: 2 point rows plus limit, motor, spring rows).
     pub joint_rows: usize,
+    /// Joint point rows solved directly, as joint trees (0: the tree solve
+    /// did nothing this step).
+    pub direct_joint_rows: usize,
     /// Portal constraint rows (3 per crossing).
     pub portal_rows: usize,
     /// The portal stage ran (the world has a portal pair).

@@ -971,6 +971,7 @@ impl World {
                     + j.def.enable_spring as usize
             })
             .sum();
+        counters.direct_joint_rows = 2 * self.joint_forest.tree_joint_count();
         counters.portal_stage_ran = has_portals;
         #[cfg(feature = "portals")]
         {
