@@ -73,7 +73,7 @@
 //! updated in [`Tracker::record`] and listed in [`Metrics::columns`].
 
 use janus2d_core::body::{BodyHandle, BodyType};
-use janus2d_core::math::{Real, Vec2};
+use janus2d_core::math::{Real, Vec2, to_f64};
 use janus2d_world::{World, WorldError};
 
 /// What a [`Tracker`] follows and how it judges a collapse.
@@ -157,10 +157,8 @@ impl ExtraMetric for PortalError {
     fn unit(&self) -> &'static str {
         "m"
     }
-    // `Real` is f32 or f64 by feature: the conversion is the identity in f64.
-    #[allow(clippy::useless_conversion)]
     fn measure(&mut self, world: &World) -> Option<f64> {
-        (world.crossing_count() > 0).then(|| f64::from(world.max_portal_error()))
+        (world.crossing_count() > 0).then(|| to_f64(world.max_portal_error()))
     }
 }
 
@@ -189,8 +187,6 @@ impl ExtraMetric for PortalMomentumError {
     fn unit(&self) -> &'static str {
         "1"
     }
-    // `Real` is f32 or f64 by feature: the cast is the identity in f64.
-    #[allow(clippy::unnecessary_cast)]
     fn measure(&mut self, world: &World) -> Option<f64> {
         let mut worst: Option<f64> = None;
         for c in world.portal_constraints() {
@@ -212,7 +208,7 @@ impl ExtraMetric for PortalMomentumError {
                     p
                 }
             };
-            let e = ((p - p0).length() / p0.length().max(Real::MIN_POSITIVE)) as f64;
+            let e = to_f64((p - p0).length() / p0.length().max(Real::MIN_POSITIVE));
             worst = Some(worst.map_or(e, |w: f64| w.max(e)));
         }
         worst
@@ -410,17 +406,17 @@ impl Tracker {
     /// Records the state after a step of length `dt` (s) that the caller
     /// took (so the caller can time the step alone).
     pub fn record(&mut self, world: &World, dt: Real) -> Result<(), WorldError> {
-        let dt = wide(dt);
+        let dt = to_f64(dt);
         let m = &mut self.metrics;
         m.steps += 1;
         m.time = m.steps as f64 * dt;
         // Half a step of tolerance: the step ending at `late_from` itself is
         // not late, whatever the rounding of `steps · dt`.
-        let late = m.time > wide(self.config.late_from) + 0.5 * dt;
+        let late = m.time > to_f64(self.config.late_from) + 0.5 * dt;
 
-        let pen = wide(world.max_penetration());
+        let pen = to_f64(world.max_penetration());
         m.max_penetration = m.max_penetration.max(pen);
-        let gap = wide(world.max_joint_gap());
+        let gap = to_f64(world.max_joint_gap());
         m.max_joint_gap = m.max_joint_gap.max(gap);
 
         let mut kinetic = 0.0;
@@ -444,15 +440,15 @@ impl Tracker {
         let mut probe_speed = 0.0;
         if let (Some(probe), Some(start)) = (self.config.probe, self.start) {
             let p = world.position(probe)?;
-            let sink = wide(start.y - p.y);
-            let drift = wide(p.x - start.x);
+            let sink = to_f64(start.y - p.y);
+            let drift = to_f64(p.x - start.x);
             m.final_sink = sink;
             m.final_drift = drift;
             m.max_sink = m.max_sink.max(sink);
             m.max_drift = m.max_drift.max(drift.abs());
-            probe_speed = wide(world.linear_velocity(probe)?.length());
+            probe_speed = to_f64(world.linear_velocity(probe)?.length());
             if let Some(rest) = self.rest {
-                let checked = m.time > wide(self.config.collapse_grace) + 0.5 * dt;
+                let checked = m.time > to_f64(self.config.collapse_grace) + 0.5 * dt;
                 let d = p - rest;
                 let half = self.config.collapse_half_extents;
                 let outside = !(d.x.abs() <= half.x && d.y.abs() <= half.y);
@@ -487,13 +483,6 @@ impl Tracker {
     }
 }
 
-/// `x` as `f64`, in both the f32 and the f64 build (where it is a no-op).
-#[inline]
-#[allow(clippy::useless_conversion)]
-fn wide(x: Real) -> f64 {
-    f64::from(x)
-}
-
 /// One dynamic body's contribution, read through the public API.
 struct BodyEnergy {
     mass: f64,
@@ -526,14 +515,14 @@ fn for_each_dynamic(world: &World, mut f: impl FnMut(&BodyEnergy)) {
             continue;
         };
         let scale = world.bodies().sim(h).map_or(1.0, |s| s.gravity_scale);
-        let mass = wide(mass);
-        let height = wide(g.x) * wide(c.x) + wide(g.y) * wide(c.y);
+        let mass = to_f64(mass);
+        let height = to_f64(g.x) * to_f64(c.x) + to_f64(g.y) * to_f64(c.y);
         f(&BodyEnergy {
             mass,
-            inertia: wide(inertia),
-            speed: wide(v.length()),
-            angular_speed: wide(w),
-            potential: -mass * wide(scale) * height,
+            inertia: to_f64(inertia),
+            speed: to_f64(v.length()),
+            angular_speed: to_f64(w),
+            potential: -mass * to_f64(scale) * height,
         });
     }
 }

@@ -14,9 +14,8 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, TestCaseError, TestError, TestRunner};
 
 /// Widens to f64 (identity under the `f64` feature).
-#[allow(clippy::useless_conversion)] // `Real` is f64 with the feature
 pub fn d(x: Real) -> f64 {
-    f64::from(x)
+    janus2d_core::math::to_f64(x)
 }
 
 /// A 2D vector widened to f64.
@@ -452,7 +451,7 @@ pub fn portal_case(
 }
 
 /// Machine epsilon of `Real`, as f64.
-#[allow(clippy::unnecessary_cast)] // `Real` is f64 with the feature
+#[allow(clippy::unnecessary_cast)] // `Real` is f64 with the feature (a const: no fn call)
 pub const EPS: f64 = EPSILON as f64;
 
 pub fn report() -> bool {

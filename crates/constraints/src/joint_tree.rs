@@ -52,7 +52,7 @@
 //!
 //! Body pivots stay positive definite and joint pivots negative definite,
 //! so the 3×3 block inverses need no pivoting. The elimination runs in f64
-//! whatever [`Real`] is: the pivots of a 670:1 chain cost about four digits,
+//! whatever [`Real`](janus2d_core::math::Real) is: the pivots of a 670:1 chain cost about four digits,
 //! which f32 does not have to spare (measured: 3e-3 relative residual in
 //! f32 arithmetic at a mass spread of 1e4, 1e-11 in f64), and scalar f64 costs
 //! the same as f32 here. A joint block has 2 rows; it
@@ -74,7 +74,8 @@ use glam::{DMat3 as Matrix3, DVec2, DVec3 as Vec3};
 use janus2d_core::body::BodySet;
 use janus2d_core::body::BodyState;
 use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
-use janus2d_core::math::{Real, Vec2, cross_sv};
+use janus2d_core::math::{Vec2, cross_sv, from_f64, to_f64};
+use janus2d_core::union_find::{find, union};
 
 use crate::parts::{apply_pair, clamp_length, load_pair, store_pair};
 use crate::revolute::RevoluteJoint;
@@ -127,15 +128,6 @@ pub struct JointForest {
     tree_joints: Vec<u32>,
 }
 
-fn find(union: &mut [u32], mut i: u32) -> u32 {
-    while union[i as usize] != i {
-        let up = union[union[i as usize] as usize];
-        union[i as usize] = up;
-        i = up;
-    }
-    i
-}
-
 /// A body that the tree moves: dynamic (some inverse mass or inertia).
 #[inline]
 fn is_moving(states: &[BodyState], s: u32) -> bool {
@@ -178,36 +170,22 @@ fn jacobian(side: f64, r: Vec2, lin: f64, ang: f64) -> Matrix3 {
 #[inline(always)]
 fn body_mass(st: &BodyState) -> (Matrix3, f64, f64) {
     let (m, lin) = if st.inv_mass > 0.0 {
-        (1.0 / widen(st.inv_mass), 1.0)
+        (1.0 / to_f64(st.inv_mass), 1.0)
     } else {
         (1.0, 0.0)
     };
     let (i, ang) = if st.inv_inertia > 0.0 {
-        (1.0 / widen(st.inv_inertia), 1.0)
+        (1.0 / to_f64(st.inv_inertia), 1.0)
     } else {
         (1.0, 0.0)
     };
     (Matrix3::from_diagonal(Vec3::new(m, m, i)), lin, ang)
 }
 
-/// Widens a [`Real`] to f64 (a no-op with the `f64` feature).
-#[inline(always)]
-#[allow(clippy::useless_conversion)]
-fn widen(x: Real) -> f64 {
-    f64::from(x)
-}
-
 /// Widens a vector to f64.
 #[inline(always)]
 fn wide(v: Vec2) -> DVec2 {
-    DVec2::new(widen(v.x), widen(v.y))
-}
-
-/// Rounds an f64 to [`Real`] (a no-op with the `f64` feature).
-#[inline(always)]
-#[allow(clippy::unnecessary_cast)]
-fn narrow(x: f64) -> Real {
-    x as Real
+    DVec2::new(to_f64(v.x), to_f64(v.y))
 }
 
 /// Relative size below which a pivot's determinant counts as zero.
@@ -289,12 +267,14 @@ impl JointForest {
             if a == 0 || b == 0 {
                 continue;
             }
-            let (ra, rb) = (find(&mut self.union, a), find(&mut self.union, b));
-            if ra == rb {
-                self.cyclic[ra as usize] = true;
-            } else {
-                self.union[ra as usize] = rb;
-                self.cyclic[rb as usize] |= self.cyclic[ra as usize];
+            match union(&mut self.union, a, b) {
+                None => {
+                    let root = find(&mut self.union, a);
+                    self.cyclic[root as usize] = true;
+                }
+                Some((root, absorbed)) => {
+                    self.cyclic[root as usize] |= self.cyclic[absorbed as usize];
+                }
             }
         }
         // Pass 2: the joints of loop-free components form the forest.
@@ -420,7 +400,7 @@ impl JointForest {
         }
         let softness = ctx.direct_joint_softness;
         let compliance = if softness.mass_scale > 0.0 {
-            widen(softness.impulse_scale) / widen(softness.mass_scale)
+            to_f64(softness.impulse_scale) / to_f64(softness.mass_scale)
         } else {
             0.0
         };
@@ -432,7 +412,7 @@ impl JointForest {
                 let (r_a, r_b, c) = j.point.arms(sa, sb);
                 let c_dot = (sb.v + cross_sv(sb.w, r_b)) - (sa.v + cross_sv(sa.w, r_a));
                 let (k11, k12, k22) = crate::parts::PointPart::effective_mass(sa, sb, r_a, r_b);
-                let (k11, k12, k22) = (widen(k11), widen(k12), widen(k22));
+                let (k11, k12, k22) = (to_f64(k11), to_f64(k12), to_f64(k22));
                 let gamma = Matrix3::from_cols(
                     Vec3::new(k11, k12, 0.0) * compliance,
                     Vec3::new(k12, k22, 0.0) * compliance,
@@ -507,7 +487,7 @@ impl JointForest {
                 continue;
             }
             let x = self.b[k];
-            let impulse = -Vec2::new(narrow(x.x), narrow(x.y));
+            let impulse = -Vec2::new(from_f64(x.x), from_f64(x.y));
             let j = &mut joints[node.index as usize];
             j.point.impulse += impulse;
             let (r_a, r_b) = self.arms[k];

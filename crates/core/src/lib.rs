@@ -12,6 +12,7 @@
 //! | [`solver`]     | the soft step and the PGS baseline                          |
 //! | [`geometry`]   | shapes, mass properties, bounding boxes, manifolds          |
 //! | [`slots`]      | generational slots behind handles                           |
+//! | [`union_find`] | union–find over dense indices (islands, joint forests)      |
 //!
 //! See `docs/architecture.md` for the crate graph and the step pipeline.
 
@@ -22,6 +23,7 @@ pub mod math;
 pub mod slots;
 pub mod softness;
 pub mod solver;
+pub mod union_find;
 
 pub use body::{BodyDef, BodyHandle, BodyMass, BodySet, BodyState, BodyType};
 pub use constraint::{Constraint, ConstraintBatch, ConstraintRows, SolverMode, StepContext};

@@ -24,6 +24,21 @@ pub type Vec2 = glam::Vec2;
 #[cfg(feature = "f64")]
 pub type Vec2 = glam::DVec2;
 
+/// `x` as f64 in both builds (the identity with the `f64` feature): for
+/// work that needs the extra digits whatever [`Real`] is, and for reports.
+#[inline(always)]
+#[allow(clippy::useless_conversion)]
+pub fn to_f64(x: Real) -> f64 {
+    f64::from(x)
+}
+
+/// An f64 rounded to [`Real`] (the identity with the `f64` feature).
+#[inline(always)]
+#[allow(clippy::unnecessary_cast)]
+pub fn from_f64(x: f64) -> Real {
+    x as Real
+}
+
 /// π in the engine's precision.
 #[cfg(not(feature = "f64"))]
 pub const PI: Real = std::f32::consts::PI;

@@ -22,6 +22,7 @@
 
 use janus2d_core::body::{BodyHandle, BodyType};
 use janus2d_core::math::Real;
+use janus2d_core::union_find::{find, union};
 
 use crate::world::World;
 
@@ -57,24 +58,6 @@ pub(crate) struct Islands {
     free: Vec<u32>,
     parent: Vec<u32>,
     min_time: Vec<Real>,
-}
-
-fn find(parent: &mut [u32], mut i: u32) -> u32 {
-    while parent[i as usize] != i {
-        let p = parent[i as usize];
-        parent[i as usize] = parent[p as usize];
-        i = p;
-    }
-    i
-}
-
-fn union(parent: &mut [u32], a: u32, b: u32) {
-    let (ra, rb) = (find(parent, a), find(parent, b));
-    if ra != rb {
-        // Smaller index is the root: deterministic.
-        let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
-        parent[hi as usize] = lo;
-    }
 }
 
 impl World {
