@@ -376,13 +376,19 @@ impl Constraint for RevoluteJoint {
             inv_mass: im,
             inv_inertia: ii,
         };
+        // Tree joints' point rows are solved directly, at their own softness.
+        let point_softness = if self.in_tree {
+            ctx.direct_joint_softness
+        } else {
+            ctx.joint_softness
+        };
         let point_row = |axis: Vec2, c: Real, impulse: Real| Row {
             jacobian: smallvec![
                 entry(self.def.body_a, -axis, -cross(r_a, axis), ima, iia),
                 entry(self.def.body_b, axis, cross(r_b, axis), imb, iib),
             ],
             c,
-            softness: ctx.joint_softness,
+            softness: point_softness,
             lower: Real::NEG_INFINITY,
             upper: Real::INFINITY,
             impulse,
