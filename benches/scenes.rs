@@ -1,48 +1,45 @@
-//! Headless benchmark of the standard scenes, timed as Box2D's benchmark
-//! program does: a fresh world per repeat, step 0 untimed, steps 1..N−1 timed
-//! as one block, the minimum over repeats reported.
+//! Headless benchmark of the standard scenes on janus2d alone, timed as
+//! Box2D's benchmark program does (a fresh world per repeat, step 0
+//! untimed, steps 1..N−1 timed as one block, the minimum over repeats),
+//! with the scenes built from the shared descriptions
+//! (`janus2d_scenes::benchmarks`). For Box2D and Rapier in the same run use
+//! the peers benchmark: `cargo run --release --manifest-path
+//! benches/peers/Cargo.toml -- all`.
 //!
 //! ```text
 //! cargo bench --bench scenes -- large_pyramid            # 3 repeats
 //! cargo bench --bench scenes -- all -r 1 --csv           # every scene, CSV
 //! cargo bench --bench scenes -- pyramid20 -s 100         # other step count
-//! cargo bench --bench scenes -- large_pyramid --sleep --warmup 600 -s 120   # settled, asleep
+//! cargo bench --bench scenes -- tumbler --no-sleep --substeps 8
 //! ```
-//!
-//! Put the numbers beside Box2D's from the same run:
-//! `python3 ../shared/anchors/box2d_scenes.py large_pyramid`.
 
-use std::time::Instant;
-
-use janus2d::prelude::*;
-use janus2d::scenes::{self, DT};
+use janus2d_scenes::benchmarks::{self, NAMES};
+use janus2d_scenes::engine::EngineOptions;
+use janus2d_scenes::janus::Janus;
+use janus2d_scenes::run::time_scene;
 
 struct Args {
     scenes: Vec<String>,
-    steps: usize,
+    steps: Option<usize>,
     repeats: usize,
     csv: bool,
     substeps: Option<u32>,
     sleep: Option<bool>,
-    warmup: usize,
 }
 
 fn parse_args() -> Args {
     let mut args = Args {
         scenes: Vec::new(),
-        steps: 0,
+        steps: None,
         repeats: 3,
         csv: false,
         substeps: None,
         sleep: None,
-        warmup: 0,
     };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
         match a.as_str() {
-            "-s" | "--steps" => {
-                args.steps = it.next().and_then(|v| v.parse().ok()).expect("--steps N")
-            }
+            "-s" | "--steps" => args.steps = it.next().and_then(|v| v.parse().ok()),
             "-r" | "--repeats" => {
                 args.repeats = it.next().and_then(|v| v.parse().ok()).expect("--repeats N")
             }
@@ -50,11 +47,8 @@ fn parse_args() -> Args {
             "--csv" => args.csv = true,
             "--sleep" => args.sleep = Some(true),
             "--no-sleep" => args.sleep = Some(false),
-            "--warmup" => args.warmup = it.next().and_then(|v| v.parse().ok()).expect("--warmup N"),
             "--bench" => {}
-            "all" => args
-                .scenes
-                .extend(scenes::NAMES.iter().map(|s| s.to_string())),
+            "all" => args.scenes.extend(NAMES.iter().map(|s| s.to_string())),
             name if !name.starts_with('-') => args.scenes.push(name.to_string()),
             other => panic!("unknown option {other}"),
         }
@@ -67,80 +61,61 @@ fn parse_args() -> Args {
 
 fn main() {
     let args = parse_args();
-    let mut def = WorldDef::default();
-    if let Some(n) = args.substeps {
-        def.solver.substeps = n;
-    }
     if args.csv {
         println!("scene,bodies,contacts,steps,repeats,min_total_ms,ms_per_step");
     } else {
         println!(
-            "janus2d scenes: single thread, dt=1/60, {} substeps",
-            def.solver.substeps
+            "janus2d scenes: single thread, dt=1/60, scene settings (sleep as Box2D's benchmark)"
         );
     }
     for name in &args.scenes {
-        // Sleep as scenes.md says: off except in `tumbler`, `spinner` and `smash`,
-        // unless the command line says otherwise.
-        let mut def = def.clone();
-        def.sleep.enabled = args
-            .sleep
-            .unwrap_or(matches!(name.as_str(), "tumbler" | "spinner" | "smash"));
-        let mut best = f64::MAX;
-        let mut runs = Vec::new();
-        let mut summary = String::new();
-        let mut bodies = 0;
-        let mut contacts = 0;
-        let mut steps = 0;
-        for _ in 0..args.repeats.max(1) {
-            let mut scene =
-                scenes::by_name(name, &def).unwrap_or_else(|| panic!("unknown scene {name}"));
-            steps = if args.steps > 1 {
-                args.steps
-            } else {
-                scene.steps
-            };
-            let start = scene.world.position(scene.probe).unwrap();
-            for _ in 0..args.warmup {
-                scene.world.step(DT).unwrap();
-            }
-            scene.world.step(DT).unwrap();
-            let t0 = Instant::now();
-            for _ in 1..steps {
-                scene.world.step(DT).unwrap();
-            }
-            let ms = t0.elapsed().as_secs_f64() * 1000.0;
-            runs.push(ms);
-            best = best.min(ms);
-            bodies = scene.world.body_count();
-            contacts = scene.world.touching_contact_count();
-            let end = scene.world.position(scene.probe).unwrap();
-            let angle = scene.world.angle(scene.probe).unwrap();
-            summary = format!(
-                "  sanity {name}: bodies={bodies} contacts={contacts} sleeping={} {}: ({:.4}, {:.4}) -> ({:.4}, {:.4}) angle={:.4} rad",
-                scene.world.sleeping_body_count(),
-                scene.probe_label,
-                start.x,
-                start.y,
-                end.x,
-                end.y,
-                angle
-            );
+        let Some(mut desc) = benchmarks::by_name(name) else {
+            eprintln!("unknown scene {name}; known: {}", NAMES.join(", "));
+            std::process::exit(2);
+        };
+        if cfg!(not(feature = "portals")) && !desc.portals.is_empty() {
+            continue;
         }
-        let per_step = best / (steps - 1) as f64;
+        if let Some(n) = args.substeps {
+            desc.settings.substeps = n;
+        }
+        if let Some(s) = args.sleep {
+            desc.settings.sleep = s;
+        }
+        let t = time_scene::<Janus>(&desc, EngineOptions::default(), args.repeats, args.steps)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let s = &t.sanity;
         if args.csv {
             println!(
-                "{name},{bodies},{contacts},{steps},{},{best:.1},{per_step:.3}",
-                args.repeats
+                "{name},{},{},{},{},{:.1},{:.3}",
+                s.bodies,
+                s.touching,
+                t.timed_steps + 1,
+                args.repeats,
+                t.total_ms,
+                t.ms_per_step()
             );
         } else {
-            let runs: Vec<String> = runs.iter().map(|r| format!("{r:.1}")).collect();
             println!(
-                "janus2d {name}: steps={steps} repeats={} min_total_ms={best:.1} ms_per_step={per_step:.3} runs_ms=[{}]",
+                "janus2d {name}: steps={} repeats={} min_total_ms={:.1} ms_per_step={:.3}",
+                t.timed_steps + 1,
                 args.repeats,
-                runs.join(", ")
+                t.total_ms,
+                t.ms_per_step()
             );
-            println!("{summary}");
+            let probe = s.probe.map_or(String::new(), |p| {
+                format!(
+                    " {} ({:.3}, {:.3}) angle {:.3}",
+                    desc.probe_label, p.position.x, p.position.y, p.angle
+                )
+            });
+            println!(
+                "  sanity: bodies={} awake={} touching={}{probe}",
+                s.bodies, s.awake, s.touching
+            );
+            for flag in s.flags(&desc) {
+                println!("  differs from Box2D: {flag}");
+            }
         }
     }
 }

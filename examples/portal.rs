@@ -5,8 +5,8 @@
 //! Run with `cargo run --release --example portal`.
 
 use janus2d::prelude::*;
-use janus2d::scenes::{self, DT};
 use janus2d::world::PortalEvent;
+use janus2d_scenes::scenes::{self, DT};
 
 fn main() -> Result<(), WorldError> {
     let (mut scene, _pair) = scenes::portal_drop(&WorldDef::default());

@@ -26,9 +26,6 @@
 //! assert!(world.position(bob).unwrap().y < -0.5);
 //! ```
 
-pub mod metrics;
-pub mod scenes;
-
 pub use janus2d_constraints as constraints;
 pub use janus2d_core as base;
 pub use janus2d_world as world;

@@ -2,7 +2,7 @@
 //! and the 160-plank bridge (planks need no collision here).
 
 use janus2d::prelude::*;
-use janus2d::scenes;
+use janus2d_scenes::scenes;
 
 const DT: Real = 1.0 / 60.0;
 

@@ -3,8 +3,8 @@
 #![cfg(feature = "portals")]
 
 use janus2d::prelude::*;
-use janus2d::scenes::{self, DT};
 use janus2d::world::{MassModel, PortalDef, PortalEvent, PortalPairDef};
+use janus2d_scenes::scenes::{self, DT};
 
 fn report() -> bool {
     std::env::var("JANUS2D_REPORT").is_ok()

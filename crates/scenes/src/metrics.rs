@@ -7,8 +7,10 @@
 //! after every step; [`Tracker::metrics`] returns the figures so far.
 //!
 //! ```
-//! use janus2d::metrics::{Tracker, TrackerConfig};
-//! use janus2d::prelude::*;
+//! use janus2d_scenes::metrics::{Tracker, TrackerConfig};
+//! use janus2d_core::body::BodyDef;
+//! use janus2d_core::math::Vec2;
+//! use janus2d_world::{World, WorldDef};
 //! let mut world = World::new(WorldDef::default()).unwrap();
 //! let ball = world
 //!     .create_body(&BodyDef::dynamic(Vec2::new(0.0, 10.0)).with_mass(1.0, 0.1))

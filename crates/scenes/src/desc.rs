@@ -1,0 +1,580 @@
+//! Scenes as data: what an engine adapter needs to build and step a scene,
+//! with no engine type in it.
+//!
+//! ```text
+//!  SceneDesc ── settings   gravity, dt, substeps, sleep, softness
+//!            ├─ bodies[]   BodyDesc ── shapes[] ShapeDesc ── Geometry
+//!            ├─ joints[]   RevoluteDesc (indices into bodies[])
+//!            ├─ script     per-step Actions: spawn / despawn a group,
+//!            │             drive a kinematic body to a target
+//!            ├─ probe      the body whose pose the sanity line reports
+//!            ├─ container  where bodies must stay (loop, drum, ring)
+//!            └─ reference  Box2D's figures after the last step
+//! ```
+//!
+//! Every length is in metres, every angle in radians, every mass in kg,
+//! every time in seconds. Values are `f64`; an adapter rounds them to its
+//! engine's scalar once, when it builds.
+
+use glam::DVec2;
+
+/// Static, kinematic or dynamic.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BodyKind {
+    /// Never moves.
+    Static,
+    /// Moves by its velocity, pushes but is not pushed.
+    Kinematic,
+    /// Moved by forces and contacts.
+    Dynamic,
+}
+
+/// Collision filter, as Box2D's: two shapes collide when each one's
+/// category is in the other's mask, unless they share a group index
+/// (positive: always collide, negative: never).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FilterDesc {
+    /// Categories the shape belongs to.
+    pub category: u64,
+    /// Categories it collides with.
+    pub mask: u64,
+    /// Group override (0: none).
+    pub group: i32,
+}
+
+impl Default for FilterDesc {
+    fn default() -> Self {
+        FilterDesc {
+            category: 1,
+            mask: u64::MAX,
+            group: 0,
+        }
+    }
+}
+
+/// A shape's geometry in its body's frame.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Geometry {
+    /// A disc.
+    Circle {
+        /// Centre, m.
+        center: DVec2,
+        /// Radius, m.
+        radius: f64,
+    },
+    /// Two centres and a radius.
+    Capsule {
+        /// First centre, m.
+        a: DVec2,
+        /// Second centre, m.
+        b: DVec2,
+        /// Radius, m.
+        radius: f64,
+    },
+    /// A (possibly rounded, offset and turned) box: each engine's own
+    /// box constructor.
+    Box {
+        /// Half extents of the core, m.
+        half: DVec2,
+        /// Centre in the body frame, m.
+        center: DVec2,
+        /// Turn in the body frame, rad.
+        angle: f64,
+        /// Rounding radius, m (0: sharp).
+        radius: f64,
+    },
+    /// The convex hull of a few points (3 to 8), rounded by `radius`.
+    Hull {
+        /// Points, m (any order).
+        points: Vec<DVec2>,
+        /// Rounding radius, m.
+        radius: f64,
+    },
+    /// A two-sided segment.
+    Segment {
+        /// First end, m.
+        a: DVec2,
+        /// Second end, m.
+        b: DVec2,
+    },
+    /// A closed one-sided chain through `points`: listed clockwise, so
+    /// each segment's colliding side faces the inside of the loop.
+    ChainLoop {
+        /// The loop's points, m.
+        points: Vec<DVec2>,
+    },
+}
+
+/// A shape on a body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShapeDesc {
+    /// Geometry in the body frame.
+    pub geometry: Geometry,
+    /// Density, kg/m².
+    pub density: f64,
+    /// Friction coefficient (mixed as `sqrt(μa μb)`).
+    pub friction: f64,
+    /// Restitution (mixed as `max`).
+    pub restitution: f64,
+    /// Collision filter.
+    pub filter: FilterDesc,
+    /// Box2D's hit events (an engine without them ignores the flag).
+    pub hit_events: bool,
+}
+
+impl ShapeDesc {
+    /// Density 1, friction 0.6, restitution 0, default filter.
+    #[must_use]
+    pub fn new(geometry: Geometry) -> Self {
+        ShapeDesc {
+            geometry,
+            density: 1.0,
+            friction: 0.6,
+            restitution: 0.0,
+            filter: FilterDesc::default(),
+            hit_events: false,
+        }
+    }
+
+    /// The same with another friction.
+    #[must_use]
+    pub fn friction(mut self, friction: f64) -> Self {
+        self.friction = friction;
+        self
+    }
+
+    /// The same with another density.
+    #[must_use]
+    pub fn density(mut self, density: f64) -> Self {
+        self.density = density;
+        self
+    }
+}
+
+/// A body and its shapes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodyDesc {
+    /// Static, kinematic or dynamic.
+    pub kind: BodyKind,
+    /// Origin, m.
+    pub position: DVec2,
+    /// Angle, rad.
+    pub angle: f64,
+    /// Velocity of the origin, m/s.
+    pub linear_velocity: DVec2,
+    /// Angular velocity, rad/s.
+    pub angular_velocity: f64,
+    /// Linear damping, 1/s.
+    pub linear_damping: f64,
+    /// Created awake (false: asleep, as Box2D's `isAwake = false`).
+    pub awake: bool,
+    /// Box2D's per-body sleep threshold, m/s (an engine with one world
+    /// threshold ignores it).
+    pub sleep_threshold: f64,
+    /// Mass and rotational inertia about the centre of mass set directly
+    /// (kg, kg·m²); `None` computes them from the shapes.
+    pub mass: Option<(f64, f64)>,
+    /// Shapes.
+    pub shapes: Vec<ShapeDesc>,
+}
+
+impl BodyDesc {
+    fn of_kind(kind: BodyKind, position: DVec2) -> Self {
+        BodyDesc {
+            kind,
+            position,
+            angle: 0.0,
+            linear_velocity: DVec2::ZERO,
+            angular_velocity: 0.0,
+            linear_damping: 0.0,
+            awake: true,
+            sleep_threshold: 0.05,
+            mass: None,
+            shapes: Vec::new(),
+        }
+    }
+
+    /// A dynamic body at `position`.
+    #[must_use]
+    pub fn dynamic(position: DVec2) -> Self {
+        Self::of_kind(BodyKind::Dynamic, position)
+    }
+
+    /// A static body at `position`.
+    #[must_use]
+    pub fn fixed(position: DVec2) -> Self {
+        Self::of_kind(BodyKind::Static, position)
+    }
+
+    /// A kinematic body at `position`.
+    #[must_use]
+    pub fn kinematic(position: DVec2) -> Self {
+        Self::of_kind(BodyKind::Kinematic, position)
+    }
+
+    /// The same with one more shape.
+    #[must_use]
+    pub fn with(mut self, shape: ShapeDesc) -> Self {
+        self.shapes.push(shape);
+        self
+    }
+}
+
+/// A revolute joint between two bodies of the same list (the scene's
+/// `bodies`, or a spawned group's).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RevoluteDesc {
+    /// Index of body a.
+    pub body_a: usize,
+    /// Index of body b.
+    pub body_b: usize,
+    /// Anchor in a's frame, m.
+    pub local_a: DVec2,
+    /// Anchor in b's frame, m.
+    pub local_b: DVec2,
+    /// `θ_b − θ_a` at joint angle zero, rad.
+    pub reference_angle: f64,
+    /// Angle limits (lower, upper), rad.
+    pub limit: Option<(f64, f64)>,
+    /// Motor (speed rad/s, max torque N·m).
+    pub motor: Option<(f64, f64)>,
+    /// Angular spring to angle 0 (Hz, damping ratio).
+    pub spring: Option<(f64, f64)>,
+    /// Whether the two bodies collide.
+    pub collide_connected: bool,
+}
+
+impl RevoluteDesc {
+    /// A plain hinge.
+    #[must_use]
+    pub fn new(body_a: usize, body_b: usize, local_a: DVec2, local_b: DVec2) -> Self {
+        RevoluteDesc {
+            body_a,
+            body_b,
+            local_a,
+            local_b,
+            reference_angle: 0.0,
+            limit: None,
+            motor: None,
+            spring: None,
+            collide_connected: false,
+        }
+    }
+}
+
+/// World settings a scene runs with.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// Gravity, m/s².
+    pub gravity: DVec2,
+    /// Step, s.
+    pub dt: f64,
+    /// Substeps per step.
+    pub substeps: u32,
+    /// Sleeping on.
+    pub sleep: bool,
+    /// Contact stiffness, Hz.
+    pub contact_hertz: f64,
+    /// Contact damping ratio.
+    pub contact_damping_ratio: f64,
+    /// Contact push-out speed cap, m/s.
+    pub contact_push_max_velocity: f64,
+    /// Joint stiffness, Hz.
+    pub joint_hertz: f64,
+    /// Joint damping ratio.
+    pub joint_damping_ratio: f64,
+}
+
+impl Default for Settings {
+    /// The shared settings: gravity (0, −10), 1/60 s, 4 substeps, sleep
+    /// off, contacts 30 Hz / ζ 10, push-out 3 m/s, joints 60 Hz / ζ 2.
+    fn default() -> Self {
+        Settings {
+            gravity: DVec2::new(0.0, -10.0),
+            dt: 1.0 / 60.0,
+            substeps: 4,
+            sleep: false,
+            contact_hertz: 30.0,
+            contact_damping_ratio: 10.0,
+            contact_push_max_velocity: 3.0,
+            joint_hertz: 60.0,
+            joint_damping_ratio: 2.0,
+        }
+    }
+}
+
+/// One thing a script does before a step.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Action {
+    /// Create a group of bodies and joints (joint indices are into the
+    /// group's own `bodies`). The adapter remembers the group by `id`.
+    Spawn {
+        /// Group id (unique among live groups).
+        id: usize,
+        /// Bodies.
+        bodies: Vec<BodyDesc>,
+        /// Joints between them.
+        joints: Vec<RevoluteDesc>,
+    },
+    /// Destroy every body (and so joint) of a live group.
+    Despawn {
+        /// Group id.
+        id: usize,
+    },
+    /// Drive a kinematic body so that it reaches this pose by the end of
+    /// the step (velocity = (target − current) / dt, as Box2D's
+    /// `b2Body_SetTargetTransform`).
+    Target {
+        /// Index into the scene's bodies.
+        body: usize,
+        /// Target origin, m.
+        position: DVec2,
+        /// Target angle, rad.
+        angle: f64,
+    },
+}
+
+/// Per-step script of a scene.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Script {
+    /// Nothing happens between steps.
+    None,
+    /// Box2D's `rain`: every 8th step, a column of `rows` groups of
+    /// `group_size` ragdolls; once `columns` are down, the oldest column
+    /// is destroyed and spawned again.
+    Rain {
+        /// Rows of groups (one per ground row).
+        rows: usize,
+        /// Columns.
+        columns: usize,
+        /// Ragdolls per group.
+        group_size: usize,
+    },
+    /// Box2D's `junkyard`: body `body` is driven to x = amplitude ·
+    /// sin(rate · t), y = 0, angle 0.
+    Pusher {
+        /// The kinematic body.
+        body: usize,
+        /// Amplitude, m.
+        amplitude: f64,
+        /// Angular rate, rad/s.
+        rate: f64,
+    },
+}
+
+impl Script {
+    /// The actions to apply before step `step` (0-based) of length `dt`.
+    pub fn actions(&self, step: usize, dt: f64, out: &mut Vec<Action>) {
+        out.clear();
+        match *self {
+            Script::None => {}
+            Script::Rain {
+                rows,
+                columns,
+                group_size,
+            } => {
+                if step & 7 != 0 {
+                    return;
+                }
+                let k = step / 8;
+                let column = if k < columns {
+                    k
+                } else {
+                    (k - columns) % columns
+                };
+                for row in 0..rows {
+                    let id = row * columns + column;
+                    if k >= columns {
+                        out.push(Action::Despawn { id });
+                    }
+                    let (bodies, joints) = crate::benchmarks::rain_group(row, column, group_size);
+                    out.push(Action::Spawn { id, bodies, joints });
+                }
+            }
+            Script::Pusher {
+                body,
+                amplitude,
+                rate,
+            } => {
+                let t = dt * step as f64;
+                out.push(Action::Target {
+                    body,
+                    position: DVec2::new(amplitude * (rate * t).sin(), 0.0),
+                    angle: 0.0,
+                });
+            }
+        }
+    }
+}
+
+/// The region bodies should stay in, in the frame of one body (or the
+/// world): "bodies outside the container" is a sanity figure.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Container {
+    /// Body whose frame the region is in (`None`: the world).
+    pub body: Option<usize>,
+    /// The region.
+    pub region: Region,
+}
+
+/// A container's region.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Region {
+    /// A disc.
+    Disc {
+        /// Centre, m.
+        center: DVec2,
+        /// Radius, m.
+        radius: f64,
+    },
+    /// An axis-aligned box.
+    Rect {
+        /// Centre, m.
+        center: DVec2,
+        /// Half extents, m.
+        half: DVec2,
+    },
+}
+
+impl Region {
+    /// Whether the local point lies inside.
+    #[must_use]
+    pub fn contains(&self, p: DVec2) -> bool {
+        match *self {
+            Region::Disc { center, radius } => (p - center).length_squared() <= radius * radius,
+            Region::Rect { center, half } => {
+                let d = (p - center).abs();
+                d.x <= half.x && d.y <= half.y
+            }
+        }
+    }
+}
+
+/// Box2D's figures after the last step (native 3.2.0-dev, single thread),
+/// for the sanity check: a run that differs by more than the tolerance is
+/// flagged.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Reference {
+    /// Touching contact pairs.
+    pub touching: Option<f64>,
+    /// Awake bodies.
+    pub awake: Option<f64>,
+    /// Bodies in the world.
+    pub bodies: Option<f64>,
+    /// Probe position (x, y), m.
+    pub probe_position: Option<DVec2>,
+    /// Probe angle, rad.
+    pub probe_angle: Option<f64>,
+}
+
+/// Relative tolerance of the count figures (touching, awake, bodies).
+pub const COUNT_TOLERANCE: f64 = 0.10;
+/// Tolerance of the probe position, m.
+pub const POSITION_TOLERANCE: f64 = 0.25;
+/// Tolerance of the probe angle, rad.
+pub const ANGLE_TOLERANCE: f64 = 0.05;
+
+/// A portal pair (janus2d only: the other engines have no portals).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PortalDesc {
+    /// Entry: body index, anchor in its frame, direction (outward normal),
+    /// half width.
+    pub entry: (usize, DVec2, DVec2, f64),
+    /// Exit, as the entry.
+    pub exit: (usize, DVec2, DVec2, f64),
+}
+
+/// A scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneDesc {
+    /// Name (as `janus2d list` and the benchmarks print it).
+    pub name: &'static str,
+    /// Steps Box2D's benchmark runs.
+    pub steps: usize,
+    /// World settings.
+    pub settings: Settings,
+    /// Bodies present at the start.
+    pub bodies: Vec<BodyDesc>,
+    /// Joints present at the start (indices into `bodies`).
+    pub joints: Vec<RevoluteDesc>,
+    /// Per-step script.
+    pub script: Script,
+    /// The body the sanity line reports.
+    pub probe: Option<usize>,
+    /// What the probe is.
+    pub probe_label: &'static str,
+    /// Where bodies must stay.
+    pub container: Option<Container>,
+    /// Box2D's figures.
+    pub reference: Reference,
+    /// Portal pairs (janus2d only).
+    pub portals: Vec<PortalDesc>,
+}
+
+impl SceneDesc {
+    /// An empty scene with the shared settings.
+    #[must_use]
+    pub fn new(name: &'static str, steps: usize) -> Self {
+        SceneDesc {
+            name,
+            steps,
+            settings: Settings::default(),
+            bodies: Vec::new(),
+            joints: Vec::new(),
+            script: Script::None,
+            probe: None,
+            probe_label: "",
+            container: None,
+            reference: Reference::default(),
+            portals: Vec::new(),
+        }
+    }
+
+    /// Adds a body; returns its index.
+    pub fn add(&mut self, body: BodyDesc) -> usize {
+        self.bodies.push(body);
+        self.bodies.len() - 1
+    }
+
+    /// Adds a joint.
+    pub fn join(&mut self, joint: RevoluteDesc) {
+        self.joints.push(joint);
+    }
+
+    /// Dynamic bodies at the start.
+    #[must_use]
+    pub fn dynamic_count(&self) -> usize {
+        self.bodies
+            .iter()
+            .filter(|b| b.kind == BodyKind::Dynamic)
+            .count()
+    }
+}
+
+/// A box geometry centred on the body origin.
+#[must_use]
+pub fn square(hx: f64, hy: f64) -> Geometry {
+    Geometry::Box {
+        half: DVec2::new(hx, hy),
+        center: DVec2::ZERO,
+        angle: 0.0,
+        radius: 0.0,
+    }
+}
+
+/// A box geometry offset from the body origin.
+#[must_use]
+pub fn offset_box(hx: f64, hy: f64, center: DVec2) -> Geometry {
+    Geometry::Box {
+        half: DVec2::new(hx, hy),
+        center,
+        angle: 0.0,
+        radius: 0.0,
+    }
+}
+
+/// `DVec2::new`, short.
+#[must_use]
+pub const fn v(x: f64, y: f64) -> DVec2 {
+    DVec2::new(x, y)
+}

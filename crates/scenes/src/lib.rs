@@ -1,0 +1,38 @@
+//! # janus2d-scenes
+//!
+//! The standard scenes — Box2D v3's ten benchmark scenes, the hard cases
+//! and the portal scenes — defined once, as engine-neutral data, with the
+//! code that runs and measures them on any engine.
+//!
+//! | module          | contents                                                        |
+//! |-----------------|-----------------------------------------------------------------|
+//! | [`desc`]        | the data: bodies, shapes, filters, joints, settings, scripts    |
+//! | [`benchmarks`]  | the benchmark scenes as descriptions                            |
+//! | [`hard`]        | the hard cases: description, run length, pass bounds            |
+//! | [`engine`]      | the [`Engine`](engine::Engine) interface an adapter implements  |
+//! | [`janus`]       | janus2d's adapter                                               |
+//! | [`measure`]     | metric code shared by all engines (penetration, joint gap, …)  |
+//! | [`run`]         | timing as Box2D does it, and the sanity figures                 |
+//! | [`scenes`]      | the scenes built into janus2d worlds (tests, examples, benches) |
+//! | [`metrics`]     | janus2d's error tracker for the tests and the accuracy sweep    |
+//!
+//! The peers benchmark (`benches/peers`) adds Box2D's and Rapier's
+//! adapters; this crate depends on janus2d alone.
+//!
+//! ```
+//! use janus2d_scenes::engine::Engine;
+//! use janus2d_scenes::{hard, janus::Janus};
+//! let case = hard::single_box();
+//! let outcome = case.run::<Janus>().unwrap();
+//! assert!(outcome.pass, "{:?}", outcome.failed);
+//! ```
+
+pub mod benchmarks;
+pub mod desc;
+pub mod engine;
+pub mod hard;
+pub mod janus;
+pub mod measure;
+pub mod metrics;
+pub mod run;
+pub mod scenes;
