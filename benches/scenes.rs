@@ -113,7 +113,8 @@ fn main() {
                 "  sanity: bodies={} awake={} touching={}{probe}",
                 s.bodies, s.awake, s.touching
             );
-            for flag in s.flags(&desc) {
+            // Box2D's reference figures hold after the scene's full run only.
+            for flag in s.flags(&desc).into_iter().filter(|_| args.steps.is_none()) {
                 println!("  differs from Box2D: {flag}");
             }
         }

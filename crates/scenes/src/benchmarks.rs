@@ -13,7 +13,7 @@
 //! | `rain`           | 1000  | 11,001            | ragdolls spawned and destroyed        |
 //! | `junkyard`       | 800   | 8,002             | pentagons pushed by a kinematic target |
 //! | `compounds`      | 500   | 3,001             | two-triangle compound bodies          |
-//! | `washer`         | 500   | 8,101             | a turning kinematic ring              |
+//! | `washer`         | 500   | 8,102             | a turning kinematic ring              |
 //! | `portal_stream`  | 1800  | 205               | 200 shapes through a portal (janus2d) |
 //! | `hole_stream`    | 1800  | 205               | the same through a plain hole         |
 //!

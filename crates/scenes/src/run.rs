@@ -77,8 +77,11 @@ impl Sanity {
                     p.position.x, p.position.y, rp.x, rp.y
                 ));
             }
+            // Angles compare modulo a full turn (engines wrap differently).
+            let turn = std::f64::consts::TAU;
             if let Some(ra) = r.probe_angle
-                && (p.angle - ra).abs() > ANGLE_TOLERANCE
+                && ((p.angle - ra + 0.5 * turn).rem_euclid(turn) - 0.5 * turn).abs()
+                    > ANGLE_TOLERANCE
             {
                 out.push(format!("probe angle {:.3} vs Box2D {ra:.3}", p.angle));
             }
