@@ -1,4 +1,4 @@
-//! Contact hard cases of `../shared/spec/scenes.md`, at the shared settings
+//! Contact hard cases of the scene definitions (`janus2d_scenes`), at the shared settings
 //! (4 substeps, sleep off), each with its bound. Box2D v3.1.1's figure at 4
 //! substeps is quoted in each test's doc; set `JANUS2D_REPORT=1` to print
 //! the measured figures.

@@ -1,4 +1,4 @@
-//! Joint-only hard cases of `../shared/spec/scenes.md`: the stretched chain
+//! Joint-only hard cases of the scene definitions (`janus2d_scenes`): the stretched chain
 //! and the 160-plank bridge (planks need no collision here).
 
 use janus2d::prelude::*;

@@ -1,5 +1,5 @@
 //! Property tests of the portal constraint and the portal map
-//! (`../shared/spec/portal.md`, "What the constraint conserves").
+//! (the portal spec (docs/portal.md), "What the constraint conserves").
 //!
 //! Every property runs at least 256 random cases (`PROPTEST_CASES` raises
 //! it): η in [0.1, 10], masses and inertias in [1e-3, 1e3], portal bodies

@@ -1,4 +1,4 @@
-//! The portal scenes of `../shared/spec/scenes.md`, each with its bound.
+//! The portal scenes of the scene definitions (`janus2d_scenes`), each with its bound.
 //! Set `JANUS2D_REPORT=1` to print the measured figures.
 #![cfg(feature = "portals")]
 

@@ -5,7 +5,7 @@
 //! | default          | `f32`    | `glam::Vec2`      |
 //! | feature `f64`    | `f64`    | `glam::DVec2`     |
 //!
-//! Conventions (the same as `../shared/spec/portal.md`):
+//! Conventions (the same as the portal spec (docs/portal.md)):
 //! - 2D cross product `a × b = a.x*b.y - a.y*b.x` is [`cross`] (glam: `perp_dot`);
 //! - `perp(v) = (-v.y, v.x)`, so `ω × v = ω * perp(v)` is [`cross_sv`];
 //! - a [`Rot`] stores cosine and sine, never the angle.

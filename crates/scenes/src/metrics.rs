@@ -564,7 +564,7 @@ pub fn free_fall_energy_loss(mass: f64, gravity: f64, h: f64, substeps: u64) -> 
     substeps as f64 * 0.5 * mass * gravity * gravity * h * h
 }
 
-/// The hard scenes of `../shared/spec/scenes.md` that the accuracy sweep
+/// The hard scenes of the scene definitions (`janus2d_scenes`) that the accuracy sweep
 /// runs, each built exactly as `tests/hard_cases.rs` and
 /// `tests/joint_scenes.rs` build them, with the probe and tracker settings
 /// that measure them.

@@ -11,7 +11,7 @@
 
 use std::time::Instant;
 
-use crate::desc::{ANGLE_TOLERANCE, COUNT_TOLERANCE, POSITION_TOLERANCE, SceneDesc};
+use crate::desc::{ANGLE_TOLERANCE, COUNT_TOLERANCE, POSITION_TOLERANCE, Reference, SceneDesc};
 use crate::engine::{BodyState, Engine, EngineOptions, StageTimes, scripted_step};
 use crate::measure::outside_container;
 
@@ -52,11 +52,32 @@ impl Sanity {
         }
     }
 
-    /// The figures that differ from Box2D's reference by more than the
-    /// tolerances of [`crate::desc`], as text (empty: same work).
+    /// The figures that differ from Box2D's stored reference (the scene's
+    /// [`Reference`]) by more than the tolerances of [`crate::desc`], as
+    /// text (empty: same work).
     #[must_use]
     pub fn flags(&self, desc: &SceneDesc) -> Vec<String> {
-        let r = &desc.reference;
+        self.flags_against(&desc.reference)
+    }
+
+    /// These figures as a reference for another run (Box2D's, measured in
+    /// the same run, is what the peers benchmark compares with).
+    #[must_use]
+    pub fn as_reference(&self) -> Reference {
+        Reference {
+            touching: Some(self.touching as f64),
+            awake: Some(self.awake as f64),
+            bodies: Some(self.bodies as f64),
+            probe_position: self.probe.map(|p| p.position),
+            probe_angle: self.probe.map(|p| p.angle),
+        }
+    }
+
+    /// The figures that differ from `r` by more than the tolerances of
+    /// [`crate::desc`], as text; bodies outside the container are always
+    /// flagged.
+    #[must_use]
+    pub fn flags_against(&self, r: &Reference) -> Vec<String> {
         let mut out = Vec::new();
         let count = |name: &str, value: usize, reference: Option<f64>, out: &mut Vec<String>| {
             if let Some(reference) = reference

@@ -56,7 +56,13 @@ pub fn shared_settings() -> WorldDef {
 /// If the description does not build (the standard ones always do).
 #[must_use]
 pub fn build(desc: &SceneDesc, def: &WorldDef) -> Scene {
-    let built = Janus::with_def(desc, def.clone()).expect("a standard scene builds");
+    scene_of(
+        Janus::with_def(desc, def.clone()).expect("a standard scene builds"),
+        desc,
+    )
+}
+
+fn scene_of(built: Janus, desc: &SceneDesc) -> Scene {
     let probe = desc.probe.map_or(built.bodies[0], |p| built.bodies[p]);
     Scene {
         world: built.world,
@@ -130,17 +136,7 @@ pub fn portal_drop(def: &WorldDef) -> (Scene, janus2d_world::PortalPairHandle) {
     let desc = benchmarks::portal_drop();
     let built = Janus::with_def(&desc, def.clone()).expect("the portal drop builds");
     let pair = built.portals[0];
-    let probe = built.bodies[desc.probe.expect("probe")];
-    (
-        Scene {
-            world: built.world,
-            probe,
-            probe_label: desc.probe_label,
-            steps: desc.steps,
-            bodies: built.bodies,
-        },
-        pair,
-    )
+    (scene_of(built, &desc), pair)
 }
 
 /// The portal stream (`with_portal`) or the same through a hole.

@@ -3,7 +3,7 @@
 //! A linked pair of portals sits on two bodies (static, kinematic or
 //! dynamic). A body whose shapes enter an aperture gets a **clone** at the
 //! partner portal, placed by the exact clone state of the portal map
-//! (`../shared/spec/portal.md`) and scaled by `η` (`1/η` the other way); a
+//! (the portal spec (docs/portal.md)) and scaled by `η` (`1/η` the other way); a
 //! [`PortalConstraint`] makes the two copies move as one object.
 //!
 //! ```text

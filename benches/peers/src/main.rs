@@ -1,0 +1,780 @@
+//! janus2d beside Box2D v3 (through `boxdd`) and Rapier (through
+//! `rapier2d`), on the same scene descriptions, in one run.
+//!
+//! ```text
+//! cargo run --release --manifest-path benches/peers/Cargo.toml -- all            # ten scenes, 1 and 2 threads
+//! cargo run --release --manifest-path benches/peers/Cargo.toml -- all --steps 5 --repeats 1   # smoke (CI)
+//! cargo run --release --manifest-path benches/peers/Cargo.toml -- profile large_pyramid tumbler
+//! cargo run --release --manifest-path benches/peers/Cargo.toml -- hard           # hard cases, pass/fail per engine
+//! cargo run --release --manifest-path benches/peers/Cargo.toml -- sweep          # substeps 1, 2, 4, 8 per engine
+//! ```
+//!
+//! | command   | prints                                                                 |
+//! |-----------|------------------------------------------------------------------------|
+//! | `all`     | per scene and engine: ms/step, ratio to Box2D, touching, awake, bodies, probe pose, bodies outside the container; figures off Box2D's flagged |
+//! | `profile` | per-stage ms/step side by side, averaged over the timed steps          |
+//! | `hard`    | every hard case on every engine, measured by the shared metric code    |
+//! | `sweep`   | error against ms/step at 1, 2, 4, 8 substeps, per engine (CSV + SVG)   |
+//! | `chart`   | `chart RUN.csv CHART.svg`: the ratio chart redrawn from an `all --csv` file |
+//!
+//! Options: `--threads 1,2`, `--repeats N` (default 2), `--steps N`,
+//! `--scenes a,b`, `--engines janus2d,box2d,rapier`, `--csv FILE`,
+//! `--svg FILE` (bar chart of the ratios), `--out DIR` (sweep output).
+//! Build with `--features simd-avx2` and `RUSTFLAGS="-C target-cpu=x86-64-v3"`
+//! for Box2D's AVX2 build beside janus2d's x86-64-v3 build.
+
+mod box2d;
+mod rapier;
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use janus2d_scenes::benchmarks::{self, BOX2D_TEN};
+use janus2d_scenes::engine::{EngineOptions, StageTimes};
+use janus2d_scenes::hard::{self, Bound, Figure, HardCase};
+use janus2d_scenes::janus::Janus;
+use janus2d_scenes::run::{Timing, time_scene};
+use plotters::prelude::*;
+
+use box2d::Box2d;
+use rapier::Rapier;
+
+/// Box2D first: the others are compared with its figures of the same run.
+const ENGINES: [&str; 3] = ["Box2D", "janus2d", "Rapier"];
+
+struct Args {
+    command: String,
+    names: Vec<String>,
+    threads: Vec<usize>,
+    repeats: usize,
+    steps: Option<usize>,
+    engines: Vec<String>,
+    csv: Option<PathBuf>,
+    svg: Option<PathBuf>,
+    md: Option<PathBuf>,
+    out: PathBuf,
+}
+
+fn parse_args() -> Args {
+    let mut args = Args {
+        command: "all".into(),
+        names: Vec::new(),
+        threads: vec![1, 2],
+        repeats: 2,
+        steps: None,
+        engines: ENGINES.iter().map(|s| s.to_string()).collect(),
+        csv: None,
+        svg: None,
+        md: None,
+        out: PathBuf::from("docs/accuracy"),
+    };
+    let list = |s: Option<String>| -> Vec<String> {
+        s.unwrap_or_default()
+            .split(',')
+            .filter(|x| !x.is_empty())
+            .map(str::to_string)
+            .collect()
+    };
+    let mut it = std::env::args().skip(1);
+    let mut first = true;
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--threads" => {
+                args.threads = list(it.next())
+                    .iter()
+                    .map(|t| t.parse().expect("--threads 1,2"))
+                    .collect()
+            }
+            "--repeats" | "-r" => {
+                args.repeats = it.next().and_then(|v| v.parse().ok()).expect("--repeats N")
+            }
+            "--steps" | "-s" => args.steps = it.next().and_then(|v| v.parse().ok()),
+            "--scenes" => args.names = list(it.next()),
+            "--engines" => args.engines = list(it.next()),
+            "--csv" => args.csv = it.next().map(PathBuf::from),
+            "--svg" => args.svg = it.next().map(PathBuf::from),
+            "--md" => args.md = it.next().map(PathBuf::from),
+            "--out" => args.out = it.next().map(PathBuf::from).expect("--out DIR"),
+            cmd if first && matches!(cmd, "all" | "profile" | "hard" | "sweep" | "chart") => {
+                args.command = cmd.into()
+            }
+            name if !name.starts_with('-') => args.names.push(name.into()),
+            other => {
+                eprintln!("unknown option {other}");
+                std::process::exit(2);
+            }
+        }
+        first = false;
+    }
+    args.engines = args
+        .engines
+        .iter()
+        .filter_map(|e| {
+            ENGINES
+                .iter()
+                .find(|k| k.eq_ignore_ascii_case(e))
+                .map(|k| k.to_string())
+        })
+        .collect();
+    args
+}
+
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("thread pool")
+}
+
+/// Times one scene on one engine with `threads` workers.
+fn time_on(
+    engine: &str,
+    desc: &janus2d_scenes::desc::SceneDesc,
+    threads: usize,
+    args: &Args,
+) -> Result<Timing, String> {
+    let options = EngineOptions { threads };
+    pool(threads).install(|| match engine {
+        "janus2d" => time_scene::<Janus>(desc, options, args.repeats, args.steps),
+        "Box2D" => time_scene::<Box2d>(desc, options, args.repeats, args.steps),
+        _ => time_scene::<Rapier>(desc, options, args.repeats, args.steps),
+    })
+}
+
+struct Row {
+    scene: String,
+    engine: String,
+    threads: usize,
+    timing: Timing,
+    flags: Vec<String>,
+}
+
+fn cmd_all(args: &Args) {
+    let names: Vec<String> = if args.names.is_empty() {
+        BOX2D_TEN.iter().map(|s| s.to_string()).collect()
+    } else {
+        args.names.clone()
+    };
+    println!(
+        "peers: {} | repeats {} | steps {} | threads {:?} | build: {}",
+        args.engines.join(", "),
+        args.repeats,
+        args.steps
+            .map_or("scene's own".to_string(), |s| s.to_string()),
+        args.threads,
+        build_label()
+    );
+    println!(
+        "{:<14} {:<8} {:>3} {:>10} {:>9} {:>7} {:>8} {:>7} {:>7}  {:<30} {:>7}  flags",
+        "scene",
+        "engine",
+        "thr",
+        "total ms",
+        "ms/step",
+        "×Box2D",
+        "touching",
+        "awake",
+        "bodies",
+        "probe (x, y, angle)",
+        "outside"
+    );
+    let mut rows: Vec<Row> = Vec::new();
+    for name in &names {
+        let Some(desc) = benchmarks::by_name(name) else {
+            eprintln!("unknown scene {name}");
+            std::process::exit(2);
+        };
+        for &threads in &args.threads {
+            let first = rows.len();
+            for engine in &args.engines {
+                let timing = match time_on(engine, &desc, threads, args) {
+                    Ok(t) => t,
+                    Err(e) => {
+                        println!("{name:<14} {engine:<8} {threads:>3}  skipped: {e}");
+                        continue;
+                    }
+                };
+                // Box2D's row is checked against its stored figures (they
+                // hold after the scene's full run only); the others against
+                // Box2D's row of this run, when there is one.
+                let box2d_now = rows[first..]
+                    .iter()
+                    .find(|r| r.engine == "Box2D")
+                    .map(|r| r.timing.sanity.as_reference());
+                let flags = match box2d_now {
+                    Some(reference) if engine != "Box2D" => timing.sanity.flags_against(&reference),
+                    _ if args.steps.is_none() => timing.sanity.flags(&desc),
+                    _ => Vec::new(),
+                };
+                rows.push(Row {
+                    scene: name.clone(),
+                    engine: engine.clone(),
+                    threads,
+                    timing,
+                    flags,
+                });
+            }
+            for r in &rows[first..] {
+                let ratio = ratio_of(&rows, name, threads, &r.engine, "Box2D")
+                    .map_or(String::new(), |x| format!("{x:.2}"));
+                let s = &r.timing.sanity;
+                let probe = s.probe.map_or("-".to_string(), |p| {
+                    format!("({:.3}, {:.3}, {:.3})", p.position.x, p.position.y, p.angle)
+                });
+                println!(
+                    "{name:<14} {:<8} {threads:>3} {:>10.1} {:>9.3} {ratio:>7} {:>8} {:>7} {:>7}  {probe:<30} {:>7}  {}",
+                    r.engine,
+                    r.timing.total_ms,
+                    r.timing.ms_per_step(),
+                    s.touching,
+                    s.awake,
+                    s.bodies,
+                    s.outside.map_or("-".to_string(), |n| n.to_string()),
+                    if r.flags.is_empty() {
+                        String::new()
+                    } else {
+                        format!("DIFFERS: {}", r.flags.join("; "))
+                    }
+                );
+            }
+        }
+    }
+    print_ratios(&rows, &names, &args.threads);
+    if let Some(path) = &args.csv {
+        let mut csv = String::from(
+            "scene,engine,threads,total_ms,ms_per_step,touching,awake,bodies,probe_x,probe_y,probe_angle,outside,flags\n",
+        );
+        for r in &rows {
+            let s = &r.timing.sanity;
+            let p = s.probe.unwrap_or_default();
+            let _ = writeln!(
+                csv,
+                "{},{},{},{:.2},{:.4},{},{},{},{:.4},{:.4},{:.4},{},{}",
+                r.scene,
+                r.engine,
+                r.threads,
+                r.timing.total_ms,
+                r.timing.ms_per_step(),
+                s.touching,
+                s.awake,
+                s.bodies,
+                p.position.x,
+                p.position.y,
+                p.angle,
+                s.outside.map_or(String::new(), |n| n.to_string()),
+                r.flags.join("; ")
+            );
+        }
+        std::fs::write(path, csv).expect("write csv");
+        println!("wrote {}", path.display());
+    }
+    if let Some(path) = &args.md {
+        std::fs::write(path, markdown_table(&rows)).expect("write markdown");
+        println!("wrote {}", path.display());
+    }
+    if let Some(path) = &args.svg {
+        bar_chart(&rows, &names, &args.threads, path).expect("draw chart");
+        println!("wrote {}", path.display());
+    }
+}
+
+/// The table as Markdown (for docs/performance.md).
+fn markdown_table(rows: &[Row]) -> String {
+    let mut md = String::from(
+        "| scene | engine | threads | ms/step | ÷ Box2D | touching | awake | bodies | probe (x, y, angle) | outside | differs from Box2D |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        let s = &r.timing.sanity;
+        let ratio = ratio_of(rows, &r.scene, r.threads, &r.engine, "Box2D")
+            .map_or(String::new(), |x| format!("{x:.2}"));
+        let probe = s.probe.map_or("–".to_string(), |p| {
+            format!("({:.3}, {:.3}, {:.3})", p.position.x, p.position.y, p.angle)
+        });
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {:.3} | {ratio} | {} | {} | {} | {probe} | {} | {} |",
+            r.scene,
+            r.engine,
+            r.threads,
+            r.timing.ms_per_step(),
+            s.touching,
+            s.awake,
+            s.bodies,
+            s.outside.map_or("–".to_string(), |n| n.to_string()),
+            r.flags.join("; ")
+        );
+    }
+    md
+}
+
+fn build_label() -> String {
+    let avx2 = cfg!(feature = "simd-avx2");
+    let v3 = cfg!(target_feature = "avx2");
+    format!(
+        "Box2D {}, janus2d/Rapier {}",
+        if avx2 {
+            "AVX2 (simd-avx2)"
+        } else {
+            "SSE2 (default)"
+        },
+        if v3 { "x86-64-v3" } else { "x86-64 (default)" }
+    )
+}
+
+fn ratio_of(rows: &[Row], scene: &str, threads: usize, engine: &str, peer: &str) -> Option<f64> {
+    let get = |e: &str| {
+        rows.iter()
+            .find(|r| r.scene == scene && r.threads == threads && r.engine == e)
+            .map(|r| r.timing.ms_per_step())
+    };
+    Some(get(engine)? / get(peer)?)
+}
+
+fn print_ratios(rows: &[Row], names: &[String], threads: &[usize]) {
+    println!("\nratios (ms/step, one run): janus2d ÷ Box2D, janus2d ÷ Rapier, Rapier ÷ Box2D");
+    for &t in threads {
+        let mut logs = [0.0f64; 3];
+        let mut n = [0usize; 3];
+        for name in names {
+            let r = [
+                ratio_of(rows, name, t, "janus2d", "Box2D"),
+                ratio_of(rows, name, t, "janus2d", "Rapier"),
+                ratio_of(rows, name, t, "Rapier", "Box2D"),
+            ];
+            let fmt = |x: Option<f64>| x.map_or("   -".to_string(), |x| format!("{x:.2}"));
+            println!(
+                "  {t} thr  {name:<14} {:>6} {:>6} {:>6}",
+                fmt(r[0]),
+                fmt(r[1]),
+                fmt(r[2])
+            );
+            for k in 0..3 {
+                if let Some(x) = r[k] {
+                    logs[k] += x.ln();
+                    n[k] += 1;
+                }
+            }
+        }
+        let g = |k: usize| {
+            if n[k] > 0 {
+                format!("{:.2}", (logs[k] / n[k] as f64).exp())
+            } else {
+                "-".into()
+            }
+        };
+        println!(
+            "  {t} thr  {:<14} {:>6} {:>6} {:>6}",
+            "geometric mean",
+            g(0),
+            g(1),
+            g(2)
+        );
+    }
+}
+
+fn bar_chart(
+    rows: &[Row],
+    names: &[String],
+    threads: &[usize],
+    path: &PathBuf,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let root = SVGBackend::new(path, (960, 480)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let series: Vec<(String, usize, &str, RGBColor)> = threads
+        .iter()
+        .flat_map(|&t| {
+            [
+                (
+                    format!("janus2d ÷ Box2D, {t} thr"),
+                    t,
+                    "Box2D",
+                    if t == 1 {
+                        RGBColor(31, 119, 180)
+                    } else {
+                        RGBColor(158, 202, 225)
+                    },
+                ),
+                (
+                    format!("janus2d ÷ Rapier, {t} thr"),
+                    t,
+                    "Rapier",
+                    if t == 1 {
+                        RGBColor(214, 39, 40)
+                    } else {
+                        RGBColor(252, 174, 145)
+                    },
+                ),
+            ]
+        })
+        .collect();
+    let max = rows
+        .iter()
+        .filter_map(|r| ratio_of(rows, &r.scene, r.threads, "janus2d", "Box2D"))
+        .chain(
+            rows.iter()
+                .filter_map(|r| ratio_of(rows, &r.scene, r.threads, "janus2d", "Rapier")),
+        )
+        .fold(1.5f64, f64::max);
+    let groups = names.len();
+    let width = series.len() as f64 + 1.0;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "janus2d time per step relative to its peers (< 1: janus2d faster)",
+            ("sans-serif", 18),
+        )
+        .margin(10)
+        .x_label_area_size(60)
+        .y_label_area_size(50)
+        .build_cartesian_2d(0.0..groups as f64 * width, 0.0..max * 1.4)?;
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(0)
+        .y_desc("ratio of ms/step")
+        .draw()?;
+    for (gi, name) in names.iter().enumerate() {
+        let x = gi as f64 * width + width / 2.0;
+        chart.draw_series(std::iter::once(Text::new(
+            name.clone(),
+            (x - 0.4 * width, -0.05 * max),
+            ("sans-serif", 12),
+        )))?;
+    }
+    for (si, (label, t, peer, color)) in series.iter().enumerate() {
+        let bars: Vec<_> = names
+            .iter()
+            .enumerate()
+            .filter_map(|(gi, name)| {
+                let r = ratio_of(rows, name, *t, "janus2d", peer)?;
+                let x0 = gi as f64 * width + 0.5 + si as f64;
+                Some(Rectangle::new([(x0, 0.0), (x0 + 0.9, r)], color.filled()))
+            })
+            .collect();
+        let c = *color;
+        chart
+            .draw_series(bars)?
+            .label(label.clone())
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 10, y + 5)], c.filled()));
+    }
+    chart.draw_series(LineSeries::new(
+        [(0.0, 1.0), (groups as f64 * width, 1.0)],
+        BLACK.stroke_width(1),
+    ))?;
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .border_style(BLACK)
+        .background_style(WHITE.mix(0.8))
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
+
+/// `chart CSV SVG`: redraws the ratio chart from a CSV that `all --csv`
+/// wrote, without running anything.
+fn cmd_chart(args: &Args) {
+    let [csv, svg] = &args.names[..] else {
+        eprintln!("usage: chart RUN.csv CHART.svg");
+        std::process::exit(2);
+    };
+    let text = std::fs::read_to_string(csv).expect("read csv");
+    let mut rows = Vec::new();
+    let mut names: Vec<String> = Vec::new();
+    let mut threads: Vec<usize> = Vec::new();
+    for line in text.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let (Some(scene), Some(engine), Some(t), Some(ms)) =
+            (f.first(), f.get(1), f.get(2), f.get(4))
+        else {
+            continue;
+        };
+        let (Ok(t), Ok(ms)) = (t.parse::<usize>(), ms.parse::<f64>()) else {
+            continue;
+        };
+        if !names.iter().any(|n| n == scene) {
+            names.push(scene.to_string());
+        }
+        if !threads.contains(&t) {
+            threads.push(t);
+        }
+        rows.push(Row {
+            scene: scene.to_string(),
+            engine: engine.to_string(),
+            threads: t,
+            timing: Timing {
+                total_ms: ms,
+                timed_steps: 1,
+                ..Timing::default()
+            },
+            flags: Vec::new(),
+        });
+    }
+    bar_chart(&rows, &names, &threads, &PathBuf::from(svg)).expect("draw chart");
+    println!("wrote {svg}");
+}
+
+fn cmd_profile(args: &Args) {
+    let names: Vec<String> = if args.names.is_empty() {
+        ["large_pyramid", "many_pyramids", "tumbler"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    } else {
+        args.names.clone()
+    };
+    let threads = args.threads.first().copied().unwrap_or(1);
+    for name in &names {
+        let Some(desc) = benchmarks::by_name(name) else {
+            eprintln!("unknown scene {name}");
+            std::process::exit(2);
+        };
+        let mut columns: Vec<(String, StageTimes)> = Vec::new();
+        for engine in &args.engines {
+            if let Ok(t) = time_on(engine, &desc, threads, args) {
+                columns.push((engine.clone(), t.stages));
+            }
+        }
+        println!(
+            "\n{name}: ms per step by stage, {threads} thread(s), averaged over the timed steps (each engine's own profile)"
+        );
+        print!("{:<12}", "stage");
+        for (e, _) in &columns {
+            print!(" {e:>9}");
+        }
+        println!();
+        for (i, (stage, _)) in StageTimes::default().named().iter().enumerate() {
+            print!("{stage:<12}");
+            for (_, st) in &columns {
+                match st.named()[i].1 {
+                    Some(x) => print!(" {x:>9.3}"),
+                    None => print!(" {:>9}", "-"),
+                }
+            }
+            println!();
+        }
+    }
+    println!(
+        "\nStages an engine does not time apart are '-'; janus2d's collide includes the portal stage, its setup lives in prepare."
+    );
+}
+
+fn run_case(engine: &str, case: &HardCase) -> Result<hard::Outcome, String> {
+    match engine {
+        "janus2d" => case.run::<Janus>(),
+        "Box2D" => case.run::<Box2d>(),
+        _ => case.run::<Rapier>(),
+    }
+}
+
+fn cmd_hard(args: &Args) {
+    let cases: Vec<HardCase> = hard::all()
+        .into_iter()
+        .filter(|c| args.names.is_empty() || args.names.iter().any(|n| n == c.name))
+        .collect();
+    let mut passes = vec![0usize; args.engines.len()];
+    println!("hard cases: 4 substeps, 1/60 s, sleep off; one metric code for every engine");
+    for case in &cases {
+        println!("\n{} [Box2D v3.1: {}]", case.name, case.box2d);
+        for (k, engine) in args.engines.iter().enumerate() {
+            match run_case(engine, case) {
+                Ok(o) => {
+                    if o.pass {
+                        passes[k] += 1;
+                    }
+                    let figures: Vec<String> = case
+                        .bounds
+                        .iter()
+                        .map(|b| {
+                            let f = b.figure();
+                            let op = match b {
+                                Bound::AtMost(_, v) => format!("≤ {}", (v * 1e4).round() / 1e4),
+                                Bound::AtLeast(_, v) => format!("≥ {}", (v * 1e4).round() / 1e4),
+                            };
+                            format!("{} {:.4} ({op})", f.name(), o.figures.get(f))
+                        })
+                        .collect();
+                    println!(
+                        "  {engine:<8} {}  {}  peak speed {:.2} m/s, penetration {:.4} m",
+                        if o.pass { "pass" } else { "FAIL" },
+                        figures.join(", "),
+                        o.figures.get(Figure::PeakSpeed),
+                        o.figures.get(Figure::Penetration)
+                    );
+                }
+                Err(e) => println!("  {engine:<8} skipped: {e}"),
+            }
+        }
+    }
+    println!("\npassed of {}:", cases.len());
+    for (k, engine) in args.engines.iter().enumerate() {
+        println!("  {engine:<8} {}", passes[k]);
+    }
+}
+
+/// One engine's sweep curve: (ms/step, error, substeps) per point.
+type Curve = (String, Vec<(f64, f64, u32)>);
+
+/// One sweep scene: the hard case and the figure its curve plots.
+struct SweepScene {
+    case: HardCase,
+    figure: Figure,
+    label: &'static str,
+}
+
+fn cmd_sweep(args: &Args) {
+    let scenes = [
+        SweepScene {
+            case: hard::large_pyramid(),
+            figure: Figure::Sink,
+            label: "top-box sink, m",
+        },
+        SweepScene {
+            case: hard::pyramid20(),
+            figure: Figure::Sink,
+            label: "top-box sink, m",
+        },
+        SweepScene {
+            case: hard::vertical_stack(15),
+            figure: Figure::StandTime,
+            label: "time the stack stands, s",
+        },
+        SweepScene {
+            case: hard::vertical_stack(20),
+            figure: Figure::StandTime,
+            label: "time the stack stands, s",
+        },
+        SweepScene {
+            case: hard::bridge(),
+            figure: Figure::LateJointGap,
+            label: "joint gap over the last second, m",
+        },
+        SweepScene {
+            case: hard::ball_and_chain(),
+            figure: Figure::JointGap,
+            label: "peak joint gap, m",
+        },
+    ];
+    let substeps = [1u32, 2, 4, 8];
+    std::fs::create_dir_all(&args.out).expect("out dir");
+    let mut csv = String::from("scene,engine,substeps,ms_per_step,figure,value,pass\n");
+    for s in scenes
+        .iter()
+        .filter(|s| args.names.is_empty() || args.names.iter().any(|n| n == s.case.name))
+    {
+        let mut curves: Vec<Curve> = Vec::new();
+        for engine in &args.engines {
+            let mut points = Vec::new();
+            for &n in &substeps {
+                let mut case = s.case.clone();
+                case.desc.settings.substeps = n;
+                if let Some(steps) = args.steps {
+                    case.steps = steps;
+                }
+                match run_case(engine, &case) {
+                    Ok(o) => {
+                        let value = o.figures.get(s.figure);
+                        println!(
+                            "{:<18} {engine:<8} substeps {n}: {:.3} ms/step, {} {value:.4}{}",
+                            s.case.name,
+                            o.step_ms,
+                            s.figure.name(),
+                            if o.pass { "" } else { "  (fails its bound)" }
+                        );
+                        let _ = writeln!(
+                            csv,
+                            "{},{engine},{n},{:.4},{},{value:.6},{}",
+                            s.case.name,
+                            o.step_ms,
+                            s.figure.name(),
+                            o.pass
+                        );
+                        points.push((o.step_ms, value, n));
+                    }
+                    Err(e) => println!("{} {engine}: {e}", s.case.name),
+                }
+            }
+            curves.push((engine.clone(), points));
+        }
+        let path = args.out.join(format!("peers_{}.svg", s.case.name));
+        if let Err(e) = sweep_chart(&path, s, &curves) {
+            eprintln!("chart {}: {e}", path.display());
+        }
+    }
+    let path = args.out.join("peers.csv");
+    std::fs::write(&path, csv).expect("write csv");
+    println!("wrote {} and peers_<scene>.svg", path.display());
+}
+
+fn sweep_chart(
+    path: &PathBuf,
+    s: &SweepScene,
+    curves: &[Curve],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let root = SVGBackend::new(path, (720, 480)).into_drawing_area();
+    root.fill(&WHITE)?;
+    // Errors span orders of magnitude: a log axis, floored at 1e-4.
+    const FLOOR: f64 = 1e-4;
+    let pts = curves.iter().flat_map(|(_, p)| p.iter());
+    let (mut x1, mut y0, mut y1) = (0.0f64, f64::MAX, FLOOR);
+    for &(x, y, _) in pts {
+        x1 = x1.max(x);
+        y0 = y0.min(y.max(FLOOR));
+        y1 = y1.max(y);
+    }
+    let y0 = y0.min(y1) * 0.5;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!(
+                "{}: {} against ms/step (substeps 1, 2, 4, 8)",
+                s.case.name, s.label
+            ),
+            ("sans-serif", 16),
+        )
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..x1 * 1.1 + 1e-6, (y0..y1 * 2.0).log_scale())?;
+    chart
+        .configure_mesh()
+        .x_desc("ms per step")
+        .y_desc(s.label)
+        .draw()?;
+    let colors = [
+        RGBColor(31, 119, 180),
+        RGBColor(255, 127, 14),
+        RGBColor(44, 160, 44),
+    ];
+    for (k, (engine, points)) in curves.iter().enumerate() {
+        let c = colors[k % 3];
+        chart
+            .draw_series(LineSeries::new(
+                points.iter().map(|p| (p.0, p.1.max(FLOOR))),
+                c.stroke_width(2),
+            ))?
+            .label(engine.clone())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], c.stroke_width(2)));
+        chart.draw_series(points.iter().map(|p| {
+            EmptyElement::at((p.0, p.1.max(FLOOR)))
+                + Circle::new((0, 0), 3, c.filled())
+                + Text::new(format!("{}", p.2), (5, -12), ("sans-serif", 11))
+        }))?;
+    }
+    chart
+        .configure_series_labels()
+        .border_style(BLACK)
+        .background_style(WHITE.mix(0.8))
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
+
+fn main() {
+    let args = parse_args();
+    match args.command.as_str() {
+        "profile" => cmd_profile(&args),
+        "hard" => cmd_hard(&args),
+        "sweep" => cmd_sweep(&args),
+        "chart" => cmd_chart(&args),
+        _ => cmd_all(&args),
+    }
+}
