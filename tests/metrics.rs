@@ -357,9 +357,12 @@ fn hard_cases_are_built_as_specified() {
     );
     let stack = cases::vertical_stack(&def, 15, 60);
     assert_eq!((stack.world.body_count(), stack.steps), (16, 3600));
-    assert_eq!(
-        stack.world.position(stack.probe).unwrap(),
-        Vec2::new(0.01, 0.55 + 1.1 * 14.0)
+    // Row 14 is even: x = −0.01 (the spec's offsets); y to rounding of
+    // the f64 description.
+    let top = stack.world.position(stack.probe).unwrap();
+    assert!(
+        (top - Vec2::new(-0.01, 0.55 + 1.1 * 14.0)).length() < 1e-5,
+        "top box at {top}"
     );
     let pyramid = cases::pyramid(&def, 20, 600, 0.5);
     assert_eq!(pyramid.world.body_count(), 211);
