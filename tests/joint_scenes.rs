@@ -2,7 +2,7 @@
 //! and the 160-plank bridge (planks need no collision here).
 
 use janus2d::prelude::*;
-use janus2d_scenes::scenes;
+use janus2d_scenes::{hard, scenes};
 
 const DT: Real = 1.0 / 60.0;
 
@@ -63,34 +63,13 @@ fn unstretched_chain_whip_reference() {
 /// Runs the chain with link spacing `spacing` for 10 s; returns the peak
 /// speed, the first time every gap is ≤ 1 cm, and the largest gap at 10 s.
 fn run_chain(spacing: Real) -> (Real, Option<Real>, Real) {
-    let mut world = World::new(scenes::shared_settings()).unwrap();
-    let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
-    let r: Real = 0.25;
-    let m = janus2d::base::math::PI * r * r;
-    let inertia = 0.5 * m * r * r;
-    let mut prev = ground;
-    let mut links = Vec::new();
-    for i in 0..40 {
-        let x = spacing * (i as Real + 0.5);
-        let b = world
-            .create_body(&BodyDef::dynamic(Vec2::new(x, 0.0)).with_mass(m, inertia))
-            .unwrap();
-        let anchor_a = if i == 0 {
-            Vec2::ZERO
-        } else {
-            Vec2::new(0.5, 0.0)
-        };
-        world
-            .create_revolute_joint(&RevoluteJointDef::new(
-                prev,
-                b,
-                anchor_a,
-                Vec2::new(-0.5, 0.0),
-            ))
-            .unwrap();
-        links.push(b);
-        prev = b;
-    }
+    // The shared description: 40 non-colliding circles r 0.25 (density 1).
+    let scene = scenes::build(
+        &hard::chain_scene(janus2d::base::math::to_f64(spacing)),
+        &scenes::shared_settings(),
+    );
+    let links = scene.bodies[1..].to_vec();
+    let mut world = scene.world;
     let mut peak_speed: Real = 0.0;
     let mut recovered_at = None;
     for k in 0..600 {

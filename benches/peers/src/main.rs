@@ -572,6 +572,7 @@ fn cmd_hard(args: &Args) {
         .filter(|c| args.names.is_empty() || args.names.iter().any(|n| n == c.name))
         .collect();
     let mut passes = vec![0usize; args.engines.len()];
+    let mut failed: Vec<Vec<&str>> = vec![Vec::new(); args.engines.len()];
     println!("hard cases: 4 substeps, 1/60 s, sleep off; one metric code for every engine");
     for case in &cases {
         println!("\n{} [Box2D v3.1: {}]", case.name, case.box2d);
@@ -580,6 +581,8 @@ fn cmd_hard(args: &Args) {
                 Ok(o) => {
                     if o.pass {
                         passes[k] += 1;
+                    } else {
+                        failed[k].push(case.name);
                     }
                     let figures: Vec<String> = case
                         .bounds
@@ -607,7 +610,12 @@ fn cmd_hard(args: &Args) {
     }
     println!("\npassed of {}:", cases.len());
     for (k, engine) in args.engines.iter().enumerate() {
-        println!("  {engine:<8} {}", passes[k]);
+        let fails = if failed[k].is_empty() {
+            String::new()
+        } else {
+            format!("   fails: {}", failed[k].join(", "))
+        };
+        println!("  {engine:<8} {}{fails}", passes[k]);
     }
 }
 

@@ -18,7 +18,7 @@ use glam::DVec2;
 use janus2d_constraints::RevoluteJointDef;
 use janus2d_core::body::{BodyDef, BodyHandle, BodyType};
 use janus2d_core::geometry::{Capsule, Circle, Polygon, Segment, Shape, make_chain};
-use janus2d_core::math::{Real, Vec2};
+use janus2d_core::math::{Real, Vec2, from_f64, to_f64};
 use janus2d_world::{Filter, JointHandle, ShapeDef, World, WorldDef, WorldError};
 
 use crate::desc::*;
@@ -160,7 +160,7 @@ pub fn create_joint(
         def = def.with_limits(lo as Real, hi as Real);
     }
     if let Some((speed, torque)) = j.motor {
-        def = def.with_motor(speed as Real, torque.min(Real::MAX as f64) as Real);
+        def = def.with_motor(speed as Real, from_f64(torque.min(to_f64(Real::MAX))));
     }
     if let Some((hz, zeta)) = j.spring {
         def = def.with_spring(hz as Real, zeta as Real);
@@ -278,10 +278,10 @@ fn state_of(world: &World, h: BodyHandle) -> Option<BodyState> {
     let p = world.position(h).ok()?;
     let v = world.linear_velocity(h).ok()?;
     Some(BodyState {
-        position: DVec2::new(p.x as f64, p.y as f64),
-        angle: world.angle(h).ok()? as f64,
-        linear_velocity: DVec2::new(v.x as f64, v.y as f64),
-        angular_velocity: world.angular_velocity(h).ok()? as f64,
+        position: DVec2::new(to_f64(p.x), to_f64(p.y)),
+        angle: to_f64(world.angle(h).ok()?),
+        linear_velocity: DVec2::new(to_f64(v.x), to_f64(v.y)),
+        angular_velocity: to_f64(world.angular_velocity(h).ok()?),
     })
 }
 

@@ -14,7 +14,7 @@ use std::collections::BTreeSet;
 
 use glam::DVec2;
 use janus2d_core::geometry::{Shape, collide};
-use janus2d_core::math::{Real, Transform};
+use janus2d_core::math::{Real, Transform, to_f64};
 
 use crate::desc::{BodyKind, FilterDesc, SceneDesc};
 use crate::engine::BodyState;
@@ -89,8 +89,8 @@ impl ShapeIndex {
             placed.push(Placed {
                 shape: k,
                 xf,
-                lower: DVec2::new(aabb.lower.x as f64, aabb.lower.y as f64),
-                upper: DVec2::new(aabb.upper.x as f64, aabb.upper.y as f64),
+                lower: DVec2::new(to_f64(aabb.lower.x), to_f64(aabb.lower.y)),
+                upper: DVec2::new(to_f64(aabb.upper.x), to_f64(aabb.upper.y)),
             });
         }
         placed.sort_by(|a, b| a.lower.x.total_cmp(&b.lower.x).then(a.shape.cmp(&b.shape)));
@@ -115,7 +115,7 @@ impl ShapeIndex {
                 }
                 let m = collide(&sa.shape, &a.xf, &sb.shape, &b.xf, 0.0);
                 for p in m.points() {
-                    deepest = deepest.max(-(p.separation as f64));
+                    deepest = deepest.max(-to_f64(p.separation));
                 }
             }
         }
