@@ -18,7 +18,7 @@ use glam::DVec2;
 use janus2d_constraints::RevoluteJointDef;
 use janus2d_core::body::{BodyDef, BodyHandle, BodyType};
 use janus2d_core::geometry::{Capsule, Circle, Polygon, Segment, Shape, make_chain};
-use janus2d_core::math::{Real, Vec2, from_f64, to_f64};
+use janus2d_core::math::{Real, Vec2, from_f64, to_f64, wrap_angle};
 use janus2d_world::{Filter, JointHandle, ShapeDef, World, WorldDef, WorldError};
 
 use crate::desc::*;
@@ -103,16 +103,22 @@ pub fn shapes_of(geometry: &Geometry) -> Result<Vec<Shape>, WorldError> {
     })
 }
 
+/// janus2d's filter for a description's (the same bits and group rule).
+#[must_use]
+pub fn filter(f: &FilterDesc) -> Filter {
+    Filter {
+        category_bits: f.category,
+        mask_bits: f.mask,
+        group_index: f.group,
+    }
+}
+
 fn shape_def(s: &ShapeDesc) -> ShapeDef {
     ShapeDef {
         density: s.density as Real,
         friction: s.friction as Real,
         restitution: s.restitution as Real,
-        filter: Filter {
-            category_bits: s.filter.category,
-            mask_bits: s.filter.mask,
-            group_index: s.filter.group,
-        },
+        filter: filter(&s.filter),
         ..ShapeDef::default()
     }
 }
@@ -265,7 +271,7 @@ impl Janus {
                 let h = self.bodies[*body];
                 let xf = self.world.transform(h)?;
                 let v = (vec(*position) - xf.p) / self.dt;
-                let w = (*angle as Real - self.world.angle(h)?) / self.dt;
+                let w = wrap_angle(*angle as Real - self.world.angle(h)?) / self.dt;
                 self.world.set_linear_velocity(h, v)?;
                 self.world.set_angular_velocity(h, w)?;
             }

@@ -16,23 +16,16 @@ use glam::DVec2;
 use janus2d_core::geometry::{Shape, collide};
 use janus2d_core::math::{Real, Transform, to_f64};
 
-use crate::desc::{BodyKind, FilterDesc, SceneDesc};
-use crate::engine::BodyState;
-use crate::janus::{shapes_of, vec};
+use janus2d_world::Filter;
 
-/// Whether two filters let their shapes collide (Box2D's rule).
-#[must_use]
-pub fn filters_collide(a: &FilterDesc, b: &FilterDesc) -> bool {
-    if a.group == b.group && a.group != 0 {
-        return a.group > 0;
-    }
-    (a.mask & b.category) != 0 && (a.category & b.mask) != 0
-}
+use crate::desc::{BodyKind, SceneDesc};
+use crate::engine::BodyState;
+use crate::janus::{filter, shapes_of, vec};
 
 struct IndexedShape {
     body: usize,
     shape: Shape,
-    filter: FilterDesc,
+    filter: Filter,
     moving: bool,
 }
 
@@ -54,7 +47,7 @@ impl ShapeIndex {
                     shapes.push(IndexedShape {
                         body,
                         shape,
-                        filter: s.filter,
+                        filter: filter(&s.filter),
                         moving: b.kind != BodyKind::Static,
                     });
                 }
@@ -106,7 +99,7 @@ impl ShapeIndex {
                     || !(sa.moving || sb.moving)
                     || b.lower.y > a.upper.y
                     || b.upper.y < a.lower.y
-                    || !filters_collide(&sa.filter, &sb.filter)
+                    || !sa.filter.should_collide(&sb.filter)
                     || self
                         .joined
                         .contains(&(sa.body.min(sb.body), sa.body.max(sb.body)))
@@ -126,10 +119,8 @@ impl ShapeIndex {
 /// Largest distance between the world anchors of the scene's joints.
 #[must_use]
 pub fn max_joint_gap(desc: &SceneDesc, states: &[Option<BodyState>]) -> f64 {
-    let world_point = |st: &BodyState, local: DVec2| {
-        let (s, c) = st.angle.sin_cos();
-        st.position + DVec2::new(c * local.x - s * local.y, s * local.x + c * local.y)
-    };
+    let world_point =
+        |st: &BodyState, local: DVec2| st.position + DVec2::from_angle(st.angle).rotate(local);
     desc.joints
         .iter()
         .filter_map(|j| {
@@ -158,13 +149,12 @@ pub fn outside_container(
         },
         None => BodyState::default(),
     };
-    let (s, co) = frame.angle.sin_cos();
+    let to_local = DVec2::from_angle(-frame.angle);
     dynamic
         .iter()
         .filter(|st| {
-            let d = st.position - frame.position;
-            let local = DVec2::new(co * d.x + s * d.y, -s * d.x + co * d.y);
-            !c.region.contains(local)
+            !c.region
+                .contains(to_local.rotate(st.position - frame.position))
         })
         .count()
 }

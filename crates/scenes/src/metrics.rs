@@ -622,6 +622,19 @@ pub mod cases {
         }
     }
 
+    /// A case whose probe swings freely, run for `steps`, late window the
+    /// last second.
+    fn swinging(scene: scenes::Scene, steps: usize) -> Case {
+        Case {
+            config: no_collapse(TrackerConfig::probe(scene.probe))
+                .with_late_from(late_from_last_second(steps)),
+            world: scene.world,
+            probe: scene.probe,
+            probe_label: scene.probe_label,
+            steps,
+        }
+    }
+
     fn late_from_last_second(steps: usize) -> Real {
         (steps as Real * DT - 1.0).max(0.0)
     }
@@ -672,14 +685,7 @@ pub mod cases {
     pub fn ball_and_chain(def: &WorldDef) -> Case {
         let scene = scenes::ball_and_chain(def);
         let steps = scene.steps;
-        Case {
-            world: scene.world,
-            probe: scene.probe,
-            probe_label: scene.probe_label,
-            steps,
-            config: no_collapse(TrackerConfig::probe(scene.probe))
-                .with_late_from(late_from_last_second(steps)),
-        }
+        swinging(scene, steps)
     }
 
     /// Portal stream ([`scenes::portal_stream`]): 200 mixed shapes pour
@@ -688,15 +694,7 @@ pub mod cases {
     /// [`PortalError`](super::PortalError).
     #[cfg(feature = "portals")]
     pub fn portal_stream(def: &WorldDef, steps: usize) -> Case {
-        let scene = scenes::portal_stream(def, true);
-        Case {
-            world: scene.world,
-            probe: scene.probe,
-            probe_label: scene.probe_label,
-            steps,
-            config: no_collapse(TrackerConfig::probe(scene.probe))
-                .with_late_from(late_from_last_second(steps)),
-        }
+        swinging(scenes::portal_stream(def, true), steps)
     }
 
     /// Bridge: 160 planks half 0.5×0.125 (density 20, mass set directly,
@@ -705,13 +703,6 @@ pub mod cases {
     pub fn bridge(def: &WorldDef) -> Case {
         let scene = scenes::bridge(def);
         let steps = scene.steps;
-        Case {
-            world: scene.world,
-            probe: scene.probe,
-            probe_label: scene.probe_label,
-            steps,
-            config: no_collapse(TrackerConfig::probe(scene.probe))
-                .with_late_from(late_from_last_second(steps)),
-        }
+        swinging(scene, steps)
     }
 }
