@@ -8,13 +8,15 @@
 //! | [`world`]     | [`World`], [`WorldDef`], handles, the step        |
 //! | [`error`]     | [`WorldError`], the typed errors of the API        |
 //! | [`collision`] | shapes, contacts, events                          |
-//! | [`broadphase`]| the dynamic AABB tree and pair finding            |
+//! | [`broadphase`]| pair finding over two dynamic trees               |
+//! | [`dynamic_tree`]| the dynamic AABB tree: insert, remove, query    |
 //! | [`portals`]   | portal pairs, crossings, clones, handover         |
 //! | [`sleep`]     | resting islands leave the solver                  |
 //! | [`profile`]   | per-stage timings and work counters               |
 
 pub mod broadphase;
 pub mod collision;
+pub mod dynamic_tree;
 pub mod error;
 #[cfg(feature = "portals")]
 pub mod portals;

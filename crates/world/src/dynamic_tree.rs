@@ -1,0 +1,1002 @@
+//! The dynamic AABB tree: an incremental bounding-volume hierarchy of fat
+//! boxes, the structure under the [broadphase](crate::broadphase).
+//!
+//! # Structure
+//!
+//! [`DynamicTree`] is an *incremental* bounding-volume hierarchy of
+//! axis-aligned boxes (the same family as Box2D's dynamic tree):
+//!
+//! ```text
+//!                 [A]            internal node: union of its two children
+//!               /     \
+//!            [B]       [C]       nodes live in one Vec, addressed by u32,
+//!           /   \     /   \      freed slots are chained in a free list
+//!         (1)   (2) (3)   [D]
+//!                        /   \   (n) leaf = one proxy: a *fat* AABB
+//!                      (4)   (5)     (the tight box grown by a margin)
+//!                                    and a user u32 payload
+//! ```
+//!
+//! Each leaf stores a **fat** box: the tight box grown by a margin (default
+//! [`DEFAULT_AABB_MARGIN`] = 0.1 m). As long as the tight box stays inside
+//! the fat one, [`DynamicTree::move_proxy`] costs one containment test and
+//! the tree is not touched; only when it leaves the fat box is the leaf
+//! removed and re-inserted.
+//!
+//! Insertion picks the sibling that minimises the total perimeter of the
+//! tree (the 2D surface-area heuristic) with a branch-and-bound descent, then
+//! walks back towards the root refitting boxes and applying local
+//! *rotations*: a child is swapped with a grandchild when that lowers the
+//! summed perimeter without making the subtree taller, or when the heights of
+//! the two children differ by more than one. This keeps the tree shallow even
+//! for adversarial (sorted) insertion orders: 10 000 boxes in a row give a
+//! height of 15 (`log2 10 000 ≈ 13.3`).
+//!
+//! # What it stores
+//!
+//! | field / item          | what                                                              |
+//! |-----------------------|-------------------------------------------------------------------|
+//! | `nodes: Vec<Node>`    | leaves and internal nodes: box, parent, children, payload, height |
+//! | free list             | freed slots chained through `parent`, reused first                |
+//! | `root`, `proxy_count` | where every descent starts; number of leaves                      |
+//! | `margin`              | tight box to fat box growth (0 for a static tree)                 |
+//! | [`NULL_NODE`]         | `u32::MAX`: no parent, no child, end of the free list             |
+//! | `NodeStack`           | traversal stack: 64 entries inline, heap only on overflow         |
+//!
+//! # Operations
+//!
+//! All on [`DynamicTree`]; the pair traversals are crate-internal, used by
+//! [`BroadPhase::update_pairs`](crate::broadphase::BroadPhase::update_pairs).
+//!
+//! | operation                            | cost / rule                                              |
+//! |--------------------------------------|----------------------------------------------------------|
+//! | `create_proxy`, `destroy_proxy`      | O(log n); ids are node indices, stable until destroyed   |
+//! | `move_proxy`                         | one `contains` test; re-insert only when it fails        |
+//! | insert / remove a leaf               | best sibling by perimeter, then refit and rotate upwards |
+//! | `query`, `query_proxies`             | O(log n + k), iterative, stops when the callback says so |
+//! | `for_each_self_pair`, `…_cross_pair` | tree against tree: each overlapping pair once            |
+//! | `shift_origin`                       | translates every box, tree shape unchanged               |
+//! | `validate`, `height`, `area_ratio`   | invariants and quality, for tests and debugging          |
+
+use janus2d_core::geometry::Aabb;
+use janus2d_core::math::{Real, Vec2};
+
+/// The "no node" index (`u32::MAX`), used for absent parents and children.
+pub const NULL_NODE: u32 = u32::MAX;
+
+/// Default fat-box margin, in metres (0.1 m): how far a shape may move
+/// before its proxy is re-inserted into the tree.
+pub const DEFAULT_AABB_MARGIN: Real = 0.1;
+
+/// Inline capacity of the traversal stack. A depth-first traversal needs at
+/// most `height + 1` entries, so the heap fallback is never used by trees of
+/// sane height (10⁶ proxies give a height near 25).
+const STACK_INLINE: usize = 64;
+
+/// Depth-first traversal stack: a fixed array on the call stack with a heap
+/// fallback that only allocates if it overflows (never in practice).
+struct NodeStack {
+    inline: [u32; STACK_INLINE],
+    len: usize,
+    spill: Vec<u32>,
+}
+
+impl NodeStack {
+    #[inline(always)]
+    fn new(first: u32) -> Self {
+        let mut inline = [NULL_NODE; STACK_INLINE];
+        inline[0] = first;
+        NodeStack {
+            inline,
+            len: 1,
+            spill: Vec::new(),
+        }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, index: u32) {
+        if self.len < STACK_INLINE {
+            self.inline[self.len] = index;
+            self.len += 1;
+        } else {
+            self.spill.push(index);
+        }
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<u32> {
+        if let Some(index) = self.spill.pop() {
+            Some(index)
+        } else if self.len > 0 {
+            self.len -= 1;
+            Some(self.inline[self.len])
+        } else {
+            None
+        }
+    }
+}
+
+/// One node of the tree: a leaf (a proxy) or an internal node.
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    /// Fat box of a leaf, or the union of the children of an internal node.
+    aabb: Aabb,
+    /// Parent index, or the next free node while on the free list.
+    parent: u32,
+    /// First child, [`NULL_NODE`] for a leaf.
+    child1: u32,
+    /// Second child, [`NULL_NODE`] for a leaf.
+    child2: u32,
+    /// Payload of a leaf.
+    user_data: u32,
+    /// 0 for a leaf, `1 + max(child heights)` otherwise.
+    height: u16,
+    /// False while on the free list.
+    allocated: bool,
+}
+
+impl Node {
+    const EMPTY: Node = Node {
+        aabb: Aabb {
+            lower: Vec2::ZERO,
+            upper: Vec2::ZERO,
+        },
+        parent: NULL_NODE,
+        child1: NULL_NODE,
+        child2: NULL_NODE,
+        user_data: 0,
+        height: 0,
+        allocated: false,
+    };
+
+    #[inline(always)]
+    fn is_leaf(&self) -> bool {
+        self.child1 == NULL_NODE
+    }
+}
+
+/// The local restructurings tried by [`DynamicTree::rotate`]. With node `A`
+/// having children `B = {D, E}` and `C = {F, G}`, `XY` swaps `X` and `Y`.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Rotation {
+    None,
+    BF,
+    BG,
+    CD,
+    CE,
+    DF,
+    DG,
+}
+
+/// An incremental AABB tree (bounding-volume hierarchy) of fat boxes.
+///
+/// Proxy ids are node indices; they stay valid until
+/// [`destroy_proxy`](Self::destroy_proxy), across any number of
+/// [`move_proxy`](Self::move_proxy) calls. All operations are deterministic:
+/// the same sequence of calls builds the same tree.
+#[derive(Clone, Debug)]
+pub struct DynamicTree {
+    nodes: Vec<Node>,
+    root: u32,
+    free_list: u32,
+    proxy_count: u32,
+    margin: Real,
+}
+
+impl Default for DynamicTree {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl DynamicTree {
+    /// An empty tree with the default margin [`DEFAULT_AABB_MARGIN`] (0.1 m).
+    pub fn new() -> Self {
+        Self::with_margin(DEFAULT_AABB_MARGIN)
+    }
+
+    /// An empty tree whose fat boxes are the tight boxes grown by `margin`
+    /// metres on every side (`margin >= 0`; 0 for proxies that never move).
+    pub fn with_margin(margin: Real) -> Self {
+        assert!(
+            margin >= 0.0 && margin.is_finite(),
+            "fat-box margin must be finite and non-negative"
+        );
+        DynamicTree {
+            nodes: Vec::new(),
+            root: NULL_NODE,
+            free_list: NULL_NODE,
+            proxy_count: 0,
+            margin,
+        }
+    }
+
+    /// The fat-box margin in metres.
+    #[inline]
+    pub fn margin(&self) -> Real {
+        self.margin
+    }
+
+    /// Number of proxies (leaves) in the tree.
+    #[inline]
+    pub fn proxy_count(&self) -> usize {
+        self.proxy_count as usize
+    }
+
+    /// True when the tree holds no proxy.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.root == NULL_NODE
+    }
+
+    /// The box enclosing every proxy, `None` when the tree is empty.
+    pub fn root_aabb(&self) -> Option<Aabb> {
+        (self.root != NULL_NODE).then(|| self.nodes[self.root as usize].aabb)
+    }
+
+    /// Height of the tree: 0 when empty or with a single proxy, otherwise the
+    /// number of edges on the longest root-to-leaf path.
+    pub fn height(&self) -> u32 {
+        if self.root == NULL_NODE {
+            0
+        } else {
+            u32::from(self.nodes[self.root as usize].height)
+        }
+    }
+
+    /// Sum of the perimeters of the internal nodes divided by the perimeter of
+    /// the root (a quality measure: lower is better; 0 for fewer than 2
+    /// proxies).
+    pub fn area_ratio(&self) -> Real {
+        if self.root == NULL_NODE {
+            return 0.0;
+        }
+        let root_perimeter = self.nodes[self.root as usize].aabb.perimeter();
+        if root_perimeter <= 0.0 {
+            return 0.0;
+        }
+        let total: Real = self
+            .nodes
+            .iter()
+            .filter(|n| n.allocated && !n.is_leaf())
+            .map(|n| n.aabb.perimeter())
+            .sum();
+        total / root_perimeter
+    }
+
+    /// Inserts a proxy for the tight box `aabb` (stored fattened by the
+    /// margin) carrying `user_data`, and returns its id.
+    pub fn create_proxy(&mut self, aabb: Aabb, user_data: u32) -> u32 {
+        debug_assert!(aabb.is_valid(), "invalid AABB {aabb:?}");
+        let id = self.allocate_node();
+        {
+            let node = &mut self.nodes[id as usize];
+            node.aabb = aabb.fattened(self.margin);
+            node.user_data = user_data;
+            node.height = 0;
+        }
+        self.insert_leaf(id);
+        self.proxy_count += 1;
+        id
+    }
+
+    /// Removes a proxy; its id may be reused by a later
+    /// [`create_proxy`](Self::create_proxy).
+    pub fn destroy_proxy(&mut self, id: u32) {
+        self.check_proxy(id);
+        self.remove_leaf(id);
+        self.free_node(id);
+        self.proxy_count -= 1;
+    }
+
+    /// Updates a proxy with its new tight box. Returns `true` when the proxy
+    /// was re-inserted (the tight box left the fat box; the new fat box is the
+    /// tight box grown by the margin), `false` when nothing changed.
+    pub fn move_proxy(&mut self, id: u32, aabb: Aabb) -> bool {
+        self.check_proxy(id);
+        debug_assert!(aabb.is_valid(), "invalid AABB {aabb:?}");
+        if self.nodes[id as usize].aabb.contains(&aabb) {
+            return false;
+        }
+        self.remove_leaf(id);
+        self.nodes[id as usize].aabb = aabb.fattened(self.margin);
+        self.insert_leaf(id);
+        true
+    }
+
+    /// The fat box of a proxy.
+    #[inline]
+    pub fn fat_aabb(&self, id: u32) -> Aabb {
+        self.check_proxy(id);
+        self.nodes[id as usize].aabb
+    }
+
+    /// The payload of a proxy.
+    #[inline]
+    pub fn user_data(&self, id: u32) -> u32 {
+        self.check_proxy(id);
+        self.nodes[id as usize].user_data
+    }
+
+    /// Calls `callback(user_data)` for every proxy whose fat box overlaps
+    /// `aabb` (touching counts), until the callback returns `false`.
+    ///
+    /// Iterative, with a stack on the call stack: no recursion and no heap
+    /// allocation.
+    #[inline]
+    pub fn query<F: FnMut(u32) -> bool>(&self, aabb: &Aabb, mut callback: F) {
+        self.query_proxies(aabb, |_, user_data| callback(user_data));
+    }
+
+    /// Like [`query`](Self::query) but the callback receives
+    /// `(proxy_id, user_data)`.
+    pub fn query_proxies<F: FnMut(u32, u32) -> bool>(&self, aabb: &Aabb, mut callback: F) {
+        if self.root == NULL_NODE {
+            return;
+        }
+        let mut stack = NodeStack::new(self.root);
+        while let Some(index) = stack.pop() {
+            let node = &self.nodes[index as usize];
+            if !node.aabb.overlaps(aabb) {
+                continue;
+            }
+            if node.is_leaf() {
+                if !callback(index, node.user_data) {
+                    return;
+                }
+            } else {
+                stack.push(node.child2);
+                stack.push(node.child1);
+            }
+        }
+    }
+
+    /// Translates every box by `-new_origin` (for large worlds: makes
+    /// `new_origin` the new coordinate origin). The tree shape is unchanged.
+    pub fn shift_origin(&mut self, new_origin: Vec2) {
+        for node in self.nodes.iter_mut().filter(|n| n.allocated) {
+            node.aabb.lower -= new_origin;
+            node.aabb.upper -= new_origin;
+        }
+    }
+
+    /// Checks every structural invariant and panics on the first violation:
+    /// parent/child links, heights, internal boxes equal to the union of their
+    /// children, leaf and free-list counts. Meant for tests and debugging.
+    pub fn validate(&self) {
+        let mut reachable = 0usize;
+        let mut leaves = 0usize;
+        if self.root != NULL_NODE {
+            assert_eq!(
+                self.nodes[self.root as usize].parent, NULL_NODE,
+                "root has a parent"
+            );
+            let mut stack: Vec<u32> = vec![self.root];
+            while let Some(index) = stack.pop() {
+                let node = &self.nodes[index as usize];
+                assert!(node.allocated, "node {index} reachable but free");
+                reachable += 1;
+                if node.is_leaf() {
+                    assert_eq!(node.child2, NULL_NODE, "leaf {index} has child2");
+                    assert_eq!(node.height, 0, "leaf {index} height");
+                    leaves += 1;
+                    continue;
+                }
+                let (c1, c2) = (node.child1, node.child2);
+                assert!(c2 != NULL_NODE && c1 != c2, "node {index} children");
+                let n1 = &self.nodes[c1 as usize];
+                let n2 = &self.nodes[c2 as usize];
+                assert_eq!(n1.parent, index, "child {c1} parent link");
+                assert_eq!(n2.parent, index, "child {c2} parent link");
+                assert_eq!(
+                    node.height,
+                    1 + n1.height.max(n2.height),
+                    "node {index} height"
+                );
+                assert!(
+                    node.aabb.contains(&n1.aabb) && node.aabb.contains(&n2.aabb),
+                    "node {index} does not contain its children"
+                );
+                assert_eq!(
+                    node.aabb,
+                    n1.aabb.union(&n2.aabb),
+                    "node {index} box is not tight"
+                );
+                stack.push(c1);
+                stack.push(c2);
+            }
+        }
+        assert_eq!(leaves, self.proxy_count as usize, "leaf count");
+        if leaves > 0 {
+            assert_eq!(reachable, 2 * leaves - 1, "node count");
+        }
+        let mut free = 0usize;
+        let mut index = self.free_list;
+        while index != NULL_NODE {
+            let node = &self.nodes[index as usize];
+            assert!(!node.allocated, "free node {index} marked allocated");
+            free += 1;
+            assert!(free <= self.nodes.len(), "free list has a cycle");
+            index = node.parent;
+        }
+        assert_eq!(reachable + free, self.nodes.len(), "leaked nodes");
+    }
+
+    /// Calls `f(user_a, user_b)` exactly once for every unordered pair of
+    /// distinct proxies whose fat boxes overlap, by descending the tree
+    /// against itself. `stack` is scratch space (cleared on entry).
+    pub(crate) fn for_each_self_pair<F: FnMut(u32, u32)>(
+        &self,
+        stack: &mut Vec<(u32, u32)>,
+        mut f: F,
+    ) {
+        stack.clear();
+        if self.root == NULL_NODE {
+            return;
+        }
+        stack.push((self.root, self.root));
+        while let Some((a, b)) = stack.pop() {
+            let na = &self.nodes[a as usize];
+            if a == b {
+                if !na.is_leaf() {
+                    stack.push((na.child1, na.child2));
+                    stack.push((na.child2, na.child2));
+                    stack.push((na.child1, na.child1));
+                }
+                continue;
+            }
+            let nb = &self.nodes[b as usize];
+            if !na.aabb.overlaps(&nb.aabb) {
+                continue;
+            }
+            Self::descend(na, a, nb, b, stack, &mut f);
+        }
+    }
+
+    /// Calls `f(user_self, user_other)` for every pair of a proxy of `self`
+    /// and a proxy of `other` whose fat boxes overlap.
+    pub(crate) fn for_each_cross_pair<F: FnMut(u32, u32)>(
+        &self,
+        other: &DynamicTree,
+        stack: &mut Vec<(u32, u32)>,
+        mut f: F,
+    ) {
+        stack.clear();
+        if self.root == NULL_NODE || other.root == NULL_NODE {
+            return;
+        }
+        stack.push((self.root, other.root));
+        while let Some((a, b)) = stack.pop() {
+            let na = &self.nodes[a as usize];
+            let nb = &other.nodes[b as usize];
+            if na.aabb.overlaps(&nb.aabb) {
+                Self::descend(na, a, nb, b, stack, &mut f);
+            }
+        }
+    }
+
+    /// One step of a simultaneous descent of two overlapping nodes: report
+    /// two leaves, otherwise split the larger internal node.
+    #[inline(always)]
+    fn descend<F: FnMut(u32, u32)>(
+        na: &Node,
+        a: u32,
+        nb: &Node,
+        b: u32,
+        stack: &mut Vec<(u32, u32)>,
+        f: &mut F,
+    ) {
+        let split_a = match (na.is_leaf(), nb.is_leaf()) {
+            (true, true) => {
+                f(na.user_data, nb.user_data);
+                return;
+            }
+            (false, true) => true,
+            (true, false) => false,
+            (false, false) => na.aabb.perimeter() >= nb.aabb.perimeter(),
+        };
+        if split_a {
+            stack.push((na.child2, b));
+            stack.push((na.child1, b));
+        } else {
+            stack.push((a, nb.child2));
+            stack.push((a, nb.child1));
+        }
+    }
+
+    // ---- internals ----------------------------------------------------
+
+    #[inline(always)]
+    fn check_proxy(&self, id: u32) {
+        let node = &self.nodes[id as usize];
+        assert!(node.allocated && node.is_leaf(), "invalid proxy id {id}");
+    }
+
+    fn allocate_node(&mut self) -> u32 {
+        if self.free_list != NULL_NODE {
+            let id = self.free_list;
+            let node = &mut self.nodes[id as usize];
+            self.free_list = node.parent;
+            *node = Node {
+                allocated: true,
+                ..Node::EMPTY
+            };
+            id
+        } else {
+            let id = u32::try_from(self.nodes.len())
+                .ok()
+                .filter(|&i| i != NULL_NODE)
+                .expect("dynamic tree node capacity exceeded");
+            self.nodes.push(Node {
+                allocated: true,
+                ..Node::EMPTY
+            });
+            id
+        }
+    }
+
+    fn free_node(&mut self, id: u32) {
+        self.nodes[id as usize] = Node {
+            parent: self.free_list,
+            ..Node::EMPTY
+        };
+        self.free_list = id;
+    }
+
+    /// Branch-and-bound search for the node whose pairing with a new leaf of
+    /// box `d` adds the least total perimeter to the tree.
+    ///
+    /// Making node `S` the sibling costs `perimeter(S ∪ D)` for the new parent
+    /// plus the growth of every ancestor of `S` (the "inherited" cost). A
+    /// subtree rooted at `X` cannot do better than
+    /// `inherited(X) + growth(X) + perimeter(D)`, so the descent stops when
+    /// both children are bounded above the best cost found so far.
+    fn find_best_sibling(&self, d: &Aabb) -> u32 {
+        let d_perimeter = d.perimeter();
+        let mut node = &self.nodes[self.root as usize];
+        let mut best = self.root;
+        let mut best_cost = node.aabb.union(d).perimeter();
+        // Perimeter growth of `node` when the new leaf goes below it.
+        let mut growth = best_cost - node.aabb.perimeter();
+        let mut inherited: Real = 0.0;
+        while !node.is_leaf() {
+            inherited += growth;
+            let mut next = NULL_NODE;
+            let mut next_lower = Real::INFINITY;
+            for child in [node.child1, node.child2] {
+                let c = &self.nodes[child as usize];
+                let direct = c.aabb.union(d).perimeter();
+                let cost = inherited + direct;
+                if cost < best_cost {
+                    best_cost = cost;
+                    best = child;
+                }
+                if !c.is_leaf() {
+                    let child_growth = direct - c.aabb.perimeter();
+                    let lower = inherited + child_growth + d_perimeter;
+                    if lower < next_lower {
+                        next = child;
+                        next_lower = lower;
+                        growth = child_growth;
+                    }
+                }
+            }
+            if next == NULL_NODE || next_lower >= best_cost {
+                break;
+            }
+            node = &self.nodes[next as usize];
+        }
+        best
+    }
+
+    fn insert_leaf(&mut self, leaf: u32) {
+        if self.root == NULL_NODE {
+            self.root = leaf;
+            self.nodes[leaf as usize].parent = NULL_NODE;
+            return;
+        }
+        let leaf_aabb = self.nodes[leaf as usize].aabb;
+        let sibling = self.find_best_sibling(&leaf_aabb);
+        let old_parent = self.nodes[sibling as usize].parent;
+        let new_parent = self.allocate_node();
+        let sibling_node = self.nodes[sibling as usize];
+        {
+            let p = &mut self.nodes[new_parent as usize];
+            p.parent = old_parent;
+            p.child1 = sibling;
+            p.child2 = leaf;
+            p.aabb = sibling_node.aabb.union(&leaf_aabb);
+            p.height = sibling_node.height + 1;
+        }
+        self.nodes[sibling as usize].parent = new_parent;
+        self.nodes[leaf as usize].parent = new_parent;
+        if old_parent == NULL_NODE {
+            self.root = new_parent;
+        } else {
+            self.replace_child(old_parent, sibling, new_parent);
+        }
+        self.rotate(new_parent);
+        self.refit_upwards(old_parent);
+    }
+
+    fn remove_leaf(&mut self, leaf: u32) {
+        if leaf == self.root {
+            self.root = NULL_NODE;
+            return;
+        }
+        let parent = self.nodes[leaf as usize].parent;
+        let p = self.nodes[parent as usize];
+        let grand = p.parent;
+        let sibling = if p.child1 == leaf { p.child2 } else { p.child1 };
+        self.nodes[sibling as usize].parent = grand;
+        self.nodes[leaf as usize].parent = NULL_NODE;
+        self.free_node(parent);
+        if grand == NULL_NODE {
+            self.root = sibling;
+        } else {
+            self.replace_child(grand, parent, sibling);
+            self.refit_upwards(grand);
+        }
+    }
+
+    #[inline]
+    fn replace_child(&mut self, parent: u32, old: u32, new: u32) {
+        let p = &mut self.nodes[parent as usize];
+        if p.child1 == old {
+            p.child1 = new;
+        } else {
+            debug_assert_eq!(p.child2, old);
+            p.child2 = new;
+        }
+    }
+
+    /// Recomputes box and height of an internal node from its children.
+    #[inline]
+    fn refit(&mut self, index: u32) {
+        let n = self.nodes[index as usize];
+        let c1 = &self.nodes[n.child1 as usize];
+        let c2 = &self.nodes[n.child2 as usize];
+        let aabb = c1.aabb.union(&c2.aabb);
+        let height = 1 + c1.height.max(c2.height);
+        let node = &mut self.nodes[index as usize];
+        node.aabb = aabb;
+        node.height = height;
+    }
+
+    /// Refits and rotates from `index` towards the root, stopping at the
+    /// first node whose box and height come out unchanged (its ancestors are
+    /// then unchanged too).
+    fn refit_upwards(&mut self, mut index: u32) {
+        while index != NULL_NODE {
+            let before = self.nodes[index as usize];
+            self.refit(index);
+            self.rotate(index);
+            let after = &self.nodes[index as usize];
+            if after.aabb == before.aabb && after.height == before.height {
+                break;
+            }
+            index = after.parent;
+        }
+    }
+
+    /// Swaps the subtrees `x` and `y` (neither an ancestor of the other)
+    /// between their parents. Boxes and heights are not refitted.
+    fn swap_subtrees(&mut self, x: u32, y: u32) {
+        let px = self.nodes[x as usize].parent;
+        let py = self.nodes[y as usize].parent;
+        self.replace_child(px, x, y);
+        self.replace_child(py, y, x);
+        self.nodes[x as usize].parent = py;
+        self.nodes[y as usize].parent = px;
+    }
+
+    /// Tries the six child/grandchild swaps below internal node `a` and
+    /// applies the one that lowers the summed perimeter the most (the box of
+    /// `a` itself never changes). When two children differ in height by more
+    /// than one, the swap that balances them best is forced instead, which
+    /// bounds the height even when perimeters are degenerate.
+    fn rotate(&mut self, a: u32) {
+        let na = self.nodes[a as usize];
+        if na.height < 2 {
+            return;
+        }
+        let (b, c) = (na.child1, na.child2);
+        let nb = self.nodes[b as usize];
+        let nc = self.nodes[c as usize];
+
+        let mut best = Rotation::None;
+        let mut best_delta: Real = 0.0;
+        let mut consider = |r: Rotation, delta: Real| {
+            if delta < best_delta {
+                best_delta = delta;
+                best = r;
+            }
+        };
+        let (b_perimeter, c_perimeter) = (nb.aabb.perimeter(), nc.aabb.perimeter());
+        let (mut d, mut e, mut f, mut g) = (NULL_NODE, NULL_NODE, NULL_NODE, NULL_NODE);
+        if !nc.is_leaf() {
+            (f, g) = (nc.child1, nc.child2);
+            let fa = self.nodes[f as usize].aabb;
+            let ga = self.nodes[g as usize].aabb;
+            consider(Rotation::BF, nb.aabb.union(&ga).perimeter() - c_perimeter);
+            consider(Rotation::BG, nb.aabb.union(&fa).perimeter() - c_perimeter);
+        }
+        if !nb.is_leaf() {
+            (d, e) = (nb.child1, nb.child2);
+            let da = self.nodes[d as usize].aabb;
+            let ea = self.nodes[e as usize].aabb;
+            consider(Rotation::CD, nc.aabb.union(&ea).perimeter() - b_perimeter);
+            consider(Rotation::CE, nc.aabb.union(&da).perimeter() - b_perimeter);
+            if !nc.is_leaf() {
+                let fa = self.nodes[f as usize].aabb;
+                let ga = self.nodes[g as usize].aabb;
+                let base = b_perimeter + c_perimeter;
+                consider(
+                    Rotation::DF,
+                    fa.union(&ea).perimeter() + da.union(&ga).perimeter() - base,
+                );
+                consider(
+                    Rotation::DG,
+                    ga.union(&ea).perimeter() + fa.union(&da).perimeter() - base,
+                );
+            }
+        }
+
+        // Height guard: an AVL-style rotation when the children are too
+        // unbalanced (promote the taller grandchild of the taller child).
+        let (hb, hc) = (nb.height, nc.height);
+        if hc > hb + 1 {
+            let hf = self.nodes[f as usize].height;
+            let hg = self.nodes[g as usize].height;
+            best = if hf >= hg { Rotation::BF } else { Rotation::BG };
+        } else if hb > hc + 1 {
+            let hd = self.nodes[d as usize].height;
+            let he = self.nodes[e as usize].height;
+            best = if hd >= he { Rotation::CD } else { Rotation::CE };
+        } else if best != Rotation::None
+            && !self.rotation_keeps_height(best, na.height, b, c, d, e, f, g)
+        {
+            best = Rotation::None;
+        }
+
+        match best {
+            Rotation::None => return,
+            Rotation::BF => {
+                self.swap_subtrees(b, f);
+                self.refit(c);
+            }
+            Rotation::BG => {
+                self.swap_subtrees(b, g);
+                self.refit(c);
+            }
+            Rotation::CD => {
+                self.swap_subtrees(c, d);
+                self.refit(b);
+            }
+            Rotation::CE => {
+                self.swap_subtrees(c, e);
+                self.refit(b);
+            }
+            Rotation::DF => {
+                self.swap_subtrees(d, f);
+                self.refit(b);
+                self.refit(c);
+            }
+            Rotation::DG => {
+                self.swap_subtrees(d, g);
+                self.refit(b);
+                self.refit(c);
+            }
+        }
+        self.refit(a);
+    }
+
+    /// True when applying rotation `r` below a node of height `h` would not
+    /// make that node taller.
+    fn rotation_keeps_height(
+        &self,
+        r: Rotation,
+        h: u16,
+        b: u32,
+        c: u32,
+        d: u32,
+        e: u32,
+        f: u32,
+        g: u32,
+    ) -> bool {
+        let hgt = |i: u32| self.nodes[i as usize].height;
+        let new_height = match r {
+            Rotation::None => return true,
+            // A = {F, {B, G}}
+            Rotation::BF => hgt(f).max(1 + hgt(b).max(hgt(g))),
+            Rotation::BG => hgt(g).max(1 + hgt(b).max(hgt(f))),
+            // A = {{C, E}, D}
+            Rotation::CD => hgt(d).max(1 + hgt(c).max(hgt(e))),
+            Rotation::CE => hgt(e).max(1 + hgt(c).max(hgt(d))),
+            // A = {{F, E}, {D, G}}
+            Rotation::DF => (1 + hgt(f).max(hgt(e))).max(1 + hgt(d).max(hgt(g))),
+            Rotation::DG => (1 + hgt(g).max(hgt(e))).max(1 + hgt(f).max(hgt(d))),
+        };
+        new_height < h
+    }
+}
+
+/// Helpers shared by the tests of this module and of the broadphase.
+#[cfg(test)]
+pub(crate) mod test_util {
+    use janus2d_core::geometry::Aabb;
+    use janus2d_core::math::{Real, Vec2};
+
+    /// Small deterministic generator (64-bit LCG, high bits).
+    pub(crate) struct Lcg(pub(crate) u64);
+
+    impl Lcg {
+        pub(crate) fn next_u32(&mut self) -> u32 {
+            self.0 = self
+                .0
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (self.0 >> 32) as u32
+        }
+
+        /// Uniform in `[0, 1)`.
+        pub(crate) fn unit(&mut self) -> Real {
+            (self.next_u32() >> 8) as Real / (1u32 << 24) as Real
+        }
+
+        pub(crate) fn range(&mut self, lo: Real, hi: Real) -> Real {
+            lo + (hi - lo) * self.unit()
+        }
+
+        pub(crate) fn below(&mut self, n: u32) -> u32 {
+            ((u64::from(self.next_u32()) * u64::from(n)) >> 32) as u32
+        }
+    }
+
+    pub(crate) fn boxed(cx: Real, cy: Real, hx: Real, hy: Real) -> Aabb {
+        Aabb::new(Vec2::new(cx - hx, cy - hy), Vec2::new(cx + hx, cy + hy))
+    }
+
+    pub(crate) fn random_box(rng: &mut Lcg, world: Real) -> Aabb {
+        let (cx, cy) = (rng.range(0.0, world), rng.range(0.0, world));
+        boxed(cx, cy, rng.range(0.05, 1.0), rng.range(0.05, 1.0))
+    }
+
+    pub(crate) fn translate(b: Aabb, d: Vec2) -> Aabb {
+        Aabb::new(b.lower + d, b.upper + d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::test_util::{Lcg, boxed, random_box, translate};
+    use super::*;
+
+    #[test]
+    fn sorted_insertion_stays_balanced_and_removal_validates() {
+        let n = 10_000u32;
+        let bound = |count: usize| 2.0 * (count as f64).log2() + 4.0;
+        // A row of unit boxes, inserted left to right.
+        let mut tree = DynamicTree::new();
+        let ids: Vec<u32> = (0..n)
+            .map(|i| tree.create_proxy(boxed(i as Real * 1.1, 0.0, 0.5, 0.5), i))
+            .collect();
+        tree.validate();
+        assert_eq!(tree.proxy_count(), n as usize);
+        let h = tree.height();
+        assert!(f64::from(h) <= bound(n as usize), "row height {h}");
+        assert!(h >= 14, "height {h} below log2(n)");
+
+        // Remove every other proxy.
+        for &id in ids.iter().step_by(2) {
+            tree.destroy_proxy(id);
+        }
+        tree.validate();
+        assert_eq!(tree.proxy_count(), (n / 2) as usize);
+        let h = tree.height();
+        assert!(
+            f64::from(h) <= bound((n / 2) as usize),
+            "height after removal {h}"
+        );
+        for (i, &id) in ids.iter().enumerate().skip(1).step_by(2) {
+            assert_eq!(tree.user_data(id), i as u32);
+        }
+
+        // Remove the rest in a scrambled order, validating periodically.
+        let mut rest: Vec<u32> = ids.iter().copied().skip(1).step_by(2).collect();
+        let mut rng = Lcg(3);
+        for i in (1..rest.len()).rev() {
+            let j = rng.below(i as u32 + 1) as usize;
+            rest.swap(i, j);
+        }
+        for (k, &id) in rest.iter().enumerate() {
+            tree.destroy_proxy(id);
+            if k % 997 == 0 {
+                tree.validate();
+            }
+        }
+        tree.validate();
+        assert!(tree.is_empty());
+        assert_eq!(tree.height(), 0);
+
+        // Node slots are recycled: refilling does not grow the node array.
+        let capacity = tree.nodes.len();
+        for i in 0..n {
+            tree.create_proxy(boxed(0.0, i as Real * 1.1, 0.5, 0.5), i);
+        }
+        tree.validate();
+        assert_eq!(tree.nodes.len(), capacity);
+        let h = tree.height();
+        assert!(f64::from(h) <= bound(n as usize), "column height {h}");
+
+        // A 100 x 100 grid in row-major order.
+        let mut grid = DynamicTree::new();
+        for i in 0..n {
+            let (x, y) = ((i % 100) as Real, (i / 100) as Real);
+            grid.create_proxy(boxed(x, y, 0.5, 0.5), i);
+        }
+        grid.validate();
+        let h = grid.height();
+        assert!(f64::from(h) <= bound(n as usize), "grid height {h}");
+    }
+
+    #[test]
+    fn query_matches_brute_force_and_stops_early() {
+        let mut rng = Lcg(4);
+        let mut tree = DynamicTree::with_margin(0.25);
+        let boxes: Vec<Aabb> = (0..3000).map(|_| random_box(&mut rng, 80.0)).collect();
+        let ids: Vec<u32> = boxes
+            .iter()
+            .enumerate()
+            .map(|(i, b)| tree.create_proxy(*b, i as u32))
+            .collect();
+        for (i, &id) in ids.iter().enumerate() {
+            assert_eq!(tree.fat_aabb(id), boxes[i].fattened(0.25));
+            assert!(!tree.move_proxy(id, translate(boxes[i], Vec2::new(0.2, -0.2))));
+        }
+        let mut total = 0;
+        for _ in 0..50 {
+            let q = boxed(rng.range(0.0, 80.0), rng.range(0.0, 80.0), 5.0, 3.0);
+            let mut found = Vec::new();
+            tree.query(&q, |u| {
+                found.push(u);
+                true
+            });
+            found.sort_unstable();
+            let expected: Vec<u32> = (0..boxes.len() as u32)
+                .filter(|&i| boxes[i as usize].fattened(0.25).overlaps(&q))
+                .collect();
+            assert_eq!(found, expected);
+            total += found.len();
+
+            let mut visits = 0;
+            tree.query(&q, |_| {
+                visits += 1;
+                visits < 3
+            });
+            assert_eq!(visits, expected.len().min(3));
+        }
+        assert!(total > 200);
+
+        // Shifting the origin moves every box and keeps the tree valid.
+        let shift = Vec2::new(10.0, -20.0);
+        tree.shift_origin(shift);
+        tree.validate();
+        for (i, &id) in ids.iter().enumerate() {
+            let expected = boxes[i].fattened(0.25);
+            assert_eq!(tree.fat_aabb(id).lower, expected.lower - shift);
+        }
+    }
+
+    #[test]
+    fn node_stack_spills_in_lifo_order() {
+        let mut stack = NodeStack::new(0);
+        for i in 1..200u32 {
+            stack.push(i);
+        }
+        for i in (0..200u32).rev() {
+            assert_eq!(stack.pop(), Some(i));
+        }
+        assert_eq!(stack.pop(), None);
+    }
+}
