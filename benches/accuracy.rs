@@ -36,7 +36,7 @@
 //! metrics come from the first repeat.
 //!
 //! Output in the out directory: `<scene>.csv` (one row per setting, every
-//! metric of `janus2d_scenes::metrics`), `<scene>_<metric>.svg` (the metric
+//! metric of `janus2d_testbed::metrics`), `<scene>_<metric>.svg` (the metric
 //! against ms/step, one curve per knob, drawn with `plotters`) and
 //! `summary.md` (the tables and the cost per extra substep).
 
@@ -46,9 +46,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use janus2d::prelude::{Real, SolverMode, SolverSettings, WorldDef};
-use janus2d_scenes::metrics::Metrics;
-use janus2d_scenes::metrics::cases::{self, Case};
-use janus2d_scenes::scenes::DT;
+use janus2d_testbed::metrics::Metrics;
+use janus2d_testbed::metrics::cases::{self, Case};
+use janus2d_testbed::scenes::DT;
 use plotters::prelude::*;
 
 type Res<T> = Result<T, Box<dyn Error>>;

@@ -2,7 +2,7 @@
 //! Box2D's benchmark program does (a fresh world per repeat, step 0
 //! untimed, steps 1..N−1 timed as one block, the minimum over repeats),
 //! with the scenes built from the shared descriptions
-//! (`janus2d_scenes::benchmarks`). For Box2D and Rapier in the same run use
+//! (`janus2d_testbed::benchmarks`). For Box2D and Rapier in the same run use
 //! the peers benchmark: `cargo run --release --manifest-path
 //! benches/peers/Cargo.toml -- all`.
 //!
@@ -13,10 +13,10 @@
 //! cargo bench --bench scenes -- tumbler --no-sleep --substeps 8
 //! ```
 
-use janus2d_scenes::benchmarks::{self, NAMES};
-use janus2d_scenes::engine::EngineOptions;
-use janus2d_scenes::janus::Janus;
-use janus2d_scenes::run::time_scene;
+use janus2d_testbed::benchmarks::{self, NAMES};
+use janus2d_testbed::engine::EngineOptions;
+use janus2d_testbed::janus::Janus;
+use janus2d_testbed::run::time_scene;
 
 struct Args {
     scenes: Vec<String>,

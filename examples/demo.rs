@@ -8,7 +8,7 @@
 use std::time::Instant;
 
 use janus2d::prelude::*;
-use janus2d_scenes::scenes::{self, DT};
+use janus2d_testbed::scenes::{self, DT};
 
 fn main() -> Result<(), WorldError> {
     println!("janus2d demo: dt = 1/60 s, 4 substeps, headless\n");

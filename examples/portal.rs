@@ -6,7 +6,7 @@
 
 use janus2d::prelude::*;
 use janus2d::world::PortalEvent;
-use janus2d_scenes::scenes::{self, DT};
+use janus2d_testbed::scenes::{self, DT};
 
 fn main() -> Result<(), WorldError> {
     let (mut scene, _pair) = scenes::portal_drop(&WorldDef::default());

@@ -4,7 +4,7 @@
 //! `cargo run --release --example portal_svg`.
 
 use janus2d::prelude::{BodyHandle, Shape, World, WorldDef};
-use janus2d_scenes::scenes::{self, DT};
+use janus2d_testbed::scenes::{self, DT};
 use plotters::prelude::*;
 
 /// World outlines of every shape of a body (polygons as vertex loops).

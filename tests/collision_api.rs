@@ -3,7 +3,7 @@
 
 use janus2d::base::geometry::GeometryError;
 use janus2d::prelude::*;
-use janus2d_scenes::scenes::{self, DT};
+use janus2d_testbed::scenes::{self, DT};
 
 fn world() -> World {
     World::new(scenes::shared_settings()).unwrap()

@@ -59,14 +59,14 @@ fn determinism_hash_matches_golden_value() {
 
 /// Pyramid 20 plus the portal drop, 120 steps: a hash of every body.
 fn contact_scene_hash() -> u64 {
-    let def = janus2d_scenes::scenes::shared_settings();
-    let mut pyramid = janus2d_scenes::scenes::large_pyramid(&def, 20);
+    let def = janus2d_testbed::scenes::shared_settings();
+    let mut pyramid = janus2d_testbed::scenes::large_pyramid(&def, 20);
     for _ in 0..120 {
         pyramid.world.step(1.0 / 60.0).unwrap();
     }
     #[cfg(feature = "portals")]
     {
-        let (mut drop, _) = janus2d_scenes::scenes::portal_drop(&def);
+        let (mut drop, _) = janus2d_testbed::scenes::portal_drop(&def);
         for _ in 0..90 {
             drop.world.step(1.0 / 60.0).unwrap();
         }

@@ -3,7 +3,7 @@
 
 use janus2d::prelude::*;
 use janus2d::world::SleepSettings;
-use janus2d_scenes::scenes::DT;
+use janus2d_testbed::scenes::DT;
 
 fn boxes_on_ground(def: WorldDef, restitution: Real) -> (World, Vec<BodyHandle>) {
     let mut world = World::new(def).unwrap();
@@ -72,7 +72,7 @@ fn no_portals_means_no_portal_stage() {
 #[cfg(feature = "portals")]
 #[test]
 fn portals_present_means_portal_stage_runs() {
-    let (mut scene, _) = janus2d_scenes::scenes::portal_drop(&WorldDef::default());
+    let (mut scene, _) = janus2d_testbed::scenes::portal_drop(&WorldDef::default());
     scene.world.step(DT).unwrap();
     assert!(scene.world.counters().portal_stage_ran);
 }
@@ -242,7 +242,7 @@ fn joint_change_wakes_both_bodies() {
 #[cfg(feature = "portals")]
 #[test]
 fn portal_crossing_keeps_bodies_awake() {
-    let (mut scene, _) = janus2d_scenes::scenes::portal_drop(&WorldDef::default());
+    let (mut scene, _) = janus2d_testbed::scenes::portal_drop(&WorldDef::default());
     let mut asleep_while_crossing = false;
     for _ in 0..120 {
         scene.world.step(DT).unwrap();

@@ -1,12 +1,12 @@
-//! Contact hard cases of the scene definitions (`janus2d_scenes`), at the shared settings
+//! Contact hard cases of the scene definitions (`janus2d_testbed`), at the shared settings
 //! (4 substeps, sleep off), each with its bound. Box2D v3.1.1's figure at 4
 //! substeps is quoted in each test's doc; set `JANUS2D_REPORT=1` to print
 //! the measured figures.
 
 use janus2d::prelude::*;
-use janus2d_scenes::hard;
-use janus2d_scenes::janus::Janus;
-use janus2d_scenes::scenes::{self, DT};
+use janus2d_testbed::hard;
+use janus2d_testbed::janus::Janus;
+use janus2d_testbed::scenes::{self, DT};
 
 fn report() -> bool {
     std::env::var("JANUS2D_REPORT").is_ok()
@@ -155,7 +155,7 @@ fn vertical_stack_of_20_meets_box2d() {
     );
 }
 
-/// Runs a shared hard case (`janus2d_scenes::hard`) on janus2d with the
+/// Runs a shared hard case (`janus2d_testbed::hard`) on janus2d with the
 /// metric code every engine of the peers benchmark is measured by, prints
 /// its figures under `JANUS2D_REPORT`, and asserts its bounds.
 fn assert_case(case: hard::HardCase) {

@@ -1,8 +1,8 @@
-//! Joint-only hard cases of the scene definitions (`janus2d_scenes`): the stretched chain
+//! Joint-only hard cases of the scene definitions (`janus2d_testbed`): the stretched chain
 //! and the 160-plank bridge (planks need no collision here).
 
 use janus2d::prelude::*;
-use janus2d_scenes::{hard, scenes};
+use janus2d_testbed::{hard, scenes};
 
 const DT: Real = 1.0 / 60.0;
 

@@ -19,15 +19,13 @@
 //! through its joint. `JANUS2D_REPORT=1` prints the
 //! worst error as a fraction of its bound.
 
-mod portal_support;
-
 use janus2d_constraints::JointForest;
 use janus2d_constraints::revolute::{RevoluteJoint, RevoluteJointDef};
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::constraint::{Constraint, StepContext};
 use janus2d_core::math::{Real, Vec2};
 use janus2d_core::solver::SolverSettings;
-use portal_support::*;
+use janus2d_testbed::support::*;
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
 

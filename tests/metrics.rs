@@ -1,8 +1,8 @@
-//! Tests of `janus2d_scenes::metrics`: each metric against a motion whose answer is
+//! Tests of `janus2d_testbed::metrics`: each metric against a motion whose answer is
 //! known in closed form. No timing here (that lives in the accuracy bench).
 
 use janus2d::prelude::*;
-use janus2d_scenes::metrics::{
+use janus2d_testbed::metrics::{
     self, ExtraMetric, Tracker, TrackerConfig, cases, free_fall_energy_loss, kinetic_energy,
     potential_energy, total_energy,
 };
@@ -400,7 +400,7 @@ fn short_stack_stands_and_loses_energy() {
 #[test]
 fn portal_metrics_measure_a_passive_crossing() {
     use janus2d::world::{PortalDef, PortalPairDef};
-    use janus2d_scenes::metrics::{ExtraMetric, PortalError, PortalMomentumError};
+    use janus2d_testbed::metrics::{ExtraMetric, PortalError, PortalMomentumError};
     let mut world = zero_gravity();
     let wall = |world: &mut World, p: Vec2| {
         let b = world.create_body(&BodyDef::fixed(p)).unwrap();

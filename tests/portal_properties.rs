@@ -13,8 +13,6 @@
 //! `eps/ε + ε²` error of a central difference (see `fd_tolerance`).
 //! `JANUS2D_REPORT=1` prints the worst measured ratio of error to bound.
 
-mod portal_support;
-
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use janus2d_constraints::parts::clamp_length;
@@ -24,7 +22,7 @@ use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::constraint::{Constraint, ConstraintRows, SolverMode, StepContext};
 use janus2d_core::math::{Real, Rot, Vec2, vec_is_finite, wrap_angle};
 use janus2d_core::solver::{SolverSettings, solve_step};
-use portal_support::*;
+use janus2d_testbed::support::*;
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
 

@@ -1,10 +1,10 @@
-//! The portal scenes of the scene definitions (`janus2d_scenes`), each with its bound.
+//! The portal scenes of the scene definitions (`janus2d_testbed`), each with its bound.
 //! Set `JANUS2D_REPORT=1` to print the measured figures.
 #![cfg(feature = "portals")]
 
 use janus2d::prelude::*;
 use janus2d::world::{MassModel, PortalDef, PortalEvent, PortalPairDef};
-use janus2d_scenes::scenes::{self, DT};
+use janus2d_testbed::scenes::{self, DT};
 
 fn report() -> bool {
     std::env::var("JANUS2D_REPORT").is_ok()

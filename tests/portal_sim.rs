@@ -5,14 +5,12 @@
 //!
 //! `JANUS2D_REPORT=1` prints the measured worst figures.
 
-mod portal_support;
-
 use janus2d_constraints::portal::PortalConstraint;
 use janus2d_constraints::portal_map::Portal;
 use janus2d_core::body::BodyType;
 use janus2d_core::math::{EPSILON, PI, Real, TAU, Vec2, cross};
 use janus2d_core::solver::{SolverSettings, solve_step};
-use portal_support::*;
+use janus2d_testbed::support::*;
 
 const DT: Real = 1.0 / 60.0;
 

@@ -12,14 +12,12 @@
 //! size of the terms, except the central difference (`eps/ε + ε²`).
 //! `JANUS2D_REPORT=1` prints the worst error as a fraction of its bound.
 
-mod portal_support;
-
 use janus2d_constraints::revolute::{RevoluteJoint, RevoluteJointDef};
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::constraint::{Constraint, ConstraintRows, StepContext};
 use janus2d_core::math::{Real, Vec2, wrap_angle};
 use janus2d_core::solver::SolverSettings;
-use portal_support::*;
+use janus2d_testbed::support::*;
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
 

@@ -52,10 +52,10 @@ use boxdd::{
     BodyId, BodyType, ChainDef, ConstraintTuning, Filter, Foundation, MassData, Polygon, Position,
     RevoluteJointDef, ShapeDef, Transform, Vec2, WorkerCount, World, WorldScalar, WorldTransform,
 };
-use janus2d_scenes::desc::{
+use janus2d_testbed::desc::{
     Action, BodyDesc, BodyKind, FilterDesc, Geometry, RevoluteDesc, SceneDesc, Settings, ShapeDesc,
 };
-use janus2d_scenes::engine::{BodyState, Engine, EngineOptions, StageTimes};
+use janus2d_testbed::engine::{BodyState, Engine, EngineOptions, StageTimes};
 
 /// A description vector as a Box2D local vector.
 fn local(x: f64, y: f64) -> Vec2 {

@@ -29,11 +29,11 @@ mod rapier;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use janus2d_scenes::benchmarks::{self, BOX2D_TEN};
-use janus2d_scenes::engine::{EngineOptions, StageTimes};
-use janus2d_scenes::hard::{self, Bound, Figure, HardCase};
-use janus2d_scenes::janus::Janus;
-use janus2d_scenes::run::{Timing, time_scene};
+use janus2d_testbed::benchmarks::{self, BOX2D_TEN};
+use janus2d_testbed::engine::{EngineOptions, StageTimes};
+use janus2d_testbed::hard::{self, Bound, Figure, HardCase};
+use janus2d_testbed::janus::Janus;
+use janus2d_testbed::run::{Timing, time_scene};
 use plotters::prelude::*;
 
 use box2d::Box2d;
@@ -129,7 +129,7 @@ fn pool(threads: usize) -> rayon::ThreadPool {
 /// Times one scene on one engine with `threads` workers.
 fn time_on(
     engine: &str,
-    desc: &janus2d_scenes::desc::SceneDesc,
+    desc: &janus2d_testbed::desc::SceneDesc,
     threads: usize,
     args: &Args,
 ) -> Result<Timing, String> {

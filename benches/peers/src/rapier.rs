@@ -89,10 +89,10 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use janus2d_scenes::desc::{
+use janus2d_testbed::desc::{
     Action, BodyDesc, BodyKind, FilterDesc, Geometry, RevoluteDesc, SceneDesc, ShapeDesc, v,
 };
-use janus2d_scenes::engine::{BodyState, Engine, EngineOptions, StageTimes};
+use janus2d_testbed::engine::{BodyState, Engine, EngineOptions, StageTimes};
 use rapier2d::prelude::*;
 
 /// A Rapier vector from description components.

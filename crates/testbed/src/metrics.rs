@@ -7,7 +7,7 @@
 //! after every step; [`Tracker::metrics`] returns the figures so far.
 //!
 //! ```
-//! use janus2d_scenes::metrics::{Tracker, TrackerConfig};
+//! use janus2d_testbed::metrics::{Tracker, TrackerConfig};
 //! use janus2d_core::body::BodyDef;
 //! use janus2d_core::math::Vec2;
 //! use janus2d_world::{World, WorldDef};
@@ -564,7 +564,7 @@ pub fn free_fall_energy_loss(mass: f64, gravity: f64, h: f64, substeps: u64) -> 
     substeps as f64 * 0.5 * mass * gravity * gravity * h * h
 }
 
-/// The hard scenes of the scene definitions (`janus2d_scenes`) that the accuracy sweep
+/// The hard scenes of the scene definitions (`janus2d_testbed`) that the accuracy sweep
 /// runs, each built exactly as `tests/hard_cases.rs` and
 /// `tests/joint_scenes.rs` build them, with the probe and tracker settings
 /// that measure them.

@@ -1,6 +1,27 @@
-//! Helpers shared by the portal test suites: body specifications built into
-//! a `BodySet`, random strategies, and momentum sums in f64.
-#![allow(dead_code)]
+//! Helpers shared by the constraint-level integration tests (the portal,
+//! revolute and joint-tree property tests and the portal simulation tests):
+//! body specifications built into a [`BodySet`], portal constraint cases,
+//! random [`proptest`](mod@proptest) strategies for both, momentum sums in
+//! f64, and a property runner ([`check`]) that reports the worst error as a
+//! fraction of its bound.
+//!
+//! The tests take everything at once with `use janus2d_testbed::support::*;`.
+//! Nothing here needs the `portals` feature: the portal constraint and the
+//! portal map live in `janus2d-constraints`, which has no such feature.
+//!
+//! ```
+//! use janus2d_core::body::BodySet;
+//! use janus2d_core::math::Vec2;
+//! use janus2d_testbed::support::{BodySpec, total_momentum};
+//!
+//! let mut set = BodySet::new();
+//! let mut spec = BodySpec::dynamic(Vec2::new(1.0, 0.0), 2.0, 0.5);
+//! spec.v = Vec2::new(0.0, 3.0);
+//! let h = spec.create(&mut set);
+//! let ([px, py, l], _scale) = total_momentum(&set, &[h]);
+//! assert_eq!((px, py), (0.0, 6.0));
+//! assert!((l - 6.0).abs() < 1e-6); // m (x vy − y vx)
+//! ```
 
 use janus2d_constraints::portal::{PortalConstraint, PortalConstraintDef};
 use janus2d_constraints::portal_map::{
@@ -454,13 +475,20 @@ pub fn portal_case(
 #[allow(clippy::unnecessary_cast)] // `Real` is f64 with the feature (a const: no fn call)
 pub const EPS: f64 = EPSILON as f64;
 
+/// Whether `JANUS2D_REPORT` is set: the tests then print their measured
+/// worst figures.
 pub fn report() -> bool {
     std::env::var("JANUS2D_REPORT").is_ok()
 }
 
-/// Runs a property (shared by the portal and revolute property tests) over at least 256 cases; the closure returns the
-/// measured error as a fraction of its bound (≤ 1 passes), and the worst
-/// fraction is printed under `JANUS2D_REPORT`.
+/// Runs a property over at least 256 cases (more if `PROPTEST_CASES` asks;
+/// no failure persistence); the closure returns the measured error as a
+/// fraction of its bound (≤ 1 passes), and the worst fraction is printed
+/// under `JANUS2D_REPORT`.
+///
+/// # Panics
+///
+/// When a case fails (with the minimal failing input) or the runner gives up.
 pub fn check<S: Strategy>(
     name: &str,
     strategy: S,

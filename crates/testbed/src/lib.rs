@@ -1,8 +1,10 @@
-//! # janus2d-scenes
+//! # janus2d-testbed
 //!
-//! The standard scenes — Box2D v3's ten benchmark scenes, the hard cases
+//! The test bed of janus2d's tests, benchmarks and examples (not published):
+//! the standard scenes — Box2D v3's ten benchmark scenes, the hard cases
 //! and the portal scenes — defined once, as engine-neutral data, with the
-//! code that runs and measures them on any engine.
+//! code that runs and measures them on any engine, and the helpers the
+//! integration tests share.
 //!
 //! | module          | contents                                                        |
 //! |-----------------|-----------------------------------------------------------------|
@@ -15,13 +17,14 @@
 //! | [`run`]         | timing as Box2D does it, and the sanity figures                 |
 //! | [`scenes`]      | the scenes built into janus2d worlds (tests, examples, benches) |
 //! | [`metrics`]     | janus2d's error tracker for the tests and the accuracy sweep    |
+//! | [`support`]     | the integration tests' helpers: body specs, strategies, momenta |
 //!
 //! The peers benchmark (`benches/peers`) adds Box2D's and Rapier's
 //! adapters; this crate depends on janus2d alone.
 //!
 //! ```
-//! use janus2d_scenes::engine::Engine;
-//! use janus2d_scenes::{hard, janus::Janus};
+//! use janus2d_testbed::engine::Engine;
+//! use janus2d_testbed::{hard, janus::Janus};
 //! let case = hard::single_box();
 //! let outcome = case.run::<Janus>().unwrap();
 //! assert!(outcome.pass, "{:?}", outcome.failed);
@@ -36,3 +39,4 @@ pub mod measure;
 pub mod metrics;
 pub mod run;
 pub mod scenes;
+pub mod support;
