@@ -12,10 +12,9 @@ use plotters::prelude::*;
 #[allow(clippy::unnecessary_cast)]
 fn outlines(world: &World, body: BodyHandle) -> Vec<Vec<(f64, f64)>> {
     let xf = world.transform(body).unwrap();
-    let c = world.collision();
     let mut out = Vec::new();
-    for &s in &c.body_shapes[body.index as usize] {
-        if let Shape::Polygon(p) = c.shapes[s as usize].geometry {
+    for s in world.body_shapes(body).unwrap() {
+        if let Shape::Polygon(p) = world.shape(s).unwrap().geometry {
             let mut pts: Vec<(f64, f64)> = p.vertices[..p.count]
                 .iter()
                 .map(|v| {

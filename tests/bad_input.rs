@@ -88,13 +88,18 @@ fn stale_and_foreign_handles_are_rejected() {
     unchanged(&mut world, |w| {
         assert_eq!(w.position(extra), Err(WorldError::StaleBody));
         assert_eq!(w.destroy_body(extra), Err(WorldError::StaleBody));
-        assert_eq!(w.position(foreign), Err(WorldError::StaleBody));
-        assert_eq!(w.destroy_body(foreign), Err(WorldError::StaleBody));
+        // Another world's handle is its own error, not a stale one.
+        assert_eq!(w.position(foreign), Err(WorldError::ForeignHandle));
+        assert_eq!(w.destroy_body(foreign), Err(WorldError::ForeignHandle));
+        assert_eq!(w.apply_torque(foreign, 1.0), Err(WorldError::ForeignHandle));
         assert_eq!(
             w.create_revolute_joint(&RevoluteJointDef::new(a, extra, Vec2::ZERO, Vec2::ZERO)),
             Err(WorldError::StaleBody)
         );
-        assert_eq!(w.destroy_joint(foreign_joint), Err(WorldError::StaleJoint));
+        assert_eq!(
+            w.destroy_joint(foreign_joint),
+            Err(WorldError::ForeignHandle)
+        );
         assert_eq!(w.apply_torque(extra, 1.0), Err(WorldError::StaleBody));
     });
     // A destroyed joint's handle goes stale too.

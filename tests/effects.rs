@@ -235,7 +235,7 @@ fn joint_change_wakes_both_bodies() {
         world.step(DT).unwrap();
     }
     assert!(world.is_sleeping(bodies[4]));
-    world.revolute_joint_def_mut(j).unwrap().enable_motor = true;
+    world.enable_joint_motor(j, true).unwrap();
     assert!(!world.is_sleeping(bodies[3]) && !world.is_sleeping(bodies[4]));
 }
 

@@ -28,10 +28,9 @@ fn kinetic_energy(world: &World, b: BodyHandle) -> Real {
 /// Width of a body's shapes along a world direction, m.
 fn extent(world: &World, b: BodyHandle, dir: Vec2) -> Real {
     let xf = world.transform(b).unwrap();
-    let c = world.collision();
     let (mut lo, mut hi) = (Real::MAX, Real::MIN);
-    for &s in &c.body_shapes[b.index as usize] {
-        let (a, z) = c.shapes[s as usize].geometry.support_extent(&xf, dir);
+    for s in world.body_shapes(b).unwrap() {
+        let (a, z) = world.shape(s).unwrap().geometry.support_extent(&xf, dir);
         lo = lo.min(a);
         hi = hi.max(z);
     }
@@ -99,7 +98,7 @@ fn portal_drop_exits_sideways_at_impact_speed() {
         // No copy touches a portal's wall while it is in the aperture.
         if world.crossing_count() > 0 {
             let clone = world.clone_of(body).unwrap();
-            for c in &world.collision().contacts {
+            for c in world.contacts() {
                 let copy = [body, clone]
                     .iter()
                     .any(|b| c.body_a == *b || c.body_b == *b);

@@ -179,6 +179,16 @@ pub struct RevoluteJoint {
 }
 
 impl RevoluteJoint {
+    /// Rows this joint adds to the solver when enabled: two point rows,
+    /// two limit rows (lower and upper) when the limit is on, one motor row
+    /// and one spring row when those are on.
+    #[must_use]
+    pub fn row_count(&self) -> usize {
+        2 + 2 * usize::from(self.def.enable_limit)
+            + usize::from(self.def.enable_motor)
+            + usize::from(self.def.enable_spring)
+    }
+
     /// A joint from a definition (validate it first).
     pub fn new(def: RevoluteJointDef) -> Self {
         RevoluteJoint {

@@ -47,17 +47,8 @@ pub enum BodyType {
 }
 
 /// A generational handle to a body. A handle to a destroyed body is stale
-/// and is rejected with a typed error.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct BodyHandle {
-    /// Slot index.
-    pub index: u32,
-    /// Generation of the slot when the handle was issued.
-    pub generation: u32,
-    /// Id of the body set (world) that issued the handle: a handle from
-    /// another world is rejected as foreign.
-    pub owner: u32,
-}
+/// and is rejected with a typed error; one from another world is foreign.
+pub type BodyHandle = crate::handle::Handle<crate::handle::BodyTag>;
 
 static NEXT_OWNER_ID: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(1);
 
@@ -325,11 +316,7 @@ impl BodySim {
             max_linear_speed: 0.0,
             max_rotation: 0.0,
             sleep_time: 0.0,
-            handle: BodyHandle {
-                index: u32::MAX,
-                generation: 0,
-                owner: 0,
-            },
+            handle: BodyHandle::new(u32::MAX, 0, 0),
             body_type: BodyType::Static,
         }
     }
@@ -575,11 +562,7 @@ impl BodySet {
         record.user_data = def.user_data;
         record.mass_override = def.mass.is_some();
         record.fixed_rotation = def.fixed_rotation;
-        let handle = BodyHandle {
-            index,
-            generation: record.generation,
-            owner: self.owner,
-        };
+        let handle = BodyHandle::new(index, record.generation, self.owner);
         let transform = Transform::new(def.position, def.angle);
         let mass = def.mass.unwrap_or(BodyMass::new(1.0, 1.0));
         let mut sim = BodySim {
@@ -743,6 +726,15 @@ impl BodySet {
         rec.location
     }
 
+    /// Where a body lives, or why its handle does not resolve.
+    pub fn check(&self, handle: BodyHandle) -> Result<BodyLocation, crate::handle::HandleError> {
+        if handle.owner != self.owner {
+            return Err(crate::handle::HandleError::Foreign);
+        }
+        self.location(handle)
+            .ok_or(crate::handle::HandleError::Stale)
+    }
+
     /// True when the handle refers to a live body.
     pub fn contains(&self, handle: BodyHandle) -> bool {
         self.location(handle).is_some()
@@ -827,11 +819,8 @@ impl BodySet {
     /// Handles of all live bodies in slot order (deterministic).
     pub fn handles(&self) -> impl Iterator<Item = BodyHandle> + '_ {
         self.records.iter().enumerate().filter_map(|(i, r)| {
-            r.location.map(|_| BodyHandle {
-                index: i as u32,
-                generation: r.generation,
-                owner: self.owner,
-            })
+            r.location
+                .map(|_| BodyHandle::new(i as u32, r.generation, self.owner))
         })
     }
 

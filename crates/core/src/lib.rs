@@ -11,6 +11,7 @@
 //! | [`constraint`] | the constraint trait, rows, blocks, the step context        |
 //! | [`solver`]     | the soft step and the PGS baseline                          |
 //! | [`geometry`]   | shapes, mass properties, bounding boxes, manifolds          |
+//! | [`handle`]     | one generational handle type for every kind of object       |
 //! | [`slots`]      | generational slots behind handles                           |
 //! | [`union_find`] | union–find over dense indices (islands, joint forests)      |
 //!
@@ -19,6 +20,7 @@
 pub mod body;
 pub mod constraint;
 pub mod geometry;
+pub mod handle;
 pub mod math;
 pub mod slots;
 pub mod softness;
@@ -27,6 +29,7 @@ pub mod union_find;
 
 pub use body::{BodyDef, BodyHandle, BodyMass, BodySet, BodyState, BodyType};
 pub use constraint::{Constraint, ConstraintBatch, ConstraintRows, SolverMode, StepContext};
+pub use handle::{Handle, HandleError};
 pub use math::{Real, Rot, Transform, Vec2};
 pub use softness::Softness;
 pub use solver::SolverSettings;

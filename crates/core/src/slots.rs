@@ -76,6 +76,33 @@ impl<T> Slots<T> {
         self.entries.get(index as usize).and_then(|e| e.1.as_ref())
     }
 
+    /// The value in live slot `index`; for indices the store itself handed
+    /// out (a free slot here is a bug in the caller, not user input).
+    ///
+    /// # Panics
+    /// When slot `index` is free.
+    #[inline]
+    #[track_caller]
+    pub fn live(&self, index: u32) -> &T {
+        self.entries[index as usize]
+            .1
+            .as_ref()
+            .expect("slot index handed out by this store")
+    }
+
+    /// Mutable access to live slot `index`; see [`Slots::live`].
+    ///
+    /// # Panics
+    /// When slot `index` is free.
+    #[inline]
+    #[track_caller]
+    pub fn live_mut(&mut self, index: u32) -> &mut T {
+        self.entries[index as usize]
+            .1
+            .as_mut()
+            .expect("slot index handed out by this store")
+    }
+
     /// Mutable access to slot `index` if it is live (any generation).
     pub fn at_mut(&mut self, index: u32) -> Option<&mut T> {
         self.entries
@@ -112,6 +139,25 @@ impl<T> Slots<T> {
     /// One past the largest index ever used.
     pub fn capacity(&self) -> u32 {
         self.entries.len() as u32
+    }
+
+    /// The value a handle refers to, checking its world and generation.
+    pub fn resolve<K>(
+        &self,
+        handle: crate::handle::Handle<K>,
+        owner: u32,
+    ) -> Result<&T, crate::handle::HandleError> {
+        if handle.owner != owner {
+            return Err(crate::handle::HandleError::Foreign);
+        }
+        self.get(handle.index, handle.generation)
+            .ok_or(crate::handle::HandleError::Stale)
+    }
+
+    /// The handle of live slot `index` in world `owner`.
+    #[must_use]
+    pub fn handle<K>(&self, index: u32, owner: u32) -> crate::handle::Handle<K> {
+        crate::handle::Handle::new(index, self.generation(index), owner)
     }
 
     /// Live values with their index, in index order.

@@ -136,7 +136,68 @@ impl Default for SolverSettings {
     }
 }
 
+/// A solver setting that is out of its range, named by its field.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SettingsError {
+    /// The field is NaN.
+    NonFinite(&'static str),
+    /// The field is negative, or an iteration count is 0 (substeps) or
+    /// above 1024.
+    OutOfRange(&'static str),
+}
+
 impl SolverSettings {
+    /// Checks every field: no real is NaN or negative, `substeps` is in
+    /// `1..=1024`, the iteration counts at most 1024. The error names the
+    /// first field that is wrong.
+    ///
+    /// ```
+    /// use janus2d_core::solver::{SettingsError, SolverSettings};
+    /// let bad = SolverSettings { contact_hertz: -1.0, ..SolverSettings::default() };
+    /// assert_eq!(bad.validate(), Err(SettingsError::OutOfRange("contact_hertz")));
+    /// assert!(SolverSettings::default().validate().is_ok());
+    /// ```
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        let reals = [
+            (self.baumgarte, "baumgarte"),
+            (self.contact_hertz, "contact_hertz"),
+            (self.contact_damping_ratio, "contact_damping_ratio"),
+            (self.contact_push_max_velocity, "contact_push_max_velocity"),
+            (self.joint_hertz, "joint_hertz"),
+            (self.joint_damping_ratio, "joint_damping_ratio"),
+            (
+                self.joint_max_correction_speed,
+                "joint_max_correction_speed",
+            ),
+            (self.restitution_threshold, "restitution_threshold"),
+            (self.contact_mass_ratio_cap, "contact_mass_ratio_cap"),
+            (self.joint_mass_ratio_cap, "joint_mass_ratio_cap"),
+            (self.direct_joint_hertz, "direct_joint_hertz"),
+            (
+                self.direct_joint_max_correction_speed,
+                "direct_joint_max_correction_speed",
+            ),
+        ];
+        for (v, name) in reals {
+            if v.is_nan() {
+                return Err(SettingsError::NonFinite(name));
+            }
+            if v < 0.0 {
+                return Err(SettingsError::OutOfRange(name));
+            }
+        }
+        if self.substeps == 0 || self.substeps > 1024 {
+            return Err(SettingsError::OutOfRange("substeps"));
+        }
+        if self.velocity_iterations > 1024 {
+            return Err(SettingsError::OutOfRange("velocity_iterations"));
+        }
+        if self.relax_iterations > 1024 {
+            return Err(SettingsError::OutOfRange("relax_iterations"));
+        }
+        Ok(())
+    }
+
     /// Builds the per-step context.
     pub fn context(&self, dt: Real, gravity: Vec2) -> StepContext {
         let (substeps, h) = match self.mode {

@@ -15,14 +15,16 @@ pub enum WorldError {
     Joint(JointError),
     /// Invalid shape input (degenerate polygon, non-positive radius, …).
     Geometry(GeometryError),
-    /// A body handle that is stale (destroyed) or was never issued by this world.
+    /// A body handle that is stale (the body was destroyed).
     StaleBody,
-    /// A joint handle that is stale or foreign.
+    /// A joint handle that is stale.
     StaleJoint,
-    /// A shape handle that is stale or foreign.
+    /// A shape handle that is stale.
     StaleShape,
-    /// A portal pair handle that is stale or foreign.
+    /// A portal pair handle that is stale.
     StalePortal,
+    /// A handle (of any kind) that another world issued.
+    ForeignHandle,
     /// Invalid portal input (η ≤ 0, zero direction, non-positive half-width).
     Portal(PortalError),
     /// A time step that is not finite or not positive.
@@ -41,10 +43,11 @@ impl std::fmt::Display for WorldError {
             WorldError::Body(e) => write!(f, "body: {e}"),
             WorldError::Joint(e) => write!(f, "joint: {e}"),
             WorldError::Geometry(e) => write!(f, "shape: {e}"),
-            WorldError::StaleBody => write!(f, "stale or foreign body handle"),
-            WorldError::StaleJoint => write!(f, "stale or foreign joint handle"),
-            WorldError::StaleShape => write!(f, "stale or foreign shape handle"),
-            WorldError::StalePortal => write!(f, "stale or foreign portal pair handle"),
+            WorldError::StaleBody => write!(f, "stale body handle"),
+            WorldError::StaleJoint => write!(f, "stale joint handle"),
+            WorldError::StaleShape => write!(f, "stale shape handle"),
+            WorldError::StalePortal => write!(f, "stale portal pair handle"),
+            WorldError::ForeignHandle => write!(f, "handle issued by another world"),
             WorldError::Portal(e) => write!(f, "portal: {e}"),
             WorldError::InvalidTimeStep => write!(f, "time step must be finite and > 0"),
             WorldError::NonFinite(what) => write!(f, "`{what}` is not finite"),
@@ -61,6 +64,15 @@ impl From<BodyError> for WorldError {
         match e {
             BodyError::StaleHandle => WorldError::StaleBody,
             e => WorldError::Body(e),
+        }
+    }
+}
+
+impl From<janus2d_core::solver::SettingsError> for WorldError {
+    fn from(e: janus2d_core::solver::SettingsError) -> Self {
+        match e {
+            janus2d_core::solver::SettingsError::NonFinite(name) => WorldError::NonFinite(name),
+            janus2d_core::solver::SettingsError::OutOfRange(name) => WorldError::OutOfRange(name),
         }
     }
 }

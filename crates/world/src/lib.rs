@@ -1,33 +1,47 @@
 //! # janus2d-world
 //!
-//! The world: the stepping loop, bodies, joints, the collision pipeline and
-//! portals.
+//! The world: the stepping loop and the stages it calls, each owning its
+//! data.
 //!
-//! | module        | what                                              |
-//! |---------------|---------------------------------------------------|
-//! | [`world`]     | [`World`], [`WorldDef`], handles, the step        |
-//! | [`error`]     | [`WorldError`], the typed errors of the API        |
-//! | [`collision`] | shapes, contacts, events                          |
-//! | [`broadphase`]| pair finding over two dynamic trees               |
-//! | [`dynamic_tree`]| the dynamic AABB tree: insert, remove, query    |
-//! | [`portals`]   | portal pairs, crossings, clones, handover         |
-//! | [`sleep`]     | resting islands leave the solver                  |
-//! | [`profile`]   | per-stage timings and work counters               |
+//! | module           | what                                                     |
+//! |------------------|----------------------------------------------------------|
+//! | [`world`]        | [`World`], [`WorldDef`], the public API and the step      |
+//! | [`error`]        | [`WorldError`], the typed errors of the API               |
+//! | [`shapes`]       | the shape store: geometry, material, filter, body → shapes |
+//! | [`contacts`]     | the contact life cycle; awake and sleeping contacts, body → contacts |
+//! | [`narrowphase`]  | manifolds of awake contacts; contact constraints          |
+//! | [`collision`]    | the collision stage: shapes + broadphase + contacts + events |
+//! | [`broadphase`]   | pair finding over two dynamic trees                      |
+//! | [`dynamic_tree`] | the dynamic AABB tree (insert, remove, rotate, query)     |
+//! | [`joints`]       | the joint set: slots, per-type storage, body → joints, no-collide pairs |
+//! | [`islands`]      | sleep timers and islands; sleeping islands leave every per-step loop |
+//! | [`portal`]       | portal pairs, crossings, clones, aperture clipping        |
+//! | [`profile`]      | per-stage timings and work counters                      |
+//! | [`hash`]         | the state hash of determinism checks                     |
+//!
+//! See `docs/architecture.md` for the stage table.
 
 pub mod broadphase;
 pub mod collision;
+pub mod contacts;
 pub mod dynamic_tree;
 pub mod error;
-#[cfg(feature = "portals")]
-pub mod portals;
+pub mod hash;
+pub mod islands;
+pub mod joints;
+pub mod narrowphase;
+pub mod portal;
 pub mod profile;
-pub mod sleep;
+pub mod shapes;
 pub mod world;
 
-pub use collision::{CollisionEvents, Filter, ShapeDef, ShapeHandle};
+pub use collision::CollisionCounters;
+pub use contacts::{CollisionEvents, Contact, ContactPointData, ShapePairEvent};
 pub use error::WorldError;
+pub use islands::SleepSettings;
+pub use joints::{JointHandle, JointKind, JointSet};
 #[cfg(feature = "portals")]
-pub use portals::{MassModel, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle};
+pub use portal::{MassModel, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle};
 pub use profile::{StepCounters, StepProfile};
-pub use sleep::SleepSettings;
-pub use world::{JointHandle, StepEvents, World, WorldDef};
+pub use shapes::{Filter, ShapeData, ShapeDef, ShapeHandle};
+pub use world::{StepEvents, World, WorldDef};

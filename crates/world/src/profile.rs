@@ -69,3 +69,48 @@ pub struct StepCounters {
     /// Sleeping bodies.
     pub sleeping_bodies: usize,
 }
+
+/// What the step's counters are gathered from.
+pub(crate) struct CounterSources<'a> {
+    pub(crate) collision_ran: bool,
+    pub(crate) collision: crate::collision::CollisionCounters,
+    pub(crate) contacts: usize,
+    pub(crate) joint_rows: usize,
+    pub(crate) direct_joint_rows: usize,
+    pub(crate) portal_stage_ran: bool,
+    /// Portal rows, bodies tested, crossings in progress.
+    pub(crate) portals: (usize, usize, usize),
+    pub(crate) gravity: bool,
+    pub(crate) bodies: &'a janus2d_core::body::BodySet,
+}
+
+impl StepCounters {
+    /// The counters of a step, from what each stage reported.
+    pub(crate) fn gather(s: &CounterSources<'_>) -> StepCounters {
+        let cc = s.collision;
+        let ran = s.collision_ran;
+        let (portal_rows, portal_bodies_tested, portal_crossings) = s.portals;
+        StepCounters {
+            collision_ran: ran,
+            pairs_tested: cc.pairs_tested,
+            pairs_created: cc.pairs_created,
+            proxies_moved: cc.proxies_moved,
+            contacts: s.contacts,
+            contact_rows: if ran { cc.contact_rows } else { 0 },
+            joint_rows: s.joint_rows,
+            direct_joint_rows: s.direct_joint_rows,
+            portal_rows,
+            portal_stage_ran: s.portal_stage_ran,
+            portal_bodies_tested,
+            portal_crossings,
+            restitution_contacts: if ran { cc.restitution_contacts } else { 0 },
+            gravity_bodies: if s.gravity {
+                s.bodies.moving_count()
+            } else {
+                0
+            },
+            awake_bodies: s.bodies.moving_count(),
+            sleeping_bodies: s.bodies.sleeping_count(),
+        }
+    }
+}

@@ -2,10 +2,17 @@
 //!
 //! ```text
 //! World::step(dt)
-//!   ├─ validate dt
+//!   ├─ validate dt; bodies created asleep go to sleep (islands)
+//!   ├─ portal clipping (portal stage; a no-op without portal pairs)
+//!   ├─ broadphase: new pairs ─ narrowphase ─ wake touched islands ─ contact constraints
 //!   ├─ solve_step (janus2d-core): prepare ─ substeps ─ restitution ─ store ─ finalize
-//!   └─ events: non-finite bodies (reset and reported)
+//!   ├─ store impulses ─ move proxies
+//!   ├─ portal crossings (commands applied by the world)
+//!   ├─ islands: sleep timers, resting islands sleep
+//!   └─ counters, events (non-finite bodies, contacts, sensors)
 //! ```
+//!
+//! The stage table with each stage's data is in `docs/architecture.md`.
 //!
 //! Everything is created from definition structs with defaults and returns
 //! a generational handle; every call that rejects its input leaves the world
@@ -15,12 +22,18 @@ use janus2d_constraints::{ContactConstraint, RevoluteJoint, RevoluteJointDef};
 use janus2d_core::BodyMass;
 use janus2d_core::body::{BodyDef, BodyHandle, BodyLocation, BodySet, BodyType, validate_mass};
 use janus2d_core::constraint::{ConstraintBatch, StepContext};
-use janus2d_core::geometry::{MassData, Shape};
+use janus2d_core::geometry::Shape;
+use janus2d_core::handle::HandleError;
 use janus2d_core::math::{Real, Rot, Transform, Vec2, cross, vec_is_finite};
 use janus2d_core::solver::{SolverProfile, SolverSettings, solve_step};
 
-use crate::collision::{Collision, CollisionCounters, CollisionEvents, ShapeDef, ShapeHandle};
+use crate::collision::{Collision, CollisionCounters, CollisionEvents};
+use crate::contacts::Contact;
 use crate::error::WorldError;
+use crate::islands::{Islands, SleepInput, SleepSettings};
+use crate::joints::{JointHandle, JointSet};
+use crate::portal::PortalStage;
+use crate::shapes::{ShapeData, ShapeDef, ShapeHandle};
 
 /// Default gravity, m/s² (usual (0, −10)).
 pub const DEFAULT_GRAVITY: Vec2 = Vec2::new(0.0, -10.0);
@@ -33,7 +46,7 @@ pub struct WorldDef {
     /// Solver accuracy and softness settings.
     pub solver: SolverSettings,
     /// When bodies fall asleep (on by default, as in Box2D and Rapier).
-    pub sleep: crate::sleep::SleepSettings,
+    pub sleep: SleepSettings,
 }
 
 impl Default for WorldDef {
@@ -41,20 +54,9 @@ impl Default for WorldDef {
         WorldDef {
             gravity: DEFAULT_GRAVITY,
             solver: SolverSettings::default(),
-            sleep: crate::sleep::SleepSettings::default(),
+            sleep: SleepSettings::default(),
         }
     }
-}
-
-/// A generational handle to a joint.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct JointHandle {
-    /// Slot index.
-    pub index: u32,
-    /// Generation of the slot when issued.
-    pub generation: u32,
-    /// Id of the world that issued it (a foreign handle is rejected).
-    pub owner: u32,
 }
 
 /// Events of the last step, read after `step`.
@@ -67,26 +69,19 @@ pub struct StepEvents {
     pub collision: CollisionEvents,
 }
 
-/// The simulation world.
+/// The simulation world: it owns one value of each stage and calls them
+/// in order, passing each what it reads.
 pub struct World {
     gravity: Vec2,
     settings: SolverSettings,
     bodies: BodySet,
-    revolute: Vec<RevoluteJoint>,
-    /// The joint forest of the last step (direct point-row solve).
-    joint_forest: janus2d_constraints::JointForest,
-    revolute_handles: Vec<JointHandle>,
-    /// Joint handle slots → index into `revolute`.
-    joint_slots: janus2d_core::slots::Slots<u32>,
+    joints: JointSet,
     collision: Collision,
     contact_constraints: Vec<ContactConstraint>,
-    #[cfg(feature = "portals")]
-    pub(crate) portals: crate::portals::Portals,
-    pub(crate) islands: crate::sleep::Islands,
-    pub(crate) sleep_settings: crate::sleep::SleepSettings,
+    pub(crate) portals: PortalStage,
+    islands: Islands,
+    sleep_settings: SleepSettings,
     wake_list: Vec<BodyHandle>,
-    /// Bodies created with `awake = false`, put to sleep at the next step.
-    pending_sleep: Vec<BodyHandle>,
     events: StepEvents,
     step_profile: crate::profile::StepProfile,
     counters: crate::profile::StepCounters,
@@ -105,24 +100,20 @@ impl World {
         if !vec_is_finite(def.gravity) {
             return Err(WorldError::NonFinite("gravity"));
         }
-        validate_settings(&def.solver)?;
+        def.solver.validate()?;
+        def.sleep.validate()?;
         let bodies = BodySet::new();
         Ok(World {
             gravity: def.gravity,
             settings: def.solver,
             collision: Collision::new(bodies.owner()),
             contact_constraints: Vec::new(),
-            #[cfg(feature = "portals")]
-            portals: crate::portals::Portals::default(),
-            islands: crate::sleep::Islands::default(),
+            portals: PortalStage::default(),
+            islands: Islands::default(),
             sleep_settings: def.sleep,
             wake_list: Vec::new(),
-            pending_sleep: Vec::new(),
+            joints: JointSet::new(bodies.owner()),
             bodies,
-            revolute: Vec::new(),
-            joint_forest: Default::default(),
-            revolute_handles: Vec::new(),
-            joint_slots: janus2d_core::slots::Slots::default(),
             events: StepEvents::default(),
             step_profile: crate::profile::StepProfile::default(),
             counters: crate::profile::StepCounters::default(),
@@ -151,7 +142,7 @@ impl World {
 
     /// Replaces the solver settings (validated).
     pub fn set_settings(&mut self, settings: SolverSettings) -> Result<(), WorldError> {
-        validate_settings(&settings)?;
+        settings.validate()?;
         self.settings = settings;
         Ok(())
     }
@@ -168,7 +159,7 @@ impl World {
 
     /// Number of live joints.
     pub fn joint_count(&self) -> usize {
-        self.revolute.len()
+        self.joints.len()
     }
 
     /// Steps taken so far.
@@ -211,55 +202,69 @@ impl World {
     pub fn create_body(&mut self, def: &BodyDef) -> Result<BodyHandle, WorldError> {
         let handle = self.bodies.create(def)?;
         if !def.awake && def.body_type != BodyType::Static {
-            self.pending_sleep.push(handle);
+            self.islands.push_pending(handle);
         }
         Ok(handle)
     }
 
-    /// Destroys a body and every joint attached to it.
+    /// Destroys a body, its shapes (their contacts end, with end events)
+    /// and every joint attached to it; the bodies it touched wake up.
+    ///
+    /// Walks the body's own contacts and joints, never the whole world.
     pub fn destroy_body(&mut self, body: BodyHandle) -> Result<(), WorldError> {
-        if !self.bodies.contains(body) {
-            return Err(WorldError::StaleBody);
-        }
-        #[cfg(feature = "portals")]
-        self.portals_forget_body(body);
-        let touching: Vec<BodyHandle> = self
-            .collision
-            .contacts
-            .iter()
-            .filter(|c| c.body_a == body || c.body_b == body)
-            .map(|c| if c.body_a == body { c.body_b } else { c.body_a })
-            .collect();
-        self.wake_all(&touching);
-        self.wake_body(body);
-        let attached: Vec<JointHandle> = self
-            .revolute
-            .iter()
-            .zip(&self.revolute_handles)
-            .filter(|(j, _)| j.def.body_a == body || j.def.body_b == body)
-            .map(|(_, h)| *h)
-            .collect();
-        for h in attached {
-            self.destroy_joint(h)?;
-        }
-        let shapes = self
-            .collision
-            .body_shapes
-            .get(body.index as usize)
-            .cloned()
-            .unwrap_or_default();
-        for s in shapes {
-            self.collision.remove_shape(s);
-        }
-        self.bodies.destroy(body)?;
+        self.check_body(body)?;
+        self.portal_forget_body(body);
+        self.destroy_body_unchecked(body);
         Ok(())
     }
 
-    fn check_body(&self, body: BodyHandle) -> Result<(), WorldError> {
-        if self.bodies.contains(body) {
-            Ok(())
+    /// Destroys a live body (checked by the caller, crossings already
+    /// ended).
+    pub(crate) fn destroy_body_unchecked(&mut self, body: BodyHandle) {
+        let touching: smallvec::SmallVec<[BodyHandle; 8]> = self
+            .collision
+            .contacts
+            .of_body(body)
+            .iter()
+            .filter_map(|&id| self.collision.contacts.get(id))
+            .map(|c| c.other(body))
+            .collect();
+        self.wake_all(&touching);
+        self.wake_body(body);
+        let attached: smallvec::SmallVec<[JointHandle; 4]> =
+            self.joints.of_body(body).iter().copied().collect();
+        for h in attached {
+            self.remove_joint(h);
+        }
+        let shapes: smallvec::SmallVec<[u32; 4]> = self
+            .collision
+            .shapes
+            .of_body(body)
+            .iter()
+            .copied()
+            .collect();
+        for s in shapes {
+            self.collision.remove_shape(s);
+        }
+        self.islands.forget(body);
+        let destroyed = self.bodies.destroy(body);
+        debug_assert!(destroyed.is_ok(), "checked by the caller");
+    }
+
+    /// `StaleBody`, or `ForeignHandle` for another world's handle.
+    fn body_error(&self, body: BodyHandle) -> WorldError {
+        if body.owner == self.bodies.owner() {
+            WorldError::StaleBody
         } else {
-            Err(WorldError::StaleBody)
+            WorldError::ForeignHandle
+        }
+    }
+
+    fn check_body(&self, body: BodyHandle) -> Result<(), WorldError> {
+        match self.bodies.check(body) {
+            Ok(_) => Ok(()),
+            Err(HandleError::Foreign) => Err(WorldError::ForeignHandle),
+            Err(HandleError::Stale) => Err(WorldError::StaleBody),
         }
     }
 
@@ -268,7 +273,7 @@ impl World {
         self.bodies
             .sim(body)
             .map(|s| s.transform)
-            .ok_or(WorldError::StaleBody)
+            .ok_or_else(|| self.body_error(body))
     }
 
     /// Body origin, m.
@@ -286,21 +291,21 @@ impl World {
         self.bodies
             .sim(body)
             .map(|s| s.center)
-            .ok_or(WorldError::StaleBody)
+            .ok_or_else(|| self.body_error(body))
     }
 
     /// Linear velocity of the centre of mass, m/s.
     pub fn linear_velocity(&self, body: BodyHandle) -> Result<Vec2, WorldError> {
         self.bodies
             .linear_velocity(body)
-            .ok_or(WorldError::StaleBody)
+            .ok_or_else(|| self.body_error(body))
     }
 
     /// Angular velocity, rad/s.
     pub fn angular_velocity(&self, body: BodyHandle) -> Result<Real, WorldError> {
         self.bodies
             .angular_velocity(body)
-            .ok_or(WorldError::StaleBody)
+            .ok_or_else(|| self.body_error(body))
     }
 
     /// Mass, kg (0 for static and kinematic bodies).
@@ -308,7 +313,7 @@ impl World {
         self.bodies
             .sim(body)
             .map(|s| s.mass)
-            .ok_or(WorldError::StaleBody)
+            .ok_or_else(|| self.body_error(body))
     }
 
     /// Rotational inertia about the centre of mass, kg·m².
@@ -316,12 +321,14 @@ impl World {
         self.bodies
             .sim(body)
             .map(|s| s.inertia)
-            .ok_or(WorldError::StaleBody)
+            .ok_or_else(|| self.body_error(body))
     }
 
     /// Body type.
     pub fn body_type(&self, body: BodyHandle) -> Result<BodyType, WorldError> {
-        self.bodies.body_type(body).ok_or(WorldError::StaleBody)
+        self.bodies
+            .body_type(body)
+            .ok_or_else(|| self.body_error(body))
     }
 
     /// Sets the linear velocity of a moving body's centre of mass.
@@ -361,6 +368,7 @@ impl World {
             return Err(WorldError::NonFinite("transform"));
         }
         self.wake_body(body);
+        self.check_body(body)?;
         let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
         sim.transform = Transform {
             p: position,
@@ -402,6 +410,7 @@ impl World {
             return Err(WorldError::NonFinite("force"));
         }
         self.wake_body(body);
+        self.check_body(body)?;
         let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
         if sim.body_type == BodyType::Dynamic {
             sim.force += force;
@@ -426,6 +435,7 @@ impl World {
             return Err(WorldError::NonFinite("torque"));
         }
         self.wake_body(body);
+        self.check_body(body)?;
         let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
         if sim.body_type == BodyType::Dynamic {
             sim.torque += torque;
@@ -444,6 +454,7 @@ impl World {
             return Err(WorldError::NonFinite("impulse"));
         }
         self.wake_body(body);
+        self.check_body(body)?;
         let loc = self.bodies.location(body).ok_or(WorldError::StaleBody)?;
         if let BodyLocation::Moving(i) = loc {
             let sim = &self.bodies.sims[i as usize];
@@ -467,6 +478,7 @@ impl World {
             return Err(WorldError::NonFinite("impulse"));
         }
         self.wake_body(body);
+        self.check_body(body)?;
         let loc = self.bodies.location(body).ok_or(WorldError::StaleBody)?;
         if let BodyLocation::Moving(i) = loc {
             let ii = self.bodies.sims[i as usize].inv_inertia;
@@ -477,7 +489,9 @@ impl World {
 
     // ----- joints -----------------------------------------------------------
 
-    /// Creates a revolute joint.
+    /// Creates a revolute joint. Its bodies and `collide_connected` are
+    /// fixed for its life; with `collide_connected = false` the contacts
+    /// between its bodies end (walking one body's contacts).
     pub fn create_revolute_joint(
         &mut self,
         def: &RevoluteJointDef,
@@ -487,77 +501,114 @@ impl World {
         self.check_body(def.body_b)?;
         self.wake_body(def.body_a);
         self.wake_body(def.body_b);
-        let (index, generation) = self.joint_slots.insert(self.revolute.len() as u32);
-        let handle = JointHandle {
-            index,
-            generation,
-            owner: self.bodies.owner(),
-        };
-        self.revolute.push(RevoluteJoint::new(def.clone()));
-        self.revolute_handles.push(handle);
+        let handle = self.joints.insert_revolute(def);
         if !def.collide_connected {
-            let key = body_pair_key(def.body_a, def.body_b);
-            *self.collision.no_collide_pairs.entry(key).or_insert(0) += 1;
             self.collision
                 .remove_contacts_between(def.body_a, def.body_b);
         }
         Ok(handle)
     }
 
-    fn joint_index(&self, joint: JointHandle) -> Result<usize, WorldError> {
-        if joint.owner != self.bodies.owner() {
-            return Err(WorldError::StaleJoint);
+    /// Removes a live joint, waking its bodies.
+    fn remove_joint(&mut self, joint: JointHandle) {
+        if let Ok((a, b)) = self.joints.remove(joint) {
+            self.wake_body(a);
+            self.wake_body(b);
         }
-        self.joint_slots
-            .get(joint.index, joint.generation)
-            .map(|&i| i as usize)
-            .ok_or(WorldError::StaleJoint)
     }
 
     /// Destroys a joint.
     pub fn destroy_joint(&mut self, joint: JointHandle) -> Result<(), WorldError> {
-        let i = self.joint_index(joint)?;
-        let (a, b) = (self.revolute[i].def.body_a, self.revolute[i].def.body_b);
-        self.wake_body(a);
-        self.wake_body(b);
-        let def = &self.revolute[i].def;
-        if !def.collide_connected {
-            let key = body_pair_key(def.body_a, def.body_b);
-            if let Some(n) = self.collision.no_collide_pairs.get_mut(&key) {
-                *n -= 1;
-                if *n == 0 {
-                    self.collision.no_collide_pairs.remove(&key);
-                }
-            }
-        }
-        self.revolute.swap_remove(i);
-        self.revolute_handles.swap_remove(i);
-        if i < self.revolute.len() {
-            let moved = self.revolute_handles[i];
-            if let Some(slot) = self.joint_slots.at_mut(moved.index) {
-                *slot = i as u32;
-            }
-        }
-        self.joint_slots.remove(joint.index, joint.generation);
+        self.joints.kind(joint)?;
+        self.remove_joint(joint);
         Ok(())
     }
 
     /// A revolute joint.
     pub fn revolute_joint(&self, joint: JointHandle) -> Result<&RevoluteJoint, WorldError> {
-        let i = self.joint_index(joint)?;
-        Ok(&self.revolute[i])
+        self.joints.revolute(joint)
     }
 
-    /// Mutable access to a revolute joint's settings (motor speed, limits, …).
-    pub fn revolute_joint_def_mut(
+    /// The joints (read access: handles, per-body lists, kinds).
+    pub fn joints(&self) -> &JointSet {
+        &self.joints
+    }
+
+    fn wake_pair(
         &mut self,
-        joint: JointHandle,
-    ) -> Result<&mut RevoluteJointDef, WorldError> {
-        let i = self.joint_index(joint)?;
-        let (a, b) = (self.revolute[i].def.body_a, self.revolute[i].def.body_b);
+        bodies: Result<(BodyHandle, BodyHandle), WorldError>,
+    ) -> Result<(), WorldError> {
+        let (a, b) = bodies?;
         self.wake_body(a);
         self.wake_body(b);
-        Ok(&mut self.revolute[i].def)
+        Ok(())
+    }
+
+    /// Sets a joint's angle limits, rad (`lower ≤ upper`); wakes its bodies.
+    pub fn set_joint_limits(
+        &mut self,
+        joint: JointHandle,
+        lower: Real,
+        upper: Real,
+    ) -> Result<(), WorldError> {
+        let r = self.joints.set_limits(joint, lower, upper);
+        self.wake_pair(r)
+    }
+
+    /// Turns a joint's limit on or off.
+    pub fn enable_joint_limit(&mut self, joint: JointHandle, on: bool) -> Result<(), WorldError> {
+        let r = self.joints.enable_limit(joint, on);
+        self.wake_pair(r)
+    }
+
+    /// Sets a joint's motor speed, rad/s.
+    pub fn set_joint_motor_speed(
+        &mut self,
+        joint: JointHandle,
+        speed: Real,
+    ) -> Result<(), WorldError> {
+        let r = self.joints.set_motor_speed(joint, speed);
+        self.wake_pair(r)
+    }
+
+    /// Sets a joint's largest motor torque, N·m (≥ 0).
+    pub fn set_joint_max_motor_torque(
+        &mut self,
+        joint: JointHandle,
+        torque: Real,
+    ) -> Result<(), WorldError> {
+        let r = self.joints.set_max_motor_torque(joint, torque);
+        self.wake_pair(r)
+    }
+
+    /// Turns a joint's motor on or off.
+    pub fn enable_joint_motor(&mut self, joint: JointHandle, on: bool) -> Result<(), WorldError> {
+        let r = self.joints.enable_motor(joint, on);
+        self.wake_pair(r)
+    }
+
+    /// Sets a joint's spring: stiffness, Hz, and damping ratio (both ≥ 0).
+    pub fn set_joint_spring(
+        &mut self,
+        joint: JointHandle,
+        hertz: Real,
+        damping_ratio: Real,
+    ) -> Result<(), WorldError> {
+        let r = self.joints.set_spring(joint, hertz, damping_ratio);
+        self.wake_pair(r)
+    }
+
+    /// Turns a joint's spring on or off.
+    pub fn enable_joint_spring(&mut self, joint: JointHandle, on: bool) -> Result<(), WorldError> {
+        let r = self.joints.enable_spring(joint, on);
+        self.wake_pair(r)
+    }
+
+    /// Enables or disables a joint (one a portal disabled can be enabled
+    /// again).
+    pub fn set_joint_enabled(&mut self, joint: JointHandle, on: bool) -> Result<(), WorldError> {
+        let r = self.joints.set_enabled(joint, on);
+        self.wake_pair(r)
     }
 
     /// Distance between a joint's two world anchors, m.
@@ -567,12 +618,13 @@ impl World {
 
     /// Handles of every joint, in storage order.
     pub fn joint_handles(&self) -> &[JointHandle] {
-        &self.revolute_handles
+        self.joints.handles()
     }
 
     /// The largest joint gap in the world, m.
     pub fn max_joint_gap(&self) -> Real {
-        self.revolute
+        self.joints
+            .revolute
             .iter()
             .map(|j| j.gap(&self.bodies))
             .fold(0.0, Real::max)
@@ -599,9 +651,10 @@ impl World {
         geometry: impl Into<Shape>,
     ) -> Result<ShapeHandle, WorldError> {
         let geometry = geometry.into();
-        let ty = self.body_type(body)?;
-        validate_shape_def(def)?;
-        crate::collision::validate_geometry(&geometry)?;
+        self.check_body(body)?;
+        let ty = self.bodies.body_type(body).unwrap_or(BodyType::Static);
+        def.validate()?;
+        geometry.validate()?;
         let mass_override = self
             .bodies
             .record(body)
@@ -612,7 +665,7 @@ impl World {
             && !mass_override
             && has_area
             && def.density <= 0.0
-            && !self.has_mass_from_shapes(body)
+            && self.collision.shapes.mass_of(body).mass <= 0.0
         {
             return Err(WorldError::OutOfRange("density"));
         }
@@ -631,8 +684,8 @@ impl World {
 
     /// Removes a shape (its contacts end; the body's mass is recomputed).
     pub fn destroy_shape(&mut self, shape: ShapeHandle) -> Result<(), WorldError> {
-        let slot = self.collision.slot(shape).ok_or(WorldError::StaleShape)?;
-        let body = self.collision.shapes[slot as usize].body;
+        let slot = self.collision.shapes.slot(shape, self.bodies.owner())?;
+        let body = self.collision.shapes.at(slot).body;
         self.wake_body(body);
         self.collision.remove_shape(slot);
         let mass_override = self
@@ -640,42 +693,33 @@ impl World {
             .record(body)
             .map(|r| r.mass_override)
             .unwrap_or(true);
-        if self.body_type(body)? == BodyType::Dynamic && !mass_override {
+        if self.bodies.body_type(body) == Some(BodyType::Dynamic) && !mass_override {
             self.update_mass_from_shapes(body);
         }
         Ok(())
     }
 
-    fn has_mass_from_shapes(&self, body: BodyHandle) -> bool {
-        self.shape_mass(body).mass > 0.0
+    /// A shape: its body, geometry, material and box.
+    pub fn shape(&self, shape: ShapeHandle) -> Result<&ShapeData, WorldError> {
+        let slot = self.collision.shapes.slot(shape, self.bodies.owner())?;
+        Ok(self.collision.shapes.at(slot))
     }
 
-    fn shape_mass(&self, body: BodyHandle) -> MassData {
-        let mut total = MassData::default();
-        let mut first = Vec2::ZERO;
-        let mut second: Real = 0.0;
-        if let Some(list) = self.collision.body_shapes.get(body.index as usize) {
-            for &s in list {
-                let shape = &self.collision.shapes[s as usize];
-                if shape.def.density <= 0.0 {
-                    continue;
-                }
-                let md = shape.geometry.compute_mass(shape.def.density);
-                total.mass += md.mass;
-                first += md.mass * md.center;
-                second += md.rotational_inertia + md.mass * md.center.length_squared();
-            }
-        }
-        if total.mass > 0.0 {
-            total.center = first / total.mass;
-            total.rotational_inertia =
-                (second - total.mass * total.center.length_squared()).max(0.0);
-        }
-        total
+    /// The shapes of a body, in creation order.
+    pub fn body_shapes(&self, body: BodyHandle) -> Result<Vec<ShapeHandle>, WorldError> {
+        self.check_body(body)?;
+        let owner = self.bodies.owner();
+        Ok(self
+            .collision
+            .shapes
+            .of_body(body)
+            .iter()
+            .map(|&s| self.collision.shapes.handle_of(s, owner))
+            .collect())
     }
 
     fn update_mass_from_shapes(&mut self, body: BodyHandle) {
-        let md = self.shape_mass(body);
+        let md = self.collision.shapes.mass_of(body);
         let fixed = self
             .bodies
             .record(body)
@@ -704,12 +748,35 @@ impl World {
 
     /// Number of live shapes.
     pub fn shape_count(&self) -> usize {
-        self.collision.shape_count()
+        self.collision.shapes.len()
     }
 
-    /// The collision pipeline (shapes, contacts) for reading.
-    pub fn collision(&self) -> &Collision {
-        &self.collision
+    /// Every contact, awake ones first, then those of sleeping islands.
+    pub fn contacts(&self) -> impl Iterator<Item = &Contact> {
+        self.collision.contacts.iter()
+    }
+
+    /// Number of contacts (awake and asleep).
+    pub fn contact_count(&self) -> usize {
+        self.collision.contacts.len()
+    }
+
+    /// Number of awake contacts (what the narrowphase visits).
+    pub fn awake_contact_count(&self) -> usize {
+        self.collision.contacts.awake().len()
+    }
+
+    /// Bodies whose shapes' fat boxes overlap `aabb` (each once, sorted).
+    pub fn bodies_in_box(&self, aabb: &janus2d_core::geometry::Aabb) -> Vec<BodyHandle> {
+        let mut out = Vec::new();
+        let shapes = &self.collision.shapes;
+        self.collision.broadphase.query(aabb, |_, payload| {
+            out.push(shapes.at(payload).body);
+            true
+        });
+        out.sort();
+        out.dedup();
+        out
     }
 
     /// Counters of the last collision pass.
@@ -726,8 +793,8 @@ impl World {
     /// (0 when nothing penetrates).
     pub fn max_penetration(&self) -> Real {
         let mut worst: Real = 0.0;
-        for c in &self.collision.contacts {
-            if c.touching && !c.sensor && c.enabled {
+        for c in self.collision.contacts.iter() {
+            if c.is_solid_touching() {
                 for p in &c.points[..c.point_count] {
                     worst = worst.max(-p.separation);
                 }
@@ -736,113 +803,52 @@ impl World {
         worst
     }
 
-    // ----- helpers for the portal and sleep stages ----------------------------
+    // ----- sleep --------------------------------------------------------------
 
-    pub(crate) fn pending_sleep_is_empty(&self) -> bool {
-        self.pending_sleep.is_empty()
+    /// Wakes the island of `body` (no effect on awake or static bodies).
+    pub fn wake_body(&mut self, body: BodyHandle) {
+        self.islands
+            .wake(body, &mut self.bodies, &mut self.collision.contacts);
     }
 
-    /// A body created asleep that the user touched before the first step
-    /// stays awake.
-    pub(crate) fn cancel_pending_sleep(&mut self, body: BodyHandle) {
-        self.pending_sleep.retain(|b| *b != body);
+    /// Wakes every island in the list.
+    fn wake_all(&mut self, bodies: &[BodyHandle]) {
+        for b in bodies {
+            self.wake_body(*b);
+        }
     }
 
-    /// Mutable body storage (crate-internal).
-    pub(crate) fn bodies_mut(&mut self) -> &mut BodySet {
-        &mut self.bodies
+    /// True when the body sleeps.
+    pub fn is_sleeping(&self, body: BodyHandle) -> bool {
+        self.bodies.is_sleeping(body)
+    }
+
+    /// Number of sleeping bodies.
+    pub fn sleeping_body_count(&self) -> usize {
+        self.bodies.sleeping_count()
+    }
+
+    /// Number of awake dynamic and kinematic bodies.
+    pub fn awake_body_count(&self) -> usize {
+        self.bodies.moving_count()
     }
 
     /// The sleep settings.
-    pub fn sleep_settings(&self) -> crate::sleep::SleepSettings {
+    pub fn sleep_settings(&self) -> SleepSettings {
         self.sleep_settings
     }
 
-    /// Changes the sleep settings; turning sleep off wakes every body.
-    pub fn set_sleep_settings(&mut self, settings: crate::sleep::SleepSettings) {
+    /// Changes the sleep settings (validated); turning sleep off wakes
+    /// every body.
+    pub fn set_sleep_settings(&mut self, settings: SleepSettings) -> Result<(), WorldError> {
+        settings.validate()?;
         if !settings.enabled {
             let sleeping: Vec<BodyHandle> =
                 self.bodies.sleeping_sims.iter().map(|s| s.handle).collect();
             self.wake_all(&sleeping);
         }
         self.sleep_settings = settings;
-    }
-
-    /// How far a body's shapes reach from its centre of mass, m.
-    pub(crate) fn body_reach(&self, body: BodyHandle) -> Real {
-        let Some(sim) = self.bodies.sim(body) else {
-            return 0.0;
-        };
-        let Some(list) = self.collision.body_shapes.get(body.index as usize) else {
-            return 0.0;
-        };
-        list.iter()
-            .map(|&s| {
-                let a = &self.collision.shapes[s as usize].aabb;
-                (a.lower - sim.center)
-                    .abs()
-                    .max((a.upper - sim.center).abs())
-                    .length()
-            })
-            .fold(0.0, Real::max)
-    }
-
-    /// Pairs of bodies held together by enabled joints or touching solid
-    /// contacts (the edges of the island graph).
-    pub(crate) fn constraint_edges(&self) -> impl Iterator<Item = (BodyHandle, BodyHandle)> + '_ {
-        let joints = self
-            .revolute
-            .iter()
-            .filter(|j| j.enabled)
-            .map(|j| (j.def.body_a, j.def.body_b));
-        let contacts = self
-            .collision
-            .contacts
-            .iter()
-            .filter(|c| c.touching && !c.sensor && c.enabled)
-            .map(|c| (c.body_a, c.body_b));
-        joints.chain(contacts)
-    }
-
-    #[cfg(feature = "portals")]
-    /// Sets a dynamic body's mass properties without touching its velocity.
-    pub(crate) fn apply_mass_keep_velocity(&mut self, body: BodyHandle, mass: BodyMass) {
-        let fixed = self
-            .bodies
-            .record(body)
-            .map(|r| r.fixed_rotation)
-            .unwrap_or(false);
-        self.bodies.apply_mass(body, mass, fixed);
-    }
-
-    #[cfg(feature = "portals")]
-    /// Joints attached to a body, in storage order.
-    pub(crate) fn joints_attached_to(&self, body: BodyHandle) -> Vec<JointHandle> {
-        self.revolute
-            .iter()
-            .zip(&self.revolute_handles)
-            .filter(|(j, _)| j.enabled && (j.def.body_a == body || j.def.body_b == body))
-            .map(|(_, h)| *h)
-            .collect()
-    }
-
-    #[cfg(feature = "portals")]
-    /// Disables a joint (the solver skips it; it stays until destroyed).
-    pub(crate) fn disable_joint(&mut self, joint: JointHandle) {
-        if let Ok(i) = self.joint_index(joint) {
-            self.revolute[i].enabled = false;
-        }
-    }
-
-    #[cfg(feature = "portals")]
-    /// Exchanges two bodies' identities (see `BodySet::swap_identity`),
-    /// moving their shapes along and dropping their contacts.
-    pub(crate) fn swap_body_identity(&mut self, a: BodyHandle, b: BodyHandle) {
-        self.collision.remove_contacts_of(a);
-        self.collision.remove_contacts_of(b);
-        if self.bodies.swap_identity(a, b).is_ok() {
-            self.collision.swap_body_shapes(a, b);
-        }
+        Ok(())
     }
 
     // ----- stepping ---------------------------------------------------------
@@ -867,47 +873,48 @@ impl World {
             d
         };
         let mut sp = crate::profile::StepProfile::default();
-        let mut counters = crate::profile::StepCounters::default();
-        self.collision.events = CollisionEvents::default();
-        if !self.pending_sleep.is_empty() {
-            let pending = std::mem::take(&mut self.pending_sleep);
-            if self.sleep_settings.enabled {
-                for b in pending {
-                    self.bodies.sleep(b);
-                }
-            }
-        }
-        let has_shapes = self.collision.shape_count() > 0;
-        #[cfg(feature = "portals")]
+        self.islands
+            .apply_pending(self.sleep_settings.enabled, &mut self.bodies);
+        let has_shapes = !self.collision.shapes.is_empty();
         let has_portals = self.portals.is_active();
-        #[cfg(not(feature = "portals"))]
-        let has_portals = false;
-        #[cfg(feature = "portals")]
         if has_portals {
-            self.portal_clipping();
+            self.portals.build_clipping(&self.bodies);
             sp.portals += lap();
         }
         if has_shapes {
-            self.collision.update_pairs(&self.bodies);
+            self.collision
+                .update_pairs(&self.bodies, &self.joints.no_collide);
             sp.broadphase += lap();
             let mut wake = std::mem::take(&mut self.wake_list);
             wake.clear();
-            #[cfg(feature = "portals")]
-            let clipping = &self.portals.clipping;
-            #[cfg(not(feature = "portals"))]
-            let clipping = &crate::collision::NO_CLIPPING;
-            self.collision
-                .narrowphase(&self.bodies, dt, clipping, &mut wake);
+            let c = &mut self.collision;
+            let input = crate::narrowphase::NarrowphaseInput {
+                shapes: &c.shapes,
+                broadphase: &c.broadphase,
+                bodies: &self.bodies,
+                dt,
+                clipping: self.portals.clipping(),
+            };
+            c.narrowphase.run(
+                &input,
+                &mut c.contacts,
+                &mut c.events,
+                &mut c.counters,
+                &mut wake,
+            );
             self.wake_all(&wake);
             let woke = !wake.is_empty();
             self.wake_list = wake;
-            self.collision
-                .build_constraints(&self.bodies, woke, &mut self.contact_constraints);
-            #[cfg(feature = "portals")]
+            crate::narrowphase::build_constraints(
+                &mut self.collision.contacts,
+                &self.bodies,
+                woke,
+                &mut self.contact_constraints,
+                &mut self.collision.counters,
+            );
             if has_portals {
-                let mut cs = std::mem::take(&mut self.contact_constraints);
-                self.apply_object_masses(&mut cs);
-                self.contact_constraints = cs;
+                self.portals
+                    .modify_contacts(&self.bodies, &mut self.contact_constraints);
             }
             sp.narrowphase += lap();
         } else {
@@ -916,18 +923,14 @@ impl World {
         // No restitution anywhere: no restitution pass.
         ctx.restitution = has_shapes && self.collision.counters.restitution_contacts > 0;
         let mut revolute = janus2d_constraints::RevoluteBatch {
-            joints: &mut self.revolute,
-            forest: &mut self.joint_forest,
+            joints: &mut self.joints.revolute,
+            forest: &mut self.joints.forest,
         };
-        #[cfg(feature = "portals")]
         let mut batches: [&mut dyn ConstraintBatch; 3] = [
             &mut revolute,
             &mut self.contact_constraints,
-            &mut self.portals.constraints,
+            self.portals.constraints_mut(),
         ];
-        #[cfg(not(feature = "portals"))]
-        let mut batches: [&mut dyn ConstraintBatch; 2] =
-            [&mut revolute, &mut self.contact_constraints];
         let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
         lap();
         if has_shapes {
@@ -935,62 +938,41 @@ impl World {
             self.collision.update_proxies(&self.bodies, dt);
             sp.broadphase += lap();
         }
-        #[cfg(feature = "portals")]
         if has_portals {
-            self.portal_stage();
+            self.portal_crossings();
             sp.portals += lap();
         } else {
-            self.portals.events.clear();
+            self.portals.clear_events();
         }
         if self.sleep_settings.enabled {
-            self.update_sleep(dt);
+            let keep_awake = self.portals.keep_awake();
+            let input = SleepInput {
+                dt,
+                settings: self.sleep_settings,
+                shapes: &self.collision.shapes,
+                keep_awake: &keep_awake,
+            };
+            self.islands.update(
+                &input,
+                &mut self.bodies,
+                &mut self.collision.contacts,
+                self.joints.edges(),
+            );
             sp.sleep += lap();
         }
         sp.solver = report.profile;
         sp.total = start.elapsed().as_secs_f64();
-        // Counters.
-        let cc = self.collision.counters;
-        counters.collision_ran = has_shapes;
-        counters.pairs_tested = cc.pairs_tested;
-        counters.pairs_created = cc.pairs_created;
-        counters.proxies_moved = cc.proxies_moved;
-        counters.contacts = self.contact_constraints.len();
-        counters.contact_rows = if has_shapes { cc.contact_rows } else { 0 };
-        counters.restitution_contacts = if has_shapes {
-            cc.restitution_contacts
-        } else {
-            0
-        };
-        counters.joint_rows = self
-            .revolute
-            .iter()
-            .filter(|j| j.enabled)
-            .map(|j| {
-                2 + 2 * j.def.enable_limit as usize
-                    + j.def.enable_motor as usize
-                    + j.def.enable_spring as usize
-            })
-            .sum();
-        counters.direct_joint_rows = 2 * self.joint_forest.tree_joint_count();
-        counters.portal_stage_ran = has_portals;
-        #[cfg(feature = "portals")]
-        {
-            counters.portal_rows = 3 * self.portals.constraints.len();
-            counters.portal_bodies_tested = if has_portals {
-                self.portals.counters.bodies_tested
-            } else {
-                0
-            };
-            counters.portal_crossings = self.portals.crossings.len();
-        }
-        counters.gravity_bodies = if self.gravity == Vec2::ZERO {
-            0
-        } else {
-            self.bodies.moving_count()
-        };
-        counters.awake_bodies = self.bodies.moving_count();
-        counters.sleeping_bodies = self.bodies.sleeping_count();
-        self.counters = counters;
+        self.counters = crate::profile::StepCounters::gather(&crate::profile::CounterSources {
+            collision_ran: has_shapes,
+            collision: self.collision.counters,
+            contacts: self.contact_constraints.len(),
+            joint_rows: self.joints.row_count(),
+            direct_joint_rows: 2 * self.joints.forest.tree_joint_count(),
+            portal_stage_ran: has_portals,
+            portals: self.portals.counters_for_step(has_portals),
+            gravity: self.gravity != Vec2::ZERO,
+            bodies: &self.bodies,
+        });
         self.step_profile = sp;
         self.events = StepEvents {
             non_finite_bodies: report.non_finite,
@@ -1001,104 +983,94 @@ impl World {
     }
 
     /// A hash of every body's transform and velocity bits, in handle order:
-    /// equal hashes mean bit-identical states.
+    /// equal hashes mean bit-identical states (see [`crate::hash`]).
     pub fn state_hash(&self) -> u64 {
-        let mut h = Fnv::new();
-        for handle in self.bodies.handles() {
-            let sim = self.bodies.sim(handle).expect("live handle");
-            let st = self.bodies.state(handle).expect("live handle");
-            h.write_u32(handle.index);
-            for x in [
-                sim.transform.p.x,
-                sim.transform.p.y,
-                sim.transform.q.c,
-                sim.transform.q.s,
-                st.v.x,
-                st.v.y,
-                st.w,
-            ] {
-                h.write_real(x);
+        crate::hash::state_hash(&self.bodies)
+    }
+}
+
+/// Internal operations the portal stage uses: each does exactly one
+/// thing to a live body, with no checks and no `Result` (the stage only
+/// passes handles it knows to be live).
+#[cfg_attr(not(feature = "portals"), allow(dead_code))]
+impl World {
+    /// Sets a dynamic body's mass properties without touching its velocity.
+    pub(crate) fn apply_mass_keep_velocity(&mut self, body: BodyHandle, mass: BodyMass) {
+        let fixed = self
+            .bodies
+            .record(body)
+            .map(|r| r.fixed_rotation)
+            .unwrap_or(false);
+        self.bodies.apply_mass(body, mass, fixed);
+    }
+
+    /// Adds an impulse at a world point to a dynamic body now (no checks).
+    pub(crate) fn push_body(
+        &mut self,
+        body: BodyHandle,
+        impulse: Vec2,
+        point: Vec2,
+        angular: Real,
+    ) {
+        self.wake_body(body);
+        if let Some(BodyLocation::Moving(i)) = self.bodies.location(body) {
+            let sim = &self.bodies.sims[i as usize];
+            if sim.body_type == BodyType::Dynamic {
+                let (im, ii, c) = (sim.inv_mass, sim.inv_inertia, sim.center);
+                let st = &mut self.bodies.states[i as usize];
+                st.v += im * impulse;
+                st.w += ii * cross(point - c, impulse);
+                st.w += ii * angular;
             }
         }
-        h.finish()
     }
-}
 
-fn body_pair_key(a: BodyHandle, b: BodyHandle) -> (u32, u32) {
-    if a.index < b.index {
-        (a.index, b.index)
-    } else {
-        (b.index, a.index)
-    }
-}
-
-fn validate_shape_def(def: &ShapeDef) -> Result<(), WorldError> {
-    for (v, name) in [
-        (def.density, "density"),
-        (def.friction, "friction"),
-        (def.restitution, "restitution"),
-    ] {
-        if !v.is_finite() {
-            return Err(WorldError::NonFinite(name));
-        }
-        if v < 0.0 {
-            return Err(WorldError::OutOfRange(name));
+    /// Sets a moving body's velocity (no checks).
+    pub(crate) fn set_velocity_unchecked(&mut self, body: BodyHandle, v: Vec2, w: Real) {
+        self.wake_body(body);
+        if let Some(s) = self.bodies.state_mut(body) {
+            s.v = v;
+            s.w = w;
         }
     }
-    Ok(())
-}
 
-fn validate_settings(s: &SolverSettings) -> Result<(), WorldError> {
-    let reals = [
-        s.baumgarte,
-        s.contact_hertz,
-        s.contact_damping_ratio,
-        s.contact_push_max_velocity,
-        s.joint_hertz,
-        s.joint_damping_ratio,
-        s.joint_max_correction_speed,
-        s.restitution_threshold,
-        s.contact_mass_ratio_cap,
-        s.joint_mass_ratio_cap,
-        s.direct_joint_hertz,
-        s.direct_joint_max_correction_speed,
-    ];
-    if reals.iter().any(|x| x.is_nan()) {
-        return Err(WorldError::NonFinite("solver settings"));
+    /// Attaches a shape whose geometry and material are known to be valid
+    /// (a portal clone's scaled copy); the body's mass is left as it is.
+    pub(crate) fn add_shape_unchecked(&mut self, body: BodyHandle, def: ShapeDef, geometry: Shape) {
+        self.collision.add_shape(&self.bodies, body, geometry, def);
     }
-    if reals.iter().any(|x| *x < 0.0) {
-        return Err(WorldError::OutOfRange("solver settings"));
-    }
-    if s.substeps == 0
-        || s.substeps > 1024
-        || s.velocity_iterations > 1024
-        || s.relax_iterations > 1024
-    {
-        return Err(WorldError::OutOfRange("iteration counts"));
-    }
-    Ok(())
-}
 
-/// FNV-1a, 64 bit: a small, stable hash for determinism checks.
-struct Fnv(u64);
-
-impl Fnv {
-    fn new() -> Self {
-        Fnv(0xcbf2_9ce4_8422_2325)
+    /// The enabled joints attached to a body, in the body's list order.
+    pub(crate) fn joints_attached_to(&self, body: BodyHandle) -> Vec<JointHandle> {
+        self.joints
+            .of_body(body)
+            .iter()
+            .copied()
+            .filter(|h| self.joints.revolute(*h).is_ok_and(|j| j.enabled))
+            .collect()
     }
-    fn write_bytes(&mut self, bytes: &[u8]) {
-        for b in bytes {
-            self.0 ^= *b as u64;
-            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+
+    /// Disables a joint (the solver skips it; it stays until destroyed).
+    pub(crate) fn disable_joint(&mut self, joint: JointHandle) {
+        let _disabled = self.joints.set_enabled(joint, false);
+    }
+
+    /// Exchanges two bodies' identities (see `BodySet::swap_identity`),
+    /// moving their shapes along and dropping their contacts.
+    pub(crate) fn swap_body_identity(&mut self, a: BodyHandle, b: BodyHandle) {
+        self.collision.remove_contacts_of(a);
+        self.collision.remove_contacts_of(b);
+        if self.bodies.swap_identity(a, b).is_ok() {
+            self.collision.swap_body_shapes(a, b);
         }
     }
-    fn write_u32(&mut self, v: u32) {
-        self.write_bytes(&v.to_le_bytes());
+
+    /// Mutable body storage and read access to shapes (portal stage).
+    pub(crate) fn bodies_mut(&mut self) -> &mut BodySet {
+        &mut self.bodies
     }
-    fn write_real(&mut self, v: Real) {
-        self.write_bytes(&v.to_bits().to_le_bytes());
-    }
-    fn finish(&self) -> u64 {
-        self.0
+
+    pub(crate) fn collision_ref(&self) -> &Collision {
+        &self.collision
     }
 }

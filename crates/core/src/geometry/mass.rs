@@ -19,6 +19,40 @@ pub struct MassData {
     pub rotational_inertia: Real,
 }
 
+impl MassData {
+    /// The mass properties of several parts of one body: total mass, the
+    /// mass-weighted centre, and the inertia about that centre by the
+    /// parallel-axis theorem (`I = Σ (Iᵢ + mᵢ|cᵢ|²) − m|c|²`). Parts in the
+    /// order given (the sum is order-dependent in the last bit).
+    ///
+    /// ```
+    /// use janus2d_core::geometry::MassData;
+    /// use janus2d_core::Vec2;
+    /// let part = |x| MassData { mass: 1.0, center: Vec2::new(x, 0.0), rotational_inertia: 0.0 };
+    /// let m = MassData::combine([part(-1.0), part(1.0)]);
+    /// assert_eq!(m.mass, 2.0);
+    /// assert_eq!(m.center, Vec2::ZERO);
+    /// assert!((m.rotational_inertia - 2.0).abs() < 1e-6);
+    /// ```
+    #[must_use]
+    pub fn combine(parts: impl IntoIterator<Item = MassData>) -> MassData {
+        let mut total = MassData::default();
+        let mut first = Vec2::ZERO;
+        let mut second: Real = 0.0;
+        for md in parts {
+            total.mass += md.mass;
+            first += md.mass * md.center;
+            second += md.rotational_inertia + md.mass * md.center.length_squared();
+        }
+        if total.mass > 0.0 {
+            total.center = first / total.mass;
+            total.rotational_inertia =
+                (second - total.mass * total.center.length_squared()).max(0.0);
+        }
+        total
+    }
+}
+
 /// Running sums of area, first moment and polar second moment about a
 /// reference point.
 #[derive(Default)]

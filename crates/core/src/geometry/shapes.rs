@@ -558,6 +558,87 @@ pub enum Shape {
 }
 
 impl Shape {
+    /// Checks a shape given by its public fields (a hand-built literal as
+    /// much as a constructed one): finite coordinates, positive radii, and
+    /// a polygon that is convex, counter-clockwise and has area.
+    pub fn validate(&self) -> Result<(), GeometryError> {
+        use GeometryError as E;
+        let finite = |pts: &[Vec2]| pts.iter().all(|p| vec_is_finite(*p));
+        match self {
+            Shape::Circle(c) => {
+                if !finite(&[c.center]) || !c.radius.is_finite() {
+                    return Err(E::NonFinite);
+                }
+                if c.radius <= 0.0 {
+                    return Err(E::NonPositiveRadius);
+                }
+            }
+            Shape::Capsule(c) => {
+                if !finite(&[c.center1, c.center2]) || !c.radius.is_finite() {
+                    return Err(E::NonFinite);
+                }
+                if c.radius <= 0.0 {
+                    return Err(E::NonPositiveRadius);
+                }
+            }
+            Shape::Segment(s) => {
+                if !finite(&[s.point1, s.point2]) {
+                    return Err(E::NonFinite);
+                }
+                if (s.point2 - s.point1).length() <= WELD_DISTANCE {
+                    return Err(E::DegenerateSegment);
+                }
+            }
+            Shape::ChainSegment(c) => {
+                if !finite(&[c.ghost1, c.segment.point1, c.segment.point2, c.ghost2]) {
+                    return Err(E::NonFinite);
+                }
+                if (c.segment.point2 - c.segment.point1).length() <= WELD_DISTANCE {
+                    return Err(E::DegenerateSegment);
+                }
+            }
+            Shape::Polygon(p) => {
+                let n = p.count;
+                if n > MAX_POLYGON_VERTICES {
+                    return Err(E::TooManyVertices { count: n });
+                }
+                if !finite(&p.vertices[..n]) || !finite(&p.normals[..n]) || !p.radius.is_finite() {
+                    return Err(E::NonFinite);
+                }
+                if p.radius < 0.0 {
+                    return Err(E::NegativeRadius);
+                }
+                if n == 2 {
+                    // A capsule core: needs a radius and a length.
+                    if p.radius <= 0.0 {
+                        return Err(E::NonPositiveRadius);
+                    }
+                    return Ok(());
+                }
+                if n < 3 {
+                    return Err(E::TooFewPoints {
+                        found: n,
+                        needed: 3,
+                    });
+                }
+                let mut area2 = 0.0;
+                for i in 0..n {
+                    let a = p.vertices[i];
+                    let b = p.vertices[(i + 1) % n];
+                    let c = p.vertices[(i + 2) % n];
+                    if cross(b - a, c - b) <= 0.0 {
+                        return Err(E::DegeneratePolygon);
+                    }
+                    area2 += cross(a, b);
+                }
+                if area2 <= 0.0 {
+                    return Err(E::DegeneratePolygon);
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// The geometric centre used for one-sided tests and as the centre of
     /// mass: circle centre, capsule/segment midpoint, polygon core centroid.
     pub fn centroid(&self) -> Vec2 {

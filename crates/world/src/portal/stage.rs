@@ -40,9 +40,12 @@ use janus2d_core::geometry::Aabb;
 use janus2d_core::math::{Real, Rot, Vec2, cross};
 use janus2d_core::slots::Slots;
 
-use crate::collision::{ApertureClip, ContactClipping};
+use super::clipping::{ApertureClip, ContactClipping};
 use crate::error::WorldError;
-use crate::world::{JointHandle, World};
+use crate::joints::JointHandle;
+use crate::world::World;
+use janus2d_core::body::BodySet;
+use janus2d_core::handle::{Handle, HandleError, PortalPairTag};
 
 /// Smallest mass fraction a straddling copy keeps (dimensionless, usual
 /// 0.1): a copy that has barely appeared is never thousands of times
@@ -118,15 +121,7 @@ impl PortalPairDef {
 }
 
 /// A generational handle to a portal pair.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct PortalPairHandle {
-    /// Slot index.
-    pub index: u32,
-    /// Generation of the slot when issued.
-    pub generation: u32,
-    /// Id of the issuing world.
-    pub owner: u32,
-}
+pub type PortalPairHandle = Handle<PortalPairTag>;
 
 /// What happened at the portals during the last step.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -198,9 +193,10 @@ pub(crate) struct Crossing {
     pub(crate) mass_clone: BodyMass,
 }
 
-/// Portal pairs, crossings and their constraints.
+/// The portal stage: pairs, crossings and their constraints, the clipping
+/// it hands the narrowphase, and its events.
 #[derive(Clone, Debug, Default)]
-pub(crate) struct Portals {
+pub(crate) struct PortalStage {
     /// Portal pair handle slots.
     pub(crate) pairs: Slots<PairData>,
     pub(crate) crossings: Vec<Crossing>,
@@ -211,9 +207,128 @@ pub(crate) struct Portals {
     pub(crate) clipping: ContactClipping,
 }
 
-impl Portals {
+impl PortalStage {
+    /// True when the world has a portal pair (otherwise the stage is skipped).
     pub(crate) fn is_active(&self) -> bool {
         !self.pairs.is_empty()
+    }
+
+    /// The clipping the narrowphase applies.
+    pub(crate) fn clipping(&self) -> &ContactClipping {
+        &self.clipping
+    }
+
+    /// The portal constraints, as the solver's third batch.
+    pub(crate) fn constraints_mut(&mut self) -> &mut Vec<PortalConstraint> {
+        &mut self.constraints
+    }
+
+    /// Clears the events of a step in which the stage did not run.
+    pub(crate) fn clear_events(&mut self) {
+        self.events.clear();
+    }
+
+    /// Portal rows, bodies tested and crossings of the step.
+    pub(crate) fn counters_for_step(&self, ran: bool) -> (usize, usize, usize) {
+        (
+            3 * self.constraints.len(),
+            if ran { self.counters.bodies_tested } else { 0 },
+            self.crossings.len(),
+        )
+    }
+
+    /// Bodies a crossing keeps awake: the two copies and both portal bodies.
+    pub(crate) fn keep_awake(&self) -> Vec<BodyHandle> {
+        let mut out = Vec::with_capacity(4 * self.crossings.len());
+        for c in &self.crossings {
+            let (entry, exit) = self.portal_bodies(c);
+            out.extend([c.original, c.clone, entry, exit]);
+        }
+        out
+    }
+
+    /// The bodies carrying a crossing's entry and exit portals.
+    pub(crate) fn portal_bodies(&self, c: &Crossing) -> (BodyHandle, BodyHandle) {
+        let d = self.pairs.at(c.pair).expect("live pair");
+        (d.portals[c.entry].body, d.portals[1 - c.entry].body)
+    }
+
+    /// Builds the contact clipping for this step's narrowphase.
+    pub(crate) fn build_clipping(&mut self, bodies: &BodySet) {
+        let mut clipping = std::mem::take(&mut self.clipping);
+        clipping.clips.clear();
+        clipping.ignored_pairs.clear();
+        for (_, d) in self.pairs.iter() {
+            for k in 0..2 {
+                let f = frame_in(bodies, &d.portals[k], &d.local[k]);
+                clipping.clips.push(ApertureClip {
+                    body: d.portals[k].body,
+                    point: f.point,
+                    normal: f.normal,
+                    half_width: d.local[k].half_width,
+                    hole: true,
+                });
+            }
+        }
+        for c in &self.crossings {
+            let d = self.pairs.at(c.pair).expect("live pair");
+            let (entry, exit) = (c.entry, 1 - c.entry);
+            for (body, side) in [(c.original, entry), (c.clone, exit)] {
+                let f = frame_in(bodies, &d.portals[side], &d.local[side]);
+                clipping.clips.push(ApertureClip {
+                    body,
+                    point: f.point,
+                    normal: f.normal,
+                    half_width: d.local[side].half_width,
+                    hole: false,
+                });
+            }
+            clipping.ignored_pairs.push((c.original, c.clone));
+        }
+        self.clipping = clipping;
+    }
+
+    /// The contact-modification hook: the contact constraints of crossing
+    /// copies respond as the whole object. With `v₂ = ηQ v₁` (static
+    /// portals) an impulse on the clone moves the object as if its mass
+    /// were `m₂ + m₁/η²` (and `m₁ + η² m₂` seen from the original);
+    /// rotation is shared, so the inertia is `I₁ + I₂`.
+    pub(crate) fn modify_contacts(
+        &self,
+        bodies: &BodySet,
+        constraints: &mut [janus2d_constraints::ContactConstraint],
+    ) {
+        if self.crossings.is_empty() {
+            return;
+        }
+        let mut objects: Vec<(BodyHandle, Real, Real)> =
+            Vec::with_capacity(2 * self.crossings.len());
+        for (c, pc) in self.crossings.iter().zip(&self.constraints) {
+            let eta = pc.def().eta;
+            let (Some(s1), Some(s2)) = (bodies.sim(c.original), bodies.sim(c.clone)) else {
+                continue;
+            };
+            let inertia = s1.inertia + s2.inertia;
+            let inv_i = if inertia > 0.0 && s1.inv_inertia > 0.0 {
+                1.0 / inertia
+            } else {
+                0.0
+            };
+            let m_orig = s1.mass + eta * eta * s2.mass;
+            let m_clone = s2.mass + s1.mass / (eta * eta);
+            objects.push((c.original, 1.0 / m_orig, inv_i));
+            objects.push((c.clone, 1.0 / m_clone, inv_i));
+        }
+        for cc in constraints.iter_mut() {
+            for &(body, inv_m, inv_i) in &objects {
+                if cc.body_a == body {
+                    cc.set_object_mass(0, inv_m, inv_i);
+                }
+                if cc.body_b == body {
+                    cc.set_object_mass(1, inv_m, inv_i);
+                }
+            }
+        }
     }
 
     pub(crate) fn crossing_of(&self, body: BodyHandle) -> Option<usize> {
@@ -223,9 +338,12 @@ impl Portals {
     }
 }
 
+fn frame_in(bodies: &BodySet, def: &PortalDef, local: &Portal) -> PortalFrame {
+    PortalFrame::new(&bodies.solver_body(def.body).sim.transform, local)
+}
+
 fn frame_of(world: &World, def: &PortalDef, local: &Portal) -> PortalFrame {
-    let sim = world.bodies().solver_body(def.body).sim;
-    PortalFrame::new(&sim.transform, local)
+    frame_in(world.bodies(), def, local)
 }
 
 fn motion_of(world: &World, body: BodyHandle) -> PortalBodyMotion {
@@ -249,7 +367,11 @@ impl World {
         let mut local = Vec::with_capacity(2);
         for p in [def.portal_a, def.portal_b] {
             if !self.bodies().contains(p.body) {
-                return Err(WorldError::StaleBody);
+                return Err(if p.body.owner == self.bodies().owner() {
+                    WorldError::StaleBody
+                } else {
+                    WorldError::ForeignHandle
+                });
             }
             local.push(
                 Portal::new(p.anchor, p.direction, p.half_width)
@@ -267,41 +389,39 @@ impl World {
             mass_model: def.mass_model,
         };
         let (index, generation) = self.portals.pairs.insert(data);
-        Ok(PortalPairHandle {
+        Ok(PortalPairHandle::new(
             index,
             generation,
-            owner: self.bodies().owner(),
-        })
+            self.bodies().owner(),
+        ))
     }
 
     fn pair_slot(&self, pair: PortalPairHandle) -> Result<u32, WorldError> {
-        let live = self
-            .portals
-            .pairs
-            .get(pair.index, pair.generation)
-            .is_some();
-        if !live || pair.owner != self.bodies().owner() {
-            return Err(WorldError::StalePortal);
+        match self.portals.pairs.resolve(pair, self.bodies().owner()) {
+            Ok(_) => Ok(pair.index),
+            Err(HandleError::Foreign) => Err(WorldError::ForeignHandle),
+            Err(HandleError::Stale) => Err(WorldError::StalePortal),
         }
-        Ok(pair.index)
     }
 
     fn pair_handle(&self, index: u32) -> PortalPairHandle {
-        PortalPairHandle {
-            index,
-            generation: self.portals.pairs.generation(index),
-            owner: self.bodies().owner(),
-        }
+        self.portals.pairs.handle(index, self.bodies().owner())
     }
 
     /// Destroys a portal pair, cancelling every crossing in progress through it.
     pub fn destroy_portal_pair(&mut self, pair: PortalPairHandle) -> Result<(), WorldError> {
         let index = self.pair_slot(pair)?;
+        self.remove_pair(index);
+        Ok(())
+    }
+
+    /// Removes live pair `index`, cancelling its crossings.
+    fn remove_pair(&mut self, index: u32) {
         while let Some(k) = self.portals.crossings.iter().position(|c| c.pair == index) {
             self.cancel_crossing(k);
         }
-        self.portals.pairs.remove(pair.index, pair.generation);
-        Ok(())
+        let generation = self.portals.pairs.generation(index);
+        self.portals.pairs.remove(index, generation);
     }
 
     /// Number of live portal pairs.
@@ -349,7 +469,7 @@ impl World {
 
     /// Called when a body is about to be destroyed: ends the crossings it
     /// takes part in and destroys the portal pairs it carries.
-    pub(crate) fn portals_forget_body(&mut self, body: BodyHandle) {
+    pub(crate) fn portal_forget_body(&mut self, body: BodyHandle) {
         let carried: Vec<u32> = self
             .portals
             .pairs
@@ -358,53 +478,17 @@ impl World {
             .map(|(i, _)| i)
             .collect();
         for index in carried {
-            let h = self.pair_handle(index);
-            let _ = self.destroy_portal_pair(h);
+            self.remove_pair(index);
         }
         while let Some(k) = self.portals.crossing_of(body) {
             self.cancel_crossing(k);
         }
     }
 
-    /// Builds the contact clipping for this step's narrowphase.
-    pub(crate) fn portal_clipping(&mut self) {
-        let mut clipping = std::mem::take(&mut self.portals.clipping);
-        clipping.clips.clear();
-        clipping.ignored_pairs.clear();
-        for (_, d) in self.portals.pairs.iter() {
-            for k in 0..2 {
-                let f = frame_of(self, &d.portals[k], &d.local[k]);
-                clipping.clips.push(ApertureClip {
-                    body: d.portals[k].body,
-                    point: f.point,
-                    normal: f.normal,
-                    half_width: d.local[k].half_width,
-                    hole: true,
-                });
-            }
-        }
-        for c in &self.portals.crossings {
-            let d = self.portals.pairs.at(c.pair).expect("live pair");
-            let (entry, exit) = (c.entry, 1 - c.entry);
-            for (body, side) in [(c.original, entry), (c.clone, exit)] {
-                let f = frame_of(self, &d.portals[side], &d.local[side]);
-                clipping.clips.push(ApertureClip {
-                    body,
-                    point: f.point,
-                    normal: f.normal,
-                    half_width: d.local[side].half_width,
-                    hole: false,
-                });
-            }
-            clipping.ignored_pairs.push((c.original, c.clone));
-        }
-        self.portals.clipping = clipping;
-    }
-
     /// Extents `(min_n, max_n, min_t, max_t)` of a body's shapes in a portal frame.
     fn extents_in(&self, body: BodyHandle, f: &PortalFrame) -> Option<(Real, Real, Real, Real)> {
         let xf = self.bodies().sim(body)?.transform;
-        let list = self.collision().body_shapes.get(body.index as usize)?;
+        let list = self.collision_ref().shapes.of_body(body);
         if list.is_empty() {
             return None;
         }
@@ -412,7 +496,7 @@ impl World {
         let offset_n = f.point.dot(f.normal);
         let offset_t = f.point.dot(f.tangent);
         for &s in list {
-            let shape = &self.collision().shapes[s as usize].geometry;
+            let shape = &self.collision_ref().shapes.at(s).geometry;
             let (a, b) = shape.support_extent(&xf, f.normal);
             n0 = n0.min(a - offset_n);
             n1 = n1.max(b - offset_n);
@@ -429,12 +513,10 @@ impl World {
             return 0.0;
         };
         let xf = sim.transform;
-        let Some(list) = self.collision().body_shapes.get(body.index as usize) else {
-            return 0.0;
-        };
+        let list = self.collision_ref().shapes.of_body(body);
         let (mut front, mut total) = (0.0, 0.0);
         for &s in list {
-            let shape = &self.collision().shapes[s as usize].geometry;
+            let shape = &self.collision_ref().shapes.at(s).geometry;
             front += shape.area_in_front(&xf, f.point, f.normal);
             total += shape.area();
         }
@@ -442,7 +524,7 @@ impl World {
     }
 
     /// The portal stage: handovers, cancellations, new crossings, weights.
-    pub(crate) fn portal_stage(&mut self) {
+    pub(crate) fn portal_crossings(&mut self) {
         self.portals.events.clear();
         let mut counters = PortalCounters::default();
         let mut crossed_this_step: Vec<BodyHandle> = Vec::new();
@@ -529,9 +611,9 @@ impl World {
         let b = f.point + w * f.tangent;
         let region = Aabb::new(a.min(b), a.max(b)).fattened(crate::collision::AABB_MARGIN);
         let mut out = Vec::new();
-        let collision = self.collision();
+        let collision = self.collision_ref();
         collision.broadphase.query(&region, |_, payload| {
-            let body = collision.shapes[payload as usize].body;
+            let body = collision.shapes.at(payload).body;
             out.push(body);
             true
         });
@@ -593,24 +675,23 @@ impl World {
             user_data: record.user_data,
             ..BodyDef::default()
         };
-        let clone = self.create_body(&clone_def).ok()?;
-        let shapes: Vec<_> = self
-            .collision()
-            .body_shapes
-            .get(body.index as usize)?
-            .clone();
+        let clone = self.bodies_mut().create(&clone_def).ok()?;
+        let shapes: Vec<u32> = self.collision_ref().shapes.of_body(body).to_vec();
         for s in shapes {
-            let data = &self.collision().shapes[s as usize];
+            let data = self.collision_ref().shapes.at(s);
             let geometry = data.geometry.scaled(eta, sim.local_center);
             let mut def = data.def.clone();
             if d.mass_model == MassModel::EnergyPreserving {
                 def.density /= eta.powi(4);
             }
-            let _ = self.create_shape(clone, &def, geometry);
+            self.add_shape_unchecked(clone, def, geometry);
         }
-        self.set_mass(clone, mass_clone).ok()?;
-        let _ = self.set_linear_velocity(clone, clone_motion.linear_velocity);
-        let _ = self.set_angular_velocity(clone, clone_motion.angular_velocity);
+        self.apply_mass_keep_velocity(clone, mass_clone);
+        self.set_velocity_unchecked(
+            clone,
+            clone_motion.linear_velocity,
+            clone_motion.angular_velocity,
+        );
         // The clone's momentum comes out of the exit portal's body.
         let clone_full = (mass_clone.mass, mass_clone.rotational_inertia);
         self.exchange_with_portal(clone, (0.0, 0.0), clone_full, d.portals[exit].body);
@@ -640,49 +721,6 @@ impl World {
         Some(())
     }
 
-    /// Tells the contact constraints of crossing copies to respond as the
-    /// whole object: with `v₂ = ηQ v₁` (static portals) an impulse on the
-    /// clone moves the object as if its mass were `m₂ + m₁/η²` (and
-    /// `m₁ + η² m₂` seen from the original); rotation is shared, so the
-    /// inertia is `I₁ + I₂`.
-    pub(crate) fn apply_object_masses(
-        &self,
-        constraints: &mut [janus2d_constraints::ContactConstraint],
-    ) {
-        if self.portals.crossings.is_empty() {
-            return;
-        }
-        let mut objects: Vec<(BodyHandle, Real, Real)> =
-            Vec::with_capacity(2 * self.portals.crossings.len());
-        for (c, pc) in self.portals.crossings.iter().zip(&self.portals.constraints) {
-            let eta = pc.def().eta;
-            let (Some(s1), Some(s2)) = (self.bodies().sim(c.original), self.bodies().sim(c.clone))
-            else {
-                continue;
-            };
-            let inertia = s1.inertia + s2.inertia;
-            let inv_i = if inertia > 0.0 && s1.inv_inertia > 0.0 {
-                1.0 / inertia
-            } else {
-                0.0
-            };
-            let m_orig = s1.mass + eta * eta * s2.mass;
-            let m_clone = s2.mass + s1.mass / (eta * eta);
-            objects.push((c.original, 1.0 / m_orig, inv_i));
-            objects.push((c.clone, 1.0 / m_clone, inv_i));
-        }
-        for cc in constraints.iter_mut() {
-            for &(body, inv_m, inv_i) in &objects {
-                if cc.body_a == body {
-                    cc.set_object_mass(0, inv_m, inv_i);
-                }
-                if cc.body_b == body {
-                    cc.set_object_mass(1, inv_m, inv_i);
-                }
-            }
-        }
-    }
-
     /// Weighs the two copies of crossing `k` by their area fractions.
     fn weigh_crossing(&mut self, k: usize, f_entry: &PortalFrame, f_exit: &PortalFrame) {
         let c = self.portals.crossings[k].clone();
@@ -695,14 +733,9 @@ impl World {
             rotational_inertia: f * m.rotational_inertia,
             center: m.center,
         };
-        let (entry_body, exit_body) = self.crossing_portal_bodies(&c);
+        let (entry_body, exit_body) = self.portals.portal_bodies(&c);
         self.set_copy_mass(c.original, scale(c.mass_original, f), entry_body);
         self.set_copy_mass(c.clone, scale(c.mass_clone, 1.0 - f), exit_body);
-    }
-
-    pub(crate) fn crossing_portal_bodies(&self, c: &Crossing) -> (BodyHandle, BodyHandle) {
-        let d = self.portals.pairs.at(c.pair).expect("live pair");
-        (d.portals[c.entry].body, d.portals[1 - c.entry].body)
     }
 
     /// Sets a crossing copy's (weighted) mass, velocity unchanged. The mass
@@ -725,8 +758,7 @@ impl World {
             let st = *self.bodies().state(body).expect("live");
             let dm = b.mass - new.mass;
             let di = b.inertia - new.rotational_inertia;
-            let _ = self.apply_linear_impulse(portal_body, dm * st.v, b.center);
-            let _ = self.apply_angular_impulse(portal_body, di * st.w);
+            self.push_body(portal_body, dm * st.v, b.center, di * st.w);
         }
         if new.mass > 0.0 {
             self.apply_mass_keep_velocity(body, new);
@@ -752,8 +784,12 @@ impl World {
             return;
         };
         let st = *self.bodies().state(body).expect("live");
-        let _ = self.apply_linear_impulse(portal_body, (from.0 - to.0) * st.v, b.center);
-        let _ = self.apply_angular_impulse(portal_body, (from.1 - to.1) * st.w);
+        self.push_body(
+            portal_body,
+            (from.0 - to.0) * st.v,
+            b.center,
+            (from.1 - to.1) * st.w,
+        );
     }
 
     /// Removes crossing `k` and its constraint, returning it.
@@ -766,7 +802,7 @@ impl World {
     /// exit side; the original's old body is removed.
     fn complete_crossing(&mut self, k: usize) {
         let c = self.take_crossing(k);
-        let (entry_body, exit_body) = self.crossing_portal_bodies(&c);
+        let (entry_body, exit_body) = self.portals.portal_bodies(&c);
         self.set_copy_mass(c.clone, c.mass_clone, exit_body);
         // What is left of the original goes into the entry portal's body.
         if let Some(b) = self.bodies().sim(c.original).copied() {
@@ -781,7 +817,7 @@ impl World {
                 .push(PortalEvent::JointDisabled { joint, pair });
         }
         self.swap_body_identity(c.original, c.clone);
-        let _ = self.destroy_body(c.clone);
+        self.destroy_body_unchecked(c.clone);
         self.portals.events.push(PortalEvent::CrossingCompleted {
             body: c.original,
             pair,
@@ -793,7 +829,7 @@ impl World {
     fn cancel_crossing(&mut self, k: usize) {
         let (entry_body, exit_body) = {
             let c = &self.portals.crossings[k];
-            self.crossing_portal_bodies(c)
+            self.portals.portal_bodies(c)
         };
         let c = self.take_crossing(k);
         if self.bodies().contains(c.original) {
@@ -803,7 +839,7 @@ impl World {
             if let Some(b) = self.bodies().sim(c.clone).copied() {
                 self.exchange_with_portal(c.clone, (b.mass, b.inertia), (0.0, 0.0), exit_body);
             }
-            let _ = self.destroy_body(c.clone);
+            self.destroy_body_unchecked(c.clone);
         }
         let pair = self.pair_handle(c.pair);
         self.portals.events.push(PortalEvent::CrossingCancelled {

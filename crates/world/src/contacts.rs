@@ -1,0 +1,350 @@
+//! The contact life cycle: persistent contacts between shapes, found by
+//! shape pair and by body, awake or asleep.
+//!
+//! ```text
+//! ContactSet
+//!   awake          Vec<Contact>     what the narrowphase and constraint building visit
+//!   sleeping       Vec<Contact>     contacts of sleeping islands (no per-step cost)
+//!   place          contact id → (list, position)
+//!   pair_index     shape pair → contact id     (lookups only, never iterated)
+//!   body_contacts  body slot → [contact id]    (destroy, remove shape, wake walk these)
+//!
+//! create ─▶ awake ──(island sleeps)──▶ sleeping ──(island wakes)──▶ awake
+//!   └────────────── destroy (end event when it was touching) ◀──────────┘
+//! ```
+//!
+//! Contacts keep a stable id for their whole life; their position in a list
+//! changes when another one is removed (swap-remove) or when they sleep or
+//! wake, always the same way for the same inputs.
+
+use std::collections::HashMap;
+
+use janus2d_core::body::{BodyHandle, BodySet};
+use janus2d_core::math::{Real, Vec2};
+use smallvec::SmallVec;
+
+use crate::shapes::ShapeHandle;
+
+/// One manifold point with its warm-starting data.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactPointData {
+    /// World point, m.
+    pub point: Vec2,
+    /// Anchor on a relative to a's centre of mass (world frame), m.
+    pub anchor_a: Vec2,
+    /// Anchor on b relative to b's centre of mass (world frame), m.
+    pub anchor_b: Vec2,
+    /// Separation when computed (negative: penetration), m.
+    pub separation: Real,
+    /// Feature id.
+    pub id: u16,
+    /// Normal impulse of the last step, N·s.
+    pub normal_impulse: Real,
+    /// Tangent impulse of the last step, N·s.
+    pub tangent_impulse: Real,
+}
+
+/// A persistent contact between two shapes whose fat boxes overlap.
+#[derive(Clone, Debug)]
+pub struct Contact {
+    /// Stable id for the contact's whole life.
+    pub id: u32,
+    /// Shape a (lower slot index).
+    pub shape_a: u32,
+    /// Shape b.
+    pub shape_b: u32,
+    /// Handles of the two shapes (for events).
+    pub shapes: [ShapeHandle; 2],
+    /// Body of shape a.
+    pub body_a: BodyHandle,
+    /// Body of shape b.
+    pub body_b: BodyHandle,
+    /// Unit normal from a to b.
+    pub normal: Vec2,
+    /// Points (the first `point_count` are valid).
+    pub points: [ContactPointData; 2],
+    /// Number of valid points.
+    pub point_count: usize,
+    /// Mixed friction.
+    pub friction: Real,
+    /// Mixed restitution.
+    pub restitution: Real,
+    /// True when the manifold has points.
+    pub touching: bool,
+    /// True when either shape is a sensor (events only).
+    pub sensor: bool,
+    /// False when a filter (portal clipping, a disabled pair) suppresses it.
+    pub enabled: bool,
+    /// Whether each body read as static (static or asleep) at the last
+    /// narrowphase; both true: the contact sleeps and is not solved.
+    pub still: [bool; 2],
+}
+
+impl Contact {
+    /// The other body of the contact.
+    #[inline]
+    #[must_use]
+    pub fn other(&self, body: BodyHandle) -> BodyHandle {
+        if self.body_a == body {
+            self.body_b
+        } else {
+            self.body_a
+        }
+    }
+
+    /// True when it pushes: touching, solid and enabled.
+    #[inline]
+    #[must_use]
+    pub fn is_solid_touching(&self) -> bool {
+        self.touching && !self.sensor && self.enabled
+    }
+}
+
+/// Two shapes that began or stopped touching.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShapePairEvent {
+    /// One shape.
+    pub shape_a: ShapeHandle,
+    /// The other shape.
+    pub shape_b: ShapeHandle,
+}
+
+/// Contact and sensor events, read after the step.
+///
+/// Events of contacts that end because a body or shape was destroyed
+/// between steps are kept and reported with the next step's.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CollisionEvents {
+    /// Solid contacts that began touching.
+    pub contact_begin: Vec<ShapePairEvent>,
+    /// Solid contacts that stopped touching (or whose shapes were destroyed).
+    pub contact_end: Vec<ShapePairEvent>,
+    /// Sensor overlaps that began.
+    pub sensor_begin: Vec<ShapePairEvent>,
+    /// Sensor overlaps that ended.
+    pub sensor_end: Vec<ShapePairEvent>,
+}
+
+impl CollisionEvents {
+    /// Records a begin (`touching`) or end event of a contact.
+    pub(crate) fn push(&mut self, c: &Contact, touching: bool) {
+        let ev = ShapePairEvent {
+            shape_a: c.shapes[0],
+            shape_b: c.shapes[1],
+        };
+        match (touching, c.sensor) {
+            (true, false) => self.contact_begin.push(ev),
+            (false, false) => self.contact_end.push(ev),
+            (true, true) => self.sensor_begin.push(ev),
+            (false, true) => self.sensor_end.push(ev),
+        }
+    }
+}
+
+/// Which list a contact id lives in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Place {
+    Free,
+    Awake(u32),
+    Sleeping(u32),
+}
+
+/// Ordered key of a pair of slot indices.
+#[inline]
+pub(crate) fn pair_key(a: u32, b: u32) -> (u32, u32) {
+    if a < b { (a, b) } else { (b, a) }
+}
+
+/// Every contact of a world, awake or asleep, with per-body adjacency.
+#[derive(Clone, Debug, Default)]
+pub struct ContactSet {
+    /// Awake contacts (the narrowphase and constraint building visit these).
+    pub(crate) awake: Vec<Contact>,
+    /// Contacts whose bodies are all asleep or static.
+    pub(crate) sleeping: Vec<Contact>,
+    place: Vec<Place>,
+    free_ids: Vec<u32>,
+    pair_index: HashMap<(u32, u32), u32>,
+    body_contacts: Vec<SmallVec<[u32; 4]>>,
+}
+
+impl ContactSet {
+    /// Number of contacts, awake and asleep.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.awake.len() + self.sleeping.len()
+    }
+
+    /// True when there is no contact.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The awake contacts, in list order.
+    #[must_use]
+    pub fn awake(&self) -> &[Contact] {
+        &self.awake
+    }
+
+    /// Every contact: awake ones first, then sleeping ones.
+    pub fn iter(&self) -> impl Iterator<Item = &Contact> {
+        self.awake.iter().chain(&self.sleeping)
+    }
+
+    /// True when shapes `a` and `b` (slots) have a contact.
+    #[must_use]
+    pub fn has_pair(&self, a: u32, b: u32) -> bool {
+        self.pair_index.contains_key(&pair_key(a, b))
+    }
+
+    /// Ids of the contacts of a body.
+    #[inline]
+    #[must_use]
+    pub fn of_body(&self, body: BodyHandle) -> &[u32] {
+        self.body_contacts
+            .get(body.index as usize)
+            .map_or(&[], |l| l.as_slice())
+    }
+
+    /// The contact with id `id`.
+    #[must_use]
+    pub fn get(&self, id: u32) -> Option<&Contact> {
+        match *self.place.get(id as usize)? {
+            Place::Free => None,
+            Place::Awake(i) => self.awake.get(i as usize),
+            Place::Sleeping(i) => self.sleeping.get(i as usize),
+        }
+    }
+
+    /// Adds an awake contact (its `id` is assigned here); returns the id.
+    pub fn insert(&mut self, mut c: Contact) -> u32 {
+        let id = match self.free_ids.pop() {
+            Some(id) => id,
+            None => {
+                self.place.push(Place::Free);
+                (self.place.len() - 1) as u32
+            }
+        };
+        c.id = id;
+        self.pair_index.insert(pair_key(c.shape_a, c.shape_b), id);
+        for body in [c.body_a, c.body_b] {
+            let b = body.index as usize;
+            if self.body_contacts.len() <= b {
+                self.body_contacts.resize(b + 1, SmallVec::new());
+            }
+            self.body_contacts[b].push(id);
+        }
+        self.place[id as usize] = Place::Awake(self.awake.len() as u32);
+        self.awake.push(c);
+        id
+    }
+
+    /// Takes contact `id` out of its list (swap-remove), fixing the place of
+    /// the contact that moved into its position.
+    fn unlink(&mut self, id: u32) -> Option<Contact> {
+        let (list, i) = match *self.place.get(id as usize)? {
+            Place::Free => return None,
+            Place::Awake(i) => (&mut self.awake, i as usize),
+            Place::Sleeping(i) => (&mut self.sleeping, i as usize),
+        };
+        let awake = matches!(self.place[id as usize], Place::Awake(_));
+        let c = list.swap_remove(i);
+        if let Some(moved) = list.get(i) {
+            self.place[moved.id as usize] = if awake {
+                Place::Awake(i as u32)
+            } else {
+                Place::Sleeping(i as u32)
+            };
+        }
+        self.place[id as usize] = Place::Free;
+        Some(c)
+    }
+
+    /// Destroys contact `id`; an end event when it was touching.
+    pub fn destroy(&mut self, id: u32, events: &mut CollisionEvents) {
+        let Some(c) = self.unlink(id) else {
+            return;
+        };
+        self.pair_index.remove(&pair_key(c.shape_a, c.shape_b));
+        for body in [c.body_a, c.body_b] {
+            if let Some(list) = self.body_contacts.get_mut(body.index as usize)
+                && let Some(k) = list.iter().position(|x| *x == id)
+            {
+                list.remove(k);
+            }
+        }
+        self.free_ids.push(id);
+        if c.touching {
+            events.push(&c, false);
+        }
+    }
+
+    /// Destroys the awake contact at position `i` (narrowphase: fat boxes
+    /// apart).
+    pub(crate) fn destroy_awake_at(&mut self, i: usize, events: &mut CollisionEvents) {
+        let id = self.awake[i].id;
+        self.destroy(id, events);
+    }
+
+    /// Destroys the contacts of `body` that `pred` selects.
+    pub fn destroy_of_body(
+        &mut self,
+        body: BodyHandle,
+        events: &mut CollisionEvents,
+        mut pred: impl FnMut(&Contact) -> bool,
+    ) {
+        let ids: SmallVec<[u32; 8]> = self
+            .of_body(body)
+            .iter()
+            .copied()
+            .filter(|&id| self.get(id).is_some_and(&mut pred))
+            .collect();
+        for id in ids {
+            self.destroy(id, events);
+        }
+    }
+
+    /// Moves the awake contacts of a body that just fell asleep whose other
+    /// body is static or asleep too into the sleeping list.
+    pub fn sleep_body(&mut self, body: BodyHandle, bodies: &BodySet) {
+        let n = self.of_body(body).len();
+        for k in 0..n {
+            let id = self.body_contacts[body.index as usize][k];
+            let Place::Awake(_) = self.place[id as usize] else {
+                continue;
+            };
+            let c = self.get(id).expect("listed contact");
+            let other = c.other(body);
+            if bodies.state_index(other).unwrap_or(0) != 0 {
+                continue; // the other body still moves
+            }
+            let mut c = self.unlink(id).expect("listed contact");
+            c.still = [true, true];
+            self.place[id as usize] = Place::Sleeping(self.sleeping.len() as u32);
+            self.sleeping.push(c);
+        }
+    }
+
+    /// Moves the sleeping contacts of a body that woke back to the awake
+    /// list (appended, in the body's list order).
+    pub fn wake_body(&mut self, body: BodyHandle) {
+        let n = self.of_body(body).len();
+        for k in 0..n {
+            let id = self.body_contacts[body.index as usize][k];
+            let Place::Sleeping(_) = self.place[id as usize] else {
+                continue;
+            };
+            let mut c = self.unlink(id).expect("listed contact");
+            c.still = [false, false];
+            self.place[id as usize] = Place::Awake(self.awake.len() as u32);
+            self.awake.push(c);
+        }
+    }
+
+    /// Mutable access to the awake contact at position `i`.
+    #[inline]
+    pub(crate) fn awake_mut(&mut self, i: usize) -> &mut Contact {
+        &mut self.awake[i]
+    }
+}

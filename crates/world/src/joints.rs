@@ -1,0 +1,355 @@
+//! The joint set: joint slots and handles, per-type storage, each body's
+//! joints, and which body pairs a joint keeps from colliding.
+//!
+//! ```text
+//! JointSet
+//!   slots        Slots<JointSlot>     handle → (JointKind, index in its type's array)
+//!   revolute     Vec<RevoluteJoint>   solver form, dense (swap-remove)
+//!   handles      Vec<JointHandle>     parallel to revolute
+//!   body_joints  body slot → [JointHandle]   (destroy body, portals walk these)
+//!   no_collide   NoCollide            body pair → joints with collide_connected = false
+//! ```
+//!
+//! A joint's bodies and `collide_connected` are fixed at creation; limits,
+//! motor, spring and the enabled switch change through validated setters
+//! that leave the joint unchanged on error.
+
+use std::collections::HashMap;
+
+use janus2d_constraints::{JointForest, RevoluteJoint, RevoluteJointDef};
+use janus2d_core::body::BodyHandle;
+use janus2d_core::handle::{Handle, HandleError, JointTag};
+use janus2d_core::math::Real;
+use janus2d_core::slots::Slots;
+use smallvec::SmallVec;
+
+use crate::error::WorldError;
+
+/// A generational handle to a joint.
+pub type JointHandle = Handle<JointTag>;
+
+/// The joint types.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum JointKind {
+    /// A pin: two anchors coincide; optional limit, motor and spring.
+    Revolute,
+}
+
+/// Where a joint lives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct JointSlot {
+    kind: JointKind,
+    index: u32,
+}
+
+/// Body pairs (slot indices, ordered) that a joint with
+/// `collide_connected = false` keeps from colliding, with how many such
+/// joints join them.
+#[derive(Clone, Debug, Default)]
+pub struct NoCollide {
+    pairs: HashMap<(u32, u32), u32>,
+}
+
+impl NoCollide {
+    /// True when a joint keeps `a` and `b` from colliding.
+    #[inline]
+    #[must_use]
+    pub fn contains(&self, a: BodyHandle, b: BodyHandle) -> bool {
+        !self.pairs.is_empty()
+            && self
+                .pairs
+                .contains_key(&crate::contacts::pair_key(a.index, b.index))
+    }
+
+    fn add(&mut self, a: BodyHandle, b: BodyHandle) {
+        *self
+            .pairs
+            .entry(crate::contacts::pair_key(a.index, b.index))
+            .or_insert(0) += 1;
+    }
+
+    fn remove(&mut self, a: BodyHandle, b: BodyHandle) {
+        let key = crate::contacts::pair_key(a.index, b.index);
+        if let Some(n) = self.pairs.get_mut(&key) {
+            *n -= 1;
+            if *n == 0 {
+                self.pairs.remove(&key);
+            }
+        }
+    }
+}
+
+/// Every joint of a world.
+#[derive(Clone, Debug, Default)]
+pub struct JointSet {
+    owner: u32,
+    slots: Slots<JointSlot>,
+    pub(crate) revolute: Vec<RevoluteJoint>,
+    handles: Vec<JointHandle>,
+    body_joints: Vec<SmallVec<[JointHandle; 2]>>,
+    pub(crate) no_collide: NoCollide,
+    /// The joint forest of the last step (direct point-row solve).
+    pub(crate) forest: JointForest,
+}
+
+impl JointSet {
+    /// An empty set for world `owner`.
+    #[must_use]
+    pub fn new(owner: u32) -> Self {
+        JointSet {
+            owner,
+            ..JointSet::default()
+        }
+    }
+
+    /// Number of joints.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// True when there is no joint.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.slots.is_empty()
+    }
+
+    /// Handles of every joint, in storage order.
+    #[must_use]
+    pub fn handles(&self) -> &[JointHandle] {
+        &self.handles
+    }
+
+    /// The joints attached to a body.
+    #[must_use]
+    pub fn of_body(&self, body: BodyHandle) -> &[JointHandle] {
+        self.body_joints
+            .get(body.index as usize)
+            .map_or(&[], |l| l.as_slice())
+    }
+
+    fn slot(&self, joint: JointHandle) -> Result<JointSlot, WorldError> {
+        match self.slots.resolve(joint, self.owner) {
+            Ok(s) => Ok(*s),
+            Err(HandleError::Foreign) => Err(WorldError::ForeignHandle),
+            Err(HandleError::Stale) => Err(WorldError::StaleJoint),
+        }
+    }
+
+    /// A revolute joint.
+    pub fn revolute(&self, joint: JointHandle) -> Result<&RevoluteJoint, WorldError> {
+        let s = self.slot(joint)?;
+        match s.kind {
+            JointKind::Revolute => Ok(&self.revolute[s.index as usize]),
+        }
+    }
+
+    fn revolute_mut(&mut self, joint: JointHandle) -> Result<&mut RevoluteJoint, WorldError> {
+        let s = self.slot(joint)?;
+        match s.kind {
+            JointKind::Revolute => Ok(&mut self.revolute[s.index as usize]),
+        }
+    }
+
+    /// The type of a joint.
+    pub fn kind(&self, joint: JointHandle) -> Result<JointKind, WorldError> {
+        self.slot(joint).map(|s| s.kind)
+    }
+
+    /// The two bodies of a joint.
+    pub fn bodies_of(&self, joint: JointHandle) -> Result<(BodyHandle, BodyHandle), WorldError> {
+        let j = self.revolute(joint)?;
+        Ok((j.def.body_a, j.def.body_b))
+    }
+
+    /// Adds a revolute joint (its definition validated and its bodies
+    /// checked by the caller).
+    pub(crate) fn insert_revolute(&mut self, def: &RevoluteJointDef) -> JointHandle {
+        let (index, generation) = self.slots.insert(JointSlot {
+            kind: JointKind::Revolute,
+            index: self.revolute.len() as u32,
+        });
+        let handle = JointHandle::new(index, generation, self.owner);
+        self.revolute.push(RevoluteJoint::new(def.clone()));
+        self.handles.push(handle);
+        for body in [def.body_a, def.body_b] {
+            let b = body.index as usize;
+            if self.body_joints.len() <= b {
+                self.body_joints.resize(b + 1, SmallVec::new());
+            }
+            self.body_joints[b].push(handle);
+        }
+        if !def.collide_connected {
+            self.no_collide.add(def.body_a, def.body_b);
+        }
+        handle
+    }
+
+    /// Removes a joint; returns its two bodies.
+    pub(crate) fn remove(
+        &mut self,
+        joint: JointHandle,
+    ) -> Result<(BodyHandle, BodyHandle), WorldError> {
+        let s = self.slot(joint)?;
+        let i = s.index as usize;
+        let def = &self.revolute[i].def;
+        let (a, b, collide) = (def.body_a, def.body_b, def.collide_connected);
+        if !collide {
+            self.no_collide.remove(a, b);
+        }
+        for body in [a, b] {
+            if let Some(list) = self.body_joints.get_mut(body.index as usize)
+                && let Some(k) = list.iter().position(|h| *h == joint)
+            {
+                list.remove(k);
+            }
+        }
+        self.revolute.swap_remove(i);
+        self.handles.swap_remove(i);
+        if i < self.revolute.len() {
+            let moved = self.handles[i];
+            if let Some(slot) = self.slots.at_mut(moved.index) {
+                slot.index = i as u32;
+            }
+        }
+        self.slots.remove(joint.index, joint.generation);
+        Ok((a, b))
+    }
+
+    /// Changes a joint's definition through `edit`, keeping the change only
+    /// when the result validates. Returns the joint's bodies (to wake).
+    fn edit(
+        &mut self,
+        joint: JointHandle,
+        edit: impl FnOnce(&mut RevoluteJointDef),
+    ) -> Result<(BodyHandle, BodyHandle), WorldError> {
+        let j = self.revolute_mut(joint)?;
+        let mut def = j.def.clone();
+        edit(&mut def);
+        def.validate()?;
+        j.def = def;
+        Ok((j.def.body_a, j.def.body_b))
+    }
+
+    /// Sets the angle limits, rad (`lower ≤ upper`, both finite).
+    pub(crate) fn set_limits(
+        &mut self,
+        joint: JointHandle,
+        lower: Real,
+        upper: Real,
+    ) -> Result<(BodyHandle, BodyHandle), WorldError> {
+        if !(lower.is_finite() && upper.is_finite()) {
+            return Err(WorldError::NonFinite("limits"));
+        }
+        if lower > upper {
+            return Err(WorldError::OutOfRange("limits"));
+        }
+        self.edit(joint, |d| {
+            d.lower_angle = lower;
+            d.upper_angle = upper;
+        })
+    }
+
+    /// Turns the limit on or off.
+    pub(crate) fn enable_limit(
+        &mut self,
+        joint: JointHandle,
+        on: bool,
+    ) -> Result<(BodyHandle, BodyHandle), WorldError> {
+        self.edit(joint, |d| d.enable_limit = on)
+    }
+
+    /// Sets the motor speed, rad/s.
+    pub(crate) fn set_motor_speed(
+        &mut self,
+        joint: JointHandle,
+        speed: Real,
+    ) -> Result<(BodyHandle, BodyHandle), WorldError> {
+        if !speed.is_finite() {
+            return Err(WorldError::NonFinite("motor_speed"));
+        }
+        self.edit(joint, |d| d.motor_speed = speed)
+    }
+
+    /// Sets the largest motor torque, N·m (≥ 0).
+    pub(crate) fn set_max_motor_torque(
+        &mut self,
+        joint: JointHandle,
+        torque: Real,
+    ) -> Result<(BodyHandle, BodyHandle), WorldError> {
+        if torque.is_nan() {
+            return Err(WorldError::NonFinite("max_motor_torque"));
+        }
+        if torque < 0.0 {
+            return Err(WorldError::OutOfRange("max_motor_torque"));
+        }
+        self.edit(joint, |d| d.max_motor_torque = torque)
+    }
+
+    /// Turns the motor on or off.
+    pub(crate) fn enable_motor(
+        &mut self,
+        joint: JointHandle,
+        on: bool,
+    ) -> Result<(BodyHandle, BodyHandle), WorldError> {
+        self.edit(joint, |d| d.enable_motor = on)
+    }
+
+    /// Sets the spring's stiffness, Hz, and damping ratio (both ≥ 0).
+    pub(crate) fn set_spring(
+        &mut self,
+        joint: JointHandle,
+        hertz: Real,
+        damping_ratio: Real,
+    ) -> Result<(BodyHandle, BodyHandle), WorldError> {
+        if !(hertz.is_finite() && damping_ratio.is_finite()) {
+            return Err(WorldError::NonFinite("spring"));
+        }
+        if hertz < 0.0 || damping_ratio < 0.0 {
+            return Err(WorldError::OutOfRange("spring"));
+        }
+        self.edit(joint, |d| {
+            d.hertz = hertz;
+            d.damping_ratio = damping_ratio;
+        })
+    }
+
+    /// Turns the spring on or off.
+    pub(crate) fn enable_spring(
+        &mut self,
+        joint: JointHandle,
+        on: bool,
+    ) -> Result<(BodyHandle, BodyHandle), WorldError> {
+        self.edit(joint, |d| d.enable_spring = on)
+    }
+
+    /// Enables or disables a joint (a disabled joint stays until destroyed
+    /// and is skipped by the solver and the islands).
+    pub(crate) fn set_enabled(
+        &mut self,
+        joint: JointHandle,
+        on: bool,
+    ) -> Result<(BodyHandle, BodyHandle), WorldError> {
+        let j = self.revolute_mut(joint)?;
+        j.enabled = on;
+        Ok((j.def.body_a, j.def.body_b))
+    }
+
+    /// Rows every enabled joint adds to the solver.
+    #[must_use]
+    pub fn row_count(&self) -> usize {
+        self.revolute
+            .iter()
+            .filter(|j| j.enabled)
+            .map(RevoluteJoint::row_count)
+            .sum()
+    }
+
+    /// Pairs of bodies held by enabled joints.
+    pub(crate) fn edges(&self) -> impl Iterator<Item = (BodyHandle, BodyHandle)> + '_ {
+        self.revolute
+            .iter()
+            .filter(|j| j.enabled)
+            .map(|j| (j.def.body_a, j.def.body_b))
+    }
+}

@@ -1,0 +1,285 @@
+//! The narrowphase: new manifolds for the awake contacts, and the contact
+//! constraints built from them.
+//!
+//! ```text
+//! phase 1 (parallel with `parallel`)   each awake contact alone:
+//!     both bodies still      → Asleep (kept as is)
+//!     fat boxes apart        → Separated
+//!     else                   → Manifold(collide(a, b, speculative))
+//! phase 2 (contact order)    destroy separated, store manifolds (impulses
+//!                            carried by feature id), apply aperture
+//!                            clipping, begin/end events, list bodies to wake
+//! build                      one ContactConstraint per touching solid
+//!                            contact: moving pairs first, static ones last
+//! ```
+//!
+//! Phase 1 results do not depend on the thread count, since each contact
+//! is computed alone; phase 2 runs in list order.
+
+use janus2d_constraints::ContactPointInput;
+use janus2d_constraints::contact::ContactConstraint;
+use janus2d_core::body::{BodyHandle, BodySet};
+use janus2d_core::geometry::{Aabb, Manifold, collide};
+use janus2d_core::math::{Real, Vec2};
+
+use crate::broadphase::BroadPhase;
+use crate::collision::{CollisionCounters, SPECULATIVE_DISTANCE};
+use crate::contacts::{CollisionEvents, Contact, ContactPointData, ContactSet};
+use crate::portal::ContactClipping;
+use crate::shapes::ShapeStore;
+
+/// Phase-1 result of the narrowphase for one contact.
+#[derive(Clone, Debug)]
+#[allow(clippy::large_enum_variant)] // one per contact in a reused buffer; no boxing
+enum ContactUpdate {
+    /// Both bodies asleep or static: keep the contact as it is.
+    Asleep,
+    /// The fat boxes separated: destroy the contact.
+    Separated,
+    /// The new manifold, with what phase 2 needs of the two bodies.
+    Manifold(Computed),
+}
+
+/// A computed manifold and the body data phase 2 needs.
+#[derive(Clone, Debug)]
+struct Computed {
+    manifold: Manifold,
+    /// Body origin minus centre of mass, per body (world frame), m.
+    offset: [Vec2; 2],
+    /// Whether each body reads as static (static or asleep).
+    still: [bool; 2],
+}
+
+/// The narrowphase's reused buffers.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Narrowphase {
+    results: Vec<ContactUpdate>,
+}
+
+/// What the narrowphase reads besides the contacts it updates.
+pub(crate) struct NarrowphaseInput<'a> {
+    pub(crate) shapes: &'a ShapeStore,
+    pub(crate) broadphase: &'a BroadPhase,
+    pub(crate) bodies: &'a BodySet,
+    pub(crate) dt: Real,
+    pub(crate) clipping: &'a ContactClipping,
+}
+
+impl Narrowphase {
+    /// Updates every awake contact's manifold; destroys contacts whose fat
+    /// boxes separated; records begin/end events.
+    ///
+    /// The speculative distance of a pair grows with how far the two bodies
+    /// can approach within `dt`: `d = d₀ + dt (|v_b − v_a| + |ω_a| R_a + |ω_b| R_b)`
+    /// with `R` the reach of a shape's box from its body's centre, so a
+    /// fast body gets its contact points before it would overshoot.
+    ///
+    /// A touching contact between a sleeping body and an awake one lists
+    /// the sleeping body in `wake`.
+    pub(crate) fn run(
+        &mut self,
+        input: &NarrowphaseInput<'_>,
+        contacts: &mut ContactSet,
+        events: &mut CollisionEvents,
+        counters: &mut CollisionCounters,
+        wake: &mut Vec<BodyHandle>,
+    ) {
+        let mut results = std::mem::take(&mut self.results);
+        results.clear();
+        {
+            let compute = |c: &Contact| update_of(c, input);
+            #[cfg(feature = "parallel")]
+            {
+                use rayon::prelude::*;
+                contacts
+                    .awake()
+                    .par_iter()
+                    .map(compute)
+                    .collect_into_vec(&mut results);
+            }
+            #[cfg(not(feature = "parallel"))]
+            results.extend(contacts.awake().iter().map(compute));
+        }
+        let clip = !input.clipping.is_empty();
+        let mut k = 0;
+        let mut tested = 0;
+        let mut touching_count = 0;
+        while k < contacts.awake().len() {
+            let update = match results[k] {
+                ContactUpdate::Asleep => {
+                    contacts.awake_mut(k).still = [true, true];
+                    k += 1;
+                    continue;
+                }
+                ContactUpdate::Separated => {
+                    contacts.destroy_awake_at(k, events);
+                    results.swap_remove(k);
+                    continue;
+                }
+                ContactUpdate::Manifold(ref m) => m,
+            };
+            tested += 1;
+            let c = contacts.awake_mut(k);
+            let was_touching = c.touching;
+            update_manifold(c, &update.manifold, update.offset);
+            c.still = update.still;
+            if clip {
+                input.clipping.apply(c);
+            }
+            let touching = c.point_count > 0;
+            c.touching = touching;
+            if touching && (update.still[0] || update.still[1]) {
+                let other = if update.still[0] { c.body_a } else { c.body_b };
+                if input.bodies.is_sleeping(other) {
+                    wake.push(other);
+                    // Woken before the solve: it moves this step.
+                    c.still = [false, false];
+                }
+            }
+            if touching {
+                touching_count += 1;
+            }
+            if touching != was_touching {
+                events.push(c, touching);
+            }
+            k += 1;
+        }
+        self.results = results;
+        counters.pairs_tested = tested;
+        counters.touching = touching_count;
+    }
+}
+
+/// The new manifold of one contact (phase 1 of the narrowphase).
+fn update_of(c: &Contact, input: &NarrowphaseInput<'_>) -> ContactUpdate {
+    let body_a = input.bodies.solver_body(c.body_a);
+    let body_b = input.bodies.solver_body(c.body_b);
+    if body_a.state_index == 0 && body_b.state_index == 0 {
+        // Both asleep (or asleep and static): nothing moves.
+        return ContactUpdate::Asleep;
+    }
+    let sa = input.shapes.at(c.shape_a);
+    let sb = input.shapes.at(c.shape_b);
+    if !input.broadphase.test_overlap(sa.proxy, sb.proxy) {
+        return ContactUpdate::Separated;
+    }
+    let (sim_a, sim_b) = (body_a.sim, body_b.sim);
+    let reach = |aabb: &Aabb, center: Vec2| {
+        (aabb.lower - center)
+            .abs()
+            .max((aabb.upper - center).abs())
+            .length()
+    };
+    let approach = (body_b.state.v - body_a.state.v).length()
+        + body_a.state.w.abs() * reach(&sa.aabb, sim_a.center)
+        + body_b.state.w.abs() * reach(&sb.aabb, sim_b.center);
+    let speculative = SPECULATIVE_DISTANCE + input.dt * approach;
+    ContactUpdate::Manifold(Computed {
+        manifold: collide(
+            &sa.geometry,
+            &sim_a.transform,
+            &sb.geometry,
+            &sim_b.transform,
+            speculative,
+        ),
+        offset: [
+            sim_a.transform.p - sim_a.center,
+            sim_b.transform.p - sim_b.center,
+        ],
+        still: [body_a.state_index == 0, body_b.state_index == 0],
+    })
+}
+
+/// Replaces a contact's manifold, carrying impulses over by feature id and
+/// converting anchors from body origins to centres of mass.
+fn update_manifold(c: &mut Contact, m: &Manifold, offset: [Vec2; 2]) {
+    let old = c.points;
+    let old_count = c.point_count;
+    c.normal = m.normal;
+    c.point_count = m.point_count;
+    let [off_a, off_b] = offset;
+    for i in 0..m.point_count {
+        let mp = &m.points[i];
+        let mut p = ContactPointData {
+            point: mp.point,
+            anchor_a: mp.anchor_a + off_a,
+            anchor_b: mp.anchor_b + off_b,
+            separation: mp.separation,
+            id: mp.id,
+            normal_impulse: 0.0,
+            tangent_impulse: 0.0,
+        };
+        if let Some(o) = old[..old_count].iter().find(|o| o.id == mp.id) {
+            p.normal_impulse = o.normal_impulse;
+            p.tangent_impulse = o.tangent_impulse;
+        }
+        c.points[i] = p;
+    }
+}
+
+/// Builds the contact constraints of touching solid awake contacts.
+///
+/// Contacts between two moving bodies come first and contacts with a
+/// static body last, so each Gauss–Seidel sweep ends on the ground: the
+/// support a stack stands on has the last word (as Box2D v3 keeps static
+/// contacts out of its first graph colour).
+///
+/// Whether a body reads as static was noted by the narrowphase
+/// ([`Contact::still`]); a contact whose two bodies are still is skipped.
+/// When islands were woken after the narrowphase (`woke`), contacts that
+/// read still are checked again.
+pub(crate) fn build_constraints(
+    contacts: &mut ContactSet,
+    bodies: &BodySet,
+    woke: bool,
+    out: &mut Vec<ContactConstraint>,
+    counters: &mut CollisionCounters,
+) {
+    out.clear();
+    if woke {
+        for k in 0..contacts.awake().len() {
+            let c = contacts.awake_mut(k);
+            if c.still == [true, true] {
+                c.still = [
+                    bodies.state_index(c.body_a) == Some(0),
+                    bodies.state_index(c.body_b) == Some(0),
+                ];
+            }
+        }
+    }
+    let (mut rows, mut bouncy) = (0, 0);
+    for static_pass in [false, true] {
+        for (k, c) in contacts.awake().iter().enumerate() {
+            if !c.is_solid_touching() {
+                continue;
+            }
+            let [sa, sb] = c.still;
+            if (sa && sb) || (sa || sb) != static_pass {
+                continue;
+            }
+            rows += 2 * c.point_count;
+            bouncy += usize::from(c.restitution > 0.0);
+            let mut inputs = [ContactPointInput::default(); 2];
+            for (input, p) in inputs.iter_mut().zip(&c.points[..c.point_count]) {
+                *input = ContactPointInput {
+                    anchor_a: p.anchor_a,
+                    anchor_b: p.anchor_b,
+                    separation: p.separation,
+                    normal_impulse: p.normal_impulse,
+                    tangent_impulse: p.tangent_impulse,
+                };
+            }
+            out.push(ContactConstraint::new(
+                c.body_a,
+                c.body_b,
+                c.normal,
+                &inputs[..c.point_count],
+                c.friction,
+                c.restitution,
+                k as u32,
+            ));
+        }
+    }
+    counters.contact_rows = rows;
+    counters.restitution_contacts = bouncy;
+}

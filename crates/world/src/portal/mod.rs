@@ -1,0 +1,26 @@
+//! Portals: linked apertures that bodies pass through, cloned and scaled.
+//!
+//! | file | what |
+//! |------|------|
+//! | `stage.rs` | pairs, crossings, clones, handover, weights; the portal API on `World` (with the `portals` feature) |
+//! | `noop.rs` | the stage's twin without the feature: no state, every step call does nothing |
+//! | [`clipping`] | aperture regions where the narrowphase drops contact points |
+//!
+//! The world calls the stage in the same places with or without the
+//! feature; only which twin is compiled changes.
+
+pub mod clipping;
+#[cfg(not(feature = "portals"))]
+mod noop;
+#[cfg(feature = "portals")]
+mod stage;
+
+pub use clipping::{ApertureClip, ContactClipping, NO_CLIPPING};
+#[cfg(not(feature = "portals"))]
+pub(crate) use noop::PortalStage;
+#[cfg(feature = "portals")]
+pub(crate) use stage::PortalStage;
+#[cfg(feature = "portals")]
+pub use stage::{
+    F_MIN, MassModel, PortalCounters, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle,
+};

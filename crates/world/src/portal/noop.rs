@@ -1,0 +1,45 @@
+//! The portal stage without the `portals` feature: it holds nothing and
+//! each of its step calls returns at once, so a world built without portals
+//! pays for none of them.
+
+use janus2d_constraints::{ContactConstraint, PortalConstraint};
+use janus2d_core::body::{BodyHandle, BodySet};
+
+use super::clipping::{ContactClipping, NO_CLIPPING};
+use crate::world::World;
+
+/// The no-op portal stage.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct PortalStage {
+    /// Always empty: the solver's third batch.
+    constraints: Vec<PortalConstraint>,
+}
+
+impl PortalStage {
+    pub(crate) fn is_active(&self) -> bool {
+        false
+    }
+    pub(crate) fn clipping(&self) -> &ContactClipping {
+        &NO_CLIPPING
+    }
+    pub(crate) fn constraints_mut(&mut self) -> &mut Vec<PortalConstraint> {
+        &mut self.constraints
+    }
+    pub(crate) fn clear_events(&mut self) {}
+    pub(crate) fn counters_for_step(&self, _ran: bool) -> (usize, usize, usize) {
+        (0, 0, 0)
+    }
+    pub(crate) fn keep_awake(&self) -> Vec<BodyHandle> {
+        Vec::new()
+    }
+    pub(crate) fn build_clipping(&mut self, _bodies: &BodySet) {}
+    pub(crate) fn modify_contacts(&self, _bodies: &BodySet, _c: &mut [ContactConstraint]) {}
+}
+
+impl World {
+    /// Nothing crosses without portals.
+    pub(crate) fn portal_crossings(&mut self) {}
+
+    /// No crossing or pair to end.
+    pub(crate) fn portal_forget_body(&mut self, _body: BodyHandle) {}
+}

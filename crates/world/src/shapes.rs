@@ -1,0 +1,282 @@
+//! The shape store: shapes, their materials and filters, and which body
+//! holds which shapes.
+//!
+//! ```text
+//! ShapeStore
+//!   slots        Slots<ShapeData>   shape handle → geometry, material, proxy, box
+//!   body_shapes  body slot → [shape slot]   (creation order)
+//! ```
+//!
+//! The store owns no contacts: the contact life cycle is in
+//! [`contacts`](crate::contacts), pair finding in
+//! [`broadphase`](crate::broadphase).
+
+use janus2d_core::body::BodyHandle;
+use janus2d_core::geometry::{Aabb, MassData, Shape};
+use janus2d_core::handle::{Handle, HandleError, ShapeTag};
+use janus2d_core::math::{Real, Vec2};
+use janus2d_core::slots::Slots;
+use smallvec::SmallVec;
+
+use crate::error::WorldError;
+
+/// A generational handle to a shape.
+pub type ShapeHandle = Handle<ShapeTag>;
+
+/// Which shapes collide: `a` and `b` collide when
+/// `(a.category & b.mask) != 0 && (b.category & a.mask) != 0`, unless they
+/// share a non-zero group index (positive: always collide; negative: never).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Filter {
+    /// The categories this shape belongs to (usual 1).
+    pub category_bits: u64,
+    /// The categories this shape collides with (usual all).
+    pub mask_bits: u64,
+    /// Group override (usual 0: none).
+    pub group_index: i32,
+}
+
+impl Default for Filter {
+    fn default() -> Self {
+        Filter {
+            category_bits: 1,
+            mask_bits: u64::MAX,
+            group_index: 0,
+        }
+    }
+}
+
+impl Filter {
+    /// Whether two filters let their shapes collide.
+    ///
+    /// ```
+    /// use janus2d_world::Filter;
+    /// let a = Filter { group_index: -1, ..Filter::default() };
+    /// assert!(!a.should_collide(&a));
+    /// assert!(Filter::default().should_collide(&Filter::default()));
+    /// ```
+    #[must_use]
+    pub fn should_collide(&self, other: &Filter) -> bool {
+        if self.group_index == other.group_index && self.group_index != 0 {
+            return self.group_index > 0;
+        }
+        (self.mask_bits & other.category_bits) != 0 && (self.category_bits & other.mask_bits) != 0
+    }
+}
+
+/// Everything needed to create a shape besides its geometry.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShapeDef {
+    /// Density, kg/m² (usual 1).
+    pub density: Real,
+    /// Friction coefficient (usual 0.6).
+    pub friction: Real,
+    /// Restitution (usual 0).
+    pub restitution: Real,
+    /// Collision filter.
+    pub filter: Filter,
+    /// A sensor only reports overlaps; it never pushes.
+    pub is_sensor: bool,
+    /// Opaque user value.
+    pub user_data: u64,
+}
+
+impl Default for ShapeDef {
+    fn default() -> Self {
+        ShapeDef {
+            density: 1.0,
+            friction: 0.6,
+            restitution: 0.0,
+            filter: Filter::default(),
+            is_sensor: false,
+            user_data: 0,
+        }
+    }
+}
+
+impl ShapeDef {
+    /// Sets the friction (builder style).
+    #[must_use]
+    pub fn with_friction(mut self, friction: Real) -> Self {
+        self.friction = friction;
+        self
+    }
+
+    /// Sets the density (builder style).
+    #[must_use]
+    pub fn with_density(mut self, density: Real) -> Self {
+        self.density = density;
+        self
+    }
+
+    /// Sets the restitution (builder style).
+    #[must_use]
+    pub fn with_restitution(mut self, restitution: Real) -> Self {
+        self.restitution = restitution;
+        self
+    }
+
+    /// Checks the material: density, friction and restitution finite and
+    /// not negative; the error names the field.
+    ///
+    /// ```
+    /// use janus2d_world::{ShapeDef, WorldError};
+    /// let bad = ShapeDef::default().with_friction(-1.0);
+    /// assert_eq!(bad.validate(), Err(WorldError::OutOfRange("friction")));
+    /// ```
+    pub fn validate(&self) -> Result<(), WorldError> {
+        for (v, name) in [
+            (self.density, "density"),
+            (self.friction, "friction"),
+            (self.restitution, "restitution"),
+        ] {
+            if !v.is_finite() {
+                return Err(WorldError::NonFinite(name));
+            }
+            if v < 0.0 {
+                return Err(WorldError::OutOfRange(name));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A shape attached to a body.
+#[derive(Clone, Debug)]
+pub struct ShapeData {
+    /// The body it is attached to.
+    pub body: BodyHandle,
+    /// Geometry in the body frame.
+    pub geometry: Shape,
+    /// Material and filter.
+    pub def: ShapeDef,
+    /// Broadphase proxy.
+    pub proxy: u32,
+    /// Tight world box at the end of the last step.
+    pub aabb: Aabb,
+}
+
+/// Shapes of a world, in generational slots, with each body's list.
+#[derive(Clone, Debug, Default)]
+pub struct ShapeStore {
+    slots: Slots<ShapeData>,
+    body_shapes: Vec<SmallVec<[u32; 2]>>,
+}
+
+impl ShapeStore {
+    /// Number of live shapes.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// True when there is no shape.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.slots.is_empty()
+    }
+
+    /// The shape in live slot `index`.
+    #[inline]
+    #[must_use]
+    pub fn at(&self, index: u32) -> &ShapeData {
+        self.slots.live(index)
+    }
+
+    /// Mutable access to live slot `index`.
+    #[inline]
+    pub fn at_mut(&mut self, index: u32) -> &mut ShapeData {
+        self.slots.live_mut(index)
+    }
+
+    /// The slot of a live shape, or why the handle does not resolve.
+    pub fn slot(&self, handle: ShapeHandle, owner: u32) -> Result<u32, WorldError> {
+        match self.slots.resolve(handle, owner) {
+            Ok(_) => Ok(handle.index),
+            Err(HandleError::Foreign) => Err(WorldError::ForeignHandle),
+            Err(HandleError::Stale) => Err(WorldError::StaleShape),
+        }
+    }
+
+    /// The handle of live slot `index`.
+    #[must_use]
+    pub fn handle_of(&self, index: u32, owner: u32) -> ShapeHandle {
+        self.slots.handle(index, owner)
+    }
+
+    /// The shape slots of a body, in creation order.
+    #[inline]
+    #[must_use]
+    pub fn of_body(&self, body: BodyHandle) -> &[u32] {
+        self.body_shapes
+            .get(body.index as usize)
+            .map_or(&[], |l| l.as_slice())
+    }
+
+    /// Stores a shape and lists it under its body; returns its slot.
+    pub fn insert(&mut self, data: ShapeData) -> u32 {
+        let b = data.body.index as usize;
+        let (index, _) = self.slots.insert(data);
+        if self.body_shapes.len() <= b {
+            self.body_shapes.resize(b + 1, SmallVec::new());
+        }
+        self.body_shapes[b].push(index);
+        index
+    }
+
+    /// Removes live slot `index` from the store and its body's list.
+    pub fn remove(&mut self, index: u32) -> ShapeData {
+        let generation = self.slots.generation(index);
+        let data = self
+            .slots
+            .remove(index, generation)
+            .expect("slot index handed out by this store");
+        if let Some(list) = self.body_shapes.get_mut(data.body.index as usize) {
+            list.retain(|i| *i != index);
+        }
+        data
+    }
+
+    /// Exchanges the shape lists of two bodies whose identities were swapped.
+    pub fn swap_bodies(&mut self, a: BodyHandle, b: BodyHandle) {
+        let (ia, ib) = (a.index as usize, b.index as usize);
+        let n = ia.max(ib) + 1;
+        if self.body_shapes.len() < n {
+            self.body_shapes.resize(n, SmallVec::new());
+        }
+        self.body_shapes.swap(ia, ib);
+        for k in 0..self.body_shapes[ia].len() {
+            let s = self.body_shapes[ia][k];
+            self.slots.live_mut(s).body = a;
+        }
+        for k in 0..self.body_shapes[ib].len() {
+            let s = self.body_shapes[ib][k];
+            self.slots.live_mut(s).body = b;
+        }
+    }
+
+    /// The mass, centre (body frame) and inertia about the centre of a
+    /// body's shapes with positive density.
+    #[must_use]
+    pub fn mass_of(&self, body: BodyHandle) -> MassData {
+        MassData::combine(self.of_body(body).iter().filter_map(|&s| {
+            let shape = self.at(s);
+            (shape.def.density > 0.0).then(|| shape.geometry.compute_mass(shape.def.density))
+        }))
+    }
+
+    /// How far a body's shapes reach from a point (its centre of mass), m.
+    #[must_use]
+    pub fn reach(&self, body: BodyHandle, center: Vec2) -> Real {
+        self.of_body(body)
+            .iter()
+            .map(|&s| {
+                let a = &self.at(s).aabb;
+                (a.lower - center)
+                    .abs()
+                    .max((a.upper - center).abs())
+                    .length()
+            })
+            .fold(0.0, Real::max)
+    }
+}
