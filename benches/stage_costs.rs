@@ -10,7 +10,7 @@
 //!
 //! Timing lives here, never in tests; compare ratios within one run.
 use janus2d::base::geometry::Circle;
-use janus2d::prelude::{BodyDef, Vec2};
+use janus2d::prelude::{BodyDef, Real, Vec2};
 use janus2d::world::{ShapeDef, World, WorldDef};
 use std::time::Instant;
 
@@ -18,9 +18,14 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let steps: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1000);
     // --- destroy_body in ~10k contacts
-    let mut def = WorldDef::default();
-    def.gravity = Vec2::ZERO;
-    def.sleep.enabled = false;
+    let def = WorldDef {
+        gravity: Vec2::ZERO,
+        sleep: janus2d::world::SleepSettings {
+            enabled: false,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
     let mut world = World::new(def).unwrap();
     let mut handles = Vec::new();
     let n = 71;
@@ -28,8 +33,8 @@ fn main() {
         for j in 0..n {
             let b = world
                 .create_body(&BodyDef::dynamic(Vec2::new(
-                    i as f32 * 0.99,
-                    j as f32 * 0.99,
+                    i as Real * 0.99,
+                    j as Real * 0.99,
                 )))
                 .unwrap();
             world
