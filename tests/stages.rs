@@ -1,0 +1,164 @@
+//! The stages' own bookkeeping: sleeping contacts leave the awake list,
+//! per-body adjacency ends the right contacts, joint setters validate, and
+//! a ragdoll falls asleep with the joint-tree solve on.
+
+use janus2d::prelude::*;
+use janus2d::world::{JointKind, WorldError};
+use janus2d_testbed::benchmarks::{rain, rain_group};
+use janus2d_testbed::desc::{Action, Script};
+use janus2d_testbed::janus::{Janus, world_def};
+use janus2d_testbed::scenes::DT;
+
+fn stack_on_ground(n: usize) -> (World, BodyHandle, Vec<BodyHandle>) {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let g = world
+        .create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0)))
+        .unwrap();
+    world
+        .create_shape(g, &ShapeDef::default(), Polygon::make_box(20.0, 1.0))
+        .unwrap();
+    let boxes = (0..n)
+        .map(|i| {
+            let b = world
+                .create_body(&BodyDef::dynamic(Vec2::new(0.0, 0.5 + i as Real)))
+                .unwrap();
+            world
+                .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+                .unwrap();
+            b
+        })
+        .collect();
+    (world, g, boxes)
+}
+
+#[test]
+fn sleeping_island_contacts_leave_the_awake_list_and_come_back_on_wake() {
+    let (mut world, _, boxes) = stack_on_ground(3);
+    for _ in 0..240 {
+        world.step(DT).unwrap();
+    }
+    assert_eq!(world.sleeping_body_count(), 3, "the stack sleeps");
+    assert_eq!(
+        world.contact_count(),
+        3,
+        "ground–box and two box–box contacts"
+    );
+    assert_eq!(world.awake_contact_count(), 0, "none is visited per step");
+    world.step(DT).unwrap();
+    assert_eq!(
+        world.counters().pairs_tested,
+        0,
+        "the narrowphase sees none"
+    );
+    world
+        .apply_linear_impulse(boxes[2], Vec2::new(0.0, 0.1), Vec2::ZERO)
+        .unwrap();
+    assert_eq!(world.sleeping_body_count(), 0);
+    assert_eq!(world.awake_contact_count(), 3, "the island's contacts woke");
+    world.step(DT).unwrap();
+    assert_eq!(world.counters().pairs_tested, 3);
+}
+
+#[test]
+fn destroying_a_body_ends_its_contacts_only_and_reports_them_next_step() {
+    let (mut world, _, boxes) = stack_on_ground(3);
+    world.step(DT).unwrap();
+    assert_eq!(world.touching_contact_count(), 3);
+    let top = boxes[2];
+    let top_shape = world.body_shapes(top).unwrap()[0];
+    world.destroy_body(top).unwrap();
+    assert_eq!(world.contact_count(), 2, "only the top box's contact ended");
+    world.step(DT).unwrap();
+    let ends = &world.events().collision.contact_end;
+    assert_eq!(ends.len(), 1, "the end event survives until the step");
+    assert!(ends[0].shape_a == top_shape || ends[0].shape_b == top_shape);
+    assert_eq!(world.touching_contact_count(), 2);
+}
+
+#[test]
+fn joint_with_collide_connected_false_ends_only_its_pair() {
+    let (mut world, _, boxes) = stack_on_ground(3);
+    world.step(DT).unwrap();
+    assert_eq!(world.contact_count(), 3);
+    let def = RevoluteJointDef::new(
+        boxes[0],
+        boxes[1],
+        Vec2::new(0.0, 0.5),
+        Vec2::new(0.0, -0.5),
+    );
+    let j = world.create_revolute_joint(&def).unwrap();
+    assert_eq!(world.contact_count(), 2, "the jointed pair's contact ended");
+    assert_eq!(world.joints().of_body(boxes[0]), &[j]);
+    assert_eq!(world.joints().kind(j), Ok(JointKind::Revolute));
+    world.destroy_body(boxes[1]).unwrap();
+    assert_eq!(world.joint_count(), 0, "the joint went with its body");
+    assert!(world.joints().of_body(boxes[0]).is_empty());
+}
+
+#[test]
+fn joint_setters_reject_bad_values_and_leave_the_joint_unchanged() {
+    let (mut world, _, boxes) = stack_on_ground(2);
+    let def = RevoluteJointDef::new(
+        boxes[0],
+        boxes[1],
+        Vec2::new(0.0, 0.5),
+        Vec2::new(0.0, -0.5),
+    );
+    let j = world.create_revolute_joint(&def).unwrap();
+    let before = world.revolute_joint(j).unwrap().def.clone();
+    assert_eq!(
+        world.set_joint_max_motor_torque(j, -1.0),
+        Err(WorldError::OutOfRange("max_motor_torque"))
+    );
+    assert_eq!(
+        world.set_joint_limits(j, 1.0, -1.0),
+        Err(WorldError::OutOfRange("limits"))
+    );
+    assert_eq!(
+        world.set_joint_motor_speed(j, Real::NAN),
+        Err(WorldError::NonFinite("motor_speed"))
+    );
+    assert_eq!(
+        world.set_joint_spring(j, -2.0, 0.5),
+        Err(WorldError::OutOfRange("spring"))
+    );
+    assert_eq!(world.revolute_joint(j).unwrap().def, before);
+    world.set_joint_limits(j, -0.5, 0.25).unwrap();
+    world.enable_joint_limit(j, true).unwrap();
+    world.set_joint_max_motor_torque(j, 10.0).unwrap();
+    world.enable_joint_motor(j, true).unwrap();
+    let d = &world.revolute_joint(j).unwrap().def;
+    assert_eq!((d.lower_angle, d.upper_angle), (-0.5, 0.25));
+    assert!(d.enable_limit && d.enable_motor && d.max_motor_torque == 10.0);
+    assert_eq!(world.revolute_joint(j).unwrap().row_count(), 2 + 2 + 1);
+    world.set_joint_enabled(j, false).unwrap();
+    assert!(!world.revolute_joint(j).unwrap().enabled);
+    world.set_joint_enabled(j, true).unwrap();
+    assert!(world.revolute_joint(j).unwrap().enabled, "enabled again");
+}
+
+#[test]
+fn rain_ragdoll_falls_asleep_with_the_joint_tree_solve_on() {
+    for direct in [true, false] {
+        let mut desc = rain();
+        desc.script = Script::None;
+        let mut def = world_def(&desc.settings);
+        def.solver.direct_joints = direct;
+        let mut e = Janus::with_def(&desc, def).unwrap();
+        let (bodies, joints) = rain_group(0, 0, 1);
+        e.try_apply(&Action::Spawn {
+            id: 0,
+            bodies,
+            joints,
+        })
+        .unwrap();
+        for _ in 0..360 {
+            e.world.step(DT).unwrap();
+        }
+        assert_eq!(
+            e.world.awake_body_count(),
+            0,
+            "direct_joints = {direct}: the ragdoll sleeps within 6 s"
+        );
+    }
+}
