@@ -391,6 +391,27 @@ fn sweep<'a, const USE_BIAS: bool>(
     }
 }
 
+/// The softness of one normal row: the contact softness scaled by the
+/// mass ratio `ρ = min(k / min(k_a, k_b), ρ_max)` of the point's two
+/// effective masses (1 for a pair with a static body). Used by the solve
+/// and reported by `rows()`.
+fn normal_softness(
+    softness: Softness,
+    moving_pair: bool,
+    rho_max: Real,
+    k_a: Real,
+    k_b: Real,
+) -> Softness {
+    let k = k_a + k_b;
+    let k_heavy = k_a.min(k_b);
+    let rho = if moving_pair && rho_max > 1.0 && k_heavy > 0.0 {
+        (k / k_heavy).min(rho_max)
+    } else {
+        1.0
+    };
+    softness.with_mass_ratio(rho)
+}
+
 impl Constraint for ContactConstraint {
     fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
         // Static, sleeping and stale bodies read the identity state 0.
@@ -424,13 +445,7 @@ impl Constraint for ContactConstraint {
             let k_a = m_a + i_a * rn_a * rn_a;
             let k_b = m_b + i_b * rn_b * rn_b;
             let k = k_a + k_b;
-            let k_heavy = k_a.min(k_b);
-            let rho = if moving_pair && rho_max > 1.0 && k_heavy > 0.0 {
-                (k / k_heavy).min(rho_max)
-            } else {
-                1.0
-            };
-            let soft = softness.with_mass_ratio(rho);
+            let soft = normal_softness(softness, moving_pair, rho_max, k_a, k_b);
             let normal_mass = if k > 0.0 { 1.0 / k } else { 0.0 };
             self.mass[i] = normal_mass;
             self.soft_mass[i] = normal_mass * soft.mass_scale;
@@ -546,7 +561,16 @@ impl Constraint for ContactConstraint {
                 let (c, softness, lower, upper) = if first == 0 {
                     // At the start of the step: r · n = −(r × t).
                     let s = self.base_separation[i] - (self.jb[i + 2] - self.ja[i + 2]);
-                    (s, softness, 0.0, Real::INFINITY)
+                    let k_a = sa.inv_mass + sa.inv_inertia * j_a * j_a;
+                    let k_b = sb.inv_mass + sb.inv_inertia * j_b * j_b;
+                    let soft = normal_softness(
+                        softness,
+                        !static_pair,
+                        ctx.contact_mass_ratio_cap,
+                        k_a,
+                        k_b,
+                    );
+                    (s, soft, 0.0, Real::INFINITY)
                 } else {
                     let m = self.friction * self.impulse[i];
                     (0.0, Softness::RIGID, -m, m)
@@ -587,4 +611,39 @@ pub fn mix_friction(a: Real, b: Real) -> Real {
 #[inline]
 pub fn mix_restitution(a: Real, b: Real) -> Real {
     a.max(b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use janus2d_core::body::BodyDef;
+    use janus2d_core::solver::SolverSettings;
+
+    #[test]
+    fn rows_report_the_mass_ratio_softness_the_solve_uses() {
+        let mut set = BodySet::new();
+        let a = set
+            .create(&BodyDef::dynamic(Vec2::ZERO).with_mass(1.0, 0.1))
+            .unwrap();
+        let b = set
+            .create(&BodyDef::dynamic(Vec2::new(0.0, 1.0)).with_mass(1000.0, 100.0))
+            .unwrap();
+        let settings = SolverSettings::default();
+        let ctx = settings.context(1.0 / 60.0, Vec2::ZERO);
+        let point = ContactPointInput {
+            anchor_a: Vec2::new(0.1, 0.5),
+            anchor_b: Vec2::new(0.1, -0.5),
+            separation: -0.01,
+            normal_impulse: 0.0,
+            tangent_impulse: 0.0,
+        };
+        let mut c = ContactConstraint::new(a, b, Vec2::Y, &[point], 0.6, 0.0, 0);
+        c.prepare(&ctx, &set);
+        let rows = c.rows(&ctx, &set);
+        let normal = rows.rows[0].softness;
+        assert_ne!(normal, ctx.contact_softness, "1:1000 is softened");
+        // The solve's scaled mass and impulse scale come from the same softness.
+        assert_eq!(c.soft_mass[0], c.mass[0] * normal.mass_scale);
+        assert_eq!(c.impulse_scale[0], normal.impulse_scale);
+    }
 }

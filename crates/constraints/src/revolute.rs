@@ -178,6 +178,21 @@ pub struct RevoluteJoint {
     point_softness: Softness,
 }
 
+/// The softness of the Gauss–Seidel point rows: the joint softness scaled
+/// by the mass ratio `ρ = min((m_a⁻¹ + m_b⁻¹) / min(m_a⁻¹, m_b⁻¹), ρ_max)`
+/// (`ρ_max` when one body is static). Used by the solve and reported by
+/// `rows()`, so both see the same rows.
+fn point_softness(ctx: &StepContext, sa: &BodyState, sb: &BodyState) -> Softness {
+    let inv_mass_sum = sa.inv_mass + sb.inv_mass;
+    let inv_mass_heavy = sa.inv_mass.min(sb.inv_mass);
+    let rho = if inv_mass_heavy > 0.0 {
+        (inv_mass_sum / inv_mass_heavy).min(ctx.joint_mass_ratio_cap)
+    } else {
+        ctx.joint_mass_ratio_cap
+    };
+    ctx.joint_softness.with_mass_ratio(rho)
+}
+
 impl RevoluteJoint {
     /// Rows this joint adds to the solver when enabled: two point rows,
     /// two limit rows (lower and upper) when the limit is on, one motor row
@@ -277,14 +292,7 @@ impl Constraint for RevoluteJoint {
             part.prepare(sa, sb);
         }
         self.spring_softness = Softness::new(self.def.hertz, self.def.damping_ratio, ctx.h);
-        let inv_mass_sum = sa.inv_mass + sb.inv_mass;
-        let inv_mass_heavy = sa.inv_mass.min(sb.inv_mass);
-        let rho = if inv_mass_heavy > 0.0 {
-            (inv_mass_sum / inv_mass_heavy).min(ctx.joint_mass_ratio_cap)
-        } else {
-            ctx.joint_mass_ratio_cap
-        };
-        self.point_softness = ctx.joint_softness.with_mass_ratio(rho);
+        self.point_softness = point_softness(ctx, sa, sb);
         if !ctx.warm_starting {
             self.point.impulse = Vec2::ZERO;
             self.spring.impulse = 0.0;
@@ -390,7 +398,7 @@ impl Constraint for RevoluteJoint {
         let point_softness = if self.in_tree {
             ctx.direct_joint_softness
         } else {
-            ctx.joint_softness
+            point_softness(ctx, a.state, b.state)
         };
         let point_row = |axis: Vec2, c: Real, impulse: Real| Row {
             jacobian: smallvec![
@@ -471,5 +479,40 @@ impl Constraint for RevoluteJoint {
 
     fn is_enabled(&self) -> bool {
         self.enabled
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use janus2d_core::body::BodyDef;
+    use janus2d_core::solver::SolverSettings;
+
+    #[test]
+    fn rows_report_the_mass_ratio_softness_the_solve_uses() {
+        let mut set = BodySet::new();
+        let a = set
+            .create(&BodyDef::dynamic(Vec2::ZERO).with_mass(1.0, 0.1))
+            .unwrap();
+        let b = set
+            .create(&BodyDef::dynamic(Vec2::new(1.0, 0.0)).with_mass(100.0, 10.0))
+            .unwrap();
+        let settings = SolverSettings::default();
+        let ctx = settings.context(1.0 / 60.0, Vec2::ZERO);
+        let mut joint = RevoluteJoint::new(RevoluteJointDef::new(
+            a,
+            b,
+            Vec2::new(0.5, 0.0),
+            Vec2::new(-0.5, 0.0),
+        ));
+        joint.prepare(&ctx, &set);
+        assert_ne!(
+            joint.point_softness, ctx.joint_softness,
+            "a 1:100 pair is softened by its mass ratio"
+        );
+        let rows = joint.rows(&ctx, &set);
+        for row in &rows.rows[..2] {
+            assert_eq!(row.softness, joint.point_softness);
+        }
     }
 }

@@ -168,24 +168,28 @@ impl BodyDef {
     }
 
     /// Sets the mass properties directly (builder style).
+    #[must_use]
     pub fn with_mass(mut self, mass: Real, rotational_inertia: Real) -> Self {
         self.mass = Some(BodyMass::new(mass, rotational_inertia));
         self
     }
 
     /// Sets the angle (builder style).
+    #[must_use]
     pub fn with_angle(mut self, angle: Real) -> Self {
         self.angle = angle;
         self
     }
 
     /// Sets the linear velocity (builder style).
+    #[must_use]
     pub fn with_velocity(mut self, v: Vec2) -> Self {
         self.linear_velocity = v;
         self
     }
 
     /// Sets the angular velocity (builder style).
+    #[must_use]
     pub fn with_angular_velocity(mut self, w: Real) -> Self {
         self.angular_velocity = w;
         self

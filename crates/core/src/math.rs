@@ -246,6 +246,55 @@ impl Transform {
     }
 }
 
+impl std::ops::Mul for Rot {
+    type Output = Rot;
+    /// `q * r`: rotate by `r`, then by `q` (same as [`Rot::mul`]).
+    ///
+    /// ```
+    /// use janus2d_core::math::Rot;
+    /// let q = Rot::from_angle(0.25) * Rot::from_angle(0.5);
+    /// assert!((q.angle() - 0.75).abs() < 1e-6);
+    /// ```
+    #[inline]
+    fn mul(self, other: Rot) -> Rot {
+        Rot::mul(self, other)
+    }
+}
+
+impl std::ops::Mul<crate::math::Vec2> for Rot {
+    type Output = Vec2;
+    /// Rotates a vector (same as [`Rot::rotate`]).
+    #[inline]
+    fn mul(self, v: Vec2) -> Vec2 {
+        self.rotate(v)
+    }
+}
+
+impl std::ops::Mul for Transform {
+    type Output = Transform;
+    /// `a * b`: apply `b`, then `a` (same as [`Transform::mul`]).
+    ///
+    /// ```
+    /// use janus2d_core::math::{Transform, Vec2};
+    /// let a = Transform::new(Vec2::new(1.0, 0.0), 0.0);
+    /// let b = Transform::new(Vec2::new(0.0, 2.0), 0.0);
+    /// assert_eq!((a * b).p, Vec2::new(1.0, 2.0));
+    /// ```
+    #[inline]
+    fn mul(self, other: Transform) -> Transform {
+        Transform::mul(&self, &other)
+    }
+}
+
+impl std::ops::Mul<Vec2> for Transform {
+    type Output = Vec2;
+    /// Applies the transform to a point (same as [`Transform::apply`]).
+    #[inline]
+    fn mul(self, v: Vec2) -> Vec2 {
+        self.apply(v)
+    }
+}
+
 /// Solves the symmetric 2×2 system `[k11 k12; k12 k22] x = b`, returning zero
 /// for a singular matrix (never NaN).
 #[inline]
