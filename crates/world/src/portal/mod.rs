@@ -2,7 +2,8 @@
 //!
 //! | file | what |
 //! |------|------|
-//! | `stage.rs` | pairs, crossings, clones, handover, weights; the portal API on `World` (with the `portals` feature) |
+//! | `stage.rs` | pairs, crossings, clones, handover, weights; the portal API on `World`, and where the world applies the stage's commands (with the `portals` feature) |
+//! | `crossing.rs` | the crossing stage's decisions, read from bodies, shapes and the broadphase, returned as commands |
 //! | `noop.rs` | the stage's twin without the feature: no state, every step call does nothing |
 //! | [`clipping`] | aperture regions where the narrowphase drops contact points |
 //!
@@ -10,6 +11,8 @@
 //! feature; only which twin is compiled changes.
 
 pub mod clipping;
+#[cfg(feature = "portals")]
+mod crossing;
 #[cfg(not(feature = "portals"))]
 mod noop;
 #[cfg(feature = "portals")]

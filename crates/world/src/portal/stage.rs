@@ -36,11 +36,11 @@
 use janus2d_constraints::portal_map::{BodyMotion, PortalBodyMotion, PortalFrame, PortalMap};
 use janus2d_constraints::{Portal, PortalConstraint, PortalConstraintDef};
 use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
-use janus2d_core::geometry::Aabb;
-use janus2d_core::math::{Real, Rot, Vec2, cross};
+use janus2d_core::math::{Real, Rot, Vec2};
 use janus2d_core::slots::Slots;
 
 use super::clipping::{ApertureClip, ContactClipping};
+use super::crossing::{PortalCommand, extents_in, front_fraction};
 use crate::error::WorldError;
 use crate::joints::JointHandle;
 use crate::world::World;
@@ -485,145 +485,90 @@ impl World {
         }
     }
 
-    /// Extents `(min_n, max_n, min_t, max_t)` of a body's shapes in a portal frame.
-    fn extents_in(&self, body: BodyHandle, f: &PortalFrame) -> Option<(Real, Real, Real, Real)> {
-        let xf = self.bodies().sim(body)?.transform;
-        let list = self.collision_ref().shapes.of_body(body);
-        if list.is_empty() {
-            return None;
-        }
-        let (mut n0, mut n1, mut t0, mut t1) = (Real::MAX, Real::MIN, Real::MAX, Real::MIN);
-        let offset_n = f.point.dot(f.normal);
-        let offset_t = f.point.dot(f.tangent);
-        for &s in list {
-            let shape = &self.collision_ref().shapes.at(s).geometry;
-            let (a, b) = shape.support_extent(&xf, f.normal);
-            n0 = n0.min(a - offset_n);
-            n1 = n1.max(b - offset_n);
-            let (a, b) = shape.support_extent(&xf, f.tangent);
-            t0 = t0.min(a - offset_t);
-            t1 = t1.max(b - offset_t);
-        }
-        Some((n0, n1, t0, t1))
-    }
-
-    /// Fraction of a body's shape area in front of a portal plane.
-    fn front_fraction(&self, body: BodyHandle, f: &PortalFrame) -> Real {
-        let Some(sim) = self.bodies().sim(body) else {
-            return 0.0;
-        };
-        let xf = sim.transform;
-        let list = self.collision_ref().shapes.of_body(body);
-        let (mut front, mut total) = (0.0, 0.0);
-        for &s in list {
-            let shape = &self.collision_ref().shapes.at(s).geometry;
-            front += shape.area_in_front(&xf, f.point, f.normal);
-            total += shape.area();
-        }
-        if total > 0.0 { front / total } else { 0.0 }
-    }
-
-    /// The portal stage: handovers, cancellations, new crossings, weights.
+    /// The crossing stage: the stage reviews the crossings in progress and
+    /// finds new entries (reading bodies, shapes and the broadphase); the
+    /// world applies the commands it returns, here and only here.
     pub(crate) fn portal_crossings(&mut self) {
         self.portals.events.clear();
         let mut counters = PortalCounters::default();
-        let mut crossed_this_step: Vec<BodyHandle> = Vec::new();
-
+        let mut crossed: Vec<BodyHandle> = Vec::new();
         // 1. Crossings in progress: hand over, cancel, or re-weight.
-        let mut k = 0;
-        while k < self.portals.crossings.len() {
-            let c = self.portals.crossings[k].clone();
-            let d = self.portals.pairs.at(c.pair).cloned().expect("live pair");
-            let f_entry = frame_of(self, &d.portals[c.entry], &d.local[c.entry]);
-            let f_exit = frame_of(self, &d.portals[1 - c.entry], &d.local[1 - c.entry]);
-            let orig_ext = self.extents_in(c.original, &f_entry);
-            let clone_ext = self.extents_in(c.clone, &f_exit);
-            if orig_ext.is_some_and(|e| e.1 < 0.0) {
-                self.complete_crossing(k);
-                counters.completed += 1;
-                crossed_this_step.push(c.original);
-                continue;
-            }
-            if clone_ext.is_some_and(|e| e.1 < 0.0) {
-                self.cancel_crossing(k);
-                counters.cancelled += 1;
-                crossed_this_step.push(c.original);
-                continue;
-            }
-            self.weigh_crossing(k, &f_entry, &f_exit);
-            k += 1;
+        let review = self
+            .portals
+            .review(self.bodies(), &self.collision_ref().shapes);
+        for command in review {
+            self.apply_portal_command(command, &mut counters, &mut crossed);
         }
-
-        // 2. New crossings: bodies whose shapes straddle an aperture and fit
-        //    its width, or whose centre swept through it during the step.
-        for index in 0..self.portals.pairs.capacity() {
-            let Some(d) = self.portals.pairs.at(index).cloned() else {
-                continue;
-            };
-            for entry in 0..2 {
-                let f = frame_of(self, &d.portals[entry], &d.local[entry]);
-                let w = d.local[entry].half_width;
-                let candidates = self.aperture_candidates(&f, w, &d);
-                counters.bodies_tested += candidates.len();
-                for body in candidates {
-                    if crossed_this_step.contains(&body) || self.portals.crossing_of(body).is_some()
-                    {
-                        continue;
-                    }
-                    let Some((n0, n1, t0, t1)) = self.extents_in(body, &f) else {
-                        continue;
-                    };
-                    let straddles = n0 < 0.0 && n1 > 0.0 && t0 >= -w && t1 <= w;
-                    let sim = self.bodies().sim(body).expect("live");
-                    let s0 = (sim.center0 - f.point).dot(f.normal);
-                    let s1 = (sim.center - f.point).dot(f.normal);
-                    let swept = s0 > 0.0 && s1 <= 0.0 && {
-                        let x = sim.center0 + (sim.center - sim.center0) * (s0 / (s0 - s1));
-                        cross(f.normal, x - f.point).abs() < w
-                    };
-                    if !(straddles || swept) {
-                        continue;
-                    }
-                    if self.start_crossing(index, entry, body).is_some() {
-                        counters.started += 1;
-                        crossed_this_step.push(body);
-                        // A fast body may already be entirely through.
-                        let k = self.portals.crossings.len() - 1;
-                        if self.extents_in(body, &f).is_some_and(|e| e.1 < 0.0) {
-                            self.complete_crossing(k);
-                            counters.completed += 1;
-                        } else {
-                            let f_exit = frame_of(self, &d.portals[1 - entry], &d.local[1 - entry]);
-                            self.weigh_crossing(k, &f, &f_exit);
-                        }
-                    }
-                }
-            }
+        // 2. New crossings.
+        let (entries, tested) = {
+            let c = self.collision_ref();
+            self.portals
+                .entries(self.bodies(), &c.shapes, &c.broadphase, &crossed)
+        };
+        counters.bodies_tested = tested;
+        for command in entries {
+            self.apply_portal_command(command, &mut counters, &mut crossed);
         }
         counters.active_crossings = self.portals.crossings.len();
         self.portals.counters = counters;
     }
 
-    /// Dynamic bodies whose shapes' boxes touch an aperture region (both
-    /// sides of the segment), sorted by handle for a deterministic order.
-    fn aperture_candidates(&self, f: &PortalFrame, w: Real, d: &PairData) -> Vec<BodyHandle> {
-        let a = f.point - w * f.tangent;
-        let b = f.point + w * f.tangent;
-        let region = Aabb::new(a.min(b), a.max(b)).fattened(crate::collision::AABB_MARGIN);
-        let mut out = Vec::new();
-        let collision = self.collision_ref();
-        collision.broadphase.query(&region, |_, payload| {
-            let body = collision.shapes.at(payload).body;
-            out.push(body);
-            true
-        });
-        out.sort();
-        out.dedup();
-        out.retain(|b| {
-            self.bodies().body_type(*b) == Some(BodyType::Dynamic)
-                && d.portals.iter().all(|p| p.body != *b)
-        });
-        out
+    /// Applies one command of the crossing stage.
+    fn apply_portal_command(
+        &mut self,
+        command: PortalCommand,
+        counters: &mut PortalCounters,
+        crossed: &mut Vec<BodyHandle>,
+    ) {
+        let frames = |w: &World, k: usize| {
+            let c = &w.portals.crossings[k];
+            let d = w.portals.pairs.at(c.pair).expect("live pair");
+            (
+                frame_of(w, &d.portals[c.entry], &d.local[c.entry]),
+                frame_of(w, &d.portals[1 - c.entry], &d.local[1 - c.entry]),
+            )
+        };
+        match command {
+            PortalCommand::Complete(original) => {
+                if let Some(k) = self.portals.crossing_of(original) {
+                    self.complete_crossing(k);
+                    counters.completed += 1;
+                    crossed.push(original);
+                }
+            }
+            PortalCommand::Cancel(original) => {
+                if let Some(k) = self.portals.crossing_of(original) {
+                    self.cancel_crossing(k);
+                    counters.cancelled += 1;
+                    crossed.push(original);
+                }
+            }
+            PortalCommand::Weigh(original) => {
+                if let Some(k) = self.portals.crossing_of(original) {
+                    let (f_entry, f_exit) = frames(self, k);
+                    self.weigh_crossing(k, &f_entry, &f_exit);
+                }
+            }
+            PortalCommand::Start { pair, entry, body } => {
+                if self.start_crossing(pair, entry, body).is_none() {
+                    return;
+                }
+                counters.started += 1;
+                crossed.push(body);
+                // A fast body may already be entirely through.
+                let k = self.portals.crossings.len() - 1;
+                let (f_entry, f_exit) = frames(self, k);
+                let through =
+                    extents_in(self.bodies(), &self.collision_ref().shapes, body, &f_entry)
+                        .is_some_and(|e| e.1 < 0.0);
+                if through {
+                    self.complete_crossing(k);
+                    counters.completed += 1;
+                } else {
+                    self.weigh_crossing(k, &f_entry, &f_exit);
+                }
+            }
+        }
     }
 
     /// Creates the clone of `body` entering portal `entry` of pair `index`.
@@ -724,8 +669,9 @@ impl World {
     /// Weighs the two copies of crossing `k` by their area fractions.
     fn weigh_crossing(&mut self, k: usize, f_entry: &PortalFrame, f_exit: &PortalFrame) {
         let c = self.portals.crossings[k].clone();
-        let a = self.front_fraction(c.original, f_entry);
-        let b = self.front_fraction(c.clone, f_exit);
+        let shapes = &self.collision_ref().shapes;
+        let a = front_fraction(self.bodies(), shapes, c.original, f_entry);
+        let b = front_fraction(self.bodies(), shapes, c.clone, f_exit);
         let f = if a + b > 0.0 { a / (a + b) } else { 0.5 };
         let f = f.clamp(F_MIN, 1.0 - F_MIN);
         let scale = |m: BodyMass, f: Real| BodyMass {
