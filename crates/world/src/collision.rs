@@ -35,12 +35,13 @@ use crate::contacts::{Contact, ContactPointData, ContactSet};
 use crate::joints::NoCollide;
 use crate::shapes::{ShapeData, ShapeDef, ShapeHandle, ShapeStore};
 
-/// Speculative distance, m (usual 0.02 = 4 × linear slop): contact points
-/// exist this far before touching.
-pub const SPECULATIVE_DISTANCE: Real = 0.02;
+/// Speculative distance, m (0.02 = 4 × linear slop): contact points exist
+/// this far before touching. One constant, defined beside the manifolds.
+pub use janus2d_core::geometry::SPECULATIVE_DISTANCE;
 
-/// Fattening margin of broadphase boxes, m (usual 0.1).
-pub const AABB_MARGIN: Real = crate::dynamic_tree::DEFAULT_AABB_MARGIN;
+/// Fattening margin of broadphase boxes, m (0.1). One constant, defined
+/// beside the tree.
+pub use crate::dynamic_tree::DEFAULT_AABB_MARGIN as AABB_MARGIN;
 
 /// Counters of the last collision pass.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
