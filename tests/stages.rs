@@ -162,3 +162,25 @@ fn rain_ragdoll_falls_asleep_with_the_joint_tree_solve_on() {
         );
     }
 }
+
+#[test]
+fn island_splits_when_bodies_part_so_the_resting_one_sleeps() {
+    let (mut world, _, boxes) = stack_on_ground(2);
+    let (low, high) = (boxes[0], boxes[1]);
+    for _ in 0..10 {
+        world.step(DT).unwrap();
+    }
+    // The top box is carried away and kept moving along the ground.
+    world.set_transform(high, Vec2::new(5.0, 0.5), 0.0).unwrap();
+    for _ in 0..120 {
+        world
+            .set_linear_velocity(high, Vec2::new(1.0, 0.0))
+            .unwrap();
+        world.step(DT).unwrap();
+    }
+    assert!(!world.is_sleeping(high), "the pushed box stays awake");
+    assert!(
+        world.is_sleeping(low),
+        "the box left behind sleeps: its island split from the moving one"
+    );
+}

@@ -166,6 +166,12 @@ pub struct ContactSet {
     free_ids: Vec<u32>,
     pair_index: HashMap<(u32, u32), u32>,
     body_contacts: Vec<SmallVec<[u32; 4]>>,
+    /// Body pairs whose solid contact began touching since the islands
+    /// last read them (they link islands).
+    pub(crate) began: Vec<(BodyHandle, BodyHandle)>,
+    /// Body pairs whose solid contact stopped touching or was destroyed
+    /// while touching (their islands may split).
+    pub(crate) ended: Vec<(BodyHandle, BodyHandle)>,
 }
 
 impl ContactSet {
@@ -277,6 +283,19 @@ impl ContactSet {
         self.free_ids.push(id);
         if c.touching {
             events.push(&c, false);
+            if c.is_solid_touching() {
+                self.ended.push((c.body_a, c.body_b));
+            }
+        }
+    }
+
+    /// Records that a solid contact between two bodies began (`true`) or
+    /// stopped touching, for the islands.
+    pub(crate) fn note_touch_change(&mut self, pair: (BodyHandle, BodyHandle), touching: bool) {
+        if touching {
+            self.began.push(pair);
+        } else {
+            self.ended.push(pair);
         }
     }
 

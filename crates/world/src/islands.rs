@@ -2,15 +2,19 @@
 //! contacts leave the narrowphase, until something touches them.
 //!
 //! ```text
+//! islands persist:
+//!   created dynamic body → its own island; a contact begins touching or a
+//!   joint is created → the two islands merge (smaller into larger); a
+//!   link goes away → the island counts it and may be split later
 //! after each step (when sleep is enabled):
 //!   timers   every awake dynamic body: slow (|v| and |ω|·reach below the
 //!            threshold) → sleep_time += dt, else 0; keep-awake bodies
 //!            (portal crossings) → 0
-//!   islands  union–find over awake dynamic bodies joined by touching solid
-//!            contacts and enabled joints
-//!   sleep    an island whose every member rested long enough: its bodies
-//!            leave the solver arrays (BodySet::sleep), its contacts move to
-//!            the sleeping list (ContactSet::sleep_body)
+//!   split    the island of the sleepiest body, if it lost links, is split
+//!            into its connected parts (one island per step, as Box2D)
+//!   sleep    an island whose every awake member rested long enough: its
+//!            bodies leave the solver arrays (BodySet::sleep), its contacts
+//!            move to the sleeping list (ContactSet::sleep_body)
 //! wake (the whole island) when:
 //!   an awake or kinematic body touches one of its bodies; a joint is
 //!   created, destroyed or changed on one; any API call changes one
@@ -22,16 +26,17 @@
 //! | [`SleepSettings::linear_threshold`] | m/s  | 0.05  |
 //! | [`SleepSettings::time_to_sleep`]    | s    | 0.5   |
 //!
-//! The stage owns the sleeping islands' membership, the bodies created
-//! asleep that wait for the first step, and its scratch space; the world
-//! passes it the bodies, shapes (for reach), contacts and joint edges.
+//! The stage owns the islands' membership, the bodies created asleep that
+//! wait for the first step, and its scratch space; the world passes it the
+//! bodies, shapes (for reach), contacts (and the links that began or ended
+//! since it last looked) and joints.
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::math::Real;
-use janus2d_core::union_find::{find, union};
 
 use crate::contacts::ContactSet;
 use crate::error::WorldError;
+use crate::joints::JointSet;
 use crate::shapes::ShapeStore;
 
 /// When bodies fall asleep.
@@ -81,19 +86,45 @@ impl SleepSettings {
     }
 }
 
-/// Sleeping islands, bodies waiting to sleep, and the union–find scratch.
+/// No island (static and kinematic bodies, free slots).
+const NONE: u32 = u32::MAX;
+
+/// A group of dynamic bodies linked by touching contacts and joints.
+#[derive(Clone, Debug, Default)]
+struct Island {
+    members: Vec<BodyHandle>,
+    /// Links removed since the island was built or last split: it may
+    /// have fallen apart.
+    removed: u32,
+    asleep: bool,
+}
+
+/// Persistent islands, bodies waiting to sleep, and scratch space.
+///
+/// ```text
+/// create dynamic body      → island of its own
+/// contact begins touching  → link: the smaller island joins the larger
+/// joint created / enabled  → link
+/// contact stops touching,  → removed += 1 (the island may have split)
+/// joint removed / disabled,
+/// body destroyed
+/// sleepiest body's island  → split into its connected parts (one per step,
+///   has removed > 0           over the members' own contacts and joints)
+/// every member rested      → the island sleeps: bodies and contacts leave
+///   time_to_sleep             the awake lists
+/// ```
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Islands {
-    /// Island id of each body slot (`u32::MAX`: awake or never slept).
+    /// Island of each body slot.
     island_of: Vec<u32>,
-    /// Members of each sleeping island (empty: free slot).
-    islands: Vec<Vec<BodyHandle>>,
+    islands: Vec<Island>,
     free: Vec<u32>,
     /// Bodies created with `awake = false`, put to sleep at the next step.
     pending: Vec<BodyHandle>,
-    parent: Vec<u32>,
     min_time: Vec<Real>,
-    groups: Vec<(u32, BodyHandle)>,
+    seen: Vec<u32>,
+    stamp: u32,
+    stack: Vec<BodyHandle>,
 }
 
 /// What the sleep update reads besides the bodies it changes.
@@ -106,6 +137,133 @@ pub(crate) struct SleepInput<'a> {
 }
 
 impl Islands {
+    fn island(&self, body: BodyHandle) -> u32 {
+        self.island_of
+            .get(body.index as usize)
+            .copied()
+            .unwrap_or(NONE)
+    }
+
+    fn set_island(&mut self, body: BodyHandle, id: u32) {
+        let i = body.index as usize;
+        if self.island_of.len() <= i {
+            self.island_of.resize(i + 1, NONE);
+        }
+        self.island_of[i] = id;
+    }
+
+    fn new_island(&mut self, members: Vec<BodyHandle>) -> u32 {
+        let island = Island {
+            members,
+            removed: 0,
+            asleep: false,
+        };
+        let id = match self.free.pop() {
+            Some(id) => {
+                self.islands[id as usize] = island;
+                id
+            }
+            None => {
+                self.islands.push(island);
+                (self.islands.len() - 1) as u32
+            }
+        };
+        for k in 0..self.islands[id as usize].members.len() {
+            let m = self.islands[id as usize].members[k];
+            self.set_island(m, id);
+        }
+        id
+    }
+
+    /// A new dynamic body: an island of its own.
+    pub(crate) fn add_body(&mut self, body: BodyHandle) {
+        self.new_island(vec![body]);
+    }
+
+    /// Forgets a body that is being destroyed (it must be awake).
+    pub(crate) fn remove_body(&mut self, body: BodyHandle) {
+        self.pending.retain(|b| *b != body);
+        let id = self.island(body);
+        if id == NONE {
+            return;
+        }
+        self.set_island(body, NONE);
+        let island = &mut self.islands[id as usize];
+        island.members.retain(|m| *m != body);
+        island.removed += 1;
+        if island.members.is_empty() {
+            self.free.push(id);
+        }
+    }
+
+    /// Two bodies became linked (touching contact, joint): their islands
+    /// merge, the smaller into the larger.
+    pub(crate) fn link(&mut self, a: BodyHandle, b: BodyHandle, bodies: &BodySet) {
+        if !(bodies.contains(a) && bodies.contains(b)) {
+            return;
+        }
+        let (ia, ib) = (self.island(a), self.island(b));
+        if ia == NONE || ib == NONE || ia == ib {
+            return;
+        }
+        let (big, small) =
+            if self.islands[ia as usize].members.len() >= self.islands[ib as usize].members.len() {
+                (ia, ib)
+            } else {
+                (ib, ia)
+            };
+        let moved = std::mem::take(&mut self.islands[small as usize]);
+        for m in &moved.members {
+            self.set_island(*m, big);
+        }
+        let island = &mut self.islands[big as usize];
+        island.members.extend(moved.members);
+        island.removed += moved.removed;
+        island.asleep = false;
+        self.free.push(small);
+    }
+
+    /// A link of `body` went away: its island may split.
+    pub(crate) fn note_removed(&mut self, body: BodyHandle) {
+        let id = self.island(body);
+        if id != NONE {
+            self.islands[id as usize].removed += 1;
+        }
+    }
+
+    /// Two bodies exchanged identities (portal handover): each handle keeps
+    /// the island of the object it now names.
+    pub(crate) fn swap_bodies(&mut self, a: BodyHandle, b: BodyHandle) {
+        let (ia, ib) = (self.island(a), self.island(b));
+        for (id, from, to) in [(ia, a, b), (ib, b, a)] {
+            if id != NONE {
+                for m in &mut self.islands[id as usize].members {
+                    if *m == from {
+                        *m = to;
+                    }
+                }
+            }
+        }
+        self.set_island(a, ib);
+        self.set_island(b, ia);
+        for id in [ia, ib] {
+            if id != NONE {
+                self.islands[id as usize].removed += 1;
+            }
+        }
+    }
+
+    /// Reads the contacts that began and stopped touching since the last
+    /// call: links and possible splits.
+    pub(crate) fn read_contact_changes(&mut self, contacts: &mut ContactSet, bodies: &BodySet) {
+        for (a, b) in std::mem::take(&mut contacts.began) {
+            self.link(a, b, bodies);
+        }
+        for (a, _) in std::mem::take(&mut contacts.ended) {
+            self.note_removed(a);
+        }
+    }
+
     /// A body created asleep: it sleeps at the next step unless touched.
     pub(crate) fn push_pending(&mut self, body: BodyHandle) {
         self.pending.push(body);
@@ -138,36 +296,31 @@ impl Islands {
         if !bodies.is_sleeping(body) {
             return;
         }
-        let island = self
-            .island_of
-            .get(body.index as usize)
-            .copied()
-            .unwrap_or(u32::MAX);
-        if island == u32::MAX {
+        let id = self.island(body);
+        if id == NONE || !self.islands[id as usize].asleep {
+            // Asleep on its own (created asleep).
             bodies.wake(body);
             contacts.wake_body(body);
             return;
         }
-        let members = std::mem::take(&mut self.islands[island as usize]);
-        for m in &members {
+        let island = &mut self.islands[id as usize];
+        island.asleep = false;
+        for m in &island.members {
             bodies.wake(*m);
-            if let Some(slot) = self.island_of.get_mut(m.index as usize) {
-                *slot = u32::MAX;
-            }
         }
-        for m in &members {
+        for m in &island.members {
             contacts.wake_body(*m);
         }
-        self.free.push(island);
     }
 
-    /// Updates sleep timers and puts resting islands to sleep.
+    /// Updates sleep timers, splits the sleepiest island that may have
+    /// fallen apart, and puts resting islands to sleep.
     pub(crate) fn update(
         &mut self,
         input: &SleepInput<'_>,
         bodies: &mut BodySet,
         contacts: &mut ContactSet,
-        joint_edges: impl Iterator<Item = (BodyHandle, BodyHandle)>,
+        joints: &JointSet,
     ) {
         let settings = input.settings;
         let tol2 = settings.linear_threshold * settings.linear_threshold;
@@ -193,93 +346,122 @@ impl Islands {
                 bodies.sims[i as usize].sleep_time = 0.0;
             }
         }
-        // Union–find over awake dynamic bodies (state indices).
-        let mut parent = std::mem::take(&mut self.parent);
-        parent.clear();
-        parent.extend(0..n as u32);
-        let contact_edges = contacts
-            .awake()
-            .iter()
-            .filter(|c| c.is_solid_touching())
-            .map(|c| (c.body_a, c.body_b));
-        for (a, b) in joint_edges.chain(contact_edges) {
-            if let (Some(ia), Some(ib)) = (dynamic_index(bodies, a), dynamic_index(bodies, b)) {
-                union(&mut parent, ia, ib);
+        // The sleepiest body whose island may have split: split that one.
+        let mut candidate = (NONE, 0.0 as Real);
+        for i in 1..n {
+            let sim = &bodies.sims[i];
+            let id = self.island(sim.handle);
+            if sim.body_type == BodyType::Dynamic
+                && id != NONE
+                && self.islands[id as usize].removed > 0
+                && sim.sleep_time >= settings.time_to_sleep
+                && sim.sleep_time > candidate.1
+            {
+                candidate = (id, sim.sleep_time);
             }
         }
-        // Kinematic bodies and anything not dynamic never sleep; an island
-        // touching a moving kinematic body stays awake through its speed.
+        if candidate.0 != NONE {
+            self.split(candidate.0, contacts, joints);
+        }
+        // The least rested awake member of each island.
         let mut min_time = std::mem::take(&mut self.min_time);
         min_time.clear();
-        min_time.resize(n, Real::MAX);
+        min_time.resize(self.islands.len(), Real::MAX);
         for i in 1..n {
-            let r = find(&mut parent, i as u32) as usize;
             let sim = &bodies.sims[i];
-            let t = if sim.body_type == BodyType::Dynamic {
-                sim.sleep_time
-            } else {
-                0.0
-            };
-            min_time[r] = min_time[r].min(t);
+            let id = self.island(sim.handle);
+            if id != NONE {
+                let t = &mut min_time[id as usize];
+                *t = t.min(sim.sleep_time);
+            }
         }
-        let mut groups = std::mem::take(&mut self.groups);
-        groups.clear();
-        for i in 1..n {
-            let r = find(&mut parent, i as u32);
-            let sim = &bodies.sims[i];
-            if sim.body_type == BodyType::Dynamic && min_time[r as usize] >= settings.time_to_sleep
+        for id in 0..self.islands.len() {
+            let island = &self.islands[id];
+            if island.asleep
+                || island.members.is_empty()
+                || min_time[id] == Real::MAX
+                || min_time[id] < settings.time_to_sleep
             {
-                groups.push((r, sim.handle));
+                continue;
+            }
+            self.islands[id].asleep = true;
+            let island = &self.islands[id];
+            for m in &island.members {
+                bodies.sleep(*m);
+            }
+            for m in &island.members {
+                contacts.sleep_body(*m, bodies);
             }
         }
-        groups.sort();
-        let mut k = 0;
-        while k < groups.len() {
-            let root = groups[k].0;
-            let mut members = Vec::new();
-            while k < groups.len() && groups[k].0 == root {
-                members.push(groups[k].1);
-                k += 1;
-            }
-            self.sleep_island(members, bodies, contacts);
-        }
-        self.parent = parent;
         self.min_time = min_time;
-        self.groups = groups;
     }
 
-    fn sleep_island(
-        &mut self,
-        members: Vec<BodyHandle>,
-        bodies: &mut BodySet,
-        contacts: &mut ContactSet,
-    ) {
-        let id = match self.free.pop() {
-            Some(id) => id,
-            None => {
-                self.islands.push(Vec::new());
-                (self.islands.len() - 1) as u32
-            }
-        };
-        for m in &members {
-            bodies.sleep(*m);
-            let idx = m.index as usize;
-            if self.island_of.len() <= idx {
-                self.island_of.resize(idx + 1, u32::MAX);
-            }
-            self.island_of[idx] = id;
+    /// Splits island `id` into its connected parts over the members' own
+    /// touching solid contacts and enabled joints.
+    fn split(&mut self, id: u32, contacts: &ContactSet, joints: &JointSet) {
+        let members = std::mem::take(&mut self.islands[id as usize].members);
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.seen.iter_mut().for_each(|s| *s = 0);
+            self.stamp = 1;
         }
-        for m in &members {
-            contacts.sleep_body(*m, bodies);
+        let stamp = self.stamp;
+        let mut parts: Vec<Vec<BodyHandle>> = Vec::new();
+        for &start in &members {
+            let si = start.index as usize;
+            if self.seen.len() <= si {
+                self.seen.resize(si + 1, 0);
+            }
+            if self.seen[si] == stamp {
+                continue;
+            }
+            self.seen[si] = stamp;
+            let mut part = Vec::new();
+            self.stack.clear();
+            self.stack.push(start);
+            while let Some(b) = self.stack.pop() {
+                part.push(b);
+                let via_contacts = contacts.of_body(b).iter().filter_map(|&c| {
+                    let c = contacts.get(c)?;
+                    c.is_solid_touching().then(|| c.other(b))
+                });
+                let via_joints = joints.of_body(b).iter().filter_map(|&j| {
+                    let joint = joints.revolute(j).ok()?;
+                    joint.enabled.then(|| {
+                        if joint.def.body_a == b {
+                            joint.def.body_b
+                        } else {
+                            joint.def.body_a
+                        }
+                    })
+                });
+                for other in via_contacts.chain(via_joints) {
+                    let oi = other.index as usize;
+                    if self.island(other) != id {
+                        continue;
+                    }
+                    if self.seen.len() <= oi {
+                        self.seen.resize(oi + 1, 0);
+                    }
+                    if self.seen[oi] != stamp {
+                        self.seen[oi] = stamp;
+                        self.stack.push(other);
+                    }
+                }
+            }
+            parts.push(part);
         }
-        self.islands[id as usize] = members;
-    }
-
-    /// Forgets a body that is being destroyed (it must be awake).
-    pub(crate) fn forget(&mut self, body: BodyHandle) {
-        self.pending.retain(|b| *b != body);
-        if let Some(slot) = self.island_of.get_mut(body.index as usize) {
-            *slot = u32::MAX;
+        let mut parts = parts.into_iter();
+        if let Some(first) = parts.next() {
+            let island = &mut self.islands[id as usize];
+            island.members = first;
+            island.removed = 0;
+        }
+        for part in parts {
+            self.new_island(part);
+        }
+        if self.islands[id as usize].members.is_empty() {
+            self.free.push(id);
         }
     }
 }

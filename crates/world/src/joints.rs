@@ -344,12 +344,4 @@ impl JointSet {
             .map(RevoluteJoint::row_count)
             .sum()
     }
-
-    /// Pairs of bodies held by enabled joints.
-    pub(crate) fn edges(&self) -> impl Iterator<Item = (BodyHandle, BodyHandle)> + '_ {
-        self.revolute
-            .iter()
-            .filter(|j| j.enabled)
-            .map(|j| (j.def.body_a, j.def.body_b))
-    }
 }

@@ -141,6 +141,10 @@ impl Narrowphase {
             }
             if touching != was_touching {
                 events.push(c, touching);
+                if !c.sensor && c.enabled {
+                    let pair = (c.body_a, c.body_b);
+                    contacts.note_touch_change(pair, touching);
+                }
             }
             k += 1;
         }

@@ -201,6 +201,9 @@ impl World {
     /// ```
     pub fn create_body(&mut self, def: &BodyDef) -> Result<BodyHandle, WorldError> {
         let handle = self.bodies.create(def)?;
+        if def.body_type == BodyType::Dynamic {
+            self.islands.add_body(handle);
+        }
         if !def.awake && def.body_type != BodyType::Static {
             self.islands.push_pending(handle);
         }
@@ -246,7 +249,7 @@ impl World {
         for s in shapes {
             self.collision.remove_shape(s);
         }
-        self.islands.forget(body);
+        self.islands.remove_body(body);
         let destroyed = self.bodies.destroy(body);
         debug_assert!(destroyed.is_ok(), "checked by the caller");
     }
@@ -502,6 +505,7 @@ impl World {
         self.wake_body(def.body_a);
         self.wake_body(def.body_b);
         let handle = self.joints.insert_revolute(def);
+        self.islands.link(def.body_a, def.body_b, &self.bodies);
         if !def.collide_connected {
             self.collision
                 .remove_contacts_between(def.body_a, def.body_b);
@@ -514,6 +518,7 @@ impl World {
         if let Ok((a, b)) = self.joints.remove(joint) {
             self.wake_body(a);
             self.wake_body(b);
+            self.islands.note_removed(a);
         }
     }
 
@@ -607,8 +612,15 @@ impl World {
     /// Enables or disables a joint (one a portal disabled can be enabled
     /// again).
     pub fn set_joint_enabled(&mut self, joint: JointHandle, on: bool) -> Result<(), WorldError> {
-        let r = self.joints.set_enabled(joint, on);
-        self.wake_pair(r)
+        let (a, b) = self.joints.set_enabled(joint, on)?;
+        self.wake_body(a);
+        self.wake_body(b);
+        if on {
+            self.islands.link(a, b, &self.bodies);
+        } else {
+            self.islands.note_removed(a);
+        }
+        Ok(())
     }
 
     /// Distance between a joint's two world anchors, m.
@@ -905,6 +917,8 @@ impl World {
             self.wake_all(&wake);
             let woke = !wake.is_empty();
             self.wake_list = wake;
+            self.islands
+                .read_contact_changes(&mut self.collision.contacts, &self.bodies);
             crate::narrowphase::build_constraints(
                 &mut self.collision.contacts,
                 &self.bodies,
@@ -956,7 +970,7 @@ impl World {
                 &input,
                 &mut self.bodies,
                 &mut self.collision.contacts,
-                self.joints.edges(),
+                &self.joints,
             );
             sp.sleep += lap();
         }
@@ -1002,6 +1016,15 @@ impl World {
             .map(|r| r.fixed_rotation)
             .unwrap_or(false);
         self.bodies.apply_mass(body, mass, fixed);
+    }
+
+    /// Creates a body from a definition known to be valid (a portal clone).
+    pub(crate) fn insert_body(&mut self, def: &BodyDef) -> Option<BodyHandle> {
+        let handle = self.bodies.create(def).ok()?;
+        if def.body_type == BodyType::Dynamic {
+            self.islands.add_body(handle);
+        }
+        Some(handle)
     }
 
     /// Adds an impulse at a world point to a dynamic body now (no checks).
@@ -1052,7 +1075,9 @@ impl World {
 
     /// Disables a joint (the solver skips it; it stays until destroyed).
     pub(crate) fn disable_joint(&mut self, joint: JointHandle) {
-        let _disabled = self.joints.set_enabled(joint, false);
+        if let Ok((a, _)) = self.joints.set_enabled(joint, false) {
+            self.islands.note_removed(a);
+        }
     }
 
     /// Exchanges two bodies' identities (see `BodySet::swap_identity`),
@@ -1062,14 +1087,11 @@ impl World {
         self.collision.remove_contacts_of(b);
         if self.bodies.swap_identity(a, b).is_ok() {
             self.collision.swap_body_shapes(a, b);
+            self.islands.swap_bodies(a, b);
         }
     }
 
-    /// Mutable body storage and read access to shapes (portal stage).
-    pub(crate) fn bodies_mut(&mut self) -> &mut BodySet {
-        &mut self.bodies
-    }
-
+    /// Read access to the collision stage (portal stage).
     pub(crate) fn collision_ref(&self) -> &Collision {
         &self.collision
     }
