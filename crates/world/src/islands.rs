@@ -117,6 +117,8 @@ struct Island {
 pub(crate) struct Islands {
     /// Island of each body slot.
     island_of: Vec<u32>,
+    /// Position of each body slot in its island's member list.
+    position: Vec<u32>,
     islands: Vec<Island>,
     free: Vec<u32>,
     /// Bodies created with `awake = false`, put to sleep at the next step.
@@ -148,8 +150,15 @@ impl Islands {
         let i = body.index as usize;
         if self.island_of.len() <= i {
             self.island_of.resize(i + 1, NONE);
+            self.position.resize(i + 1, 0);
         }
         self.island_of[i] = id;
+    }
+
+    /// Records that `body` is member `k` of island `id`.
+    fn place(&mut self, body: BodyHandle, id: u32, k: usize) {
+        self.set_island(body, id);
+        self.position[body.index as usize] = k as u32;
     }
 
     fn new_island(&mut self, members: Vec<BodyHandle>) -> u32 {
@@ -170,7 +179,7 @@ impl Islands {
         };
         for k in 0..self.islands[id as usize].members.len() {
             let m = self.islands[id as usize].members[k];
-            self.set_island(m, id);
+            self.place(m, id, k);
         }
         id
     }
@@ -187,10 +196,15 @@ impl Islands {
         if id == NONE {
             return;
         }
+        let k = self.position[body.index as usize] as usize;
         self.set_island(body, NONE);
         let island = &mut self.islands[id as usize];
-        island.members.retain(|m| *m != body);
+        island.members.swap_remove(k);
         island.removed += 1;
+        if let Some(&moved) = island.members.get(k) {
+            self.position[moved.index as usize] = k as u32;
+        }
+        let island = &self.islands[id as usize];
         if island.members.is_empty() {
             self.free.push(id);
         }
@@ -213,8 +227,9 @@ impl Islands {
                 (ib, ia)
             };
         let moved = std::mem::take(&mut self.islands[small as usize]);
-        for m in &moved.members {
-            self.set_island(*m, big);
+        let base = self.islands[big as usize].members.len();
+        for (k, m) in moved.members.iter().enumerate() {
+            self.place(*m, big, base + k);
         }
         let island = &mut self.islands[big as usize];
         island.members.extend(moved.members);
@@ -235,6 +250,13 @@ impl Islands {
     /// the island of the object it now names.
     pub(crate) fn swap_bodies(&mut self, a: BodyHandle, b: BodyHandle) {
         let (ia, ib) = (self.island(a), self.island(b));
+        if ia == ib {
+            // One island holds both: membership is unchanged.
+            if ia != NONE {
+                self.islands[ia as usize].removed += 1;
+            }
+            return;
+        }
         for (id, from, to) in [(ia, a, b), (ib, b, a)] {
             if id != NONE {
                 for m in &mut self.islands[id as usize].members {
@@ -244,8 +266,12 @@ impl Islands {
                 }
             }
         }
-        self.set_island(a, ib);
-        self.set_island(b, ia);
+        let (pa, pb) = (
+            self.position.get(a.index as usize).copied().unwrap_or(0),
+            self.position.get(b.index as usize).copied().unwrap_or(0),
+        );
+        self.place(a, ib, pb as usize);
+        self.place(b, ia, pa as usize);
         for id in [ia, ib] {
             if id != NONE {
                 self.islands[id as usize].removed += 1;
@@ -453,6 +479,9 @@ impl Islands {
         }
         let mut parts = parts.into_iter();
         if let Some(first) = parts.next() {
+            for (k, m) in first.iter().enumerate() {
+                self.place(*m, id, k);
+            }
             let island = &mut self.islands[id as usize];
             island.members = first;
             island.removed = 0;
