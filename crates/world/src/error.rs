@@ -59,6 +59,17 @@ impl std::fmt::Display for WorldError {
 
 impl std::error::Error for WorldError {}
 
+impl WorldError {
+    /// The error of a handle that does not resolve: `ForeignHandle` for
+    /// another world's, `stale` (the kind's own stale error) otherwise.
+    pub(crate) fn of_handle(e: janus2d_core::handle::HandleError, stale: WorldError) -> Self {
+        match e {
+            janus2d_core::handle::HandleError::Foreign => WorldError::ForeignHandle,
+            janus2d_core::handle::HandleError::Stale => stale,
+        }
+    }
+}
+
 impl From<BodyError> for WorldError {
     fn from(e: BodyError) -> Self {
         match e {

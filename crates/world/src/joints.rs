@@ -18,7 +18,7 @@ use std::collections::HashMap;
 
 use janus2d_constraints::{JointForest, RevoluteJoint, RevoluteJointDef};
 use janus2d_core::body::BodyHandle;
-use janus2d_core::handle::{Handle, HandleError, JointTag};
+use janus2d_core::handle::{Handle, JointTag};
 use janus2d_core::math::Real;
 use janus2d_core::slots::Slots;
 use smallvec::SmallVec;
@@ -129,11 +129,10 @@ impl JointSet {
     }
 
     fn slot(&self, joint: JointHandle) -> Result<JointSlot, WorldError> {
-        match self.slots.resolve(joint, self.owner) {
-            Ok(s) => Ok(*s),
-            Err(HandleError::Foreign) => Err(WorldError::ForeignHandle),
-            Err(HandleError::Stale) => Err(WorldError::StaleJoint),
-        }
+        self.slots
+            .resolve(joint, self.owner)
+            .copied()
+            .map_err(|e| WorldError::of_handle(e, WorldError::StaleJoint))
     }
 
     /// A revolute joint.

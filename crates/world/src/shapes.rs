@@ -13,7 +13,7 @@
 
 use janus2d_core::body::BodyHandle;
 use janus2d_core::geometry::{Aabb, MassData, Shape};
-use janus2d_core::handle::{Handle, HandleError, ShapeTag};
+use janus2d_core::handle::{Handle, ShapeTag};
 use janus2d_core::math::{Real, Vec2};
 use janus2d_core::slots::Slots;
 use smallvec::SmallVec;
@@ -191,11 +191,10 @@ impl ShapeStore {
 
     /// The slot of a live shape, or why the handle does not resolve.
     pub fn slot(&self, handle: ShapeHandle, owner: u32) -> Result<u32, WorldError> {
-        match self.slots.resolve(handle, owner) {
-            Ok(_) => Ok(handle.index),
-            Err(HandleError::Foreign) => Err(WorldError::ForeignHandle),
-            Err(HandleError::Stale) => Err(WorldError::StaleShape),
-        }
+        self.slots
+            .resolve(handle, owner)
+            .map(|_| handle.index)
+            .map_err(|e| WorldError::of_handle(e, WorldError::StaleShape))
     }
 
     /// The handle of live slot `index`.

@@ -23,7 +23,6 @@ use janus2d_core::BodyMass;
 use janus2d_core::body::{BodyDef, BodyHandle, BodyLocation, BodySet, BodyType, validate_mass};
 use janus2d_core::constraint::{ConstraintBatch, StepContext};
 use janus2d_core::geometry::Shape;
-use janus2d_core::handle::HandleError;
 use janus2d_core::math::{Real, Rot, Transform, Vec2, cross, vec_is_finite};
 use janus2d_core::solver::{SolverProfile, SolverSettings, solve_step};
 
@@ -264,11 +263,10 @@ impl World {
     }
 
     fn check_body(&self, body: BodyHandle) -> Result<(), WorldError> {
-        match self.bodies.check(body) {
-            Ok(_) => Ok(()),
-            Err(HandleError::Foreign) => Err(WorldError::ForeignHandle),
-            Err(HandleError::Stale) => Err(WorldError::StaleBody),
-        }
+        self.bodies
+            .check(body)
+            .map(|_| ())
+            .map_err(|e| WorldError::of_handle(e, WorldError::StaleBody))
     }
 
     /// Body origin and rotation.

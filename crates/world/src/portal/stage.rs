@@ -45,7 +45,7 @@ use crate::error::WorldError;
 use crate::joints::JointHandle;
 use crate::world::World;
 use janus2d_core::body::BodySet;
-use janus2d_core::handle::{Handle, HandleError, PortalPairTag};
+use janus2d_core::handle::{Handle, PortalPairTag};
 
 /// Smallest mass fraction a straddling copy keeps (dimensionless, usual
 /// 0.1): a copy that has barely appeared is never thousands of times
@@ -397,11 +397,11 @@ impl World {
     }
 
     fn pair_slot(&self, pair: PortalPairHandle) -> Result<u32, WorldError> {
-        match self.portals.pairs.resolve(pair, self.bodies().owner()) {
-            Ok(_) => Ok(pair.index),
-            Err(HandleError::Foreign) => Err(WorldError::ForeignHandle),
-            Err(HandleError::Stale) => Err(WorldError::StalePortal),
-        }
+        self.portals
+            .pairs
+            .resolve(pair, self.bodies().owner())
+            .map(|_| pair.index)
+            .map_err(|e| WorldError::of_handle(e, WorldError::StalePortal))
     }
 
     fn pair_handle(&self, index: u32) -> PortalPairHandle {
