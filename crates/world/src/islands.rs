@@ -124,6 +124,7 @@ pub(crate) struct Islands {
     /// Bodies created with `awake = false`, put to sleep at the next step.
     pending: Vec<BodyHandle>,
     min_time: Vec<Real>,
+    touched: Vec<u32>,
     seen: Vec<u32>,
     stamp: u32,
     stack: Vec<BodyHandle>,
@@ -389,25 +390,32 @@ impl Islands {
         if candidate.0 != NONE {
             self.split(candidate.0, contacts, joints);
         }
-        // The least rested awake member of each island.
+        // The least rested awake member of each island with awake members
+        // (sleeping islands are not visited; `min_time` is kept at MAX
+        // between steps, so only the touched entries are reset).
         let mut min_time = std::mem::take(&mut self.min_time);
-        min_time.clear();
         min_time.resize(self.islands.len(), Real::MAX);
+        let mut touched = std::mem::take(&mut self.touched);
+        touched.clear();
         for i in 1..n {
             let sim = &bodies.sims[i];
             let id = self.island(sim.handle);
             if id != NONE {
                 let t = &mut min_time[id as usize];
+                if *t == Real::MAX {
+                    touched.push(id);
+                }
                 *t = t.min(sim.sleep_time);
             }
         }
-        for id in 0..self.islands.len() {
+        // In island order, as a pass over every island would visit them.
+        touched.sort_unstable();
+        for &id in &touched {
+            let id = id as usize;
+            let rested = min_time[id] >= settings.time_to_sleep;
+            min_time[id] = Real::MAX;
             let island = &self.islands[id];
-            if island.asleep
-                || island.members.is_empty()
-                || min_time[id] == Real::MAX
-                || min_time[id] < settings.time_to_sleep
-            {
+            if island.asleep || island.members.is_empty() || !rested {
                 continue;
             }
             self.islands[id].asleep = true;
@@ -420,6 +428,7 @@ impl Islands {
             }
         }
         self.min_time = min_time;
+        self.touched = touched;
     }
 
     /// Splits island `id` into its connected parts over the members' own
