@@ -61,7 +61,7 @@ fn main() {
     );
     // --- rain
     use janus2d_testbed::benchmarks::rain;
-    use janus2d_testbed::engine::{Engine, EngineOptions};
+    use janus2d_testbed::engine::Engine;
     use janus2d_testbed::janus::Janus;
     let desc = rain();
     let mut wd = janus2d_testbed::janus::world_def(&desc.settings);
@@ -69,7 +69,6 @@ fn main() {
         wd.solver.direct_joints = false;
     }
     let mut e = Janus::with_def(&desc, wd).unwrap();
-    let _ = EngineOptions::default();
     let mut buf = Vec::new();
     let (mut despawn, mut nd, mut ordinary, mut no) = (0.0, 0, 0.0, 0);
     for step in 0..steps {

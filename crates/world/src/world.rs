@@ -199,10 +199,7 @@ impl World {
     /// assert!(world.position(ball).unwrap().y < 4.0);
     /// ```
     pub fn create_body(&mut self, def: &BodyDef) -> Result<BodyHandle, WorldError> {
-        let handle = self.bodies.create(def)?;
-        if def.body_type == BodyType::Dynamic {
-            self.islands.add_body(handle);
-        }
+        let handle = self.insert_body(def)?;
         if !def.awake && def.body_type != BodyType::Static {
             self.islands.push_pending(handle);
         }
@@ -255,11 +252,7 @@ impl World {
 
     /// `StaleBody`, or `ForeignHandle` for another world's handle.
     fn body_error(&self, body: BodyHandle) -> WorldError {
-        if body.owner == self.bodies.owner() {
-            WorldError::StaleBody
-        } else {
-            WorldError::ForeignHandle
-        }
+        self.check_body(body).err().unwrap_or(WorldError::StaleBody)
     }
 
     fn check_body(&self, body: BodyHandle) -> Result<(), WorldError> {
@@ -610,15 +603,26 @@ impl World {
     /// Enables or disables a joint (one a portal disabled can be enabled
     /// again).
     pub fn set_joint_enabled(&mut self, joint: JointHandle, on: bool) -> Result<(), WorldError> {
-        let (a, b) = self.joints.set_enabled(joint, on)?;
+        let (a, b) = self.switch_joint(joint, on)?;
         self.wake_body(a);
         self.wake_body(b);
+        Ok(())
+    }
+
+    /// Enables or disables a joint and tells the islands (linked when on,
+    /// a removed link when off); wakes nothing.
+    fn switch_joint(
+        &mut self,
+        joint: JointHandle,
+        on: bool,
+    ) -> Result<(BodyHandle, BodyHandle), WorldError> {
+        let (a, b) = self.joints.set_enabled(joint, on)?;
         if on {
             self.islands.link(a, b, &self.bodies);
         } else {
             self.islands.note_removed(a);
         }
-        Ok(())
+        Ok((a, b))
     }
 
     /// Distance between a joint's two world anchors, m.
@@ -1016,13 +1020,14 @@ impl World {
         self.bodies.apply_mass(body, mass, fixed);
     }
 
-    /// Creates a body from a definition known to be valid (a portal clone).
-    pub(crate) fn insert_body(&mut self, def: &BodyDef) -> Option<BodyHandle> {
-        let handle = self.bodies.create(def).ok()?;
+    /// Creates a body (validated by `BodySet::create`) in an island of its
+    /// own when dynamic; `create_body` adds the asleep-at-creation rule.
+    pub(crate) fn insert_body(&mut self, def: &BodyDef) -> Result<BodyHandle, WorldError> {
+        let handle = self.bodies.create(def)?;
         if def.body_type == BodyType::Dynamic {
             self.islands.add_body(handle);
         }
-        Some(handle)
+        Ok(handle)
     }
 
     /// Adds an impulse at a world point to a dynamic body now (no checks).
@@ -1073,9 +1078,8 @@ impl World {
 
     /// Disables a joint (the solver skips it; it stays until destroyed).
     pub(crate) fn disable_joint(&mut self, joint: JointHandle) {
-        if let Ok((a, _)) = self.joints.set_enabled(joint, false) {
-            self.islands.note_removed(a);
-        }
+        let switched = self.switch_joint(joint, false);
+        debug_assert!(switched.is_ok(), "the portal stage passes live joints");
     }
 
     /// Exchanges two bodies' identities (see `BodySet::swap_identity`),

@@ -620,7 +620,7 @@ impl World {
             user_data: record.user_data,
             ..BodyDef::default()
         };
-        let clone = self.insert_body(&clone_def)?;
+        let clone = self.insert_body(&clone_def).ok()?;
         let shapes: Vec<u32> = self.collision_ref().shapes.of_body(body).to_vec();
         for s in shapes {
             let data = self.collision_ref().shapes.at(s);
