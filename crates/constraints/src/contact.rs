@@ -77,7 +77,7 @@ pub const MAX_MANIFOLD_POINTS: usize = 2;
 /// Rows of a constraint: the normal rows of points 0 and 1, then their
 /// friction rows. A one-point manifold leaves rows 1 and 3 at zero (zero
 /// Jacobian, mass and impulse), which the solve passes through exactly.
-const ROWS: usize = 2 * MAX_MANIFOLD_POINTS;
+pub(crate) const ROWS: usize = 2 * MAX_MANIFOLD_POINTS;
 
 // The solve is written out for two points (four rows).
 const _: () = assert!(MAX_MANIFOLD_POINTS == 2);
@@ -111,34 +111,34 @@ pub struct ContactPointInput {
 pub struct ContactConstraint {
     /// Angular Jacobian parts on a per row: `r_a × n` (rows 0, 1) and
     /// `r_a × t` (rows 2, 3), m.
-    ja: [Real; ROWS],
+    pub(crate) ja: [Real; ROWS],
     /// Angular Jacobian parts on b per row: `r_b × n`, `r_b × t`, m.
-    jb: [Real; ROWS],
+    pub(crate) jb: [Real; ROWS],
     /// Accumulated impulse per row, N·s.
-    impulse: [Real; ROWS],
+    pub(crate) impulse: [Real; ROWS],
     /// State index of body a (0: static, sleeping or stale).
-    state_a: u32,
+    pub(crate) state_a: u32,
     /// State index of body b.
-    state_b: u32,
+    pub(crate) state_b: u32,
     /// Unit normal from a to b (world).
     pub normal: Vec2,
     /// Rigid effective mass `1 / k` per row, kg.
-    mass: [Real; ROWS],
+    pub(crate) mass: [Real; ROWS],
     /// Mixed friction coefficient `√(μ_a μ_b)`.
     pub friction: Real,
     /// Bias rate of the contact softness (static or moving pair), 1/s.
-    bias_rate: Real,
+    pub(crate) bias_rate: Real,
     /// `s₀ − n · (r_b − r_a)` per point: the separation at zero position
     /// deltas is `base + (r_a × t) − (r_b × t)`, m.
-    base_separation: [Real; MAX_MANIFOLD_POINTS],
+    pub(crate) base_separation: [Real; MAX_MANIFOLD_POINTS],
     /// Soft effective mass `s_m / k` of each normal row, kg.
-    soft_mass: [Real; MAX_MANIFOLD_POINTS],
+    pub(crate) soft_mass: [Real; MAX_MANIFOLD_POINTS],
     /// Soft impulse scale `s_i` of each normal row (dimensionless).
-    impulse_scale: [Real; MAX_MANIFOLD_POINTS],
+    pub(crate) impulse_scale: [Real; MAX_MANIFOLD_POINTS],
     /// Largest normal impulse applied in one iteration (restitution gate).
-    max_normal_impulse: [Real; MAX_MANIFOLD_POINTS],
+    pub(crate) max_normal_impulse: [Real; MAX_MANIFOLD_POINTS],
     /// Number of points (0 to 2).
-    point_count: u32,
+    pub(crate) point_count: u32,
     /// Normal velocity before the solve (for restitution), m/s.
     relative_velocity: [Real; MAX_MANIFOLD_POINTS],
     /// Mixed restitution `max(e_a, e_b)`.
@@ -149,10 +149,9 @@ pub struct ContactConstraint {
     pub body_a: BodyHandle,
     /// Body b.
     pub body_b: BodyHandle,
-    /// Inverse mass and inertia of the whole object a body belongs to, when
-    /// it is one copy of an object crossing a portal (see
-    /// [`ContactConstraint::set_object_mass`]).
-    object_mass: [Option<(Real, Real)>; 2],
+    /// Inverse masses and inertias the impulses act with, loaded from the
+    /// bodies at prepare: `[m_a⁻¹, i_a⁻¹, m_b⁻¹, i_b⁻¹]`.
+    pub(crate) applied_masses: [Real; 4],
 }
 
 /// `max(x, floor)` that returns `floor` when `x` is NaN (as `Real::max`),
@@ -208,7 +207,7 @@ impl ContactConstraint {
             contact_index,
             body_a,
             body_b,
-            object_mass: [None, None],
+            applied_masses: [0.0; 4],
         };
         for (i, p) in points.iter().take(MAX_MANIFOLD_POINTS).enumerate() {
             let (r_a, r_b) = (p.anchor_a, p.anchor_b);
@@ -224,14 +223,68 @@ impl ContactConstraint {
         c
     }
 
-    /// Makes body `side` (0: a, 1: b) respond as the whole object it is a
-    /// copy of: while an object crosses a portal its two copies move as one,
-    /// so a contact on one copy must stop the object, not only the copy.
-    /// The effective masses use the object's inverse mass and inertia; the
-    /// impulses still act on the copy, and the portal constraint carries
-    /// the object's share to the other copy.
-    pub fn set_object_mass(&mut self, side: usize, inv_mass: Real, inv_inertia: Real) {
-        self.object_mass[side] = Some((inv_mass, inv_inertia));
+    /// True when the solve changes body `side`'s state (0: a, 1: b): it
+    /// has an inverse mass or inertia.
+    #[inline]
+    pub(crate) fn moves(&self, side: usize) -> bool {
+        self.applied_masses[2 * side] > 0.0 || self.applied_masses[2 * side + 1] > 0.0
+    }
+
+    /// The effective masses and softness of every row from the inverse
+    /// masses `k_masses = [m_a⁻¹, i_a⁻¹, m_b⁻¹, i_b⁻¹]` (the bodies' own
+    /// at prepare; a whole object's for a portal copy, through the contact
+    /// batch's modification hook).
+    pub(crate) fn prepare_rows(
+        &mut self,
+        ctx: &StepContext,
+        bodies: &BodySet,
+        k_masses: [Real; 4],
+    ) {
+        let sa = &bodies.states[self.state_a as usize];
+        let sb = &bodies.states[self.state_b as usize];
+        let [m_a, i_a, m_b, i_b] = k_masses;
+        let static_pair = self.applied_masses[0] == 0.0 || self.applied_masses[2] == 0.0;
+        let softness = if static_pair {
+            ctx.static_softness
+        } else {
+            ctx.contact_softness
+        };
+        self.bias_rate = softness.bias_rate;
+        let moving_pair = !static_pair;
+        let rho_max = ctx.contact_mass_ratio_cap;
+        let dv = sb.v - sa.v;
+        let dvn = dv.dot(self.normal);
+        for i in 0..self.point_count() {
+            let (rn_a, rn_b) = (self.ja[i], self.jb[i]);
+            let (rt_a, rt_b) = (self.ja[i + 2], self.jb[i + 2]);
+            let k_a = m_a + i_a * rn_a * rn_a;
+            let k_b = m_b + i_b * rn_b * rn_b;
+            let k = k_a + k_b;
+            let soft = normal_softness(softness, moving_pair, rho_max, k_a, k_b);
+            let normal_mass = if k > 0.0 { 1.0 / k } else { 0.0 };
+            self.mass[i] = normal_mass;
+            self.soft_mass[i] = normal_mass * soft.mass_scale;
+            self.impulse_scale[i] = soft.impulse_scale;
+            let k_t = m_a + m_b + i_a * rt_a * rt_a + i_b * rt_b * rt_b;
+            self.mass[i + 2] = if k_t > 0.0 { 1.0 / k_t } else { 0.0 };
+            self.relative_velocity[i] = dvn + (sb.w * rn_b - sa.w * rn_a);
+            self.max_normal_impulse[i] = 0.0;
+        }
+    }
+
+    /// Applies the impulses kept from the last step, `Δv = M⁻¹ Jᵀ λ`.
+    pub(crate) fn apply_warm_start(&self, states: &mut [BodyState]) {
+        let (ia, ib) = (self.state_a as usize, self.state_b as usize);
+        let [m_a, i_a, m_b, i_b] = self.applied_masses;
+        let lambda = &self.impulse;
+        let p = (lambda[0] + lambda[1]) * self.normal + (lambda[2] + lambda[3]) * self.tangent();
+        let (l_a, l_b) = (dot_rows(lambda, &self.ja), dot_rows(lambda, &self.jb));
+        let sa = &mut states[ia];
+        sa.v -= m_a * p;
+        sa.w -= i_a * l_a;
+        let sb = &mut states[ib];
+        sb.v += m_b * p;
+        sb.w += i_b * l_b;
     }
 
     /// Number of points.
@@ -268,7 +321,7 @@ impl ContactConstraint {
     /// normal clamp works on the increment, `Δλ = max(λ, −λ_acc)`, so that
     /// `λ_acc + Δλ ≥ 0`.
     #[inline(always)]
-    fn solve_rows<const USE_BIAS: bool>(
+    pub(crate) fn solve_rows<const USE_BIAS: bool>(
         &mut self,
         states: &mut [BodyState],
         inv_h: Real,
@@ -276,7 +329,7 @@ impl ContactConstraint {
     ) {
         let (ia, ib) = (self.state_a as usize, self.state_b as usize);
         let (sa, sb) = (&states[ia], &states[ib]);
-        let (m_a, i_a, m_b, i_b) = (sa.inv_mass, sa.inv_inertia, sb.inv_mass, sb.inv_inertia);
+        let [m_a, i_a, m_b, i_b] = self.applied_masses;
         let (v_a, w_a, v_b, w_b) = (sa.v, sa.w, sb.v, sb.w);
         let (qa, qb) = (sa.dq, sb.dq);
         let n = self.normal;
@@ -419,58 +472,15 @@ impl Constraint for ContactConstraint {
         self.state_b = bodies.state_index(self.body_b).unwrap_or(0);
         let sa = &bodies.states[self.state_a as usize];
         let sb = &bodies.states[self.state_b as usize];
-        let (mut m_a, mut i_a) = (sa.inv_mass, sa.inv_inertia);
-        let (mut m_b, mut i_b) = (sb.inv_mass, sb.inv_inertia);
-        let static_pair = m_a == 0.0 || m_b == 0.0;
-        // Crossing copies respond as their whole object (K only).
-        if let Some((m, i)) = self.object_mass[0] {
-            (m_a, i_a) = (m, i);
-        }
-        if let Some((m, i)) = self.object_mass[1] {
-            (m_b, i_b) = (m, i);
-        }
-        let softness = if static_pair {
-            ctx.static_softness
-        } else {
-            ctx.contact_softness
-        };
-        self.bias_rate = softness.bias_rate;
-        let moving_pair = !static_pair;
-        let rho_max = ctx.contact_mass_ratio_cap;
-        let dv = sb.v - sa.v;
-        let dvn = dv.dot(self.normal);
-        for i in 0..self.point_count() {
-            let (rn_a, rn_b) = (self.ja[i], self.jb[i]);
-            let (rt_a, rt_b) = (self.ja[i + 2], self.jb[i + 2]);
-            let k_a = m_a + i_a * rn_a * rn_a;
-            let k_b = m_b + i_b * rn_b * rn_b;
-            let k = k_a + k_b;
-            let soft = normal_softness(softness, moving_pair, rho_max, k_a, k_b);
-            let normal_mass = if k > 0.0 { 1.0 / k } else { 0.0 };
-            self.mass[i] = normal_mass;
-            self.soft_mass[i] = normal_mass * soft.mass_scale;
-            self.impulse_scale[i] = soft.impulse_scale;
-            let k_t = m_a + m_b + i_a * rt_a * rt_a + i_b * rt_b * rt_b;
-            self.mass[i + 2] = if k_t > 0.0 { 1.0 / k_t } else { 0.0 };
-            self.relative_velocity[i] = dvn + (sb.w * rn_b - sa.w * rn_a);
-            self.max_normal_impulse[i] = 0.0;
-        }
+        self.applied_masses = [sa.inv_mass, sa.inv_inertia, sb.inv_mass, sb.inv_inertia];
+        self.prepare_rows(ctx, bodies, self.applied_masses);
         if !ctx.warm_starting {
             self.impulse = [0.0; ROWS];
         }
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        let (ia, ib) = (self.state_a as usize, self.state_b as usize);
-        let lambda = &self.impulse;
-        let p = (lambda[0] + lambda[1]) * self.normal + (lambda[2] + lambda[3]) * self.tangent();
-        let (l_a, l_b) = (dot_rows(lambda, &self.ja), dot_rows(lambda, &self.jb));
-        let sa = &mut states[ia];
-        sa.v -= sa.inv_mass * p;
-        sa.w -= sa.inv_inertia * l_a;
-        let sb = &mut states[ib];
-        sb.v += sb.inv_mass * p;
-        sb.w += sb.inv_inertia * l_b;
+        self.apply_warm_start(states);
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {

@@ -15,6 +15,7 @@
 //! without bias) and reports its rows through `Constraint::rows`.
 
 pub mod contact;
+pub mod contact_solver;
 pub mod joint_tree;
 pub mod parts;
 pub mod portal;
@@ -22,6 +23,7 @@ pub mod portal_map;
 pub mod revolute;
 
 pub use contact::{ContactConstraint, ContactPointInput};
+pub use contact_solver::{ContactBatch, ContactSolver, ObjectMass};
 pub use joint_tree::{JointForest, RevoluteBatch};
 pub use portal::{PortalConstraint, PortalConstraintDef};
 pub use portal_map::{Portal, PortalError, PortalMap, PortalPair};

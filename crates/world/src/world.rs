@@ -18,7 +18,9 @@
 //! a generational handle; every call that rejects its input leaves the world
 //! unchanged.
 
-use janus2d_constraints::{ContactConstraint, RevoluteJoint, RevoluteJointDef};
+use janus2d_constraints::{
+    ContactConstraint, ContactSolver, ObjectMass, RevoluteJoint, RevoluteJointDef,
+};
 use janus2d_core::BodyMass;
 use janus2d_core::body::{BodyDef, BodyHandle, BodyLocation, BodySet, BodyType, validate_mass};
 use janus2d_core::constraint::{ConstraintBatch, StepContext};
@@ -77,6 +79,11 @@ pub struct World {
     joints: JointSet,
     collision: Collision,
     contact_constraints: Vec<ContactConstraint>,
+    /// The contact constraints' coloured, lane-packed form (the contact
+    /// solve's own data).
+    contact_solver: ContactSolver,
+    /// The contact-modification hook's data for this step (portal copies).
+    object_masses: Vec<ObjectMass>,
     pub(crate) portals: PortalStage,
     islands: Islands,
     sleep_settings: SleepSettings,
@@ -107,6 +114,8 @@ impl World {
             settings: def.solver,
             collision: Collision::new(bodies.owner()),
             contact_constraints: Vec::new(),
+            contact_solver: ContactSolver::new(),
+            object_masses: Vec::new(),
             portals: PortalStage::default(),
             islands: Islands::default(),
             sleep_settings: def.sleep,
@@ -928,10 +937,8 @@ impl World {
                 &mut self.contact_constraints,
                 &mut self.collision.counters,
             );
-            if has_portals {
-                self.portals
-                    .modify_contacts(&self.bodies, &mut self.contact_constraints);
-            }
+            self.portals
+                .object_masses(&self.bodies, &mut self.object_masses);
             sp.narrowphase += lap();
         } else {
             self.contact_constraints.clear();
@@ -942,11 +949,13 @@ impl World {
             joints: &mut self.joints.revolute,
             forest: &mut self.joints.forest,
         };
-        let mut batches: [&mut dyn ConstraintBatch; 3] = [
-            &mut revolute,
-            &mut self.contact_constraints,
-            self.portals.constraints_mut(),
-        ];
+        let mut contacts = janus2d_constraints::ContactBatch {
+            constraints: &mut self.contact_constraints,
+            solver: &mut self.contact_solver,
+            object_masses: &self.object_masses,
+        };
+        let mut batches: [&mut dyn ConstraintBatch; 3] =
+            [&mut revolute, &mut contacts, self.portals.constraints_mut()];
         let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
         lap();
         if has_shapes {

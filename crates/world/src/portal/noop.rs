@@ -2,7 +2,7 @@
 //! each of its step calls returns at once, so a world built without portals
 //! pays for none of them.
 
-use janus2d_constraints::{ContactConstraint, PortalConstraint};
+use janus2d_constraints::{ObjectMass, PortalConstraint};
 use janus2d_core::body::{BodyHandle, BodySet};
 
 use super::clipping::{ContactClipping, NO_CLIPPING};
@@ -33,7 +33,9 @@ impl PortalStage {
         Vec::new()
     }
     pub(crate) fn build_clipping(&mut self, _bodies: &BodySet) {}
-    pub(crate) fn modify_contacts(&self, _bodies: &BodySet, _c: &mut [ContactConstraint]) {}
+    pub(crate) fn object_masses(&self, _bodies: &BodySet, out: &mut Vec<ObjectMass>) {
+        out.clear();
+    }
 }
 
 impl World {

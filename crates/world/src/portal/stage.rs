@@ -34,7 +34,7 @@
 //! The whole stage is skipped when the world has no portal pair.
 
 use janus2d_constraints::portal_map::{BodyMotion, PortalBodyMotion, PortalFrame, PortalMap};
-use janus2d_constraints::{Portal, PortalConstraint, PortalConstraintDef};
+use janus2d_constraints::{ObjectMass, Portal, PortalConstraint, PortalConstraintDef};
 use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
 use janus2d_core::math::{Real, Rot, Vec2};
 use janus2d_core::slots::Slots;
@@ -288,46 +288,37 @@ impl PortalStage {
         self.clipping = clipping;
     }
 
-    /// The contact-modification hook: the contact constraints of crossing
-    /// copies respond as the whole object. With `v₂ = ηQ v₁` (static
-    /// portals) an impulse on the clone moves the object as if its mass
-    /// were `m₂ + m₁/η²` (and `m₁ + η² m₂` seen from the original);
-    /// rotation is shared, so the inertia is `I₁ + I₂`.
-    pub(crate) fn modify_contacts(
-        &self,
-        bodies: &BodySet,
-        constraints: &mut [janus2d_constraints::ContactConstraint],
-    ) {
-        if self.crossings.is_empty() {
-            return;
-        }
-        let mut objects: Vec<(BodyHandle, Real, Real)> =
-            Vec::with_capacity(2 * self.crossings.len());
+    /// The contact-modification hook's data: the contact constraints of
+    /// crossing copies build their effective masses on the whole object.
+    /// With `v₂ = ηQ v₁` (static portals) an impulse on the clone moves the
+    /// object as if its mass were `m₂ + m₁/η²` (and `m₁ + η² m₂` seen from
+    /// the original); rotation is shared, so the inertia is `I₁ + I₂`.
+    /// Fills `out` (cleared first), one entry per copy.
+    pub(crate) fn object_masses(&self, bodies: &BodySet, out: &mut Vec<ObjectMass>) {
+        out.clear();
         for (c, pc) in self.crossings.iter().zip(&self.constraints) {
             let eta = pc.def().eta;
             let (Some(s1), Some(s2)) = (bodies.sim(c.original), bodies.sim(c.clone)) else {
                 continue;
             };
             let inertia = s1.inertia + s2.inertia;
-            let inv_i = if inertia > 0.0 && s1.inv_inertia > 0.0 {
+            let inv_inertia = if inertia > 0.0 && s1.inv_inertia > 0.0 {
                 1.0 / inertia
             } else {
                 0.0
             };
             let m_orig = s1.mass + eta * eta * s2.mass;
             let m_clone = s2.mass + s1.mass / (eta * eta);
-            objects.push((c.original, 1.0 / m_orig, inv_i));
-            objects.push((c.clone, 1.0 / m_clone, inv_i));
-        }
-        for cc in constraints.iter_mut() {
-            for &(body, inv_m, inv_i) in &objects {
-                if cc.body_a == body {
-                    cc.set_object_mass(0, inv_m, inv_i);
-                }
-                if cc.body_b == body {
-                    cc.set_object_mass(1, inv_m, inv_i);
-                }
-            }
+            out.push(ObjectMass {
+                body: c.original,
+                inv_mass: 1.0 / m_orig,
+                inv_inertia,
+            });
+            out.push(ObjectMass {
+                body: c.clone,
+                inv_mass: 1.0 / m_clone,
+                inv_inertia,
+            });
         }
     }
 
