@@ -223,13 +223,6 @@ impl ContactConstraint {
         c
     }
 
-    /// True when the solve changes body `side`'s state (0: a, 1: b): it
-    /// has an inverse mass or inertia.
-    #[inline]
-    pub(crate) fn moves(&self, side: usize) -> bool {
-        self.applied_masses[2 * side] > 0.0 || self.applied_masses[2 * side + 1] > 0.0
-    }
-
     /// The effective masses and softness of every row from the inverse
     /// masses `k_masses = [m_a⁻¹, i_a⁻¹, m_b⁻¹, i_b⁻¹]` (the bodies' own
     /// at prepare; a whole object's for a portal copy, through the contact

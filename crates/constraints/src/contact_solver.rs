@@ -5,10 +5,12 @@
 //! prepare    scalar, one ContactConstraint at a time (anchors, K, softness),
 //!            then the object-mass hook, then colour and pack:
 //!
-//!   colour   greedy, in constraint order: the first colour in which neither
-//!            dynamic body already appears (static and kinematic bodies take
-//!            no colour: the solve never changes their state)
-//!   pack     each colour's contacts in chunks of LANES, structure of arrays
+//!   colour   (while the pipeline builds the constraints) greedy: the
+//!            first colour in which neither dynamic body already appears
+//!            (static and kinematic bodies take no colour: the solve never
+//!            changes their state); constraints are built colour by colour
+//!   pack     each colour's consecutive constraints in chunks of LANES,
+//!            structure of arrays
 //!
 //!            colour 0: [c0 c3 c7 … ] [c12 … pad]     chunk = LANES lanes
 //!            colour 1: [c1 c4 … pad]
@@ -54,9 +56,8 @@ type W = wide::f32x8;
 #[cfg(feature = "f64")]
 type W = wide::f64x4;
 
-/// Number of colours; a contact whose bodies both appear in every colour
-/// goes to the overflow list.
-pub const COLOURS: usize = 24;
+pub use janus2d_core::graph::COLOURS;
+use janus2d_core::graph::ColourGraph;
 
 /// A dynamic body that stands for a whole object (a copy crossing a
 /// portal): its contacts build their effective masses on the object's
@@ -129,18 +130,25 @@ struct WideContact {
 
 /// The coloured, lane-packed form of a step's contact constraints: the
 /// contact batch's own data.
+///
+/// The pipeline offers each contact to [`ContactSolver::colour`] and then
+/// builds the constraints in [`ContactSolver::order`] (colour by colour,
+/// overflow last), so that every chunk packs consecutive constraints.
 #[derive(Clone, Debug, Default)]
 pub struct ContactSolver {
     /// Chunks, colour by colour.
     chunks: Vec<WideContact>,
-    /// `colour_start[c]..colour_start[c + 1]`: the chunks of colour `c`.
+    /// `colour_start[c]..colour_start[c + 1]`: the chunks of colour `c`
+    /// (colours without contacts left out).
     colour_start: Vec<usize>,
-    /// Constraints that found no colour, solved scalar.
-    overflow: Vec<u32>,
-    /// Colour bits per body state (scratch).
-    body_colours: Vec<u32>,
-    /// Constraint indices per colour (scratch).
-    colour_lists: Vec<Vec<u32>>,
+    /// The colouring of this step.
+    graph: ColourGraph,
+    /// Items offered per colour; the last list is the overflow.
+    lists: Vec<Vec<u32>>,
+    /// Constraints per colour, overflow last, as built.
+    counts: Vec<usize>,
+    /// First overflow constraint (all before it are in chunks).
+    overflow_start: usize,
     /// The lanes' impulses were written back to the constraints.
     unpacked: bool,
 }
@@ -158,57 +166,71 @@ impl ContactSolver {
         self.colour_start.len().saturating_sub(1)
     }
 
-    /// Number of constraints in the overflow list (solved scalar).
+    /// Number of constraints in the overflow (solved scalar).
     #[must_use]
     pub fn overflow_count(&self) -> usize {
-        self.overflow.len()
+        self.counts.last().copied().unwrap_or(0)
     }
 
-    /// Colours the prepared constraints and packs them into lanes.
-    fn pack(&mut self, constraints: &[ContactConstraint], state_count: usize) {
-        self.body_colours.clear();
-        self.body_colours.resize(state_count, 0);
-        if self.colour_lists.len() < COLOURS {
-            self.colour_lists.resize_with(COLOURS, Vec::new);
-        }
-        for list in &mut self.colour_lists {
+    /// Starts a step's colouring for `state_count` body states.
+    pub fn begin_colouring(&mut self, state_count: usize) {
+        self.graph.reset(state_count);
+        self.lists.resize_with(COLOURS + 1, Vec::new);
+        for list in &mut self.lists {
             list.clear();
         }
-        self.overflow.clear();
-        for (i, c) in constraints.iter().enumerate() {
-            let (a, b) = (c.state_a as usize, c.state_b as usize);
-            // Only bodies whose state the solve changes take a colour.
-            let moves_a = a != 0 && c.moves(0);
-            let moves_b = b != 0 && c.moves(1);
-            let used = if moves_a { self.body_colours[a] } else { 0 }
-                | if moves_b { self.body_colours[b] } else { 0 };
-            let colour = (!used).trailing_zeros() as usize;
-            if colour >= COLOURS {
-                self.overflow.push(i as u32);
-                continue;
-            }
-            let bit = 1u32 << colour;
-            if moves_a {
-                self.body_colours[a] |= bit;
-            }
-            if moves_b {
-                self.body_colours[b] |= bit;
-            }
-            self.colour_lists[colour].push(i as u32);
+    }
+
+    /// Offers item `item` (the pipeline's own index) whose bodies have the
+    /// state indices `a` and `b`, `None` for a body the solve does not move
+    /// (static, kinematic or asleep).
+    pub fn colour(&mut self, item: u32, a: Option<u32>, b: Option<u32>) {
+        let slot = self.graph.assign(a, b).unwrap_or(COLOURS);
+        self.lists[slot].push(item);
+    }
+
+    /// The offered items in the order the constraints must be built:
+    /// colour by colour, then the overflow.
+    pub fn order(&self) -> impl Iterator<Item = u32> + '_ {
+        self.lists.iter().flatten().copied()
+    }
+
+    /// Packs the prepared constraints, built in [`ContactSolver::order`],
+    /// into chunks. Constraints built otherwise (their count differs from
+    /// the items offered) are all solved scalar.
+    fn pack(&mut self, constraints: &[ContactConstraint]) {
+        self.counts.clear();
+        self.counts.extend(self.lists.iter().map(Vec::len));
+        let offered: usize = self.counts.iter().sum();
+        if offered != constraints.len() || self.counts.is_empty() {
+            self.counts.clear();
+            self.counts.push(constraints.len());
         }
         self.chunks.clear();
         self.colour_start.clear();
         self.colour_start.push(0);
-        for list in &self.colour_lists {
-            if list.is_empty() {
+        let mut first = 0;
+        let (colours, _) = self.counts.split_at(self.counts.len() - 1);
+        for &count in colours {
+            if count == 0 {
                 continue;
             }
-            for group in list.chunks(LANES) {
-                self.chunks.push(WideContact::pack(constraints, group));
+            let range = first..first + count;
+            for start in range.clone().step_by(LANES) {
+                let end = (start + LANES).min(range.end);
+                self.chunks.push(WideContact::empty());
+                let chunk = self.chunks.last_mut().expect("just pushed");
+                chunk.fill(constraints, start, end);
             }
             self.colour_start.push(self.chunks.len());
+            first += count;
         }
+        self.overflow_start = first;
         self.unpacked = false;
+        // A colouring serves one build: the next pack needs a new one.
+        for list in &mut self.lists {
+            list.clear();
+        }
     }
 
     /// Writes the lanes' impulses back to their constraints (once per step).
@@ -226,8 +248,8 @@ impl ContactSolver {
         for chunk in &mut self.chunks {
             chunk.warm_start(states);
         }
-        for &i in &self.overflow {
-            constraints[i as usize].apply_warm_start(states);
+        for c in &constraints[self.overflow_start..] {
+            c.apply_warm_start(states);
         }
     }
 
@@ -252,8 +274,7 @@ impl ContactSolver {
                 }
             }
         }
-        for &i in &self.overflow {
-            let c = &mut constraints[i as usize];
+        for c in &mut constraints[self.overflow_start..] {
             if use_bias {
                 c.solve_rows::<true>(states, inv_h, push_max);
             } else {
@@ -343,36 +364,34 @@ impl WideContact {
         }
     }
 
-    fn pack(constraints: &[ContactConstraint], group: &[u32]) -> Self {
-        let mut w = Self::empty();
-        for (k, &i) in group.iter().enumerate() {
-            let c = &constraints[i as usize];
-            w.state_a[k] = c.state_a;
-            w.state_b[k] = c.state_b;
-            w.source[k] = i;
+    /// Loads constraints `start..end` (at most [`LANES`]) into the lanes.
+    fn fill(&mut self, constraints: &[ContactConstraint], start: usize, end: usize) {
+        for (k, c) in constraints[start..end].iter().enumerate() {
+            self.state_a[k] = c.state_a;
+            self.state_b[k] = c.state_b;
+            self.source[k] = (start + k) as u32;
             let [m_a, i_a, m_b, i_b] = c.applied_masses;
-            w.inv_mass_a.as_array_mut()[k] = m_a;
-            w.inv_inertia_a.as_array_mut()[k] = i_a;
-            w.inv_mass_b.as_array_mut()[k] = m_b;
-            w.inv_inertia_b.as_array_mut()[k] = i_b;
-            w.n_x.as_array_mut()[k] = c.normal.x;
-            w.n_y.as_array_mut()[k] = c.normal.y;
+            self.inv_mass_a.as_array_mut()[k] = m_a;
+            self.inv_inertia_a.as_array_mut()[k] = i_a;
+            self.inv_mass_b.as_array_mut()[k] = m_b;
+            self.inv_inertia_b.as_array_mut()[k] = i_b;
+            self.n_x.as_array_mut()[k] = c.normal.x;
+            self.n_y.as_array_mut()[k] = c.normal.y;
             for row in 0..ROWS {
-                w.ja[row].as_array_mut()[k] = c.ja[row];
-                w.jb[row].as_array_mut()[k] = c.jb[row];
-                w.mass[row].as_array_mut()[k] = c.mass[row];
-                w.impulse[row].as_array_mut()[k] = c.impulse[row];
+                self.ja[row].as_array_mut()[k] = c.ja[row];
+                self.jb[row].as_array_mut()[k] = c.jb[row];
+                self.mass[row].as_array_mut()[k] = c.mass[row];
+                self.impulse[row].as_array_mut()[k] = c.impulse[row];
             }
             for p in 0..MAX_MANIFOLD_POINTS {
-                w.soft_mass[p].as_array_mut()[k] = c.soft_mass[p];
-                w.impulse_scale[p].as_array_mut()[k] = c.impulse_scale[p];
-                w.base_separation[p].as_array_mut()[k] = c.base_separation[p];
-                w.max_normal_impulse[p].as_array_mut()[k] = c.max_normal_impulse[p];
+                self.soft_mass[p].as_array_mut()[k] = c.soft_mass[p];
+                self.impulse_scale[p].as_array_mut()[k] = c.impulse_scale[p];
+                self.base_separation[p].as_array_mut()[k] = c.base_separation[p];
+                self.max_normal_impulse[p].as_array_mut()[k] = c.max_normal_impulse[p];
             }
-            w.friction.as_array_mut()[k] = c.friction;
-            w.bias_rate.as_array_mut()[k] = c.bias_rate;
+            self.friction.as_array_mut()[k] = c.friction;
+            self.bias_rate.as_array_mut()[k] = c.bias_rate;
         }
-        w
     }
 
     fn unpack(&self, constraints: &mut [ContactConstraint]) {
@@ -584,7 +603,7 @@ impl ConstraintBatch for ContactBatch<'_> {
                 }
             }
         }
-        self.solver.pack(self.constraints, bodies.states.len());
+        self.solver.pack(self.constraints);
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {

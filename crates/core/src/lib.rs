@@ -20,6 +20,7 @@
 pub mod body;
 pub mod constraint;
 pub mod geometry;
+pub mod graph;
 pub mod handle;
 pub mod math;
 pub mod slots;

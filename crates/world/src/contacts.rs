@@ -366,4 +366,11 @@ impl ContactSet {
     pub(crate) fn awake_mut(&mut self, i: usize) -> &mut Contact {
         &mut self.awake[i]
     }
+
+    /// The awake contacts, mutable in place (the narrowphase's phase 1:
+    /// the list's order and length do not change).
+    #[inline]
+    pub(crate) fn awake_slice_mut(&mut self) -> &mut [Contact] {
+        &mut self.awake
+    }
 }

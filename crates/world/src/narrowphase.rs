@@ -2,13 +2,14 @@
 //! constraints built from them.
 //!
 //! ```text
-//! phase 1 (parallel with `parallel`)   each awake contact alone:
+//! phase 1 (parallel with `parallel`)   each awake contact alone, in place:
 //!     both bodies still      → Asleep (kept as is)
 //!     fat boxes apart        → Separated
-//!     else                   → Manifold(collide(a, b, speculative))
-//! phase 2 (contact order)    destroy separated, store manifolds (impulses
-//!                            carried by feature id), apply aperture
-//!                            clipping, begin/end events, list bodies to wake
+//!     else                   → Updated: collide(a, b, speculative) stored
+//!                              (impulses carried by feature id), aperture
+//!                              clipping applied, touching flag set
+//! phase 2 (contact order)    destroy separated, begin/end events, list
+//!                            bodies to wake
 //! build                      one ContactConstraint per touching solid
 //!                            contact: moving pairs first, static ones last
 //! ```
@@ -18,6 +19,7 @@
 
 use janus2d_constraints::ContactPointInput;
 use janus2d_constraints::contact::ContactConstraint;
+use janus2d_constraints::contact_solver::ContactSolver;
 use janus2d_core::body::{BodyHandle, BodySet};
 use janus2d_core::geometry::{Aabb, Manifold, collide};
 use janus2d_core::math::{Real, Vec2};
@@ -28,26 +30,19 @@ use crate::contacts::{CollisionEvents, Contact, ContactPointData, ContactSet};
 use crate::portal::ContactClipping;
 use crate::shapes::ShapeStore;
 
-/// Phase-1 result of the narrowphase for one contact.
-#[derive(Clone, Debug)]
-#[allow(clippy::large_enum_variant)] // one per contact in a reused buffer; no boxing
+/// Phase-1 outcome of the narrowphase for one contact (its manifold is
+/// already updated in place).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum ContactUpdate {
-    /// Both bodies asleep or static: keep the contact as it is.
+    /// Both bodies asleep or static: the contact is kept as it is.
     Asleep,
     /// The fat boxes separated: destroy the contact.
     Separated,
-    /// The new manifold, with what phase 2 needs of the two bodies.
-    Manifold(Computed),
-}
-
-/// A computed manifold and the body data phase 2 needs.
-#[derive(Clone, Debug)]
-struct Computed {
-    manifold: Manifold,
-    /// Body origin minus centre of mass, per body (world frame), m.
-    offset: [Vec2; 2],
-    /// Whether each body reads as static (static or asleep).
-    still: [bool; 2],
+    /// New manifold stored; `was_touching` is the touching flag before.
+    Updated {
+        /// Whether the contact touched before this update.
+        was_touching: bool,
+    },
 }
 
 /// The narrowphase's reused buffers.
@@ -87,27 +82,25 @@ impl Narrowphase {
         let mut results = std::mem::take(&mut self.results);
         results.clear();
         {
-            let compute = |c: &Contact| update_of(c, input);
+            let compute = |c: &mut Contact| update_in_place(c, input);
             #[cfg(feature = "parallel")]
             {
                 use rayon::prelude::*;
                 contacts
-                    .awake()
-                    .par_iter()
+                    .awake_slice_mut()
+                    .par_iter_mut()
                     .map(compute)
                     .collect_into_vec(&mut results);
             }
             #[cfg(not(feature = "parallel"))]
-            results.extend(contacts.awake().iter().map(compute));
+            results.extend(contacts.awake_slice_mut().iter_mut().map(compute));
         }
-        let clip = !input.clipping.is_empty();
         let mut k = 0;
         let mut tested = 0;
         let mut touching_count = 0;
         while k < contacts.awake().len() {
-            let update = match results[k] {
+            let was_touching = match results[k] {
                 ContactUpdate::Asleep => {
-                    contacts.awake_mut(k).still = [true, true];
                     k += 1;
                     continue;
                 }
@@ -116,20 +109,13 @@ impl Narrowphase {
                     results.swap_remove(k);
                     continue;
                 }
-                ContactUpdate::Manifold(ref m) => m,
+                ContactUpdate::Updated { was_touching } => was_touching,
             };
             tested += 1;
             let c = contacts.awake_mut(k);
-            let was_touching = c.touching;
-            update_manifold(c, &update.manifold, update.offset);
-            c.still = update.still;
-            if clip {
-                input.clipping.apply(c);
-            }
-            let touching = c.point_count > 0;
-            c.touching = touching;
-            if touching && (update.still[0] || update.still[1]) {
-                let other = if update.still[0] { c.body_a } else { c.body_b };
+            let touching = c.touching;
+            if touching && (c.still[0] || c.still[1]) {
+                let other = if c.still[0] { c.body_a } else { c.body_b };
                 if input.bodies.is_sleeping(other) {
                     wake.push(other);
                     // Woken before the solve: it moves this step.
@@ -154,12 +140,15 @@ impl Narrowphase {
     }
 }
 
-/// The new manifold of one contact (phase 1 of the narrowphase).
-fn update_of(c: &Contact, input: &NarrowphaseInput<'_>) -> ContactUpdate {
+/// Phase 1 of the narrowphase for one contact, on the contact alone: the
+/// new manifold (impulses carried over by feature id), the aperture
+/// clipping and the touching flag.
+fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpdate {
     let body_a = input.bodies.solver_body(c.body_a);
     let body_b = input.bodies.solver_body(c.body_b);
     if body_a.state_index == 0 && body_b.state_index == 0 {
         // Both asleep (or asleep and static): nothing moves.
+        c.still = [true, true];
         return ContactUpdate::Asleep;
     }
     let sa = input.shapes.at(c.shape_a);
@@ -178,20 +167,25 @@ fn update_of(c: &Contact, input: &NarrowphaseInput<'_>) -> ContactUpdate {
         + body_a.state.w.abs() * reach(&sa.aabb, sim_a.center)
         + body_b.state.w.abs() * reach(&sb.aabb, sim_b.center);
     let speculative = SPECULATIVE_DISTANCE + input.dt * approach;
-    ContactUpdate::Manifold(Computed {
-        manifold: collide(
-            &sa.geometry,
-            &sim_a.transform,
-            &sb.geometry,
-            &sim_b.transform,
-            speculative,
-        ),
-        offset: [
-            sim_a.transform.p - sim_a.center,
-            sim_b.transform.p - sim_b.center,
-        ],
-        still: [body_a.state_index == 0, body_b.state_index == 0],
-    })
+    let manifold = collide(
+        &sa.geometry,
+        &sim_a.transform,
+        &sb.geometry,
+        &sim_b.transform,
+        speculative,
+    );
+    let offset = [
+        sim_a.transform.p - sim_a.center,
+        sim_b.transform.p - sim_b.center,
+    ];
+    let was_touching = c.touching;
+    update_manifold(c, &manifold, offset);
+    c.still = [body_a.state_index == 0, body_b.state_index == 0];
+    if !input.clipping.is_empty() {
+        input.clipping.apply(c);
+    }
+    c.touching = c.point_count > 0;
+    ContactUpdate::Updated { was_touching }
 }
 
 /// Replaces a contact's manifold, carrying impulses over by feature id and
@@ -237,6 +231,7 @@ pub(crate) fn build_constraints(
     bodies: &BodySet,
     woke: bool,
     out: &mut Vec<ContactConstraint>,
+    solver: &mut ContactSolver,
     counters: &mut CollisionCounters,
 ) {
     out.clear();
@@ -251,7 +246,13 @@ pub(crate) fn build_constraints(
             }
         }
     }
-    let (mut rows, mut bouncy) = (0, 0);
+    // The state index of a body the solve moves (dynamic and awake).
+    let moving = |body: BodyHandle| {
+        let i = bodies.state_index(body)?;
+        let sim = bodies.sims.get(i as usize)?;
+        (i != 0 && (sim.inv_mass > 0.0 || sim.inv_inertia > 0.0)).then_some(i)
+    };
+    solver.begin_colouring(bodies.states.len());
     for static_pass in [false, true] {
         for (k, c) in contacts.awake().iter().enumerate() {
             if !c.is_solid_touching() {
@@ -261,28 +262,34 @@ pub(crate) fn build_constraints(
             if (sa && sb) || (sa || sb) != static_pass {
                 continue;
             }
-            rows += 2 * c.point_count;
-            bouncy += usize::from(c.restitution > 0.0);
-            let mut inputs = [ContactPointInput::default(); 2];
-            for (input, p) in inputs.iter_mut().zip(&c.points[..c.point_count]) {
-                *input = ContactPointInput {
-                    anchor_a: p.anchor_a,
-                    anchor_b: p.anchor_b,
-                    separation: p.separation,
-                    normal_impulse: p.normal_impulse,
-                    tangent_impulse: p.tangent_impulse,
-                };
-            }
-            out.push(ContactConstraint::new(
-                c.body_a,
-                c.body_b,
-                c.normal,
-                &inputs[..c.point_count],
-                c.friction,
-                c.restitution,
-                k as u32,
-            ));
+            solver.colour(k as u32, moving(c.body_a), moving(c.body_b));
         }
+    }
+    let (mut rows, mut bouncy) = (0, 0);
+    let awake = contacts.awake();
+    for k in solver.order() {
+        let c = &awake[k as usize];
+        rows += 2 * c.point_count;
+        bouncy += usize::from(c.restitution > 0.0);
+        let mut inputs = [ContactPointInput::default(); 2];
+        for (input, p) in inputs.iter_mut().zip(&c.points[..c.point_count]) {
+            *input = ContactPointInput {
+                anchor_a: p.anchor_a,
+                anchor_b: p.anchor_b,
+                separation: p.separation,
+                normal_impulse: p.normal_impulse,
+                tangent_impulse: p.tangent_impulse,
+            };
+        }
+        out.push(ContactConstraint::new(
+            c.body_a,
+            c.body_b,
+            c.normal,
+            &inputs[..c.point_count],
+            c.friction,
+            c.restitution,
+            k,
+        ));
     }
     counters.contact_rows = rows;
     counters.restitution_contacts = bouncy;

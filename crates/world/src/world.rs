@@ -935,6 +935,7 @@ impl World {
                 &self.bodies,
                 woke,
                 &mut self.contact_constraints,
+                &mut self.contact_solver,
                 &mut self.collision.counters,
             );
             self.portals
