@@ -94,9 +94,8 @@ struct WideContact {
     state_a: [u32; LANES],
     /// State index of body b per lane.
     state_b: [u32; LANES],
-    /// Index of the lane's contact in the constraint list (`u32::MAX`:
-    /// padding).
-    source: [u32; LANES],
+    /// Number of lanes in use (the rest are padding).
+    len: usize,
     /// Inverse masses the impulses act with, 1/kg.
     inv_mass_a: W,
     inv_mass_b: W,
@@ -128,30 +127,30 @@ struct WideContact {
     max_normal_impulse: [W; MAX_MANIFOLD_POINTS],
 }
 
-/// The coloured, lane-packed form of a step's contact constraints: the
-/// contact batch's own data.
+/// A step's contact constraints, colour by colour, and their lane-packed
+/// form: the contact batch's own data.
 ///
-/// The pipeline offers each contact to [`ContactSolver::colour`] and then
-/// builds the constraints in [`ContactSolver::order`] (colour by colour,
-/// overflow last), so that every chunk packs consecutive constraints.
+/// The pipeline builds the constraints in two passes over its contacts:
+/// [`ContactSolver::assign`] gives each its colour (or the overflow), then
+/// [`ContactSolver::push`] appends it to that colour's list. Both passes
+/// read the contacts in order and each colour's list is written in order,
+/// so neither pass jumps around memory.
 #[derive(Clone, Debug, Default)]
 pub struct ContactSolver {
+    /// Constraints per colour; the last list is the overflow.
+    colours: Vec<Vec<ContactConstraint>>,
     /// Chunks, colour by colour.
     chunks: Vec<WideContact>,
-    /// `colour_start[c]..colour_start[c + 1]`: the chunks of colour `c`
-    /// (colours without contacts left out).
+    /// `colour_start[c]..colour_start[c + 1]`: the chunks of colour `c`.
     colour_start: Vec<usize>,
     /// The colouring of this step.
     graph: ColourGraph,
-    /// Items offered per colour; the last list is the overflow.
-    lists: Vec<Vec<u32>>,
-    /// Constraints per colour, overflow last, as built.
-    counts: Vec<usize>,
-    /// First overflow constraint (all before it are in chunks).
-    overflow_start: usize,
     /// The lanes' impulses were written back to the constraints.
     unpacked: bool,
 }
+
+/// The slot of the overflow list in [`ContactSolver`]'s colours.
+pub const OVERFLOW: u8 = COLOURS as u8;
 
 impl ContactSolver {
     /// An empty solver.
@@ -160,95 +159,109 @@ impl ContactSolver {
         Self::default()
     }
 
-    /// Number of colours in use.
+    /// Number of colours (the overflow not counted).
     #[must_use]
     pub fn colour_count(&self) -> usize {
-        self.colour_start.len().saturating_sub(1)
+        COLOURS
     }
 
-    /// Number of constraints in the overflow (solved scalar).
+    /// Number of constraints in colour `colour` ([`OVERFLOW`] for the
+    /// overflow, solved scalar).
     #[must_use]
-    pub fn overflow_count(&self) -> usize {
-        self.counts.last().copied().unwrap_or(0)
+    pub fn count_in(&self, colour: u8) -> usize {
+        self.colours.get(colour as usize).map_or(0, Vec::len)
     }
 
-    /// Starts a step's colouring for `state_count` body states.
-    pub fn begin_colouring(&mut self, state_count: usize) {
+    /// Number of constraints.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.colours.iter().map(Vec::len).sum()
+    }
+
+    /// True when there is no constraint.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Every constraint, colour by colour, overflow last.
+    pub fn constraints(&self) -> impl Iterator<Item = &ContactConstraint> {
+        self.colours.iter().flatten()
+    }
+
+    /// Drops every constraint and starts a step's colouring for
+    /// `state_count` body states.
+    pub fn begin(&mut self, state_count: usize) {
         self.graph.reset(state_count);
-        self.lists.resize_with(COLOURS + 1, Vec::new);
-        for list in &mut self.lists {
+        self.colours.resize_with(COLOURS + 1, Vec::new);
+        for list in &mut self.colours {
             list.clear();
-        }
-    }
-
-    /// Offers item `item` (the pipeline's own index) whose bodies have the
-    /// state indices `a` and `b`, `None` for a body the solve does not move
-    /// (static, kinematic or asleep).
-    pub fn colour(&mut self, item: u32, a: Option<u32>, b: Option<u32>) {
-        let slot = self.graph.assign(a, b).unwrap_or(COLOURS);
-        self.lists[slot].push(item);
-    }
-
-    /// The offered items in the order the constraints must be built:
-    /// colour by colour, then the overflow.
-    pub fn order(&self) -> impl Iterator<Item = u32> + '_ {
-        self.lists.iter().flatten().copied()
-    }
-
-    /// Packs the prepared constraints, built in [`ContactSolver::order`],
-    /// into chunks. Constraints built otherwise (their count differs from
-    /// the items offered) are all solved scalar.
-    fn pack(&mut self, constraints: &[ContactConstraint]) {
-        self.counts.clear();
-        self.counts.extend(self.lists.iter().map(Vec::len));
-        let offered: usize = self.counts.iter().sum();
-        if offered != constraints.len() || self.counts.is_empty() {
-            self.counts.clear();
-            self.counts.push(constraints.len());
         }
         self.chunks.clear();
         self.colour_start.clear();
+    }
+
+    /// The colour of a constraint whose bodies have the state indices `a`
+    /// and `b` (`None` for a body the solve does not move: static,
+    /// kinematic or asleep), marking both bodies in it; [`OVERFLOW`] when
+    /// none is free.
+    pub fn assign(&mut self, a: Option<u32>, b: Option<u32>) -> u8 {
+        self.graph.assign(a, b).map_or(OVERFLOW, |c| c as u8)
+    }
+
+    /// Appends a constraint to the colour [`ContactSolver::assign`] gave it.
+    pub fn push(&mut self, colour: u8, constraint: ContactConstraint) {
+        let slot = (colour as usize).min(COLOURS);
+        if self.colours.len() <= slot {
+            self.colours.resize_with(COLOURS + 1, Vec::new);
+        }
+        self.colours[slot].push(constraint);
+    }
+
+    /// Packs each colour's prepared constraints into chunks.
+    fn pack(&mut self) {
+        self.chunks.clear();
+        self.colour_start.clear();
         self.colour_start.push(0);
-        let mut first = 0;
-        let (colours, _) = self.counts.split_at(self.counts.len() - 1);
-        for &count in colours {
-            if count == 0 {
-                continue;
-            }
-            let range = first..first + count;
-            for start in range.clone().step_by(LANES) {
-                let end = (start + LANES).min(range.end);
+        let colours = self.colours.len().min(COLOURS);
+        for list in &self.colours[..colours] {
+            for start in (0..list.len()).step_by(LANES) {
+                let end = (start + LANES).min(list.len());
                 self.chunks.push(WideContact::empty());
                 let chunk = self.chunks.last_mut().expect("just pushed");
-                chunk.fill(constraints, start, end);
+                chunk.fill(list, start, end);
             }
             self.colour_start.push(self.chunks.len());
-            first += count;
         }
-        self.overflow_start = first;
         self.unpacked = false;
-        // A colouring serves one build: the next pack needs a new one.
-        for list in &mut self.lists {
-            list.clear();
-        }
     }
 
     /// Writes the lanes' impulses back to their constraints (once per step).
-    fn unpack(&mut self, constraints: &mut [ContactConstraint]) {
+    fn unpack(&mut self) {
         if self.unpacked {
             return;
         }
-        for chunk in &self.chunks {
-            chunk.unpack(constraints);
+        for colour in 0..self.colour_start.len().saturating_sub(1) {
+            let list = &mut self.colours[colour];
+            let chunks = &self.chunks[self.colour_start[colour]..self.colour_start[colour + 1]];
+            for (chunk, part) in chunks.iter().zip(list.chunks_mut(LANES)) {
+                chunk.unpack(part);
+            }
         }
         self.unpacked = true;
     }
 
-    fn warm_start(&mut self, constraints: &mut [ContactConstraint], states: &mut [BodyState]) {
+    fn overflow_mut(&mut self) -> &mut [ContactConstraint] {
+        self.colours
+            .get_mut(COLOURS)
+            .map_or(&mut [], Vec::as_mut_slice)
+    }
+
+    fn warm_start(&mut self, states: &mut [BodyState]) {
         for chunk in &mut self.chunks {
             chunk.warm_start(states);
         }
-        for c in &constraints[self.overflow_start..] {
+        for c in self.overflow_mut() {
             c.apply_warm_start(states);
         }
     }
@@ -256,13 +269,12 @@ impl ContactSolver {
     fn solve(
         &mut self,
         ctx: &StepContext,
-        constraints: &mut [ContactConstraint],
         states: &mut [BodyState],
         use_bias: bool,
         reverse: bool,
     ) {
         let (inv_h, push_max) = (ctx.inv_h, ctx.contact_push_max_velocity);
-        let colours = self.colour_count();
+        let colours = self.colour_start.len().saturating_sub(1);
         for k in 0..colours {
             let colour = if reverse { colours - 1 - k } else { k };
             let range = self.colour_start[colour]..self.colour_start[colour + 1];
@@ -274,7 +286,7 @@ impl ContactSolver {
                 }
             }
         }
-        for c in &mut constraints[self.overflow_start..] {
+        for c in self.overflow_mut() {
             if use_bias {
                 c.solve_rows::<true>(states, inv_h, push_max);
             } else {
@@ -344,7 +356,7 @@ impl WideContact {
         WideContact {
             state_a: [0; LANES],
             state_b: [0; LANES],
-            source: [u32::MAX; LANES],
+            len: 0,
             inv_mass_a: z,
             inv_mass_b: z,
             inv_inertia_a: z,
@@ -366,10 +378,10 @@ impl WideContact {
 
     /// Loads constraints `start..end` (at most [`LANES`]) into the lanes.
     fn fill(&mut self, constraints: &[ContactConstraint], start: usize, end: usize) {
+        self.len = end - start;
         for (k, c) in constraints[start..end].iter().enumerate() {
             self.state_a[k] = c.state_a;
             self.state_b[k] = c.state_b;
-            self.source[k] = (start + k) as u32;
             let [m_a, i_a, m_b, i_b] = c.applied_masses;
             self.inv_mass_a.as_array_mut()[k] = m_a;
             self.inv_inertia_a.as_array_mut()[k] = i_a;
@@ -394,13 +406,12 @@ impl WideContact {
         }
     }
 
+    /// Writes the lanes' impulses back to the constraints this chunk was
+    /// filled from (`constraints`, in lane order).
     fn unpack(&self, constraints: &mut [ContactConstraint]) {
         let impulse = self.impulse.map(W::to_array);
         let max_normal = self.max_normal_impulse.map(W::to_array);
-        for k in 0..LANES {
-            let Some(c) = constraints.get_mut(self.source[k] as usize) else {
-                continue;
-            };
+        for (k, c) in constraints.iter_mut().take(self.len).enumerate() {
             for row in 0..ROWS {
                 c.impulse[row] = impulse[row][k];
             }
@@ -570,12 +581,10 @@ fn dot_rows(x: &[W; ROWS], y: &[W; ROWS]) -> W {
     (x[0] * y[0] + x[1] * y[1]) + (x[2] * y[2] + x[3] * y[3])
 }
 
-/// The contact constraints of a step and their colour-and-lane form, as
-/// one batch for the solver.
+/// The contact constraints of a step, in their colours, as one batch for
+/// the solver.
 pub struct ContactBatch<'a> {
-    /// The step's contact constraints (built by the collision pipeline).
-    pub constraints: &'a mut Vec<ContactConstraint>,
-    /// Their coloured, packed form.
+    /// The constraints and their packed form.
     pub solver: &'a mut ContactSolver,
     /// The contact-modification hook's data: bodies whose contacts build
     /// their effective masses on a whole object's mass (portal copies).
@@ -584,30 +593,30 @@ pub struct ContactBatch<'a> {
 
 impl ConstraintBatch for ContactBatch<'_> {
     fn count(&self) -> usize {
-        self.constraints.len()
+        self.solver.len()
     }
 
     fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
-        for c in self.constraints.iter_mut() {
+        let objects = self.object_masses;
+        for c in self.solver.colours.iter_mut().flatten() {
             c.prepare(ctx, bodies);
-        }
-        if !self.object_masses.is_empty() {
-            for c in self.constraints.iter_mut() {
-                let find = |body| self.object_masses.iter().find(|o| o.body == body);
-                let (oa, ob) = (find(c.body_a), find(c.body_b));
-                if oa.is_some() || ob.is_some() {
-                    let [m_a, i_a, m_b, i_b] = c.applied_masses;
-                    let (m_a, i_a) = oa.map_or((m_a, i_a), |o| (o.inv_mass, o.inv_inertia));
-                    let (m_b, i_b) = ob.map_or((m_b, i_b), |o| (o.inv_mass, o.inv_inertia));
-                    c.prepare_rows(ctx, bodies, [m_a, i_a, m_b, i_b]);
-                }
+            if objects.is_empty() {
+                continue;
+            }
+            let find = |body| objects.iter().find(|o| o.body == body);
+            let (oa, ob) = (find(c.body_a), find(c.body_b));
+            if oa.is_some() || ob.is_some() {
+                let [m_a, i_a, m_b, i_b] = c.applied_masses;
+                let (m_a, i_a) = oa.map_or((m_a, i_a), |o| (o.inv_mass, o.inv_inertia));
+                let (m_b, i_b) = ob.map_or((m_b, i_b), |o| (o.inv_mass, o.inv_inertia));
+                c.prepare_rows(ctx, bodies, [m_a, i_a, m_b, i_b]);
             }
         }
-        self.solver.pack(self.constraints);
+        self.solver.pack();
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        self.solver.warm_start(self.constraints, states);
+        self.solver.warm_start(states);
     }
 
     fn solve(
@@ -617,18 +626,17 @@ impl ConstraintBatch for ContactBatch<'_> {
         use_bias: bool,
         reverse: bool,
     ) {
-        self.solver
-            .solve(ctx, self.constraints, states, use_bias, reverse);
+        self.solver.solve(ctx, states, use_bias, reverse);
     }
 
     fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
-        self.solver.unpack(self.constraints);
-        for c in self.constraints.iter_mut() {
+        self.solver.unpack();
+        for c in self.solver.colours.iter_mut().flatten() {
             c.apply_restitution(ctx, states);
         }
     }
 
     fn store_impulses(&mut self) {
-        self.solver.unpack(self.constraints);
+        self.solver.unpack();
     }
 }

@@ -205,7 +205,10 @@ impl Collision {
     }
 
     /// Copies solved impulses back into the contacts (for warm starting).
-    pub(crate) fn store_impulses(&mut self, constraints: &[ContactConstraint]) {
+    pub(crate) fn store_impulses<'a>(
+        &mut self,
+        constraints: impl Iterator<Item = &'a ContactConstraint>,
+    ) {
         for cc in constraints {
             let c = self.contacts.awake_mut(cc.contact_index as usize);
             for i in 0..cc.point_count() {

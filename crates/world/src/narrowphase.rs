@@ -49,6 +49,10 @@ enum ContactUpdate {
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Narrowphase {
     results: Vec<ContactUpdate>,
+    /// Colour of each awake contact while the constraints are built.
+    colour_of: Vec<u8>,
+    /// Solved contacts: index, moving state indices, pair with a static body.
+    solved: Vec<(u32, Option<u32>, Option<u32>, bool)>,
 }
 
 /// What the narrowphase reads besides the contacts it updates.
@@ -215,26 +219,30 @@ fn update_manifold(c: &mut Contact, m: &Manifold, offset: [Vec2; 2]) {
     }
 }
 
-/// Builds the contact constraints of touching solid awake contacts.
+/// Builds the contact constraints of touching solid awake contacts, in
+/// their colours.
 ///
-/// Contacts between two moving bodies come first and contacts with a
-/// static body last, so each Gauss–Seidel sweep ends on the ground: the
-/// support a stack stands on has the last word (as Box2D v3 keeps static
-/// contacts out of its first graph colour).
+/// Contacts between two moving bodies take colours first and contacts with
+/// a static body after them, so the static ones gather in the later
+/// colours and each Gauss–Seidel sweep ends near the ground: the support a
+/// stack stands on has the last word (Box2D v3 likewise keeps static
+/// contacts out of its first graph colours).
 ///
 /// Whether a body reads as static was noted by the narrowphase
 /// ([`Contact::still`]); a contact whose two bodies are still is skipped.
 /// When islands were woken after the narrowphase (`woke`), contacts that
 /// read still are checked again.
 pub(crate) fn build_constraints(
+    narrowphase: &mut Narrowphase,
     contacts: &mut ContactSet,
     bodies: &BodySet,
     woke: bool,
-    out: &mut Vec<ContactConstraint>,
     solver: &mut ContactSolver,
     counters: &mut CollisionCounters,
 ) {
-    out.clear();
+    let Narrowphase {
+        colour_of, solved, ..
+    } = narrowphase;
     if woke {
         for k in 0..contacts.awake().len() {
             let c = contacts.awake_mut(k);
@@ -252,23 +260,36 @@ pub(crate) fn build_constraints(
         let sim = bodies.sims.get(i as usize)?;
         (i != 0 && (sim.inv_mass > 0.0 || sim.inv_inertia > 0.0)).then_some(i)
     };
-    solver.begin_colouring(bodies.states.len());
+    // Pass 1: colours, moving pairs first, static pairs last. One read of
+    // the contacts lists the solved ones; the two colour passes then run
+    // over that short list.
+    const NOT_SOLVED: u8 = u8::MAX;
+    solver.begin(bodies.states.len());
+    let awake = contacts.awake();
+    colour_of.clear();
+    colour_of.resize(awake.len(), NOT_SOLVED);
+    solved.clear();
+    for (k, c) in awake.iter().enumerate() {
+        let [sa, sb] = c.still;
+        if !c.is_solid_touching() || (sa && sb) {
+            continue;
+        }
+        solved.push((k as u32, moving(c.body_a), moving(c.body_b), sa || sb));
+    }
     for static_pass in [false, true] {
-        for (k, c) in contacts.awake().iter().enumerate() {
-            if !c.is_solid_touching() {
-                continue;
+        for &(k, a, b, is_static) in solved.iter() {
+            if is_static == static_pass {
+                colour_of[k as usize] = solver.assign(a, b);
             }
-            let [sa, sb] = c.still;
-            if (sa && sb) || (sa || sb) != static_pass {
-                continue;
-            }
-            solver.colour(k as u32, moving(c.body_a), moving(c.body_b));
         }
     }
+    // Pass 2: the constraints, appended to their colours in contact order.
     let (mut rows, mut bouncy) = (0, 0);
-    let awake = contacts.awake();
-    for k in solver.order() {
-        let c = &awake[k as usize];
+    for (k, c) in awake.iter().enumerate() {
+        let colour = colour_of[k];
+        if colour == NOT_SOLVED {
+            continue;
+        }
         rows += 2 * c.point_count;
         bouncy += usize::from(c.restitution > 0.0);
         let mut inputs = [ContactPointInput::default(); 2];
@@ -281,15 +302,16 @@ pub(crate) fn build_constraints(
                 tangent_impulse: p.tangent_impulse,
             };
         }
-        out.push(ContactConstraint::new(
+        let constraint = ContactConstraint::new(
             c.body_a,
             c.body_b,
             c.normal,
             &inputs[..c.point_count],
             c.friction,
             c.restitution,
-            k,
-        ));
+            k as u32,
+        );
+        solver.push(colour, constraint);
     }
     counters.contact_rows = rows;
     counters.restitution_contacts = bouncy;

@@ -18,9 +18,7 @@
 //! a generational handle; every call that rejects its input leaves the world
 //! unchanged.
 
-use janus2d_constraints::{
-    ContactConstraint, ContactSolver, ObjectMass, RevoluteJoint, RevoluteJointDef,
-};
+use janus2d_constraints::{ContactSolver, ObjectMass, RevoluteJoint, RevoluteJointDef};
 use janus2d_core::BodyMass;
 use janus2d_core::body::{BodyDef, BodyHandle, BodyLocation, BodySet, BodyType, validate_mass};
 use janus2d_core::constraint::{ConstraintBatch, StepContext};
@@ -78,9 +76,8 @@ pub struct World {
     bodies: BodySet,
     joints: JointSet,
     collision: Collision,
-    contact_constraints: Vec<ContactConstraint>,
-    /// The contact constraints' coloured, lane-packed form (the contact
-    /// solve's own data).
+    /// The step's contact constraints in their colours and lanes (the
+    /// contact solve's own data).
     contact_solver: ContactSolver,
     /// The contact-modification hook's data for this step (portal copies).
     object_masses: Vec<ObjectMass>,
@@ -113,7 +110,6 @@ impl World {
             gravity: def.gravity,
             settings: def.solver,
             collision: Collision::new(bodies.owner()),
-            contact_constraints: Vec::new(),
             contact_solver: ContactSolver::new(),
             object_masses: Vec::new(),
             portals: PortalStage::default(),
@@ -809,7 +805,7 @@ impl World {
 
     /// Number of touching solid contacts after the last step.
     pub fn touching_contact_count(&self) -> usize {
-        self.contact_constraints.len()
+        self.contact_solver.len()
     }
 
     /// The most negative separation of any touching contact point, m
@@ -931,10 +927,10 @@ impl World {
             self.islands
                 .read_contact_changes(&mut self.collision.contacts, &self.bodies);
             crate::narrowphase::build_constraints(
+                &mut self.collision.narrowphase,
                 &mut self.collision.contacts,
                 &self.bodies,
                 woke,
-                &mut self.contact_constraints,
                 &mut self.contact_solver,
                 &mut self.collision.counters,
             );
@@ -942,7 +938,7 @@ impl World {
                 .object_masses(&self.bodies, &mut self.object_masses);
             sp.narrowphase += lap();
         } else {
-            self.contact_constraints.clear();
+            self.contact_solver.begin(0);
         }
         // No restitution anywhere: no restitution pass.
         ctx.restitution = has_shapes && self.collision.counters.restitution_contacts > 0;
@@ -951,7 +947,6 @@ impl World {
             forest: &mut self.joints.forest,
         };
         let mut contacts = janus2d_constraints::ContactBatch {
-            constraints: &mut self.contact_constraints,
             solver: &mut self.contact_solver,
             object_masses: &self.object_masses,
         };
@@ -960,7 +955,8 @@ impl World {
         let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
         lap();
         if has_shapes {
-            self.collision.store_impulses(&self.contact_constraints);
+            self.collision
+                .store_impulses(self.contact_solver.constraints());
             self.collision.update_proxies(&self.bodies, dt);
             sp.broadphase += lap();
         }
@@ -991,7 +987,7 @@ impl World {
         self.counters = crate::profile::StepCounters::gather(&crate::profile::CounterSources {
             collision_ran: has_shapes,
             collision: self.collision.counters,
-            contacts: self.contact_constraints.len(),
+            contacts: self.contact_solver.len(),
             joint_rows: self.joints.row_count(),
             direct_joint_rows: 2 * self.joints.forest.tree_joint_count(),
             portal_stage_ran: has_portals,
