@@ -34,6 +34,13 @@ impl PortalStage {
     }
     pub(crate) fn build_clipping(&mut self, _bodies: &BodySet) {}
     pub(crate) fn modify_contacts(&self, _bodies: &BodySet, _c: &mut [ContactConstraint]) {}
+    pub(crate) fn query_apertures(
+        &self,
+        _bodies: &BodySet,
+        _owner: u32,
+    ) -> Vec<crate::query::QueryAperture> {
+        Vec::new()
+    }
 }
 
 impl World {
