@@ -3,7 +3,6 @@
 //! `cargo run --release --example picking`.
 
 use janus2d::prelude::*;
-use janus2d::world::QueryFilter;
 
 /// What the picking found (the queries test reads it too).
 pub struct Report {

@@ -4,7 +4,6 @@
 use janus2d::base::geometry::Aabb;
 use janus2d::prelude::*;
 use janus2d::world::query::QueryProblem;
-use janus2d::world::{QueryFilter, RayHit};
 
 #[path = "../examples/picking.rs"]
 #[allow(dead_code)]

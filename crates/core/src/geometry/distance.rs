@@ -111,8 +111,10 @@ impl ShapeProxy {
                 (2, c.radius)
             }
             Shape::Polygon(p) => {
-                points[..p.count].copy_from_slice(&p.vertices[..p.count]);
-                (p.count, p.radius)
+                // An unvalidated polygon's count is clamped, never trusted.
+                let n = p.count.clamp(1, MAX_POLYGON_VERTICES);
+                points[..n].copy_from_slice(&p.vertices[..n]);
+                (n, p.radius)
             }
             Shape::Segment(s) => {
                 points[0] = s.point1;

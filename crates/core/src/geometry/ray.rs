@@ -26,7 +26,7 @@
 //! assert!((hit.normal - Vec2::new(-1.0, 0.0)).length() < 1e-6);
 //! ```
 
-use super::shapes::{ChainSegment, Polygon, Shape, right_perp};
+use super::shapes::{ChainSegment, MAX_POLYGON_VERTICES, Polygon, Shape, right_perp};
 use crate::math::{EPSILON, Real, Transform, Vec2};
 
 /// A ray: the points `origin + s · translation` for `s` in `[0, max_fraction]`.
@@ -202,7 +202,7 @@ pub fn ray_rounded_segment(ray: &RayInput, p1: Vec2, p2: Vec2, r: Real) -> Optio
 
 /// Ray against a polygon (sharp, rounded, or a 2-vertex capsule core).
 pub fn ray_polygon(ray: &RayInput, p: &Polygon) -> Option<CastHit> {
-    if !usable(ray) {
+    if !usable(ray) || p.count == 0 || p.count > MAX_POLYGON_VERTICES {
         return None;
     }
     if p.count == 2 {
