@@ -1037,6 +1037,70 @@ impl World {
         Ok(crate::query::distance_between(&ctx, sa, sb))
     }
 
+    // ----- kinematic targets ---------------------------------------------------
+
+    /// Sets the velocities that bring a kinematic (or dynamic) body from its
+    /// pose to `target` (body origin and rotation) in one step of `dt`, so
+    /// that what rests on it is carried along (as Box2D's
+    /// `b2Body_SetTargetTransform`; unlike [`set_transform`](Self::set_transform),
+    /// which teleports). The centre of mass moves by `target_center − center`
+    /// exactly; the angular velocity is chosen so that the solver's substep
+    /// rotation lands on the target angle (the shorter way round). The
+    /// velocities stay until set again. Wakes the body.
+    ///
+    /// Errors: a stale handle, a non-finite target (`NonFinite("target")`),
+    /// a `dt` that is not finite and positive, a static body
+    /// ([`WorldError::NotMovable`]).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Transform, Vec2};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let platform = world.create_body(&BodyDef::kinematic(Vec2::ZERO)).unwrap();
+    /// let target = Transform::new(Vec2::new(0.1, 0.05), 0.02);
+    /// world.set_target_transform(platform, target, 1.0 / 60.0).unwrap();
+    /// world.step(1.0 / 60.0).unwrap();
+    /// let xf = world.transform(platform).unwrap();
+    /// assert!((xf.p - target.p).length() < 1e-5);
+    /// assert!((xf.q.angle() - 0.02).abs() < 1e-5);
+    /// ```
+    pub fn set_target_transform(
+        &mut self,
+        body: BodyHandle,
+        target: Transform,
+        dt: Real,
+    ) -> Result<(), WorldError> {
+        if !(vec_is_finite(target.p) && target.q.is_finite()) {
+            return Err(WorldError::NonFinite("target"));
+        }
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(WorldError::InvalidTimeStep);
+        }
+        if self.body_type(body)? == BodyType::Static {
+            return Err(WorldError::NotMovable);
+        }
+        let sim = self.bodies.sim(body).ok_or_else(|| self.body_error(body))?;
+        let q2 = target.q.normalize();
+        let center2 = q2.rotate(sim.local_center) + target.p;
+        let v = (center2 - sim.center) / dt;
+        let delta = sim.transform.q.relative_angle(q2);
+        // Each substep turns by atan(h ω) (first-order, normalised): choose ω
+        // so that the substeps add up to `delta`.
+        let ctx = self.step_context(dt);
+        let per_substep = delta / ctx.substeps.max(1) as Real;
+        let w = if per_substep.abs() < 1.0 {
+            per_substep.tan() * ctx.inv_h
+        } else {
+            delta / dt
+        };
+        self.wake_body(body);
+        if let Some(s) = self.bodies.state_mut(body) {
+            s.v = v;
+            s.w = w;
+        }
+        Ok(())
+    }
+
     // ----- sleep --------------------------------------------------------------
 
     /// Wakes the island of `body` (no effect on awake or static bodies).
