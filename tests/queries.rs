@@ -353,6 +353,212 @@ fn picking_example_grabs_the_box_under_the_cursor() {
     );
 }
 
+/// Small deterministic generator (64-bit LCG).
+struct Lcg(u64);
+
+impl Lcg {
+    fn unit(&mut self) -> Real {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        ((self.0 >> 40) as Real) / ((1u64 << 24) as Real)
+    }
+    fn range(&mut self, lo: Real, hi: Real) -> Real {
+        lo + (hi - lo) * self.unit()
+    }
+}
+
+/// A jumble of circles, boxes, capsules and rounded boxes, turned, some
+/// dynamic, some static; returns (world, every shape with its body).
+fn jumble(seed: u64) -> (World, Vec<(ShapeHandle, BodyHandle)>) {
+    let mut w = World::new(WorldDef {
+        gravity: Vec2::ZERO,
+        ..WorldDef::default()
+    })
+    .unwrap();
+    let mut rng = Lcg(seed);
+    let mut out = Vec::new();
+    for i in 0..60 {
+        let p = v(rng.range(-20.0, 20.0), rng.range(-20.0, 20.0));
+        let angle = rng.range(-3.0, 3.0);
+        let def = if i % 3 == 0 {
+            BodyDef::fixed(p)
+        } else {
+            BodyDef::dynamic(p)
+        };
+        let b = w.create_body(&def).unwrap();
+        w.set_transform(b, p, angle).unwrap();
+        let geometry: Shape = match i % 4 {
+            0 => Circle::new(v(0.2, 0.0), rng.range(0.2, 1.0))
+                .unwrap()
+                .into(),
+            1 => Polygon::make_box(rng.range(0.2, 1.5), rng.range(0.2, 1.5)).into(),
+            2 => Capsule::new(v(-0.5, 0.0), v(0.5, 0.3), rng.range(0.1, 0.5))
+                .unwrap()
+                .into(),
+            _ => Polygon::make_rounded_box(rng.range(0.2, 1.0), rng.range(0.2, 1.0), 0.2).into(),
+        };
+        let s = w.create_shape(b, &ShapeDef::default(), geometry).unwrap();
+        out.push((s, b));
+    }
+    (w, out)
+}
+
+#[test]
+fn ray_casts_match_brute_force_over_every_shape() {
+    let (w, shapes) = jumble(7);
+    let mut rng = Lcg(8);
+    let f = QueryFilter::default();
+    for _ in 0..200 {
+        let origin = v(rng.range(-25.0, 25.0), rng.range(-25.0, 25.0));
+        let d = v(rng.range(-30.0, 30.0), rng.range(-30.0, 30.0));
+        let ray = janus2d::base::geometry::RayInput::new(origin, d);
+        let mut brute: Vec<(Real, ShapeHandle)> = shapes
+            .iter()
+            .filter_map(|&(s, b)| {
+                let xf = w.transform(b).unwrap();
+                let g = &w.shape(s).unwrap().geometry;
+                g.ray_cast(&xf, &ray).map(|h| (h.fraction, s))
+            })
+            .collect();
+        brute.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let hits = all_hits(&w, origin, d, &f);
+        assert_eq!(hits.len(), brute.len());
+        for (h, (fr, s)) in hits.iter().zip(&brute) {
+            assert!((h.fraction - fr).abs() < 1e-6);
+            assert!(hits.iter().any(|x| x.shape == *s));
+        }
+        let closest = w.cast_ray_closest(origin, d, &f).unwrap();
+        assert_eq!(closest.map(|h| h.fraction), brute.first().map(|b| b.0));
+    }
+}
+
+#[test]
+fn overlaps_match_brute_force_over_every_shape() {
+    use janus2d::base::geometry::{ShapeProxy, shapes_overlap};
+    let (w, shapes) = jumble(9);
+    let mut rng = Lcg(10);
+    let f = QueryFilter::default();
+    let mut nonempty = 0;
+    for _ in 0..200 {
+        let c = v(rng.range(-22.0, 22.0), rng.range(-22.0, 22.0));
+        let half = v(rng.range(0.1, 2.0), rng.range(0.1, 2.0));
+        let aabb = Aabb::new(c - half, c + half);
+        let boxed = ShapeProxy::from_box(aabb.lower, aabb.upper);
+        let point = ShapeProxy::point(c);
+        let mut want_box = Vec::new();
+        let mut want_point = Vec::new();
+        for &(s, b) in &shapes {
+            let xf = w.transform(b).unwrap();
+            let p = ShapeProxy::from_shape(&w.shape(s).unwrap().geometry);
+            if shapes_overlap(&p, &xf, &boxed, &Transform::IDENTITY) {
+                want_box.push(s);
+            }
+            if shapes_overlap(&p, &xf, &point, &Transform::IDENTITY) {
+                want_point.push(s);
+            }
+        }
+        want_box.sort();
+        want_point.sort();
+        let mut got_box = Vec::new();
+        w.overlap_aabb(&aabb, &f, |o| {
+            got_box.push(o.shape);
+            true
+        })
+        .unwrap();
+        let mut got_point = Vec::new();
+        w.overlap_point(c, &f, |o| {
+            got_point.push(o.shape);
+            true
+        })
+        .unwrap();
+        assert_eq!(got_box, want_box);
+        assert_eq!(got_point, want_point);
+        nonempty += usize::from(!want_box.is_empty());
+    }
+    assert!(nonempty > 20, "the boxes met shapes only {nonempty} times");
+}
+
+#[test]
+fn shape_cast_fraction_is_the_first_touch() {
+    let (w, _) = jumble(11);
+    let mut rng = Lcg(12);
+    let f = QueryFilter::default();
+    let disc = Shape::Circle(Circle::new(Vec2::ZERO, 0.3).unwrap());
+    let probe = Shape::Polygon(Polygon::make_box(0.3, 0.2));
+    let mut hits = 0;
+    for i in 0..100 {
+        let shape = if i % 2 == 0 { &disc } else { &probe };
+        let start = Transform::new(
+            v(rng.range(-25.0, 25.0), rng.range(-25.0, 25.0)),
+            rng.range(-3.0, 3.0),
+        );
+        let d = v(rng.range(-30.0, 30.0), rng.range(-30.0, 30.0));
+        let touching = |t: Real| {
+            let xf = Transform {
+                p: start.p + t * d,
+                q: start.q,
+            };
+            let mut n = 0;
+            w.overlap_shape(shape, &xf, &f, |_| {
+                n += 1;
+                true
+            })
+            .unwrap();
+            n > 0
+        };
+        if touching(0.0) {
+            continue;
+        }
+        let Some(hit) = w.cast_shape_closest(shape, &start, d, &f).unwrap() else {
+            // No hit: the swept shape touches nothing along the way.
+            assert!((1..=200).all(|k| !touching(k as Real / 200.0)));
+            continue;
+        };
+        hits += 1;
+        let len = d.length();
+        // Just before the fraction: apart; a millimetre past: touching.
+        assert!(
+            !touching((hit.fraction - 2e-3 / len).max(0.0)),
+            "{i}: {hit:?}"
+        );
+        assert!(touching(hit.fraction + 1e-3 / len), "{i}: {hit:?}");
+    }
+    assert!(hits > 20, "only {hits} casts hit");
+}
+
+#[test]
+fn queries_see_sleeping_bodies() {
+    let mut w = world();
+    fixed_box(&mut w, v(0.0, -0.5), 5.0, 0.5, &ShapeDef::default());
+    let b = ball(&mut w, v(0.0, 0.5), 0.5);
+    for _ in 0..200 {
+        w.step(1.0 / 60.0).unwrap();
+    }
+    assert!(w.is_sleeping(b));
+    let hit = w
+        .cast_ray_closest(v(-3.0, 0.5), v(6.0, 0.0), &QueryFilter::default())
+        .unwrap()
+        .unwrap();
+    assert_eq!(hit.body, b);
+    assert!((hit.point.x + 0.5).abs() < 0.01);
+    assert!(w.is_sleeping(b), "a query does not wake anything");
+}
+
+#[test]
+fn ray_starting_inside_a_shape_skips_it() {
+    let mut w = world();
+    let row = box_row(&mut w);
+    // From the centre of the first box: it is not hit, the second is.
+    let hit = w
+        .cast_ray_closest(v(2.0, 0.0), v(10.0, 0.0), &QueryFilter::default())
+        .unwrap()
+        .unwrap();
+    assert_eq!(hit.body, row[1]);
+    assert!((hit.fraction - 0.15).abs() < 1e-6);
+}
+
 #[cfg(feature = "portals")]
 mod through_portals {
     use super::*;
@@ -421,6 +627,76 @@ mod through_portals {
             .unwrap();
         assert_eq!(lip.body, a);
         assert_eq!(lip.portal_hops, 0);
+    }
+
+    #[test]
+    fn ray_through_a_turned_exit_leaves_along_its_normal() {
+        // Entry faces −x at (5, 0); exit faces +y on a floor at (30, 0).
+        let mut w = world();
+        let a = fixed_box(&mut w, v(5.5, 0.0), 0.5, 3.0, &ShapeDef::default());
+        let floor = fixed_box(&mut w, v(30.0, -0.5), 3.0, 0.5, &ShapeDef::default());
+        w.create_portal_pair(&PortalPairDef::new(
+            PortalDef {
+                body: a,
+                anchor: v(-0.5, 0.0),
+                direction: -Vec2::X,
+                half_width: 1.0,
+            },
+            PortalDef {
+                body: floor,
+                anchor: v(0.0, 0.5),
+                direction: Vec2::Y,
+                half_width: 1.0,
+            },
+        ))
+        .unwrap();
+        // Q = R(π/2): the offset +0.5 along y at the entry maps to −0.5 along x.
+        let ceiling = fixed_box(&mut w, v(29.5, 4.5), 1.0, 0.5, &ShapeDef::default());
+        let through = QueryFilter::default().through_portals();
+        let hit = w
+            .cast_ray_closest(v(0.0, 0.5), v(10.0, 0.0), &through)
+            .unwrap()
+            .unwrap();
+        assert_eq!(hit.body, ceiling);
+        // Crossed at fraction 0.5 at (30 − 0.5, 0); the ceiling's face y = 4 is 4 m on.
+        assert!((hit.point - v(29.5, 4.0)).length() < 1e-4, "{hit:?}");
+        assert!((hit.fraction - 0.9).abs() < 1e-5);
+        assert!((hit.normal - v(0.0, -1.0)).length() < 1e-5);
+    }
+
+    #[test]
+    fn facing_portals_end_after_the_hop_limit() {
+        use janus2d::world::query::MAX_PORTAL_HOPS;
+        // Entry faces −x at x = 5, exit faces +x at x = −5: a ray along +x
+        // comes back to the entry after every pass.
+        let mut w = world();
+        let a = fixed_box(&mut w, v(5.5, 0.0), 0.5, 3.0, &ShapeDef::default());
+        let b = fixed_box(&mut w, v(-5.5, 0.0), 0.5, 3.0, &ShapeDef::default());
+        w.create_portal_pair(&PortalPairDef::new(
+            PortalDef {
+                body: a,
+                anchor: v(-0.5, 0.0),
+                direction: -Vec2::X,
+                half_width: 1.0,
+            },
+            PortalDef {
+                body: b,
+                anchor: v(0.5, 0.0),
+                direction: Vec2::X,
+                half_width: 1.0,
+            },
+        ))
+        .unwrap();
+        let through = QueryFilter::default().through_portals();
+        let hit = w
+            .cast_ray_closest(v(0.0, 0.0), v(100.0, 0.0), &through)
+            .unwrap()
+            .unwrap();
+        assert_eq!(hit.portal_hops, MAX_PORTAL_HOPS);
+        assert_eq!(hit.body, a, "after the last hop the aperture is a wall");
+        // 5 m to the entry, then 10 m per pass.
+        let expect = (5.0 + 10.0 * MAX_PORTAL_HOPS as Real) / 100.0;
+        assert!((hit.fraction - expect).abs() < 1e-5, "{hit:?}");
     }
 
     #[test]

@@ -36,7 +36,8 @@
 //! is not hit inside the aperture (the hole of the portal clipping). Each hit
 //! reports how many apertures it went through ([`RayHit::portal_hops`]) and
 //! the last one ([`RayHit::last_portal`]); fractions stay those of the
-//! original translation. At most [`MAX_PORTAL_HOPS`] apertures are crossed.
+//! original translation. At most [`MAX_PORTAL_HOPS`] apertures are crossed;
+//! after that the apertures are walls again (two facing portals end).
 
 use janus2d_constraints::portal_map::PortalMap;
 use janus2d_core::body::{BodyHandle, BodySet};
@@ -359,7 +360,9 @@ impl QueryContext<'_> {
         let mut hits: Vec<(Real, u32, CastHit)> = Vec::new();
         loop {
             let max_u = leg.local(max_fraction);
-            let portal = if filter.through_portals && leg.hops < MAX_PORTAL_HOPS {
+            // After the last allowed hop the apertures are walls again.
+            let may_cross = filter.through_portals && leg.hops < MAX_PORTAL_HOPS;
+            let portal = if may_cross {
                 self.first_aperture(&leg, max_u)
             } else {
                 None
@@ -367,7 +370,7 @@ impl QueryContext<'_> {
             let limit = portal.map_or(max_u, |(u, _)| u);
             hits.clear();
             gather(&leg, limit, &mut hits);
-            if filter.through_portals {
+            if may_cross {
                 hits.retain(|(_, slot, h)| !self.in_hole(self.shapes.at(*slot).body, h.point));
             }
             hits.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
@@ -602,4 +605,136 @@ pub(crate) fn distance_between(ctx: &QueryContext<'_>, a: u32, b: u32) -> Distan
         &ShapeProxy::from_shape(&db.geometry),
         &ctx.transform_of(db.body),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use janus2d_constraints::portal_map::PortalFrame;
+
+    fn v(x: Real, y: Real) -> Vec2 {
+        Vec2::new(x, y)
+    }
+
+    fn aperture(point: Vec2, normal: Vec2, half_width: Real) -> QueryAperture {
+        QueryAperture {
+            pair: Handle::new(0, 1, 0),
+            side: 0,
+            body: BodyHandle::new(0, 1, 0),
+            half_width,
+            map: PortalMap {
+                frame1: PortalFrame::from_point_normal(point, normal),
+                frame2: PortalFrame::from_point_normal(v(10.0, 0.0), Vec2::Y),
+                eta: 2.0,
+            },
+        }
+    }
+
+    #[test]
+    fn aperture_hole_spans_the_width_and_twice_it_in_depth() {
+        // Aperture at the origin facing −x, half-width 1: the wall is at x > 0.
+        let a = aperture(Vec2::ZERO, -Vec2::X, 1.0);
+        assert!(a.holds(v(0.0, 0.9)));
+        assert!(!a.holds(v(0.0, 1.1)), "the lips are not the hole");
+        assert!(a.holds(v(1.9, 0.0)), "2w deep behind the surface");
+        assert!(!a.holds(v(2.1, 0.0)));
+        assert!(
+            !a.holds(v(-0.1, 0.0)),
+            "in front of the surface is not the hole"
+        );
+    }
+
+    #[test]
+    fn leg_fractions_map_back_to_the_original_translation() {
+        let leg = Leg {
+            origin: Vec2::ZERO,
+            translation: Vec2::X,
+            start: 0.5,
+            rot: Rot::IDENTITY,
+            scale: 1.0,
+            hops: 1,
+            last: None,
+        };
+        assert_eq!(leg.global(0.0), 0.5);
+        assert_eq!(leg.global(1.0), 1.0);
+        assert!((leg.global(0.4) - 0.7).abs() < 1e-6);
+        assert!((leg.local(0.7) - 0.4).abs() < 1e-6);
+        assert_eq!(leg.local(0.2), 0.0, "before the leg clamps to its start");
+    }
+
+    #[test]
+    fn next_leg_maps_point_direction_length_turn_and_scale() {
+        // Entry facing −x at the origin; exit facing +y at (10, 0), η = 2.
+        let (shapes, broadphase, bodies) =
+            (ShapeStore::default(), BroadPhase::new(), BodySet::new());
+        let ctx = QueryContext {
+            shapes: &shapes,
+            broadphase: &broadphase,
+            bodies: &bodies,
+            owner: bodies.owner(),
+            apertures: vec![aperture(Vec2::ZERO, -Vec2::X, 1.0)],
+        };
+        let leg = Leg {
+            origin: v(-4.0, 0.5),
+            translation: v(8.0, 0.0),
+            start: 0.0,
+            rot: Rot::IDENTITY,
+            scale: 1.0,
+            hops: 0,
+            last: None,
+        };
+        let (u, k) = ctx.first_aperture(&leg, 1.0).unwrap();
+        assert!((u - 0.5).abs() < 1e-6);
+        // Too short to reach it, or outside its span: no crossing.
+        assert!(ctx.first_aperture(&leg, 0.49).is_none());
+        let high = Leg {
+            origin: v(-4.0, 1.5),
+            ..leg
+        };
+        assert!(ctx.first_aperture(&high, 1.0).is_none());
+        let next = ctx.next_leg(&leg, u, k);
+        // Q takes the entry normal (−x) to minus the exit normal (−y): a
+        // quarter turn anticlockwise; the offset +0.5 y maps to 2 · (−0.5, 0).
+        assert!((next.origin - v(9.0, 0.0)).length() < 1e-5, "{next:?}");
+        // The 4 m left become 8 m along +y (out of the exit).
+        assert!((next.translation - v(0.0, 8.0)).length() < 1e-5);
+        assert!((next.start - 0.5).abs() < 1e-6);
+        assert!((next.rot.angle() - janus2d_core::math::PI / 2.0).abs() < 1e-5);
+        assert_eq!((next.scale, next.hops), (2.0, 1));
+        let hop = next.last.unwrap();
+        assert!((hop.entry_point - v(0.0, 0.5)).length() < 1e-6);
+        // Leaving the exit along +n: the exit aperture is not crossed again.
+        let mut back = ctx;
+        back.apertures = vec![aperture(v(9.0, 0.0), Vec2::Y, 2.0)];
+        assert!(back.first_aperture(&next, 1.0).is_none());
+    }
+
+    #[test]
+    fn filter_accepts_by_category_mask_body_and_sensor() {
+        use crate::shapes::{Filter, ShapeDef};
+        let body = BodyHandle::new(3, 1, 0);
+        let data = |category_bits: u64, is_sensor: bool| ShapeData {
+            body,
+            geometry: Shape::Circle(janus2d_core::geometry::Circle {
+                center: Vec2::ZERO,
+                radius: 1.0,
+            }),
+            def: ShapeDef {
+                filter: Filter {
+                    category_bits,
+                    ..Filter::default()
+                },
+                is_sensor,
+                ..ShapeDef::default()
+            },
+            proxy: 0,
+            aabb: Aabb::default(),
+        };
+        let f = QueryFilter::default();
+        assert!(f.accepts(&data(1, false)));
+        assert!(!f.accepts(&data(1, true)), "sensors are not seen");
+        assert!(!f.with_mask(0b10).accepts(&data(1, false)));
+        assert!(f.with_mask(0b10).accepts(&data(0b10, false)));
+        assert!(!f.excluding(body).accepts(&data(1, false)));
+    }
 }
