@@ -639,6 +639,132 @@ mod tests {
     }
 
     #[test]
+    fn gjk_matches_brute_force_on_random_polygons() {
+        use crate::geometry::ray::point_segment_distance_sq;
+        let mut seed: u64 = 5;
+        let mut unit = move || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((seed >> 40) as Real) / ((1u64 << 24) as Real)
+        };
+        let mut separated = 0;
+        for _ in 0..500 {
+            let poly = |unit: &mut dyn FnMut() -> Real| {
+                let pts: Vec<Vec2> = (0..6)
+                    .map(|_| v(2.0 * unit() - 1.0, 2.0 * unit() - 1.0))
+                    .collect();
+                Polygon::from_hull(&pts, 0.0).ok()
+            };
+            let (Some(pa), Some(pb)) = (poly(&mut unit), poly(&mut unit)) else {
+                continue;
+            };
+            let xa = at(3.0 * unit(), 3.0 * unit(), 6.0 * unit());
+            let xb = at(3.0 * unit(), 3.0 * unit(), 6.0 * unit());
+            let wa: Vec<Vec2> = pa.vertices[..pa.count]
+                .iter()
+                .map(|p| xa.apply(*p))
+                .collect();
+            let wb: Vec<Vec2> = pb.vertices[..pb.count]
+                .iter()
+                .map(|p| xb.apply(*p))
+                .collect();
+            // SAT over every edge normal: separated when one axis splits them.
+            let split = |u: &[Vec2], w: &[Vec2]| {
+                (0..u.len()).any(|i| {
+                    let e = u[(i + 1) % u.len()] - u[i];
+                    let n = Vec2::new(e.y, -e.x);
+                    let lim = u.iter().map(|p| p.dot(n)).fold(Real::MIN, Real::max);
+                    w.iter().all(|p| p.dot(n) > lim)
+                })
+            };
+            let apart = split(&wa, &wb) || split(&wb, &wa);
+            let brute = |u: &[Vec2], w: &[Vec2]| {
+                u.iter()
+                    .flat_map(|p| (0..w.len()).map(move |i| (p, i)))
+                    .map(|(p, i)| point_segment_distance_sq(*p, w[i], w[(i + 1) % w.len()]))
+                    .fold(Real::MAX, Real::min)
+                    .sqrt()
+            };
+            let out = shape_distance(
+                &proxy(Shape::Polygon(pa)),
+                &xa,
+                &proxy(Shape::Polygon(pb)),
+                &xb,
+            );
+            if apart {
+                separated += 1;
+                let want = brute(&wa, &wb).min(brute(&wb, &wa));
+                assert!(
+                    (out.distance - want).abs() < 1e-4,
+                    "{} vs {want}",
+                    out.distance
+                );
+                assert!(((out.point_b - out.point_a).length() - want).abs() < 1e-4);
+            } else {
+                assert_eq!(out.distance, 0.0);
+            }
+        }
+        assert!(separated > 50, "only {separated} separated pairs");
+    }
+
+    #[test]
+    fn ray_hits_agree_with_gjk_point_distance() {
+        use crate::geometry::RayInput;
+        let mut seed: u64 = 21;
+        let mut unit = move || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((seed >> 40) as Real) / ((1u64 << 24) as Real)
+        };
+        let shapes = [
+            Shape::Circle(Circle::new(v(0.3, -0.2), 0.7).unwrap()),
+            Shape::Capsule(Capsule::new(v(-0.6, 0.0), v(0.5, 0.4), 0.3).unwrap()),
+            Shape::Polygon(Polygon::make_offset_box(0.8, 0.4, v(0.1, 0.2), 0.5)),
+            Shape::Polygon(Polygon::make_rounded_box(0.5, 0.3, 0.25)),
+        ];
+        let mut hits = 0;
+        for k in 0..2000 {
+            let shape = &shapes[k % shapes.len()];
+            let xf = at(unit() - 0.5, unit() - 0.5, 6.0 * unit());
+            let origin = v(6.0 * unit() - 3.0, 6.0 * unit() - 3.0);
+            let d = v(6.0 * unit() - 3.0, 6.0 * unit() - 3.0);
+            let p = proxy(*shape);
+            let gap = |x: Vec2| {
+                shape_distance(&p, &xf, &ShapeProxy::point(x), &Transform::IDENTITY).distance
+            };
+            let inside =
+                |x: Vec2| shapes_overlap(&p, &xf, &ShapeProxy::point(x), &Transform::IDENTITY);
+            if inside(origin) {
+                assert!(shape.ray_cast(&xf, &RayInput::new(origin, d)).is_none());
+                continue;
+            }
+            match shape.ray_cast(&xf, &RayInput::new(origin, d)) {
+                Some(h) => {
+                    hits += 1;
+                    assert!(
+                        gap(h.point) < 1e-4,
+                        "{k}: hit {h:?} is {} off",
+                        gap(h.point)
+                    );
+                    let before = origin + (h.fraction - 1e-3 / d.length()).max(0.0) * d;
+                    assert!(h.fraction == 0.0 || !inside(before), "{k}: entered earlier");
+                    assert!((h.normal.length() - 1.0).abs() < 1e-5);
+                    assert!(h.normal.dot(d) <= 0.0, "{k}: normal faces away");
+                }
+                None => {
+                    for i in 0..=100 {
+                        let x = origin + (i as Real / 100.0) * d;
+                        assert!(!inside(x), "{k}: missed a point inside");
+                    }
+                }
+            }
+        }
+        assert!(hits > 100, "only {hits} hits");
+    }
+
+    #[test]
     fn proxy_constructor_validates() {
         assert!(ShapeProxy::new(&[], 0.0).is_err());
         assert!(ShapeProxy::new(&[v(0.0, 0.0)], -1.0).is_err());
