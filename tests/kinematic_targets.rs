@@ -4,6 +4,10 @@
 
 use janus2d::prelude::*;
 
+#[path = "../examples/moving_platform.rs"]
+#[allow(dead_code)]
+mod moving_platform;
+
 const DT: Real = 1.0 / 60.0;
 const RADIUS: Real = 2.0;
 const OMEGA: Real = 1.0; // rad/s: 2 m/s, centripetal 2 m/s² (< μ g = 6)
@@ -120,4 +124,16 @@ fn target_transform_reaches_a_turned_target_and_rejects_bad_input() {
         Err(WorldError::InvalidTimeStep)
     );
     assert_eq!(w.state_hash(), before);
+}
+
+#[test]
+fn moving_platform_example_carries_its_rider() {
+    let r = moving_platform::run().unwrap();
+    assert_eq!(r.steps, 377);
+    assert!(r.max_drift < 0.01, "rider drifted {} m", r.max_drift);
+    assert!(
+        r.max_platform_error < 1e-3,
+        "platform {} m off",
+        r.max_platform_error
+    );
 }
