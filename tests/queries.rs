@@ -721,6 +721,40 @@ mod through_portals {
     }
 
     #[test]
+    fn shape_too_wide_for_the_aperture_meets_its_lips() {
+        let (w, a, _b, _target, _decoy) = portal_scene();
+        // Radius 1.5 around y = 0.5 reaches the lip end (5, 1) when its centre
+        // is √(1.5² − 0.5²) = √2 before the face.
+        let disc = Shape::Circle(Circle::new(Vec2::ZERO, 1.5).unwrap());
+        let through = QueryFilter::default().through_portals();
+        let hit = w
+            .cast_shape_closest(
+                &disc,
+                &Transform::new(v(0.0, 0.5), 0.0),
+                v(10.0, 0.0),
+                &through,
+            )
+            .unwrap()
+            .unwrap();
+        assert_eq!(hit.body, a);
+        assert_eq!(hit.portal_hops, 0);
+        let expect = (5.0 - (2.0 as Real).sqrt()) / 10.0;
+        assert!((hit.fraction - expect).abs() < 1e-4, "{hit:?}");
+        assert!((hit.point - v(5.0, 1.0)).length() < 1e-4);
+        // Without the flag the face is met first, at the aperture.
+        let plain = w
+            .cast_shape_closest(
+                &disc,
+                &Transform::new(v(0.0, 0.5), 0.0),
+                v(10.0, 0.0),
+                &QueryFilter::default(),
+            )
+            .unwrap()
+            .unwrap();
+        assert!((plain.fraction - 0.35).abs() < 1e-4, "{plain:?}");
+    }
+
+    #[test]
     fn shape_cast_through_a_portal_is_scaled_and_continues() {
         let (w, _a, _b, target, _decoy) = portal_scene();
         // A disc of radius 0.2 fits the aperture; its image has radius 0.4.

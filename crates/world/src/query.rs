@@ -33,7 +33,9 @@
 //! portal aperture from its front continues from the mapped point `T(x)` in
 //! the mapped direction, its remaining length scaled by `η` (a cast shape is
 //! also turned by `Q` and scaled by `η`). The wall that carries the aperture
-//! is not hit inside the aperture (the hole of the portal clipping). Each hit
+//! is not hit inside the aperture (the hole of the portal clipping); a cast
+//! shape too wide for the aperture meets its lips (the aperture's end
+//! points). Each hit
 //! reports how many apertures it went through ([`RayHit::portal_hops`]) and
 //! the last one ([`RayHit::last_portal`]); fractions stay those of the
 //! original translation. At most [`MAX_PORTAL_HOPS`] apertures are crossed;
@@ -333,9 +335,39 @@ impl QueryContext<'_> {
         }
     }
 
-    /// Runs the legs of a cast: `gather(leg, max_u, out)` pushes the exact
-    /// hits `(local fraction, shape slot, hit)` of one leg; they are sorted
-    /// and handed to `callback` with the clipping rules of the module docs.
+    /// Drops the hits on a portal body inside its aperture's hole.
+    fn drop_hole_hits(&self, hits: &mut Vec<(Real, u32, CastHit)>) {
+        hits.retain(|(_, slot, h)| !self.in_hole(self.shapes.at(*slot).body, h.point));
+    }
+
+    /// The accepted shape of `body` whose surface is within
+    /// [`LINEAR_SLOP`] of `point` (the nearest; ties by slot).
+    fn shape_at(&self, body: BodyHandle, point: Vec2, filter: &QueryFilter) -> Option<u32> {
+        let probe = ShapeProxy::point(point);
+        let mut best: Option<(Real, u32)> = None;
+        for &slot in self.shapes.of_body(body) {
+            let data = self.shapes.at(slot);
+            if !filter.accepts(data) {
+                continue;
+            }
+            let d = janus2d_core::geometry::shape_distance(
+                &ShapeProxy::from_shape(&data.geometry),
+                &self.transform_of(body),
+                &probe,
+                &Transform::IDENTITY,
+            )
+            .distance;
+            if d <= LINEAR_SLOP && best.is_none_or(|(b, _)| d < b) {
+                best = Some((d, slot));
+            }
+        }
+        best.map(|(_, slot)| slot)
+    }
+
+    /// Runs the legs of a cast: `gather(leg, max_u, may_cross, out)` pushes
+    /// the exact hits `(local fraction, shape slot, hit)` of one leg (without
+    /// those in an aperture's hole when `may_cross`); they are sorted and
+    /// handed to `callback` with the clipping rules of the module docs.
     fn run_cast<G, F>(
         &self,
         origin: Vec2,
@@ -344,7 +376,7 @@ impl QueryContext<'_> {
         mut gather: G,
         mut callback: F,
     ) where
-        G: FnMut(&Leg, Real, &mut Vec<(Real, u32, CastHit)>),
+        G: FnMut(&Leg, Real, bool, &mut Vec<(Real, u32, CastHit)>),
         F: FnMut(&RayHit) -> Real,
     {
         let mut leg = Leg {
@@ -369,10 +401,10 @@ impl QueryContext<'_> {
             };
             let limit = portal.map_or(max_u, |(u, _)| u);
             hits.clear();
-            gather(&leg, limit, &mut hits);
-            if may_cross {
-                hits.retain(|(_, slot, h)| !self.in_hole(self.shapes.at(*slot).body, h.point));
-            }
+            gather(&leg, limit, may_cross, &mut hits);
+            // One hit per shape (its first), then nearest first.
+            hits.sort_by(|a, b| a.1.cmp(&b.1).then(a.0.total_cmp(&b.0)));
+            hits.dedup_by_key(|h| h.1);
             hits.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             for &(u, slot, h) in &hits {
                 let fraction = leg.global(u);
@@ -418,7 +450,7 @@ pub(crate) fn cast_ray<F: FnMut(&RayHit) -> Real>(
 ) -> Result<(), WorldError> {
     check_vec(origin, "origin")?;
     check_translation(translation)?;
-    let gather = |leg: &Leg, max_u: Real, out: &mut Vec<(Real, u32, CastHit)>| {
+    let gather = |leg: &Leg, max_u: Real, may_cross: bool, out: &mut Vec<(Real, u32, CastHit)>| {
         let ray = RayInput {
             origin: leg.origin,
             translation: leg.translation,
@@ -434,6 +466,9 @@ pub(crate) fn cast_ray<F: FnMut(&RayHit) -> Real>(
                 }
                 true
             });
+        if may_cross {
+            ctx.drop_hole_hits(out);
+        }
     };
     ctx.run_cast(origin, translation, filter, gather, callback);
     Ok(())
@@ -453,7 +488,7 @@ pub(crate) fn cast_shape<F: FnMut(&RayHit) -> Real>(
         .map_err(|e| bad("shape", QueryProblem::Shape(e)))?;
     check_transform(xf)?;
     check_translation(translation)?;
-    let gather = |leg: &Leg, max_u: Real, out: &mut Vec<(Real, u32, CastHit)>| {
+    let gather = |leg: &Leg, max_u: Real, may_cross: bool, out: &mut Vec<(Real, u32, CastHit)>| {
         let caster = if leg.scale == 1.0 {
             *shape
         } else {
@@ -491,6 +526,31 @@ pub(crate) fn cast_shape<F: FnMut(&RayHit) -> Real>(
             }
             true
         });
+        if may_cross {
+            ctx.drop_hole_hits(out);
+            // The lips: a shape too wide for an aperture meets its two end
+            // points (where the hole meets the wall surface) first.
+            for a in &ctx.apertures {
+                let f = &a.map.frame1;
+                for side in [-1.0, 1.0] {
+                    let corner = f.point + side * a.half_width * f.tangent;
+                    let lip = ShapeProxy::point(corner);
+                    let hit = shape_cast(
+                        &lip,
+                        &Transform::IDENTITY,
+                        &proxy_b,
+                        &start,
+                        leg.translation,
+                        max_u,
+                    );
+                    if let Some(h) = hit
+                        && let Some(slot) = ctx.shape_at(a.body, corner, filter)
+                    {
+                        out.push((h.fraction, slot, h));
+                    }
+                }
+            }
+        }
     };
     ctx.run_cast(xf.p, translation, filter, gather, callback);
     Ok(())
