@@ -41,7 +41,8 @@ pub mod prelude {
     pub use janus2d_core::math::{Real, Rot, Transform, Vec2};
     pub use janus2d_core::solver::SolverSettings;
     pub use janus2d_world::{
-        Filter, JointHandle, ShapeDef, ShapeHandle, StepEvents, World, WorldDef, WorldError,
+        Filter, JointHandle, QueryFilter, RayHit, ShapeDef, ShapeHandle, ShapeOverlap, StepEvents,
+        World, WorldDef, WorldError,
     };
 }
 

@@ -261,6 +261,30 @@ impl BroadPhase {
         }
     }
 
+    /// Calls `callback(proxy, payload)` for every proxy (static or not) whose
+    /// fat box the segment `origin + s · translation`, `s ∈ [0,
+    /// max_fraction]`, touches, until the callback returns `false`. Movable
+    /// proxies are visited first.
+    pub fn ray_query<F: FnMut(u32, u32) -> bool>(
+        &self,
+        origin: Vec2,
+        translation: Vec2,
+        max_fraction: Real,
+        mut callback: F,
+    ) {
+        let proxies = &self.proxies;
+        let mut go_on = true;
+        for tree in [&self.dynamic_tree, &self.static_tree] {
+            if !go_on {
+                break;
+            }
+            tree.ray_query(origin, translation, max_fraction, |_, proxy| {
+                go_on = callback(proxy, proxies[proxy as usize].payload);
+                go_on
+            });
+        }
+    }
+
     /// Finds the new overlapping pairs: every pair of proxies whose fat boxes
     /// overlap and of which at least one moved (was created, re-inserted or
     /// touched) since the previous call; static–static pairs are never

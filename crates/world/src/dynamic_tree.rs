@@ -54,6 +54,7 @@
 //! | `move_proxy`                         | one `contains` test; re-insert only when it fails        |
 //! | insert / remove a leaf               | best sibling by perimeter, then refit and rotate upwards |
 //! | `query`, `query_proxies`             | O(log n + k), iterative, stops when the callback says so |
+//! | `ray_query`                          | the boxes a segment touches (slab test per node)         |
 //! | `for_each_self_pair`, `…_cross_pair` | tree against tree: each overlapping pair once            |
 //! | `shift_origin`                       | translates every box, tree shape unchanged               |
 //! | `validate`, `height`, `area_ratio`   | invariants and quality, for tests and debugging          |
@@ -338,6 +339,39 @@ impl DynamicTree {
         while let Some(index) = stack.pop() {
             let node = &self.nodes[index as usize];
             if !node.aabb.overlaps(aabb) {
+                continue;
+            }
+            if node.is_leaf() {
+                if !callback(index, node.user_data) {
+                    return;
+                }
+            } else {
+                stack.push(node.child2);
+                stack.push(node.child1);
+            }
+        }
+    }
+
+    /// Calls `callback(proxy_id, user_data)` for every proxy whose fat box
+    /// the segment `origin + s · translation`, `s ∈ [0, max_fraction]`,
+    /// touches, in depth-first order, until the callback returns `false`.
+    ///
+    /// Each node's box is tested with the slab method; a zero translation
+    /// visits the boxes that contain `origin`. Iterative, no allocation.
+    pub fn ray_query<F: FnMut(u32, u32) -> bool>(
+        &self,
+        origin: Vec2,
+        translation: Vec2,
+        max_fraction: Real,
+        mut callback: F,
+    ) {
+        if self.root == NULL_NODE {
+            return;
+        }
+        let mut stack = NodeStack::new(self.root);
+        while let Some(index) = stack.pop() {
+            let node = &self.nodes[index as usize];
+            if !segment_touches_box(origin, translation, max_fraction, &node.aabb) {
                 continue;
             }
             if node.is_leaf() {
@@ -822,6 +856,32 @@ impl DynamicTree {
 }
 
 /// Helpers shared by the tests of this module and of the broadphase.
+/// True when the segment `origin + s · d`, `s ∈ [0, max_fraction]`, touches
+/// the box (slab method; touching counts).
+fn segment_touches_box(origin: Vec2, d: Vec2, max_fraction: Real, b: &Aabb) -> bool {
+    let (mut lo, mut hi) = (0.0 as Real, max_fraction);
+    for (o, dd, l, u) in [
+        (origin.x, d.x, b.lower.x, b.upper.x),
+        (origin.y, d.y, b.lower.y, b.upper.y),
+    ] {
+        if dd == 0.0 {
+            if o < l || o > u {
+                return false;
+            }
+        } else {
+            let inv = 1.0 / dd;
+            let (t1, t2) = ((l - o) * inv, (u - o) * inv);
+            let (t1, t2) = if t1 <= t2 { (t1, t2) } else { (t2, t1) };
+            lo = lo.max(t1);
+            hi = hi.min(t2);
+            if lo > hi {
+                return false;
+            }
+        }
+    }
+    true
+}
+
 #[cfg(test)]
 pub(crate) mod test_util {
     use janus2d_core::geometry::Aabb;
@@ -938,6 +998,50 @@ mod tests {
         grid.validate();
         let h = grid.height();
         assert!(f64::from(h) <= bound(n as usize), "grid height {h}");
+    }
+
+    #[test]
+    fn ray_query_matches_brute_force_slab_test() {
+        let mut rng = Lcg(11);
+        let mut tree = DynamicTree::with_margin(0.0);
+        let boxes: Vec<Aabb> = (0..2000).map(|_| random_box(&mut rng, 60.0)).collect();
+        for (i, b) in boxes.iter().enumerate() {
+            tree.create_proxy(*b, i as u32);
+        }
+        for _ in 0..50 {
+            let origin = Vec2::new(rng.range(-5.0, 65.0), rng.range(-5.0, 65.0));
+            let d = Vec2::new(rng.range(-40.0, 40.0), rng.range(-40.0, 40.0));
+            let max_fraction = rng.range(0.2, 1.0);
+            let mut got = Vec::new();
+            tree.ray_query(origin, d, max_fraction, |_, u| {
+                got.push(u);
+                true
+            });
+            got.sort_unstable();
+            let want: Vec<u32> = (0..boxes.len() as u32)
+                .filter(|&i| segment_touches_box(origin, d, max_fraction, &boxes[i as usize]))
+                .collect();
+            assert_eq!(got, want);
+        }
+        // A horizontal ray through a row of boxes: exactly the ones it crosses.
+        let mut row = DynamicTree::with_margin(0.0);
+        for i in 0..10 {
+            row.create_proxy(boxed(i as Real * 2.0, 0.0, 0.5, 0.5), i);
+        }
+        let mut got = Vec::new();
+        row.ray_query(Vec2::new(-1.0, 0.2), Vec2::new(8.0, 0.0), 1.0, |_, u| {
+            got.push(u);
+            true
+        });
+        got.sort_unstable();
+        assert_eq!(got, vec![0, 1, 2, 3]);
+        // Stops when the callback says so.
+        let mut count = 0;
+        row.ray_query(Vec2::new(-1.0, 0.2), Vec2::new(30.0, 0.0), 1.0, |_, _| {
+            count += 1;
+            false
+        });
+        assert_eq!(count, 1);
     }
 
     #[test]

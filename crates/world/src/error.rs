@@ -35,6 +35,17 @@ pub enum WorldError {
     OutOfRange(&'static str),
     /// The operation needs a dynamic body.
     NotDynamic,
+    /// The operation needs a kinematic or dynamic body (not a static one).
+    NotMovable,
+    /// A scene query input that is non-finite or degenerate: names the
+    /// field (`origin`, `translation`, `point`, `aabb`, `transform`,
+    /// `shape`) and what is wrong with it.
+    BadQuery {
+        /// The input at fault.
+        field: &'static str,
+        /// What is wrong with it.
+        problem: crate::query::QueryProblem,
+    },
 }
 
 impl std::fmt::Display for WorldError {
@@ -53,6 +64,8 @@ impl std::fmt::Display for WorldError {
             WorldError::NonFinite(what) => write!(f, "`{what}` is not finite"),
             WorldError::OutOfRange(what) => write!(f, "`{what}` is out of range"),
             WorldError::NotDynamic => write!(f, "operation needs a dynamic body"),
+            WorldError::NotMovable => write!(f, "operation needs a kinematic or dynamic body"),
+            WorldError::BadQuery { field, problem } => write!(f, "query `{field}` {problem}"),
         }
     }
 }

@@ -17,6 +17,7 @@
 //! | [`islands`]      | sleep timers and islands; sleeping islands leave every per-step loop |
 //! | [`portal`]       | portal pairs, crossings, clones, aperture clipping        |
 //! | [`profile`]      | per-stage timings and work counters                      |
+//! | [`query`]        | scene queries: rays, shape casts, overlaps, distances    |
 //! | [`hash`]         | the state hash of determinism checks                     |
 //!
 //! See `docs/architecture.md` for the stage table.
@@ -32,6 +33,7 @@ pub mod joints;
 pub mod narrowphase;
 pub mod portal;
 pub mod profile;
+pub mod query;
 pub mod shapes;
 pub mod world;
 
@@ -43,5 +45,6 @@ pub use joints::{JointHandle, JointKind, JointSet};
 #[cfg(feature = "portals")]
 pub use portal::{MassModel, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle};
 pub use profile::{StepCounters, StepProfile};
+pub use query::{PortalHop, QueryFilter, QueryProblem, RayHit, ShapeOverlap};
 pub use shapes::{Filter, ShapeData, ShapeDef, ShapeHandle};
 pub use world::{StepEvents, World, WorldDef};

@@ -822,6 +822,290 @@ impl World {
         worst
     }
 
+    // ----- scene queries (logic in query.rs) ---------------------------------
+
+    fn query_context(&self, filter: &crate::query::QueryFilter) -> crate::query::QueryContext<'_> {
+        let owner = self.bodies.owner();
+        crate::query::QueryContext {
+            shapes: &self.collision.shapes,
+            broadphase: &self.collision.broadphase,
+            bodies: &self.bodies,
+            owner,
+            apertures: if filter.through_portals {
+                self.portals.query_apertures(&self.bodies, owner)
+            } else {
+                Vec::new()
+            },
+        }
+    }
+
+    /// Casts the ray `origin + s · translation`, `s ∈ [0, 1]`, and hands
+    /// every hit to `callback`, nearest first; the callback returns `-1` to
+    /// ignore the hit, `0` to stop, a fraction to clip the ray, `1` to go
+    /// on (see [`crate::query`]). Errors: a non-finite origin or
+    /// translation, a zero translation ([`WorldError::BadQuery`]).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef, QueryFilter};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Polygon;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// for x in [2.0, 4.0] {
+    ///     let b = world.create_body(&BodyDef::fixed(Vec2::new(x, 0.0))).unwrap();
+    ///     world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    /// }
+    /// let mut fractions = Vec::new();
+    /// world.cast_ray_with(Vec2::ZERO, Vec2::new(10.0, 0.0), &QueryFilter::default(), |hit| {
+    ///     fractions.push(hit.fraction);
+    ///     1.0 // go on: every hit
+    /// }).unwrap();
+    /// assert_eq!(fractions.len(), 2);
+    /// assert!((fractions[0] - 0.15).abs() < 1e-6 && (fractions[1] - 0.35).abs() < 1e-6);
+    /// ```
+    pub fn cast_ray_with<F: FnMut(&crate::query::RayHit) -> Real>(
+        &self,
+        origin: Vec2,
+        translation: Vec2,
+        filter: &crate::query::QueryFilter,
+        callback: F,
+    ) -> Result<(), WorldError> {
+        let ctx = self.query_context(filter);
+        crate::query::cast_ray(&ctx, origin, translation, filter, callback)
+    }
+
+    /// The nearest hit of the ray `origin + s · translation`, `s ∈ [0, 1]`,
+    /// or `None`. Errors as [`cast_ray_with`](Self::cast_ray_with).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef, QueryFilter};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Circle;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::fixed(Vec2::new(0.0, 5.0))).unwrap();
+    /// world.create_shape(b, &ShapeDef::default(), Circle::new(Vec2::ZERO, 1.0).unwrap()).unwrap();
+    /// let hit = world
+    ///     .cast_ray_closest(Vec2::ZERO, Vec2::new(0.0, 10.0), &QueryFilter::default())
+    ///     .unwrap()
+    ///     .unwrap();
+    /// assert_eq!(hit.body, b);
+    /// assert!((hit.point - Vec2::new(0.0, 4.0)).length() < 1e-5);
+    /// assert!((hit.normal - Vec2::new(0.0, -1.0)).length() < 1e-5);
+    /// ```
+    pub fn cast_ray_closest(
+        &self,
+        origin: Vec2,
+        translation: Vec2,
+        filter: &crate::query::QueryFilter,
+    ) -> Result<Option<crate::query::RayHit>, WorldError> {
+        let mut best = None;
+        self.cast_ray_with(origin, translation, filter, |hit| {
+            best = Some(*hit);
+            hit.fraction
+        })?;
+        Ok(best)
+    }
+
+    /// Sweeps `shape`, placed by `transform`, along `translation` and hands
+    /// every shape it meets to `callback` (nearest first, same return rule
+    /// as [`cast_ray_with`](Self::cast_ray_with)). A hit's point and normal
+    /// are on the surface of the shape hit; shapes the swept shape already
+    /// overlaps at the start are hits at fraction 0. Errors: an invalid
+    /// shape, a non-finite transform or translation, a zero translation.
+    pub fn cast_shape_with<F: FnMut(&crate::query::RayHit) -> Real>(
+        &self,
+        shape: &Shape,
+        transform: &Transform,
+        translation: Vec2,
+        filter: &crate::query::QueryFilter,
+        callback: F,
+    ) -> Result<(), WorldError> {
+        let ctx = self.query_context(filter);
+        crate::query::cast_shape(&ctx, shape, transform, translation, filter, callback)
+    }
+
+    /// The first shape that `shape`, placed by `transform` and swept along
+    /// `translation`, meets, or `None`. Errors as
+    /// [`cast_shape_with`](Self::cast_shape_with).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef, QueryFilter};
+    /// use janus2d_core::{BodyDef, Transform, Vec2};
+    /// use janus2d_core::geometry::{Circle, Polygon, Shape};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let wall = world.create_body(&BodyDef::fixed(Vec2::new(6.0, 0.0))).unwrap();
+    /// world.create_shape(wall, &ShapeDef::default(), Polygon::make_box(1.0, 1.0)).unwrap();
+    /// let ball = Shape::Circle(Circle::new(Vec2::ZERO, 0.5).unwrap());
+    /// let hit = world
+    ///     .cast_shape_closest(&ball, &Transform::IDENTITY, Vec2::new(10.0, 0.0), &QueryFilter::default())
+    ///     .unwrap()
+    ///     .unwrap();
+    /// // The ball's centre stops at x = 4.5, touching the face at x = 5.
+    /// assert!((hit.fraction - 0.45).abs() < 1e-3);
+    /// assert!((hit.normal - Vec2::new(-1.0, 0.0)).length() < 1e-3);
+    /// ```
+    pub fn cast_shape_closest(
+        &self,
+        shape: &Shape,
+        transform: &Transform,
+        translation: Vec2,
+        filter: &crate::query::QueryFilter,
+    ) -> Result<Option<crate::query::RayHit>, WorldError> {
+        let mut best = None;
+        self.cast_shape_with(shape, transform, translation, filter, |hit| {
+            best = Some(*hit);
+            hit.fraction
+        })?;
+        Ok(best)
+    }
+
+    /// Hands `callback` every shape whose surface meets `aabb` (exact: a
+    /// fat box that meets it is not enough), in shape slot order, until it
+    /// returns `false`. Errors: a non-finite or inverted box.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef, QueryFilter};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::{Aabb, Circle};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    /// world.create_shape(b, &ShapeDef::default(), Circle::new(Vec2::ZERO, 0.5).unwrap()).unwrap();
+    /// let near = Aabb::new(Vec2::new(0.51, -0.1), Vec2::new(1.0, 0.1)); // 1 cm off the ball
+    /// let mut found = 0;
+    /// world.overlap_aabb(&near, &QueryFilter::default(), |_| { found += 1; true }).unwrap();
+    /// assert_eq!(found, 0);
+    /// ```
+    pub fn overlap_aabb<F: FnMut(crate::query::ShapeOverlap) -> bool>(
+        &self,
+        aabb: &janus2d_core::geometry::Aabb,
+        filter: &crate::query::QueryFilter,
+        callback: F,
+    ) -> Result<(), WorldError> {
+        let ctx = self.query_context(filter);
+        crate::query::overlap_aabb(&ctx, aabb, filter, callback)
+    }
+
+    /// Hands `callback` every shape that touches or overlaps `shape` placed
+    /// by `transform`, in shape slot order, until it returns `false`.
+    /// Errors: an invalid shape or a non-finite transform.
+    pub fn overlap_shape<F: FnMut(crate::query::ShapeOverlap) -> bool>(
+        &self,
+        shape: &Shape,
+        transform: &Transform,
+        filter: &crate::query::QueryFilter,
+        callback: F,
+    ) -> Result<(), WorldError> {
+        let ctx = self.query_context(filter);
+        crate::query::overlap_shape(&ctx, shape, transform, filter, callback)
+    }
+
+    /// Hands `callback` every solid shape that contains `point` (segments
+    /// and chain segments never do), in shape slot order, until it returns
+    /// `false`: what is under the mouse. Errors: a non-finite point.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef, QueryFilter};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Polygon;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::new(1.0, 1.0))).unwrap();
+    /// world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    /// let mut picked = None;
+    /// world.overlap_point(Vec2::new(1.2, 0.7), &QueryFilter::default(), |o| {
+    ///     picked = Some(o.body);
+    ///     false // the first is enough
+    /// }).unwrap();
+    /// assert_eq!(picked, Some(b));
+    /// ```
+    pub fn overlap_point<F: FnMut(crate::query::ShapeOverlap) -> bool>(
+        &self,
+        point: Vec2,
+        filter: &crate::query::QueryFilter,
+        callback: F,
+    ) -> Result<(), WorldError> {
+        let ctx = self.query_context(filter);
+        crate::query::overlap_point(&ctx, point, filter, callback)
+    }
+
+    /// Distance between the surfaces of two shapes at their bodies' current
+    /// poses, their closest points and the unit normal from `a` to `b`
+    /// (distance 0 when they touch or overlap). Errors: a stale or foreign
+    /// shape handle.
+    pub fn shape_distance(
+        &self,
+        a: ShapeHandle,
+        b: ShapeHandle,
+    ) -> Result<janus2d_core::geometry::DistanceOutput, WorldError> {
+        let owner = self.bodies.owner();
+        let sa = self.collision.shapes.slot(a, owner)?;
+        let sb = self.collision.shapes.slot(b, owner)?;
+        let ctx = self.query_context(&crate::query::QueryFilter::default());
+        Ok(crate::query::distance_between(&ctx, sa, sb))
+    }
+
+    // ----- kinematic targets ---------------------------------------------------
+
+    /// Sets the velocities that bring a kinematic (or dynamic) body from its
+    /// pose to `target` (body origin and rotation) in one step of `dt`, so
+    /// that what rests on it is carried along (as Box2D's
+    /// `b2Body_SetTargetTransform`; unlike [`set_transform`](Self::set_transform),
+    /// which teleports). The centre of mass moves by `target_center − center`
+    /// exactly; the angular velocity is chosen so that the solver's substep
+    /// rotation lands on the target angle (the shorter way round). The
+    /// velocities stay until set again. Wakes the body.
+    ///
+    /// Errors: a stale handle, a non-finite target (`NonFinite("target")`),
+    /// a `dt` that is not finite and positive, a static body
+    /// ([`WorldError::NotMovable`]).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Transform, Vec2};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let platform = world.create_body(&BodyDef::kinematic(Vec2::ZERO)).unwrap();
+    /// let target = Transform::new(Vec2::new(0.1, 0.05), 0.02);
+    /// world.set_target_transform(platform, target, 1.0 / 60.0).unwrap();
+    /// world.step(1.0 / 60.0).unwrap();
+    /// let xf = world.transform(platform).unwrap();
+    /// assert!((xf.p - target.p).length() < 1e-5);
+    /// assert!((xf.q.angle() - 0.02).abs() < 1e-5);
+    /// ```
+    pub fn set_target_transform(
+        &mut self,
+        body: BodyHandle,
+        target: Transform,
+        dt: Real,
+    ) -> Result<(), WorldError> {
+        if !(vec_is_finite(target.p) && target.q.is_finite()) {
+            return Err(WorldError::NonFinite("target"));
+        }
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(WorldError::InvalidTimeStep);
+        }
+        if self.body_type(body)? == BodyType::Static {
+            return Err(WorldError::NotMovable);
+        }
+        let sim = self.bodies.sim(body).ok_or_else(|| self.body_error(body))?;
+        let q2 = target.q.normalize();
+        let center2 = q2.rotate(sim.local_center) + target.p;
+        let v = (center2 - sim.center) / dt;
+        let delta = sim.transform.q.relative_angle(q2);
+        // Each substep turns by atan(h ω) (first-order, normalised): choose ω
+        // so that the substeps add up to `delta`.
+        let ctx = self.step_context(dt);
+        let per_substep = delta / ctx.substeps.max(1) as Real;
+        let w = if per_substep.abs() < 1.0 {
+            per_substep.tan() * ctx.inv_h
+        } else {
+            delta / dt
+        };
+        self.wake_body(body);
+        if let Some(s) = self.bodies.state_mut(body) {
+            s.v = v;
+            s.w = w;
+        }
+        Ok(())
+    }
+
     // ----- sleep --------------------------------------------------------------
 
     /// Wakes the island of `body` (no effect on awake or static bodies).

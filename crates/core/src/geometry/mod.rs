@@ -10,6 +10,9 @@
 //! - [`query`]: [`Shape::compute_aabb`], [`Shape::support_extent`],
 //!   [`Shape::scaled`], [`Shape::area_in_front`] (exact).
 //! - [`manifold`]: [`collide`] → [`Manifold`].
+//! - [`ray`]: [`Shape::ray_cast`] → [`CastHit`] (fraction, point, normal).
+//! - [`distance`]: [`ShapeProxy`], GJK [`shape_distance`] (closest points),
+//!   [`shapes_overlap`], [`shape_cast`] (a shape swept along a translation).
 //!
 //! # Manifold conventions
 //!
@@ -45,17 +48,24 @@
 //!   snag on an internal vertex are dropped (see [`ChainSegment`]).
 
 pub mod aabb;
+pub mod distance;
 pub mod manifold;
 pub mod mass;
 pub mod query;
+pub mod ray;
 pub mod shapes;
 
 pub use aabb::Aabb;
+pub use distance::{
+    CAST_MAX_ITERATIONS, CAST_TOLERANCE, DistanceOutput, GJK_MAX_ITERATIONS, ShapeProxy,
+    shape_cast, shape_distance, shapes_overlap,
+};
 pub use manifold::{
     CAPSULE_PARALLEL_SINE, CHAIN_FACE_SINE, Manifold, ManifoldPoint, REFERENCE_FACE_TOLERANCE,
     collide, feature_id,
 };
 pub use mass::MassData;
+pub use ray::{CastHit, RayInput};
 pub use shapes::{
     Capsule, ChainSegment, Circle, GeometryError, LINEAR_SLOP, MAX_POLYGON_VERTICES, Polygon,
     SPECULATIVE_DISTANCE, Segment, Shape, WELD_DISTANCE, make_chain,

@@ -36,6 +36,13 @@ impl PortalStage {
     pub(crate) fn object_masses(&self, _bodies: &BodySet, out: &mut Vec<ObjectMass>) {
         out.clear();
     }
+    pub(crate) fn query_apertures(
+        &self,
+        _bodies: &BodySet,
+        _owner: u32,
+    ) -> Vec<crate::query::QueryAperture> {
+        Vec::new()
+    }
 }
 
 impl World {

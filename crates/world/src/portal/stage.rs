@@ -288,6 +288,37 @@ impl PortalStage {
         self.clipping = clipping;
     }
 
+    /// Both apertures of every pair in world space, with the map to the
+    /// partner, for rays and shape casts through portals.
+    pub(crate) fn query_apertures(
+        &self,
+        bodies: &BodySet,
+        owner: u32,
+    ) -> Vec<crate::query::QueryAperture> {
+        let mut out = Vec::with_capacity(2 * self.pairs.len());
+        for (index, d) in self.pairs.iter() {
+            let frames = [
+                frame_in(bodies, &d.portals[0], &d.local[0]),
+                frame_in(bodies, &d.portals[1], &d.local[1]),
+            ];
+            for k in 0..2 {
+                let eta = if k == 0 { d.eta } else { 1.0 / d.eta };
+                out.push(crate::query::QueryAperture {
+                    pair: self.pairs.handle(index, owner),
+                    side: k,
+                    body: d.portals[k].body,
+                    half_width: d.local[k].half_width,
+                    map: PortalMap {
+                        frame1: frames[k],
+                        frame2: frames[1 - k],
+                        eta,
+                    },
+                });
+            }
+        }
+        out
+    }
+
     /// The contact-modification hook's data: the contact constraints of
     /// crossing copies build their effective masses on the whole object.
     /// With `v₂ = ηQ v₁` (static portals) an impulse on the clone moves the
