@@ -68,6 +68,9 @@ fn main() {
     if std::env::var("DIRECT").as_deref() == Ok("0") {
         wd.solver.direct_joints = false;
     }
+    if let Some(hz) = std::env::var("DIRECT_HZ").ok().and_then(|s| s.parse().ok()) {
+        wd.solver.direct_joint_hertz = hz;
+    }
     let mut e = Janus::with_def(&desc, wd).unwrap();
     let mut buf = Vec::new();
     let (mut despawn, mut nd, mut ordinary, mut no) = (0.0, 0, 0.0, 0);

@@ -184,3 +184,59 @@ fn island_splits_when_bodies_part_so_the_resting_one_sleeps() {
         "the box left behind sleeps: its island split from the moving one"
     );
 }
+
+/// A ball drifting at 0.08 m/s in zero gravity: above the world's 0.05 m/s
+/// threshold it never sleeps; with its own threshold of 0.1 m/s it sleeps
+/// once it has been slow for `time_to_sleep`.
+fn drifting_ball(threshold: Option<Real>) -> (World, BodyHandle) {
+    let mut world = World::new(WorldDef {
+        gravity: Vec2::ZERO,
+        ..WorldDef::default()
+    })
+    .unwrap();
+    let def = BodyDef {
+        linear_velocity: Vec2::new(0.08, 0.0),
+        sleep_threshold: threshold,
+        ..BodyDef::dynamic(Vec2::ZERO)
+    };
+    let b = world.create_body(&def).unwrap();
+    world
+        .create_shape(
+            b,
+            &ShapeDef::default(),
+            Circle::new(Vec2::ZERO, 0.25).unwrap(),
+        )
+        .unwrap();
+    (world, b)
+}
+
+#[test]
+fn per_body_sleep_threshold_decides_when_a_slow_body_sleeps() {
+    let (mut world, _) = drifting_ball(None);
+    for _ in 0..120 {
+        world.step(DT).unwrap();
+    }
+    assert_eq!(world.sleeping_body_count(), 0, "0.08 m/s > 0.05 m/s");
+    let (mut world, _) = drifting_ball(Some(0.1));
+    for _ in 0..29 {
+        world.step(DT).unwrap();
+    }
+    assert_eq!(world.sleeping_body_count(), 0, "not yet 0.5 s");
+    for _ in 0..10 {
+        world.step(DT).unwrap();
+    }
+    assert_eq!(world.sleeping_body_count(), 1, "slow for 0.5 s: asleep");
+}
+
+#[test]
+fn negative_or_nan_sleep_threshold_is_refused() {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    for bad in [-0.1, Real::NAN] {
+        let def = BodyDef {
+            sleep_threshold: Some(bad),
+            ..BodyDef::dynamic(Vec2::ZERO)
+        };
+        assert!(world.create_body(&def).is_err(), "{bad}");
+    }
+    assert_eq!(world.body_count(), 0, "nothing created");
+}

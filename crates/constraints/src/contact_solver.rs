@@ -337,6 +337,21 @@ fn gather(states: &[BodyState], index: &[u32; LANES]) -> WideBody {
     }
 }
 
+/// The lanes' velocities only (the warm start needs no position deltas).
+#[inline(always)]
+fn gather_velocity(states: &[BodyState], index: &[u32; LANES]) -> (W, W, W) {
+    let mut v_x = [0.0; LANES];
+    let mut v_y = [0.0; LANES];
+    let mut w = [0.0; LANES];
+    for k in 0..LANES {
+        let s = &states[index[k] as usize];
+        v_x[k] = s.v.x;
+        v_y[k] = s.v.y;
+        w[k] = s.w;
+    }
+    (W::from(v_x), W::from(v_y), W::from(w))
+}
+
 /// Writes the lanes' velocities back. Lanes on the identity state, on a
 /// static or on a kinematic body write what they read.
 #[inline(always)]
@@ -424,8 +439,6 @@ impl WideContact {
     /// Applies the kept impulses: `Δv = M⁻¹ Jᵀ λ`.
     #[inline(always)]
     fn warm_start(&mut self, states: &mut [BodyState]) {
-        let a = gather(states, &self.state_a);
-        let b = gather(states, &self.state_b);
         let (n_x, n_y) = (self.n_x, self.n_y);
         let lambda = &self.impulse;
         let (pn, pt) = (lambda[0] + lambda[1], lambda[2] + lambda[3]);
@@ -434,19 +447,21 @@ impl WideContact {
         let p_y = pn * n_y - pt * n_x;
         let l_a = dot_rows(lambda, &self.ja);
         let l_b = dot_rows(lambda, &self.jb);
+        let (v_x, v_y, w) = gather_velocity(states, &self.state_a);
         scatter(
             states,
             &self.state_a,
-            a.v_x - self.inv_mass_a * p_x,
-            a.v_y - self.inv_mass_a * p_y,
-            a.w - self.inv_inertia_a * l_a,
+            v_x - self.inv_mass_a * p_x,
+            v_y - self.inv_mass_a * p_y,
+            w - self.inv_inertia_a * l_a,
         );
+        let (v_x, v_y, w) = gather_velocity(states, &self.state_b);
         scatter(
             states,
             &self.state_b,
-            b.v_x + self.inv_mass_b * p_x,
-            b.v_y + self.inv_mass_b * p_y,
-            b.w + self.inv_inertia_b * l_b,
+            v_x + self.inv_mass_b * p_x,
+            v_y + self.inv_mass_b * p_y,
+            w + self.inv_inertia_b * l_b,
         );
     }
 

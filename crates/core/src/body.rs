@@ -114,6 +114,10 @@ pub struct BodyDef {
     /// (after its shapes are attached), and it costs nothing until something
     /// wakes it.
     pub awake: bool,
+    /// Speed below which the body counts as resting for sleep, m/s; `None`
+    /// takes the world's `SleepSettings::linear_threshold` (usual `None`;
+    /// Box2D's `sleepThreshold`, default 0.05 m/s).
+    pub sleep_threshold: Option<Real>,
     /// Opaque user value.
     pub user_data: u64,
 }
@@ -134,6 +138,7 @@ impl Default for BodyDef {
             mass: None,
             fixed_rotation: false,
             awake: true,
+            sleep_threshold: None,
             user_data: 0,
         }
     }
@@ -294,6 +299,8 @@ pub struct BodySim {
     pub max_rotation: Real,
     /// How long the body has been slow enough to sleep, s.
     pub sleep_time: Real,
+    /// The body's own sleep speed threshold, m/s; negative: the world's.
+    pub sleep_threshold: Real,
     /// The handle of the body this belongs to.
     pub handle: BodyHandle,
     /// Static, kinematic or dynamic.
@@ -320,6 +327,7 @@ impl BodySim {
             max_linear_speed: 0.0,
             max_rotation: 0.0,
             sleep_time: 0.0,
+            sleep_threshold: -1.0,
             handle: BodyHandle::new(u32::MAX, 0, 0),
             body_type: BodyType::Static,
         }
@@ -428,6 +436,12 @@ pub fn validate_body_def(def: &BodyDef) -> Result<(), BodyError> {
     }
     if def.max_rotation < 0.0 {
         return Err(BodyError::Negative("max_rotation"));
+    }
+    if let Some(t) = def.sleep_threshold {
+        check_finite(t, "sleep_threshold")?;
+        if t < 0.0 {
+            return Err(BodyError::Negative("sleep_threshold"));
+        }
     }
     if let Some(m) = def.mass {
         validate_mass(def.body_type, &m, def.fixed_rotation)?;
@@ -587,6 +601,7 @@ impl BodySet {
             max_linear_speed: def.max_linear_speed,
             max_rotation: def.max_rotation,
             sleep_time: 0.0,
+            sleep_threshold: def.sleep_threshold.unwrap_or(-1.0),
             handle,
             body_type: def.body_type,
         };

@@ -8,7 +8,7 @@
 //! | `Geometry::ChainLoop`  | `make_chain(points, true)`: one-sided segments |
 //! | `FilterDesc`           | `Filter` (same bits and group rule)          |
 //! | `BodyDesc::mass`       | `BodyDef::with_mass`                         |
-//! | `sleep_threshold`      | ignored: janus2d has one world threshold     |
+//! | `sleep_threshold`      | `BodyDef::sleep_threshold`                   |
 //! | `hit_events`           | ignored: janus2d reports begin/end only      |
 //! | `Action::Target`       | velocity = (target − current) / dt           |
 
@@ -135,6 +135,7 @@ pub fn create_body(world: &mut World, b: &BodyDesc) -> Result<BodyHandle, WorldE
     def.angular_velocity = b.angular_velocity as Real;
     def.linear_damping = b.linear_damping as Real;
     def.awake = b.awake;
+    def.sleep_threshold = Some(b.sleep_threshold as Real);
     if let Some((m, i)) = b.mass {
         def = def.with_mass(m as Real, i as Real);
     }

@@ -361,6 +361,11 @@ impl Islands {
             let reach = input.shapes.reach(handle, center);
             let st = bodies.states[i];
             let sim = &mut bodies.sims[i];
+            let tol2 = if sim.sleep_threshold >= 0.0 {
+                sim.sleep_threshold * sim.sleep_threshold
+            } else {
+                tol2
+            };
             let slow = st.v.length_squared() <= tol2 && st.w * st.w * reach * reach <= tol2;
             if sim.body_type == BodyType::Dynamic && slow {
                 sim.sleep_time += input.dt;

@@ -639,6 +639,8 @@ impl World {
             max_rotation: sim.max_rotation,
             mass: Some(mass_clone),
             fixed_rotation: record.fixed_rotation,
+            // Speeds scale by η through the portal.
+            sleep_threshold: (sim.sleep_threshold >= 0.0).then_some(eta * sim.sleep_threshold),
             user_data: record.user_data,
             ..BodyDef::default()
         };
