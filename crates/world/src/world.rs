@@ -1235,7 +1235,7 @@ impl World {
             object_masses: &self.object_masses,
         };
         let mut batches: [&mut dyn ConstraintBatch; 3] =
-            [&mut revolute, &mut contacts, self.portals.constraints_mut()];
+            [&mut contacts, &mut revolute, self.portals.constraints_mut()];
         let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
         lap();
         if has_shapes {
