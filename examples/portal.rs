@@ -24,8 +24,7 @@ fn main() -> Result<(), WorldError> {
         let p = world.position(body)?;
         let v = world.linear_velocity(body)?;
         let dynamic = world
-            .bodies()
-            .handles()
+            .body_handles()
             .filter(|h| world.body_type(*h) == Ok(BodyType::Dynamic))
             .count();
         let events: Vec<String> = world

@@ -46,11 +46,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .x_desc("x [m]")
         .y_desc("y [m]")
         .draw()?;
-    let statics: Vec<BodyHandle> = world
-        .bodies()
-        .handles()
-        .filter(|h| *h != scene.probe)
-        .collect();
+    let statics: Vec<BodyHandle> = world.body_handles().filter(|h| *h != scene.probe).collect();
     for b in &statics {
         for o in outlines(world, *b) {
             chart.draw_series(std::iter::once(plotters::element::Polygon::new(

@@ -118,7 +118,7 @@ fn joint_to_the_same_body_is_rejected() {
             w.create_revolute_joint(&RevoluteJointDef::new(b, b, Vec2::ZERO, Vec2::ZERO)),
             Err(WorldError::Joint(JointError::SameBody))
         );
-        let a = w.bodies().handles().next().unwrap();
+        let a = w.body_handles().next().unwrap();
         assert_eq!(
             w.create_revolute_joint(
                 &RevoluteJointDef::new(a, b, Vec2::ZERO, Vec2::ZERO).with_limits(1.0, -1.0)

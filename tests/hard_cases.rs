@@ -14,7 +14,7 @@ fn report() -> bool {
 
 /// Asserts every body is finite and none is below `floor` (centre height).
 fn assert_sane(world: &World, floor: Real) {
-    for h in world.bodies().handles() {
+    for h in world.body_handles() {
         if world.body_type(h).unwrap() != BodyType::Dynamic {
             continue;
         }
@@ -240,7 +240,7 @@ fn high_mass_ratio_3_big_box_on_small_boxes_box_ground() {
 #[test]
 fn ball_and_chain_peak_gap() {
     let (world, peak_gap) = run_ball_and_chain(&scenes::shared_settings());
-    let bodies: Vec<BodyHandle> = world.bodies().handles().collect();
+    let bodies: Vec<BodyHandle> = world.body_handles().collect();
     if report() {
         eprintln!("ball and chain: peak joint gap {peak_gap:.4} m");
     }

@@ -89,8 +89,7 @@ fn run_chain(spacing: Real) -> (Real, Option<Real>, Real) {
 fn bridge_joint_gap_over_last_second() {
     let mut world = scenes::bridge(&scenes::shared_settings()).world;
     let planks: Vec<BodyHandle> = world
-        .bodies()
-        .handles()
+        .body_handles()
         .filter(|h| world.body_type(*h) == Ok(BodyType::Dynamic))
         .collect();
     let mut peak_gap_last: Real = 0.0;

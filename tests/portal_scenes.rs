@@ -12,8 +12,7 @@ fn report() -> bool {
 
 fn dynamic_count(world: &World) -> usize {
     world
-        .bodies()
-        .handles()
+        .body_handles()
         .filter(|h| world.body_type(*h) == Ok(BodyType::Dynamic))
         .count()
 }
@@ -79,7 +78,7 @@ fn completed(world: &World) -> bool {
 fn portal_drop_exits_sideways_at_impact_speed() {
     let (mut scene, _) = scenes::portal_drop(&WorldDef::default());
     let (world, body) = (&mut scene.world, scene.probe);
-    let portal_bodies: Vec<BodyHandle> = world.bodies().handles().filter(|h| *h != body).collect();
+    let portal_bodies: Vec<BodyHandle> = world.body_handles().filter(|h| *h != body).collect();
     let mut impact_speed = 0.0;
     let mut exit_velocity = None;
     for _ in 0..150 {
@@ -392,7 +391,7 @@ fn portal_dynamic_bodies_conserve_momentum() {
     launched_box(&mut world, Vec2::new(-1.0, 0.1), Vec2::new(4.0, 0.0), 0.3);
     let momentum = |world: &World| {
         let (mut p, mut l) = (Vec2::ZERO, 0.0 as Real);
-        for h in world.bodies().handles() {
+        for h in world.body_handles() {
             if world.body_type(h).unwrap() != BodyType::Dynamic {
                 continue;
             }
@@ -535,8 +534,7 @@ fn portal_stream_conserves_bodies() {
         assert!(world.events().non_finite_bodies.is_empty());
     }
     let all_finite = world
-        .bodies()
-        .handles()
+        .body_handles()
         .all(|h| world.position(h).unwrap().is_finite());
     if report() {
         eprintln!(
@@ -563,7 +561,7 @@ fn destroying_a_portal_ends_crossings_cleanly() {
         }
         let clone = world.clone_of(scene.probe).unwrap();
         if destroy_body {
-            let floor = world.bodies().handles().next().unwrap();
+            let floor = world.body_handles().next().unwrap();
             world.destroy_body(floor).unwrap();
         } else {
             world.destroy_portal_pair(pair).unwrap();

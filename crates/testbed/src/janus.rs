@@ -313,7 +313,7 @@ impl Engine for Janus {
 
     fn dynamic_states(&self, out: &mut Vec<BodyState>) {
         out.clear();
-        for h in self.world.bodies().handles() {
+        for h in self.world.body_handles() {
             if self.world.body_type(h) == Ok(BodyType::Dynamic) {
                 out.extend(state_of(&self.world, h));
             }

@@ -193,7 +193,7 @@ impl ExtraMetric for PortalMomentumError {
         let mut worst: Option<f64> = None;
         for c in world.portal_constraints() {
             let def = c.def();
-            let q = c.map(world.bodies()).rotation();
+            let q = world.portal_constraint_map(c).rotation();
             let (m1, v1) = (
                 world.mass(def.body).ok()?,
                 world.linear_velocity(def.body).ok()?,
@@ -503,7 +503,7 @@ impl BodyEnergy {
 
 fn for_each_dynamic(world: &World, mut f: impl FnMut(&BodyEnergy)) {
     let g = world.gravity();
-    for h in world.bodies().handles() {
+    for h in world.body_handles() {
         if !matches!(world.body_type(h), Ok(BodyType::Dynamic)) {
             continue;
         }
@@ -516,7 +516,7 @@ fn for_each_dynamic(world: &World, mut f: impl FnMut(&BodyEnergy)) {
         ) else {
             continue;
         };
-        let scale = world.bodies().sim(h).map_or(1.0, |s| s.gravity_scale);
+        let scale = world.gravity_scale(h).unwrap_or(1.0);
         let mass = to_f64(mass);
         let height = to_f64(g.x) * to_f64(c.x) + to_f64(g.y) * to_f64(c.y);
         f(&BodyEnergy {

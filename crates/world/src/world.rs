@@ -151,9 +151,23 @@ impl World {
         Ok(())
     }
 
-    /// Read access to the body storage (for metrics and tests).
-    pub fn bodies(&self) -> &BodySet {
+    /// The body storage (the solver's arrays; internal to the engine).
+    #[cfg_attr(not(feature = "portals"), allow(dead_code))]
+    pub(crate) fn bodies(&self) -> &BodySet {
         &self.bodies
+    }
+
+    /// Every live body's handle, in slot order.
+    pub fn body_handles(&self) -> impl Iterator<Item = BodyHandle> + '_ {
+        self.bodies.handles()
+    }
+
+    /// The body's gravity scale (dimensionless).
+    pub fn gravity_scale(&self, body: BodyHandle) -> Result<Real, WorldError> {
+        self.bodies
+            .sim(body)
+            .map(|s| s.gravity_scale)
+            .ok_or_else(|| self.body_error(body))
     }
 
     /// Number of live bodies.

@@ -471,6 +471,12 @@ impl World {
         &self.portals.constraints
     }
 
+    /// The current map (T, Q, η) of a crossing's portal constraint, at the
+    /// portal bodies' present poses.
+    pub fn portal_constraint_map(&self, constraint: &PortalConstraint) -> PortalMap {
+        constraint.map(self.bodies())
+    }
+
     /// The clone of `body` while it crosses, if any.
     pub fn clone_of(&self, body: BodyHandle) -> Option<BodyHandle> {
         self.portals
