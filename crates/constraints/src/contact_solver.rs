@@ -2,29 +2,29 @@
 //! [`ContactConstraint`] run [`LANES`] contacts at a time.
 //!
 //! ```text
-//! prepare    scalar, one ContactConstraint at a time (anchors, K, softness),
-//!            then the object-mass hook, then colour and pack:
-//!
-//!   colour   (while the pipeline builds the constraints) greedy: the
-//!            first colour in which neither dynamic body already appears
-//!            (static and kinematic bodies take no colour: the solve never
-//!            changes their state); constraints are built colour by colour
-//!   pack     each colour's consecutive constraints in chunks of LANES,
-//!            structure of arrays
+//! build      (the collision pipeline, two passes over its contacts)
+//!   colour   greedy: the first colour in which neither moving body
+//!            already appears (static, kinematic and sleeping bodies take
+//!            no colour: the solve never changes their state)
+//!   push     each contact's lane data into the open chunk of its colour,
+//!            structure of arrays; the overflow (a body in every colour, or
+//!            a portal copy whose contacts need the object-mass hook) as
+//!            scalar ContactConstraints
 //!
 //!            colour 0: [c0 c3 c7 … ] [c12 … pad]     chunk = LANES lanes
 //!            colour 1: [c1 c4 … pad]
 //!            …
-//!            overflow: c9 c40 …   (a body in every colour: solved scalar)
+//!            overflow: c9 c40 …
 //!
-//! warm start, solve (bias), relax (no bias)
-//!            colour by colour (reversed on alternate sweeps), chunk by
-//!            chunk: gather the lanes' body states, the row arithmetic of
-//!            ContactConstraint::solve_rows on lanes, scatter the
-//!            velocities; then the overflow contacts, scalar
-//! restitution, store
-//!            the lanes' impulses go back to their ContactConstraints, which
-//!            do the rest scalar
+//! prepare    lane-wise: K, the mass-ratio softness, the approach speed;
+//!            overflow scalar, then the object-mass hook on it
+//! warm start, solve (bias), relax (no bias), restitution
+//!            colour by colour (solve and relax reversed on alternate
+//!            sweeps), chunk by chunk: gather the lanes' body states, the
+//!            row arithmetic of ContactConstraint on lanes, scatter the
+//!            velocities; then the overflow, scalar
+//! store      the impulses of every lane and overflow constraint go back to
+//!            the pipeline's contacts, by contact index
 //! ```
 //!
 //! Within a colour no dynamic body appears twice, so the lanes of a chunk
@@ -39,10 +39,10 @@
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState};
 use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
-use janus2d_core::math::{Real, Vec2};
-use wide::CmpGt;
+use janus2d_core::math::{Real, Vec2, cross};
+use wide::{CmpEq, CmpGt, CmpLt, CmpNe};
 
-use crate::contact::{ContactConstraint, MAX_MANIFOLD_POINTS, ROWS};
+use crate::contact::{ContactConstraint, ContactPointInput, MAX_MANIFOLD_POINTS, ROWS};
 
 /// Lanes of the SIMD type.
 #[cfg(not(feature = "f64"))]
@@ -94,8 +94,16 @@ struct WideContact {
     state_a: [u32; LANES],
     /// State index of body b per lane.
     state_b: [u32; LANES],
+    /// The pipeline's contact index per lane.
+    contact: [u32; LANES],
     /// Number of lanes in use (the rest are padding).
     len: usize,
+    /// 1 where the lane's manifold has a second point, else 0.
+    second: W,
+    /// Restitution coefficient.
+    restitution: W,
+    /// Normal velocity of each point before the solve (restitution), m/s.
+    relative_velocity: [W; MAX_MANIFOLD_POINTS],
     /// Inverse masses the impulses act with, 1/kg.
     inv_mass_a: W,
     inv_mass_b: W,
@@ -127,29 +135,54 @@ struct WideContact {
     max_normal_impulse: [W; MAX_MANIFOLD_POINTS],
 }
 
-/// A step's contact constraints, colour by colour, and their lane-packed
-/// form: the contact batch's own data.
-///
-/// The pipeline builds the constraints in two passes over its contacts:
-/// [`ContactSolver::assign`] gives each its colour (or the overflow), then
-/// [`ContactSolver::push`] appends it to that colour's list. Both passes
-/// read the contacts in order and each colour's list is written in order,
-/// so neither pass jumps around memory.
-#[derive(Clone, Debug, Default)]
-pub struct ContactSolver {
-    /// Constraints per colour; the last list is the overflow.
-    colours: Vec<Vec<ContactConstraint>>,
-    /// Chunks, colour by colour.
-    chunks: Vec<WideContact>,
-    /// `colour_start[c]..colour_start[c + 1]`: the chunks of colour `c`.
-    colour_start: Vec<usize>,
-    /// The colouring of this step.
-    graph: ColourGraph,
-    /// The lanes' impulses were written back to the constraints.
-    unpacked: bool,
+/// What the collision pipeline hands over for one contact: everything a
+/// lane (or an overflow constraint) is built from.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactLane {
+    /// Body a.
+    pub body_a: BodyHandle,
+    /// Body b.
+    pub body_b: BodyHandle,
+    /// State index of body a (0: static or asleep).
+    pub state_a: u32,
+    /// State index of body b.
+    pub state_b: u32,
+    /// Inverse masses and inertias `[m_a⁻¹, i_a⁻¹, m_b⁻¹, i_b⁻¹]` the
+    /// impulses act with (0 for a static, kinematic or sleeping body).
+    pub inv_masses: [Real; 4],
+    /// Unit normal from a to b.
+    pub normal: Vec2,
+    /// The manifold's points (the first `point_count`).
+    pub points: [ContactPointInput; MAX_MANIFOLD_POINTS],
+    /// Number of points (1 or 2).
+    pub point_count: usize,
+    /// Mixed friction.
+    pub friction: Real,
+    /// Mixed restitution.
+    pub restitution: Real,
+    /// The pipeline's index of the contact (impulses are stored back by it).
+    pub contact_index: u32,
 }
 
-/// The slot of the overflow list in [`ContactSolver`]'s colours.
+/// A step's contact constraints in their colours and lanes: the contact
+/// batch's own data.
+///
+/// The pipeline builds it in two passes over its contacts:
+/// [`ContactSolver::assign`] gives each its colour (or the overflow), then
+/// [`ContactSolver::push`] writes it into the open chunk of that colour.
+/// Both passes read the contacts in order, and the open chunks (one per
+/// colour) stay in cache, so neither pass jumps around memory.
+#[derive(Clone, Debug, Default)]
+pub struct ContactSolver {
+    /// Chunks per colour; the last chunk of a colour may have free lanes.
+    colours: Vec<Vec<WideContact>>,
+    /// Contacts solved one by one.
+    overflow: Vec<ContactConstraint>,
+    /// The colouring of this step.
+    graph: ColourGraph,
+}
+
+/// The slot of the overflow in [`ContactSolver::assign`]'s answers.
 pub const OVERFLOW: u8 = COLOURS as u8;
 
 impl ContactSolver {
@@ -165,103 +198,132 @@ impl ContactSolver {
         COLOURS
     }
 
-    /// Number of constraints in colour `colour` ([`OVERFLOW`] for the
+    /// Number of contacts in colour `colour` ([`OVERFLOW`] for the
     /// overflow, solved scalar).
     #[must_use]
     pub fn count_in(&self, colour: u8) -> usize {
-        self.colours.get(colour as usize).map_or(0, Vec::len)
+        if colour >= OVERFLOW {
+            return self.overflow.len();
+        }
+        self.colours
+            .get(colour as usize)
+            .map_or(0, |chunks| chunks.iter().map(|c| c.len).sum())
     }
 
-    /// Number of constraints.
+    /// Number of contacts.
     #[must_use]
     pub fn len(&self) -> usize {
-        self.colours.iter().map(Vec::len).sum()
+        (0..=OVERFLOW).map(|c| self.count_in(c)).sum()
     }
 
-    /// True when there is no constraint.
+    /// True when there is no contact.
     #[must_use]
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
 
-    /// Every constraint, colour by colour, overflow last.
-    pub fn constraints(&self) -> impl Iterator<Item = &ContactConstraint> {
-        self.colours.iter().flatten()
-    }
-
-    /// Drops every constraint and starts a step's colouring for
-    /// `state_count` body states.
+    /// Drops every contact and starts a step's colouring for `state_count`
+    /// body states.
     pub fn begin(&mut self, state_count: usize) {
         self.graph.reset(state_count);
-        self.colours.resize_with(COLOURS + 1, Vec::new);
-        for list in &mut self.colours {
-            list.clear();
+        self.colours.resize_with(COLOURS, Vec::new);
+        for chunks in &mut self.colours {
+            chunks.clear();
         }
-        self.chunks.clear();
-        self.colour_start.clear();
+        self.overflow.clear();
     }
 
-    /// The colour of a constraint whose bodies have the state indices `a`
-    /// and `b` (`None` for a body the solve does not move: static,
-    /// kinematic or asleep), marking both bodies in it; [`OVERFLOW`] when
-    /// none is free.
+    /// The colour of a contact whose bodies have the state indices `a` and
+    /// `b` (`None` for a body the solve does not move: static, kinematic
+    /// or asleep), marking both bodies in it; [`OVERFLOW`] when none is
+    /// free.
     pub fn assign(&mut self, a: Option<u32>, b: Option<u32>) -> u8 {
         self.graph.assign(a, b).map_or(OVERFLOW, |c| c as u8)
     }
 
-    /// Appends a constraint to the colour [`ContactSolver::assign`] gave it.
-    pub fn push(&mut self, colour: u8, constraint: ContactConstraint) {
-        let slot = (colour as usize).min(COLOURS);
-        if self.colours.len() <= slot {
-            self.colours.resize_with(COLOURS + 1, Vec::new);
-        }
-        self.colours[slot].push(constraint);
-    }
-
-    /// Packs each colour's prepared constraints into chunks.
-    fn pack(&mut self) {
-        self.chunks.clear();
-        self.colour_start.clear();
-        self.colour_start.push(0);
-        let colours = self.colours.len().min(COLOURS);
-        for list in &self.colours[..colours] {
-            for start in (0..list.len()).step_by(LANES) {
-                let end = (start + LANES).min(list.len());
-                self.chunks.push(WideContact::empty());
-                let chunk = self.chunks.last_mut().expect("just pushed");
-                chunk.fill(list, start, end);
-            }
-            self.colour_start.push(self.chunks.len());
-        }
-        self.unpacked = false;
-    }
-
-    /// Writes the lanes' impulses back to their constraints (once per step).
-    fn unpack(&mut self) {
-        if self.unpacked {
+    /// Adds a contact to the colour [`ContactSolver::assign`] gave it
+    /// ([`OVERFLOW`]: solved scalar).
+    pub fn push(&mut self, colour: u8, lane: &ContactLane) {
+        let count = lane.point_count.min(MAX_MANIFOLD_POINTS);
+        if colour >= OVERFLOW {
+            let mut c = ContactConstraint::new(
+                lane.body_a,
+                lane.body_b,
+                lane.normal,
+                &lane.points[..count],
+                lane.friction,
+                lane.restitution,
+                lane.contact_index,
+            );
+            c.state_a = lane.state_a;
+            c.state_b = lane.state_b;
+            self.overflow.push(c);
             return;
         }
-        for colour in 0..self.colour_start.len().saturating_sub(1) {
-            let list = &mut self.colours[colour];
-            let chunks = &self.chunks[self.colour_start[colour]..self.colour_start[colour + 1]];
-            for (chunk, part) in chunks.iter().zip(list.chunks_mut(LANES)) {
-                chunk.unpack(part);
-            }
+        if self.colours.len() < COLOURS {
+            self.colours.resize_with(COLOURS, Vec::new);
         }
-        self.unpacked = true;
+        let chunks = &mut self.colours[colour as usize];
+        if chunks.last().is_none_or(|c| c.len == LANES) {
+            chunks.push(WideContact::empty());
+        }
+        let chunk = chunks.last_mut().expect("a chunk with a free lane");
+        chunk.push(lane, count);
     }
 
-    fn overflow_mut(&mut self) -> &mut [ContactConstraint] {
-        self.colours
-            .get_mut(COLOURS)
-            .map_or(&mut [], Vec::as_mut_slice)
+    /// Calls `store(contact_index, point, normal_impulse, tangent_impulse)`
+    /// for every point of every contact: the impulses to keep for the next
+    /// step's warm start.
+    pub fn for_each_impulse(&self, mut store: impl FnMut(u32, usize, Real, Real)) {
+        for chunk in self.colours.iter().flatten() {
+            let impulse = chunk.impulse.map(W::to_array);
+            let second = chunk.second.to_array();
+            for k in 0..chunk.len {
+                let points = if second[k] > 0.0 { 2 } else { 1 };
+                for i in 0..points {
+                    store(chunk.contact[k], i, impulse[i][k], impulse[i + 2][k]);
+                }
+            }
+        }
+        for c in &self.overflow {
+            for i in 0..c.point_count() {
+                let (n, t) = c.impulses(i);
+                store(c.contact_index, i, n, t);
+            }
+        }
+    }
+
+    /// The contacts of the overflow, solved one by one.
+    #[must_use]
+    pub fn overflow(&self) -> &[ContactConstraint] {
+        &self.overflow
+    }
+
+    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet, objects: &[ObjectMass]) {
+        for chunk in self.colours.iter_mut().flatten() {
+            chunk.prepare(ctx, &bodies.states);
+        }
+        for c in &mut self.overflow {
+            c.prepare(ctx, bodies);
+            if objects.is_empty() {
+                continue;
+            }
+            let find = |body| objects.iter().find(|o| o.body == body);
+            let (oa, ob) = (find(c.body_a), find(c.body_b));
+            if oa.is_some() || ob.is_some() {
+                let [m_a, i_a, m_b, i_b] = c.applied_masses;
+                let (m_a, i_a) = oa.map_or((m_a, i_a), |o| (o.inv_mass, o.inv_inertia));
+                let (m_b, i_b) = ob.map_or((m_b, i_b), |o| (o.inv_mass, o.inv_inertia));
+                c.prepare_rows(ctx, bodies, [m_a, i_a, m_b, i_b]);
+            }
+        }
     }
 
     fn warm_start(&mut self, states: &mut [BodyState]) {
-        for chunk in &mut self.chunks {
+        for chunk in self.colours.iter_mut().flatten() {
             chunk.warm_start(states);
         }
-        for c in self.overflow_mut() {
+        for c in &self.overflow {
             c.apply_warm_start(states);
         }
     }
@@ -274,11 +336,10 @@ impl ContactSolver {
         reverse: bool,
     ) {
         let (inv_h, push_max) = (ctx.inv_h, ctx.contact_push_max_velocity);
-        let colours = self.colour_start.len().saturating_sub(1);
+        let colours = self.colours.len();
         for k in 0..colours {
             let colour = if reverse { colours - 1 - k } else { k };
-            let range = self.colour_start[colour]..self.colour_start[colour + 1];
-            for chunk in &mut self.chunks[range] {
+            for chunk in &mut self.colours[colour] {
                 if use_bias {
                     chunk.solve::<true>(states, inv_h, push_max);
                 } else {
@@ -286,12 +347,22 @@ impl ContactSolver {
                 }
             }
         }
-        for c in self.overflow_mut() {
+        for c in &mut self.overflow {
             if use_bias {
                 c.solve_rows::<true>(states, inv_h, push_max);
             } else {
                 c.solve_rows::<false>(states, inv_h, push_max);
             }
+        }
+    }
+
+    fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+        let threshold = splat(ctx.restitution_threshold);
+        for chunk in self.colours.iter_mut().flatten() {
+            chunk.apply_restitution(states, threshold);
+        }
+        for c in &mut self.overflow {
+            c.apply_restitution(ctx, states);
         }
     }
 }
@@ -371,7 +442,11 @@ impl WideContact {
         WideContact {
             state_a: [0; LANES],
             state_b: [0; LANES],
+            contact: [u32::MAX; LANES],
             len: 0,
+            second: z,
+            restitution: z,
+            relative_velocity: [z; MAX_MANIFOLD_POINTS],
             inv_mass_a: z,
             inv_mass_b: z,
             inv_inertia_a: z,
@@ -391,49 +466,134 @@ impl WideContact {
         }
     }
 
-    /// Loads constraints `start..end` (at most [`LANES`]) into the lanes.
-    fn fill(&mut self, constraints: &[ContactConstraint], start: usize, end: usize) {
-        self.len = end - start;
-        for (k, c) in constraints[start..end].iter().enumerate() {
-            self.state_a[k] = c.state_a;
-            self.state_b[k] = c.state_b;
-            let [m_a, i_a, m_b, i_b] = c.applied_masses;
-            self.inv_mass_a.as_array_mut()[k] = m_a;
-            self.inv_inertia_a.as_array_mut()[k] = i_a;
-            self.inv_mass_b.as_array_mut()[k] = m_b;
-            self.inv_inertia_b.as_array_mut()[k] = i_b;
-            self.n_x.as_array_mut()[k] = c.normal.x;
-            self.n_y.as_array_mut()[k] = c.normal.y;
-            for row in 0..ROWS {
-                self.ja[row].as_array_mut()[k] = c.ja[row];
-                self.jb[row].as_array_mut()[k] = c.jb[row];
-                self.mass[row].as_array_mut()[k] = c.mass[row];
-                self.impulse[row].as_array_mut()[k] = c.impulse[row];
-            }
-            for p in 0..MAX_MANIFOLD_POINTS {
-                self.soft_mass[p].as_array_mut()[k] = c.soft_mass[p];
-                self.impulse_scale[p].as_array_mut()[k] = c.impulse_scale[p];
-                self.base_separation[p].as_array_mut()[k] = c.base_separation[p];
-                self.max_normal_impulse[p].as_array_mut()[k] = c.max_normal_impulse[p];
-            }
-            self.friction.as_array_mut()[k] = c.friction;
-            self.bias_rate.as_array_mut()[k] = c.bias_rate;
+    /// Writes a contact into the next free lane: the Jacobian's angular
+    /// parts from the anchors (as `ContactConstraint::new`), the kept
+    /// impulses, the masses.
+    fn push(&mut self, lane: &ContactLane, count: usize) {
+        let k = self.len;
+        self.len += 1;
+        self.state_a[k] = lane.state_a;
+        self.state_b[k] = lane.state_b;
+        self.contact[k] = lane.contact_index;
+        let [m_a, i_a, m_b, i_b] = lane.inv_masses;
+        self.inv_mass_a.as_array_mut()[k] = m_a;
+        self.inv_inertia_a.as_array_mut()[k] = i_a;
+        self.inv_mass_b.as_array_mut()[k] = m_b;
+        self.inv_inertia_b.as_array_mut()[k] = i_b;
+        let n = lane.normal;
+        let t = Vec2::new(n.y, -n.x);
+        self.n_x.as_array_mut()[k] = n.x;
+        self.n_y.as_array_mut()[k] = n.y;
+        self.friction.as_array_mut()[k] = lane.friction;
+        self.restitution.as_array_mut()[k] = lane.restitution;
+        self.second.as_array_mut()[k] = if count > 1 { 1.0 } else { 0.0 };
+        for (i, p) in lane.points[..count].iter().enumerate() {
+            let (r_a, r_b) = (p.anchor_a, p.anchor_b);
+            let (rt_a, rt_b) = (cross(r_a, t), cross(r_b, t));
+            self.ja[i].as_array_mut()[k] = cross(r_a, n);
+            self.jb[i].as_array_mut()[k] = cross(r_b, n);
+            self.ja[i + 2].as_array_mut()[k] = rt_a;
+            self.jb[i + 2].as_array_mut()[k] = rt_b;
+            // r · n = −(r × t).
+            self.base_separation[i].as_array_mut()[k] = p.separation + (rt_b - rt_a);
+            self.impulse[i].as_array_mut()[k] = p.normal_impulse;
+            self.impulse[i + 2].as_array_mut()[k] = p.tangent_impulse;
         }
     }
 
-    /// Writes the lanes' impulses back to the constraints this chunk was
-    /// filled from (`constraints`, in lane order).
-    fn unpack(&self, constraints: &mut [ContactConstraint]) {
-        let impulse = self.impulse.map(W::to_array);
-        let max_normal = self.max_normal_impulse.map(W::to_array);
-        for (k, c) in constraints.iter_mut().take(self.len).enumerate() {
-            for row in 0..ROWS {
-                c.impulse[row] = impulse[row][k];
+    /// Effective masses, the mass-ratio softness of each normal row and the
+    /// approach speeds, lane-wise (the arithmetic of
+    /// `ContactConstraint::prepare`).
+    fn prepare(&mut self, ctx: &StepContext, states: &[BodyState]) {
+        let zero = W::splat(0.0);
+        let one = W::splat(1.0);
+        let (m_a, i_a) = (self.inv_mass_a, self.inv_inertia_a);
+        let (m_b, i_b) = (self.inv_mass_b, self.inv_inertia_b);
+        // A pair with a static (or kinematic, or sleeping) body.
+        let static_pair = m_a.cmp_eq(zero) | m_b.cmp_eq(zero);
+        let (sc, ss) = (ctx.contact_softness, ctx.static_softness);
+        self.bias_rate = static_pair.blend(splat(ss.bias_rate), splat(sc.bias_rate));
+        let rho_max = ctx.contact_mass_ratio_cap;
+        let stiffen = rho_max > 1.0 && sc.impulse_scale > 0.0;
+        let a2 = if sc.impulse_scale > 0.0 {
+            sc.mass_scale / sc.impulse_scale
+        } else {
+            0.0
+        };
+        let (v_xa, v_ya, w_a) = gather_velocity(states, &self.state_a);
+        let (v_xb, v_yb, w_b) = gather_velocity(states, &self.state_b);
+        let dvn = (v_xb - v_xa) * self.n_x + (v_yb - v_ya) * self.n_y;
+        let keep = [one, self.second];
+        for i in 0..MAX_MANIFOLD_POINTS {
+            let (rn_a, rn_b) = (self.ja[i], self.jb[i]);
+            let (rt_a, rt_b) = (self.ja[i + 2], self.jb[i + 2]);
+            let k_a = m_a + i_a * rn_a * rn_a;
+            let k_b = m_b + i_b * rn_b * rn_b;
+            let k = k_a + k_b;
+            let normal_mass = k.cmp_gt(zero).blend(one / k, zero) * keep[i];
+            // Softness::with_mass_ratio on lanes: ρ = min(k / min(k_a, k_b), ρ_max).
+            let (mut mass_scale, mut impulse_scale) =
+                (splat(sc.mass_scale), splat(sc.impulse_scale));
+            if stiffen {
+                let k_heavy = k_a.fast_min(k_b);
+                let rho = (k / k_heavy).fast_min(splat(rho_max));
+                let stiffer = k_heavy.cmp_gt(zero) & rho.cmp_gt(one);
+                let scaled = one / (one + rho * splat(a2));
+                impulse_scale = stiffer.blend(scaled, impulse_scale);
+                mass_scale = stiffer.blend(one - scaled, mass_scale);
             }
-            for i in 0..MAX_MANIFOLD_POINTS {
-                c.max_normal_impulse[i] = max_normal[i][k];
-            }
+            let mass_scale = static_pair.blend(splat(ss.mass_scale), mass_scale);
+            let impulse_scale = static_pair.blend(splat(ss.impulse_scale), impulse_scale);
+            self.mass[i] = normal_mass;
+            self.soft_mass[i] = normal_mass * mass_scale;
+            self.impulse_scale[i] = impulse_scale;
+            let k_t = m_a + m_b + i_a * rt_a * rt_a + i_b * rt_b * rt_b;
+            self.mass[i + 2] = k_t.cmp_gt(zero).blend(one / k_t, zero) * keep[i];
+            self.relative_velocity[i] = dvn + (w_b * rn_b - w_a * rn_a);
+            self.max_normal_impulse[i] = zero;
         }
+        if !ctx.warm_starting {
+            self.impulse = [zero; ROWS];
+        }
+    }
+
+    /// Restitution lane-wise, point 0 then point 1: where a point approached
+    /// faster than the threshold and pushed, drive `Ċ` to `−e · Ċ_before`.
+    fn apply_restitution(&mut self, states: &mut [BodyState], threshold: W) {
+        let zero = W::splat(0.0);
+        if self.restitution.cmp_gt(zero).none() {
+            return;
+        }
+        let (mut v_xa, mut v_ya, mut w_a) = gather_velocity(states, &self.state_a);
+        let (mut v_xb, mut v_yb, mut w_b) = gather_velocity(states, &self.state_b);
+        let (n_x, n_y) = (self.n_x, self.n_y);
+        let e = self.restitution;
+        for i in 0..MAX_MANIFOLD_POINTS {
+            let rv = self.relative_velocity[i];
+            let active = self.restitution.cmp_gt(zero)
+                & rv.cmp_lt(zero - threshold)
+                & self.max_normal_impulse[i].cmp_ne(zero);
+            if active.none() {
+                continue;
+            }
+            let (rn_a, rn_b) = (self.ja[i], self.jb[i]);
+            let c_dot = (v_xb - v_xa) * n_x + (v_yb - v_ya) * n_y + (w_b * rn_b - w_a * rn_a);
+            let lambda = zero - self.mass[i] * (c_dot + e * rv);
+            let old = self.impulse[i];
+            let new_impulse = (old + lambda).fast_max(zero);
+            let applied = active.blend(new_impulse - old, zero);
+            self.impulse[i] = old + applied;
+            self.max_normal_impulse[i] = self.max_normal_impulse[i].fast_max(applied);
+            let (p_x, p_y) = (applied * n_x, applied * n_y);
+            v_xa -= self.inv_mass_a * p_x;
+            v_ya -= self.inv_mass_a * p_y;
+            w_a -= self.inv_inertia_a * applied * rn_a;
+            v_xb += self.inv_mass_b * p_x;
+            v_yb += self.inv_mass_b * p_y;
+            w_b += self.inv_inertia_b * applied * rn_b;
+        }
+        scatter(states, &self.state_a, v_xa, v_ya, w_a);
+        scatter(states, &self.state_b, v_xb, v_yb, w_b);
     }
 
     /// Applies the kept impulses: `Δv = M⁻¹ Jᵀ λ`.
@@ -602,7 +762,8 @@ pub struct ContactBatch<'a> {
     /// The constraints and their packed form.
     pub solver: &'a mut ContactSolver,
     /// The contact-modification hook's data: bodies whose contacts build
-    /// their effective masses on a whole object's mass (portal copies).
+    /// their effective masses on a whole object's mass (portal copies; the
+    /// pipeline puts their contacts in the overflow).
     pub object_masses: &'a [ObjectMass],
 }
 
@@ -612,22 +773,7 @@ impl ConstraintBatch for ContactBatch<'_> {
     }
 
     fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
-        let objects = self.object_masses;
-        for c in self.solver.colours.iter_mut().flatten() {
-            c.prepare(ctx, bodies);
-            if objects.is_empty() {
-                continue;
-            }
-            let find = |body| objects.iter().find(|o| o.body == body);
-            let (oa, ob) = (find(c.body_a), find(c.body_b));
-            if oa.is_some() || ob.is_some() {
-                let [m_a, i_a, m_b, i_b] = c.applied_masses;
-                let (m_a, i_a) = oa.map_or((m_a, i_a), |o| (o.inv_mass, o.inv_inertia));
-                let (m_b, i_b) = ob.map_or((m_b, i_b), |o| (o.inv_mass, o.inv_inertia));
-                c.prepare_rows(ctx, bodies, [m_a, i_a, m_b, i_b]);
-            }
-        }
-        self.solver.pack();
+        self.solver.prepare(ctx, bodies, self.object_masses);
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
@@ -645,13 +791,8 @@ impl ConstraintBatch for ContactBatch<'_> {
     }
 
     fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
-        self.solver.unpack();
-        for c in self.solver.colours.iter_mut().flatten() {
-            c.apply_restitution(ctx, states);
-        }
+        self.solver.apply_restitution(ctx, states);
     }
 
-    fn store_impulses(&mut self) {
-        self.solver.unpack();
-    }
+    fn store_impulses(&mut self) {}
 }

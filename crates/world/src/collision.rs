@@ -23,7 +23,7 @@
 //! Contacts are iterated in list order and found through indices used only
 //! for lookups: the order of every loop is the same for the same inputs.
 
-use janus2d_constraints::ContactConstraint;
+use janus2d_constraints::ContactSolver;
 use janus2d_constraints::contact::{mix_friction, mix_restitution};
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::geometry::{Aabb, Shape};
@@ -205,18 +205,13 @@ impl Collision {
     }
 
     /// Copies solved impulses back into the contacts (for warm starting).
-    pub(crate) fn store_impulses<'a>(
-        &mut self,
-        constraints: impl Iterator<Item = &'a ContactConstraint>,
-    ) {
-        for cc in constraints {
-            let c = self.contacts.awake_mut(cc.contact_index as usize);
-            for i in 0..cc.point_count() {
-                let (n, t) = cc.impulses(i);
-                c.points[i].normal_impulse = n;
-                c.points[i].tangent_impulse = t;
-            }
-        }
+    pub(crate) fn store_impulses(&mut self, solver: &ContactSolver) {
+        let contacts = &mut self.contacts;
+        solver.for_each_impulse(|index, point, normal, tangent| {
+            let p = &mut contacts.awake_mut(index as usize).points[point];
+            p.normal_impulse = normal;
+            p.tangent_impulse = tangent;
+        });
     }
 
     /// Recomputes the boxes of the shapes of moving bodies and moves their

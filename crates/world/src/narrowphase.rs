@@ -18,8 +18,8 @@
 //! is computed alone; phase 2 runs in list order.
 
 use janus2d_constraints::ContactPointInput;
-use janus2d_constraints::contact::ContactConstraint;
-use janus2d_constraints::contact_solver::ContactSolver;
+use janus2d_constraints::ObjectMass;
+use janus2d_constraints::contact_solver::{ContactLane, ContactSolver, OVERFLOW};
 use janus2d_core::body::{BodyHandle, BodySet};
 use janus2d_core::geometry::{Aabb, Manifold, collide};
 use janus2d_core::math::{Real, Vec2};
@@ -49,10 +49,25 @@ enum ContactUpdate {
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Narrowphase {
     results: Vec<ContactUpdate>,
-    /// Colour of each awake contact while the constraints are built.
-    colour_of: Vec<u8>,
-    /// Solved contacts: index, moving state indices, pair with a static body.
-    solved: Vec<(u32, Option<u32>, Option<u32>, bool)>,
+    /// The contacts solved this step, in contact order.
+    solved: Vec<SolvedContact>,
+}
+
+/// A contact the solve takes this step, as the build's first pass found it.
+#[derive(Clone, Copy, Debug)]
+struct SolvedContact {
+    /// Index in the awake list.
+    index: u32,
+    /// State index of each body (0: static or asleep).
+    state: [u32; 2],
+    /// Whether the solve moves each body.
+    moving: [bool; 2],
+    /// Against a static (or sleeping) body: coloured after the moving pairs.
+    with_static: bool,
+    /// A portal copy takes part: the object-mass hook, in the overflow.
+    copy: bool,
+    /// Its colour ([`OVERFLOW`]: solved scalar).
+    colour: u8,
 }
 
 /// What the narrowphase reads besides the contacts it updates.
@@ -237,12 +252,11 @@ pub(crate) fn build_constraints(
     contacts: &mut ContactSet,
     bodies: &BodySet,
     woke: bool,
+    objects: &[ObjectMass],
     solver: &mut ContactSolver,
     counters: &mut CollisionCounters,
 ) {
-    let Narrowphase {
-        colour_of, solved, ..
-    } = narrowphase;
+    let solved = &mut narrowphase.solved;
     if woke {
         for k in 0..contacts.awake().len() {
             let c = contacts.awake_mut(k);
@@ -254,46 +268,64 @@ pub(crate) fn build_constraints(
             }
         }
     }
-    // The state index of a body the solve moves (dynamic and awake).
-    let moving = |body: BodyHandle| {
-        let i = bodies.state_index(body)?;
-        let sim = bodies.sims.get(i as usize)?;
-        (i != 0 && (sim.inv_mass > 0.0 || sim.inv_inertia > 0.0)).then_some(i)
+    // The state index of a body (0: static or asleep) and whether the
+    // solve moves it (dynamic and awake).
+    let state_of = |body: BodyHandle| -> (u32, bool) {
+        let i = bodies.state_index(body).unwrap_or(0);
+        let moving = i != 0
+            && bodies
+                .sims
+                .get(i as usize)
+                .is_some_and(|sim| sim.inv_mass > 0.0 || sim.inv_inertia > 0.0);
+        (i, moving)
     };
+    // A portal copy: its contacts take the object-mass hook, in the overflow.
+    let is_copy = |body: BodyHandle| objects.iter().any(|o| o.body == body);
     // Pass 1: colours, moving pairs first, static pairs last. One read of
     // the contacts lists the solved ones; the two colour passes then run
     // over that short list.
-    const NOT_SOLVED: u8 = u8::MAX;
     solver.begin(bodies.states.len());
     let awake = contacts.awake();
-    colour_of.clear();
-    colour_of.resize(awake.len(), NOT_SOLVED);
     solved.clear();
     for (k, c) in awake.iter().enumerate() {
         let [sa, sb] = c.still;
         if !c.is_solid_touching() || (sa && sb) {
             continue;
         }
-        solved.push((k as u32, moving(c.body_a), moving(c.body_b), sa || sb));
+        let (ia, moving_a) = state_of(c.body_a);
+        let (ib, moving_b) = state_of(c.body_b);
+        let copy = !objects.is_empty() && (is_copy(c.body_a) || is_copy(c.body_b));
+        solved.push(SolvedContact {
+            index: k as u32,
+            state: [ia, ib],
+            moving: [moving_a, moving_b],
+            with_static: sa || sb,
+            copy,
+            colour: OVERFLOW,
+        });
     }
     for static_pass in [false, true] {
-        for &(k, a, b, is_static) in solved.iter() {
-            if is_static == static_pass {
-                colour_of[k as usize] = solver.assign(a, b);
+        for s in solved.iter_mut() {
+            if s.with_static == static_pass {
+                s.colour = if s.copy {
+                    OVERFLOW
+                } else {
+                    let [ia, ib] = s.state;
+                    let [ma, mb] = s.moving;
+                    solver.assign(ma.then_some(ia), mb.then_some(ib))
+                };
             }
         }
     }
-    // Pass 2: the constraints, appended to their colours in contact order.
+    // Pass 2: each contact into its colour, in contact order.
     let (mut rows, mut bouncy) = (0, 0);
-    for (k, c) in awake.iter().enumerate() {
-        let colour = colour_of[k];
-        if colour == NOT_SOLVED {
-            continue;
-        }
+    for s in solved.iter() {
+        let k = s.index as usize;
+        let c = &awake[k];
         rows += 2 * c.point_count;
         bouncy += usize::from(c.restitution > 0.0);
-        let mut inputs = [ContactPointInput::default(); 2];
-        for (input, p) in inputs.iter_mut().zip(&c.points[..c.point_count]) {
+        let mut points = [ContactPointInput::default(); 2];
+        for (input, p) in points.iter_mut().zip(&c.points[..c.point_count]) {
             *input = ContactPointInput {
                 anchor_a: p.anchor_a,
                 anchor_b: p.anchor_b,
@@ -302,16 +334,29 @@ pub(crate) fn build_constraints(
                 tangent_impulse: p.tangent_impulse,
             };
         }
-        let constraint = ContactConstraint::new(
-            c.body_a,
-            c.body_b,
-            c.normal,
-            &inputs[..c.point_count],
-            c.friction,
-            c.restitution,
-            k as u32,
-        );
-        solver.push(colour, constraint);
+        let masses = |i: u32| {
+            bodies
+                .sims
+                .get(i as usize)
+                .filter(|_| i != 0)
+                .map_or((0.0, 0.0), |sim| (sim.inv_mass, sim.inv_inertia))
+        };
+        let [ia, ib] = s.state;
+        let ((m_a, i_a), (m_b, i_b)) = (masses(ia), masses(ib));
+        let lane = ContactLane {
+            body_a: c.body_a,
+            body_b: c.body_b,
+            state_a: ia,
+            state_b: ib,
+            inv_masses: [m_a, i_a, m_b, i_b],
+            normal: c.normal,
+            points,
+            point_count: c.point_count,
+            friction: c.friction,
+            restitution: c.restitution,
+            contact_index: k as u32,
+        };
+        solver.push(s.colour, &lane);
     }
     counters.contact_rows = rows;
     counters.restitution_contacts = bouncy;

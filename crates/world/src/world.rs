@@ -1224,16 +1224,17 @@ impl World {
             self.wake_list = wake;
             self.islands
                 .read_contact_changes(&mut self.collision.contacts, &self.bodies);
+            self.portals
+                .object_masses(&self.bodies, &mut self.object_masses);
             crate::narrowphase::build_constraints(
                 &mut self.collision.narrowphase,
                 &mut self.collision.contacts,
                 &self.bodies,
                 woke,
+                &self.object_masses,
                 &mut self.contact_solver,
                 &mut self.collision.counters,
             );
-            self.portals
-                .object_masses(&self.bodies, &mut self.object_masses);
             sp.narrowphase += lap();
         } else {
             self.contact_solver.begin(0);
@@ -1253,8 +1254,7 @@ impl World {
         let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
         lap();
         if has_shapes {
-            self.collision
-                .store_impulses(self.contact_solver.constraints());
+            self.collision.store_impulses(&self.contact_solver);
             self.collision.update_proxies(&self.bodies, dt);
             sp.broadphase += lap();
         }
