@@ -1,0 +1,1 @@
+//! janus2d-cli (being written).

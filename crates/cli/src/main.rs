@@ -1,0 +1,2 @@
+//! The `janus2d` command (being written).
+fn main() {}

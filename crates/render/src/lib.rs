@@ -1,0 +1,1 @@
+//! janus2d-render (being written).
