@@ -120,8 +120,9 @@ fn union(acc: Option<Aabb>, b: &Aabb) -> Option<Aabb> {
 }
 
 /// The box around every shape of the world; when the static shapes reach
-/// far beyond the moving ones (a 200 m ground under a 10 m stack), the
-/// moving bodies' box grown to 3 times its size, clipped to the whole.
+/// more than 20 times beyond the moving ones both ways (a huge static
+/// box around a small pile), the moving bodies' box grown to 3 times its
+/// size, clipped to the whole.
 /// An empty world gives a 2 m box around the origin.
 #[must_use]
 pub fn scene_bounds(world: &World) -> Aabb {
@@ -141,12 +142,12 @@ pub fn scene_bounds(world: &World) -> Aabb {
     let Some(all) = all else {
         return Aabb::new(Vec2::splat(-1.0), Vec2::splat(1.0));
     };
-    let area = |b: &Aabb| {
-        let e = b.upper - b.lower;
-        to_f64(e.x.max(0.1)) * to_f64(e.y.max(0.1))
+    let wide = |b: &Aabb, m: &Aabb| {
+        let (e, f) = (b.upper - b.lower, m.upper - m.lower);
+        to_f64(e.x) > 20.0 * to_f64(f.x.max(0.5)) && to_f64(e.y) > 20.0 * to_f64(f.y.max(0.5))
     };
     match moving {
-        Some(m) if area(&all) > 16.0 * area(&m) => {
+        Some(m) if wide(&all, &m) => {
             let c = 0.5 * (m.lower + m.upper);
             let h = 1.5 * (m.upper - m.lower);
             let grown = Aabb::new(c - h, c + h);
