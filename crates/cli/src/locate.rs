@@ -184,9 +184,9 @@ mod tests {
     #[test]
     fn finds_nested_fields() {
         let text = "{\n  \"a\": [1, {\"b\": \"x,]}\"}],\n  \"bodies\": [\n    {},\n    {\"shapes\": [ {\"density\": -1} ]}\n  ]\n}";
-        assert_eq!(locate(text, "bodies[1].shapes[0].density"), Some((5, 28)));
+        assert_eq!(locate(text, "bodies[1].shapes[0].density"), Some((5, 30)));
         assert_eq!(locate(text, "bodies[1]"), Some((5, 5)));
-        assert_eq!(locate(text, "a[1].b"), Some((2, 16)));
+        assert_eq!(locate(text, "a[1].b"), Some((2, 18)));
         // A field the file left out: the enclosing one.
         assert_eq!(locate(text, "bodies[0].shapes"), Some((4, 5)));
         assert_eq!(locate(text, ""), Some((1, 1)));
