@@ -533,6 +533,7 @@ fn run_here<W: Write>(
     let mut bar: Option<indicatif::ProgressBar> = None;
     let mut wall = 0.0;
     let mut sum = StageMs::default();
+    #[cfg_attr(not(feature = "portals"), allow(unused_mut))]
     let mut crossings = [0usize; 3];
     let mut non_finite_steps = 0;
     let mut printed = 0usize;

@@ -23,6 +23,7 @@ fn temp(name: &str) -> PathBuf {
     dir.join(name)
 }
 
+#[cfg(feature = "portals")]
 fn example() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/playground.json")
 }
@@ -44,13 +45,13 @@ fn every_small_built_in_scene_runs() {
     }
 }
 
+#[cfg(feature = "portals")]
 #[test]
 fn the_example_file_builds_and_runs() {
     let mut scene = runner::load(example().to_str().unwrap()).unwrap();
     assert_eq!(scene.name, "playground");
     assert_eq!(scene.world().body_count(), 11);
     assert_eq!(scene.world().joint_count(), 3);
-    #[cfg(feature = "portals")]
     assert_eq!(scene.world().portal_pair_count(), 1);
     let mut out = Vec::new();
     let s = runner::run(&mut scene, &quiet(120), &mut out).unwrap();

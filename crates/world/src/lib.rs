@@ -8,7 +8,7 @@
 //! | [`world`]        | [`World`], [`WorldDef`], the public API and the step      |
 //! | [`error`]        | [`WorldError`], the typed errors of the API               |
 //! | [`shapes`]       | the shape store: geometry, material, filter, body → shapes |
-//! | [`debug_draw`]   | the [`DebugDraw`](debug_draw::DebugDraw) trait, draw flags and colours, the drawing walk |
+//! | [`debug_draw`]   | the [`DebugDraw`] trait, draw flags and colours, the drawing walk |
 //! | [`contacts`]     | the contact life cycle; awake and sleeping contacts, body → contacts |
 //! | [`narrowphase`]  | manifolds of awake contacts; contact constraints          |
 //! | [`collision`]    | the collision stage: shapes + broadphase + contacts + events |
