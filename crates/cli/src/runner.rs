@@ -165,7 +165,7 @@ pub struct RunOptions {
     pub steps: Option<usize>,
     /// Substeps (the scene's own by default).
     pub substeps: Option<u32>,
-    /// Worker threads for the parallel narrowphase (1: this thread).
+    /// Worker threads of the parallel narrowphase (a pool of exactly this many).
     pub threads: usize,
     /// Pictures.
     pub frames: Frames,
@@ -428,9 +428,8 @@ pub fn run<W: Write + Send>(
     if options.threads == 0 {
         return Err(CliError::Invalid("--threads must be at least 1".into()));
     }
-    if options.threads == 1 {
-        return run_here(scene, options, out);
-    }
+    // Always inside a pool of exactly `threads` (the world's parallel
+    // narrowphase would otherwise use rayon's global pool, one thread per core).
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(options.threads)
         .build()
