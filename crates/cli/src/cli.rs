@@ -5,6 +5,7 @@
 //! | `janus2d list` | the built-in scenes, by group, with their bodies and steps |
 //! | `janus2d run SCENE [--steps N] [--substeps N] [--threads N] [--png DIR \| --gif FILE] [--every K] [--size WxH] [--follow] [--draw FLAGS] [--profile] [--csv FILE]` | runs a built-in scene or a scene file, prints what happened and a summary |
 //! | `janus2d export SCENE [-o FILE]` | writes a built-in scene (one without a script) as a scene file |
+//! | `janus2d serve [SCENE] [--port P]` | runs the scene and streams it to a page on `http://127.0.0.1:P/` ([`crate::serve`]) |
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -33,6 +34,15 @@ pub enum Command {
     List,
     /// Run a built-in scene or a JSON scene file.
     Run(RunArgs),
+    /// Run a scene and show it on a page at http://127.0.0.1:PORT/.
+    Serve {
+        /// A built-in scene or a scene file.
+        #[arg(default_value = "portal_drop")]
+        scene: String,
+        /// The port (0: any free one).
+        #[arg(long, default_value_t = 8080)]
+        port: u16,
+    },
     /// Write a built-in scene as a JSON scene file.
     Export {
         /// The built-in scene.
@@ -209,6 +219,13 @@ pub fn execute<W: Write + Send>(cli: &Cli, out: &mut W) -> Result<(), CliError> 
             let mut scene = runner::load(&args.scene)?;
             runner::run(&mut scene, &options, out).map(|_| ())
         }
+        Command::Serve { scene, port } => crate::serve::serve(scene, *port, |addr| {
+            let _ = writeln!(
+                out,
+                "janus2d serve {scene}: open http://{addr}/ (Ctrl-C stops)"
+            );
+            let _ = out.flush();
+        }),
         Command::Export { scene, out: file } => {
             let e = catalog::find(scene)?;
             let text = SceneFile::from_desc(&e.desc)
