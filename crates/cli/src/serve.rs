@@ -21,6 +21,9 @@
 //! | `{"cmd":"scene","name":"tumbler"}`    | another built-in scene            |
 //! | `{"cmd":"substeps","n":8}`            | substeps from now on              |
 //! | `{"cmd":"draw","flags":"+contacts"}`  | draw flags as `run --draw` takes  |
+//! | `{"cmd":"knob","name":"contact_hertz","value":60}` | a solver setting, live ([`Control::Knob`]) |
+//! | `{"cmd":"grab","x":1,"y":2}`, `drag`, `release` | pull a body by a spring (5 Hz, ζ 0.7, at most 1000 g of force) |
+//! | `{"cmd":"spawn","x":1,"y":2}`         | drop a 1 m box there              |
 //!
 //! | message out                           | what                              |
 //! |---------------------------------------|-----------------------------------|
@@ -37,9 +40,11 @@ use axum::extract::State;
 use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
 use axum::response::{Html, IntoResponse, Response};
 use axum::routing::get;
-use janus2d_core::math::{Real, Vec2, to_f64};
-use janus2d_world::DrawOptions;
+use janus2d_core::body::{BodyDef, BodyHandle, BodyType};
+use janus2d_core::geometry::{Aabb, Polygon, Shape};
+use janus2d_core::math::{Real, Transform, Vec2, from_f64, to_f64};
 use janus2d_world::debug_draw::{Color, DebugDraw};
+use janus2d_world::{DrawOptions, ShapeDef, World};
 use serde::Deserialize;
 use serde_json::{Value, json};
 
@@ -52,7 +57,7 @@ use crate::runner::{self, Loaded};
 pub const PAGE: &str = include_str!("serve_page.html");
 
 /// A control from the page.
-#[derive(Clone, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(tag = "cmd", rename_all = "snake_case")]
 pub enum Control {
     /// Stop stepping.
@@ -77,6 +82,40 @@ pub enum Control {
     Draw {
         /// The flags.
         flags: String,
+    },
+    /// An accuracy knob of the solver settings, live: `relax_iterations`,
+    /// `contact_hertz`, `contact_damping_ratio`, `contact_push_max_velocity`,
+    /// `joint_hertz`, `joint_damping_ratio`, `restitution_threshold`,
+    /// `warm_starting` (0 or 1), or `gravity` (its y, m/s²).
+    Knob {
+        /// The setting.
+        name: String,
+        /// Its new value.
+        value: f64,
+    },
+    /// Grabs the dynamic body under a world point (m): a spring then pulls
+    /// that point of it towards the drag target.
+    Grab {
+        /// x, m.
+        x: f64,
+        /// y, m.
+        y: f64,
+    },
+    /// Moves the drag target (m).
+    Drag {
+        /// x, m.
+        x: f64,
+        /// y, m.
+        y: f64,
+    },
+    /// Lets the grabbed body go.
+    Release,
+    /// Drops a 1 m box at a world point (m).
+    Spawn {
+        /// x, m.
+        x: f64,
+        /// y, m.
+        y: f64,
     },
 }
 
@@ -169,6 +208,15 @@ pub fn scene_message(scene: &Loaded) -> String {
         "dt": to_f64(scene.dt),
         "substeps": scene.world().settings().substeps,
         "bodies": scene.world().body_count(),
+        "settings": {
+            "relax_iterations": scene.world().settings().relax_iterations,
+            "contact_hertz": to_f64(scene.world().settings().contact_hertz),
+            "contact_damping_ratio": to_f64(scene.world().settings().contact_damping_ratio),
+            "joint_hertz": to_f64(scene.world().settings().joint_hertz),
+            "joint_damping_ratio": to_f64(scene.world().settings().joint_damping_ratio),
+            "contact_push_max_velocity": to_f64(scene.world().settings().contact_push_max_velocity),
+            "gravity": to_f64(scene.world().gravity().y),
+        },
     })
     .to_string()
 }
@@ -216,6 +264,56 @@ pub struct Session {
     step: usize,
     running: bool,
     draw: DrawOptions,
+    /// The grabbed body, the grabbed point in its frame, the target.
+    grab: Option<(BodyHandle, Vec2, Vec2)>,
+}
+
+/// Drag spring frequency, Hz.
+const GRAB_HERTZ: f64 = 5.0;
+/// Drag spring damping ratio.
+const GRAB_DAMPING: f64 = 0.7;
+/// Largest drag force per kilogram, N/kg.
+const GRAB_MAX_ACCEL: f64 = 1000.0 * 9.81;
+
+fn point(x: f64, y: f64) -> Result<Vec2, CliError> {
+    if x.is_finite() && y.is_finite() {
+        Ok(Vec2::new(from_f64(x), from_f64(y)))
+    } else {
+        Err(CliError::Invalid("a point must be finite".into()))
+    }
+}
+
+/// Whether the world point `p` lies in `shape` of a body at `xf`.
+fn contains(shape: &Shape, xf: &Transform, p: Vec2) -> bool {
+    let l = xf.apply_inv(p);
+    let near_segment = |a: Vec2, b: Vec2, r: Real| {
+        let d = b - a;
+        let t = ((l - a).dot(d) / d.length_squared().max(Real::EPSILON)).clamp(0.0, 1.0);
+        (a + t * d).distance(l) <= r
+    };
+    match shape {
+        Shape::Circle(c) => c.center.distance(l) <= c.radius,
+        Shape::Capsule(c) => near_segment(c.center1, c.center2, c.radius),
+        Shape::Polygon(poly) => {
+            (0..poly.count).all(|i| poly.normals[i].dot(l - poly.vertices[i]) <= poly.radius)
+        }
+        Shape::Segment(_) | Shape::ChainSegment(_) => false,
+    }
+}
+
+/// The dynamic body with a shape under `p`, if any.
+pub fn body_at(world: &World, p: Vec2) -> Option<BodyHandle> {
+    let probe = Aabb::new(p - Vec2::splat(0.01), p + Vec2::splat(0.01));
+    world.bodies_in_box(&probe).into_iter().find(|&b| {
+        world.body_type(b) == Ok(BodyType::Dynamic)
+            && world.transform(b).is_ok_and(|xf| {
+                world
+                    .body_shapes(b)
+                    .unwrap_or_default()
+                    .iter()
+                    .any(|&s| world.shape(s).is_ok_and(|d| contains(&d.geometry, &xf, p)))
+            })
+    })
 }
 
 impl Session {
@@ -227,7 +325,45 @@ impl Session {
             step: 0,
             running: true,
             draw: DrawOptions::default(),
+            grab: None,
         })
+    }
+
+    /// The grabbed body, if any.
+    #[must_use]
+    pub fn grabbed(&self) -> Option<BodyHandle> {
+        self.grab.map(|g| g.0)
+    }
+
+    fn knob(&mut self, name: &str, value: f64) -> Result<(), CliError> {
+        let bad = || CliError::Invalid(format!("knob `{name}` = {value}: out of range"));
+        if !value.is_finite() {
+            return Err(bad());
+        }
+        let world = self.scene.world_mut();
+        if name == "gravity" {
+            let g = world.gravity();
+            return world
+                .set_gravity(Vec2::new(g.x, from_f64(value)))
+                .map_err(|_| bad());
+        }
+        let mut s = world.settings().clone();
+        let v = from_f64(value);
+        match name {
+            "relax_iterations" if value >= 0.0 => s.relax_iterations = value as u32,
+            "contact_hertz" => s.contact_hertz = v,
+            "contact_damping_ratio" => s.contact_damping_ratio = v,
+            "contact_push_max_velocity" => s.contact_push_max_velocity = v,
+            "joint_hertz" => s.joint_hertz = v,
+            "joint_damping_ratio" => s.joint_damping_ratio = v,
+            "restitution_threshold" => s.restitution_threshold = v,
+            "warm_starting" => s.warm_starting = value != 0.0,
+            "relax_iterations" => return Err(bad()),
+            other => return Err(CliError::Invalid(format!("no knob `{other}`"))),
+        }
+        world
+            .set_settings(s)
+            .map_err(|e| CliError::Invalid(format!("knob `{name}`: {e}")))
     }
 
     /// The scene.
@@ -279,12 +415,64 @@ impl Session {
                     .map_err(|e| CliError::Invalid(format!("substeps {n}: {e}")))?;
             }
             Control::Draw { flags } => self.draw = parse_draw(&flags)?,
+            Control::Knob { name, value } => self.knob(&name, value)?,
+            Control::Grab { x, y } => {
+                let p = point(x, y)?;
+                let world = self.scene.world();
+                self.grab = body_at(world, p)
+                    .and_then(|b| Some((b, world.transform(b).ok()?.apply_inv(p), p)));
+            }
+            Control::Drag { x, y } => {
+                let p = point(x, y)?;
+                if let Some(g) = &mut self.grab {
+                    g.2 = p;
+                }
+            }
+            Control::Release => self.grab = None,
+            Control::Spawn { x, y } => {
+                let p = point(x, y)?;
+                let world = self.scene.world_mut();
+                let b = world.create_body(&BodyDef::dynamic(p))?;
+                world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))?;
+            }
         }
         Ok(None)
     }
 
+    /// The drag spring's force for this step, applied at the grabbed point.
+    fn pull(&mut self) {
+        let Some((body, local, target)) = self.grab else {
+            return;
+        };
+        let world = self.scene.world_mut();
+        let (Ok(xf), Ok(m), Ok(v), Ok(w), Ok(c)) = (
+            world.transform(body),
+            world.mass(body),
+            world.linear_velocity(body),
+            world.angular_velocity(body),
+            world.center_of_mass(body),
+        ) else {
+            self.grab = None;
+            return;
+        };
+        let anchor = xf.apply(local);
+        let v_anchor = v + janus2d_core::math::cross_sv(w, anchor - c);
+        let omega = 2.0 * std::f64::consts::PI * GRAB_HERTZ;
+        let (k, d) = (
+            from_f64(omega * omega),
+            from_f64(2.0 * GRAB_DAMPING * omega),
+        );
+        let mut accel = k * (target - anchor) - d * v_anchor;
+        let max = from_f64(GRAB_MAX_ACCEL);
+        if accel.length() > max {
+            accel = accel.normalize() * max;
+        }
+        let _ = world.apply_force(body, m * accel, anchor);
+    }
+
     /// One step.
     pub fn advance(&mut self) -> Result<(), CliError> {
+        self.pull();
         self.scene.step(self.step)?;
         self.step += 1;
         Ok(())

@@ -138,11 +138,93 @@ fn the_session_applies_controls() {
     assert_eq!(s.step_count(), 0);
     let frame: Value = serde_json::from_str(&s.frame()).unwrap();
     assert_eq!(frame["type"], "frame");
+    // Knobs.
+    s.apply(Control::Knob {
+        name: "contact_hertz".into(),
+        value: 45.0,
+    })
+    .unwrap();
+    assert_eq!(s.scene().world().settings().contact_hertz, 45.0);
+    s.apply(Control::Knob {
+        name: "warm_starting".into(),
+        value: 0.0,
+    })
+    .unwrap();
+    assert!(!s.scene().world().settings().warm_starting);
+    s.apply(Control::Knob {
+        name: "gravity".into(),
+        value: -5.0,
+    })
+    .unwrap();
+    assert_eq!(s.scene().world().gravity().y, -5.0);
+    assert!(
+        s.apply(Control::Knob {
+            name: "colour".into(),
+            value: 1.0
+        })
+        .is_err()
+    );
+    assert!(
+        s.apply(Control::Knob {
+            name: "contact_hertz".into(),
+            value: f64::NAN
+        })
+        .is_err()
+    );
     let c: Control = serde_json::from_str(r#"{"cmd":"scene","name":"tumbler"}"#).unwrap();
     assert_eq!(
         c,
         Control::Scene {
             name: "tumbler".into()
         }
+    );
+}
+
+/// A drag pulls the body to the target; a click on nothing grabs
+/// nothing; shift-click drops a box.
+#[test]
+fn grab_drag_and_spawn() {
+    let mut s = Session::new("single_box").unwrap();
+    // single_box: a unit box resting on the ground at (0, 0.5)..; find it.
+    let world = s.scene().world();
+    let body = world
+        .bodies()
+        .handles()
+        .find(|&b| world.body_type(b) == Ok(janus2d_core::body::BodyType::Dynamic))
+        .unwrap();
+    let p = world.position(body).unwrap();
+    let (x, y) = (f64::from(p.x), f64::from(p.y));
+    s.apply(Control::Grab { x: x + 100.0, y }).unwrap();
+    assert_eq!(s.grabbed(), None, "nothing under the cursor");
+    s.apply(Control::Grab { x, y }).unwrap();
+    assert_eq!(s.grabbed(), Some(body));
+    s.apply(Control::Drag {
+        x: x + 3.0,
+        y: y + 2.0,
+    })
+    .unwrap();
+    for _ in 0..120 {
+        s.advance().unwrap();
+    }
+    let q = s.scene().world().position(body).unwrap();
+    assert!(
+        (f64::from(q.x) - (x + 3.0)).abs() < 0.3,
+        "pulled to the target: {q:?}"
+    );
+    assert!(
+        (f64::from(q.y) - (y + 2.0)).abs() < 0.3,
+        "held up against gravity: {q:?}"
+    );
+    s.apply(Control::Release).unwrap();
+    assert_eq!(s.grabbed(), None);
+    let before = s.scene().world().body_count();
+    s.apply(Control::Spawn { x: 2.0, y: 5.0 }).unwrap();
+    assert_eq!(s.scene().world().body_count(), before + 1);
+    assert!(
+        s.apply(Control::Spawn {
+            x: f64::NAN,
+            y: 0.0
+        })
+        .is_err()
     );
 }
