@@ -193,7 +193,10 @@ fn grab_drag_and_spawn() {
         .find(|&b| world.body_type(b) == Ok(janus2d_core::body::BodyType::Dynamic))
         .unwrap();
     let p = world.position(body).unwrap();
-    let (x, y) = (f64::from(p.x), f64::from(p.y));
+    let (x, y) = (
+        janus2d_core::math::to_f64(p.x),
+        janus2d_core::math::to_f64(p.y),
+    );
     s.apply(Control::Grab { x: x + 100.0, y }).unwrap();
     assert_eq!(s.grabbed(), None, "nothing under the cursor");
     s.apply(Control::Grab { x, y }).unwrap();
@@ -208,11 +211,11 @@ fn grab_drag_and_spawn() {
     }
     let q = s.scene().world().position(body).unwrap();
     assert!(
-        (f64::from(q.x) - (x + 3.0)).abs() < 0.3,
+        (janus2d_core::math::to_f64(q.x) - (x + 3.0)).abs() < 0.3,
         "pulled to the target: {q:?}"
     );
     assert!(
-        (f64::from(q.y) - (y + 2.0)).abs() < 0.3,
+        (janus2d_core::math::to_f64(q.y) - (y + 2.0)).abs() < 0.3,
         "held up against gravity: {q:?}"
     );
     s.apply(Control::Release).unwrap();
