@@ -656,7 +656,9 @@ mod tests {
     fn one_polygon_per_box_and_nothing_else_by_default() {
         let world = stack(5);
         let mut r = Recorder::default();
-        world.debug_draw(&mut r, &DrawOptions::default());
+        // Through a trait object too.
+        let d: &mut dyn DebugDraw = &mut r;
+        world.debug_draw(d, &DrawOptions::default());
         assert_eq!(r.solid_polygons, 5);
         assert_eq!(r.segments, 1, "the ground segment");
         assert_eq!(r.points + r.polygons + r.transforms, 0);

@@ -1003,7 +1003,7 @@ impl World {
     /// Reads only; costs nothing when not called.
     pub fn debug_draw(
         &self,
-        draw: &mut impl crate::debug_draw::DebugDraw,
+        draw: &mut (impl crate::debug_draw::DebugDraw + ?Sized),
         options: &crate::debug_draw::DrawOptions,
     ) {
         let island_of = |body| self.islands.island_id(body);
