@@ -428,6 +428,12 @@ pub fn run<W: Write + Send>(
     if options.threads == 0 {
         return Err(CliError::Invalid("--threads must be at least 1".into()));
     }
+    if options.threads > 1 && cfg!(not(feature = "parallel")) {
+        return Err(CliError::Invalid(format!(
+            "--threads {} needs the parallel narrowphase: build with `--features parallel` (cargo run --release -p janus2d-cli --features parallel -- …)",
+            options.threads
+        )));
+    }
     // Always inside a pool of exactly `threads` (the world's parallel
     // narrowphase would otherwise use rayon's global pool, one thread per core).
     let pool = rayon::ThreadPoolBuilder::new()

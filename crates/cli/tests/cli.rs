@@ -238,8 +238,19 @@ fn frames_and_csv_are_written() {
 #[test]
 fn threads_substeps_and_bad_options() {
     let mut scene = runner::load("hard/pyramid20").unwrap();
-    let options = RunOptions {
+    let two = RunOptions {
         threads: 2,
+        ..quiet(2)
+    };
+    let threaded = runner::run(&mut scene, &two, &mut Vec::new());
+    if cfg!(feature = "parallel") {
+        threaded.unwrap();
+    } else {
+        assert!(matches!(threaded, Err(CliError::Invalid(m)) if m.contains("parallel")));
+    }
+    let mut scene = runner::load("hard/pyramid20").unwrap();
+    let options = RunOptions {
+        threads: 1,
         substeps: Some(2),
         profile: true,
         ..quiet(5)
