@@ -1,7 +1,8 @@
 // A manual browser check of `janus2d serve` (not run by CI): drives a
 // headless Chromium through the DevTools protocol with Node's WebSocket —
 // loads the page, reads the status once frames arrive, pauses (the step
-// stops), steps once (+1), plays again, and writes a screenshot.
+// stops), steps once (+1), plays again, drags a body to the right, and
+// writes a screenshot.
 //
 //   janus2d serve pyramid20 --port 8080 &
 //   chromium --headless=new --no-sandbox --remote-debugging-port=9333 about:blank &
@@ -42,6 +43,18 @@ const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
   console.log("paused steps", s1, s2, "after step", s3);
   await evaluate("document.getElementById('play').click()");
   await sleep(800);
+  // Drag the last solid polygon (a dynamic body drawn after the ground) 120 px right.
+  const centre = `(() => { const ps = last.prims.filter((p) => p[0] === "P"); const p = ps[ps.length - 1];
+    let x = 0, y = 0, n = 0; for (let i = 3; i + 1 < p.length; i += 2) { x += p[i]; y += p[i + 1]; n++; }
+    const r = view.getBoundingClientRect(); return [sx(x / n) + r.left, sy(y / n) + r.top, x / n]; })()`;
+  const [px, py, x0] = await evaluate(centre);
+  const mouse = (type, x, y) => call("Input.dispatchMouseEvent", { type, x, y, button: "left", buttons: 1, clickCount: 1 });
+  await mouse("mousePressed", px, py);
+  for (let k = 1; k <= 6; k++) { await mouse("mouseMoved", px + 20 * k, py); await sleep(100); }
+  await sleep(1500);
+  const [, , x1] = await evaluate(centre);
+  await mouse("mouseReleased", px + 120, py);
+  console.log(`dragged body x ${x0.toFixed(2)} -> ${x1.toFixed(2)} m`);
   const shot = await call("Page.captureScreenshot", { format: "png" });
   fs.writeFileSync(out, Buffer.from(shot.result.data, "base64"));
   ws.close(); process.exit(0);
