@@ -3,7 +3,7 @@
 //! | command | what |
 //! |---------|------|
 //! | `janus2d list` | the built-in scenes, by group, with their bodies and steps |
-//! | `janus2d run SCENE [--steps N] [--substeps N] [--threads N] [--png DIR \| --gif FILE] [--every K] [--size WxH] [--follow] [--draw FLAGS] [--profile] [--csv FILE]` | runs a built-in scene or a scene file, prints what happened and a summary |
+//! | `janus2d run SCENE [--steps N] [--substeps N] [--threads N] [--png DIR \| --gif FILE \| --svg DIR] [--every K] [--size WxH] [--follow] [--draw FLAGS] [--profile] [--csv FILE]` | runs a built-in scene or a scene file, prints what happened and a summary |
 //! | `janus2d export SCENE [-o FILE]` | writes a built-in scene (one without a script) as a scene file |
 //! | `janus2d serve [SCENE] [--port P]` | runs the scene and streams it to a page on `http://127.0.0.1:P/` ([`crate::serve`]) |
 
@@ -72,8 +72,11 @@ pub struct RunArgs {
     #[arg(long, conflicts_with = "gif")]
     pub png: Option<PathBuf>,
     /// Write the run as a looping GIF.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "svg")]
     pub gif: Option<PathBuf>,
+    /// Write an SVG frame into this folder every `--every` steps.
+    #[arg(long, conflicts_with = "png")]
+    pub svg: Option<PathBuf>,
     /// A frame every K steps (PNG 1, GIF 2).
     #[arg(long)]
     pub every: Option<usize>,
@@ -155,10 +158,11 @@ pub fn parse_draw(s: &str) -> Result<DrawOptions, CliError> {
 impl RunArgs {
     /// The run options these arguments give.
     pub fn options(&self) -> Result<RunOptions, CliError> {
-        let frames = match (&self.png, &self.gif) {
-            (Some(d), _) => Frames::Png(d.clone()),
-            (None, Some(g)) => Frames::Gif(g.clone()),
-            (None, None) => Frames::None,
+        let frames = match (&self.png, &self.gif, &self.svg) {
+            (Some(d), _, _) => Frames::Png(d.clone()),
+            (None, Some(g), _) => Frames::Gif(g.clone()),
+            (None, None, Some(d)) => Frames::Svg(d.clone()),
+            (None, None, None) => Frames::None,
         };
         if self.every == Some(0) {
             return Err(CliError::Invalid("--every must be at least 1".into()));

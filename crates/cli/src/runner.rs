@@ -156,6 +156,8 @@ pub enum Frames {
     Png(PathBuf),
     /// One GIF file.
     Gif(PathBuf),
+    /// SVG files `frame_00000.svg`, … in this folder.
+    Svg(PathBuf),
 }
 
 /// How to run.
@@ -355,6 +357,7 @@ struct Pictures {
     raster: Raster,
     gif: Option<GifWriter<std::io::BufWriter<std::fs::File>>>,
     dir: Option<PathBuf>,
+    svg: bool,
     written: usize,
 }
 
@@ -362,7 +365,7 @@ impl Pictures {
     fn new(frames: &Frames, camera: Camera, delay_cs: u16) -> Result<Option<Pictures>, CliError> {
         let (gif, dir) = match frames {
             Frames::None => return Ok(None),
-            Frames::Png(dir) => {
+            Frames::Png(dir) | Frames::Svg(dir) => {
                 std::fs::create_dir_all(dir).map_err(|e| CliError::io(dir, &e))?;
                 (None, Some(dir.clone()))
             }
@@ -381,11 +384,21 @@ impl Pictures {
             raster: Raster::new(camera)?,
             gif,
             dir,
+            svg: matches!(frames, Frames::Svg(_)),
             written: 0,
         }))
     }
 
     fn shoot(&mut self, world: &World, draw: &DrawOptions) -> Result<(), CliError> {
+        if self.svg {
+            if let Some(dir) = &self.dir {
+                let mut svg = janus2d_render::Svg::new(self.raster.camera);
+                svg.draw_world(world, draw);
+                svg.save(&dir.join(format!("frame_{:05}.svg", self.written)))?;
+            }
+            self.written += 1;
+            return Ok(());
+        }
         self.raster.draw_world(world, draw);
         if let Some(g) = &mut self.gif {
             g.add(&self.raster)?;

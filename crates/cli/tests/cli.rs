@@ -222,6 +222,18 @@ fn frames_and_csv_are_written() {
     assert!(lines.iter().all(|l| l.split(',').count() == cols));
     assert!(lines[6].starts_with("6,0.1"));
 
+    let svg_dir = temp("svg");
+    let mut scene = runner::load("single_box").unwrap();
+    let options = RunOptions {
+        frames: Frames::Svg(svg_dir.clone()),
+        every: Some(3),
+        ..quiet(6)
+    };
+    let s = runner::run(&mut scene, &options, &mut Vec::new()).unwrap();
+    assert_eq!(s.frames, 3);
+    let doc = std::fs::read_to_string(svg_dir.join("frame_00002.svg")).unwrap();
+    assert_eq!(doc.matches("<polygon").count(), 2, "the ground and the box");
+
     let mut scene = runner::load("single_box").unwrap();
     let options = RunOptions {
         frames: Frames::Gif(gif.clone()),
@@ -294,6 +306,7 @@ fn arguments_parse() {
     assert_eq!(o.frames, Frames::Gif("a.gif".into()));
     // --png and --gif exclude each other.
     assert!(Cli::try_parse_from(["janus2d", "run", "x", "--png", "d", "--gif", "g"]).is_err());
+    assert!(Cli::try_parse_from(["janus2d", "run", "x", "--svg", "d", "--gif", "g"]).is_err());
     assert!(parse_size("0x10").is_err() && parse_size("wide").is_err());
     let d = parse_draw("+contacts,-joints").unwrap();
     assert!(d.contacts && !d.joints && d.shapes);
