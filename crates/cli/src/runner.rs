@@ -138,7 +138,11 @@ pub fn load(scene: &str) -> Result<Loaded, CliError> {
             dt: built.dt,
             steps: built.steps.unwrap_or(DEFAULT_FILE_STEPS),
             probe: built.probe,
-            probe_label: "probe".to_owned(),
+            probe_label: match &file.probe {
+                Some(scene_file::BodyRef::Id(id)) => id.clone(),
+                Some(scene_file::BodyRef::Index(i)) => format!("body {i}"),
+                None => String::new(),
+            },
             driver: Driver::Plain(Box::new(built.world)),
         });
     }
