@@ -646,10 +646,10 @@ fn run_here<W: Write>(
             && start.elapsed().as_secs_f64() > 1.0
             && step + 1 < steps
         {
-            let b = indicatif::ProgressBar::new(steps as u64);
-            if let Ok(style) = indicatif::ProgressStyle::with_template(
-                "  {bar:40} {pos}/{len} steps, {per_sec}, {eta} left",
-            ) {
+            let b = indicatif::ProgressBar::new(steps as u64).with_position(step as u64 + 1);
+            if let Ok(style) =
+                indicatif::ProgressStyle::with_template("  {bar:40} {pos}/{len} steps, {eta} left")
+            {
                 b.set_style(style);
             }
             bar = Some(b);
