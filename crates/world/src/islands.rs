@@ -140,6 +140,13 @@ pub(crate) struct SleepInput<'a> {
 }
 
 impl Islands {
+    /// The id of the island `body` belongs to (read-only, for drawing);
+    /// `None` for static and kinematic bodies. Ids are reused once an
+    /// island is gone.
+    pub(crate) fn island_id(&self, body: BodyHandle) -> Option<u32> {
+        Some(self.island(body)).filter(|&id| id != NONE)
+    }
+
     fn island(&self, body: BodyHandle) -> u32 {
         self.island_of
             .get(body.index as usize)

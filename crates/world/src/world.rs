@@ -1302,6 +1302,18 @@ impl World {
         Ok(())
     }
 
+    /// Draws the world through `draw`: shapes, joints, contacts, boxes,
+    /// islands, portals… as `options` says (see [`crate::debug_draw`]).
+    /// Reads only; costs nothing when not called.
+    pub fn debug_draw(
+        &self,
+        draw: &mut (impl crate::debug_draw::DebugDraw + ?Sized),
+        options: &crate::debug_draw::DrawOptions,
+    ) {
+        let island_of = |body| self.islands.island_id(body);
+        crate::debug_draw::draw_world(self, &island_of, draw, options);
+    }
+
     /// A hash of every body's transform and velocity bits, in handle order:
     /// equal hashes mean bit-identical states (see [`crate::hash`]).
     pub fn state_hash(&self) -> u64 {

@@ -477,6 +477,33 @@ impl World {
         constraint.map(self.bodies())
     }
 
+    /// Every live portal pair with its definition as the world holds it:
+    /// directions normalised, `eta` set to the pair's scale (read-only,
+    /// for drawing and tools).
+    pub fn portal_pairs(&self) -> impl Iterator<Item = (PortalPairHandle, PortalPairDef)> + '_ {
+        self.portals.pairs.iter().map(|(index, d)| {
+            let def = |k: usize| PortalDef {
+                direction: d.local[k].direction,
+                half_width: d.local[k].half_width,
+                ..d.portals[k]
+            };
+            let pair = PortalPairDef {
+                portal_a: def(0),
+                portal_b: def(1),
+                eta: Some(d.eta),
+                mass_model: d.mass_model,
+            };
+            (self.pair_handle(index), pair)
+        })
+    }
+
+    /// The aperture clipping the last step's narrowphase applied: the hole
+    /// of each portal and the half-space behind each crossing copy
+    /// (read-only, for drawing).
+    pub fn portal_clipping(&self) -> &ContactClipping {
+        self.portals.clipping()
+    }
+
     /// The clone of `body` while it crosses, if any.
     pub fn clone_of(&self, body: BodyHandle) -> Option<BodyHandle> {
         self.portals

@@ -1,0 +1,1060 @@
+//! Scene files: a world described in JSON — settings, bodies with their
+//! shapes, revolute joints and portal pairs — read with `serde` into the
+//! description structs below and built into a [`World`] through the
+//! engine's definition structs (`BodyDef`, `ShapeDef`, the shapes,
+//! `RevoluteJointDef`, `PortalPairDef`).
+//!
+//! ```json
+//! {
+//!   "name": "hinge",
+//!   "steps": 120,
+//!   "settings": { "gravity": [0, -10], "substeps": 4 },
+//!   "bodies": [
+//!     { "id": "ground", "type": "static",
+//!       "shapes": [ { "geometry": { "box": { "half": [10, 0.5] } } } ] },
+//!     { "id": "bar", "position": [1, 2],
+//!       "shapes": [ { "geometry": { "box": { "half": [1, 0.1] } }, "density": 2 } ] }
+//!   ],
+//!   "joints": [ { "body_a": "ground", "body_b": "bar", "anchor": [0, 2] } ]
+//! }
+//! ```
+//!
+//! | key | what | default |
+//! |-----|------|---------|
+//! | `name`, `steps`, `probe` | label; steps `janus2d run` takes; the body the summary reports | file name, 600, none |
+//! | `settings` | `gravity` [x, y] m/s², `dt` s, `substeps`, `relax_iterations`, `sleep`, `contact_hertz`, `contact_damping_ratio`, `contact_push_max_velocity` m/s, `joint_hertz`, `joint_damping_ratio`, `restitution_threshold` m/s, `warm_starting` | the world's defaults, dt 1/60 |
+//! | body | `id`, `type` (`static`, `kinematic`, `dynamic`), `position`, `angle`, `linear_velocity`, `angular_velocity`, `linear_damping`, `angular_damping`, `gravity_scale`, `fixed_rotation`, `awake`, `mass` {`mass`, `inertia`, `center`}, `shapes` | dynamic at the origin, mass from the shapes |
+//! | shape | `geometry` (one of below), `density`, `friction`, `restitution`, `sensor`, `filter` {`category`, `mask`, `group`} | 1, 0.6, 0, false, collides with all |
+//! | geometry | `circle` {`center`, `radius`}, `capsule` {`a`, `b`, `radius`}, `box` {`half`, `center`, `angle`, `radius`}, `polygon` {`points`, `radius`} (convex hull), `segment` {`a`, `b`}, `chain` {`points`, `closed`} (one-sided) | |
+//! | joint | `body_a`, `body_b` (index or id), `anchor` (world point) or `anchor_a`/`anchor_b` (body frames), `reference_angle`, `limit` [lower, upper], `motor` {`speed`, `max_torque`}, `spring` {`hertz`, `damping_ratio`}, `collide_connected` | a plain hinge |
+//! | portal pair | `a`, `b`: {`body`, `anchor`, `direction`, `half_width`}; `eta`, `mass_model` (`same_material`, `energy_preserving`) | η = w_b / w_a |
+//!
+//! Unknown keys are errors. A file that does not parse or does not build
+//! gives a [`SceneFileError`] naming the line, the column and the field
+//! (`bodies[1].shapes[0].density`).
+
+use std::fmt;
+
+use glam::DVec2;
+use janus2d_constraints::RevoluteJointDef;
+use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
+use janus2d_core::geometry::{Shape, make_chain};
+use janus2d_core::math::{Real, Vec2, from_f64, to_f64};
+use janus2d_testbed::desc::{self, Geometry, SceneDesc};
+use janus2d_world::{Filter, ShapeDef, World, WorldDef};
+use serde::{Deserialize, Serialize};
+
+/// A whole scene file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// A label.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub name: String,
+    /// Steps `janus2d run` takes by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub steps: Option<usize>,
+    /// World settings.
+    #[serde(default)]
+    pub settings: SettingsFile,
+    /// Bodies, in creation order.
+    #[serde(default)]
+    pub bodies: Vec<BodyFile>,
+    /// Revolute joints.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub joints: Vec<JointFile>,
+    /// Portal pairs.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub portals: Vec<PortalPairFile>,
+    /// The body the summary reports.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub probe: Option<BodyRef>,
+}
+
+/// World settings (every key optional).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SettingsFile {
+    /// Gravity, m/s².
+    pub gravity: [f64; 2],
+    /// Step, s.
+    pub dt: f64,
+    /// Substeps per step.
+    pub substeps: u32,
+    /// Relax iterations per substep.
+    pub relax_iterations: u32,
+    /// Sleeping on.
+    pub sleep: bool,
+    /// Contact stiffness, Hz.
+    pub contact_hertz: f64,
+    /// Contact damping ratio.
+    pub contact_damping_ratio: f64,
+    /// Contact push-out speed cap, m/s.
+    pub contact_push_max_velocity: f64,
+    /// Joint stiffness, Hz.
+    pub joint_hertz: f64,
+    /// Joint damping ratio.
+    pub joint_damping_ratio: f64,
+    /// Restitution threshold, m/s.
+    pub restitution_threshold: f64,
+    /// Warm starting on.
+    pub warm_starting: bool,
+}
+
+impl Default for SettingsFile {
+    /// The world's defaults ([`WorldDef::default`]) and a 1/60 s step.
+    fn default() -> Self {
+        let w = WorldDef::default();
+        let s = &w.solver;
+        SettingsFile {
+            gravity: [to_f64(w.gravity.x), to_f64(w.gravity.y)],
+            dt: 1.0 / 60.0,
+            substeps: s.substeps,
+            relax_iterations: s.relax_iterations,
+            sleep: w.sleep.enabled,
+            contact_hertz: to_f64(s.contact_hertz),
+            contact_damping_ratio: to_f64(s.contact_damping_ratio),
+            contact_push_max_velocity: to_f64(s.contact_push_max_velocity),
+            joint_hertz: to_f64(s.joint_hertz),
+            joint_damping_ratio: to_f64(s.joint_damping_ratio),
+            restitution_threshold: to_f64(s.restitution_threshold),
+            warm_starting: s.warm_starting,
+        }
+    }
+}
+
+/// Static, kinematic or dynamic.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BodyKindFile {
+    /// Never moves.
+    Static,
+    /// Moves by its velocity.
+    Kinematic,
+    /// Moved by forces and contacts (default).
+    #[default]
+    Dynamic,
+}
+
+/// Mass properties set directly.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MassFile {
+    /// Mass, kg.
+    pub mass: f64,
+    /// Rotational inertia about the centre of mass, kg·m².
+    pub inertia: f64,
+    /// Centre of mass in the body frame, m.
+    #[serde(default, skip_serializing_if = "is_zero2")]
+    pub center: [f64; 2],
+}
+
+/// A body and its shapes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyFile {
+    /// A name joints, portals and the probe can refer to.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub id: Option<String>,
+    /// Static, kinematic or dynamic (default).
+    #[serde(rename = "type", default)]
+    pub kind: BodyKindFile,
+    /// Origin, m.
+    #[serde(default, skip_serializing_if = "is_zero2")]
+    pub position: [f64; 2],
+    /// Angle, rad.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub angle: f64,
+    /// Velocity, m/s.
+    #[serde(default, skip_serializing_if = "is_zero2")]
+    pub linear_velocity: [f64; 2],
+    /// Angular velocity, rad/s.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub angular_velocity: f64,
+    /// Linear damping, 1/s.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub linear_damping: f64,
+    /// Angular damping, 1/s.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub angular_damping: f64,
+    /// Gravity scale.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub gravity_scale: f64,
+    /// No rotation.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub fixed_rotation: bool,
+    /// Created awake.
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub awake: bool,
+    /// Mass set directly (otherwise from the shapes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mass: Option<MassFile>,
+    /// Shapes.
+    #[serde(default)]
+    pub shapes: Vec<ShapeFile>,
+}
+
+/// A collision filter.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FilterFile {
+    /// Categories the shape belongs to.
+    pub category: u64,
+    /// Categories it collides with.
+    pub mask: u64,
+    /// Group (positive: always collide, negative: never, 0: none).
+    pub group: i32,
+}
+
+impl Default for FilterFile {
+    fn default() -> Self {
+        let f = Filter::default();
+        FilterFile {
+            category: f.category_bits,
+            mask: f.mask_bits,
+            group: f.group_index,
+        }
+    }
+}
+
+/// A shape's geometry in its body's frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum GeometryFile {
+    /// A disc.
+    Circle {
+        /// Centre, m.
+        #[serde(default)]
+        center: [f64; 2],
+        /// Radius, m.
+        radius: f64,
+    },
+    /// A capsule.
+    Capsule {
+        /// First centre, m.
+        a: [f64; 2],
+        /// Second centre, m.
+        b: [f64; 2],
+        /// Radius, m.
+        radius: f64,
+    },
+    /// A (possibly offset, turned, rounded) box.
+    Box {
+        /// Half extents, m.
+        half: [f64; 2],
+        /// Centre, m.
+        #[serde(default, skip_serializing_if = "is_zero2")]
+        center: [f64; 2],
+        /// Turn, rad.
+        #[serde(default, skip_serializing_if = "is_zero")]
+        angle: f64,
+        /// Rounding radius, m.
+        #[serde(default, skip_serializing_if = "is_zero")]
+        radius: f64,
+    },
+    /// The convex hull of 3 to 8 points.
+    Polygon {
+        /// Points, m.
+        points: Vec<[f64; 2]>,
+        /// Rounding radius, m.
+        #[serde(default, skip_serializing_if = "is_zero")]
+        radius: f64,
+    },
+    /// A two-sided segment.
+    Segment {
+        /// First end, m.
+        a: [f64; 2],
+        /// Second end, m.
+        b: [f64; 2],
+    },
+    /// One-sided chain segments through `points` (colliding on the right
+    /// of the direction of travel).
+    Chain {
+        /// Points, m.
+        points: Vec<[f64; 2]>,
+        /// A closed loop.
+        #[serde(default)]
+        closed: bool,
+    },
+}
+
+/// A shape on a body.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShapeFile {
+    /// Geometry.
+    pub geometry: GeometryFile,
+    /// Density, kg/m².
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub density: f64,
+    /// Friction.
+    #[serde(default = "friction", skip_serializing_if = "is_friction")]
+    pub friction: f64,
+    /// Restitution.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub restitution: f64,
+    /// A sensor (overlap events only).
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub sensor: bool,
+    /// Collision filter.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filter: Option<FilterFile>,
+}
+
+/// A body named by its index in `bodies` or by its `id`.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum BodyRef {
+    /// Index into `bodies`.
+    Index(usize),
+    /// A body's `id`.
+    Id(String),
+}
+
+/// A motor.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotorFile {
+    /// Target speed, rad/s.
+    pub speed: f64,
+    /// Torque cap, N·m.
+    pub max_torque: f64,
+}
+
+/// An angular spring.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringFile {
+    /// Stiffness, Hz.
+    pub hertz: f64,
+    /// Damping ratio.
+    pub damping_ratio: f64,
+}
+
+/// The joint types a file can hold.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum JointKindFile {
+    /// A revolute joint (the only one the engine has).
+    #[default]
+    Revolute,
+}
+
+/// A revolute joint.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointFile {
+    /// The joint type (`revolute`).
+    #[serde(rename = "type", default)]
+    pub kind: JointKindFile,
+    /// Body a.
+    pub body_a: BodyRef,
+    /// Body b.
+    pub body_b: BodyRef,
+    /// The anchor as a world point at creation, m (or give both locals).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub anchor: Option<[f64; 2]>,
+    /// Anchor in a's frame, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub anchor_a: Option<[f64; 2]>,
+    /// Anchor in b's frame, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub anchor_b: Option<[f64; 2]>,
+    /// `θ_b − θ_a` at joint angle zero, rad.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub reference_angle: f64,
+    /// Angle limits [lower, upper], rad.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub limit: Option<[f64; 2]>,
+    /// Motor.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motor: Option<MotorFile>,
+    /// Spring.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spring: Option<SpringFile>,
+    /// Whether the two bodies collide.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub collide_connected: bool,
+}
+
+/// One portal of a pair.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PortalFile {
+    /// The body carrying it.
+    pub body: BodyRef,
+    /// Aperture centre in the body frame, m.
+    pub anchor: [f64; 2],
+    /// Outward normal in the body frame.
+    pub direction: [f64; 2],
+    /// Half the aperture width, m.
+    pub half_width: f64,
+}
+
+/// How a clone's mass follows from the original's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MassModelFile {
+    /// Same density (default).
+    #[default]
+    SameMaterial,
+    /// Density times η⁻⁴ (kinetic energy kept).
+    EnergyPreserving,
+}
+
+/// A linked pair of portals.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PortalPairFile {
+    /// Portal a.
+    pub a: PortalFile,
+    /// Portal b.
+    pub b: PortalFile,
+    /// Scale from a to b (default `w_b / w_a`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eta: Option<f64>,
+    /// The clone mass model.
+    #[serde(default, skip_serializing_if = "is_default_model")]
+    pub mass_model: MassModelFile,
+}
+
+fn one() -> f64 {
+    1.0
+}
+fn yes() -> bool {
+    true
+}
+fn friction() -> f64 {
+    0.6
+}
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+fn is_one(x: &f64) -> bool {
+    *x == 1.0
+}
+fn is_friction(x: &f64) -> bool {
+    *x == 0.6
+}
+fn is_zero2(x: &[f64; 2]) -> bool {
+    x[0] == 0.0 && x[1] == 0.0
+}
+fn is_false(x: &bool) -> bool {
+    !*x
+}
+fn is_true(x: &bool) -> bool {
+    *x
+}
+fn is_default_model(m: &MassModelFile) -> bool {
+    *m == MassModelFile::SameMaterial
+}
+
+/// What kind of problem a scene file has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ErrorKind {
+    /// Not JSON (a missing comma, an unclosed brace).
+    Syntax,
+    /// JSON, but not a scene: an unknown or missing key, a wrong type.
+    Data,
+    /// A scene the engine rejects: a bad value, an unknown body reference.
+    Invalid,
+    /// The file could not be read.
+    Io,
+}
+
+/// A bad scene file: where, which field, what.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SceneFileError {
+    /// The file (as given), empty for text parsed directly.
+    pub file: String,
+    /// The kind of problem.
+    pub kind: ErrorKind,
+    /// Line, from 1 (0: unknown).
+    pub line: usize,
+    /// Column, from 1 (0: unknown).
+    pub column: usize,
+    /// The field, as a path: `bodies[1].shapes[0].density` (empty: the
+    /// whole file).
+    pub field: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl fmt::Display for SceneFileError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let file = if self.file.is_empty() {
+            "scene"
+        } else {
+            &self.file
+        };
+        write!(f, "{file}")?;
+        if self.line > 0 {
+            write!(f, ":{}:{}", self.line, self.column)?;
+        }
+        if !self.field.is_empty() {
+            write!(f, ": field `{}`", self.field)?;
+        }
+        write!(f, ": {}", self.message)
+    }
+}
+
+impl std::error::Error for SceneFileError {}
+
+/// A problem found while building, before it is located in the text.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Invalid {
+    /// The field path.
+    pub field: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+fn invalid(field: impl Into<String>, message: impl fmt::Display) -> Invalid {
+    Invalid {
+        field: field.into(),
+        message: message.to_string(),
+    }
+}
+
+/// serde_json's message without its " at line L column C" tail.
+fn strip_position(message: &str) -> &str {
+    match message.rfind(" at line ") {
+        Some(i) => &message[..i],
+        None => message,
+    }
+}
+
+/// Parses a scene file's text; `file` names it in errors.
+pub fn parse(text: &str, file: &str) -> Result<SceneFile, SceneFileError> {
+    let mut de = serde_json::Deserializer::from_str(text);
+    let parsed: Result<SceneFile, _> = serde_path_to_error::deserialize(&mut de);
+    let scene = parsed.map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.into_inner();
+        let kind = match inner.classify() {
+            serde_json::error::Category::Data => ErrorKind::Data,
+            _ => ErrorKind::Syntax,
+        };
+        SceneFileError {
+            file: file.to_owned(),
+            kind,
+            line: inner.line(),
+            column: inner.column(),
+            field: if path == "." { String::new() } else { path },
+            message: strip_position(&inner.to_string()).to_owned(),
+        }
+    })?;
+    de.end().map_err(|e| SceneFileError {
+        file: file.to_owned(),
+        kind: ErrorKind::Syntax,
+        line: e.line(),
+        column: e.column(),
+        field: String::new(),
+        message: strip_position(&e.to_string()).to_owned(),
+    })?;
+    Ok(scene)
+}
+
+/// A scene file built into a world.
+pub struct Built {
+    /// The world.
+    pub world: World,
+    /// Step, s.
+    pub dt: Real,
+    /// The file's steps, if it gives them.
+    pub steps: Option<usize>,
+    /// Handles of the file's bodies, by index.
+    pub bodies: Vec<BodyHandle>,
+    /// The probe body.
+    pub probe: Option<BodyHandle>,
+}
+
+fn v2(p: [f64; 2]) -> Vec2 {
+    Vec2::new(from_f64(p[0]), from_f64(p[1]))
+}
+
+fn d2(p: [f64; 2]) -> DVec2 {
+    DVec2::new(p[0], p[1])
+}
+
+fn finite(field: &str, values: &[f64]) -> Result<(), Invalid> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(invalid(field, "not a finite number"))
+    }
+}
+
+impl SettingsFile {
+    /// The world definition and step these settings give.
+    pub fn world_def(&self) -> Result<(WorldDef, Real), Invalid> {
+        finite("settings.gravity", &self.gravity)?;
+        if !(self.dt.is_finite() && self.dt > 0.0) {
+            return Err(invalid("settings.dt", "the step must be finite and > 0"));
+        }
+        let mut def = WorldDef {
+            gravity: v2(self.gravity),
+            ..WorldDef::default()
+        };
+        def.sleep.enabled = self.sleep;
+        let s = &mut def.solver;
+        s.substeps = self.substeps;
+        s.relax_iterations = self.relax_iterations;
+        s.contact_hertz = from_f64(self.contact_hertz);
+        s.contact_damping_ratio = from_f64(self.contact_damping_ratio);
+        s.contact_push_max_velocity = from_f64(self.contact_push_max_velocity);
+        s.joint_hertz = from_f64(self.joint_hertz);
+        s.joint_damping_ratio = from_f64(self.joint_damping_ratio);
+        s.restitution_threshold = from_f64(self.restitution_threshold);
+        s.warm_starting = self.warm_starting;
+        def.solver.validate().map_err(|e| {
+            invalid(
+                "settings",
+                format!("{}", janus2d_world::WorldError::from(e)),
+            )
+        })?;
+        Ok((def, from_f64(self.dt)))
+    }
+}
+
+impl GeometryFile {
+    /// The engine shapes of this geometry (a chain gives one per segment).
+    pub fn shapes(&self) -> Result<Vec<Shape>, String> {
+        let pts = |p: &[[f64; 2]]| -> Vec<Vec2> { p.iter().map(|q| v2(*q)).collect() };
+        let geometry = match self {
+            GeometryFile::Chain { points, closed } => {
+                return make_chain(&pts(points), *closed)
+                    .map(|c| c.into_iter().map(Shape::from).collect())
+                    .map_err(|e| e.to_string());
+            }
+            GeometryFile::Circle { center, radius } => Geometry::Circle {
+                center: d2(*center),
+                radius: *radius,
+            },
+            GeometryFile::Capsule { a, b, radius } => Geometry::Capsule {
+                a: d2(*a),
+                b: d2(*b),
+                radius: *radius,
+            },
+            GeometryFile::Box {
+                half,
+                center,
+                angle,
+                radius,
+            } => {
+                if !(half[0] > 0.0 && half[1] > 0.0) {
+                    return Err("half extents must be > 0".into());
+                }
+                Geometry::Box {
+                    half: d2(*half),
+                    center: d2(*center),
+                    angle: *angle,
+                    radius: *radius,
+                }
+            }
+            GeometryFile::Polygon { points, radius } => {
+                if !(3..=janus2d_core::geometry::MAX_POLYGON_VERTICES).contains(&points.len()) {
+                    return Err(format!(
+                        "a polygon needs 3 to {} points",
+                        janus2d_core::geometry::MAX_POLYGON_VERTICES
+                    ));
+                }
+                Geometry::Hull {
+                    points: points.iter().map(|p| d2(*p)).collect(),
+                    radius: *radius,
+                }
+            }
+            GeometryFile::Segment { a, b } => Geometry::Segment {
+                a: d2(*a),
+                b: d2(*b),
+            },
+        };
+        janus2d_testbed::janus::shapes_of(&geometry).map_err(|e| e.to_string())
+    }
+}
+
+impl SceneFile {
+    fn resolve(&self, r: &BodyRef, field: &str) -> Result<usize, Invalid> {
+        match r {
+            BodyRef::Index(i) if *i < self.bodies.len() => Ok(*i),
+            BodyRef::Index(i) => Err(invalid(
+                field,
+                format!("body {i} does not exist ({} bodies)", self.bodies.len()),
+            )),
+            BodyRef::Id(id) => self
+                .bodies
+                .iter()
+                .position(|b| b.id.as_deref() == Some(id.as_str()))
+                .ok_or_else(|| invalid(field, format!("no body has the id `{id}`"))),
+        }
+    }
+
+    /// Builds the scene into a new world; the error names the field.
+    pub fn build(&self) -> Result<Built, Invalid> {
+        let (def, dt) = self.settings.world_def()?;
+        let mut world = World::new(def).map_err(|e| invalid("settings", e))?;
+        for (i, b) in self.bodies.iter().enumerate() {
+            if let Some(id) = &b.id
+                && self.bodies[..i].iter().any(|o| o.id.as_ref() == Some(id))
+            {
+                return Err(invalid(
+                    format!("bodies[{i}].id"),
+                    format!("`{id}` is used twice"),
+                ));
+            }
+        }
+        let mut bodies = Vec::with_capacity(self.bodies.len());
+        for (i, b) in self.bodies.iter().enumerate() {
+            let f = |k: &str| format!("bodies[{i}].{k}");
+            finite(&f("position"), &b.position)?;
+            finite(&f("linear_velocity"), &b.linear_velocity)?;
+            let mut bd = BodyDef {
+                body_type: match b.kind {
+                    BodyKindFile::Static => BodyType::Static,
+                    BodyKindFile::Kinematic => BodyType::Kinematic,
+                    BodyKindFile::Dynamic => BodyType::Dynamic,
+                },
+                position: v2(b.position),
+                angle: from_f64(b.angle),
+                linear_velocity: v2(b.linear_velocity),
+                angular_velocity: from_f64(b.angular_velocity),
+                linear_damping: from_f64(b.linear_damping),
+                angular_damping: from_f64(b.angular_damping),
+                gravity_scale: from_f64(b.gravity_scale),
+                fixed_rotation: b.fixed_rotation,
+                awake: b.awake,
+                ..BodyDef::default()
+            };
+            if let Some(m) = &b.mass {
+                finite(&f("mass"), &[m.mass, m.inertia, m.center[0], m.center[1]])?;
+                bd.mass = Some(BodyMass {
+                    center: v2(m.center),
+                    ..BodyMass::new(from_f64(m.mass), from_f64(m.inertia))
+                });
+            }
+            let h = world
+                .create_body(&bd)
+                .map_err(|e| invalid(format!("bodies[{i}]"), e))?;
+            for (k, s) in b.shapes.iter().enumerate() {
+                let field = format!("bodies[{i}].shapes[{k}]");
+                let sd = ShapeDef {
+                    density: from_f64(s.density),
+                    friction: from_f64(s.friction),
+                    restitution: from_f64(s.restitution),
+                    is_sensor: s.sensor,
+                    filter: s.filter.as_ref().map_or_else(Filter::default, |f| Filter {
+                        category_bits: f.category,
+                        mask_bits: f.mask,
+                        group_index: f.group,
+                    }),
+                    ..ShapeDef::default()
+                };
+                let shapes = s
+                    .geometry
+                    .shapes()
+                    .map_err(|e| invalid(format!("{field}.geometry"), e))?;
+                for shape in shapes {
+                    world
+                        .create_shape(h, &sd, shape)
+                        .map_err(|e| invalid(field.clone(), e))?;
+                }
+            }
+            bodies.push(h);
+        }
+        for (j, jf) in self.joints.iter().enumerate() {
+            let f = |k: &str| format!("joints[{j}].{k}");
+            let a = self.resolve(&jf.body_a, &f("body_a"))?;
+            let b = self.resolve(&jf.body_b, &f("body_b"))?;
+            let (la, lb) = match (jf.anchor, jf.anchor_a, jf.anchor_b) {
+                (_, Some(la), Some(lb)) => (v2(la), v2(lb)),
+                (Some(p), None, None) => {
+                    finite(&f("anchor"), &p)?;
+                    let p = v2(p);
+                    let xa = world
+                        .transform(bodies[a])
+                        .map_err(|e| invalid(f("body_a"), e))?;
+                    let xb = world
+                        .transform(bodies[b])
+                        .map_err(|e| invalid(f("body_b"), e))?;
+                    (xa.apply_inv(p), xb.apply_inv(p))
+                }
+                _ => {
+                    return Err(invalid(
+                        format!("joints[{j}]"),
+                        "give `anchor` (a world point) or both `anchor_a` and `anchor_b`",
+                    ));
+                }
+            };
+            let mut def = RevoluteJointDef::new(bodies[a], bodies[b], la, lb);
+            def.reference_angle = from_f64(jf.reference_angle);
+            def.collide_connected = jf.collide_connected;
+            if let Some([lo, hi]) = jf.limit {
+                def = def.with_limits(from_f64(lo), from_f64(hi));
+            }
+            if let Some(m) = &jf.motor {
+                def = def.with_motor(
+                    from_f64(m.speed),
+                    from_f64(m.max_torque.min(to_f64(Real::MAX))),
+                );
+            }
+            if let Some(s) = &jf.spring {
+                def = def.with_spring(from_f64(s.hertz), from_f64(s.damping_ratio));
+            }
+            world
+                .create_revolute_joint(&def)
+                .map_err(|e| invalid(format!("joints[{j}]"), e))?;
+        }
+        self.build_portals(&mut world, &bodies)?;
+        let probe = match &self.probe {
+            Some(r) => Some(bodies[self.resolve(r, "probe")?]),
+            None => None,
+        };
+        Ok(Built {
+            world,
+            dt,
+            steps: self.steps,
+            bodies,
+            probe,
+        })
+    }
+
+    #[cfg(feature = "portals")]
+    fn build_portals(&self, world: &mut World, bodies: &[BodyHandle]) -> Result<(), Invalid> {
+        use janus2d_world::{MassModel, PortalDef, PortalPairDef};
+        for (p, pf) in self.portals.iter().enumerate() {
+            let portal = |side: &PortalFile, name: &str| -> Result<PortalDef, Invalid> {
+                let field = format!("portals[{p}].{name}");
+                let i = self.resolve(&side.body, &format!("{field}.body"))?;
+                finite(
+                    &field,
+                    &[
+                        side.anchor[0],
+                        side.anchor[1],
+                        side.direction[0],
+                        side.direction[1],
+                        side.half_width,
+                    ],
+                )?;
+                Ok(PortalDef {
+                    body: bodies[i],
+                    anchor: v2(side.anchor),
+                    direction: v2(side.direction),
+                    half_width: from_f64(side.half_width),
+                })
+            };
+            let def = PortalPairDef {
+                portal_a: portal(&pf.a, "a")?,
+                portal_b: portal(&pf.b, "b")?,
+                eta: pf.eta.map(from_f64),
+                mass_model: match pf.mass_model {
+                    MassModelFile::SameMaterial => MassModel::SameMaterial,
+                    MassModelFile::EnergyPreserving => MassModel::EnergyPreserving,
+                },
+            };
+            world
+                .create_portal_pair(&def)
+                .map_err(|e| invalid(format!("portals[{p}]"), e))?;
+        }
+        Ok(())
+    }
+
+    #[cfg(not(feature = "portals"))]
+    fn build_portals(&self, _world: &mut World, _bodies: &[BodyHandle]) -> Result<(), Invalid> {
+        if self.portals.is_empty() {
+            Ok(())
+        } else {
+            Err(invalid("portals", "portals need the `portals` feature"))
+        }
+    }
+
+    /// The file of a built-in description (settings, bodies, joints,
+    /// portals, probe). A scene with a per-step script cannot be written
+    /// as a file.
+    pub fn from_desc(d: &SceneDesc) -> Result<SceneFile, String> {
+        if !matches!(d.script, desc::Script::None) {
+            return Err(format!(
+                "`{}` has a per-step script, which a scene file cannot hold",
+                d.name
+            ));
+        }
+        let s = &d.settings;
+        let w = WorldDef::default();
+        let settings = SettingsFile {
+            gravity: [s.gravity.x, s.gravity.y],
+            dt: s.dt,
+            substeps: s.substeps,
+            relax_iterations: w.solver.relax_iterations,
+            sleep: s.sleep,
+            contact_hertz: s.contact_hertz,
+            contact_damping_ratio: s.contact_damping_ratio,
+            contact_push_max_velocity: s.contact_push_max_velocity,
+            joint_hertz: s.joint_hertz,
+            joint_damping_ratio: s.joint_damping_ratio,
+            ..SettingsFile::default()
+        };
+        let a2 = |p: DVec2| [p.x, p.y];
+        let bodies = d
+            .bodies
+            .iter()
+            .map(|b| BodyFile {
+                id: None,
+                kind: match b.kind {
+                    desc::BodyKind::Static => BodyKindFile::Static,
+                    desc::BodyKind::Kinematic => BodyKindFile::Kinematic,
+                    desc::BodyKind::Dynamic => BodyKindFile::Dynamic,
+                },
+                position: a2(b.position),
+                angle: b.angle,
+                linear_velocity: a2(b.linear_velocity),
+                angular_velocity: b.angular_velocity,
+                linear_damping: b.linear_damping,
+                angular_damping: 0.0,
+                gravity_scale: 1.0,
+                fixed_rotation: false,
+                awake: b.awake,
+                mass: b.mass.map(|(mass, inertia)| MassFile {
+                    mass,
+                    inertia,
+                    center: [0.0, 0.0],
+                }),
+                shapes: b
+                    .shapes
+                    .iter()
+                    .map(|s| ShapeFile {
+                        geometry: match &s.geometry {
+                            Geometry::Circle { center, radius } => GeometryFile::Circle {
+                                center: a2(*center),
+                                radius: *radius,
+                            },
+                            Geometry::Capsule { a, b, radius } => GeometryFile::Capsule {
+                                a: a2(*a),
+                                b: a2(*b),
+                                radius: *radius,
+                            },
+                            Geometry::Box {
+                                half,
+                                center,
+                                angle,
+                                radius,
+                            } => GeometryFile::Box {
+                                half: a2(*half),
+                                center: a2(*center),
+                                angle: *angle,
+                                radius: *radius,
+                            },
+                            Geometry::Hull { points, radius } => GeometryFile::Polygon {
+                                points: points.iter().map(|p| a2(*p)).collect(),
+                                radius: *radius,
+                            },
+                            Geometry::Segment { a, b } => GeometryFile::Segment {
+                                a: a2(*a),
+                                b: a2(*b),
+                            },
+                            Geometry::ChainLoop { points } => GeometryFile::Chain {
+                                points: points.iter().map(|p| a2(*p)).collect(),
+                                closed: true,
+                            },
+                        },
+                        density: s.density,
+                        friction: s.friction,
+                        restitution: s.restitution,
+                        sensor: false,
+                        filter: (s.filter != desc::FilterDesc::default()).then_some(FilterFile {
+                            category: s.filter.category,
+                            mask: s.filter.mask,
+                            group: s.filter.group,
+                        }),
+                    })
+                    .collect(),
+            })
+            .collect();
+        let joints = d
+            .joints
+            .iter()
+            .map(|j| JointFile {
+                kind: JointKindFile::Revolute,
+                body_a: BodyRef::Index(j.body_a),
+                body_b: BodyRef::Index(j.body_b),
+                anchor: None,
+                anchor_a: Some(a2(j.local_a)),
+                anchor_b: Some(a2(j.local_b)),
+                reference_angle: j.reference_angle,
+                limit: j.limit.map(|(lo, hi)| [lo, hi]),
+                motor: j
+                    .motor
+                    .map(|(speed, max_torque)| MotorFile { speed, max_torque }),
+                spring: j.spring.map(|(hertz, damping_ratio)| SpringFile {
+                    hertz,
+                    damping_ratio,
+                }),
+                collide_connected: j.collide_connected,
+            })
+            .collect();
+        let side = |(body, anchor, direction, half_width): (usize, DVec2, DVec2, f64)| PortalFile {
+            body: BodyRef::Index(body),
+            anchor: a2(anchor),
+            direction: a2(direction),
+            half_width,
+        };
+        let portals = d
+            .portals
+            .iter()
+            .map(|p| PortalPairFile {
+                a: side(p.entry),
+                b: side(p.exit),
+                eta: None,
+                mass_model: MassModelFile::SameMaterial,
+            })
+            .collect();
+        Ok(SceneFile {
+            name: d.name.to_owned(),
+            steps: Some(d.steps),
+            settings,
+            bodies,
+            joints,
+            portals,
+            probe: d.probe.map(BodyRef::Index),
+        })
+    }
+
+    /// The file as pretty JSON.
+    #[must_use]
+    pub fn to_json(&self) -> String {
+        // Serialising plain data with string keys cannot fail.
+        serde_json::to_string_pretty(self).unwrap_or_default()
+    }
+}
+
+/// Parses and builds a scene file's text; every error carries the line,
+/// column and field (`file` names the file in errors).
+pub fn load(text: &str, file: &str) -> Result<(SceneFile, Built), SceneFileError> {
+    let scene = parse(text, file)?;
+    match scene.build() {
+        Ok(built) => Ok((scene, built)),
+        Err(e) => {
+            let (line, column) = crate::locate::locate(text, &e.field).unwrap_or((0, 0));
+            Err(SceneFileError {
+                file: file.to_owned(),
+                kind: ErrorKind::Invalid,
+                line,
+                column,
+                field: e.field,
+                message: e.message,
+            })
+        }
+    }
+}
+
+/// Reads, parses and builds a scene file.
+pub fn load_file(path: &std::path::Path) -> Result<(SceneFile, Built), SceneFileError> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| SceneFileError {
+        file: name.clone(),
+        kind: ErrorKind::Io,
+        line: 0,
+        column: 0,
+        field: String::new(),
+        message: e.to_string(),
+    })?;
+    load(&text, &name)
+}

@@ -1,0 +1,232 @@
+//! `janus2d serve` end to end without a browser: the page and the scene
+//! list over HTTP, then the WebSocket protocol (frames arrive, pause,
+//! step, reset, draw flags, a bad scene), and the session on its own.
+
+use std::time::Duration;
+
+use futures_util::{SinkExt, StreamExt};
+use janus2d_cli::serve::{Control, Session, app};
+use serde_json::Value;
+use tokio::io::{AsyncReadExt, AsyncWriteExt};
+use tokio_tungstenite::tungstenite::Message;
+
+async fn get(addr: std::net::SocketAddr, path: &str) -> String {
+    let mut s = tokio::net::TcpStream::connect(addr).await.unwrap();
+    let req = format!("GET {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n");
+    s.write_all(req.as_bytes()).await.unwrap();
+    let mut body = String::new();
+    s.read_to_string(&mut body).await.unwrap();
+    body
+}
+
+type Ws =
+    tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
+
+async fn next(ws: &mut Ws) -> Value {
+    loop {
+        let msg = tokio::time::timeout(Duration::from_secs(10), ws.next())
+            .await
+            .expect("a message within 10 s")
+            .expect("open")
+            .expect("ok");
+        if let Message::Text(t) = msg {
+            return serde_json::from_str(t.as_str()).unwrap();
+        }
+    }
+}
+
+async fn next_of(ws: &mut Ws, kind: &str) -> Value {
+    loop {
+        let m = next(ws).await;
+        if m["type"] == kind {
+            return m;
+        }
+    }
+}
+
+async fn send(ws: &mut Ws, json: &str) {
+    ws.send(Message::Text(json.to_owned().into()))
+        .await
+        .unwrap();
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn page_scenes_and_the_websocket_protocol() {
+    let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
+    let addr = listener.local_addr().unwrap();
+    tokio::spawn(async move { axum::serve(listener, app("single_box")).await });
+
+    let page = get(addr, "/").await;
+    assert!(page.starts_with("HTTP/1.1 200"), "{page}");
+    assert!(page.contains("<canvas") && page.contains("/ws"));
+    let scenes = get(addr, "/scenes").await;
+    assert!(scenes.contains("\"single_box\"") && scenes.contains("\"tumbler\""));
+
+    let (mut ws, _) = tokio_tungstenite::connect_async(format!("ws://{addr}/ws"))
+        .await
+        .unwrap();
+    let scene = next_of(&mut ws, "scene").await;
+    assert_eq!(scene["name"], "single_box");
+    assert_eq!(scene["bounds"].as_array().unwrap().len(), 4);
+    // Frames arrive and the steps go on.
+    let a = next_of(&mut ws, "frame").await;
+    let b = next_of(&mut ws, "frame").await;
+    assert!(b["step"].as_u64() > a["step"].as_u64());
+    assert_eq!(a["bodies"], 2);
+    let prims = a["prims"].as_array().unwrap();
+    assert!(prims.iter().any(|p| p[0] == "P"), "the box as a polygon");
+
+    // Pause: the step stops moving.
+    send(&mut ws, r#"{"cmd":"pause"}"#).await;
+    let mut paused = next_of(&mut ws, "frame").await;
+    while paused["running"] == true {
+        paused = next_of(&mut ws, "frame").await;
+    }
+    let still = next_of(&mut ws, "frame").await;
+    assert_eq!(still["step"], paused["step"]);
+    // Step once.
+    send(&mut ws, r#"{"cmd":"step"}"#).await;
+    let mut stepped = next_of(&mut ws, "frame").await;
+    while stepped["step"] == paused["step"] {
+        stepped = next_of(&mut ws, "frame").await;
+    }
+    assert_eq!(
+        stepped["step"].as_u64(),
+        paused["step"].as_u64().map(|s| s + 1)
+    );
+    // Draw flags: boxes appear as outlines.
+    send(&mut ws, r#"{"cmd":"draw","flags":"aabbs"}"#).await;
+    let mut f = next_of(&mut ws, "frame").await;
+    while !f["prims"].as_array().unwrap().iter().any(|p| p[0] == "p") {
+        f = next_of(&mut ws, "frame").await;
+    }
+    // A bad scene and a bad control are errors, and the session goes on.
+    send(&mut ws, r#"{"cmd":"scene","name":"no_such_scene"}"#).await;
+    let e = next_of(&mut ws, "error").await;
+    assert!(e["message"].as_str().unwrap().contains("no_such_scene"));
+    send(&mut ws, r#"{"cmd":"fly"}"#).await;
+    let e = next_of(&mut ws, "error").await;
+    assert!(e["message"].as_str().unwrap().contains("bad control"));
+    // Reset and another scene.
+    send(&mut ws, r#"{"cmd":"reset"}"#).await;
+    next_of(&mut ws, "scene").await;
+    let f = next_of(&mut ws, "frame").await;
+    assert!(f["step"].as_u64().unwrap() <= 1);
+    send(&mut ws, r#"{"cmd":"scene","name":"bridge"}"#).await;
+    let s = next_of(&mut ws, "scene").await;
+    assert_eq!(s["name"], "bridge");
+    ws.close(None).await.unwrap();
+}
+
+#[test]
+fn the_session_applies_controls() {
+    let mut s = Session::new("single_box").unwrap();
+    assert!(s.running());
+    s.apply(Control::Step).unwrap();
+    assert!(!s.running());
+    assert_eq!(s.step_count(), 1);
+    s.apply(Control::Substeps { n: 8 }).unwrap();
+    assert_eq!(s.scene().world().settings().substeps, 8);
+    assert!(s.apply(Control::Substeps { n: 0 }).is_err());
+    assert!(
+        s.apply(Control::Draw {
+            flags: "bogus".into()
+        })
+        .is_err()
+    );
+    assert!(s.apply(Control::Reset).unwrap().is_some());
+    assert_eq!(s.step_count(), 0);
+    let frame: Value = serde_json::from_str(&s.frame()).unwrap();
+    assert_eq!(frame["type"], "frame");
+    // Knobs.
+    s.apply(Control::Knob {
+        name: "contact_hertz".into(),
+        value: 45.0,
+    })
+    .unwrap();
+    assert_eq!(s.scene().world().settings().contact_hertz, 45.0);
+    s.apply(Control::Knob {
+        name: "warm_starting".into(),
+        value: 0.0,
+    })
+    .unwrap();
+    assert!(!s.scene().world().settings().warm_starting);
+    s.apply(Control::Knob {
+        name: "gravity".into(),
+        value: -5.0,
+    })
+    .unwrap();
+    assert_eq!(s.scene().world().gravity().y, -5.0);
+    assert!(
+        s.apply(Control::Knob {
+            name: "colour".into(),
+            value: 1.0
+        })
+        .is_err()
+    );
+    assert!(
+        s.apply(Control::Knob {
+            name: "contact_hertz".into(),
+            value: f64::NAN
+        })
+        .is_err()
+    );
+    let c: Control = serde_json::from_str(r#"{"cmd":"scene","name":"tumbler"}"#).unwrap();
+    assert_eq!(
+        c,
+        Control::Scene {
+            name: "tumbler".into()
+        }
+    );
+}
+
+/// A drag pulls the body to the target; a click on nothing grabs
+/// nothing; shift-click drops a box.
+#[test]
+fn grab_drag_and_spawn() {
+    let mut s = Session::new("single_box").unwrap();
+    // single_box: a unit box resting on the ground at (0, 0.5)..; find it.
+    let world = s.scene().world();
+    let body = world
+        .body_handles()
+        .find(|&b| world.body_type(b) == Ok(janus2d_core::body::BodyType::Dynamic))
+        .unwrap();
+    let p = world.position(body).unwrap();
+    let (x, y) = (
+        janus2d_core::math::to_f64(p.x),
+        janus2d_core::math::to_f64(p.y),
+    );
+    s.apply(Control::Grab { x: x + 100.0, y }).unwrap();
+    assert_eq!(s.grabbed(), None, "nothing under the cursor");
+    s.apply(Control::Grab { x, y }).unwrap();
+    assert_eq!(s.grabbed(), Some(body));
+    s.apply(Control::Drag {
+        x: x + 3.0,
+        y: y + 2.0,
+    })
+    .unwrap();
+    for _ in 0..120 {
+        s.advance().unwrap();
+    }
+    let q = s.scene().world().position(body).unwrap();
+    assert!(
+        (janus2d_core::math::to_f64(q.x) - (x + 3.0)).abs() < 0.3,
+        "pulled to the target: {q:?}"
+    );
+    assert!(
+        (janus2d_core::math::to_f64(q.y) - (y + 2.0)).abs() < 0.3,
+        "held up against gravity: {q:?}"
+    );
+    s.apply(Control::Release).unwrap();
+    assert_eq!(s.grabbed(), None);
+    let before = s.scene().world().body_count();
+    s.apply(Control::Spawn { x: 2.0, y: 5.0 }).unwrap();
+    assert_eq!(s.scene().world().body_count(), before + 1);
+    assert!(
+        s.apply(Control::Spawn {
+            x: f64::NAN,
+            y: 0.0
+        })
+        .is_err()
+    );
+}
