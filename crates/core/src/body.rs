@@ -4,7 +4,7 @@
 //!                 handle (index, generation)
 //!                          │
 //!                          ▼
-//!   records: Vec<BodyRecord>   ── bookkeeping: type, generation, where the body lives
+//!   records: Slots<BodyRecord> ── bookkeeping: generation (the slots'), where the body lives
 //!                          │
 //!          ┌───────────────┴────────────────┐
 //!          ▼ moving (dynamic, kinematic)     ▼ static
@@ -25,6 +25,7 @@
 //! impulses written to it are multiplied by zero inverse mass.
 
 use crate::math::{Real, Rot, Transform, Vec2, vec_is_finite};
+use crate::slots::Slots;
 
 /// Default maximum linear speed of a body, m/s (usual value 400 m/s, Box2D's
 /// `4 m × 100` at unit length scale).
@@ -347,13 +348,12 @@ pub enum BodyLocation {
     Sleeping(u32),
 }
 
-/// Bookkeeping for one body slot.
+/// Bookkeeping for one live body (its slot's generation is kept by the
+/// [`Slots`] that hold the records).
 #[derive(Clone, Debug, PartialEq)]
 pub struct BodyRecord {
-    /// Current generation of the slot.
-    pub generation: u32,
-    /// Where the body lives, or `None` for a free slot.
-    pub location: Option<BodyLocation>,
+    /// Where the body lives.
+    pub location: BodyLocation,
     /// Opaque user value.
     pub user_data: u64,
     /// True when the mass was set directly rather than from shapes.
@@ -377,8 +377,7 @@ pub struct SolverBody<'a> {
 #[derive(Clone, Debug)]
 pub struct BodySet {
     owner: u32,
-    records: Vec<BodyRecord>,
-    free: Vec<u32>,
+    records: Slots<BodyRecord>,
     /// Per-step data of moving bodies; index 0 is the static sentinel.
     pub sims: Vec<BodySim>,
     /// Hot state of moving bodies; index 0 is [`BodyState::IDENTITY`].
@@ -474,8 +473,7 @@ impl BodySet {
     pub fn new() -> Self {
         BodySet {
             owner: next_owner_id(),
-            records: Vec::new(),
-            free: Vec::new(),
+            records: Slots::default(),
             sims: vec![BodySim::sentinel()],
             states: vec![BodyState::IDENTITY],
             static_sims: Vec::new(),
@@ -511,7 +509,7 @@ impl BodySet {
         let mut state = self.states.swap_remove(i);
         if i < self.sims.len() {
             let moved = self.sims[i].handle;
-            self.records[moved.index as usize].location = Some(BodyLocation::Moving(i as u32));
+            self.records.live_mut(moved.index).location = BodyLocation::Moving(i as u32);
         }
         state.v = Vec2::ZERO;
         state.w = 0.0;
@@ -519,9 +517,8 @@ impl BodySet {
         state.dq = Rot::IDENTITY;
         self.sleeping_sims.push(sim);
         self.sleeping_states.push(state);
-        self.records[handle.index as usize].location = Some(BodyLocation::Sleeping(
-            (self.sleeping_sims.len() - 1) as u32,
-        ));
+        self.records.live_mut(handle.index).location =
+            BodyLocation::Sleeping((self.sleeping_sims.len() - 1) as u32);
     }
 
     /// Wakes a sleeping body (back into the solver's arrays, timer reset).
@@ -535,13 +532,13 @@ impl BodySet {
         let state = self.sleeping_states.swap_remove(j);
         if j < self.sleeping_sims.len() {
             let moved = self.sleeping_sims[j].handle;
-            self.records[moved.index as usize].location = Some(BodyLocation::Sleeping(j as u32));
+            self.records.live_mut(moved.index).location = BodyLocation::Sleeping(j as u32);
         }
         sim.sleep_time = 0.0;
         self.sims.push(sim);
         self.states.push(state);
-        self.records[handle.index as usize].location =
-            Some(BodyLocation::Moving((self.sims.len() - 1) as u32));
+        self.records.live_mut(handle.index).location =
+            BodyLocation::Moving((self.sims.len() - 1) as u32);
     }
 
     /// True when the body sleeps.
@@ -562,25 +559,14 @@ impl BodySet {
     /// Creates a body. Bad input returns an error and changes nothing.
     pub fn create(&mut self, def: &BodyDef) -> Result<BodyHandle, BodyError> {
         validate_body_def(def)?;
-        let index = match self.free.pop() {
-            Some(i) => i,
-            None => {
-                self.records.push(BodyRecord {
-                    generation: 0,
-                    location: None,
-                    user_data: 0,
-                    mass_override: false,
-                    fixed_rotation: false,
-                });
-                (self.records.len() - 1) as u32
-            }
-        };
-        let record = &mut self.records[index as usize];
-        record.generation = record.generation.wrapping_add(1);
-        record.user_data = def.user_data;
-        record.mass_override = def.mass.is_some();
-        record.fixed_rotation = def.fixed_rotation;
-        let handle = BodyHandle::new(index, record.generation, self.owner);
+        // The location is set once the body's data is placed below.
+        let (index, generation) = self.records.insert(BodyRecord {
+            location: BodyLocation::Static(u32::MAX),
+            user_data: def.user_data,
+            mass_override: def.mass.is_some(),
+            fixed_rotation: def.fixed_rotation,
+        });
+        let handle = BodyHandle::new(index, generation, self.owner);
         let transform = Transform::new(def.position, def.angle);
         let mass = def.mass.unwrap_or(BodyMass::new(1.0, 1.0));
         let mut sim = BodySim {
@@ -619,12 +605,12 @@ impl BodySet {
             self.states.push(state);
             BodyLocation::Moving((self.sims.len() - 1) as u32)
         };
-        self.records[index as usize].location = Some(location);
+        self.records.live_mut(index).location = location;
         if def.body_type == BodyType::Dynamic {
             self.apply_mass(handle, mass, def.fixed_rotation);
             // Velocity given for the origin: keep it for the centre (same when
             // the centre is at the origin; otherwise add ω × r).
-            if let Some(BodyLocation::Moving(i)) = self.records[index as usize].location {
+            if let BodyLocation::Moving(i) = self.records.live(index).location {
                 let sim = &self.sims[i as usize];
                 let r = sim.center - sim.transform.p;
                 let st = &mut self.states[i as usize];
@@ -677,8 +663,7 @@ impl BodySet {
                 self.states.swap_remove(i);
                 if i < self.sims.len() {
                     let moved = self.sims[i].handle;
-                    self.records[moved.index as usize].location =
-                        Some(BodyLocation::Moving(i as u32));
+                    self.records.live_mut(moved.index).location = BodyLocation::Moving(i as u32);
                 }
             }
             BodyLocation::Static(j) => {
@@ -686,8 +671,7 @@ impl BodySet {
                 self.static_sims.swap_remove(j);
                 if j < self.static_sims.len() {
                     let moved = self.static_sims[j].handle;
-                    self.records[moved.index as usize].location =
-                        Some(BodyLocation::Static(j as u32));
+                    self.records.live_mut(moved.index).location = BodyLocation::Static(j as u32);
                 }
             }
             BodyLocation::Sleeping(j) => {
@@ -696,14 +680,11 @@ impl BodySet {
                 self.sleeping_states.swap_remove(j);
                 if j < self.sleeping_sims.len() {
                     let moved = self.sleeping_sims[j].handle;
-                    self.records[moved.index as usize].location =
-                        Some(BodyLocation::Sleeping(j as u32));
+                    self.records.live_mut(moved.index).location = BodyLocation::Sleeping(j as u32);
                 }
             }
         }
-        let rec = &mut self.records[handle.index as usize];
-        rec.location = None;
-        self.free.push(handle.index);
+        self.records.remove(handle.index, handle.generation);
         Ok(())
     }
 
@@ -714,17 +695,11 @@ impl BodySet {
     pub fn swap_identity(&mut self, a: BodyHandle, b: BodyHandle) -> Result<(), BodyError> {
         let la = self.location(a).ok_or(BodyError::StaleHandle)?;
         let lb = self.location(b).ok_or(BodyError::StaleHandle)?;
-        let (ia, ib) = (a.index as usize, b.index as usize);
-        let ra = self.records[ia].clone();
-        let rb = self.records[ib].clone();
-        self.records[ia].location = Some(lb);
-        self.records[ia].user_data = rb.user_data;
-        self.records[ia].mass_override = rb.mass_override;
-        self.records[ia].fixed_rotation = rb.fixed_rotation;
-        self.records[ib].location = Some(la);
-        self.records[ib].user_data = ra.user_data;
-        self.records[ib].mass_override = ra.mass_override;
-        self.records[ib].fixed_rotation = ra.fixed_rotation;
+        let (ia, ib) = (a.index, b.index);
+        let ra = self.records.live(ia).clone();
+        let rb = self.records.live(ib).clone();
+        *self.records.live_mut(ia) = BodyRecord { location: lb, ..rb };
+        *self.records.live_mut(ib) = BodyRecord { location: la, ..ra };
         let set_handle = |set: &mut BodySet, loc: BodyLocation, h: BodyHandle| match loc {
             BodyLocation::Moving(i) => set.sims[i as usize].handle = h,
             BodyLocation::Static(j) => set.static_sims[j as usize].handle = h,
@@ -738,11 +713,12 @@ impl BodySet {
     /// Where a live body lives, or `None` for a stale handle.
     #[inline]
     pub fn location(&self, handle: BodyHandle) -> Option<BodyLocation> {
-        let rec = self.records.get(handle.index as usize)?;
-        if rec.generation != handle.generation || handle.owner != self.owner {
+        if handle.owner != self.owner {
             return None;
         }
-        rec.location
+        self.records
+            .get(handle.index, handle.generation)
+            .map(|r| r.location)
     }
 
     /// Where a body lives, or why its handle does not resolve.
@@ -761,8 +737,10 @@ impl BodySet {
 
     /// The record of a live body.
     pub fn record(&self, handle: BodyHandle) -> Option<&BodyRecord> {
-        self.location(handle)?;
-        self.records.get(handle.index as usize)
+        if handle.owner != self.owner {
+            return None;
+        }
+        self.records.get(handle.index, handle.generation)
     }
 
     /// The per-step data of a live body.
@@ -837,10 +815,9 @@ impl BodySet {
 
     /// Handles of all live bodies in slot order (deterministic).
     pub fn handles(&self) -> impl Iterator<Item = BodyHandle> + '_ {
-        self.records.iter().enumerate().filter_map(|(i, r)| {
-            r.location
-                .map(|_| BodyHandle::new(i as u32, r.generation, self.owner))
-        })
+        self.records
+            .iter()
+            .map(|(i, _)| self.records.handle(i, self.owner))
     }
 
     /// The body type of a live body.
