@@ -114,6 +114,11 @@ pub struct BodyDef {
     /// (after its shapes are attached), and it costs nothing until something
     /// wakes it.
     pub awake: bool,
+    /// A bullet (usual false): when fast, it is also swept against the
+    /// shapes of other (non-bullet) dynamic and kinematic bodies, not only
+    /// against static ones, so it cannot pass through a thin moving body
+    /// (as Box2D's `isBullet`). Costs a time-of-impact search per fast step.
+    pub bullet: bool,
     /// Opaque user value.
     pub user_data: u64,
 }
@@ -134,6 +139,7 @@ impl Default for BodyDef {
             mass: None,
             fixed_rotation: false,
             awake: true,
+            bullet: false,
             user_data: 0,
         }
     }
@@ -192,6 +198,13 @@ impl BodyDef {
     #[must_use]
     pub fn with_angular_velocity(mut self, w: Real) -> Self {
         self.angular_velocity = w;
+        self
+    }
+
+    /// Makes the body a bullet (builder style; see [`BodyDef::bullet`]).
+    #[must_use]
+    pub fn as_bullet(mut self) -> Self {
+        self.bullet = true;
         self
     }
 }
@@ -298,6 +311,8 @@ pub struct BodySim {
     pub handle: BodyHandle,
     /// Static, kinematic or dynamic.
     pub body_type: BodyType,
+    /// Swept against moving bodies too when fast ([`BodyDef::bullet`]).
+    pub bullet: bool,
 }
 
 impl BodySim {
@@ -322,6 +337,7 @@ impl BodySim {
             sleep_time: 0.0,
             handle: BodyHandle::new(u32::MAX, 0, 0),
             body_type: BodyType::Static,
+            bullet: false,
         }
     }
 }
@@ -589,6 +605,7 @@ impl BodySet {
             sleep_time: 0.0,
             handle,
             body_type: def.body_type,
+            bullet: def.bullet,
         };
         let location = if def.body_type == BodyType::Static {
             self.static_sims.push(sim);

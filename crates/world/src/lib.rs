@@ -8,6 +8,7 @@
 //! | [`world`]        | [`World`], [`WorldDef`], the public API and the step      |
 //! | [`error`]        | [`WorldError`], the typed errors of the API               |
 //! | [`shapes`]       | the shape store: geometry, material, filter, body → shapes |
+//! | [`continuous`]   | continuous collision: fast bodies swept to their time of impact |
 //! | [`contacts`]     | the contact life cycle; awake and sleeping contacts, body → contacts |
 //! | [`narrowphase`]  | manifolds of awake contacts; contact constraints          |
 //! | [`collision`]    | the collision stage: shapes + broadphase + contacts + events |
@@ -25,6 +26,7 @@
 pub mod broadphase;
 pub mod collision;
 pub mod contacts;
+pub mod continuous;
 pub mod dynamic_tree;
 pub mod error;
 pub mod hash;
@@ -39,6 +41,7 @@ pub mod world;
 
 pub use collision::CollisionCounters;
 pub use contacts::{CollisionEvents, Contact, ContactPointData, ShapePairEvent};
+pub use continuous::ContinuousCounters;
 pub use error::WorldError;
 pub use islands::SleepSettings;
 pub use joints::{JointHandle, JointKind, JointSet};

@@ -639,6 +639,7 @@ impl World {
             max_rotation: sim.max_rotation,
             mass: Some(mass_clone),
             fixed_rotation: record.fixed_rotation,
+            bullet: sim.bullet,
             user_data: record.user_data,
             ..BodyDef::default()
         };
