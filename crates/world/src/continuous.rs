@@ -14,7 +14,9 @@
 //!             a one-sided chain segment unless the shape's centroid crosses
 //!             it from its front
 //!       time_of_impact (janus2d-core); a touch at fraction 0 retries with a
-//!             small disc at the shape's centroid (Box2D's fallback)
+//!             small disc at the shape's centroid (Box2D's fallback); the
+//!             centroid never crosses a one-sided chain segment (one that
+//!             starts on its line, pressed into it, is held where it started)
 //!       portals: a hit inside an aperture's hole is no hit
 //!     portals: a centre that crosses an aperture from its front stops on
 //!       the aperture plane, so the crossing stage sees it straddle
@@ -69,6 +71,11 @@ pub(crate) struct ContinuousStage {
     bullets: Vec<u32>,
     candidates: Vec<u32>,
 }
+
+/// How far behind a one-sided chain segment's line a fast shape's centroid
+/// may start and still be held in front, as a fraction of its smallest
+/// extent (dimensionless; 0.25).
+pub const HUG_FRACTION: Real = 0.25;
 
 impl ContinuousStage {
     /// A stage, on or off.
@@ -190,6 +197,7 @@ impl ContinuousStage {
                 .union(&geometry.compute_aabb(&xf2));
             let centroid = geometry.centroid();
             let (c1, c2) = (xf1.apply(centroid), xf2.apply(centroid));
+            let shape_min = shape_extent(geometry, centroid).min_extent;
             let mut candidates = std::mem::take(&mut self.candidates);
             candidates.clear();
             bp.static_tree().query(&swept, |proxy| {
@@ -235,15 +243,43 @@ impl ContinuousStage {
                         _ => Sweep::stationary(&other_sim.transform),
                     }
                 };
+                // One-sided chain segments: only a centroid that goes from
+                // the front to behind the segment's line is stopped, and it
+                // never crosses the segment itself (a shape pressed deep into
+                // the chain, where the time of impact sees an overlap, would
+                // escape once its centre is behind).
+                let mut chain_fraction: Real = 1.0;
                 if let Shape::ChainSegment(chain) = &other.geometry {
-                    // One-sided: only a centroid that goes from the front to
-                    // behind the segment's line is stopped.
                     let xf = other_sim.transform;
                     let p1 = xf.apply(chain.segment.point1);
+                    let p2 = xf.apply(chain.segment.point2);
                     let n = xf.q.rotate(chain.normal());
                     let (o1, o2) = ((c1 - p1).dot(n), (c2 - p1).dot(n));
-                    if o1 < 0.0 || o2 > 0.0 {
-                        continue;
+                    if o2 > 0.0 || o1 == o2 || o1 < -HUG_FRACTION * shape_min {
+                        continue; // ends in front, or started well behind
+                    }
+                    let e = p2 - p1;
+                    let slack = LINEAR_SLOP / e.length();
+                    let within = |x: Vec2| {
+                        let along = (x - p1).dot(e) / e.length_squared();
+                        (-slack..=1.0 + slack).contains(&along)
+                    };
+                    // Where the centroid's path meets the line (its start
+                    // when it starts behind).
+                    let crossing = if o1 > 0.0 {
+                        c1 + (o1 / (o1 - o2)) * (c2 - c1)
+                    } else {
+                        c1
+                    };
+                    if within(crossing) || (o1 <= 0.0 && within(c2)) {
+                        chain_fraction = if o1 <= LINEAR_SLOP {
+                            // Hugging the chain (pressed into it, up to a
+                            // fraction of its extent behind): held where it
+                            // started rather than let out.
+                            0.0
+                        } else {
+                            (o1 - LINEAR_SLOP) / (o1 - o2)
+                        };
                     }
                 }
                 let other_proxy = ShapeProxy::from_shape(&other.geometry);
@@ -257,12 +293,17 @@ impl ContinuousStage {
                     // Touching at the start: a small disc at the centroid
                     // still must not pass (Box2D's fallback).
                     let mut small = ShapeProxy::point(centroid);
-                    small.radius = 0.25 * shape_extent(geometry, centroid).min_extent;
+                    small.radius = 0.25 * shape_min;
                     self.counters.toi_calls += 1;
                     let out = time_of_impact(&other_proxy, &other_sweep, &small, sweep, best);
                     if out.fraction > 0.0 && out.fraction < best && usable(out.state) {
                         hit = Some((out.fraction, small));
                     }
+                }
+                if chain_fraction < best && hit.is_none_or(|(f, _)| chain_fraction < f) {
+                    let mut centre = ShapeProxy::point(centroid);
+                    centre.radius = 0.0;
+                    hit = Some((chain_fraction, centre));
                 }
                 let Some((fraction, hit_proxy)) = hit else {
                     continue;
