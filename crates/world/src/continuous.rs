@@ -18,8 +18,8 @@
 //!             centroid never crosses a one-sided chain segment (one that
 //!             starts on its line, pressed into it, is held where it started)
 //!       portals: a hit inside an aperture's hole is no hit
-//!     portals: a centre that crosses an aperture from its front stops on
-//!       the aperture plane, so the crossing stage sees it straddle
+//!     portals: a centre that crosses an aperture from its front stops just
+//!       behind the aperture plane, so the crossing stage sees it straddle
 //!   move back  (first fraction t < 1): pose at t; velocity kept, so the
 //!     next step's speculative contact stops the body
 //! ```
@@ -329,8 +329,8 @@ impl ContinuousStage {
     }
 }
 
-/// The fraction at which the body's centre crosses a portal aperture from
-/// its front, within its span (1: none). A body already crossing is left to
+/// The fraction at which the body's centre, crossing a portal aperture from
+/// its front within its span, is a linear slop behind it (1: none). A body already crossing is left to
 /// the portal stage.
 fn aperture_fraction(
     body: janus2d_core::body::BodyHandle,
@@ -344,8 +344,10 @@ fn aperture_fraction(
     for clip in clipping.clips.iter().filter(|c| c.hole && c.body != body) {
         let s0 = (sweep.c1 - clip.point).dot(clip.normal);
         let s1 = (sweep.c2 - clip.point).dot(clip.normal);
-        if s0 > 0.0 && s1 <= 0.0 {
-            let u = s0 / (s0 - s1);
+        // Stopped a linear slop behind the plane, so that the crossing
+        // stage sees the centre swept through (never frozen on the plane).
+        if s0 > 0.0 && s1 < -LINEAR_SLOP {
+            let u = (s0 + LINEAR_SLOP) / (s0 - s1);
             let x = sweep.center_at(u);
             if cross(clip.normal, x - clip.point).abs() < clip.half_width && u < best {
                 best = u;
