@@ -119,6 +119,11 @@ pub struct BodyDef {
     /// takes the world's `SleepSettings::linear_threshold` (usual `None`;
     /// Box2D's `sleepThreshold`, default 0.05 m/s).
     pub sleep_threshold: Option<Real>,
+    /// A bullet (usual false): when fast, it is also swept against the
+    /// shapes of other (non-bullet) dynamic and kinematic bodies, not only
+    /// against static ones, so it cannot pass through a thin moving body
+    /// (as Box2D's `isBullet`). Costs a time-of-impact search per fast step.
+    pub bullet: bool,
     /// Opaque user value.
     pub user_data: u64,
 }
@@ -140,6 +145,7 @@ impl Default for BodyDef {
             fixed_rotation: false,
             awake: true,
             sleep_threshold: None,
+            bullet: false,
             user_data: 0,
         }
     }
@@ -198,6 +204,13 @@ impl BodyDef {
     #[must_use]
     pub fn with_angular_velocity(mut self, w: Real) -> Self {
         self.angular_velocity = w;
+        self
+    }
+
+    /// Makes the body a bullet (builder style; see [`BodyDef::bullet`]).
+    #[must_use]
+    pub fn as_bullet(mut self) -> Self {
+        self.bullet = true;
         self
     }
 }
@@ -306,6 +319,8 @@ pub struct BodySim {
     pub handle: BodyHandle,
     /// Static, kinematic or dynamic.
     pub body_type: BodyType,
+    /// Swept against moving bodies too when fast ([`BodyDef::bullet`]).
+    pub bullet: bool,
 }
 
 impl BodySim {
@@ -331,6 +346,7 @@ impl BodySim {
             sleep_threshold: -1.0,
             handle: BodyHandle::new(u32::MAX, 0, 0),
             body_type: BodyType::Static,
+            bullet: false,
         }
     }
 }
@@ -590,6 +606,7 @@ impl BodySet {
             sleep_threshold: def.sleep_threshold.unwrap_or(-1.0),
             handle,
             body_type: def.body_type,
+            bullet: def.bullet,
         };
         let location = if def.body_type == BodyType::Static {
             self.static_sims.push(sim);

@@ -254,6 +254,10 @@ pub trait ConstraintBatch {
     /// Solve every constraint once, in storage order or (`reverse`) the
     /// opposite order.
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, reverse: bool);
+    /// A second solve pass that runs after every batch's `solve` in the same
+    /// sweep (usual: nothing). The exact joint-tree solve runs here, so the
+    /// joints it solves have the last word after the contacts.
+    fn solve_late(&mut self, _ctx: &StepContext, _states: &mut [BodyState], _use_bias: bool) {}
     /// Restitution for every constraint.
     fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]);
     /// Store impulses of every constraint.

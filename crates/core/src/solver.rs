@@ -482,6 +482,9 @@ pub fn solve_step(
             for &i in &active {
                 batches[i].solve(ctx, &mut bodies.states, true, flip);
             }
+            for &i in &active {
+                batches[i].solve_late(ctx, &mut bodies.states, true);
+            }
         }
         report.profile.solve += lap(&mut t);
         integrate_positions(ctx, bodies);
@@ -489,6 +492,9 @@ pub fn solve_step(
         for _ in 0..relax_iterations {
             for &i in &active {
                 batches[i].solve(ctx, &mut bodies.states, false, !flip);
+            }
+            for &i in &active {
+                batches[i].solve_late(ctx, &mut bodies.states, false);
             }
         }
         report.profile.relax += lap(&mut t);

@@ -9,6 +9,7 @@
 //! | [`error`]        | [`WorldError`], the typed errors of the API               |
 //! | [`shapes`]       | the shape store: geometry, material, filter, body → shapes |
 //! | [`debug_draw`]   | the [`DebugDraw`] trait, draw flags and colours, the drawing walk |
+//! | [`continuous`]   | continuous collision: fast bodies swept to their time of impact |
 //! | [`contacts`]     | the contact life cycle; awake and sleeping contacts, body → contacts |
 //! | [`narrowphase`]  | manifolds of awake contacts; contact constraints          |
 //! | [`collision`]    | the collision stage: shapes + broadphase + contacts + events |
@@ -26,6 +27,7 @@
 pub mod broadphase;
 pub mod collision;
 pub mod contacts;
+pub mod continuous;
 pub mod debug_draw;
 pub mod dynamic_tree;
 pub mod error;
@@ -41,6 +43,7 @@ pub mod world;
 
 pub use collision::CollisionCounters;
 pub use contacts::{CollisionEvents, Contact, ContactPointData, ShapePairEvent};
+pub use continuous::ContinuousCounters;
 pub use debug_draw::{Color, DebugDraw, DrawOptions, Palette};
 pub use error::WorldError;
 pub use islands::SleepSettings;

@@ -7,6 +7,7 @@
 //! | `narrowphase`    | manifolds of every awake contact                   |
 //! | `portals`        | clipping, crossings, handovers, weights            |
 //! | `solver.*`       | the solver's stages ([`SolverProfile`]): prepare, integrate, warm start, solve, relax, restitution, finalize |
+//! | `continuous`     | fast bodies swept to their time of impact          |
 //! | `sleep`          | sleep timers and islands                           |
 //!
 //! A stage whose feature the scene lacks is not entered: its time is zero
@@ -26,6 +27,8 @@ pub struct StepProfile {
     /// The solver's stages (prepare, integrate, warm start, solve, relax,
     /// restitution, finalize).
     pub solver: SolverProfile,
+    /// Continuous collision (fast-body test, sweeps, moves back).
+    pub continuous: f64,
     /// Sleep.
     pub sleep: f64,
     /// Whole step.
@@ -68,6 +71,12 @@ pub struct StepCounters {
     pub awake_bodies: usize,
     /// Sleeping bodies.
     pub sleeping_bodies: usize,
+    /// Fast bodies swept by continuous collision (0: no time-of-impact work).
+    pub toi_bodies: usize,
+    /// Time-of-impact searches run.
+    pub toi_calls: usize,
+    /// Bodies moved back to a time of impact.
+    pub toi_hits: usize,
 }
 
 /// What the step's counters are gathered from.
@@ -82,6 +91,7 @@ pub(crate) struct CounterSources<'a> {
     pub(crate) portals: (usize, usize, usize),
     pub(crate) gravity: bool,
     pub(crate) bodies: &'a janus2d_core::body::BodySet,
+    pub(crate) continuous: crate::continuous::ContinuousCounters,
 }
 
 impl StepCounters {
@@ -111,6 +121,9 @@ impl StepCounters {
             },
             awake_bodies: s.bodies.moving_count(),
             sleeping_bodies: s.bodies.sleeping_count(),
+            toi_bodies: s.continuous.toi_bodies,
+            toi_calls: s.continuous.toi_calls,
+            toi_hits: s.continuous.toi_hits,
         }
     }
 }

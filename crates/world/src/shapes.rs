@@ -156,11 +156,34 @@ pub struct ShapeData {
     pub aabb: Aabb,
 }
 
+/// The size figures of a body's solid shapes that continuous collision
+/// reads (kept up to date as shapes come and go).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyExtent {
+    /// Smallest [`min_extent`](janus2d_core::geometry::ShapeExtent::min_extent)
+    /// of the body's solid shapes, m (`Real::MAX` without one).
+    pub min_extent: Real,
+    /// Largest distance from the body origin to the surface of a solid
+    /// shape, m (0 without one).
+    pub max_extent: Real,
+}
+
+impl Default for BodyExtent {
+    fn default() -> Self {
+        BodyExtent {
+            min_extent: Real::MAX,
+            max_extent: 0.0,
+        }
+    }
+}
+
 /// Shapes of a world, in generational slots, with each body's list.
 #[derive(Clone, Debug, Default)]
 pub struct ShapeStore {
     slots: Slots<ShapeData>,
     body_shapes: Vec<SmallVec<[u32; 2]>>,
+    /// Per body slot, the extents of its solid shapes.
+    body_extents: Vec<BodyExtent>,
 }
 
 impl ShapeStore {
@@ -212,6 +235,36 @@ impl ShapeStore {
             .map_or(&[], |l| l.as_slice())
     }
 
+    /// The extents of a body's solid shapes (see [`BodyExtent`]).
+    #[inline]
+    #[must_use]
+    pub fn extent_of(&self, body: BodyHandle) -> BodyExtent {
+        self.body_extents
+            .get(body.index as usize)
+            .copied()
+            .unwrap_or_default()
+    }
+
+    /// Recomputes the extents of body slot `b` from its solid shapes.
+    pub(crate) fn refresh_extent(&mut self, b: usize) {
+        if self.body_extents.len() <= b {
+            self.body_extents.resize(b + 1, BodyExtent::default());
+        }
+        let mut e = BodyExtent::default();
+        if let Some(list) = self.body_shapes.get(b) {
+            for &s in list {
+                let shape = self.slots.live(s);
+                if shape.def.is_sensor {
+                    continue;
+                }
+                let x = janus2d_core::geometry::shape_extent(&shape.geometry, Vec2::ZERO);
+                e.min_extent = e.min_extent.min(x.min_extent);
+                e.max_extent = e.max_extent.max(x.max_extent);
+            }
+        }
+        self.body_extents[b] = e;
+    }
+
     /// Stores a shape and lists it under its body; returns its slot.
     pub fn insert(&mut self, data: ShapeData) -> u32 {
         let b = data.body.index as usize;
@@ -220,6 +273,7 @@ impl ShapeStore {
             self.body_shapes.resize(b + 1, SmallVec::new());
         }
         self.body_shapes[b].push(index);
+        self.refresh_extent(b);
         index
     }
 
@@ -233,6 +287,7 @@ impl ShapeStore {
         if let Some(list) = self.body_shapes.get_mut(data.body.index as usize) {
             list.retain(|i| *i != index);
         }
+        self.refresh_extent(data.body.index as usize);
         data
     }
 
@@ -252,6 +307,8 @@ impl ShapeStore {
             let s = self.body_shapes[ib][k];
             self.slots.live_mut(s).body = b;
         }
+        self.refresh_extent(ia);
+        self.refresh_extent(ib);
     }
 
     /// The mass, centre (body frame) and inertia about the centre of a

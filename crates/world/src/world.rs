@@ -6,6 +6,7 @@
 //!   ├─ portal clipping (portal stage; a no-op without portal pairs)
 //!   ├─ broadphase: new pairs ─ narrowphase ─ wake touched islands ─ contact constraints
 //!   ├─ solve_step (janus2d-core): prepare ─ substeps ─ restitution ─ store ─ finalize
+//!   ├─ continuous: fast bodies swept, moved back to their time of impact
 //!   ├─ store impulses ─ move proxies
 //!   ├─ portal crossings (commands applied by the world)
 //!   ├─ islands: sleep timers, resting islands sleep
@@ -46,6 +47,10 @@ pub struct WorldDef {
     pub solver: SolverSettings,
     /// When bodies fall asleep (on by default, as in Box2D and Rapier).
     pub sleep: SleepSettings,
+    /// Continuous collision of fast bodies against static shapes, and of
+    /// bullets against moving ones (on by default, as in Box2D; see
+    /// [`crate::continuous`]).
+    pub enable_continuous: bool,
 }
 
 impl Default for WorldDef {
@@ -54,6 +59,7 @@ impl Default for WorldDef {
             gravity: DEFAULT_GRAVITY,
             solver: SolverSettings::default(),
             sleep: SleepSettings::default(),
+            enable_continuous: true,
         }
     }
 }
@@ -83,6 +89,7 @@ pub struct World {
     object_masses: Vec<ObjectMass>,
     pub(crate) portals: PortalStage,
     islands: Islands,
+    continuous: crate::continuous::ContinuousStage,
     sleep_settings: SleepSettings,
     wake_list: Vec<BodyHandle>,
     events: StepEvents,
@@ -114,6 +121,7 @@ impl World {
             object_masses: Vec::new(),
             portals: PortalStage::default(),
             islands: Islands::default(),
+            continuous: crate::continuous::ContinuousStage::new(def.enable_continuous),
             sleep_settings: def.sleep,
             wake_list: Vec::new(),
             joints: JointSet::new(bodies.owner()),
@@ -1168,6 +1176,18 @@ impl World {
         Ok(())
     }
 
+    // ----- continuous collision ---------------------------------------------
+
+    /// True when continuous collision is on ([`WorldDef::enable_continuous`]).
+    pub fn continuous_enabled(&self) -> bool {
+        self.continuous.enabled
+    }
+
+    /// Turns continuous collision on or off from the next step.
+    pub fn set_continuous_enabled(&mut self, on: bool) {
+        self.continuous.enabled = on;
+    }
+
     // ----- stepping ---------------------------------------------------------
 
     /// The step context the solver uses for a step of `dt`.
@@ -1250,9 +1270,20 @@ impl World {
             object_masses: &self.object_masses,
         };
         let mut batches: [&mut dyn ConstraintBatch; 3] =
-            [&mut contacts, &mut revolute, self.portals.constraints_mut()];
+            [&mut revolute, &mut contacts, self.portals.constraints_mut()];
         let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
         lap();
+        if has_shapes {
+            let c = &self.collision;
+            let input = crate::continuous::ContinuousInput {
+                shapes: &c.shapes,
+                broadphase: &c.broadphase,
+                no_collide: &self.joints.no_collide,
+                clipping: self.portals.clipping(),
+            };
+            self.continuous.run(&mut self.bodies, &input);
+            sp.continuous += lap();
+        }
         if has_shapes {
             self.collision.store_impulses(&self.contact_solver);
             self.collision.update_proxies(&self.bodies, dt);
@@ -1292,6 +1323,7 @@ impl World {
             portals: self.portals.counters_for_step(has_portals),
             gravity: self.gravity != Vec2::ZERO,
             bodies: &self.bodies,
+            continuous: self.continuous.counters(),
         });
         self.step_profile = sp;
         self.events = StepEvents {

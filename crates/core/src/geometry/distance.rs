@@ -350,7 +350,7 @@ fn solve3(s: &mut [SimplexVertex; 3], n: &mut usize) {
 }
 
 /// Distance between the core point sets (radius ignored).
-fn core_distance(
+pub(crate) fn core_distance(
     a: &ShapeProxy,
     xf_a: &Transform,
     b: &ShapeProxy,

@@ -13,6 +13,8 @@
 //! - [`ray`]: [`Shape::ray_cast`] → [`CastHit`] (fraction, point, normal).
 //! - [`distance`]: [`ShapeProxy`], GJK [`shape_distance`] (closest points),
 //!   [`shapes_overlap`], [`shape_cast`] (a shape swept along a translation).
+//! - [`toi`]: [`Sweep`], [`time_of_impact`] → [`ToiOutput`] (continuous
+//!   collision of two moving, turning shapes), [`shape_extent`].
 //!
 //! # Manifold conventions
 //!
@@ -54,6 +56,7 @@ pub mod mass;
 pub mod query;
 pub mod ray;
 pub mod shapes;
+pub mod toi;
 
 pub use aabb::Aabb;
 pub use distance::{
@@ -69,4 +72,7 @@ pub use ray::{CastHit, RayInput};
 pub use shapes::{
     Capsule, ChainSegment, Circle, GeometryError, LINEAR_SLOP, MAX_POLYGON_VERTICES, Polygon,
     SPECULATIVE_DISTANCE, Segment, Shape, WELD_DISTANCE, make_chain,
+};
+pub use toi::{
+    ShapeExtent, Sweep, TOI_MAX_ITERATIONS, ToiOutput, ToiState, shape_extent, time_of_impact,
 };

@@ -80,6 +80,22 @@ impl ContactClipping {
         self.clips.is_empty() && self.ignored_pairs.is_empty()
     }
 
+    /// True when `p` lies in the hole of an aperture on `body` (a point the
+    /// narrowphase would drop from a contact with that body).
+    #[cfg_attr(not(feature = "portals"), allow(dead_code))]
+    pub(crate) fn in_hole(&self, body: BodyHandle, p: Vec2) -> bool {
+        self.clips
+            .iter()
+            .any(|clip| clip.hole && clip.body == body && clip.drops(p))
+    }
+
+    /// True when the pair `(a, b)` never touches (a crossing copy and its twin).
+    pub(crate) fn ignores(&self, a: BodyHandle, b: BodyHandle) -> bool {
+        self.ignored_pairs
+            .iter()
+            .any(|&(x, y)| (a == x && b == y) || (a == y && b == x))
+    }
+
     /// Drops the points of `c` that the clipping covers.
     pub(crate) fn apply(&self, c: &mut Contact) {
         if self

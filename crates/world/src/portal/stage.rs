@@ -674,6 +674,7 @@ impl World {
             fixed_rotation: record.fixed_rotation,
             // Speeds scale by η through the portal.
             sleep_threshold: (sim.sleep_threshold >= 0.0).then_some(eta * sim.sleep_threshold),
+            bullet: sim.bullet,
             user_data: record.user_data,
             ..BodyDef::default()
         };

@@ -1,0 +1,358 @@
+//! Continuous collision: fast bodies are swept over the step and moved back
+//! to their first time of impact, so they cannot pass through thin
+//! geometry (as Box2D v3's `b2SolveContinuous`).
+//!
+//! ```text
+//! after the solve's finalize (start and end poses known), before proxies move:
+//!   fast test  (every awake dynamic body with a solid shape)
+//!     travel = |Δc| + |Δq| · (max_extent + |local centre|)
+//!     fast when travel > max(½ · min_extent, LINEAR_SLOP)
+//!   sweep      (each fast body; bullets after the others)
+//!     per solid shape: broadphase box query over its start ∪ end box
+//!       static tree (every fast body), dynamic tree (bullets: non-bullet bodies)
+//!       skip: same body, sensors, filtered, joints without collide_connected,
+//!             a one-sided chain segment unless the shape's centroid crosses
+//!             it from its front
+//!       time_of_impact (janus2d-core); a touch at fraction 0 retries with a
+//!             small disc at the shape's centroid (Box2D's fallback); the
+//!             centroid never crosses a one-sided chain segment (one that
+//!             starts on its line, pressed into it, is held where it started)
+//!       portals: a hit inside an aperture's hole is no hit
+//!     portals: a centre that crosses an aperture from its front stops just
+//!       behind the aperture plane, so the crossing stage sees it straddle
+//!   move back  (first fraction t < 1): pose at t; velocity kept, so the
+//!     next step's speculative contact stops the body
+//! ```
+//!
+//! A scene where nothing is fast does one cheap test per awake dynamic body
+//! and nothing else: [`ContinuousCounters::toi_bodies`] stays 0.
+
+use janus2d_core::body::{BodyLocation, BodySet, BodyType};
+use janus2d_core::geometry::{
+    LINEAR_SLOP, Shape, ShapeProxy, Sweep, ToiState, shape_distance, shape_extent, time_of_impact,
+};
+use janus2d_core::math::{Real, Vec2, cross};
+
+use crate::broadphase::BroadPhase;
+use crate::joints::NoCollide;
+use crate::portal::ContactClipping;
+use crate::shapes::ShapeStore;
+
+/// Fraction of a body's smallest extent it may travel in one step before it
+/// counts as fast (dimensionless; usual 0.5, Box2D's safety factor).
+pub const FAST_FRACTION: Real = 0.5;
+
+/// Work of the last continuous pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ContinuousCounters {
+    /// Fast bodies swept (bullets included).
+    pub toi_bodies: usize,
+    /// Time-of-impact searches run.
+    pub toi_calls: usize,
+    /// Bodies moved back to a time of impact.
+    pub toi_hits: usize,
+}
+
+/// What the continuous stage reads besides the bodies.
+pub(crate) struct ContinuousInput<'a> {
+    pub(crate) shapes: &'a ShapeStore,
+    pub(crate) broadphase: &'a BroadPhase,
+    pub(crate) no_collide: &'a NoCollide,
+    /// The portal stage's aperture clipping (empty without portals).
+    pub(crate) clipping: &'a ContactClipping,
+}
+
+/// The continuous stage: the switch, its scratch lists and its counters.
+#[derive(Clone, Debug)]
+pub(crate) struct ContinuousStage {
+    pub(crate) enabled: bool,
+    counters: ContinuousCounters,
+    fast: Vec<u32>,
+    bullets: Vec<u32>,
+    candidates: Vec<u32>,
+}
+
+/// How far behind a one-sided chain segment's line a fast shape's centroid
+/// may start and still be held in front, as a fraction of its smallest
+/// extent (dimensionless; 0.25).
+pub const HUG_FRACTION: Real = 0.25;
+
+impl ContinuousStage {
+    /// A stage, on or off.
+    pub(crate) fn new(enabled: bool) -> Self {
+        ContinuousStage {
+            enabled,
+            counters: ContinuousCounters::default(),
+            fast: Vec::new(),
+            bullets: Vec::new(),
+            candidates: Vec::new(),
+        }
+    }
+
+    /// The counters of the last pass.
+    pub(crate) fn counters(&self) -> ContinuousCounters {
+        self.counters
+    }
+
+    /// Sweeps the fast bodies and moves those that hit something back to
+    /// their time of impact.
+    pub(crate) fn run(&mut self, bodies: &mut BodySet, input: &ContinuousInput<'_>) {
+        self.counters = ContinuousCounters::default();
+        self.fast.clear();
+        self.bullets.clear();
+        if !self.enabled {
+            return;
+        }
+        for (i, sim) in bodies.sims.iter().enumerate().skip(1) {
+            if sim.body_type != BodyType::Dynamic {
+                continue;
+            }
+            let e = input.shapes.extent_of(sim.handle);
+            if e.min_extent == Real::MAX {
+                continue; // no solid shape
+            }
+            let dc = sim.center - sim.center0;
+            let q = sim.transform.q;
+            let q0 = sim.rotation0;
+            let chord = Vec2::new(q.c - q0.c, q.s - q0.s);
+            let arm = e.max_extent + sim.local_center.length();
+            let threshold = (FAST_FRACTION * e.min_extent).max(LINEAR_SLOP);
+            let lin = dc.length_squared();
+            let rot = chord.length_squared() * arm * arm;
+            // |Δc| + |Δq| arm ≤ √(2 (|Δc|² + |Δq|² arm²)): most bodies need no root.
+            if 2.0 * (lin + rot) <= threshold * threshold {
+                continue;
+            }
+            if lin.sqrt() + rot.sqrt() <= threshold {
+                continue;
+            }
+            if sim.bullet {
+                self.bullets.push(i as u32);
+            } else {
+                self.fast.push(i as u32);
+            }
+        }
+        self.counters.toi_bodies = self.fast.len() + self.bullets.len();
+        let fast = std::mem::take(&mut self.fast);
+        for &i in &fast {
+            self.sweep_body(i as usize, bodies, input, false);
+        }
+        self.fast = fast;
+        let bullets = std::mem::take(&mut self.bullets);
+        for &i in &bullets {
+            self.sweep_body(i as usize, bodies, input, true);
+        }
+        self.bullets = bullets;
+    }
+
+    /// Sweeps moving body `i` and moves it back when it hits.
+    fn sweep_body(
+        &mut self,
+        i: usize,
+        bodies: &mut BodySet,
+        input: &ContinuousInput<'_>,
+        bullet: bool,
+    ) {
+        let sim = &bodies.sims[i];
+        let sweep = Sweep::between(
+            sim.local_center,
+            sim.center0,
+            sim.rotation0,
+            sim.center,
+            sim.transform.q,
+        );
+        let fraction = self.first_impact(sim.handle, &sweep, bodies, input, bullet);
+        if fraction < 1.0 {
+            let sim = &mut bodies.sims[i];
+            sim.transform = sweep.transform_at(fraction);
+            sim.center = sweep.center_at(fraction);
+            self.counters.toi_hits += 1;
+        }
+    }
+
+    /// The first fraction of the step at which the body's sweep meets what
+    /// it may not pass (1: nothing).
+    fn first_impact(
+        &mut self,
+        body: janus2d_core::body::BodyHandle,
+        sweep: &Sweep,
+        bodies: &BodySet,
+        input: &ContinuousInput<'_>,
+        bullet: bool,
+    ) -> Real {
+        let shapes = input.shapes;
+        let bp = input.broadphase;
+        let xf1 = sweep.transform_at(0.0);
+        let xf2 = sweep.transform_at(1.0);
+        let mut best: Real = 1.0;
+        for &s in shapes.of_body(body) {
+            let fast_shape = shapes.at(s);
+            if fast_shape.def.is_sensor {
+                continue;
+            }
+            let geometry = &fast_shape.geometry;
+            let proxy = ShapeProxy::from_shape(geometry);
+            let swept = geometry
+                .compute_aabb(&xf1)
+                .union(&geometry.compute_aabb(&xf2));
+            let centroid = geometry.centroid();
+            let (c1, c2) = (xf1.apply(centroid), xf2.apply(centroid));
+            let shape_min = shape_extent(geometry, centroid).min_extent;
+            let mut candidates = std::mem::take(&mut self.candidates);
+            candidates.clear();
+            bp.static_tree().query(&swept, |proxy| {
+                candidates.push(bp.payload(proxy));
+                true
+            });
+            if bullet {
+                bp.dynamic_tree().query(&swept, |proxy| {
+                    candidates.push(bp.payload(proxy));
+                    true
+                });
+            }
+            // Tree order depends on history; the answer must not.
+            candidates.sort_unstable();
+            candidates.dedup();
+            for &other_slot in &candidates {
+                let other = shapes.at(other_slot);
+                if other.body == body
+                    || other.def.is_sensor
+                    || !fast_shape.def.filter.should_collide(&other.def.filter)
+                    || input.no_collide.contains(body, other.body)
+                    || input.clipping.ignores(body, other.body)
+                {
+                    continue;
+                }
+                let Some(other_sim) = bodies.sim(other.body) else {
+                    continue;
+                };
+                let other_sweep = if other_sim.body_type == BodyType::Static {
+                    Sweep::stationary(&other_sim.transform)
+                } else {
+                    if other_sim.bullet {
+                        continue; // bullets do not sweep against bullets
+                    }
+                    match bodies.location(other.body) {
+                        Some(BodyLocation::Moving(_)) => Sweep::between(
+                            other_sim.local_center,
+                            other_sim.center0,
+                            other_sim.rotation0,
+                            other_sim.center,
+                            other_sim.transform.q,
+                        ),
+                        _ => Sweep::stationary(&other_sim.transform),
+                    }
+                };
+                // One-sided chain segments: only a centroid that goes from
+                // the front to behind the segment's line is stopped, and it
+                // never crosses the segment itself (a shape pressed deep into
+                // the chain, where the time of impact sees an overlap, would
+                // escape once its centre is behind).
+                let mut chain_fraction: Real = 1.0;
+                if let Shape::ChainSegment(chain) = &other.geometry {
+                    let xf = other_sim.transform;
+                    let p1 = xf.apply(chain.segment.point1);
+                    let p2 = xf.apply(chain.segment.point2);
+                    let n = xf.q.rotate(chain.normal());
+                    let (o1, o2) = ((c1 - p1).dot(n), (c2 - p1).dot(n));
+                    if o2 > 0.0 || o1 == o2 || o1 < -HUG_FRACTION * shape_min {
+                        continue; // ends in front, or started well behind
+                    }
+                    let e = p2 - p1;
+                    let slack = LINEAR_SLOP / e.length();
+                    let within = |x: Vec2| {
+                        let along = (x - p1).dot(e) / e.length_squared();
+                        (-slack..=1.0 + slack).contains(&along)
+                    };
+                    // Where the centroid's path meets the line (its start
+                    // when it starts behind).
+                    let crossing = if o1 > 0.0 {
+                        c1 + (o1 / (o1 - o2)) * (c2 - c1)
+                    } else {
+                        c1
+                    };
+                    if within(crossing) || (o1 <= 0.0 && within(c2)) {
+                        chain_fraction = if o1 <= LINEAR_SLOP {
+                            // Hugging the chain (pressed into it, up to a
+                            // fraction of its extent behind): held where it
+                            // started rather than let out.
+                            0.0
+                        } else {
+                            (o1 - LINEAR_SLOP) / (o1 - o2)
+                        };
+                    }
+                }
+                let other_proxy = ShapeProxy::from_shape(&other.geometry);
+                self.counters.toi_calls += 1;
+                let out = time_of_impact(&other_proxy, &other_sweep, &proxy, sweep, best);
+                let usable = |state: ToiState| matches!(state, ToiState::Hit | ToiState::Failed);
+                let mut hit = None;
+                if out.fraction > 0.0 && out.fraction < best && usable(out.state) {
+                    hit = Some((out.fraction, proxy));
+                } else if out.fraction == 0.0 && out.state != ToiState::Separated {
+                    // Touching at the start: a small disc at the centroid
+                    // still must not pass (Box2D's fallback).
+                    let mut small = ShapeProxy::point(centroid);
+                    small.radius = 0.25 * shape_min;
+                    self.counters.toi_calls += 1;
+                    let out = time_of_impact(&other_proxy, &other_sweep, &small, sweep, best);
+                    if out.fraction > 0.0 && out.fraction < best && usable(out.state) {
+                        hit = Some((out.fraction, small));
+                    }
+                }
+                if chain_fraction < best && hit.is_none_or(|(f, _)| chain_fraction < f) {
+                    let mut centre = ShapeProxy::point(centroid);
+                    centre.radius = 0.0;
+                    hit = Some((chain_fraction, centre));
+                }
+                let Some((fraction, hit_proxy)) = hit else {
+                    continue;
+                };
+                if !input.clipping.clips.is_empty() {
+                    // A hit inside an aperture's hole is no hit: the body
+                    // goes through the portal instead.
+                    let d = shape_distance(
+                        &other_proxy,
+                        &other_sweep.transform_at(fraction),
+                        &hit_proxy,
+                        &sweep.transform_at(fraction),
+                    );
+                    if input.clipping.in_hole(other.body, d.point_a) {
+                        continue;
+                    }
+                }
+                best = fraction;
+            }
+            self.candidates = candidates;
+        }
+        best.min(aperture_fraction(body, sweep, input.clipping))
+    }
+}
+
+/// The fraction at which the body's centre, crossing a portal aperture from
+/// its front within its span, is a linear slop behind it (1: none). A body already crossing is left to
+/// the portal stage.
+fn aperture_fraction(
+    body: janus2d_core::body::BodyHandle,
+    sweep: &Sweep,
+    clipping: &ContactClipping,
+) -> Real {
+    let mut best: Real = 1.0;
+    if clipping.clips.iter().any(|c| !c.hole && c.body == body) {
+        return best;
+    }
+    for clip in clipping.clips.iter().filter(|c| c.hole && c.body != body) {
+        let s0 = (sweep.c1 - clip.point).dot(clip.normal);
+        let s1 = (sweep.c2 - clip.point).dot(clip.normal);
+        // Stopped a linear slop behind the plane, so that the crossing
+        // stage sees the centre swept through (never frozen on the plane).
+        if s0 > 0.0 && s1 < -LINEAR_SLOP {
+            let u = (s0 + LINEAR_SLOP) / (s0 - s1);
+            let x = sweep.center_at(u);
+            if cross(clip.normal, x - clip.point).abs() < clip.half_width && u < best {
+                best = u;
+            }
+        }
+    }
+    best
+}
