@@ -119,6 +119,12 @@ pub struct BodyDef {
     /// against static ones, so it cannot pass through a thin moving body
     /// (as Box2D's `isBullet`). Costs a time-of-impact search per fast step.
     pub bullet: bool,
+    /// May fall asleep (usual true); `false` keeps it awake, and its island
+    /// with it.
+    pub enable_sleep: bool,
+    /// Speed below which this body counts as at rest, m/s (`None`, usual:
+    /// the world's sleep `linear_threshold`).
+    pub sleep_threshold: Option<Real>,
     /// Opaque user value.
     pub user_data: u64,
 }
@@ -140,6 +146,8 @@ impl Default for BodyDef {
             fixed_rotation: false,
             awake: true,
             bullet: false,
+            enable_sleep: true,
+            sleep_threshold: None,
             user_data: 0,
         }
     }
@@ -313,6 +321,10 @@ pub struct BodySim {
     pub body_type: BodyType,
     /// Swept against moving bodies too when fast ([`BodyDef::bullet`]).
     pub bullet: bool,
+    /// May fall asleep ([`BodyDef::enable_sleep`]).
+    pub enable_sleep: bool,
+    /// Own rest speed, m/s ([`BodyDef::sleep_threshold`]).
+    pub sleep_threshold: Option<Real>,
 }
 
 impl BodySim {
@@ -338,6 +350,8 @@ impl BodySim {
             handle: BodyHandle::new(u32::MAX, 0, 0),
             body_type: BodyType::Static,
             bullet: false,
+            enable_sleep: true,
+            sleep_threshold: None,
         }
     }
 }
@@ -444,6 +458,12 @@ pub fn validate_body_def(def: &BodyDef) -> Result<(), BodyError> {
     }
     if def.max_rotation < 0.0 {
         return Err(BodyError::Negative("max_rotation"));
+    }
+    if let Some(t) = def.sleep_threshold {
+        check_finite(t, "sleep_threshold")?;
+        if t < 0.0 {
+            return Err(BodyError::Negative("sleep_threshold"));
+        }
     }
     if let Some(m) = def.mass {
         validate_mass(def.body_type, &m, def.fixed_rotation)?;
@@ -606,6 +626,8 @@ impl BodySet {
             handle,
             body_type: def.body_type,
             bullet: def.bullet,
+            enable_sleep: def.enable_sleep,
+            sleep_threshold: def.sleep_threshold,
         };
         let location = if def.body_type == BodyType::Static {
             self.static_sims.push(sim);
@@ -765,6 +787,12 @@ impl BodySet {
     pub fn record(&self, handle: BodyHandle) -> Option<&BodyRecord> {
         self.location(handle)?;
         self.records.get(handle.index as usize)
+    }
+
+    /// The mutable record of a live body (user data, mass override).
+    pub fn record_mut(&mut self, handle: BodyHandle) -> Option<&mut BodyRecord> {
+        self.location(handle)?;
+        self.records.get_mut(handle.index as usize)
     }
 
     /// The per-step data of a live body.
