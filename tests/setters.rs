@@ -315,3 +315,141 @@ fn fallible_shape_helpers_return_errors_instead_of_panicking() {
     );
     assert!((Shape::Polygon(Polygon::try_make_box(0.5, 0.25).unwrap()).area() - 0.5).abs() < 1e-6);
 }
+
+#[test]
+fn set_body_type_static_to_dynamic_falls_and_moves_its_proxies() {
+    let mut w = world();
+    ground(&mut w);
+    let b = w.create_body(&BodyDef::fixed(Vec2::new(0.0, 3.0))).unwrap();
+    w.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    let statics = w.bodies().static_sims.len();
+    w.set_body_type(b, BodyType::Dynamic).unwrap();
+    assert_eq!(w.body_type(b).unwrap(), BodyType::Dynamic);
+    assert_eq!(w.bodies().static_sims.len(), statics - 1);
+    assert!(w.is_awake(b).unwrap());
+    assert!((w.mass(b).unwrap() - 1.0).abs() < 1e-6);
+    for _ in 0..120 {
+        w.step(DT).unwrap();
+    }
+    let y = w.position(b).unwrap().y;
+    assert!((y - 0.5).abs() < 0.02, "landed on the ground: {y}");
+    // A ray still finds it (its new proxy is in the movable tree).
+    let hit = w
+        .cast_ray_closest(
+            Vec2::new(-5.0, 0.5),
+            Vec2::new(10.0, 0.0),
+            &QueryFilter::default(),
+        )
+        .unwrap()
+        .unwrap();
+    assert_eq!(hit.body, b);
+}
+
+#[test]
+fn set_body_type_dynamic_to_static_holds_a_box_in_the_air() {
+    let mut w = world();
+    let (shelf, _) = crate_at(&mut w, Vec2::new(0.0, 3.0), &ShapeDef::default());
+    let (rider, _) = crate_at(&mut w, Vec2::new(0.0, 4.0), &ShapeDef::default());
+    w.step(DT).unwrap();
+    w.set_body_type(shelf, BodyType::Static).unwrap();
+    assert_eq!(w.mass(shelf).unwrap(), 0.0);
+    assert_eq!(w.linear_velocity(shelf).unwrap(), Vec2::ZERO);
+    let y0 = w.position(shelf).unwrap().y;
+    for _ in 0..120 {
+        w.step(DT).unwrap();
+    }
+    assert_eq!(
+        w.position(shelf).unwrap().y,
+        y0,
+        "a static body does not move"
+    );
+    let gap = w.position(rider).unwrap().y - y0;
+    assert!((gap - 1.0).abs() < 0.02, "the rider rests on it: {gap}");
+    assert!(w.contact_count() >= 1);
+}
+
+#[test]
+fn set_body_type_kinematic_ignores_gravity_and_keeps_its_velocity() {
+    let mut w = world();
+    let (b, _) = crate_at(&mut w, Vec2::ZERO, &ShapeDef::default());
+    w.set_linear_velocity(b, Vec2::new(1.0, 0.0)).unwrap();
+    w.set_body_type(b, BodyType::Kinematic).unwrap();
+    for _ in 0..60 {
+        w.step(DT).unwrap();
+    }
+    let p = w.position(b).unwrap();
+    assert!((p.x - 1.0).abs() < 1e-3 && p.y.abs() < 1e-6, "{p}");
+    assert_eq!(w.mass(b).unwrap(), 0.0);
+}
+
+#[test]
+fn set_body_type_makes_a_jointed_anchor_swing() {
+    // A pendulum hung from a static anchor body; the anchor made dynamic
+    // falls with the bob (the joint links their islands).
+    let mut w = world();
+    let anchor = w
+        .create_body(&BodyDef::fixed(Vec2::new(0.0, 10.0)))
+        .unwrap();
+    w.create_shape(anchor, &ShapeDef::default(), Polygon::make_box(0.1, 0.1))
+        .unwrap();
+    let (bob, _) = crate_at(&mut w, Vec2::new(1.0, 10.0), &ShapeDef::default());
+    w.create_revolute_joint(&RevoluteJointDef::new(
+        anchor,
+        bob,
+        Vec2::ZERO,
+        Vec2::new(-1.0, 0.0),
+    ))
+    .unwrap();
+    for _ in 0..10 {
+        w.step(DT).unwrap();
+    }
+    assert_eq!(w.position(anchor).unwrap().y, 10.0, "pinned while static");
+    w.set_body_type(anchor, BodyType::Dynamic).unwrap();
+    for _ in 0..30 {
+        w.step(DT).unwrap();
+    }
+    assert!(w.position(anchor).unwrap().y < 9.0, "the anchor falls");
+    assert!(w.max_joint_gap() < 0.05, "{}", w.max_joint_gap());
+}
+
+#[test]
+fn set_body_type_rejects_stale_handles_and_same_type_is_a_no_op() {
+    let mut w = world();
+    let (b, _) = crate_at(&mut w, Vec2::ZERO, &ShapeDef::default());
+    w.set_body_type(b, BodyType::Dynamic).unwrap();
+    w.destroy_body(b).unwrap();
+    assert_eq!(
+        w.set_body_type(b, BodyType::Static),
+        Err(WorldError::StaleBody)
+    );
+}
+
+#[cfg(feature = "portals")]
+#[test]
+fn set_body_type_of_a_portal_body_is_refused() {
+    use janus2d::world::{PortalDef, PortalPairDef};
+    let mut w = world();
+    let (a, _) = ground(&mut w);
+    let b = w
+        .create_body(&BodyDef::fixed(Vec2::new(30.0, 0.0)))
+        .unwrap();
+    w.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 5.0))
+        .unwrap();
+    let portal = |body, anchor, direction| PortalDef {
+        body,
+        anchor,
+        direction,
+        half_width: 1.0,
+    };
+    w.create_portal_pair(&PortalPairDef::new(
+        portal(a, Vec2::new(0.0, 0.5), Vec2::Y),
+        portal(b, Vec2::new(0.5, 0.0), Vec2::X),
+    ))
+    .unwrap();
+    assert_eq!(
+        w.set_body_type(a, BodyType::Dynamic),
+        Err(WorldError::PortalBody)
+    );
+    assert_eq!(w.body_type(a).unwrap(), BodyType::Static, "unchanged");
+}

@@ -759,6 +759,82 @@ impl BodySet {
         Ok(())
     }
 
+    /// Changes a live body's type, moving its data between the moving and
+    /// static arrays. A body that stops being dynamic loses its mass (0, as
+    /// every static and kinematic body); one that becomes static stops; one
+    /// that becomes dynamic gets 1 kg and 1 kg·m² about its origin until
+    /// the caller sets its mass ([`BodySet::apply_mass`]). A sleeping body
+    /// comes back awake. Velocities of a body that keeps moving are kept.
+    pub fn set_body_type(&mut self, handle: BodyHandle, ty: BodyType) -> Result<(), BodyError> {
+        let loc = self.location(handle).ok_or(BodyError::StaleHandle)?;
+        let (mut sim, mut state) = match loc {
+            BodyLocation::Moving(i) => {
+                let i = i as usize;
+                let sim = self.sims.swap_remove(i);
+                let state = self.states.swap_remove(i);
+                if i < self.sims.len() {
+                    let moved = self.sims[i].handle;
+                    self.records[moved.index as usize].location =
+                        Some(BodyLocation::Moving(i as u32));
+                }
+                (sim, state)
+            }
+            BodyLocation::Static(j) => {
+                let j = j as usize;
+                let sim = self.static_sims.swap_remove(j);
+                if j < self.static_sims.len() {
+                    let moved = self.static_sims[j].handle;
+                    self.records[moved.index as usize].location =
+                        Some(BodyLocation::Static(j as u32));
+                }
+                (sim, BodyState::IDENTITY)
+            }
+            BodyLocation::Sleeping(j) => {
+                let j = j as usize;
+                let sim = self.sleeping_sims.swap_remove(j);
+                let state = self.sleeping_states.swap_remove(j);
+                if j < self.sleeping_sims.len() {
+                    let moved = self.sleeping_sims[j].handle;
+                    self.records[moved.index as usize].location =
+                        Some(BodyLocation::Sleeping(j as u32));
+                }
+                (sim, state)
+            }
+        };
+        sim.body_type = ty;
+        sim.sleep_time = 0.0;
+        sim.force = Vec2::ZERO;
+        sim.torque = 0.0;
+        sim.mass = 0.0;
+        sim.inertia = 0.0;
+        sim.inv_mass = 0.0;
+        sim.inv_inertia = 0.0;
+        sim.local_center = Vec2::ZERO;
+        sim.center = sim.transform.p;
+        sim.center0 = sim.center;
+        sim.rotation0 = sim.transform.q;
+        state.inv_mass = 0.0;
+        state.inv_inertia = 0.0;
+        state.dp = Vec2::ZERO;
+        state.dq = Rot::IDENTITY;
+        let location = if ty == BodyType::Static {
+            self.static_sims.push(sim);
+            BodyLocation::Static((self.static_sims.len() - 1) as u32)
+        } else {
+            self.sims.push(sim);
+            self.states.push(state);
+            BodyLocation::Moving((self.sims.len() - 1) as u32)
+        };
+        let record = &mut self.records[handle.index as usize];
+        record.location = Some(location);
+        record.mass_override = false;
+        if ty == BodyType::Dynamic {
+            let fixed = record.fixed_rotation;
+            self.apply_mass(handle, BodyMass::new(1.0, 1.0), fixed);
+        }
+        Ok(())
+    }
+
     /// Where a live body lives, or `None` for a stale handle.
     #[inline]
     pub fn location(&self, handle: BodyHandle) -> Option<BodyLocation> {

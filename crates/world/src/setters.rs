@@ -2,6 +2,7 @@
 //!
 //! | what | getters | setters |
 //! |------|---------|---------|
+//! | type | [`World::body_type`] | [`World::set_body_type`] (proxies move between the static and movable trees) |
 //! | sleep | [`World::is_awake`], [`World::body_enable_sleep`], [`World::body_sleep_threshold`] | [`World::set_awake`], [`World::set_body_enable_sleep`], [`World::set_body_sleep_threshold`] |
 //! | continuous | [`World::is_bullet`] | [`World::set_bullet`] |
 //! | mass | [`World::has_mass_override`] | [`World::set_mass`] (stays set), [`World::reset_mass_from_shapes`] |
@@ -174,6 +175,80 @@ impl World {
             self.wake_body(body);
             self.update_mass_from_shapes(body);
         }
+        Ok(())
+    }
+
+    /// Changes a body's type (as Box2D's `b2Body_SetType`): its contacts end
+    /// (end events; the bodies it touched wake), its shapes' proxies move
+    /// to the static or the movable tree, and it joins or leaves the
+    /// islands. A body that becomes dynamic gets its mass from its shapes; a
+    /// directly set mass is dropped. One that becomes static stops.
+    /// Errors: a stale handle; [`WorldError::PortalBody`] for a body that
+    /// carries or is crossing a portal (the world is then unchanged).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef};
+    /// use janus2d_core::{BodyDef, BodyType, Vec2};
+    /// use janus2d_core::geometry::Polygon;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::fixed(Vec2::new(0.0, 5.0))).unwrap();
+    /// world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    /// world.set_body_type(b, BodyType::Dynamic).unwrap();
+    /// world.step(1.0 / 60.0).unwrap();
+    /// assert!(world.position(b).unwrap().y < 5.0); // it falls now
+    /// assert!((world.mass(b).unwrap() - 1.0).abs() < 1e-6);
+    /// ```
+    pub fn set_body_type(&mut self, body: BodyHandle, ty: BodyType) -> Result<(), WorldError> {
+        self.check_body(body)?;
+        let old = self.bodies.body_type(body).ok_or(WorldError::StaleBody)?;
+        if old == ty {
+            return Ok(());
+        }
+        if self.portals.involves(body) {
+            return Err(WorldError::PortalBody);
+        }
+        self.wake_body(body);
+        let touching: smallvec::SmallVec<[BodyHandle; 8]> = self
+            .collision
+            .contacts
+            .of_body(body)
+            .iter()
+            .filter_map(|&id| self.collision.contacts.get(id))
+            .map(|c| c.other(body))
+            .collect();
+        for b in touching {
+            self.wake_body(b);
+        }
+        self.collision.remove_contacts_of(body);
+        if old == BodyType::Dynamic {
+            self.islands.remove_body(body);
+        }
+        self.bodies.set_body_type(body, ty)?;
+        let joints: smallvec::SmallVec<[JointHandle; 4]> =
+            self.joints.of_body(body).iter().copied().collect();
+        if ty == BodyType::Dynamic {
+            self.islands.add_body(body);
+            self.update_mass_from_shapes(body);
+        }
+        for j in joints {
+            let Ok((a, b)) = self.joints.bodies_of(j) else {
+                continue;
+            };
+            let other = if a == body { b } else { a };
+            self.wake_body(other);
+            let enabled = self.joints.revolute(j).is_ok_and(|r| r.enabled);
+            if ty == BodyType::Dynamic && enabled {
+                self.islands.link(a, b, &self.bodies);
+            } else {
+                self.islands.note_removed(other);
+            }
+        }
+        let xf = self
+            .bodies
+            .sim(body)
+            .map_or(janus2d_core::math::Transform::IDENTITY, |s| s.transform);
+        self.collision
+            .reproxy_body(body, &xf, ty == BodyType::Static);
         Ok(())
     }
 

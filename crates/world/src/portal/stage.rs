@@ -353,6 +353,15 @@ impl PortalStage {
         }
     }
 
+    /// True when `body` carries a portal or is crossing one.
+    pub(crate) fn involves(&self, body: BodyHandle) -> bool {
+        self.crossing_of(body).is_some()
+            || self
+                .pairs
+                .iter()
+                .any(|(_, d)| d.portals.iter().any(|p| p.body == body))
+    }
+
     pub(crate) fn crossing_of(&self, body: BodyHandle) -> Option<usize> {
         self.crossings
             .iter()
