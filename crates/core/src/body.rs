@@ -115,15 +115,17 @@ pub struct BodyDef {
     /// (after its shapes are attached), and it costs nothing until something
     /// wakes it.
     pub awake: bool,
-    /// Speed below which the body counts as resting for sleep, m/s; `None`
-    /// takes the world's `SleepSettings::linear_threshold` (usual `None`;
-    /// Box2D's `sleepThreshold`, default 0.05 m/s).
-    pub sleep_threshold: Option<Real>,
     /// A bullet (usual false): when fast, it is also swept against the
     /// shapes of other (non-bullet) dynamic and kinematic bodies, not only
     /// against static ones, so it cannot pass through a thin moving body
     /// (as Box2D's `isBullet`). Costs a time-of-impact search per fast step.
     pub bullet: bool,
+    /// May fall asleep (usual true); `false` keeps it awake, and its island
+    /// with it.
+    pub enable_sleep: bool,
+    /// Speed below which this body counts as at rest, m/s (`None`, usual:
+    /// the world's sleep `linear_threshold`).
+    pub sleep_threshold: Option<Real>,
     /// Opaque user value.
     pub user_data: u64,
 }
@@ -144,8 +146,9 @@ impl Default for BodyDef {
             mass: None,
             fixed_rotation: false,
             awake: true,
-            sleep_threshold: None,
             bullet: false,
+            enable_sleep: true,
+            sleep_threshold: None,
             user_data: 0,
         }
     }
@@ -313,14 +316,16 @@ pub struct BodySim {
     pub max_rotation: Real,
     /// How long the body has been slow enough to sleep, s.
     pub sleep_time: Real,
-    /// The body's own sleep speed threshold, m/s; negative: the world's.
-    pub sleep_threshold: Real,
     /// The handle of the body this belongs to.
     pub handle: BodyHandle,
     /// Static, kinematic or dynamic.
     pub body_type: BodyType,
     /// Swept against moving bodies too when fast ([`BodyDef::bullet`]).
     pub bullet: bool,
+    /// May fall asleep ([`BodyDef::enable_sleep`]).
+    pub enable_sleep: bool,
+    /// Own rest speed, m/s ([`BodyDef::sleep_threshold`]).
+    pub sleep_threshold: Option<Real>,
 }
 
 impl BodySim {
@@ -343,10 +348,11 @@ impl BodySim {
             max_linear_speed: 0.0,
             max_rotation: 0.0,
             sleep_time: 0.0,
-            sleep_threshold: -1.0,
             handle: BodyHandle::new(u32::MAX, 0, 0),
             body_type: BodyType::Static,
             bullet: false,
+            enable_sleep: true,
+            sleep_threshold: None,
         }
     }
 }
@@ -603,10 +609,11 @@ impl BodySet {
             max_linear_speed: def.max_linear_speed,
             max_rotation: def.max_rotation,
             sleep_time: 0.0,
-            sleep_threshold: def.sleep_threshold.unwrap_or(-1.0),
             handle,
             body_type: def.body_type,
             bullet: def.bullet,
+            enable_sleep: def.enable_sleep,
+            sleep_threshold: def.sleep_threshold,
         };
         let location = if def.body_type == BodyType::Static {
             self.static_sims.push(sim);
@@ -727,6 +734,79 @@ impl BodySet {
         Ok(())
     }
 
+    /// Changes a live body's type, moving its data between the moving and
+    /// static arrays. A body that stops being dynamic loses its mass (0, as
+    /// every static and kinematic body); one that becomes static stops; one
+    /// that becomes dynamic gets 1 kg and 1 kg·m² about its origin until
+    /// the caller sets its mass ([`BodySet::apply_mass`]). A sleeping body
+    /// comes back awake. Velocities of a body that keeps moving are kept.
+    pub fn set_body_type(&mut self, handle: BodyHandle, ty: BodyType) -> Result<(), BodyError> {
+        let loc = self.location(handle).ok_or(BodyError::StaleHandle)?;
+        let (mut sim, mut state) = match loc {
+            BodyLocation::Moving(i) => {
+                let i = i as usize;
+                let sim = self.sims.swap_remove(i);
+                let state = self.states.swap_remove(i);
+                if i < self.sims.len() {
+                    let moved = self.sims[i].handle;
+                    self.records.live_mut(moved.index).location = BodyLocation::Moving(i as u32);
+                }
+                (sim, state)
+            }
+            BodyLocation::Static(j) => {
+                let j = j as usize;
+                let sim = self.static_sims.swap_remove(j);
+                if j < self.static_sims.len() {
+                    let moved = self.static_sims[j].handle;
+                    self.records.live_mut(moved.index).location = BodyLocation::Static(j as u32);
+                }
+                (sim, BodyState::IDENTITY)
+            }
+            BodyLocation::Sleeping(j) => {
+                let j = j as usize;
+                let sim = self.sleeping_sims.swap_remove(j);
+                let state = self.sleeping_states.swap_remove(j);
+                if j < self.sleeping_sims.len() {
+                    let moved = self.sleeping_sims[j].handle;
+                    self.records.live_mut(moved.index).location = BodyLocation::Sleeping(j as u32);
+                }
+                (sim, state)
+            }
+        };
+        sim.body_type = ty;
+        sim.sleep_time = 0.0;
+        sim.force = Vec2::ZERO;
+        sim.torque = 0.0;
+        sim.mass = 0.0;
+        sim.inertia = 0.0;
+        sim.inv_mass = 0.0;
+        sim.inv_inertia = 0.0;
+        sim.local_center = Vec2::ZERO;
+        sim.center = sim.transform.p;
+        sim.center0 = sim.center;
+        sim.rotation0 = sim.transform.q;
+        state.inv_mass = 0.0;
+        state.inv_inertia = 0.0;
+        state.dp = Vec2::ZERO;
+        state.dq = Rot::IDENTITY;
+        let location = if ty == BodyType::Static {
+            self.static_sims.push(sim);
+            BodyLocation::Static((self.static_sims.len() - 1) as u32)
+        } else {
+            self.sims.push(sim);
+            self.states.push(state);
+            BodyLocation::Moving((self.sims.len() - 1) as u32)
+        };
+        let record = self.records.live_mut(handle.index);
+        record.location = location;
+        record.mass_override = false;
+        if ty == BodyType::Dynamic {
+            let fixed = record.fixed_rotation;
+            self.apply_mass(handle, BodyMass::new(1.0, 1.0), fixed);
+        }
+        Ok(())
+    }
+
     /// Where a live body lives, or `None` for a stale handle.
     #[inline]
     pub fn location(&self, handle: BodyHandle) -> Option<BodyLocation> {
@@ -758,6 +838,12 @@ impl BodySet {
             return None;
         }
         self.records.get(handle.index, handle.generation)
+    }
+
+    /// The mutable record of a live body (user data, mass override).
+    pub fn record_mut(&mut self, handle: BodyHandle) -> Option<&mut BodyRecord> {
+        self.location(handle)?;
+        self.records.get_mut(handle.index, handle.generation)
     }
 
     /// The per-step data of a live body.

@@ -130,7 +130,6 @@ impl Collision {
     }
 
     /// Removes every contact of a body (end events for touching ones).
-    #[cfg_attr(not(feature = "portals"), allow(dead_code))]
     pub(crate) fn remove_contacts_of(&mut self, body: BodyHandle) {
         self.contacts
             .destroy_of_body(body, &mut self.events, |_| true);
@@ -245,6 +244,22 @@ impl Collision {
             }
         }
         self.counters.proxies_moved = moved;
+    }
+
+    /// Moves a body's shape proxies to the tree of its (new) type: each is
+    /// destroyed and created again, so its pairs are found afresh.
+    pub(crate) fn reproxy_body(&mut self, body: BodyHandle, xf: &Transform, is_static: bool) {
+        let n = self.shapes.of_body(body).len();
+        for k in 0..n {
+            let s = self.shapes.of_body(body)[k];
+            let old = self.shapes.at(s).proxy;
+            self.broadphase.destroy_proxy(old);
+            let aabb = self.shapes.at(s).geometry.compute_aabb(xf);
+            let proxy = self.broadphase.create_proxy(aabb, s, is_static);
+            let shape = self.shapes.at_mut(s);
+            shape.aabb = aabb;
+            shape.proxy = proxy;
+        }
     }
 
     /// Recomputes one body's shape boxes now (after a teleport).

@@ -223,6 +223,15 @@ impl ContactSet {
         }
     }
 
+    /// Mutable access to the contact with id `id`.
+    pub(crate) fn get_mut(&mut self, id: u32) -> Option<&mut Contact> {
+        match *self.place.get(id as usize)? {
+            Place::Free => None,
+            Place::Awake(i) => self.awake.get_mut(i as usize),
+            Place::Sleeping(i) => self.sleeping.get_mut(i as usize),
+        }
+    }
+
     /// Adds an awake contact (its `id` is assigned here); returns the id.
     pub fn insert(&mut self, mut c: Contact) -> u32 {
         let id = match self.free_ids.pop() {

@@ -37,6 +37,9 @@ pub enum WorldError {
     NotDynamic,
     /// The operation needs a kinematic or dynamic body (not a static one).
     NotMovable,
+    /// The body carries a portal or is crossing one: the operation would
+    /// break the portal stage's bookkeeping.
+    PortalBody,
     /// A scene query input that is non-finite or degenerate: names the
     /// field (`origin`, `translation`, `point`, `aabb`, `transform`,
     /// `shape`) and what is wrong with it.
@@ -65,6 +68,7 @@ impl std::fmt::Display for WorldError {
             WorldError::OutOfRange(what) => write!(f, "`{what}` is out of range"),
             WorldError::NotDynamic => write!(f, "operation needs a dynamic body"),
             WorldError::NotMovable => write!(f, "operation needs a kinematic or dynamic body"),
+            WorldError::PortalBody => write!(f, "the body carries or is crossing a portal"),
             WorldError::BadQuery { field, problem } => write!(f, "query `{field}` {problem}"),
         }
     }

@@ -315,6 +315,34 @@ impl Islands {
         }
     }
 
+    /// Puts the island of awake dynamic `body` to sleep now (its bodies
+    /// leave the solver, its contacts the narrowphase). A body without an
+    /// island sleeps alone.
+    pub(crate) fn sleep_now(
+        &mut self,
+        body: BodyHandle,
+        bodies: &mut BodySet,
+        contacts: &mut ContactSet,
+    ) {
+        let id = self.island(body);
+        if id == NONE {
+            bodies.sleep(body);
+            contacts.sleep_body(body, bodies);
+            return;
+        }
+        let island = &mut self.islands[id as usize];
+        if island.asleep {
+            return;
+        }
+        island.asleep = true;
+        for m in &island.members {
+            bodies.sleep(*m);
+        }
+        for m in &island.members {
+            contacts.sleep_body(*m, bodies);
+        }
+    }
+
     /// Wakes the island of `body`: its bodies return to the solver and its
     /// contacts to the narrowphase. No effect on awake or static bodies.
     pub(crate) fn wake(
@@ -368,13 +396,9 @@ impl Islands {
             let reach = input.shapes.reach(handle, center);
             let st = bodies.states[i];
             let sim = &mut bodies.sims[i];
-            let tol2 = if sim.sleep_threshold >= 0.0 {
-                sim.sleep_threshold * sim.sleep_threshold
-            } else {
-                tol2
-            };
+            let tol2 = sim.sleep_threshold.map_or(tol2, |t| t * t);
             let slow = st.v.length_squared() <= tol2 && st.w * st.w * reach * reach <= tol2;
-            if sim.body_type == BodyType::Dynamic && slow {
+            if sim.body_type == BodyType::Dynamic && slow && sim.enable_sleep {
                 sim.sleep_time += input.dt;
             } else {
                 sim.sleep_time = 0.0;

@@ -40,6 +40,7 @@ pub enum JointKind {
 struct JointSlot {
     kind: JointKind,
     index: u32,
+    user_data: u64,
 }
 
 /// Body pairs (slot indices, ordered) that a joint with
@@ -135,6 +136,22 @@ impl JointSet {
             .map_err(|e| WorldError::of_handle(e, WorldError::StaleJoint))
     }
 
+    /// A joint's opaque user value (0 until set).
+    pub fn user_data(&self, joint: JointHandle) -> Result<u64, WorldError> {
+        Ok(self.slot(joint)?.user_data)
+    }
+
+    /// Sets a joint's opaque user value.
+    pub(crate) fn set_user_data(
+        &mut self,
+        joint: JointHandle,
+        value: u64,
+    ) -> Result<(), WorldError> {
+        self.slot(joint)?;
+        self.slots.live_mut(joint.index).user_data = value;
+        Ok(())
+    }
+
     /// A revolute joint.
     pub fn revolute(&self, joint: JointHandle) -> Result<&RevoluteJoint, WorldError> {
         let s = self.slot(joint)?;
@@ -167,6 +184,7 @@ impl JointSet {
         let (index, generation) = self.slots.insert(JointSlot {
             kind: JointKind::Revolute,
             index: self.revolute.len() as u32,
+            user_data: 0,
         });
         let handle = JointHandle::new(index, generation, self.owner);
         self.revolute.push(RevoluteJoint::new(def.clone()));

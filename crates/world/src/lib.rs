@@ -19,6 +19,7 @@
 //! | [`islands`]      | sleep timers and islands; sleeping islands leave every per-step loop |
 //! | [`portal`]       | portal pairs, crossings, clones, aperture clipping        |
 //! | [`profile`]      | per-stage timings and work counters                      |
+//! | [`setters`]      | setters and getters of bodies, shapes and joints after creation |
 //! | [`query`]        | scene queries: rays, shape casts, overlaps, distances    |
 //! | [`hash`]         | the state hash of determinism checks                     |
 //!
@@ -38,6 +39,7 @@ pub mod narrowphase;
 pub mod portal;
 pub mod profile;
 pub mod query;
+pub mod setters;
 pub mod shapes;
 pub mod world;
 

@@ -79,18 +79,18 @@ pub struct StepEvents {
 pub struct World {
     gravity: Vec2,
     settings: SolverSettings,
-    bodies: BodySet,
-    joints: JointSet,
-    collision: Collision,
+    pub(crate) bodies: BodySet,
+    pub(crate) joints: JointSet,
+    pub(crate) collision: Collision,
     /// The step's contact constraints in their colours and lanes (the
     /// contact solve's own data).
     contact_solver: ContactSolver,
     /// The contact-modification hook's data for this step (portal copies).
     object_masses: Vec<ObjectMass>,
     pub(crate) portals: PortalStage,
-    islands: Islands,
+    pub(crate) islands: Islands,
     continuous: crate::continuous::ContinuousStage,
-    sleep_settings: SleepSettings,
+    pub(crate) sleep_settings: SleepSettings,
     wake_list: Vec<BodyHandle>,
     events: StepEvents,
     step_profile: crate::profile::StepProfile,
@@ -278,11 +278,11 @@ impl World {
     }
 
     /// `StaleBody`, or `ForeignHandle` for another world's handle.
-    fn body_error(&self, body: BodyHandle) -> WorldError {
+    pub(crate) fn body_error(&self, body: BodyHandle) -> WorldError {
         self.check_body(body).err().unwrap_or(WorldError::StaleBody)
     }
 
-    fn check_body(&self, body: BodyHandle) -> Result<(), WorldError> {
+    pub(crate) fn check_body(&self, body: BodyHandle) -> Result<(), WorldError> {
         self.bodies
             .check(body)
             .map(|_| ())
@@ -403,7 +403,9 @@ impl World {
         Ok(())
     }
 
-    /// Sets the mass properties of a dynamic body directly.
+    /// Sets the mass properties of a dynamic body directly. The mass stays
+    /// set when shapes are added, removed or changed, until
+    /// [`reset_mass_from_shapes`](Self::reset_mass_from_shapes).
     pub fn set_mass(&mut self, body: BodyHandle, mass: BodyMass) -> Result<(), WorldError> {
         let ty = self.body_type(body)?;
         let fixed = self
@@ -417,6 +419,9 @@ impl World {
         }
         self.wake_body(body);
         self.bodies.apply_mass(body, mass, fixed);
+        if let Some(r) = self.bodies.record_mut(body) {
+            r.mass_override = true;
+        }
         Ok(())
     }
 
@@ -759,7 +764,7 @@ impl World {
             .collect())
     }
 
-    fn update_mass_from_shapes(&mut self, body: BodyHandle) {
+    pub(crate) fn update_mass_from_shapes(&mut self, body: BodyHandle) {
         let md = self.collision.shapes.mass_of(body);
         let fixed = self
             .bodies

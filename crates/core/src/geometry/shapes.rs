@@ -291,7 +291,8 @@ impl Polygon {
     /// An axis-aligned box centred on the body origin with half-widths `hx`, `hy`.
     ///
     /// # Panics
-    /// If `hx` or `hy` is not finite and positive.
+    /// If `hx` or `hy` is not finite and positive; [`try_make_box`](Self::try_make_box)
+    /// returns an error instead.
     pub fn make_box(hx: Real, hy: Real) -> Polygon {
         Self::make_offset_rounded_box(hx, hy, Vec2::ZERO, Rot::IDENTITY, 0.0)
     }
@@ -352,6 +353,88 @@ impl Polygon {
             p.normals[i] = q.rotate(local_n[i]);
         }
         p
+    }
+
+    /// [`make_box`](Self::make_box) that returns an error instead of
+    /// panicking: [`GeometryError::NonFinite`] for a NaN or infinite
+    /// half-width, [`GeometryError::DegeneratePolygon`] for one ≤ 0.
+    ///
+    /// ```
+    /// use janus2d_core::geometry::{GeometryError, Polygon};
+    /// assert_eq!(Polygon::try_make_box(0.0, 1.0), Err(GeometryError::DegeneratePolygon));
+    /// assert!(Polygon::try_make_box(0.5, 1.0).is_ok());
+    /// ```
+    pub fn try_make_box(hx: Real, hy: Real) -> Result<Polygon, GeometryError> {
+        Self::try_make_offset_rounded_box(hx, hy, Vec2::ZERO, 0.0, 0.0)
+    }
+
+    /// [`make_offset_box`](Self::make_offset_box) that returns an error
+    /// instead of panicking (non-finite input, a half-width ≤ 0).
+    pub fn try_make_offset_box(
+        hx: Real,
+        hy: Real,
+        center: Vec2,
+        angle: Real,
+    ) -> Result<Polygon, GeometryError> {
+        Self::try_make_offset_rounded_box(hx, hy, center, angle, 0.0)
+    }
+
+    /// [`make_rounded_box`](Self::make_rounded_box) that returns an error
+    /// instead of panicking (non-finite input, a half-width ≤ 0, a negative
+    /// radius: [`GeometryError::NegativeRadius`]).
+    pub fn try_make_rounded_box(
+        hx: Real,
+        hy: Real,
+        radius: Real,
+    ) -> Result<Polygon, GeometryError> {
+        Self::try_make_offset_rounded_box(hx, hy, Vec2::ZERO, 0.0, radius)
+    }
+
+    fn try_make_offset_rounded_box(
+        hx: Real,
+        hy: Real,
+        center: Vec2,
+        angle: Real,
+        radius: Real,
+    ) -> Result<Polygon, GeometryError> {
+        let finite = hx.is_finite()
+            && hy.is_finite()
+            && radius.is_finite()
+            && vec_is_finite(center)
+            && angle.is_finite();
+        if !finite {
+            return Err(GeometryError::NonFinite);
+        }
+        if hx <= 0.0 || hy <= 0.0 {
+            return Err(GeometryError::DegeneratePolygon);
+        }
+        if radius < 0.0 {
+            return Err(GeometryError::NegativeRadius);
+        }
+        Ok(Self::make_offset_rounded_box(
+            hx,
+            hy,
+            center,
+            Rot::from_angle(angle),
+            radius,
+        ))
+    }
+
+    /// A validated capsule polygon ([`make_capsule`](Self::make_capsule)):
+    /// errors for non-finite input, a radius ≤ 0
+    /// ([`GeometryError::NonPositiveRadius`]) or a core shorter than
+    /// [`WELD_DISTANCE`] ([`GeometryError::DegenerateSegment`]).
+    pub fn try_make_capsule(p1: Vec2, p2: Vec2, radius: Real) -> Result<Polygon, GeometryError> {
+        if !(vec_is_finite(p1) && vec_is_finite(p2) && radius.is_finite()) {
+            return Err(GeometryError::NonFinite);
+        }
+        if radius <= 0.0 {
+            return Err(GeometryError::NonPositiveRadius);
+        }
+        if (p2 - p1).length() <= WELD_DISTANCE {
+            return Err(GeometryError::DegenerateSegment);
+        }
+        Ok(Self::make_capsule(p1, p2, radius))
     }
 
     /// A capsule as a 2-vertex rounded polygon (`count == 2`): the core

@@ -33,6 +33,9 @@ impl PortalStage {
         Vec::new()
     }
     pub(crate) fn build_clipping(&mut self, _bodies: &BodySet) {}
+    pub(crate) fn involves(&self, _body: BodyHandle) -> bool {
+        false
+    }
     pub(crate) fn object_masses(&self, _bodies: &BodySet, out: &mut Vec<ObjectMass>) {
         out.clear();
     }

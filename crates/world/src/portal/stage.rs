@@ -353,6 +353,15 @@ impl PortalStage {
         }
     }
 
+    /// True when `body` carries a portal or is crossing one.
+    pub(crate) fn involves(&self, body: BodyHandle) -> bool {
+        self.crossing_of(body).is_some()
+            || self
+                .pairs
+                .iter()
+                .any(|(_, d)| d.portals.iter().any(|p| p.body == body))
+    }
+
     pub(crate) fn crossing_of(&self, body: BodyHandle) -> Option<usize> {
         self.crossings
             .iter()
@@ -673,7 +682,7 @@ impl World {
             mass: Some(mass_clone),
             fixed_rotation: record.fixed_rotation,
             // Speeds scale by η through the portal.
-            sleep_threshold: (sim.sleep_threshold >= 0.0).then_some(eta * sim.sleep_threshold),
+            sleep_threshold: sim.sleep_threshold.map(|t| eta * t),
             bullet: sim.bullet,
             user_data: record.user_data,
             ..BodyDef::default()
