@@ -677,37 +677,47 @@ impl BodySet {
         st.inv_inertia = sim.inv_inertia;
     }
 
-    /// Destroys a body; its slot's generation makes old handles stale.
-    pub fn destroy(&mut self, handle: BodyHandle) -> Result<(), BodyError> {
-        let loc = self.location(handle).ok_or(BodyError::StaleHandle)?;
+    /// Removes a body's data from the array `loc` names (the last entry
+    /// moves into its place) and returns it; its record is left to the
+    /// caller. A static body's state is the identity.
+    fn take(&mut self, loc: BodyLocation) -> (BodySim, BodyState) {
         match loc {
             BodyLocation::Moving(i) => {
                 let i = i as usize;
-                self.sims.swap_remove(i);
-                self.states.swap_remove(i);
+                let sim = self.sims.swap_remove(i);
+                let state = self.states.swap_remove(i);
                 if i < self.sims.len() {
                     let moved = self.sims[i].handle;
                     self.records.live_mut(moved.index).location = BodyLocation::Moving(i as u32);
                 }
+                (sim, state)
             }
             BodyLocation::Static(j) => {
                 let j = j as usize;
-                self.static_sims.swap_remove(j);
+                let sim = self.static_sims.swap_remove(j);
                 if j < self.static_sims.len() {
                     let moved = self.static_sims[j].handle;
                     self.records.live_mut(moved.index).location = BodyLocation::Static(j as u32);
                 }
+                (sim, BodyState::IDENTITY)
             }
             BodyLocation::Sleeping(j) => {
                 let j = j as usize;
-                self.sleeping_sims.swap_remove(j);
-                self.sleeping_states.swap_remove(j);
+                let sim = self.sleeping_sims.swap_remove(j);
+                let state = self.sleeping_states.swap_remove(j);
                 if j < self.sleeping_sims.len() {
                     let moved = self.sleeping_sims[j].handle;
                     self.records.live_mut(moved.index).location = BodyLocation::Sleeping(j as u32);
                 }
+                (sim, state)
             }
         }
+    }
+
+    /// Destroys a body; its slot's generation makes old handles stale.
+    pub fn destroy(&mut self, handle: BodyHandle) -> Result<(), BodyError> {
+        let loc = self.location(handle).ok_or(BodyError::StaleHandle)?;
+        self.take(loc);
         self.records.remove(handle.index, handle.generation);
         Ok(())
     }
@@ -742,37 +752,7 @@ impl BodySet {
     /// comes back awake. Velocities of a body that keeps moving are kept.
     pub fn set_body_type(&mut self, handle: BodyHandle, ty: BodyType) -> Result<(), BodyError> {
         let loc = self.location(handle).ok_or(BodyError::StaleHandle)?;
-        let (mut sim, mut state) = match loc {
-            BodyLocation::Moving(i) => {
-                let i = i as usize;
-                let sim = self.sims.swap_remove(i);
-                let state = self.states.swap_remove(i);
-                if i < self.sims.len() {
-                    let moved = self.sims[i].handle;
-                    self.records.live_mut(moved.index).location = BodyLocation::Moving(i as u32);
-                }
-                (sim, state)
-            }
-            BodyLocation::Static(j) => {
-                let j = j as usize;
-                let sim = self.static_sims.swap_remove(j);
-                if j < self.static_sims.len() {
-                    let moved = self.static_sims[j].handle;
-                    self.records.live_mut(moved.index).location = BodyLocation::Static(j as u32);
-                }
-                (sim, BodyState::IDENTITY)
-            }
-            BodyLocation::Sleeping(j) => {
-                let j = j as usize;
-                let sim = self.sleeping_sims.swap_remove(j);
-                let state = self.sleeping_states.swap_remove(j);
-                if j < self.sleeping_sims.len() {
-                    let moved = self.sleeping_sims[j].handle;
-                    self.records.live_mut(moved.index).location = BodyLocation::Sleeping(j as u32);
-                }
-                (sim, state)
-            }
-        };
+        let (mut sim, mut state) = self.take(loc);
         sim.body_type = ty;
         sim.sleep_time = 0.0;
         sim.force = Vec2::ZERO;
