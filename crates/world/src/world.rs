@@ -557,6 +557,18 @@ impl World {
         self.joints.revolute(joint)
     }
 
+    /// Force the joint applied to its body b over the last solved step, N
+    /// (body a got the opposite); kept while its bodies sleep.
+    pub fn joint_force(&self, joint: JointHandle) -> Result<Vec2, WorldError> {
+        Ok(self.joints.revolute(joint)?.constraint_force())
+    }
+
+    /// Torque about the joint axis (springs, motors, limits) applied to
+    /// body b over the last solved step, N·m; kept while its bodies sleep.
+    pub fn joint_torque(&self, joint: JointHandle) -> Result<Real, WorldError> {
+        Ok(self.joints.revolute(joint)?.constraint_torque())
+    }
+
     /// The joints (read access: handles, per-body lists, kinds).
     pub fn joints(&self) -> &JointSet {
         &self.joints
