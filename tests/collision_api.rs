@@ -244,3 +244,45 @@ fn bad_shapes_are_rejected_and_the_world_is_unchanged() {
     assert_eq!(w.shape_count(), shapes);
     assert_eq!(w.mass(b).unwrap(), mass);
 }
+
+/// A ball dropped from 1.8 m (its bottom) hits the ground at
+/// √(2 g h) ≈ 5.9 m/s: one hit event of about that speed, with the normal
+/// along y; resting afterwards gives none; without the flag, none at all.
+#[test]
+fn hit_events_report_the_approach_speed_of_a_hard_landing_only() {
+    for flag in [true, false] {
+        let mut world = World::new(WorldDef::default()).unwrap();
+        let g = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+        world
+            .create_shape(g, &ShapeDef::default(), Polygon::make_box(5.0, 0.5))
+            .unwrap();
+        let ball = world
+            .create_body(&BodyDef::dynamic(Vec2::new(0.0, 2.55)))
+            .unwrap();
+        let def = ShapeDef {
+            enable_hit_events: flag,
+            ..ShapeDef::default()
+        };
+        world
+            .create_shape(ball, &def, Circle::new(Vec2::ZERO, 0.25).unwrap())
+            .unwrap();
+        let mut hits = Vec::new();
+        for _ in 0..180 {
+            world.step(1.0 / 60.0).unwrap();
+            hits.extend(world.events().collision.hits.iter().copied());
+        }
+        if !flag {
+            assert!(hits.is_empty(), "no flag, no hits: {hits:?}");
+            continue;
+        }
+        assert_eq!(hits.len(), 1, "one landing: {hits:?}");
+        let expected = (2.0 * 9.81 * 1.8 as Real).sqrt();
+        let h = hits[0];
+        assert!(
+            (h.approach_speed - expected).abs() < 0.3,
+            "approach {} vs {expected}",
+            h.approach_speed
+        );
+        assert!(h.normal.y.abs() > 0.99 && h.point.y.abs() < 0.6);
+    }
+}

@@ -140,7 +140,7 @@ pub struct ContactConstraint {
     /// Number of points (0 to 2).
     pub(crate) point_count: u32,
     /// Normal velocity before the solve (for restitution), m/s.
-    relative_velocity: [Real; MAX_MANIFOLD_POINTS],
+    pub(crate) relative_velocity: [Real; MAX_MANIFOLD_POINTS],
     /// Mixed restitution `max(e_a, e_b)`.
     pub restitution: Real,
     /// Index of the contact in the world's contact list (for storing impulses).

@@ -293,6 +293,34 @@ impl ContactSolver {
         }
     }
 
+    /// Calls `hit(contact_index, point, approach_speed)` for every point
+    /// that approached faster than `threshold` (m/s) before the solve and
+    /// pushed (a positive normal impulse increment).
+    pub fn for_each_approach(&self, threshold: Real, mut hit: impl FnMut(u32, usize, Real)) {
+        for chunk in self.colours.iter().flatten() {
+            let approach = chunk.relative_velocity.map(W::to_array);
+            let pushed = chunk.max_normal_impulse.map(W::to_array);
+            let second = chunk.second.to_array();
+            for k in 0..chunk.len {
+                let points = if second[k] > 0.0 { 2 } else { 1 };
+                for i in 0..points {
+                    let speed = -approach[i][k];
+                    if speed > threshold && pushed[i][k] > 0.0 {
+                        hit(chunk.contact[k], i, speed);
+                    }
+                }
+            }
+        }
+        for c in &self.overflow {
+            for i in 0..c.point_count() {
+                let speed = -c.relative_velocity[i];
+                if speed > threshold && c.max_normal_impulse[i] > 0.0 {
+                    hit(c.contact_index, i, speed);
+                }
+            }
+        }
+    }
+
     /// The contacts of the overflow, solved one by one.
     #[must_use]
     pub fn overflow(&self) -> &[ContactConstraint] {

@@ -9,7 +9,7 @@
 //! | `FilterDesc`           | `Filter` (same bits and group rule)          |
 //! | `BodyDesc::mass`       | `BodyDef::with_mass`                         |
 //! | `sleep_threshold`      | `BodyDef::sleep_threshold`                   |
-//! | `hit_events`           | ignored: janus2d reports begin/end only      |
+//! | `hit_events`           | `ShapeDef::enable_hit_events`                |
 //! | `Action::Target`       | velocity = (target − current) / dt           |
 
 use std::collections::BTreeMap;
@@ -119,6 +119,7 @@ fn shape_def(s: &ShapeDesc) -> ShapeDef {
         friction: s.friction as Real,
         restitution: s.restitution as Real,
         filter: filter(&s.filter),
+        enable_hit_events: s.hit_events,
         ..ShapeDef::default()
     }
 }

@@ -193,6 +193,7 @@ impl Collision {
                 restitution: mix_restitution(sa.def.restitution, sb.def.restitution),
                 touching: false,
                 sensor: sa.def.is_sensor || sb.def.is_sensor,
+                hit_events: sa.def.enable_hit_events || sb.def.enable_hit_events,
                 enabled: true,
                 still: [false, false],
             };
@@ -201,6 +202,35 @@ impl Collision {
         }
         self.counters.pairs_created = created;
         self.candidates = candidates;
+    }
+
+    /// Hit events of the step: for each contact with hit events on, its
+    /// point that approached fastest, when faster than `threshold` (m/s)
+    /// and it pushed.
+    pub(crate) fn collect_hits(&mut self, solver: &ContactSolver, threshold: Real) {
+        let mut best: Vec<(u32, usize, Real)> = Vec::new();
+        let contacts = &self.contacts;
+        solver.for_each_approach(threshold, |index, point, speed| {
+            if !contacts.awake()[index as usize].hit_events {
+                return;
+            }
+            match best.iter_mut().find(|b| b.0 == index) {
+                Some(b) if b.2 < speed => *b = (index, point, speed),
+                Some(_) => {}
+                None => best.push((index, point, speed)),
+            }
+        });
+        best.sort_unstable_by_key(|b| b.0);
+        for (index, point, speed) in best {
+            let c = &self.contacts.awake()[index as usize];
+            self.events.hits.push(crate::contacts::HitEvent {
+                shape_a: c.shapes[0],
+                shape_b: c.shapes[1],
+                point: c.points[point].point,
+                normal: c.normal,
+                approach_speed: speed,
+            });
+        }
     }
 
     /// Copies solved impulses back into the contacts (for warm starting).

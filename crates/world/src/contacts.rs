@@ -73,6 +73,8 @@ pub struct Contact {
     pub touching: bool,
     /// True when either shape is a sensor (events only).
     pub sensor: bool,
+    /// True when either shape asked for hit events.
+    pub hit_events: bool,
     /// False when a filter (portal clipping, a disabled pair) suppresses it.
     pub enabled: bool,
     /// Whether each body read as static (static or asleep) at the last
@@ -123,6 +125,26 @@ pub struct CollisionEvents {
     pub sensor_begin: Vec<ShapePairEvent>,
     /// Sensor overlaps that ended.
     pub sensor_end: Vec<ShapePairEvent>,
+    /// Contacts of shapes with hit events on that pushed this step with an
+    /// approach speed above the world's threshold, in contact order.
+    pub hits: Vec<HitEvent>,
+}
+
+/// A contact that hit hard enough (see `ShapeDef::enable_hit_events` and
+/// `WorldDef::hit_event_threshold`): its fastest-approaching point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HitEvent {
+    /// Shape a of the contact.
+    pub shape_a: ShapeHandle,
+    /// Shape b of the contact.
+    pub shape_b: ShapeHandle,
+    /// World point of the contact point, m.
+    pub point: Vec2,
+    /// Unit normal from a to b.
+    pub normal: Vec2,
+    /// Speed at which the point approached along the normal before the
+    /// solve, m/s (positive).
+    pub approach_speed: Real,
 }
 
 impl CollisionEvents {

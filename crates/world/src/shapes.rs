@@ -77,6 +77,10 @@ pub struct ShapeDef {
     pub filter: Filter,
     /// A sensor only reports overlaps; it never pushes.
     pub is_sensor: bool,
+    /// Report hit events for this shape's contacts (usual false): after a
+    /// step, each contact that pushed with an approach speed above the
+    /// world's `hit_event_threshold` gives a [`HitEvent`](crate::contacts::HitEvent).
+    pub enable_hit_events: bool,
     /// Opaque user value.
     pub user_data: u64,
 }
@@ -89,6 +93,7 @@ impl Default for ShapeDef {
             restitution: 0.0,
             filter: Filter::default(),
             is_sensor: false,
+            enable_hit_events: false,
             user_data: 0,
         }
     }
@@ -184,9 +189,18 @@ pub struct ShapeStore {
     body_shapes: Vec<SmallVec<[u32; 2]>>,
     /// Per body slot, the extents of its solid shapes.
     body_extents: Vec<BodyExtent>,
+    /// Number of live shapes with hit events on (the hit pass runs only
+    /// when some shape asks for it).
+    hit_event_shapes: usize,
 }
 
 impl ShapeStore {
+    /// Number of live shapes with hit events on.
+    #[must_use]
+    pub fn hit_event_shapes(&self) -> usize {
+        self.hit_event_shapes
+    }
+
     /// Number of live shapes.
     #[must_use]
     pub fn len(&self) -> usize {
@@ -268,6 +282,7 @@ impl ShapeStore {
     /// Stores a shape and lists it under its body; returns its slot.
     pub fn insert(&mut self, data: ShapeData) -> u32 {
         let b = data.body.index as usize;
+        self.hit_event_shapes += usize::from(data.def.enable_hit_events);
         let (index, _) = self.slots.insert(data);
         if self.body_shapes.len() <= b {
             self.body_shapes.resize(b + 1, SmallVec::new());
@@ -284,6 +299,7 @@ impl ShapeStore {
             .slots
             .remove(index, generation)
             .expect("slot index handed out by this store");
+        self.hit_event_shapes -= usize::from(data.def.enable_hit_events);
         if let Some(list) = self.body_shapes.get_mut(data.body.index as usize) {
             list.retain(|i| *i != index);
         }

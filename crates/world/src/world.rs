@@ -51,6 +51,10 @@ pub struct WorldDef {
     /// bullets against moving ones (on by default, as in Box2D; see
     /// [`crate::continuous`]).
     pub enable_continuous: bool,
+    /// Approach speed above which a contact of a shape with hit events on
+    /// reports a [`HitEvent`](crate::contacts::HitEvent), m/s (usual 1, as
+    /// Box2D's `hitEventThreshold`).
+    pub hit_event_threshold: Real,
 }
 
 impl Default for WorldDef {
@@ -60,6 +64,7 @@ impl Default for WorldDef {
             solver: SolverSettings::default(),
             sleep: SleepSettings::default(),
             enable_continuous: true,
+            hit_event_threshold: 1.0,
         }
     }
 }
@@ -90,6 +95,8 @@ pub struct World {
     pub(crate) portals: PortalStage,
     pub(crate) islands: Islands,
     continuous: crate::continuous::ContinuousStage,
+    /// Approach speed above which hit events are reported, m/s.
+    hit_event_threshold: Real,
     pub(crate) sleep_settings: SleepSettings,
     wake_list: Vec<BodyHandle>,
     events: StepEvents,
@@ -112,6 +119,12 @@ impl World {
         }
         def.solver.validate()?;
         def.sleep.validate()?;
+        if def.hit_event_threshold.is_nan() {
+            return Err(WorldError::NonFinite("hit_event_threshold"));
+        }
+        if def.hit_event_threshold < 0.0 {
+            return Err(WorldError::OutOfRange("hit_event_threshold"));
+        }
         let bodies = BodySet::new();
         Ok(World {
             gravity: def.gravity,
@@ -122,6 +135,7 @@ impl World {
             portals: PortalStage::default(),
             islands: Islands::default(),
             continuous: crate::continuous::ContinuousStage::new(def.enable_continuous),
+            hit_event_threshold: def.hit_event_threshold,
             sleep_settings: def.sleep,
             wake_list: Vec::new(),
             joints: JointSet::new(bodies.owner()),
@@ -1303,6 +1317,10 @@ impl World {
         }
         if has_shapes {
             self.collision.store_impulses(&self.contact_solver);
+            if self.collision.shapes.hit_event_shapes() > 0 {
+                self.collision
+                    .collect_hits(&self.contact_solver, self.hit_event_threshold);
+            }
             self.collision.update_proxies(&self.bodies, dt);
             sp.broadphase += lap();
         }
