@@ -214,10 +214,14 @@ impl Collision {
             if !contacts.awake()[index as usize].hit_events {
                 return;
             }
-            match best.iter_mut().find(|b| b.0 == index) {
-                Some(b) if b.2 < speed => *b = (index, point, speed),
-                Some(_) => {}
-                None => best.push((index, point, speed)),
+            // A contact's points come one after the other.
+            match best.last_mut() {
+                Some(b) if b.0 == index => {
+                    if b.2 < speed {
+                        *b = (index, point, speed);
+                    }
+                }
+                _ => best.push((index, point, speed)),
             }
         });
         best.sort_unstable_by_key(|b| b.0);
