@@ -50,6 +50,7 @@ pub use debug_draw::{Color, DebugDraw, DrawOptions, Palette};
 pub use error::WorldError;
 pub use islands::SleepSettings;
 pub use joints::{JointHandle, JointKind, JointSet};
+pub use narrowphase::{PreSolve, PreSolveFn};
 #[cfg(feature = "portals")]
 pub use portal::{MassModel, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle};
 pub use profile::{StepCounters, StepProfile};

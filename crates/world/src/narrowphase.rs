@@ -30,6 +30,34 @@ use crate::contacts::{CollisionEvents, Contact, ContactPointData, ContactSet};
 use crate::portal::ContactClipping;
 use crate::shapes::ShapeStore;
 
+/// What a pre-solve hook sees of a touching contact before it is solved
+/// (see `World::set_pre_solve`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PreSolve {
+    /// Shape a.
+    pub shape_a: crate::shapes::ShapeHandle,
+    /// Shape b.
+    pub shape_b: crate::shapes::ShapeHandle,
+    /// Body of shape a.
+    pub body_a: BodyHandle,
+    /// Body of shape b.
+    pub body_b: BodyHandle,
+    /// Unit normal from a to b.
+    pub normal: Vec2,
+    /// Separation of each point (the first `point_count`), m.
+    pub separations: [Real; 2],
+    /// Number of points.
+    pub point_count: usize,
+    /// Linear velocity of body a, m/s.
+    pub velocity_a: Vec2,
+    /// Linear velocity of body b, m/s.
+    pub velocity_b: Vec2,
+}
+
+/// A pre-solve hook: `false` leaves the contact out of this step's solve
+/// (a one-way platform lets a body through from below).
+pub type PreSolveFn = Box<dyn FnMut(&PreSolve) -> bool + Send>;
+
 /// Phase-1 outcome of the narrowphase for one contact (its manifold is
 /// already updated in place).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -253,6 +281,7 @@ pub(crate) fn build_constraints(
     bodies: &BodySet,
     woke: bool,
     objects: &[ObjectMass],
+    mut pre_solve: Option<&mut PreSolveFn>,
     solver: &mut ContactSolver,
     counters: &mut CollisionCounters,
 ) {
@@ -291,6 +320,27 @@ pub(crate) fn build_constraints(
         let [sa, sb] = c.still;
         if !c.is_solid_touching() || (sa && sb) {
             continue;
+        }
+        if let Some(hook) = pre_solve.as_mut() {
+            let velocity = |b| bodies.state(b).map_or(Vec2::ZERO, |s| s.v);
+            let mut separations = [0.0; 2];
+            for (s, p) in separations.iter_mut().zip(&c.points[..c.point_count]) {
+                *s = p.separation;
+            }
+            let view = PreSolve {
+                shape_a: c.shapes[0],
+                shape_b: c.shapes[1],
+                body_a: c.body_a,
+                body_b: c.body_b,
+                normal: c.normal,
+                separations,
+                point_count: c.point_count,
+                velocity_a: velocity(c.body_a),
+                velocity_b: velocity(c.body_b),
+            };
+            if !hook(&view) {
+                continue;
+            }
         }
         let (ia, moving_a) = state_of(c.body_a);
         let (ib, moving_b) = state_of(c.body_b);

@@ -97,6 +97,8 @@ pub struct World {
     continuous: crate::continuous::ContinuousStage,
     /// Approach speed above which hit events are reported, m/s.
     hit_event_threshold: Real,
+    /// The user's pre-solve hook, if any (called per touching contact).
+    pre_solve: Option<crate::narrowphase::PreSolveFn>,
     pub(crate) sleep_settings: SleepSettings,
     wake_list: Vec<BodyHandle>,
     events: StepEvents,
@@ -136,6 +138,7 @@ impl World {
             islands: Islands::default(),
             continuous: crate::continuous::ContinuousStage::new(def.enable_continuous),
             hit_event_threshold: def.hit_event_threshold,
+            pre_solve: None,
             sleep_settings: def.sleep,
             wake_list: Vec::new(),
             joints: JointSet::new(bodies.owner()),
@@ -569,6 +572,22 @@ impl World {
     /// A revolute joint.
     pub fn revolute_joint(&self, joint: JointHandle) -> Result<&RevoluteJoint, WorldError> {
         self.joints.revolute(joint)
+    }
+
+    /// Sets (or with `None` removes) the pre-solve hook: called after the
+    /// narrowphase for every touching solid contact, in contact order; a
+    /// `false` leaves that contact out of this step's solve (one-way
+    /// platforms, conveyor rules). Without a hook the step makes no call.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// // Contacts whose normal points down (from a to b) are ignored.
+    /// world.set_pre_solve(Some(Box::new(|c| c.normal.y >= 0.0)));
+    /// world.step(1.0 / 60.0).unwrap();
+    /// ```
+    pub fn set_pre_solve(&mut self, hook: Option<crate::narrowphase::PreSolveFn>) {
+        self.pre_solve = hook;
     }
 
     /// Force the joint applied to its body b over the last solved step, N
@@ -1283,6 +1302,7 @@ impl World {
                 &self.bodies,
                 woke,
                 &self.object_masses,
+                self.pre_solve.as_mut(),
                 &mut self.contact_solver,
                 &mut self.collision.counters,
             );
