@@ -4,6 +4,8 @@
 #
 #   janus2d run SCENE --steps N --every N --svg|--png DIR --size WxH
 #
+#     --fit each (the camera fits the frame it draws; a scene may say otherwise)
+#
 # keeps the last frame (step N). Small scenes become SVG, the big ones PNG
 # (PNG frames draw no text: tiny-skia has no fonts). JANUS2D overrides the
 # command (default: cargo run --release -q -p janus2d-cli --).
@@ -23,10 +25,11 @@ frame() {
   local scene=$1 steps=$2 format=$3 size=$4
   shift 4
   [[ -z $only || $scene == *"$only"* ]] || return 0
-  local file=${scene//\//_}
+  local file=${scene//\//_} fit=(--fit each)
+  [[ " $* " != *" --fit "* ]] || fit=()
   rm -rf "$tmp/f"
   "${janus[@]}" run "$scene" --steps "$steps" --every "$steps" "--$format" "$tmp/f" \
-    --size "$size" --no-progress "$@" >/dev/null
+    --size "$size" "${fit[@]}" --no-progress "$@" >/dev/null
   cp "$tmp/f/frame_00001.$format" "$out/$file.$format"
   echo "$out/$file.$format  ($scene, step $steps, $(du -k "$out/$file.$format" | cut -f1) KB)"
 }
@@ -37,8 +40,8 @@ frame many_pyramids 60 png 240x160
 frame joint_grid 120 png 240x160
 frame tumbler 240 png 240x160
 frame smash 60 png 240x160
-frame spinner 240 png 240x160
-frame rain 600 png 240x160 --fit grow
+frame spinner 240 png 240x160 --fit once # (bodies thrown out of the loop would zoom out)
+frame rain 600 png 240x160
 frame junkyard 240 png 240x160
 frame compounds 240 png 240x160
 frame washer 240 png 240x160
