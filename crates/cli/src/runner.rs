@@ -592,7 +592,7 @@ fn run_here<W: Write>(
                 *camera = Camera::fit(&all, width, height, 0.05);
             }
             Fit::Every(n) => {
-                if step > 0 && step % n == 0 {
+                if step > 0 && step.is_multiple_of(n) {
                     *camera = Camera::fit_world(world, width, height);
                 }
             }
