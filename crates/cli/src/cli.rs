@@ -3,7 +3,7 @@
 //! | command | what |
 //! |---------|------|
 //! | `janus2d list` | the built-in scenes, by group, with their bodies and steps |
-//! | `janus2d run SCENE [--steps N] [--substeps N] [--threads N] [--png DIR \| --gif FILE \| --svg DIR] [--every K] [--size WxH] [--follow] [--draw FLAGS] [--profile] [--csv FILE]` | runs a built-in scene or a scene file, prints what happened and a summary |
+//! | `janus2d run SCENE [--steps N] [--substeps N] [--threads N] [--png DIR \| --gif FILE \| --svg DIR] [--every K] [--size WxH] [--follow] [--fit once\|each\|grow\|N] [--draw FLAGS] [--profile] [--csv FILE]` | runs a built-in scene or a scene file, prints what happened and a summary |
 //! | `janus2d export SCENE [-o FILE]` | writes a built-in scene (one without a script) as a scene file |
 //! | `janus2d serve [SCENE] [--port P]` | runs the scene and streams it to a page on `http://127.0.0.1:P/` ([`crate::serve`]) |
 
@@ -86,6 +86,11 @@ pub struct RunArgs {
     /// The camera follows the scene's probe body.
     #[arg(long)]
     pub follow: bool,
+    /// When the camera fits the scene: `once` (the first frame), `each`
+    /// frame, `grow` (every frame, over all seen so far: it only zooms
+    /// out, so bodies spawned later stay in view) or every N steps.
+    #[arg(long, default_value = "once")]
+    pub fit: String,
     /// What the pictures show: `default`, `all`, `none`, or a comma list
     /// of shapes, sleep, islands, joints, contacts, normals, impulses,
     /// aabbs, transforms, portals, apertures, crossings (`+flag` adds to
@@ -175,6 +180,7 @@ impl RunArgs {
             every: self.every,
             size: parse_size(&self.size)?,
             follow: self.follow,
+            fit: self.fit.parse()?,
             draw: match &self.draw {
                 Some(d) => parse_draw(d)?,
                 None => DrawOptions::default(),

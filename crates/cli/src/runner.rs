@@ -15,8 +15,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use janus2d_core::body::BodyHandle;
+use janus2d_core::geometry::Aabb;
 use janus2d_core::math::{Real, to_f64};
-use janus2d_render::{Camera, GifWriter, Raster};
+use janus2d_render::{Camera, GifWriter, Raster, scene_bounds};
 use janus2d_testbed::desc::{Action, SceneDesc};
 use janus2d_testbed::janus::Janus;
 use janus2d_world::{DrawOptions, StepCounters, World};
@@ -151,6 +152,42 @@ pub fn load(scene: &str) -> Result<Loaded, CliError> {
     Loaded::from_desc(&e.name, &source, e.desc, e.steps)
 }
 
+/// How the camera of the pictures fits the scene (`--fit`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Fit {
+    /// Once, on the first frame: the view never moves (unless it follows
+    /// the probe).
+    #[default]
+    Once,
+    /// On every frame: the view zooms with the scene.
+    Each,
+    /// On every frame, over everything seen so far: the view only ever
+    /// zooms out, so bodies spawned later (the rain scene's ragdolls) stay
+    /// in the picture and settled ones do not jump.
+    Grow,
+    /// Again every this many steps (≥ 1).
+    Every(usize),
+}
+
+impl std::str::FromStr for Fit {
+    type Err = CliError;
+
+    /// `once`, `each`, `grow`, or a number of steps `N` (≥ 1).
+    fn from_str(s: &str) -> Result<Fit, CliError> {
+        match s.trim() {
+            "once" => Ok(Fit::Once),
+            "each" => Ok(Fit::Each),
+            "grow" => Ok(Fit::Grow),
+            n => match n.parse::<usize>() {
+                Ok(k) if k >= 1 => Ok(Fit::Every(k)),
+                _ => Err(CliError::Invalid(format!(
+                    "--fit `{s}`: expected once, each, grow or a number of steps (at least 1)"
+                ))),
+            },
+        }
+    }
+}
+
 /// Pictures a run writes.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Frames {
@@ -181,6 +218,8 @@ pub struct RunOptions {
     pub size: (u32, u32),
     /// The camera follows the probe instead of staying on the scene.
     pub follow: bool,
+    /// When the camera fits the scene again.
+    pub fit: Fit,
     /// What the pictures show.
     pub draw: DrawOptions,
     /// Print the per-stage profile table and the counters.
@@ -203,6 +242,7 @@ impl Default for RunOptions {
             every: None,
             size: (640, 360),
             follow: false,
+            fit: Fit::Once,
             draw: DrawOptions::default(),
             profile: false,
             csv: None,
@@ -538,7 +578,25 @@ fn run_here<W: Write>(
         }
         None => None,
     };
-    let follow = |camera: &mut Camera, scene: &Loaded| {
+    // The union of the scene's boxes so far (`--fit grow`).
+    let mut seen: Option<Aabb> = None;
+    let mut aim = |camera: &mut Camera, scene: &Loaded, step: usize| {
+        let world = scene.world();
+        match options.fit {
+            Fit::Once => {}
+            Fit::Each => *camera = Camera::fit_world(world, width, height),
+            Fit::Grow => {
+                let b = scene_bounds(world);
+                let all = seen.map_or(b, |s| s.union(&b));
+                seen = Some(all);
+                *camera = Camera::fit(&all, width, height, 0.05);
+            }
+            Fit::Every(n) => {
+                if step > 0 && step.is_multiple_of(n) {
+                    *camera = Camera::fit_world(world, width, height);
+                }
+            }
+        }
         if options.follow
             && let Some(p) = scene.probe
         {
@@ -546,7 +604,7 @@ fn run_here<W: Write>(
         }
     };
     if let Some(pics) = &mut pictures {
-        follow(&mut camera, scene);
+        aim(&mut camera, scene, 0);
         pics.raster.camera = camera;
         pics.shoot(scene.world(), &options.draw)?;
     }
@@ -637,7 +695,7 @@ fn run_here<W: Write>(
         if let Some(pics) = &mut pictures
             && (step + 1) % every == 0
         {
-            follow(&mut camera, scene);
+            aim(&mut camera, scene, step + 1);
             pics.raster.camera = camera;
             pics.shoot(scene.world(), &options.draw)?;
         }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::Parser;
 use janus2d_cli::cli::{Cli, Command, parse_draw, parse_size};
-use janus2d_cli::runner::{self, Frames, RunOptions};
+use janus2d_cli::runner::{self, Fit, Frames, RunOptions};
 use janus2d_cli::scene_file::{self, ErrorKind, SceneFile};
 use janus2d_cli::{CliError, catalog};
 
@@ -245,6 +245,44 @@ fn frames_and_csv_are_written() {
     assert_eq!(s.frames, 6, "the first and every 2nd step");
     let bytes = std::fs::read(&gif).unwrap();
     assert_eq!(&bytes[..6], b"GIF89a");
+}
+
+#[test]
+fn the_camera_fits_once_each_frame_growing_or_every_n_steps() {
+    assert_eq!("once".parse::<Fit>().unwrap(), Fit::Once);
+    assert_eq!("each".parse::<Fit>().unwrap(), Fit::Each);
+    assert_eq!("grow".parse::<Fit>().unwrap(), Fit::Grow);
+    assert_eq!("25".parse::<Fit>().unwrap(), Fit::Every(25));
+    for bad in ["0", "-3", "always", ""] {
+        assert!(bad.parse::<Fit>().is_err(), "`{bad}`");
+    }
+    let cli = Cli::try_parse_from(["janus2d", "run", "rain", "--fit", "grow"]).unwrap();
+    let Command::Run(args) = cli.command else {
+        panic!("run")
+    };
+    assert_eq!(args.options().unwrap().fit, Fit::Grow);
+    let cli = Cli::try_parse_from(["janus2d", "run", "rain", "--fit", "sometimes"]).unwrap();
+    let Command::Run(args) = cli.command else {
+        panic!("run")
+    };
+    assert!(
+        args.options().is_err(),
+        "a bad --fit is an error, not a panic"
+    );
+
+    for fit in [Fit::Each, Fit::Grow, Fit::Every(2)] {
+        let dir = temp(&format!("fit-{fit:?}"));
+        let mut scene = runner::load("single_box").unwrap();
+        let options = RunOptions {
+            frames: Frames::Svg(dir.clone()),
+            fit,
+            ..quiet(4)
+        };
+        let s = runner::run(&mut scene, &options, &mut Vec::new()).unwrap();
+        assert_eq!(s.frames, 5, "{fit:?}");
+        let doc = std::fs::read_to_string(dir.join("frame_00004.svg")).unwrap();
+        assert_eq!(doc.matches("<polygon").count(), 2, "{fit:?}: both in view");
+    }
 }
 
 #[test]

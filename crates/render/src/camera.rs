@@ -122,21 +122,34 @@ fn union(acc: Option<Aabb>, b: &Aabb) -> Option<Aabb> {
 /// The box around every shape of the world; when the static shapes reach
 /// more than 20 times beyond the moving ones both ways (a huge static
 /// box around a small pile), the moving bodies' box grown to 3 times its
-/// size, clipped to the whole.
-/// An empty world gives a 2 m box around the origin.
+/// size, clipped to the whole. A moving body without shapes counts as a
+/// 1 m box around its origin. An empty world gives a 2 m box around the origin.
 #[must_use]
 pub fn scene_bounds(world: &World) -> Aabb {
     let mut all: Option<Aabb> = None;
     let mut moving: Option<Aabb> = None;
     for body in world.body_handles() {
         let dynamic = world.body_type(body).is_ok_and(|t| t != BodyType::Static);
-        for s in world.body_shapes(body).unwrap_or_default() {
-            if let Ok(d) = world.shape(s) {
+        let shapes = world.body_shapes(body).unwrap_or_default();
+        for s in &shapes {
+            if let Ok(d) = world.shape(*s) {
                 all = union(all, &d.aabb);
                 if dynamic {
                     moving = union(moving, &d.aabb);
                 }
             }
+        }
+        // A moving body without shapes (the bridge's planks have a mass
+        // and no shapes): a 1 m box around its origin, so that the joints
+        // drawn between such bodies are in view.
+        if dynamic
+            && shapes.is_empty()
+            && let Ok(p) = world.position(body)
+            && p.is_finite()
+        {
+            let b = Aabb::new(p - Vec2::splat(0.5), p + Vec2::splat(0.5));
+            all = union(all, &b);
+            moving = union(moving, &b);
         }
     }
     let Some(all) = all else {

@@ -8,7 +8,7 @@
 //   chromium --headless=new --no-sandbox --remote-debugging-port=9333 about:blank &
 //   node --experimental-websocket crates/cli/tests/browser/cdp_check.js 9333 http://127.0.0.1:8080/ page.png
 //
-// The CI test of the issue (playwright-core) is still to be written.
+// The CI test is testbed.test.js (playwright-core), run by .ci/browser-test.
 const fs = require("fs");
 const [,, debugPort, pageUrl, out] = process.argv;
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
