@@ -378,9 +378,15 @@ mod tests {
                 "r {r}: {} vs {expected}",
                 out.fraction
             );
-            // The surfaces never cross at the reported fraction.
+            // The surfaces overlap by at most the slop at the reported
+            // fraction (by design exactly the slop for the larger balls, so
+            // the bound carries a rounding margin of 1e-6 m).
             let xf = s.transform_at(out.fraction);
-            assert!(xf.p.x + r <= 5.0 + LINEAR_SLOP);
+            assert!(
+                xf.p.x + r <= 5.0 + LINEAR_SLOP + 1e-6,
+                "r {r}: {}",
+                xf.p.x + r
+            );
         }
     }
 
