@@ -208,17 +208,7 @@ impl World {
             return Err(WorldError::PortalBody);
         }
         self.wake_body(body);
-        let touching: smallvec::SmallVec<[BodyHandle; 8]> = self
-            .collision
-            .contacts
-            .of_body(body)
-            .iter()
-            .filter_map(|&id| self.collision.contacts.get(id))
-            .map(|c| c.other(body))
-            .collect();
-        for b in touching {
-            self.wake_body(b);
-        }
+        self.wake_touching(body);
         self.collision.remove_contacts_of(body);
         if old == BodyType::Dynamic {
             self.islands.remove_body(body);

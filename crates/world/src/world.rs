@@ -261,9 +261,8 @@ impl World {
         Ok(())
     }
 
-    /// Destroys a live body (checked by the caller, crossings already
-    /// ended).
-    pub(crate) fn destroy_body_unchecked(&mut self, body: BodyHandle) {
+    /// Wakes every body that has a contact with `body` (its own list).
+    pub(crate) fn wake_touching(&mut self, body: BodyHandle) {
         let touching: smallvec::SmallVec<[BodyHandle; 8]> = self
             .collision
             .contacts
@@ -273,6 +272,12 @@ impl World {
             .map(|c| c.other(body))
             .collect();
         self.wake_all(&touching);
+    }
+
+    /// Destroys a live body (checked by the caller, crossings already
+    /// ended).
+    pub(crate) fn destroy_body_unchecked(&mut self, body: BodyHandle) {
+        self.wake_touching(body);
         self.wake_body(body);
         let attached: smallvec::SmallVec<[JointHandle; 4]> =
             self.joints.of_body(body).iter().copied().collect();
