@@ -424,19 +424,6 @@ impl ContactConstraint {
     }
 }
 
-/// Solves every constraint of a sweep once.
-#[inline(always)]
-fn sweep<'a, const USE_BIAS: bool>(
-    items: impl Iterator<Item = &'a mut ContactConstraint>,
-    states: &mut [BodyState],
-    ctx: &StepContext,
-) {
-    let (inv_h, push_max) = (ctx.inv_h, ctx.contact_push_max_velocity);
-    for c in items {
-        c.solve_rows::<USE_BIAS>(states, inv_h, push_max);
-    }
-}
-
 /// The softness of one normal row: the contact softness scaled by the
 /// mass ratio `ρ = min(k / min(k_a, k_b), ρ_max)` of the point's two
 /// effective masses (1 for a pair with a static body). Used by the solve
@@ -482,21 +469,6 @@ impl Constraint for ContactConstraint {
             self.solve_rows::<true>(states, inv_h, push_max);
         } else {
             self.solve_rows::<false>(states, inv_h, push_max);
-        }
-    }
-
-    fn solve_all(
-        items: &mut [Self],
-        ctx: &StepContext,
-        states: &mut [BodyState],
-        use_bias: bool,
-        reverse: bool,
-    ) {
-        match (use_bias, reverse) {
-            (true, false) => sweep::<true>(items.iter_mut(), states, ctx),
-            (true, true) => sweep::<true>(items.iter_mut().rev(), states, ctx),
-            (false, false) => sweep::<false>(items.iter_mut(), states, ctx),
-            (false, true) => sweep::<false>(items.iter_mut().rev(), states, ctx),
         }
     }
 

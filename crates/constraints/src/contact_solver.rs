@@ -180,6 +180,8 @@ pub struct ContactSolver {
     overflow: Vec<ContactConstraint>,
     /// The colouring of this step.
     graph: ColourGraph,
+    /// Number of contacts pushed since [`ContactSolver::begin`].
+    len: usize,
 }
 
 /// The slot of the overflow in [`ContactSolver::assign`]'s answers.
@@ -190,12 +192,6 @@ impl ContactSolver {
     #[must_use]
     pub fn new() -> Self {
         Self::default()
-    }
-
-    /// Number of colours (the overflow not counted).
-    #[must_use]
-    pub fn colour_count(&self) -> usize {
-        COLOURS
     }
 
     /// Number of contacts in colour `colour` ([`OVERFLOW`] for the
@@ -213,7 +209,7 @@ impl ContactSolver {
     /// Number of contacts.
     #[must_use]
     pub fn len(&self) -> usize {
-        (0..=OVERFLOW).map(|c| self.count_in(c)).sum()
+        self.len
     }
 
     /// True when there is no contact.
@@ -231,6 +227,7 @@ impl ContactSolver {
             chunks.clear();
         }
         self.overflow.clear();
+        self.len = 0;
     }
 
     /// The colour of a contact whose bodies have the state indices `a` and
@@ -244,6 +241,7 @@ impl ContactSolver {
     /// Adds a contact to the colour [`ContactSolver::assign`] gave it
     /// ([`OVERFLOW`]: solved scalar).
     pub fn push(&mut self, colour: u8, lane: &ContactLane) {
+        self.len += 1;
         let count = lane.point_count.min(MAX_MANIFOLD_POINTS);
         if colour >= OVERFLOW {
             let mut c = ContactConstraint::new(

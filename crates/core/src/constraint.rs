@@ -23,7 +23,8 @@
 //! constraint type lives in its own `Vec`, and the [`ConstraintBatch`]
 //! implementation for `Vec<C>` runs a monomorphic loop over it. `dyn` is used
 //! once per type per stage. A type may replace its solve loop
-//! ([`Constraint::solve_all`]), as contacts do.
+//! ([`Constraint::solve_all`]), or its whole batch: contacts have their
+//! own (`janus2d_constraints::contact_solver`, colours and SIMD lanes).
 
 use smallvec::SmallVec;
 
@@ -215,8 +216,8 @@ pub trait Constraint {
 
     /// Solves every enabled constraint of `items` once, in storage order or
     /// (`reverse`) the opposite order: the batch's solve stage. A type may
-    /// override it with a loop of its own (contacts do, to hoist `use_bias`
-    /// and the step constants out of the loop).
+    /// override it with a loop of its own (to hoist `use_bias` and the step
+    /// constants out of the loop).
     fn solve_all(
         items: &mut [Self],
         ctx: &StepContext,
