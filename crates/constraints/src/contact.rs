@@ -152,6 +152,10 @@ pub struct ContactConstraint {
     /// Inverse masses and inertias the impulses act with, loaded from the
     /// bodies at prepare: `[m_a⁻¹, i_a⁻¹, m_b⁻¹, i_b⁻¹]`.
     pub(crate) applied_masses: [Real; 4],
+    /// `Σ λ_warm start − λ_prepare` per row: with the final `λ`, the
+    /// impulse of the whole step, N·s (see
+    /// [`PointImpulse`](crate::contact_solver::PointImpulse)).
+    pub(crate) step_base: [Real; ROWS],
 }
 
 /// `max(x, floor)` that returns `floor` when `x` is NaN (as `Real::max`),
@@ -208,6 +212,7 @@ impl ContactConstraint {
             body_a,
             body_b,
             applied_masses: [0.0; 4],
+            step_base: [0.0; ROWS],
         };
         for (i, p) in points.iter().take(MAX_MANIFOLD_POINTS).enumerate() {
             let (r_a, r_b) = (p.anchor_a, p.anchor_b);
@@ -266,10 +271,13 @@ impl ContactConstraint {
     }
 
     /// Applies the impulses kept from the last step, `Δv = M⁻¹ Jᵀ λ`.
-    pub(crate) fn apply_warm_start(&self, states: &mut [BodyState]) {
+    pub(crate) fn apply_warm_start(&mut self, states: &mut [BodyState]) {
         let (ia, ib) = (self.state_a as usize, self.state_b as usize);
         let [m_a, i_a, m_b, i_b] = self.applied_masses;
         let lambda = &self.impulse;
+        for (base, &l) in self.step_base.iter_mut().zip(lambda) {
+            *base += l;
+        }
         let p = (lambda[0] + lambda[1]) * self.normal + (lambda[2] + lambda[3]) * self.tangent();
         let (l_a, l_b) = (dot_rows(lambda, &self.ja), dot_rows(lambda, &self.jb));
         let sa = &mut states[ia];
@@ -290,9 +298,22 @@ impl ContactConstraint {
         (self.impulse[i], self.impulse[i + MAX_MANIFOLD_POINTS])
     }
 
-    /// Total normal impulse of the last step, N·s.
+    /// Accumulated normal impulse of the points summed (what one substep
+    /// applies at warm start), N·s.
     pub fn total_normal_impulse(&self) -> Real {
         self.impulse[..self.point_count()].iter().sum()
+    }
+
+    /// The kept and step-total impulses of point `i`.
+    #[must_use]
+    pub fn point_impulse(&self, i: usize) -> crate::contact_solver::PointImpulse {
+        let (n, t) = self.impulses(i);
+        crate::contact_solver::PointImpulse {
+            normal: n,
+            tangent: t,
+            total_normal: self.step_base[i] + n,
+            total_tangent: self.step_base[i + MAX_MANIFOLD_POINTS] + t,
+        }
     }
 
     #[inline(always)]
@@ -457,6 +478,7 @@ impl Constraint for ContactConstraint {
         if !ctx.warm_starting {
             self.impulse = [0.0; ROWS];
         }
+        self.step_base = self.impulse.map(|l| -l);
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {

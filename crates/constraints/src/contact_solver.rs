@@ -133,6 +133,36 @@ struct WideContact {
     impulse: [W; ROWS],
     /// Largest normal impulse increment (restitution gate), N·s.
     max_normal_impulse: [W; MAX_MANIFOLD_POINTS],
+    /// Step totals less the current impulse: `Σ_warm starts λ − λ_prepare`
+    /// per row, N·s (see [`PointImpulse`]).
+    step_base: [W; ROWS],
+}
+
+/// The impulses of one manifold point after a step, N·s.
+///
+/// `normal` and `tangent` are the accumulated impulses kept for the next
+/// step's warm start (what one substep applies). The totals are what the
+/// whole step applied: every warm start re-applies the kept impulse, and
+/// every solve, relax and restitution increment adds to it, so
+///
+/// ```text
+/// total = Σ_substeps λ_warm start + (λ_end − λ_prepare)
+/// ```
+///
+/// which a lane keeps as `step_base = Σ λ_warm start − λ_prepare` (added to
+/// at warm start only, never in the solve loop) plus the final `λ`. A box
+/// of mass `m` resting on the ground reads a total normal impulse of
+/// `m g dt` for any substep count.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PointImpulse {
+    /// Accumulated normal impulse (warm start), N·s.
+    pub normal: Real,
+    /// Accumulated tangent impulse (warm start), N·s.
+    pub tangent: Real,
+    /// Normal impulse applied over the whole step, N·s.
+    pub total_normal: Real,
+    /// Tangent impulse applied over the whole step, N·s.
+    pub total_tangent: Real,
 }
 
 /// What the collision pipeline hands over for one contact: everything a
@@ -269,24 +299,34 @@ impl ContactSolver {
         chunk.push(lane, count);
     }
 
-    /// Calls `store(contact_index, point, normal_impulse, tangent_impulse)`
-    /// for every point of every contact: the impulses to keep for the next
-    /// step's warm start.
-    pub fn for_each_impulse(&self, mut store: impl FnMut(u32, usize, Real, Real)) {
+    /// Calls `store(contact_index, point, impulses)` for every point of
+    /// every contact: the impulses to keep for the next step's warm start
+    /// and the step's totals.
+    pub fn for_each_impulse(&self, mut store: impl FnMut(u32, usize, PointImpulse)) {
         for chunk in self.colours.iter().flatten() {
             let impulse = chunk.impulse.map(W::to_array);
+            let base = chunk.step_base.map(W::to_array);
             let second = chunk.second.to_array();
             for k in 0..chunk.len {
                 let points = if second[k] > 0.0 { 2 } else { 1 };
                 for i in 0..points {
-                    store(chunk.contact[k], i, impulse[i][k], impulse[i + 2][k]);
+                    let (n, t) = (impulse[i][k], impulse[i + 2][k]);
+                    store(
+                        chunk.contact[k],
+                        i,
+                        PointImpulse {
+                            normal: n,
+                            tangent: t,
+                            total_normal: base[i][k] + n,
+                            total_tangent: base[i + 2][k] + t,
+                        },
+                    );
                 }
             }
         }
         for c in &self.overflow {
             for i in 0..c.point_count() {
-                let (n, t) = c.impulses(i);
-                store(c.contact_index, i, n, t);
+                store(c.contact_index, i, c.point_impulse(i));
             }
         }
     }
@@ -349,7 +389,7 @@ impl ContactSolver {
         for chunk in self.colours.iter_mut().flatten() {
             chunk.warm_start(states);
         }
-        for c in &self.overflow {
+        for c in &mut self.overflow {
             c.apply_warm_start(states);
         }
     }
@@ -489,6 +529,7 @@ impl WideContact {
             bias_rate: z,
             impulse: [z; ROWS],
             max_normal_impulse: [z; MAX_MANIFOLD_POINTS],
+            step_base: [z; ROWS],
         }
     }
 
@@ -581,6 +622,7 @@ impl WideContact {
         if !ctx.warm_starting {
             self.impulse = [zero; ROWS];
         }
+        self.step_base = self.impulse.map(|l| zero - l);
     }
 
     /// Restitution lane-wise, point 0 then point 1: where a point approached
@@ -627,6 +669,9 @@ impl WideContact {
     fn warm_start(&mut self, states: &mut [BodyState]) {
         let (n_x, n_y) = (self.n_x, self.n_y);
         let lambda = &self.impulse;
+        for (base, &l) in self.step_base.iter_mut().zip(lambda) {
+            *base += l;
+        }
         let (pn, pt) = (lambda[0] + lambda[1], lambda[2] + lambda[3]);
         // p = pn n + pt t with t = (n_y, −n_x).
         let p_x = pn * n_x + pt * n_y;

@@ -135,17 +135,22 @@ impl Collision {
             .destroy_of_body(body, &mut self.events, |_| true);
     }
 
+    /// Makes the broadphase report every pair of a body's shapes again at
+    /// the next pair update (a filter that kept them apart went).
+    pub(crate) fn refind_pairs_of(&mut self, body: BodyHandle) {
+        for &s in self.shapes.of_body(body) {
+            self.broadphase.touch_proxy(self.shapes.at(s).proxy);
+        }
+    }
+
     /// Exchanges the shape lists of two bodies whose identities were swapped
     /// (their contacts must be gone already).
     #[cfg_attr(not(feature = "portals"), allow(dead_code))]
     pub(crate) fn swap_body_shapes(&mut self, a: BodyHandle, b: BodyHandle) {
         self.shapes.swap_bodies(a, b);
         // Proxies must report their pairs again under the new owners.
-        for body in [a, b] {
-            for &s in self.shapes.of_body(body) {
-                self.broadphase.touch_proxy(self.shapes.at(s).proxy);
-            }
-        }
+        self.refind_pairs_of(a);
+        self.refind_pairs_of(b);
     }
 
     fn should_pair(&self, bodies: &BodySet, no_collide: &NoCollide, a: u32, b: u32) -> bool {
@@ -240,10 +245,12 @@ impl Collision {
     /// Copies solved impulses back into the contacts (for warm starting).
     pub(crate) fn store_impulses(&mut self, solver: &ContactSolver) {
         let contacts = &mut self.contacts;
-        solver.for_each_impulse(|index, point, normal, tangent| {
+        solver.for_each_impulse(|index, point, impulse| {
             let p = &mut contacts.awake_mut(index as usize).points[point];
-            p.normal_impulse = normal;
-            p.tangent_impulse = tangent;
+            p.normal_impulse = impulse.normal;
+            p.tangent_impulse = impulse.tangent;
+            p.total_normal_impulse = impulse.total_normal;
+            p.total_tangent_impulse = impulse.total_tangent;
         });
     }
 

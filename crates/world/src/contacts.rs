@@ -38,10 +38,19 @@ pub struct ContactPointData {
     pub separation: Real,
     /// Feature id.
     pub id: u16,
-    /// Normal impulse of the last step, N·s.
+    /// Accumulated normal impulse kept for the next step's warm start
+    /// (what one substep applies), N·s.
     pub normal_impulse: Real,
-    /// Tangent impulse of the last step, N·s.
+    /// Accumulated tangent impulse kept for the warm start, N·s.
     pub tangent_impulse: Real,
+    /// Normal impulse the last step applied in all, over every substep,
+    /// warm start and restitution, N·s (0 when the contact was not solved
+    /// in that step; kept while its bodies sleep). Divided by the step it
+    /// is the mean contact force, N.
+    pub total_normal_impulse: Real,
+    /// Tangent (friction) impulse the last step applied in all, N·s, along
+    /// `t = (n.y, −n.x)`.
+    pub total_tangent_impulse: Real,
 }
 
 /// A persistent contact between two shapes whose fat boxes overlap.
@@ -92,6 +101,19 @@ impl Contact {
         } else {
             self.body_a
         }
+    }
+
+    /// The valid manifold points.
+    #[inline]
+    #[must_use]
+    pub fn points(&self) -> &[ContactPointData] {
+        &self.points[..self.point_count]
+    }
+
+    /// Normal impulse the last step applied through all points, N·s.
+    #[must_use]
+    pub fn total_normal_impulse(&self) -> Real {
+        self.points().iter().map(|p| p.total_normal_impulse).sum()
     }
 
     /// True when it pushes: touching, solid and enabled.

@@ -206,7 +206,7 @@ impl JointSet {
     pub(crate) fn remove(
         &mut self,
         joint: JointHandle,
-    ) -> Result<(BodyHandle, BodyHandle), WorldError> {
+    ) -> Result<(BodyHandle, BodyHandle, bool), WorldError> {
         let s = self.slot(joint)?;
         let i = s.index as usize;
         let def = &self.revolute[i].def;
@@ -230,7 +230,9 @@ impl JointSet {
             }
         }
         self.slots.remove(joint.index, joint.generation);
-        Ok((a, b))
+        // The pair may collide again once no joint keeps it apart.
+        let freed = !collide && !self.no_collide.contains(a, b);
+        Ok((a, b, freed))
     }
 
     /// Changes a joint's definition through `edit`, keeping the change only

@@ -253,6 +253,8 @@ fn update_manifold(c: &mut Contact, m: &Manifold, offset: [Vec2; 2]) {
             id: mp.id,
             normal_impulse: 0.0,
             tangent_impulse: 0.0,
+            total_normal_impulse: 0.0,
+            total_tangent_impulse: 0.0,
         };
         if let Some(o) = old[..old_count].iter().find(|o| o.id == mp.id) {
             p.normal_impulse = o.normal_impulse;

@@ -560,7 +560,13 @@ impl World {
 
     /// Removes a live joint, waking its bodies.
     fn remove_joint(&mut self, joint: JointHandle) {
-        if let Ok((a, b)) = self.joints.remove(joint) {
+        if let Ok((a, b, freed)) = self.joints.remove(joint) {
+            if freed {
+                // Their proxies may not move again for a long time: the
+                // broadphase looks for their pairs at the next step.
+                self.collision.refind_pairs_of(a);
+                self.collision.refind_pairs_of(b);
+            }
             self.wake_body(a);
             self.wake_body(b);
             self.islands.note_removed(a);
@@ -850,6 +856,53 @@ impl World {
     /// Every contact, awake ones first, then those of sleeping islands.
     pub fn contacts(&self) -> impl Iterator<Item = &Contact> {
         self.collision.contacts.iter()
+    }
+
+    /// The touching solid contacts of a body, in the order of its contact
+    /// list: normal (from the contact's `body_a` to `body_b`), points with
+    /// separation, and the impulses of the last step (kept impulses and the
+    /// step totals, [`ContactPointData`](crate::contacts::ContactPointData)).
+    ///
+    /// ```
+    /// use janus2d_world::{ShapeDef, World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Polygon;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    /// world.create_shape(ground, &ShapeDef::default(), Polygon::make_box(5.0, 0.5)).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 1.0))).unwrap();
+    /// world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    /// for _ in 0..60 {
+    ///     world.step(1.0 / 60.0).unwrap();
+    /// }
+    /// // The ground carries the box: m g over the step.
+    /// let push: f32 = world.body_contacts(b).unwrap().map(|c| c.total_normal_impulse()).sum();
+    /// let weight_impulse = world.mass(b).unwrap() * 9.81 / 60.0;
+    /// assert!((push - weight_impulse).abs() < 0.02 * weight_impulse);
+    /// ```
+    pub fn body_contacts(
+        &self,
+        body: BodyHandle,
+    ) -> Result<impl Iterator<Item = &Contact> + '_, WorldError> {
+        self.check_body(body)?;
+        let contacts = &self.collision.contacts;
+        Ok(contacts
+            .of_body(body)
+            .iter()
+            .filter_map(|&id| contacts.get(id))
+            .filter(|c| c.touching && !c.sensor))
+    }
+
+    /// The touching solid contacts of one shape (as
+    /// [`World::body_contacts`]).
+    pub fn shape_contacts(
+        &self,
+        shape: ShapeHandle,
+    ) -> Result<impl Iterator<Item = &Contact> + '_, WorldError> {
+        let body = self.shape(shape)?.body;
+        Ok(self
+            .body_contacts(body)?
+            .filter(move |c| c.shapes.contains(&shape)))
     }
 
     /// Number of contacts (awake and asleep).

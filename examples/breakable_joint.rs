@@ -1,0 +1,108 @@
+//! A sign hung from a ceiling by two revolute joints that break above a
+//! force threshold, read back after every step with `World::joint_force`.
+//! A ball dropped on it snaps both joints; a light one does not.
+//! Run with `cargo run --release --example breakable_joint`.
+
+use janus2d::prelude::*;
+
+/// Force above which a joint breaks, N.
+pub const BREAK_FORCE: Real = 400.0;
+
+/// What happened to the sign.
+#[derive(Debug)]
+pub struct Report {
+    /// Upward force of the two joints together on the sign while it just
+    /// hangs, N (two hooks on one rigid sign share the sideways load in a
+    /// way statics leaves open; their vertical sum is its weight).
+    pub hanging_force: Real,
+    /// The sign's weight `m g`, N.
+    pub sign_weight: Real,
+    /// Largest force read on a joint before it broke, N.
+    pub peak_force: Real,
+    /// Steps at which each joint broke (`None`: it held).
+    pub broke_at: [Option<usize>; 2],
+    /// How far the sign's centre fell below where it hung, m.
+    pub sign_drop: Real,
+}
+
+/// Hangs a 2 kg sign, drops a ball (radius 0.3 m) of `ball_density`
+/// kg/m² on it from 2.7 m above and simulates 3 s at 60 Hz.
+pub fn run(ball_density: Real) -> Result<Report, WorldError> {
+    let dt: Real = 1.0 / 60.0;
+    let mut world = World::new(WorldDef::default())?;
+    // The hooks: a static body without shapes, so nothing but the sign
+    // stops the ball.
+    let ceiling = world.create_body(&BodyDef::fixed(Vec2::new(0.0, 10.0)))?;
+    // A 2 m × 0.5 m sign of 2 kg, hanging 1 m under the ceiling by two
+    // joints at its top corners' anchors.
+    let sign_at = Vec2::new(0.0, 8.65);
+    let sign = world.create_body(&BodyDef::dynamic(sign_at))?;
+    let sign_def = ShapeDef {
+        density: 2.0,
+        ..ShapeDef::default()
+    };
+    world.create_shape(sign, &sign_def, Polygon::make_box(1.0, 0.25))?;
+    let mut joints = Vec::new();
+    for x in [-0.9, 0.9] {
+        let anchor = Vec2::new(x, 8.9);
+        joints.push(world.create_revolute_joint(&RevoluteJointDef::new(
+            ceiling,
+            sign,
+            anchor - Vec2::new(0.0, 10.0),
+            anchor - sign_at,
+        ))?);
+    }
+    world.set_body_enable_sleep(sign, false)?;
+    for _ in 0..60 {
+        world.step(dt)?;
+    }
+    let hanging_force = joints
+        .iter()
+        .map(|&j| world.joint_force(j).map(|f| f.y))
+        .sum::<Result<Real, _>>()?;
+    let sign_weight = world.mass(sign)? * -world.gravity().y;
+
+    let ball = world.create_body(&BodyDef::dynamic(Vec2::new(0.3, 11.9)))?;
+    let ball_def = ShapeDef {
+        density: ball_density,
+        ..ShapeDef::default()
+    };
+    world.create_shape(ball, &ball_def, Circle::new(Vec2::ZERO, 0.3)?)?;
+    let (mut peak_force, mut broke_at): (Real, [Option<usize>; 2]) = (0.0, [None, None]);
+    for step in 0..180 {
+        world.step(dt)?;
+        for (k, &j) in joints.iter().enumerate() {
+            if broke_at[k].is_some() {
+                continue;
+            }
+            let force = world.joint_force(j)?.length();
+            if force > BREAK_FORCE {
+                world.destroy_joint(j)?;
+                broke_at[k] = Some(step);
+                println!("step {step:3}: joint {k} broke at {force:.0} N");
+            } else {
+                peak_force = peak_force.max(force);
+            }
+        }
+    }
+    let sign_drop = sign_at.y - world.position(sign)?.y;
+    Ok(Report {
+        hanging_force,
+        sign_weight,
+        peak_force,
+        broke_at,
+        sign_drop,
+    })
+}
+
+fn main() -> Result<(), WorldError> {
+    for (label, density) in [("light ball", 0.5), ("heavy ball", 200.0)] {
+        let r = run(density)?;
+        println!(
+            "{label}: the joints carried {:.2} N (sign weight {:.2} N), peak {:.0} N below the \
+             {BREAK_FORCE} N limit, broke at step {:?}, sign fell {:.2} m",
+            r.hanging_force, r.sign_weight, r.peak_force, r.broke_at, r.sign_drop
+        );
+    }
+    Ok(())
+}
