@@ -234,3 +234,52 @@ fn destroying_a_joint_lets_its_resting_bodies_collide_again() {
     let y = w.position(b).unwrap().y;
     assert!(y > 1.49, "still inside the block: y = {y}");
 }
+
+fn resting_pair() -> (World, ShapeHandle, BodyHandle, ShapeHandle) {
+    let mut w = world_with(4);
+    let g = ground(&mut w, 0.0);
+    let g_shape = w.body_shapes(g).unwrap()[0];
+    let b = w
+        .create_body(&BodyDef::dynamic(Vec2::new(0.0, 0.5)))
+        .unwrap();
+    let s = w
+        .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    settle(&mut w, 5);
+    assert_eq!(w.body_contacts(b).unwrap().count(), 1);
+    (w, g_shape, b, s)
+}
+
+fn ended(w: &World, a: ShapeHandle, b: ShapeHandle) -> usize {
+    w.events()
+        .collision
+        .contact_end
+        .iter()
+        .filter(|e| [e.shape_a, e.shape_b].contains(&a) && [e.shape_a, e.shape_b].contains(&b))
+        .count()
+}
+
+#[test]
+fn joining_touching_bodies_reports_their_contact_end_at_the_next_step() {
+    let (mut w, g_shape, b, s) = resting_pair();
+    let g = w.shape_body(g_shape).unwrap();
+    w.create_revolute_joint(&RevoluteJointDef::new(
+        g,
+        b,
+        Vec2::new(0.0, 0.5),
+        Vec2::ZERO,
+    ))
+    .unwrap();
+    w.step(DT).unwrap();
+    assert_eq!(ended(&w, g_shape, s), 1);
+    assert_eq!(w.body_contacts(b).unwrap().count(), 0);
+}
+
+#[test]
+fn destroying_a_touching_shape_reports_its_contact_end_at_the_next_step() {
+    let (mut w, g_shape, b, s) = resting_pair();
+    w.destroy_shape(s).unwrap();
+    w.step(DT).unwrap();
+    assert_eq!(ended(&w, g_shape, s), 1);
+    assert_eq!(w.body_contacts(b).unwrap().count(), 0);
+}
