@@ -866,8 +866,83 @@ fn collide_chain_polygon(
     }
     let seg = Polygon::make_capsule(a.segment.point1, a.segment.point2, 0.0);
     let m = collide_polygons(&seg, xf_a, pb, xf_b, spec);
-    if m.point_count == 0 || !chain_admits(a, xf_a.q.inv_rotate(m.normal)) {
+    if m.point_count == 0 {
+        return m;
+    }
+    if !chain_admits(a, xf_a.q.inv_rotate(m.normal)) {
+        // The separating axis belongs to a vertex the neighbour handles, or
+        // to a face of the polygon (a polygon pressed deep into the chain
+        // turns its own face normal into the best axis): contact along this
+        // segment's own face where the polygon lies over it. Dropping it
+        // instead let a polygon pressed into a concave corner of a loop
+        // through the wall, neither segment holding it.
+        return chain_face_manifold(a, xf_a, pb, xf_b, spec);
+    }
+    m
+}
+
+/// The manifold of a polygon against chain segment `a` with the segment's
+/// front normal as the reference face: the polygon's edge most
+/// anti-parallel to it, clipped to the segment's extent (empty when the
+/// polygon does not lie over the segment). `xf` places the polygon in the
+/// segment's frame. Feature ids: `(0, i22)` and `(1, i21)`, as a reference
+/// edge `0 → 1`.
+fn chain_face_manifold(
+    a: &ChainSegment,
+    xf_a: &Transform,
+    pb: &Polygon,
+    xf_b: &Transform,
+    spec: Real,
+) -> Manifold {
+    let xf = xf_a.inv_mul(xf_b);
+    let (p1, p2) = (a.segment.point1, a.segment.point2);
+    let e = p2 - p1;
+    let len = e.length();
+    if len.is_nan() || len <= EPSILON {
         return Manifold::EMPTY;
+    }
+    let u1 = e / len;
+    let n1 = right_perp(u1);
+    let mut i21 = 0;
+    let mut min_dot = Real::INFINITY;
+    for i in 0..pb.count {
+        let d = n1.dot(xf.q.rotate(pb.normals[i]));
+        if d < min_dot {
+            min_dot = d;
+            i21 = i;
+        }
+    }
+    let i22 = next_index(i21, pb.count);
+    let v21 = xf.apply(pb.vertices[i21]);
+    let v22 = xf.apply(pb.vertices[i22]);
+    let (t21, t22) = ((v21 - p1).dot(u1), (v22 - p1).dot(u1));
+    // The incident edge runs against the reference edge: v22 is the lower.
+    let (lower, upper) = (t22.min(t21), t22.max(t21));
+    if upper < 0.0 || lower > len {
+        return Manifold::EMPTY;
+    }
+    let at = |t: Real| {
+        let span = t21 - t22;
+        if span.abs() > EPSILON {
+            v22.lerp(v21, ((t - t22) / span).clamp(0.0, 1.0))
+        } else {
+            v22
+        }
+    };
+    let v_lower = at(lower.max(0.0));
+    let v_upper = at(upper.min(len));
+    let d_ab = xf_a.p - xf_b.p;
+    let mut m = Manifold::EMPTY;
+    for (v, id) in [(v_lower, feature_id(0, i22)), (v_upper, feature_id(1, i21))] {
+        let s_core = (v - p1).dot(n1);
+        let separation = s_core - pb.radius;
+        if separation < spec {
+            let mid = v - 0.5 * (s_core + pb.radius) * n1;
+            m.push_local(xf_a, d_ab, mid, separation, id);
+        }
+    }
+    if m.point_count > 0 {
+        m.normal = xf_a.q.rotate(n1);
     }
     m
 }
@@ -1309,6 +1384,47 @@ mod tests {
                 }
             }
             assert!(points >= 2, "x {x}: {points} points");
+        }
+    }
+
+    /// A box pressed deep into the concave vertex of a valley (as the
+    /// spinner's paddle presses bodies into its loop) turns its own face
+    /// normal into the best axis; the segments must still hold it along
+    /// their faces (they used to drop it, and it passed through the wall).
+    #[test]
+    fn chain_holds_a_box_pressed_deep_into_a_concave_vertex() {
+        // Right to left, front normals up: a valley with its vertex at 0.
+        let chain = make_chain(&[v(4.0, 1.0), v(0.0, 0.0), v(-4.0, 1.0)], false).unwrap();
+        let b = boxes(0.35);
+        let xa = xf(0.0, 0.0, 0.0);
+        for (x, y, angle) in [(0.1, 0.12, 0.6), (-0.15, 0.1, -0.5), (0.0, 0.05, 0.78)] {
+            let xb = xf(x, y, angle);
+            let mut deepest: Real = 0.0;
+            let mut manifolds = 0;
+            for s in &chain {
+                let m = collide(&Shape::ChainSegment(*s), &xa, &b, &xb, SPEC);
+                check_conventions(&m, &xa, &xb);
+                if m.point_count > 0 {
+                    manifolds += 1;
+                    assert!(
+                        near(m.normal, s.normal(), TOL),
+                        "{:?} vs {:?}",
+                        m.normal,
+                        s.normal()
+                    );
+                    for p in m.points() {
+                        deepest = deepest.min(p.separation);
+                    }
+                }
+            }
+            assert!(
+                manifolds >= 1,
+                "box at ({x}, {y}, {angle}): no segment holds it"
+            );
+            assert!(
+                deepest < -0.1,
+                "box at ({x}, {y}, {angle}): deepest {deepest}"
+            );
         }
     }
 
