@@ -6,7 +6,9 @@
 //!   awake          Vec<Contact>     what the narrowphase and constraint building visit
 //!   sleeping       Vec<Contact>     contacts of sleeping islands (no per-step cost)
 //!   place          contact id → (list, position)
-//!   pair_index     shape pair → contact id     (lookups only, never iterated)
+//!   shape_pairs    shape slot → [(other shape slot, contact id)]
+//!                  (is a pair new? the broadphase reports candidates
+//!                  grouped by shape, so the list scanned stays in cache)
 //!   body_contacts  body slot → [contact id]    (destroy, remove shape, wake walk these)
 //!
 //! create ─▶ awake ──(island sleeps)──▶ sleeping ──(island wakes)──▶ awake
@@ -16,8 +18,6 @@
 //! Contacts keep a stable id for their whole life; their position in a list
 //! changes when another one is removed (swap-remove) or when they sleep or
 //! wake, always the same way for the same inputs.
-
-use std::collections::HashMap;
 
 use janus2d_core::body::{BodyHandle, BodySet};
 use janus2d_core::math::{Real, Vec2};
@@ -208,7 +208,7 @@ pub struct ContactSet {
     pub(crate) sleeping: Vec<Contact>,
     place: Vec<Place>,
     free_ids: Vec<u32>,
-    pair_index: HashMap<(u32, u32), u32>,
+    shape_pairs: Vec<SmallVec<[(u32, u32); 4]>>,
     body_contacts: Vec<SmallVec<[u32; 4]>>,
     /// Body pairs whose solid contact began touching since the islands
     /// last read them (they link islands).
@@ -245,7 +245,19 @@ impl ContactSet {
     /// True when shapes `a` and `b` (slots) have a contact.
     #[must_use]
     pub fn has_pair(&self, a: u32, b: u32) -> bool {
-        self.pair_index.contains_key(&pair_key(a, b))
+        let list = |s: u32| {
+            self.shape_pairs
+                .get(s as usize)
+                .map_or(&[][..], |l| l.as_slice())
+        };
+        let (la, lb) = (list(a), list(b));
+        // Scan the shorter list (a ground shape may touch hundreds).
+        let (short, other) = if la.len() <= lb.len() {
+            (la, b)
+        } else {
+            (lb, a)
+        };
+        short.iter().any(|&(s, _)| s == other)
     }
 
     /// Ids of the contacts of a body.
@@ -286,7 +298,13 @@ impl ContactSet {
             }
         };
         c.id = id;
-        self.pair_index.insert(pair_key(c.shape_a, c.shape_b), id);
+        for (shape, other) in [(c.shape_a, c.shape_b), (c.shape_b, c.shape_a)] {
+            let s = shape as usize;
+            if self.shape_pairs.len() <= s {
+                self.shape_pairs.resize(s + 1, SmallVec::new());
+            }
+            self.shape_pairs[s].push((other, id));
+        }
         for body in [c.body_a, c.body_b] {
             let b = body.index as usize;
             if self.body_contacts.len() <= b {
@@ -325,7 +343,13 @@ impl ContactSet {
         let Some(c) = self.unlink(id) else {
             return;
         };
-        self.pair_index.remove(&pair_key(c.shape_a, c.shape_b));
+        for shape in [c.shape_a, c.shape_b] {
+            if let Some(list) = self.shape_pairs.get_mut(shape as usize)
+                && let Some(k) = list.iter().position(|&(_, x)| x == id)
+            {
+                list.swap_remove(k);
+            }
+        }
         for body in [c.body_a, c.body_b] {
             if let Some(list) = self.body_contacts.get_mut(body.index as usize)
                 && let Some(k) = list.iter().position(|x| *x == id)
