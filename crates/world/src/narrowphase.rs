@@ -66,10 +66,17 @@ enum ContactUpdate {
     Asleep,
     /// The fat boxes separated: destroy the contact.
     Separated,
-    /// New manifold stored; `was_touching` is the touching flag before.
+    /// New manifold stored; what the serial pass needs, so that it reads
+    /// the contact itself only when something changed.
     Updated {
         /// Whether the contact touched before this update.
         was_touching: bool,
+        /// Whether it touches now.
+        touching: bool,
+        /// Touching, solid and enabled: the solve may take it.
+        solid: bool,
+        /// Touching with a still body that is asleep: that body wakes.
+        wake: bool,
     },
 }
 
@@ -77,6 +84,13 @@ enum ContactUpdate {
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Narrowphase {
     results: Vec<ContactUpdate>,
+    /// Awake positions of the contacts that touched solidly at the last
+    /// run, in contact order (what constraint building reads, instead of
+    /// every awake contact).
+    touching: Vec<u32>,
+    /// Number of awake contacts when the last run ended; contacts woken
+    /// after it are appended beyond.
+    scanned: usize,
     /// The contacts solved this step, in contact order.
     solved: Vec<SolvedContact>,
 }
@@ -142,11 +156,17 @@ impl Narrowphase {
             #[cfg(not(feature = "parallel"))]
             results.extend(contacts.awake_slice_mut().iter_mut().map(compute));
         }
+        // Serial pass over the results: a contact is read again only when
+        // it is destroyed, begins or ends touching, or wakes a body, and a
+        // swap-remove only moves a contact not yet visited, so the
+        // positions recorded in `touching` stay valid.
+        let touching_list = &mut self.touching;
+        touching_list.clear();
         let mut k = 0;
         let mut tested = 0;
         let mut touching_count = 0;
         while k < contacts.awake().len() {
-            let was_touching = match results[k] {
+            let (was_touching, touching, solid, wakes) = match results[k] {
                 ContactUpdate::Asleep => {
                     k += 1;
                     continue;
@@ -156,23 +176,29 @@ impl Narrowphase {
                     results.swap_remove(k);
                     continue;
                 }
-                ContactUpdate::Updated { was_touching } => was_touching,
+                ContactUpdate::Updated {
+                    was_touching,
+                    touching,
+                    solid,
+                    wake,
+                } => (was_touching, touching, solid, wake),
             };
             tested += 1;
-            let c = contacts.awake_mut(k);
-            let touching = c.touching;
-            if touching && (c.still[0] || c.still[1]) {
+            if wakes {
+                let c = contacts.awake_mut(k);
                 let other = if c.still[0] { c.body_a } else { c.body_b };
-                if input.bodies.is_sleeping(other) {
-                    wake.push(other);
-                    // Woken before the solve: it moves this step.
-                    c.still = [false, false];
-                }
+                wake.push(other);
+                // Woken before the solve: it moves this step.
+                c.still = [false, false];
             }
             if touching {
                 touching_count += 1;
+                if solid {
+                    touching_list.push(k as u32);
+                }
             }
             if touching != was_touching {
+                let c = contacts.awake_mut(k);
                 events.push(c, touching);
                 if !c.sensor && c.enabled {
                     let pair = (c.body_a, c.body_b);
@@ -181,6 +207,7 @@ impl Narrowphase {
             }
             k += 1;
         }
+        self.scanned = contacts.awake().len();
         self.results = results;
         counters.pairs_tested = tested;
         counters.touching = touching_count;
@@ -232,7 +259,22 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
         input.clipping.apply(c);
     }
     c.touching = c.point_count > 0;
-    ContactUpdate::Updated { was_touching }
+    let wake = c.touching && {
+        let other = if c.still[0] {
+            Some(c.body_a)
+        } else if c.still[1] {
+            Some(c.body_b)
+        } else {
+            None
+        };
+        other.is_some_and(|b| input.bodies.is_sleeping(b))
+    };
+    ContactUpdate::Updated {
+        was_touching,
+        touching: c.touching,
+        solid: c.is_solid_touching(),
+        wake,
+    }
 }
 
 /// Replaces a contact's manifold, carrying impulses over by feature id and
@@ -288,8 +330,16 @@ pub(crate) fn build_constraints(
     counters: &mut CollisionCounters,
 ) {
     let solved = &mut narrowphase.solved;
+    // The contacts to look at: those the narrowphase found touching, then
+    // any woken (appended) since.
+    let woken = narrowphase.scanned.min(contacts.awake().len())..contacts.awake().len();
+    let candidates = narrowphase
+        .touching
+        .iter()
+        .map(|&k| k as usize)
+        .chain(woken);
     if woke {
-        for k in 0..contacts.awake().len() {
+        for k in candidates.clone() {
             let c = contacts.awake_mut(k);
             if c.still == [true, true] {
                 c.still = [
@@ -318,7 +368,8 @@ pub(crate) fn build_constraints(
     solver.begin(bodies.states.len());
     let awake = contacts.awake();
     solved.clear();
-    for (k, c) in awake.iter().enumerate() {
+    for k in candidates {
+        let c = &awake[k];
         let [sa, sb] = c.still;
         if !c.is_solid_touching() || (sa && sb) {
             continue;
