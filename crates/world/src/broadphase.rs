@@ -59,6 +59,9 @@ const BULK_DIVISOR: usize = 4;
 /// Per-proxy record of the [`BroadPhase`].
 #[derive(Clone, Copy, Debug)]
 struct ProxySlot {
+    /// The fat box of the leaf, kept here too so that the narrowphase's
+    /// overlap test per contact reads one slot instead of slot and node.
+    fat: Aabb,
     /// Leaf id in the tree selected by `is_static`.
     leaf: u32,
     /// User payload (a shape key).
@@ -157,6 +160,7 @@ impl BroadPhase {
             None => {
                 let id = u32::try_from(self.proxies.len()).expect("too many proxies");
                 self.proxies.push(ProxySlot {
+                    fat: aabb,
                     leaf: NULL_NODE,
                     payload: 0,
                     is_static: false,
@@ -173,6 +177,7 @@ impl BroadPhase {
         };
         let leaf = tree.create_proxy(aabb, id);
         self.proxies[id as usize] = ProxySlot {
+            fat: tree.fat_aabb(leaf),
             leaf,
             payload,
             is_static,
@@ -201,8 +206,11 @@ impl BroadPhase {
     /// pairs are reported by the next [`update_pairs`](Self::update_pairs).
     pub fn move_proxy(&mut self, proxy: u32, aabb: Aabb) -> bool {
         let slot = self.slot(proxy);
-        let reinserted = self.tree_mut(slot.is_static).move_proxy(slot.leaf, aabb);
+        let tree = self.tree_mut(slot.is_static);
+        let reinserted = tree.move_proxy(slot.leaf, aabb);
         if reinserted {
+            let fat = tree.fat_aabb(slot.leaf);
+            self.proxies[proxy as usize].fat = fat;
             self.mark_moved(proxy);
         }
         reinserted
@@ -224,8 +232,7 @@ impl BroadPhase {
 
     /// The fat box of a proxy.
     pub fn fat_aabb(&self, proxy: u32) -> Aabb {
-        let slot = self.slot(proxy);
-        self.tree(slot.is_static).fat_aabb(slot.leaf)
+        self.slot(proxy).fat
     }
 
     /// The payload of a proxy.
@@ -347,7 +354,7 @@ impl BroadPhase {
         } else {
             for &m in &moves {
                 let slot = proxies[m as usize];
-                let fat = self.tree(slot.is_static).fat_aabb(slot.leaf);
+                let fat = slot.fat;
                 let mut visit = |other: u32| {
                     let o = &proxies[other as usize];
                     // When both moved, only the smaller id reports the pair.
@@ -378,6 +385,12 @@ impl BroadPhase {
     pub fn shift_origin(&mut self, new_origin: Vec2) {
         self.dynamic_tree.shift_origin(new_origin);
         self.static_tree.shift_origin(new_origin);
+        for i in 0..self.proxies.len() {
+            let s = self.proxies[i];
+            if s.alive {
+                self.proxies[i].fat = self.tree(s.is_static).fat_aabb(s.leaf);
+            }
+        }
     }
 
     /// Validates both trees and the proxy table; panics on inconsistency.
@@ -394,6 +407,11 @@ impl BroadPhase {
                 self.tree(s.is_static).user_data(s.leaf) as usize,
                 id,
                 "proxy {id} leaf link"
+            );
+            assert_eq!(
+                self.tree(s.is_static).fat_aabb(s.leaf),
+                s.fat,
+                "proxy {id} fat box"
             );
         }
         assert_eq!(live[0], self.dynamic_tree.proxy_count(), "dynamic count");
