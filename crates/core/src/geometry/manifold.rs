@@ -717,16 +717,18 @@ pub(crate) fn collide_polygons(
     let s_lower = s_lower - radius;
     let s_upper = s_upper - radius;
 
-    let mut m = Manifold::EMPTY;
+    // The normal is written first and the manifold built in place: setting
+    // it after the points made the return copy stall on a partial store.
+    let mut m = Manifold {
+        normal: xf_a.q.rotate(if flip { -n } else { n }),
+        ..Manifold::EMPTY
+    };
     if flip {
         if s_upper < spec {
             m.push_local(xf_a, d_ab, m_upper, s_upper, feature_id(i21, i12));
         }
         if s_lower < spec {
             m.push_local(xf_a, d_ab, m_lower, s_lower, feature_id(i22, i11));
-        }
-        if m.point_count > 0 {
-            m.normal = xf_a.q.rotate(-n);
         }
     } else {
         if s_lower < spec {
@@ -735,9 +737,9 @@ pub(crate) fn collide_polygons(
         if s_upper < spec {
             m.push_local(xf_a, d_ab, m_upper, s_upper, feature_id(i12, i21));
         }
-        if m.point_count > 0 {
-            m.normal = xf_a.q.rotate(n);
-        }
+    }
+    if m.point_count == 0 {
+        return Manifold::EMPTY;
     }
     m
 }
