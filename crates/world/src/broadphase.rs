@@ -206,6 +206,10 @@ impl BroadPhase {
     /// pairs are reported by the next [`update_pairs`](Self::update_pairs).
     pub fn move_proxy(&mut self, proxy: u32, aabb: Aabb) -> bool {
         let slot = self.slot(proxy);
+        if slot.fat.contains(&aabb) {
+            // Still inside its fat box: the tree is not touched.
+            return false;
+        }
         let tree = self.tree_mut(slot.is_static);
         let reinserted = tree.move_proxy(slot.leaf, aabb);
         if reinserted {
