@@ -129,6 +129,56 @@ impl JointSet {
             .map_or(&[], |l| l.as_slice())
     }
 
+    /// Checks the set against the bodies (for `World::validate`): handles
+    /// ↔ slots ↔ storage, each joint's bodies live and listing it, every
+    /// body list holding live joints of that body, no-collide counts.
+    pub(crate) fn check(&self, bodies: &janus2d_core::body::BodySet) -> Result<(), String> {
+        if self.handles.len() != self.slots.len() || self.revolute.len() != self.slots.len() {
+            return Err(format!(
+                "{} handles, {} slots, {} joints",
+                self.handles.len(),
+                self.slots.len(),
+                self.revolute.len()
+            ));
+        }
+        let mut no_collide: HashMap<(u32, u32), u32> = HashMap::new();
+        for (k, &h) in self.handles.iter().enumerate() {
+            let slot = self.slot(h).map_err(|e| format!("joint handle {k}: {e}"))?;
+            if slot.index as usize != k {
+                return Err(format!("joint {k}: its slot points at {}", slot.index));
+            }
+            let j = &self.revolute[k];
+            let (a, b) = (j.def.body_a, j.def.body_b);
+            for body in [a, b] {
+                if !bodies.contains(body) {
+                    return Err(format!("joint {k}: body {body:?} is not live"));
+                }
+                if !self.of_body(body).contains(&h) {
+                    return Err(format!("joint {k}: not listed under body {body:?}"));
+                }
+            }
+            if !j.def.collide_connected {
+                *no_collide
+                    .entry(crate::contacts::pair_key(a.index, b.index))
+                    .or_insert(0) += 1;
+            }
+        }
+        for (b, list) in self.body_joints.iter().enumerate() {
+            for h in list {
+                let (ja, jb) = self
+                    .bodies_of(*h)
+                    .map_err(|e| format!("body slot {b} lists a dead joint: {e}"))?;
+                if ja.index as usize != b && jb.index as usize != b {
+                    return Err(format!("body slot {b} lists a joint of other bodies"));
+                }
+            }
+        }
+        if no_collide != self.no_collide.pairs {
+            return Err("no-collide pairs differ from the joints'".into());
+        }
+        Ok(())
+    }
+
     fn slot(&self, joint: JointHandle) -> Result<JointSlot, WorldError> {
         self.slots
             .resolve(joint, self.owner)

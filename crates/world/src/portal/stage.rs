@@ -362,6 +362,60 @@ impl PortalStage {
                 .any(|(_, d)| d.portals.iter().any(|p| p.body == body))
     }
 
+    /// Checks pairs ↔ crossings ↔ clones ↔ constraints (for
+    /// `World::validate`): portal bodies live, η finite and positive, one
+    /// constraint per crossing naming its two copies and portal bodies,
+    /// copies live, distinct and in no other crossing.
+    pub(crate) fn check(&self, bodies: &BodySet) -> Result<(), String> {
+        for (index, d) in self.pairs.iter() {
+            if !(d.eta.is_finite() && d.eta > 0.0) {
+                return Err(format!("pair {index}: eta {}", d.eta));
+            }
+            if let Some(p) = d.portals.iter().find(|p| !bodies.contains(p.body)) {
+                return Err(format!(
+                    "pair {index}: portal body {:?} is not live",
+                    p.body
+                ));
+            }
+        }
+        if self.crossings.len() != self.constraints.len() {
+            return Err(format!(
+                "{} crossings, {} constraints",
+                self.crossings.len(),
+                self.constraints.len()
+            ));
+        }
+        for (k, (c, pc)) in self.crossings.iter().zip(&self.constraints).enumerate() {
+            if self.pairs.at(c.pair).is_none() {
+                return Err(format!("crossing {k}: its pair is gone"));
+            }
+            if c.original == c.clone || !bodies.contains(c.original) || !bodies.contains(c.clone) {
+                return Err(format!(
+                    "crossing {k}: copies {:?}, {:?}",
+                    c.original, c.clone
+                ));
+            }
+            let def = pc.def();
+            if def.body != c.original || def.clone != c.clone {
+                return Err(format!("crossing {k}: its constraint names other bodies"));
+            }
+            let (entry, exit) = self.portal_bodies(c);
+            if def.portal_body_a != entry || def.portal_body_b != exit {
+                return Err(format!(
+                    "crossing {k}: its constraint names other portal bodies"
+                ));
+            }
+            let shared = self.crossings[k + 1..].iter().any(|o| {
+                [o.original, o.clone].contains(&c.original)
+                    || [o.original, o.clone].contains(&c.clone)
+            });
+            if shared {
+                return Err(format!("crossing {k}: a copy is in another crossing"));
+            }
+        }
+        Ok(())
+    }
+
     pub(crate) fn crossing_of(&self, body: BodyHandle) -> Option<usize> {
         self.crossings
             .iter()
