@@ -231,6 +231,16 @@ pub enum BodyError {
     Negative(&'static str),
     /// The handle refers to a destroyed body or was never issued.
     StaleHandle,
+    /// A finite value outside its stated range (see [`crate::limits`]):
+    /// names the field and the range (for a magnitude, `min = -max`).
+    OutOfBounds {
+        /// The field at fault.
+        field: &'static str,
+        /// Smallest allowed value.
+        min: Real,
+        /// Largest allowed value.
+        max: Real,
+    },
 }
 
 impl std::fmt::Display for BodyError {
@@ -243,6 +253,9 @@ impl std::fmt::Display for BodyError {
             }
             BodyError::Negative(field) => write!(f, "body field `{field}` is negative"),
             BodyError::StaleHandle => write!(f, "stale or foreign body handle"),
+            BodyError::OutOfBounds { field, min, max } => {
+                write!(f, "body field `{field}` must lie in [{min:e}, {max:e}]")
+            }
         }
     }
 }
@@ -435,15 +448,59 @@ fn check_finite_vec(v: Vec2, field: &'static str) -> Result<(), BodyError> {
     }
 }
 
+/// `|v| ≤ max` for a finite `v` (the caller checked finiteness).
+fn check_magnitude(v: Real, max: Real, field: &'static str) -> Result<(), BodyError> {
+    if v.abs() <= max {
+        Ok(())
+    } else {
+        Err(BodyError::OutOfBounds {
+            field,
+            min: -max,
+            max,
+        })
+    }
+}
+
+/// A body position: finite, each coordinate within
+/// [`MAX_COORDINATE`](crate::limits::MAX_COORDINATE).
+pub fn check_position(p: Vec2, field: &'static str) -> Result<(), BodyError> {
+    check_finite_vec(p, field)?;
+    let max = crate::limits::MAX_COORDINATE;
+    check_magnitude(p.x, max, field)?;
+    check_magnitude(p.y, max, field)
+}
+
+/// A linear velocity: finite, its length within
+/// [`MAX_SPEED`](crate::limits::MAX_SPEED).
+pub fn check_velocity(v: Vec2, field: &'static str) -> Result<(), BodyError> {
+    check_finite_vec(v, field)?;
+    let max = crate::limits::MAX_SPEED;
+    check_magnitude(v.x, max, field)?;
+    check_magnitude(v.y, max, field)?;
+    check_magnitude(v.length(), max, field)
+}
+
+/// An angular velocity: finite, within
+/// [`MAX_ANGULAR_SPEED`](crate::limits::MAX_ANGULAR_SPEED).
+pub fn check_angular_velocity(w: Real, field: &'static str) -> Result<(), BodyError> {
+    check_finite(w, field)?;
+    check_magnitude(w, crate::limits::MAX_ANGULAR_SPEED, field)
+}
+
 /// Validates a body definition without creating anything.
 pub fn validate_body_def(def: &BodyDef) -> Result<(), BodyError> {
-    check_finite_vec(def.position, "position")?;
+    check_position(def.position, "position")?;
     check_finite(def.angle, "angle")?;
-    check_finite_vec(def.linear_velocity, "linear_velocity")?;
-    check_finite(def.angular_velocity, "angular_velocity")?;
+    check_velocity(def.linear_velocity, "linear_velocity")?;
+    check_angular_velocity(def.angular_velocity, "angular_velocity")?;
     check_finite(def.linear_damping, "linear_damping")?;
     check_finite(def.angular_damping, "angular_damping")?;
     check_finite(def.gravity_scale, "gravity_scale")?;
+    check_magnitude(
+        def.gravity_scale,
+        crate::limits::MAX_GRAVITY_SCALE,
+        "gravity_scale",
+    )?;
     check_finite(def.max_linear_speed, "max_linear_speed")?;
     check_finite(def.max_rotation, "max_rotation")?;
     if def.linear_damping < 0.0 {
@@ -455,6 +512,11 @@ pub fn validate_body_def(def: &BodyDef) -> Result<(), BodyError> {
     if def.max_linear_speed < 0.0 {
         return Err(BodyError::Negative("max_linear_speed"));
     }
+    check_magnitude(
+        def.max_linear_speed,
+        crate::limits::MAX_SPEED,
+        "max_linear_speed",
+    )?;
     if def.max_rotation < 0.0 {
         return Err(BodyError::Negative("max_rotation"));
     }
@@ -470,7 +532,11 @@ pub fn validate_body_def(def: &BodyDef) -> Result<(), BodyError> {
     Ok(())
 }
 
-/// Validates mass properties for a body of the given type.
+/// Validates mass properties for a body of the given type: a dynamic
+/// body's mass within [`MASS_RANGE`](crate::limits::MASS_RANGE), its
+/// rotational inertia (unless `fixed_rotation`) within
+/// [`INERTIA_RANGE`](crate::limits::INERTIA_RANGE), the centre within
+/// [`MAX_EXTENT`](crate::limits::MAX_EXTENT) of the origin.
 pub fn validate_mass(
     body_type: BodyType,
     m: &BodyMass,
@@ -486,6 +552,25 @@ pub fn validate_mass(
         if !fixed_rotation && m.rotational_inertia <= 0.0 {
             return Err(BodyError::NonPositiveInertia);
         }
+        let (lo, hi) = crate::limits::MASS_RANGE;
+        if !crate::limits::in_range(m.mass, (lo, hi)) {
+            return Err(BodyError::OutOfBounds {
+                field: "mass",
+                min: lo,
+                max: hi,
+            });
+        }
+        let (lo, hi) = crate::limits::INERTIA_RANGE;
+        if !fixed_rotation && !crate::limits::in_range(m.rotational_inertia, (lo, hi)) {
+            return Err(BodyError::OutOfBounds {
+                field: "rotational_inertia",
+                min: lo,
+                max: hi,
+            });
+        }
+        let max = crate::limits::MAX_EXTENT;
+        check_magnitude(m.center.x, max, "center")?;
+        check_magnitude(m.center.y, max, "center")?;
     }
     Ok(())
 }
@@ -712,6 +797,135 @@ impl BodySet {
                 (sim, state)
             }
         }
+    }
+
+    /// Puts back every moving body whose pose (origin, rotation or centre)
+    /// is not finite or has a coordinate beyond `max_coordinate` back at its
+    /// start-of-step pose (`center0`, `rotation0`), at rest, and appends
+    /// its handle to `out`. Run after a solve: the solver's own check sees
+    /// velocities and deltas, this one the pose they produced.
+    pub fn reset_escaped(&mut self, max_coordinate: Real, out: &mut Vec<BodyHandle>) {
+        let inside = |p: Vec2| {
+            vec_is_finite(p) && p.x.abs() <= max_coordinate && p.y.abs() <= max_coordinate
+        };
+        let BodySet { sims, states, .. } = self;
+        for (sim, state) in sims.iter_mut().zip(states.iter_mut()).skip(1) {
+            let ok = inside(sim.transform.p) && inside(sim.center) && sim.transform.q.is_finite();
+            if ok {
+                continue;
+            }
+            sim.center = sim.center0;
+            sim.transform.q = sim.rotation0;
+            sim.transform.p = sim.center - sim.transform.q.rotate(sim.local_center);
+            state.v = Vec2::ZERO;
+            state.w = 0.0;
+            state.dp = Vec2::ZERO;
+            state.dq = Rot::IDENTITY;
+            if !out.contains(&sim.handle) {
+                out.push(sim.handle);
+            }
+        }
+    }
+
+    /// Checks the set's own invariants (for `World::validate`): records ↔
+    /// arrays (each live record's location holds a sim with its handle,
+    /// static bodies in the static array and nowhere else, every array
+    /// entry owned by a live record), the sentinel state, and every stored
+    /// number finite with a dynamic body's inverse mass `1 / mass`. The
+    /// error says what is wrong.
+    pub fn check_invariants(&self) -> Result<(), String> {
+        if self.sims.len() != self.states.len() || self.sims.is_empty() {
+            return Err("sims and states differ in length".into());
+        }
+        if self.sleeping_sims.len() != self.sleeping_states.len() {
+            return Err("sleeping sims and states differ in length".into());
+        }
+        if self.states[0] != BodyState::IDENTITY {
+            return Err("the static sentinel state is not the identity".into());
+        }
+        let mut live = 0usize;
+        for (index, record) in self.records.iter() {
+            live += 1;
+            let handle = BodyHandle::new(index, self.records.generation(index), self.owner);
+            let (sim, is_static) = match record.location {
+                BodyLocation::Moving(i) if i >= 1 => (self.sims.get(i as usize), false),
+                BodyLocation::Moving(_) => (None, false),
+                BodyLocation::Static(j) => (self.static_sims.get(j as usize), true),
+                BodyLocation::Sleeping(j) => (self.sleeping_sims.get(j as usize), false),
+            };
+            let Some(sim) = sim else {
+                return Err(format!(
+                    "body {index}: location {:?} out of its array",
+                    record.location
+                ));
+            };
+            if sim.handle != handle {
+                return Err(format!(
+                    "body {index}: its array entry belongs to {:?}",
+                    sim.handle
+                ));
+            }
+            if is_static != (sim.body_type == BodyType::Static) {
+                return Err(format!(
+                    "body {index}: type {:?} in the wrong array",
+                    sim.body_type
+                ));
+            }
+        }
+        if live != self.len() {
+            return Err(format!(
+                "{live} live records but {} array entries",
+                self.len()
+            ));
+        }
+        let moving = self.sims.iter().zip(&self.states).skip(1);
+        let sleeping = self.sleeping_sims.iter().zip(&self.sleeping_states);
+        let statics = self.static_sims.iter().map(|s| (s, &BodyState::IDENTITY));
+        for (sim, state) in moving.chain(sleeping).chain(statics) {
+            let reals = [
+                sim.torque,
+                sim.mass,
+                sim.inertia,
+                sim.inv_mass,
+                sim.inv_inertia,
+                sim.gravity_scale,
+                sim.linear_damping,
+                sim.angular_damping,
+                sim.max_linear_speed,
+                sim.max_rotation,
+                sim.sleep_time,
+                state.w,
+                state.inv_mass,
+                state.inv_inertia,
+            ];
+            let vecs = [
+                sim.transform.p,
+                sim.center,
+                sim.center0,
+                sim.local_center,
+                sim.force,
+                state.v,
+                state.dp,
+            ];
+            let finite = reals.iter().all(|x| x.is_finite())
+                && vecs.iter().all(|v| vec_is_finite(*v))
+                && sim.transform.q.is_finite()
+                && sim.rotation0.is_finite()
+                && state.dq.is_finite();
+            if !finite {
+                return Err(format!(
+                    "body {:?}: a stored number is not finite",
+                    sim.handle
+                ));
+            }
+            if sim.body_type == BodyType::Dynamic && !(sim.mass > 0.0 && sim.inv_mass > 0.0) {
+                return Err(format!(
+                    "dynamic body {:?}: mass {} inverse {}",
+                    sim.handle, sim.mass, sim.inv_mass
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// Destroys a body; its slot's generation makes old handles stale.

@@ -11,6 +11,7 @@
 //! | [`constraint`] | the constraint trait, rows, blocks, the step context        |
 //! | [`solver`]     | the soft step and the PGS baseline                          |
 //! | [`geometry`]   | shapes, mass properties, bounding boxes, manifolds          |
+//! | [`limits`]     | the stated finite range of every input value                |
 //! | [`handle`]     | one generational handle type for every kind of object       |
 //! | [`slots`]      | generational slots behind handles                           |
 //! | [`union_find`] | union–find over dense indices (islands, joint forests)      |
@@ -22,6 +23,7 @@ pub mod constraint;
 pub mod geometry;
 pub mod graph;
 pub mod handle;
+pub mod limits;
 pub mod math;
 pub mod slots;
 pub mod softness;

@@ -220,6 +220,12 @@ impl BroadPhase {
         reinserted
     }
 
+    /// True when `proxy` names a live proxy (never panics; for checks).
+    #[must_use]
+    pub fn is_live(&self, proxy: u32) -> bool {
+        self.proxies.get(proxy as usize).is_some_and(|s| s.alive)
+    }
+
     /// Marks a proxy as moved without changing its box, so that the next
     /// [`update_pairs`](Self::update_pairs) reports all its pairs again (for
     /// instance after its collision filter changed).

@@ -61,7 +61,7 @@ pub struct CollisionCounters {
 }
 
 /// Shapes, broadphase and contacts of a world.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub(crate) struct Collision {
     pub(crate) owner: u32,
     pub(crate) shapes: ShapeStore,
@@ -107,9 +107,54 @@ impl Collision {
             proxy: 0,
             aabb,
         });
-        let proxy = self.broadphase.create_proxy(aabb, index, is_static);
+        let proxy = self
+            .broadphase
+            .create_proxy(bounded(aabb), index, is_static);
         self.shapes.at_mut(index).proxy = proxy;
         self.shapes.handle_of(index, self.owner)
+    }
+
+    /// Checks shapes ↔ broadphase proxies (for `World::validate`): each
+    /// shape's proxy is live, carries the shape's slot, sits in the tree
+    /// of its body's type, and its fat box contains the shape's box at the
+    /// body's current pose; no other proxy is live.
+    pub(crate) fn check_proxies(&self, bodies: &BodySet) -> Result<(), String> {
+        let mut count = 0usize;
+        for body in bodies.handles() {
+            let Some(sim) = bodies.sim(body) else {
+                continue;
+            };
+            for &s in self.shapes.of_body(body) {
+                count += 1;
+                let shape = self.shapes.at(s);
+                if !self.broadphase.is_live(shape.proxy) {
+                    return Err(format!("shape {s}: proxy {} is not live", shape.proxy));
+                }
+                if self.broadphase.payload(shape.proxy) != s {
+                    return Err(format!("shape {s}: its proxy carries another shape"));
+                }
+                let is_static = sim.body_type == BodyType::Static;
+                if self.broadphase.is_static(shape.proxy) != is_static {
+                    return Err(format!("shape {s}: proxy in the wrong tree"));
+                }
+                let now = bounded(shape.geometry.compute_aabb(&sim.transform));
+                if !self.broadphase.fat_aabb(shape.proxy).contains(&now) {
+                    return Err(format!(
+                        "shape {s}: proxy box {:?} does not contain the shape's {:?}",
+                        self.broadphase.fat_aabb(shape.proxy),
+                        now
+                    ));
+                }
+            }
+        }
+        if count != self.shapes.len() || self.broadphase.proxy_count() != count {
+            return Err(format!(
+                "{} shapes, {count} on live bodies, {} proxies",
+                self.shapes.len(),
+                self.broadphase.proxy_count()
+            ));
+        }
+        Ok(())
     }
 
     /// Removes a shape and its contacts (end events for touching ones).
@@ -245,12 +290,16 @@ impl Collision {
     /// Copies solved impulses back into the contacts (for warm starting).
     pub(crate) fn store_impulses(&mut self, solver: &ContactSolver) {
         let contacts = &mut self.contacts;
+        // A non-finite impulse (a solve that blew up) is not kept for warm
+        // starting: the contact starts cold next step instead of carrying
+        // NaN into it.
+        let finite = |x: Real| if x.is_finite() { x } else { 0.0 };
         solver.for_each_impulse(|index, point, impulse| {
             let p = &mut contacts.awake_mut(index as usize).points[point];
-            p.normal_impulse = impulse.normal;
-            p.tangent_impulse = impulse.tangent;
-            p.total_normal_impulse = impulse.total_normal;
-            p.total_tangent_impulse = impulse.total_tangent;
+            p.normal_impulse = finite(impulse.normal);
+            p.tangent_impulse = finite(impulse.tangent);
+            p.total_normal_impulse = finite(impulse.total_normal);
+            p.total_tangent_impulse = finite(impulse.total_tangent);
         });
     }
 
@@ -279,7 +328,7 @@ impl Collision {
                         aabb.upper + sweep.max(Vec2::ZERO),
                     );
                 }
-                if self.broadphase.move_proxy(shape.proxy, aabb) {
+                if self.broadphase.move_proxy(shape.proxy, bounded(aabb)) {
                     moved += 1;
                 }
             }
@@ -296,7 +345,7 @@ impl Collision {
             let old = self.shapes.at(s).proxy;
             self.broadphase.destroy_proxy(old);
             let aabb = self.shapes.at(s).geometry.compute_aabb(xf);
-            let proxy = self.broadphase.create_proxy(aabb, s, is_static);
+            let proxy = self.broadphase.create_proxy(bounded(aabb), s, is_static);
             let shape = self.shapes.at_mut(s);
             shape.aabb = aabb;
             shape.proxy = proxy;
@@ -312,8 +361,37 @@ impl Collision {
             let aabb = shape.geometry.compute_aabb(xf);
             shape.aabb = aabb;
             let proxy = shape.proxy;
-            self.broadphase.move_proxy(proxy, aabb);
+            self.broadphase.move_proxy(proxy, bounded(aabb));
             self.broadphase.touch_proxy(proxy);
         }
     }
+}
+
+/// Largest coordinate of a box handed to the broadphase, m: four times
+/// [`MAX_COORDINATE`](janus2d_core::limits::MAX_COORDINATE), beyond any
+/// shape on a body inside the world.
+pub const MAX_BOX_COORDINATE: Real = 4.0 * janus2d_core::limits::MAX_COORDINATE;
+
+/// The box handed to the broadphase: `aabb` itself when it is valid and
+/// inside [`MAX_BOX_COORDINATE`] (always, while the API's limits hold),
+/// otherwise clamped into it with NaN coordinates at 0, so that no
+/// invalid box ever reaches a tree.
+#[must_use]
+pub fn bounded(aabb: Aabb) -> Aabb {
+    let m = MAX_BOX_COORDINATE;
+    let inside = |v: Vec2| v.x.abs() <= m && v.y.abs() <= m;
+    if aabb.lower.x <= aabb.upper.x
+        && aabb.lower.y <= aabb.upper.y
+        && inside(aabb.lower)
+        && inside(aabb.upper)
+    {
+        return aabb;
+    }
+    let fix = |x: Real| if x.is_nan() { 0.0 } else { x.clamp(-m, m) };
+    let (lx, ux) = (fix(aabb.lower.x), fix(aabb.upper.x));
+    let (ly, uy) = (fix(aabb.lower.y), fix(aabb.upper.y));
+    Aabb::new(
+        Vec2::new(lx.min(ux), ly.min(uy)),
+        Vec2::new(lx.max(ux), ly.max(uy)),
+    )
 }

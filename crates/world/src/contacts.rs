@@ -288,6 +288,106 @@ impl ContactSet {
         }
     }
 
+    /// Checks the set against bodies and shapes (for `World::validate`):
+    /// ids ↔ places ↔ lists, the per-shape pair lists (each contact listed
+    /// once under each of its shapes, naming the other), shapes live and on the contact's bodies, each
+    /// contact listed under both bodies and the body lists holding only
+    /// contacts of that body, no sleeping contact with an awake body, and
+    /// every point, normal and impulse finite.
+    pub(crate) fn check(
+        &self,
+        bodies: &janus2d_core::body::BodySet,
+        shapes: &crate::shapes::ShapeStore,
+    ) -> Result<(), String> {
+        use janus2d_core::body::BodyLocation;
+        let listed: usize = self.shape_pairs.iter().map(|l| l.len()).sum();
+        if listed != 2 * self.len() {
+            return Err(format!(
+                "{listed} shape pair entries for {} contacts",
+                self.len()
+            ));
+        }
+        let lists = [(true, &self.awake), (false, &self.sleeping)];
+        for (awake, list) in lists {
+            for (i, c) in list.iter().enumerate() {
+                let expected = if awake {
+                    Place::Awake(i as u32)
+                } else {
+                    Place::Sleeping(i as u32)
+                };
+                if self.place.get(c.id as usize) != Some(&expected) {
+                    return Err(format!("contact {}: place is not {expected:?}", c.id));
+                }
+                for (shape, other) in [(c.shape_a, c.shape_b), (c.shape_b, c.shape_a)] {
+                    let list = self
+                        .shape_pairs
+                        .get(shape as usize)
+                        .map_or(&[][..], |l| l.as_slice());
+                    if list.iter().filter(|&&e| e == (other, c.id)).count() != 1 {
+                        return Err(format!(
+                            "contact {}: not listed once under shape {shape}",
+                            c.id
+                        ));
+                    }
+                }
+                for (slot, body) in [(c.shape_a, c.body_a), (c.shape_b, c.body_b)] {
+                    if !bodies.contains(body) {
+                        return Err(format!("contact {}: body {body:?} is not live", c.id));
+                    }
+                    if !shapes.of_body(body).contains(&slot) {
+                        return Err(format!("contact {}: shape {slot} is not on {body:?}", c.id));
+                    }
+                    if self.of_body(body).iter().filter(|&&k| k == c.id).count() != 1 {
+                        return Err(format!("contact {}: not listed once under {body:?}", c.id));
+                    }
+                }
+                if !awake {
+                    for body in [c.body_a, c.body_b] {
+                        if matches!(bodies.location(body), Some(BodyLocation::Moving(_))) {
+                            return Err(format!(
+                                "sleeping contact {} has awake body {body:?}",
+                                c.id
+                            ));
+                        }
+                    }
+                }
+                let finite = janus2d_core::math::vec_is_finite(c.normal)
+                    && c.friction.is_finite()
+                    && c.restitution.is_finite()
+                    && c.point_count <= 2
+                    && c.points[..c.point_count].iter().all(|p| {
+                        janus2d_core::math::vec_is_finite(p.point)
+                            && janus2d_core::math::vec_is_finite(p.anchor_a)
+                            && janus2d_core::math::vec_is_finite(p.anchor_b)
+                            && p.separation.is_finite()
+                            && p.normal_impulse.is_finite()
+                            && p.tangent_impulse.is_finite()
+                            && p.total_normal_impulse.is_finite()
+                            && p.total_tangent_impulse.is_finite()
+                    });
+                if !finite {
+                    return Err(format!("contact {}: a stored number is not finite", c.id));
+                }
+            }
+        }
+        for (b, list) in self.body_contacts.iter().enumerate() {
+            for &id in list {
+                match self.get(id) {
+                    Some(c) if c.body_a.index as usize == b || c.body_b.index as usize == b => {}
+                    _ => return Err(format!("body slot {b} lists contact {id}, not its own")),
+                }
+            }
+        }
+        let free = self.place.iter().filter(|p| **p == Place::Free).count();
+        if free != self.free_ids.len() {
+            return Err(format!(
+                "{free} free places, {} free ids",
+                self.free_ids.len()
+            ));
+        }
+        Ok(())
+    }
+
     /// Adds an awake contact (its `id` is assigned here); returns the id.
     pub fn insert(&mut self, mut c: Contact) -> u32 {
         let id = match self.free_ids.pop() {

@@ -5,6 +5,7 @@ use janus2d_constraints::JointError;
 use janus2d_constraints::PortalError;
 use janus2d_core::body::BodyError;
 use janus2d_core::geometry::GeometryError;
+use janus2d_core::math::Real;
 
 /// Anything the world API can reject.
 #[derive(Clone, Debug, PartialEq)]
@@ -33,6 +34,17 @@ pub enum WorldError {
     NonFinite(&'static str),
     /// A value outside its allowed range (names it).
     OutOfRange(&'static str),
+    /// A finite value outside its stated range (see
+    /// [`janus2d_core::limits`]): names the field and the range (for a
+    /// magnitude, `min = -max`).
+    OutOfBounds {
+        /// The field at fault.
+        field: &'static str,
+        /// Smallest allowed value.
+        min: Real,
+        /// Largest allowed value.
+        max: Real,
+    },
     /// The operation needs a dynamic body.
     NotDynamic,
     /// The operation needs a kinematic or dynamic body (not a static one).
@@ -66,6 +78,9 @@ impl std::fmt::Display for WorldError {
             WorldError::InvalidTimeStep => write!(f, "time step must be finite and > 0"),
             WorldError::NonFinite(what) => write!(f, "`{what}` is not finite"),
             WorldError::OutOfRange(what) => write!(f, "`{what}` is out of range"),
+            WorldError::OutOfBounds { field, min, max } => {
+                write!(f, "`{field}` must lie in [{min:e}, {max:e}]")
+            }
             WorldError::NotDynamic => write!(f, "operation needs a dynamic body"),
             WorldError::NotMovable => write!(f, "operation needs a kinematic or dynamic body"),
             WorldError::PortalBody => write!(f, "the body carries or is crossing a portal"),

@@ -192,6 +192,50 @@ impl Islands {
         id
     }
 
+    /// Checks the islands against the bodies (for `World::validate`):
+    /// every live dynamic body in exactly one island at its recorded
+    /// position, members live and dynamic, free ids empty, an island that
+    /// sleeps has only sleeping members, pending bodies live.
+    pub(crate) fn check(&self, bodies: &BodySet) -> Result<(), String> {
+        let mut members = 0usize;
+        for (id, island) in self.islands.iter().enumerate() {
+            let free = self.free.contains(&(id as u32));
+            if free != island.members.is_empty() {
+                return Err(format!(
+                    "island {id}: free {free} with {} members",
+                    island.members.len()
+                ));
+            }
+            for (k, &m) in island.members.iter().enumerate() {
+                members += 1;
+                if bodies.body_type(m) != Some(BodyType::Dynamic) {
+                    return Err(format!(
+                        "island {id}: member {m:?} is not a live dynamic body"
+                    ));
+                }
+                if self.island(m) != id as u32 || self.position[m.index as usize] != k as u32 {
+                    return Err(format!("island {id}: member {m:?} records another place"));
+                }
+                if island.asleep && !bodies.is_sleeping(m) {
+                    return Err(format!("island {id} sleeps but member {m:?} is awake"));
+                }
+            }
+        }
+        let dynamic = bodies
+            .handles()
+            .filter(|&h| bodies.body_type(h) == Some(BodyType::Dynamic))
+            .count();
+        if dynamic != members {
+            return Err(format!(
+                "{dynamic} dynamic bodies, {members} island members"
+            ));
+        }
+        if let Some(b) = self.pending.iter().find(|b| !bodies.contains(**b)) {
+            return Err(format!("pending body {b:?} is not live"));
+        }
+        Ok(())
+    }
+
     /// A new dynamic body: an island of its own.
     pub(crate) fn add_body(&mut self, body: BodyHandle) {
         self.new_island(vec![body]);

@@ -129,6 +129,56 @@ impl JointSet {
             .map_or(&[], |l| l.as_slice())
     }
 
+    /// Checks the set against the bodies (for `World::validate`): handles
+    /// ↔ slots ↔ storage, each joint's bodies live and listing it, every
+    /// body list holding live joints of that body, no-collide counts.
+    pub(crate) fn check(&self, bodies: &janus2d_core::body::BodySet) -> Result<(), String> {
+        if self.handles.len() != self.slots.len() || self.revolute.len() != self.slots.len() {
+            return Err(format!(
+                "{} handles, {} slots, {} joints",
+                self.handles.len(),
+                self.slots.len(),
+                self.revolute.len()
+            ));
+        }
+        let mut no_collide: HashMap<(u32, u32), u32> = HashMap::new();
+        for (k, &h) in self.handles.iter().enumerate() {
+            let slot = self.slot(h).map_err(|e| format!("joint handle {k}: {e}"))?;
+            if slot.index as usize != k {
+                return Err(format!("joint {k}: its slot points at {}", slot.index));
+            }
+            let j = &self.revolute[k];
+            let (a, b) = (j.def.body_a, j.def.body_b);
+            for body in [a, b] {
+                if !bodies.contains(body) {
+                    return Err(format!("joint {k}: body {body:?} is not live"));
+                }
+                if !self.of_body(body).contains(&h) {
+                    return Err(format!("joint {k}: not listed under body {body:?}"));
+                }
+            }
+            if !j.def.collide_connected {
+                *no_collide
+                    .entry(crate::contacts::pair_key(a.index, b.index))
+                    .or_insert(0) += 1;
+            }
+        }
+        for (b, list) in self.body_joints.iter().enumerate() {
+            for h in list {
+                let (ja, jb) = self
+                    .bodies_of(*h)
+                    .map_err(|e| format!("body slot {b} lists a dead joint: {e}"))?;
+                if ja.index as usize != b && jb.index as usize != b {
+                    return Err(format!("body slot {b} lists a joint of other bodies"));
+                }
+            }
+        }
+        if no_collide != self.no_collide.pairs {
+            return Err("no-collide pairs differ from the joints'".into());
+        }
+        Ok(())
+    }
+
     fn slot(&self, joint: JointHandle) -> Result<JointSlot, WorldError> {
         self.slots
             .resolve(joint, self.owner)
@@ -287,6 +337,7 @@ impl JointSet {
         if !speed.is_finite() {
             return Err(WorldError::NonFinite("motor_speed"));
         }
+        check_motor_speed(speed)?;
         self.edit(joint, |d| d.motor_speed = speed)
     }
 
@@ -327,6 +378,7 @@ impl JointSet {
         if hertz < 0.0 || damping_ratio < 0.0 {
             return Err(WorldError::OutOfRange("spring"));
         }
+        check_spring(hertz, damping_ratio)?;
         self.edit(joint, |d| {
             d.hertz = hertz;
             d.damping_ratio = damping_ratio;
@@ -363,4 +415,63 @@ impl JointSet {
             .map(RevoluteJoint::row_count)
             .sum()
     }
+}
+
+/// The world's limits on a joint definition, beyond
+/// [`RevoluteJointDef::validate`]: local anchors within
+/// [`MAX_EXTENT`](janus2d_core::limits::MAX_EXTENT), the motor speed
+/// within [`MAX_ANGULAR_SPEED`](janus2d_core::limits::MAX_ANGULAR_SPEED),
+/// the spring within [`MAX_SPRING_HERTZ`] and
+/// [`MAX_DAMPING_RATIO`](janus2d_core::limits::MAX_DAMPING_RATIO).
+pub(crate) fn check_joint_limits(def: &RevoluteJointDef) -> Result<(), WorldError> {
+    let max = janus2d_core::limits::MAX_EXTENT;
+    for (a, field) in [
+        (def.local_anchor_a, "local_anchor_a"),
+        (def.local_anchor_b, "local_anchor_b"),
+    ] {
+        if a.x.abs() > max || a.y.abs() > max {
+            return Err(WorldError::OutOfBounds {
+                field,
+                min: -max,
+                max,
+            });
+        }
+    }
+    check_motor_speed(def.motor_speed)?;
+    check_spring(def.hertz, def.damping_ratio)
+}
+
+/// Largest joint spring stiffness, Hz (1e6: a stiffer spring's softness
+/// overflows).
+pub const MAX_SPRING_HERTZ: Real = 1e6;
+
+fn check_motor_speed(speed: Real) -> Result<(), WorldError> {
+    let max = janus2d_core::limits::MAX_ANGULAR_SPEED;
+    if speed.abs() > max {
+        return Err(WorldError::OutOfBounds {
+            field: "motor_speed",
+            min: -max,
+            max,
+        });
+    }
+    Ok(())
+}
+
+fn check_spring(hertz: Real, damping_ratio: Real) -> Result<(), WorldError> {
+    if hertz > MAX_SPRING_HERTZ {
+        return Err(WorldError::OutOfBounds {
+            field: "hertz",
+            min: 0.0,
+            max: MAX_SPRING_HERTZ,
+        });
+    }
+    let max = janus2d_core::limits::MAX_DAMPING_RATIO;
+    if damping_ratio > max {
+        return Err(WorldError::OutOfBounds {
+            field: "damping_ratio",
+            min: 0.0,
+            max,
+        });
+    }
+    Ok(())
 }

@@ -22,6 +22,8 @@
 //! | [`setters`]      | setters and getters of bodies, shapes and joints after creation |
 //! | [`query`]        | scene queries: rays, shape casts, overlaps, distances    |
 //! | [`hash`]         | the state hash of determinism checks                     |
+//! | [`snapshot`]     | [`Snapshot`]: `World::snapshot` and `World::restore`      |
+//! | [`validate`]     | [`World::validate`]: every cross-structure invariant     |
 //!
 //! See `docs/architecture.md` for the stage table.
 
@@ -41,6 +43,8 @@ pub mod profile;
 pub mod query;
 pub mod setters;
 pub mod shapes;
+pub mod snapshot;
+pub mod validate;
 pub mod world;
 
 pub use collision::CollisionCounters;
@@ -56,4 +60,6 @@ pub use portal::{MassModel, PortalDef, PortalEvent, PortalPairDef, PortalPairHan
 pub use profile::{StepCounters, StepProfile};
 pub use query::{PortalHop, QueryFilter, QueryProblem, RayHit, ShapeOverlap};
 pub use shapes::{Filter, ShapeData, ShapeDef, ShapeHandle};
+pub use snapshot::Snapshot;
+pub use validate::{Invariant, InvariantError};
 pub use world::{StepEvents, World, WorldDef};

@@ -29,7 +29,7 @@ fn check_material(v: Real, name: &'static str) -> Result<(), WorldError> {
     if v < 0.0 {
         return Err(WorldError::OutOfRange(name));
     }
-    Ok(())
+    crate::shapes::check_material_limit(v, name)
 }
 
 impl World {
@@ -348,6 +348,7 @@ impl World {
     ) -> Result<(), WorldError> {
         let slot = self.shape_slot(shape)?;
         check_material(density, "density")?;
+        crate::world::check_shape_mass(&self.collision.shapes.at(slot).geometry, density)?;
         let body = self.collision.shapes.at(slot).body;
         self.collision.shapes.at_mut(slot).def.density = density;
         let follows = self.bodies.record(body).is_some_and(|r| !r.mass_override);

@@ -142,8 +142,29 @@ impl ShapeDef {
                 return Err(WorldError::OutOfRange(name));
             }
         }
-        Ok(())
+        check_material_limit(self.friction, "friction")?;
+        check_material_limit(self.restitution, "restitution")
     }
+}
+
+/// Friction and restitution within
+/// [`MAX_FRICTION`](janus2d_core::limits::MAX_FRICTION) and
+/// [`MAX_RESTITUTION`](janus2d_core::limits::MAX_RESTITUTION) (other names
+/// pass).
+pub(crate) fn check_material_limit(v: Real, name: &'static str) -> Result<(), WorldError> {
+    let max = match name {
+        "friction" => janus2d_core::limits::MAX_FRICTION,
+        "restitution" => janus2d_core::limits::MAX_RESTITUTION,
+        _ => return Ok(()),
+    };
+    if v > max {
+        return Err(WorldError::OutOfBounds {
+            field: name,
+            min: 0.0,
+            max,
+        });
+    }
+    Ok(())
 }
 
 /// A shape attached to a body.
@@ -277,6 +298,57 @@ impl ShapeStore {
             }
         }
         self.body_extents[b] = e;
+    }
+
+    /// Checks the store against the bodies (for `World::validate`): every
+    /// live shape's body is live and lists it, every body list holds live
+    /// shapes of that body once, the geometry is valid, material and box
+    /// finite, and the hit-event count matches.
+    pub(crate) fn check(&self, bodies: &janus2d_core::body::BodySet) -> Result<(), String> {
+        let mut hits = 0;
+        for (index, shape) in self.slots.iter() {
+            hits += usize::from(shape.def.enable_hit_events);
+            if !bodies.contains(shape.body) {
+                return Err(format!("shape {index}: body {:?} is not live", shape.body));
+            }
+            let listed = self
+                .of_body(shape.body)
+                .iter()
+                .filter(|&&s| s == index)
+                .count();
+            if listed != 1 {
+                return Err(format!(
+                    "shape {index}: listed {listed} times under its body"
+                ));
+            }
+            // Portal clones carry scaled copies: cores may be short.
+            if let Err(e) = shape.geometry.validate_scaled() {
+                return Err(format!("shape {index}: geometry invalid: {e}"));
+            }
+            let a = &shape.aabb;
+            let finite = janus2d_core::math::vec_is_finite(a.lower)
+                && janus2d_core::math::vec_is_finite(a.upper)
+                && a.lower.x <= a.upper.x
+                && a.lower.y <= a.upper.y;
+            if !finite || shape.def.validate().is_err() {
+                return Err(format!("shape {index}: box or material invalid"));
+            }
+        }
+        if hits != self.hit_event_shapes {
+            return Err(format!(
+                "{hits} hit-event shapes, counted {}",
+                self.hit_event_shapes
+            ));
+        }
+        for (b, list) in self.body_shapes.iter().enumerate() {
+            for &s in list {
+                match self.slots.at(s) {
+                    Some(shape) if shape.body.index as usize == b => {}
+                    _ => return Err(format!("body slot {b} lists shape {s}, not its own")),
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Stores a shape and lists it under its body; returns its slot.

@@ -116,10 +116,8 @@ impl World {
     /// assert_eq!(world.body_count(), 0);
     /// ```
     pub fn new(def: WorldDef) -> Result<World, WorldError> {
-        if !vec_is_finite(def.gravity) {
-            return Err(WorldError::NonFinite("gravity"));
-        }
-        def.solver.validate()?;
+        check_gravity(def.gravity)?;
+        check_settings(&def.solver)?;
         def.sleep.validate()?;
         if def.hit_event_threshold.is_nan() {
             return Err(WorldError::NonFinite("hit_event_threshold"));
@@ -155,11 +153,10 @@ impl World {
         self.gravity
     }
 
-    /// Sets gravity (rejects non-finite values).
+    /// Sets gravity (rejects non-finite values and a length above
+    /// [`MAX_GRAVITY`](janus2d_core::limits::MAX_GRAVITY)).
     pub fn set_gravity(&mut self, gravity: Vec2) -> Result<(), WorldError> {
-        if !vec_is_finite(gravity) {
-            return Err(WorldError::NonFinite("gravity"));
-        }
+        check_gravity(gravity)?;
         self.gravity = gravity;
         Ok(())
     }
@@ -169,9 +166,13 @@ impl World {
         &self.settings
     }
 
-    /// Replaces the solver settings (validated).
+    /// Replaces the solver settings (validated: every real finite and not
+    /// negative, damping ratios at most
+    /// [`MAX_DAMPING_RATIO`](janus2d_core::limits::MAX_DAMPING_RATIO); the
+    /// contact and iterative joint stiffness are capped at a quarter of
+    /// the substep rate at each step, see [`World::step_context`]).
     pub fn set_settings(&mut self, settings: SolverSettings) -> Result<(), WorldError> {
-        settings.validate()?;
+        check_settings(&settings)?;
         self.settings = settings;
         Ok(())
     }
@@ -242,9 +243,14 @@ impl World {
     /// world.step(1.0 / 60.0).unwrap();
     /// assert!(world.position(ball).unwrap().y < 4.0);
     /// ```
+    ///
+    /// A kinematic body given a velocity is created awake even with
+    /// `awake: false` (a sleeping kinematic body would never move).
     pub fn create_body(&mut self, def: &BodyDef) -> Result<BodyHandle, WorldError> {
         let handle = self.insert_body(def)?;
-        if !def.awake && def.body_type != BodyType::Static {
+        let moving_kinematic = def.body_type == BodyType::Kinematic
+            && (def.linear_velocity != Vec2::ZERO || def.angular_velocity != 0.0);
+        if !def.awake && def.body_type != BodyType::Static && !moving_kinematic {
             self.islands.push_pending(handle);
         }
         Ok(handle)
@@ -254,10 +260,15 @@ impl World {
     /// and every joint attached to it; the bodies it touched wake up.
     ///
     /// Walks the body's own contacts and joints, never the whole world.
+    /// Destroying a portal clone cancels its crossing (which destroys the
+    /// clone; the original stays).
     pub fn destroy_body(&mut self, body: BodyHandle) -> Result<(), WorldError> {
         self.check_body(body)?;
         self.portal_forget_body(body);
-        self.destroy_body_unchecked(body);
+        // A clone is already gone with its cancelled crossing.
+        if self.bodies.contains(body) {
+            self.destroy_body_unchecked(body);
+        }
         Ok(())
     }
 
@@ -302,6 +313,22 @@ impl World {
     /// `StaleBody`, or `ForeignHandle` for another world's handle.
     pub(crate) fn body_error(&self, body: BodyHandle) -> WorldError {
         self.check_body(body).err().unwrap_or(WorldError::StaleBody)
+    }
+
+    /// A live body that is kinematic or dynamic (`NotMovable` otherwise).
+    fn check_movable(&self, body: BodyHandle) -> Result<(), WorldError> {
+        match self.body_type(body)? {
+            BodyType::Static => Err(WorldError::NotMovable),
+            _ => Ok(()),
+        }
+    }
+
+    /// A live dynamic body (`NotDynamic` otherwise).
+    fn check_dynamic(&self, body: BodyHandle) -> Result<(), WorldError> {
+        match self.body_type(body)? {
+            BodyType::Dynamic => Ok(()),
+            _ => Err(WorldError::NotDynamic),
+        }
     }
 
     pub(crate) fn check_body(&self, body: BodyHandle) -> Result<(), WorldError> {
@@ -375,25 +402,26 @@ impl World {
     }
 
     /// Sets the linear velocity of a moving body's centre of mass.
+    /// Errors: non-finite, or faster than
+    /// [`MAX_SPEED`](janus2d_core::limits::MAX_SPEED); a static body
+    /// ([`WorldError::NotMovable`]).
     pub fn set_linear_velocity(&mut self, body: BodyHandle, v: Vec2) -> Result<(), WorldError> {
-        if !vec_is_finite(v) {
-            return Err(WorldError::NonFinite("linear_velocity"));
-        }
+        janus2d_core::body::check_velocity(v, "linear_velocity")?;
+        self.check_movable(body)?;
         self.wake_body(body);
-        self.check_body(body)?;
         if let Some(s) = self.bodies.state_mut(body) {
             s.v = v;
         }
         Ok(())
     }
 
-    /// Sets the angular velocity of a moving body.
+    /// Sets the angular velocity of a moving body. Errors: non-finite, or
+    /// above [`MAX_ANGULAR_SPEED`](janus2d_core::limits::MAX_ANGULAR_SPEED);
+    /// a static body ([`WorldError::NotMovable`]).
     pub fn set_angular_velocity(&mut self, body: BodyHandle, w: Real) -> Result<(), WorldError> {
-        if !w.is_finite() {
-            return Err(WorldError::NonFinite("angular_velocity"));
-        }
+        janus2d_core::body::check_angular_velocity(w, "angular_velocity")?;
+        self.check_movable(body)?;
         self.wake_body(body);
-        self.check_body(body)?;
         if let Some(s) = self.bodies.state_mut(body) {
             s.w = w;
         }
@@ -410,8 +438,9 @@ impl World {
         if !vec_is_finite(position) || !angle.is_finite() {
             return Err(WorldError::NonFinite("transform"));
         }
-        self.wake_body(body);
+        janus2d_core::body::check_position(position, "transform")?;
         self.check_body(body)?;
+        self.wake_body(body);
         let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
         sim.transform = Transform {
             p: position,
@@ -457,13 +486,19 @@ impl World {
         if !vec_is_finite(force) || !vec_is_finite(point) {
             return Err(WorldError::NonFinite("force"));
         }
-        self.wake_body(body);
-        self.check_body(body)?;
-        let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
-        if sim.body_type == BodyType::Dynamic {
-            sim.force += force;
-            sim.torque += cross(point - sim.center, force);
+        self.check_dynamic(body)?;
+        let sim = self.bodies.sim(body).ok_or(WorldError::StaleBody)?;
+        let (f, t) = (
+            sim.force + force,
+            sim.torque + cross(point - sim.center, force),
+        );
+        if !(vec_is_finite(f) && t.is_finite()) {
+            return Err(accumulated("force"));
         }
+        self.wake_body(body);
+        let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
+        sim.force = f;
+        sim.torque = t;
         Ok(())
     }
 
@@ -482,12 +517,14 @@ impl World {
         if !torque.is_finite() {
             return Err(WorldError::NonFinite("torque"));
         }
-        self.wake_body(body);
-        self.check_body(body)?;
-        let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
-        if sim.body_type == BodyType::Dynamic {
-            sim.torque += torque;
+        self.check_dynamic(body)?;
+        let sim = self.bodies.sim(body).ok_or(WorldError::StaleBody)?;
+        if !(sim.torque + torque).is_finite() {
+            return Err(accumulated("torque"));
         }
+        self.wake_body(body);
+        let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
+        sim.torque += torque;
         Ok(())
     }
 
@@ -501,17 +538,17 @@ impl World {
         if !vec_is_finite(impulse) || !vec_is_finite(point) {
             return Err(WorldError::NonFinite("impulse"));
         }
+        self.check_dynamic(body)?;
+        let sim = self.bodies.sim(body).ok_or(WorldError::StaleBody)?;
+        let (im, ii, c) = (sim.inv_mass, sim.inv_inertia, sim.center);
+        let (v0, w0) = (self.linear_velocity(body)?, self.angular_velocity(body)?);
+        let v = v0 + im * impulse;
+        let w = w0 + ii * cross(point - c, impulse);
+        check_resulting_velocity(v, w)?;
         self.wake_body(body);
-        self.check_body(body)?;
-        let loc = self.bodies.location(body).ok_or(WorldError::StaleBody)?;
-        if let BodyLocation::Moving(i) = loc {
-            let sim = &self.bodies.sims[i as usize];
-            if sim.body_type == BodyType::Dynamic {
-                let (im, ii, c) = (sim.inv_mass, sim.inv_inertia, sim.center);
-                let st = &mut self.bodies.states[i as usize];
-                st.v += im * impulse;
-                st.w += ii * cross(point - c, impulse);
-            }
+        if let Some(st) = self.bodies.state_mut(body) {
+            st.v = v;
+            st.w = w;
         }
         Ok(())
     }
@@ -525,12 +562,18 @@ impl World {
         if !impulse.is_finite() {
             return Err(WorldError::NonFinite("impulse"));
         }
+        self.check_dynamic(body)?;
+        let ii = self
+            .bodies
+            .sim(body)
+            .ok_or(WorldError::StaleBody)?
+            .inv_inertia;
+        let v = self.linear_velocity(body)?;
+        let w = self.angular_velocity(body)? + ii * impulse;
+        check_resulting_velocity(v, w)?;
         self.wake_body(body);
-        self.check_body(body)?;
-        let loc = self.bodies.location(body).ok_or(WorldError::StaleBody)?;
-        if let BodyLocation::Moving(i) = loc {
-            let ii = self.bodies.sims[i as usize].inv_inertia;
-            self.bodies.states[i as usize].w += ii * impulse;
+        if let Some(st) = self.bodies.state_mut(body) {
+            st.w = w;
         }
         Ok(())
     }
@@ -545,6 +588,7 @@ impl World {
         def: &RevoluteJointDef,
     ) -> Result<JointHandle, WorldError> {
         def.validate()?;
+        crate::joints::check_joint_limits(def)?;
         self.check_body(def.body_a)?;
         self.check_body(def.body_b)?;
         self.wake_body(def.body_a);
@@ -599,6 +643,35 @@ impl World {
     /// ```
     pub fn set_pre_solve(&mut self, hook: Option<crate::narrowphase::PreSolveFn>) {
         self.pre_solve = hook;
+    }
+
+    /// Takes the pre-solve hook out (restore keeps it across).
+    pub(crate) fn take_pre_solve(&mut self) -> Option<crate::narrowphase::PreSolveFn> {
+        self.pre_solve.take()
+    }
+
+    /// Every field copied but the pre-solve hook (a snapshot's world).
+    pub(crate) fn copy_state(&self) -> World {
+        World {
+            gravity: self.gravity,
+            settings: self.settings.clone(),
+            bodies: self.bodies.clone(),
+            joints: self.joints.clone(),
+            collision: self.collision.clone(),
+            contact_solver: self.contact_solver.clone(),
+            object_masses: self.object_masses.clone(),
+            portals: self.portals.clone(),
+            islands: self.islands.clone(),
+            continuous: self.continuous.clone(),
+            hit_event_threshold: self.hit_event_threshold,
+            pre_solve: None,
+            sleep_settings: self.sleep_settings,
+            wake_list: self.wake_list.clone(),
+            events: self.events.clone(),
+            step_profile: self.step_profile.clone(),
+            counters: self.counters,
+            step_count: self.step_count,
+        }
     }
 
     /// Force the joint applied to its body b over the last solved step, N
@@ -757,6 +830,7 @@ impl World {
         let ty = self.bodies.body_type(body).unwrap_or(BodyType::Static);
         def.validate()?;
         geometry.validate()?;
+        check_shape_mass(&geometry, def.density)?;
         let mass_override = self
             .bodies
             .record(body)
@@ -844,6 +918,16 @@ impl World {
                 rotational_inertia: mass.mass * 1e-3,
                 ..mass
             }
+        };
+        // Mass from shapes is clamped into the stated ranges (a tiny
+        // density must not give an infinite inverse mass).
+        let mass = BodyMass {
+            mass: janus2d_core::limits::clamp_to(mass.mass, janus2d_core::limits::MASS_RANGE),
+            rotational_inertia: janus2d_core::limits::clamp_to(
+                mass.rotational_inertia,
+                janus2d_core::limits::INERTIA_RANGE,
+            ),
+            center: mass.center,
         };
         self.bodies.apply_mass(body, mass, fixed);
     }
@@ -1208,6 +1292,10 @@ impl World {
         if !(vec_is_finite(target.p) && target.q.is_finite()) {
             return Err(WorldError::NonFinite("target"));
         }
+        janus2d_core::body::check_position(target.p, "target")?;
+        if target.q.c == 0.0 && target.q.s == 0.0 {
+            return Err(WorldError::OutOfRange("target"));
+        }
         if !(dt.is_finite() && dt > 0.0) {
             return Err(WorldError::InvalidTimeStep);
         }
@@ -1228,6 +1316,8 @@ impl World {
         } else {
             delta / dt
         };
+        janus2d_core::body::check_velocity(v, "target")?;
+        janus2d_core::body::check_angular_velocity(w, "target")?;
         self.wake_body(body);
         if let Some(s) = self.bodies.state_mut(body) {
             s.v = v;
@@ -1298,9 +1388,26 @@ impl World {
 
     // ----- stepping ---------------------------------------------------------
 
-    /// The step context the solver uses for a step of `dt`.
+    /// The step context the solver uses for a step of `dt`: the contact
+    /// and iterative joint stiffness are capped at a quarter of the
+    /// substep rate ([`MAX_HERTZ_FRACTION`](janus2d_core::limits::MAX_HERTZ_FRACTION),
+    /// as Box2D caps its contact hertz): a stiffer soft row cannot be
+    /// resolved by the substeps (and `1e30` Hz would give no softness).
     pub fn step_context(&self, dt: Real) -> StepContext {
-        self.settings.context(dt, self.gravity)
+        let substeps = match self.settings.mode {
+            janus2d_core::SolverMode::SoftStep => self.settings.substeps.max(1),
+            janus2d_core::SolverMode::PgsBaumgarte => 1,
+        };
+        let cap = janus2d_core::limits::MAX_HERTZ_FRACTION * substeps as Real / dt;
+        if self.settings.contact_hertz <= cap && self.settings.joint_hertz <= cap {
+            return self.settings.context(dt, self.gravity);
+        }
+        let capped = SolverSettings {
+            contact_hertz: self.settings.contact_hertz.min(cap),
+            joint_hertz: self.settings.joint_hertz.min(cap),
+            ..self.settings.clone()
+        };
+        capped.context(dt, self.gravity)
     }
 
     /// Advances the world by `dt` seconds (finite, > 0).
@@ -1380,7 +1487,14 @@ impl World {
         };
         let mut batches: [&mut dyn ConstraintBatch; 3] =
             [&mut revolute, &mut contacts, self.portals.constraints_mut()];
-        let report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
+        let mut report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
+        // The solver checks velocities and deltas; a pose they carried out
+        // of the world (or to inf) is put back here, before any box is
+        // computed from it.
+        self.bodies.reset_escaped(
+            2.0 * janus2d_core::limits::MAX_COORDINATE,
+            &mut report.non_finite,
+        );
         lap();
         if has_shapes {
             let c = &self.collision;
@@ -1457,6 +1571,25 @@ impl World {
     ) {
         let island_of = |body| self.islands.island_id(body);
         crate::debug_draw::draw_world(self, &island_of, draw, options);
+    }
+
+    /// The world-level part of [`World::validate`]: gravity and settings
+    /// within their limits, the contact solver's colours adding up.
+    pub(crate) fn check_world_values(&self) -> Result<(), String> {
+        check_gravity(self.gravity).map_err(|e| e.to_string())?;
+        check_settings(&self.settings).map_err(|e| e.to_string())?;
+        self.sleep_settings.validate().map_err(|e| e.to_string())?;
+        let coloured: usize = (0..janus2d_core::graph::COLOURS as u8)
+            .map(|k| self.contact_solver.count_in(k))
+            .sum::<usize>()
+            + self.contact_solver.overflow().len();
+        if coloured != self.contact_solver.len() {
+            return Err(format!(
+                "{coloured} contacts in colours, {} in the solver",
+                self.contact_solver.len()
+            ));
+        }
+        Ok(())
     }
 
     /// A hash of every body's transform and velocity bits, in handle order:
@@ -1558,4 +1691,113 @@ impl World {
     pub(crate) fn collision_ref(&self) -> &Collision {
         &self.collision
     }
+}
+
+/// Gravity: finite, its length at most
+/// [`MAX_GRAVITY`](janus2d_core::limits::MAX_GRAVITY).
+fn check_gravity(gravity: Vec2) -> Result<(), WorldError> {
+    if !vec_is_finite(gravity) {
+        return Err(WorldError::NonFinite("gravity"));
+    }
+    let max = janus2d_core::limits::MAX_GRAVITY;
+    if gravity.x.abs() > max || gravity.y.abs() > max || gravity.length() > max {
+        return Err(WorldError::OutOfBounds {
+            field: "gravity",
+            min: 0.0,
+            max,
+        });
+    }
+    Ok(())
+}
+
+/// Solver settings: [`SolverSettings::validate`], then every real finite
+/// (`inf` Hz or an infinite damping ratio give NaN softness) and the
+/// damping ratios at most
+/// [`MAX_DAMPING_RATIO`](janus2d_core::limits::MAX_DAMPING_RATIO).
+pub(crate) fn check_settings(s: &SolverSettings) -> Result<(), WorldError> {
+    s.validate()?;
+    let reals = [
+        (s.baumgarte, "baumgarte"),
+        (s.contact_hertz, "contact_hertz"),
+        (s.contact_damping_ratio, "contact_damping_ratio"),
+        (s.contact_push_max_velocity, "contact_push_max_velocity"),
+        (s.joint_hertz, "joint_hertz"),
+        (s.joint_damping_ratio, "joint_damping_ratio"),
+        (s.joint_max_correction_speed, "joint_max_correction_speed"),
+        (s.restitution_threshold, "restitution_threshold"),
+        (s.contact_mass_ratio_cap, "contact_mass_ratio_cap"),
+        (s.joint_mass_ratio_cap, "joint_mass_ratio_cap"),
+        (s.direct_joint_hertz, "direct_joint_hertz"),
+        (
+            s.direct_joint_max_correction_speed,
+            "direct_joint_max_correction_speed",
+        ),
+    ];
+    for (v, name) in reals {
+        if !v.is_finite() {
+            return Err(WorldError::NonFinite(name));
+        }
+    }
+    let max = janus2d_core::limits::MAX_DAMPING_RATIO;
+    for (v, name) in [
+        (s.contact_damping_ratio, "contact_damping_ratio"),
+        (s.joint_damping_ratio, "joint_damping_ratio"),
+    ] {
+        if v > max {
+            return Err(WorldError::OutOfBounds {
+                field: name,
+                min: 0.0,
+                max,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The mass a shape adds at `density` must be at most the largest body
+/// mass, [`MASS_RANGE`](janus2d_core::limits::MASS_RANGE)`.1` (a radius of
+/// 1e6 m at a density of 1e38 overflows); the error names `density` and
+/// the largest density this shape may have. Within the extent limit the
+/// inertia is then finite (at most about 1e29 kg·m²).
+pub(crate) fn check_shape_mass(geometry: &Shape, density: Real) -> Result<(), WorldError> {
+    let area = geometry.area();
+    if density <= 0.0 || area <= 0.0 {
+        return Ok(());
+    }
+    let md = geometry.compute_mass(density);
+    let (_, max_mass) = janus2d_core::limits::MASS_RANGE;
+    if !(md.mass.is_finite() && md.mass <= max_mass && md.rotational_inertia.is_finite()) {
+        return Err(WorldError::OutOfBounds {
+            field: "density",
+            min: 0.0,
+            max: max_mass / area,
+        });
+    }
+    Ok(())
+}
+
+/// A force or torque whose sum for the step would not be finite.
+fn accumulated(field: &'static str) -> WorldError {
+    WorldError::OutOfBounds {
+        field,
+        min: -Real::MAX,
+        max: Real::MAX,
+    }
+}
+
+/// The velocity an impulse gives must stay within
+/// [`MAX_SPEED`](janus2d_core::limits::MAX_SPEED) and
+/// [`MAX_ANGULAR_SPEED`](janus2d_core::limits::MAX_ANGULAR_SPEED); the
+/// error names `impulse` and the speed limit.
+fn check_resulting_velocity(v: Vec2, w: Real) -> Result<(), WorldError> {
+    let to_impulse = |e: janus2d_core::body::BodyError| match e {
+        janus2d_core::body::BodyError::OutOfBounds { min, max, .. } => WorldError::OutOfBounds {
+            field: "impulse",
+            min,
+            max,
+        },
+        _ => WorldError::NonFinite("impulse"),
+    };
+    janus2d_core::body::check_velocity(v, "impulse").map_err(to_impulse)?;
+    janus2d_core::body::check_angular_velocity(w, "impulse").map_err(to_impulse)
 }

@@ -58,6 +58,20 @@ pub enum GeometryError {
     },
     /// A segment, capsule core or chain link is shorter than [`WELD_DISTANCE`].
     DegenerateSegment,
+    /// A coordinate or radius beyond `max` (the stated shape extent,
+    /// [`MAX_EXTENT`](crate::limits::MAX_EXTENT)), m.
+    ExtentTooLarge {
+        /// The limit, m.
+        max: Real,
+    },
+    /// A hand-built polygon whose normal of edge `edge` is not the unit
+    /// outward normal of that edge (within 1e-3).
+    BadNormal {
+        /// The edge index.
+        edge: usize,
+    },
+    /// A hand-built polygon whose `centroid` lies outside its core.
+    CentroidOutside,
 }
 
 impl fmt::Display for GeometryError {
@@ -78,6 +92,19 @@ impl fmt::Display for GeometryError {
             GeometryError::DegenerateSegment => {
                 write!(f, "segment is shorter than the weld distance")
             }
+            GeometryError::ExtentTooLarge { max } => {
+                write!(
+                    f,
+                    "a coordinate or radius exceeds the shape extent {max:e} m"
+                )
+            }
+            GeometryError::BadNormal { edge } => {
+                write!(
+                    f,
+                    "normal {edge} is not the unit outward normal of its edge"
+                )
+            }
+            GeometryError::CentroidOutside => write!(f, "polygon centroid lies outside it"),
         }
     }
 }
@@ -624,6 +651,12 @@ fn remove_collinear(hull: &mut Vec<Vec2>) {
     }
 }
 
+/// True when `n` is the unit vector `expected` within 1e-3 (a hand-built
+/// polygon's normals are checked against its edges).
+fn normal_matches(n: Vec2, expected: Vec2) -> bool {
+    (n - expected).length() <= 1e-3
+}
+
 /// Any collision shape, in its body's local frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[allow(clippy::large_enum_variant)] // a Box would add an indirection to every collision
@@ -643,8 +676,58 @@ pub enum Shape {
 impl Shape {
     /// Checks a shape given by its public fields (a hand-built literal as
     /// much as a constructed one): finite coordinates, positive radii, and
-    /// a polygon that is convex, counter-clockwise and has area.
+    /// a polygon that is convex, counter-clockwise and has area, with unit
+    /// outward normals and its centroid inside; a capsule core longer than
+    /// [`WELD_DISTANCE`]; every coordinate and radius within
+    /// [`MAX_EXTENT`](crate::limits::MAX_EXTENT).
     pub fn validate(&self) -> Result<(), GeometryError> {
+        self.validate_form(WELD_DISTANCE)?;
+        self.validate_extent()
+    }
+
+    /// [`validate`](Self::validate) for a shape the engine scaled (a portal
+    /// clone's copy): segment, chain and capsule cores need only a
+    /// non-zero length, since a valid core scaled by `η < 1` may be
+    /// shorter than [`WELD_DISTANCE`].
+    pub fn validate_scaled(&self) -> Result<(), GeometryError> {
+        self.validate_form(0.0)?;
+        self.validate_extent()
+    }
+
+    fn validate_extent(&self) -> Result<(), GeometryError> {
+        let max = crate::limits::MAX_EXTENT;
+        let small = |v: Real| v.abs() <= max;
+        let ok = match self {
+            Shape::Circle(c) => small(c.center.x) && small(c.center.y) && small(c.radius),
+            Shape::Capsule(c) => {
+                [c.center1, c.center2]
+                    .iter()
+                    .all(|p| small(p.x) && small(p.y))
+                    && small(c.radius)
+            }
+            Shape::Segment(s) => [s.point1, s.point2]
+                .iter()
+                .all(|p| small(p.x) && small(p.y)),
+            Shape::ChainSegment(c) => [c.ghost1, c.segment.point1, c.segment.point2, c.ghost2]
+                .iter()
+                .all(|p| small(p.x) && small(p.y)),
+            Shape::Polygon(p) => {
+                p.vertices[..p.count]
+                    .iter()
+                    .all(|v| small(v.x) && small(v.y))
+                    && small(p.radius)
+            }
+        };
+        if ok {
+            Ok(())
+        } else {
+            Err(GeometryError::ExtentTooLarge { max })
+        }
+    }
+
+    /// The checks of [`validate`](Self::validate) but the extent, with
+    /// cores longer than `min_core`.
+    fn validate_form(&self, min_core: Real) -> Result<(), GeometryError> {
         use GeometryError as E;
         let finite = |pts: &[Vec2]| pts.iter().all(|p| vec_is_finite(*p));
         match self {
@@ -663,12 +746,15 @@ impl Shape {
                 if c.radius <= 0.0 {
                     return Err(E::NonPositiveRadius);
                 }
+                if (c.center2 - c.center1).length() <= min_core {
+                    return Err(E::DegenerateSegment);
+                }
             }
             Shape::Segment(s) => {
                 if !finite(&[s.point1, s.point2]) {
                     return Err(E::NonFinite);
                 }
-                if (s.point2 - s.point1).length() <= WELD_DISTANCE {
+                if (s.point2 - s.point1).length() <= min_core {
                     return Err(E::DegenerateSegment);
                 }
             }
@@ -676,7 +762,7 @@ impl Shape {
                 if !finite(&[c.ghost1, c.segment.point1, c.segment.point2, c.ghost2]) {
                     return Err(E::NonFinite);
                 }
-                if (c.segment.point2 - c.segment.point1).length() <= WELD_DISTANCE {
+                if (c.segment.point2 - c.segment.point1).length() <= min_core {
                     return Err(E::DegenerateSegment);
                 }
             }
@@ -685,16 +771,31 @@ impl Shape {
                 if n > MAX_POLYGON_VERTICES {
                     return Err(E::TooManyVertices { count: n });
                 }
-                if !finite(&p.vertices[..n]) || !finite(&p.normals[..n]) || !p.radius.is_finite() {
+                if !finite(&p.vertices[..n])
+                    || !finite(&p.normals[..n])
+                    || !p.radius.is_finite()
+                    || !vec_is_finite(p.centroid)
+                {
                     return Err(E::NonFinite);
                 }
                 if p.radius < 0.0 {
                     return Err(E::NegativeRadius);
                 }
                 if n == 2 {
-                    // A capsule core: needs a radius and a length.
+                    // A capsule core: needs a radius, a length and the two
+                    // opposite side normals.
                     if p.radius <= 0.0 {
                         return Err(E::NonPositiveRadius);
+                    }
+                    let edge = p.vertices[1] - p.vertices[0];
+                    if edge.length() <= min_core {
+                        return Err(E::DegenerateSegment);
+                    }
+                    let side = right_perp(edge.normalize());
+                    for (k, expected) in [(0, side), (1, -side)] {
+                        if !normal_matches(p.normals[k], expected) {
+                            return Err(E::BadNormal { edge: k });
+                        }
                     }
                     return Ok(());
                 }
@@ -704,7 +805,11 @@ impl Shape {
                         needed: 3,
                     });
                 }
+                // Twice the area, about the first vertex (not the origin:
+                // a small polygon far from its body origin would lose the
+                // area to rounding).
                 let mut area2 = 0.0;
+                let o = p.vertices[0];
                 for i in 0..n {
                     let a = p.vertices[i];
                     let b = p.vertices[(i + 1) % n];
@@ -712,10 +817,35 @@ impl Shape {
                     if cross(b - a, c - b) <= 0.0 {
                         return Err(E::DegeneratePolygon);
                     }
-                    area2 += cross(a, b);
+                    area2 += cross(a - o, b - o);
                 }
                 if area2 <= 0.0 {
                     return Err(E::DegeneratePolygon);
+                }
+                for i in 0..n {
+                    let edge = p.vertices[(i + 1) % n] - p.vertices[i];
+                    let len = edge.length();
+                    if len <= EPSILON {
+                        return Err(E::DegeneratePolygon);
+                    }
+                    if !normal_matches(p.normals[i], right_perp(edge / len)) {
+                        return Err(E::BadNormal { edge: i });
+                    }
+                }
+                // The centroid (the centre of mass) lies inside the core,
+                // with a tolerance of the weld distance plus the rounding of
+                // coordinates this large (a sliver far out has its centroid
+                // on an edge to within a few ulps).
+                let scale = p.vertices[..n]
+                    .iter()
+                    .fold(p.centroid.abs().max_element(), |m, v| {
+                        m.max(v.abs().max_element())
+                    });
+                let tolerance = WELD_DISTANCE + 16.0 * EPSILON * scale;
+                for i in 0..n {
+                    if p.normals[i].dot(p.centroid - p.vertices[i]) > tolerance {
+                        return Err(E::CentroidOutside);
+                    }
                 }
             }
         }

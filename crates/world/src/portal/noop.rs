@@ -36,6 +36,9 @@ impl PortalStage {
     pub(crate) fn involves(&self, _body: BodyHandle) -> bool {
         false
     }
+    pub(crate) fn check(&self, _bodies: &BodySet) -> Result<(), String> {
+        Ok(())
+    }
     pub(crate) fn object_masses(&self, _bodies: &BodySet, out: &mut Vec<ObjectMass>) {
         out.clear();
     }

@@ -362,6 +362,60 @@ impl PortalStage {
                 .any(|(_, d)| d.portals.iter().any(|p| p.body == body))
     }
 
+    /// Checks pairs ↔ crossings ↔ clones ↔ constraints (for
+    /// `World::validate`): portal bodies live, η finite and positive, one
+    /// constraint per crossing naming its two copies and portal bodies,
+    /// copies live, distinct and in no other crossing.
+    pub(crate) fn check(&self, bodies: &BodySet) -> Result<(), String> {
+        for (index, d) in self.pairs.iter() {
+            if !(d.eta.is_finite() && d.eta > 0.0) {
+                return Err(format!("pair {index}: eta {}", d.eta));
+            }
+            if let Some(p) = d.portals.iter().find(|p| !bodies.contains(p.body)) {
+                return Err(format!(
+                    "pair {index}: portal body {:?} is not live",
+                    p.body
+                ));
+            }
+        }
+        if self.crossings.len() != self.constraints.len() {
+            return Err(format!(
+                "{} crossings, {} constraints",
+                self.crossings.len(),
+                self.constraints.len()
+            ));
+        }
+        for (k, (c, pc)) in self.crossings.iter().zip(&self.constraints).enumerate() {
+            if self.pairs.at(c.pair).is_none() {
+                return Err(format!("crossing {k}: its pair is gone"));
+            }
+            if c.original == c.clone || !bodies.contains(c.original) || !bodies.contains(c.clone) {
+                return Err(format!(
+                    "crossing {k}: copies {:?}, {:?}",
+                    c.original, c.clone
+                ));
+            }
+            let def = pc.def();
+            if def.body != c.original || def.clone != c.clone {
+                return Err(format!("crossing {k}: its constraint names other bodies"));
+            }
+            let (entry, exit) = self.portal_bodies(c);
+            if def.portal_body_a != entry || def.portal_body_b != exit {
+                return Err(format!(
+                    "crossing {k}: its constraint names other portal bodies"
+                ));
+            }
+            let shared = self.crossings[k + 1..].iter().any(|o| {
+                [o.original, o.clone].contains(&c.original)
+                    || [o.original, o.clone].contains(&c.clone)
+            });
+            if shared {
+                return Err(format!("crossing {k}: a copy is in another crossing"));
+            }
+        }
+        Ok(())
+    }
+
     pub(crate) fn crossing_of(&self, body: BodyHandle) -> Option<usize> {
         self.crossings
             .iter()
@@ -390,7 +444,9 @@ impl World {
     /// Creates a linked pair of portals.
     ///
     /// Rejects stale body handles, non-finite values, a zero direction, a
-    /// non-positive half-width and `η ≤ 0`.
+    /// non-positive half-width, `η ≤ 0` and an `η` outside
+    /// [`ETA_RANGE`](janus2d_core::limits::ETA_RANGE); a body that is
+    /// crossing a portal ([`WorldError::PortalBody`]).
     pub fn create_portal_pair(
         &mut self,
         def: &PortalPairDef,
@@ -404,6 +460,11 @@ impl World {
                     WorldError::ForeignHandle
                 });
             }
+            // A copy in a crossing may be destroyed by the stage at any
+            // step: it cannot carry a portal.
+            if self.portals.crossing_of(p.body).is_some() {
+                return Err(WorldError::PortalBody);
+            }
             local.push(
                 Portal::new(p.anchor, p.direction, p.half_width)
                     .map_err(WorldError::Portal)?
@@ -413,6 +474,14 @@ impl World {
         let local = [local[0], local[1]];
         let eta = def.eta.unwrap_or(local[1].half_width / local[0].half_width);
         janus2d_constraints::portal_map::validate_eta(eta).map_err(WorldError::Portal)?;
+        let (lo, hi) = janus2d_core::limits::ETA_RANGE;
+        if !(lo..=hi).contains(&eta) {
+            return Err(WorldError::OutOfBounds {
+                field: "eta",
+                min: lo,
+                max: hi,
+            });
+        }
         let data = PairData {
             portals: [def.portal_a, def.portal_b],
             local,

@@ -1,0 +1,96 @@
+//! The stated finite ranges of every value the API accepts.
+//!
+//! A value outside its range is a typed error naming the field and the
+//! limit (`OutOfBounds { field, min, max }`), never a silent clamp, with
+//! one exception: mass properties *computed from shapes* are clamped into
+//! [`MASS_RANGE`] and [`INERTIA_RANGE`] (a directly given mass is checked).
+//! The ranges are far beyond anything a simulation needs; they exist so
+//! that no sum, product or inverse the engine forms can overflow.
+//!
+//! | limit                   | value              | applies to                                             |
+//! |-------------------------|--------------------|--------------------------------------------------------|
+//! | [`MAX_COORDINATE`]      | 1e9 m              | body positions, teleports, targets; a pose beyond twice it after a step is reset and reported |
+//! | [`MAX_EXTENT`]          | 1e7 m              | shape coordinates and radii (body frame)               |
+//! | [`MASS_RANGE`]          | 1e-12 … 1e15 kg    | the mass of a dynamic body                             |
+//! | [`INERTIA_RANGE`]       | 1e-20 … 1e25 kg·m² | the rotational inertia of a dynamic, rotating body     |
+//! | [`MAX_SPEED`]           | 1e9 m/s            | velocities given, `max_linear_speed`                    |
+//! | [`MAX_ANGULAR_SPEED`]   | 1e9 rad/s          | angular velocities given                               |
+//! | [`MAX_GRAVITY`]         | 1e6 m/s²           | the length of world gravity                            |
+//! | [`MAX_GRAVITY_SCALE`]   | 1e6                | the magnitude of a body's gravity scale                |
+//! | [`MAX_DAMPING_RATIO`]   | 1e4                | contact and joint damping ratios                        |
+//! | [`MAX_FRICTION`]        | 1e6                | a shape's friction coefficient                         |
+//! | [`MAX_RESTITUTION`]     | 1e3                | a shape's restitution                                  |
+//! | [`ETA_RANGE`]           | 1e-3 … 1e3         | a portal pair's scale η (a clone's mass goes as η², its inertia as η⁴) |
+//! | [`MAX_HERTZ_FRACTION`]  | 0.25               | contact and iterative joint stiffness are capped at this fraction of the substep rate, as Box2D caps them |
+
+use crate::math::Real;
+
+/// Largest magnitude of a body coordinate, m (1e9).
+pub const MAX_COORDINATE: Real = 1e9;
+
+/// Largest magnitude of a shape coordinate or radius in its body's frame,
+/// m (1e7).
+pub const MAX_EXTENT: Real = 1e7;
+
+/// Allowed mass of a dynamic body, kg: `[1e-12, 1e15]`.
+pub const MASS_RANGE: (Real, Real) = (1e-12, 1e15);
+
+/// Allowed rotational inertia of a dynamic rotating body, kg·m²:
+/// `[1e-20, 1e25]`.
+pub const INERTIA_RANGE: (Real, Real) = (1e-20, 1e25);
+
+/// Largest linear speed a body may be given (and largest
+/// `max_linear_speed`), m/s (1e9).
+pub const MAX_SPEED: Real = 1e9;
+
+/// Largest angular speed a body may be given, rad/s (1e9).
+pub const MAX_ANGULAR_SPEED: Real = 1e9;
+
+/// Largest length of world gravity, m/s² (1e6).
+pub const MAX_GRAVITY: Real = 1e6;
+
+/// Largest magnitude of a body's gravity scale (1e6).
+pub const MAX_GRAVITY_SCALE: Real = 1e6;
+
+/// Largest contact or joint damping ratio (1e4).
+pub const MAX_DAMPING_RATIO: Real = 1e4;
+
+/// Largest friction coefficient of a shape (1e6: the friction impulse
+/// bound `μ λ_n` must stay finite).
+pub const MAX_FRICTION: Real = 1e6;
+
+/// Largest restitution of a shape (1e3).
+pub const MAX_RESTITUTION: Real = 1e3;
+
+/// Allowed scale η of a portal pair: `[1e-3, 1e3]`.
+pub const ETA_RANGE: (Real, Real) = (1e-3, 1e3);
+
+/// Contact stiffness and iterative joint stiffness are capped at this
+/// fraction of the substep rate `1 / h` (0.25, as Box2D caps
+/// `contactHertz`): stiffer soft rows cannot be resolved by the substeps.
+pub const MAX_HERTZ_FRACTION: Real = 0.25;
+
+/// True when `v` is finite and `|v| ≤ max`.
+#[inline]
+#[must_use]
+pub fn within(v: Real, max: Real) -> bool {
+    v.is_finite() && v.abs() <= max
+}
+
+/// True when `v` is finite and in `[range.0, range.1]`.
+#[inline]
+#[must_use]
+pub fn in_range(v: Real, range: (Real, Real)) -> bool {
+    v.is_finite() && v >= range.0 && v <= range.1
+}
+
+/// `v` clamped into `range` (NaN gives the lower end).
+#[inline]
+#[must_use]
+pub fn clamp_to(v: Real, range: (Real, Real)) -> Real {
+    if v.is_nan() {
+        range.0
+    } else {
+        v.clamp(range.0, range.1)
+    }
+}

@@ -1,0 +1,522 @@
+//! The API as a state machine: random sequences of every mutating call,
+//! valid and invalid values mixed (NaN, ±inf, 1e30, −0.0, zero and negative
+//! sizes, degenerate polygons, stale and foreign handles, η ≤ 0, coincident
+//! portals). After every operation: no panic; an `Err` left the world
+//! unchanged (state hash and counts); [`World::validate`] passes (which
+//! includes every stored number being finite).
+//!
+//! CI runs 48 cases of up to 48 operations, each from one of three
+//! starting worlds (a ground box, the portal drop, a small pyramid). A longer run:
+//!
+//! ```text
+//! JANUS_STATE_MACHINE_CASES=5000 cargo test --release --test api_state_machine
+//! ```
+#![cfg(feature = "portals")]
+
+use janus2d::prelude::*;
+use janus2d::world::{PortalDef, PortalPairDef, PortalPairHandle, SleepSettings};
+use proptest::prelude::*;
+
+/// A real: mostly ordinary, often special.
+fn real() -> impl Strategy<Value = Real> {
+    prop_oneof![
+        6 => -10.0 as Real..10.0,
+        1 => Just(Real::NAN),
+        1 => Just(Real::INFINITY),
+        1 => Just(Real::NEG_INFINITY),
+        1 => Just(1e30 as Real),
+        1 => Just(-1e30 as Real),
+        1 => Just(-0.0 as Real),
+        1 => Just(0.0 as Real),
+        1 => Just(-1.0 as Real),
+        1 => Just(1e-40 as Real),
+        1 => Just(1e9 as Real),
+    ]
+}
+
+/// A positive size, sometimes bad.
+fn size() -> impl Strategy<Value = Real> {
+    prop_oneof![6 => 0.05 as Real..2.0, 2 => real()]
+}
+
+fn vec2() -> impl Strategy<Value = Vec2> {
+    (real(), real()).prop_map(|(x, y)| Vec2::new(x, y))
+}
+
+/// A mostly sane position (so that things meet), sometimes anything.
+fn place() -> impl Strategy<Value = Vec2> {
+    prop_oneof![
+        5 => (-4.0 as Real..4.0, -1.0 as Real..6.0).prop_map(|(x, y)| Vec2::new(x, y)),
+        1 => vec2(),
+    ]
+}
+
+#[derive(Clone, Debug)]
+enum Geometry {
+    Circle(Vec2, Real),
+    Box(Real, Real),
+    Capsule(Vec2, Vec2, Real),
+    Hull(Vec<Vec2>, Real),
+    Segment(Vec2, Vec2),
+    InwardBox(Real),
+}
+
+fn geometry() -> impl Strategy<Value = Geometry> {
+    prop_oneof![
+        (place(), size()).prop_map(|(c, r)| Geometry::Circle(c * 0.1, r)),
+        (size(), size()).prop_map(|(a, b)| Geometry::Box(a, b)),
+        (place(), place(), size()).prop_map(|(a, b, r)| Geometry::Capsule(a * 0.2, b * 0.2, r)),
+        (proptest::collection::vec(place(), 0..10), size())
+            .prop_map(|(p, r)| Geometry::Hull(p.iter().map(|v| *v * 0.3).collect(), r * 0.1)),
+        (place(), place()).prop_map(|(a, b)| Geometry::Segment(a, b)),
+        size().prop_map(Geometry::InwardBox),
+    ]
+}
+
+#[derive(Clone, Debug)]
+enum Op {
+    CreateBody {
+        ty: u8,
+        position: Vec2,
+        velocity: Vec2,
+        w: Real,
+        mass: Option<(Real, Real)>,
+        awake: bool,
+        bullet: bool,
+    },
+    DestroyBody(usize),
+    CreateShape {
+        body: usize,
+        geometry: Geometry,
+        density: Real,
+        friction: Real,
+        sensor: bool,
+    },
+    DestroyShape(usize),
+    CreateJoint {
+        a: usize,
+        b: usize,
+        anchor: Vec2,
+        limits: Option<(Real, Real)>,
+        collide: bool,
+    },
+    DestroyJoint(usize),
+    CreatePortalPair {
+        a: usize,
+        b: usize,
+        anchor: Vec2,
+        half_width: Real,
+        eta: Option<Real>,
+        coincident: bool,
+    },
+    DestroyPortalPair(usize),
+    SetVelocity(usize, Vec2, Real),
+    SetTransform(usize, Vec2, Real),
+    SetMass(usize, Real, Real),
+    SetBodyType(usize, u8),
+    Force(usize, Vec2),
+    Impulse(usize, Vec2, Vec2),
+    Torque(usize, Real),
+    Settings {
+        hertz: Real,
+        damping: Real,
+        substeps: u32,
+    },
+    Gravity(Vec2),
+    Sleep {
+        enabled: bool,
+        threshold: Real,
+        time: Real,
+    },
+    Step(Real),
+    /// Thirty steps of 1/60 s (bodies fall, touch, cross portals, sleep).
+    StepMany,
+    Snapshot,
+    Restore,
+}
+
+fn op() -> impl Strategy<Value = Op> {
+    let pick = || 0usize..64;
+    prop_oneof![
+        4 => (0u8..3, place(), prop_oneof![3 => Just(Vec2::ZERO), 1 => vec2()], real(),
+              proptest::option::weighted(0.3, (real(), real())), any::<bool>(), any::<bool>())
+            .prop_map(|(ty, position, velocity, w, mass, awake, bullet)| Op::CreateBody {
+                ty, position, velocity, w, mass, awake: awake || ty == 0, bullet,
+            }),
+        1 => pick().prop_map(Op::DestroyBody),
+        4 => (pick(), geometry(), prop_oneof![3 => Just(1.0 as Real), 1 => real()], prop_oneof![3 => Just(0.6 as Real), 1 => real()], proptest::bool::weighted(0.1))
+            .prop_map(|(body, geometry, density, friction, sensor)| Op::CreateShape { body, geometry, density, friction, sensor }),
+        1 => pick().prop_map(Op::DestroyShape),
+        2 => (pick(), pick(), place(), proptest::option::weighted(0.3, (real(), real())), any::<bool>())
+            .prop_map(|(a, b, anchor, limits, collide)| Op::CreateJoint { a, b, anchor, limits, collide }),
+        1 => pick().prop_map(Op::DestroyJoint),
+        1 => (pick(), pick(), place(), size(), proptest::option::weighted(0.5, real()), proptest::bool::weighted(0.2))
+            .prop_map(|(a, b, anchor, half_width, eta, coincident)| Op::CreatePortalPair { a, b, anchor, half_width, eta, coincident }),
+        1 => pick().prop_map(Op::DestroyPortalPair),
+        2 => (pick(), vec2(), real()).prop_map(|(b, v, w)| Op::SetVelocity(b, v, w)),
+        1 => (pick(), place(), real()).prop_map(|(b, p, a)| Op::SetTransform(b, p, a)),
+        1 => (pick(), real(), real()).prop_map(|(b, m, i)| Op::SetMass(b, m, i)),
+        1 => (pick(), 0u8..3).prop_map(|(b, t)| Op::SetBodyType(b, t)),
+        1 => (pick(), vec2()).prop_map(|(b, f)| Op::Force(b, f)),
+        1 => (pick(), vec2(), place()).prop_map(|(b, i, p)| Op::Impulse(b, i, p)),
+        1 => (pick(), real()).prop_map(|(b, t)| Op::Torque(b, t)),
+        1 => (prop_oneof![3 => Just(30.0 as Real), 1 => real()], prop_oneof![3 => Just(10.0 as Real), 1 => real()], prop_oneof![3 => Just(4u32), 1 => 0u32..12])
+            .prop_map(|(hertz, damping, substeps)| Op::Settings { hertz, damping, substeps }),
+        1 => prop_oneof![3 => Just(Vec2::new(0.0, -10.0)), 1 => vec2()].prop_map(Op::Gravity),
+        1 => (any::<bool>(), prop_oneof![2 => Just(0.05 as Real), 1 => real()], prop_oneof![2 => Just(0.5 as Real), 1 => real()])
+            .prop_map(|(enabled, threshold, time)| Op::Sleep { enabled, threshold, time }),
+        8 => prop_oneof![6 => Just(1.0 as Real / 60.0), 1 => Just(1.0 as Real / 240.0), 1 => Just(0.1 as Real), 1 => real()].prop_map(Op::Step),
+        2 => Just(Op::StepMany),
+        1 => Just(Op::Snapshot),
+        1 => Just(Op::Restore),
+    ]
+}
+
+/// Everything the test issued: live and stale handles alike, and a few
+/// handles of another world.
+struct Issued {
+    bodies: Vec<BodyHandle>,
+    shapes: Vec<ShapeHandle>,
+    joints: Vec<JointHandle>,
+    pairs: Vec<PortalPairHandle>,
+    foreign_body: BodyHandle,
+    foreign_shape: ShapeHandle,
+    foreign_joint: JointHandle,
+}
+
+fn pick<T: Copy>(list: &[T], k: usize, foreign: T) -> T {
+    if list.is_empty() || k % 16 == 15 {
+        foreign
+    } else {
+        list[k % list.len()]
+    }
+}
+
+fn fingerprint(w: &World) -> (u64, usize, usize, usize, usize, usize, usize) {
+    (
+        w.state_hash(),
+        w.body_count(),
+        w.shape_count(),
+        w.joint_count(),
+        w.contact_count(),
+        w.sleeping_body_count(),
+        w.portal_pair_count(),
+    )
+}
+
+fn body_type(t: u8) -> BodyType {
+    match t % 3 {
+        0 => BodyType::Static,
+        1 => BodyType::Kinematic,
+        _ => BodyType::Dynamic,
+    }
+}
+
+fn shape_of(g: &Geometry) -> Option<Shape> {
+    Some(match g {
+        Geometry::Circle(c, r) => Shape::Circle(Circle {
+            center: *c,
+            radius: *r,
+        }),
+        Geometry::Box(a, b) => Shape::Polygon(Polygon::try_make_box(*a, *b).ok()?),
+        Geometry::Capsule(a, b, r) => Shape::Capsule(Capsule {
+            center1: *a,
+            center2: *b,
+            radius: *r,
+        }),
+        Geometry::Hull(p, r) => Shape::Polygon(Polygon::from_hull(p, *r).ok()?),
+        Geometry::Segment(a, b) => Shape::Segment(Segment {
+            point1: *a,
+            point2: *b,
+        }),
+        Geometry::InwardBox(h) => {
+            let mut p = Polygon::try_make_box(*h, *h).ok()?;
+            for n in p.normals.iter_mut() {
+                *n = -*n;
+            }
+            Shape::Polygon(p)
+        }
+    })
+}
+
+fn apply(
+    w: &mut World,
+    issued: &mut Issued,
+    saved: &mut Option<janus2d::world::Snapshot>,
+    op: &Op,
+) -> Result<(), WorldError> {
+    let fb = issued.foreign_body;
+    let body = |k: usize, i: &Issued| pick(&i.bodies, k, fb);
+    match op {
+        Op::CreateBody {
+            ty,
+            position,
+            velocity,
+            w: aw,
+            mass,
+            awake,
+            bullet,
+        } => {
+            let def = BodyDef {
+                body_type: body_type(*ty),
+                position: *position,
+                linear_velocity: *velocity,
+                angular_velocity: *aw,
+                mass: mass.map(|(m, i)| BodyMass::new(m, i)),
+                awake: *awake,
+                bullet: *bullet,
+                ..BodyDef::default()
+            };
+            let h = w.create_body(&def)?;
+            issued.bodies.push(h);
+            Ok(())
+        }
+        Op::DestroyBody(k) => w.destroy_body(body(*k, issued)),
+        Op::CreateShape {
+            body: k,
+            geometry,
+            density,
+            friction,
+            sensor,
+        } => {
+            let def = ShapeDef {
+                density: *density,
+                friction: *friction,
+                is_sensor: *sensor,
+                ..ShapeDef::default()
+            };
+            let Some(shape) = shape_of(geometry) else {
+                return Err(WorldError::OutOfRange("constructor refused"));
+            };
+            let h = w.create_shape(body(*k, issued), &def, shape)?;
+            issued.shapes.push(h);
+            Ok(())
+        }
+        Op::DestroyShape(k) => w.destroy_shape(pick(&issued.shapes, *k, issued.foreign_shape)),
+        Op::CreateJoint {
+            a,
+            b,
+            anchor,
+            limits,
+            collide,
+        } => {
+            let mut def =
+                RevoluteJointDef::new(body(*a, issued), body(*b, issued), *anchor, -*anchor);
+            def.collide_connected = *collide;
+            if let Some((lo, hi)) = limits {
+                def = def.with_limits(*lo, *hi);
+            }
+            let h = w.create_revolute_joint(&def)?;
+            issued.joints.push(h);
+            Ok(())
+        }
+        Op::DestroyJoint(k) => w.destroy_joint(pick(&issued.joints, *k, issued.foreign_joint)),
+        Op::CreatePortalPair {
+            a,
+            b,
+            anchor,
+            half_width,
+            eta,
+            coincident,
+        } => {
+            let pa = PortalDef {
+                body: body(*a, issued),
+                anchor: *anchor,
+                direction: Vec2::new(0.0, 1.0),
+                half_width: *half_width,
+            };
+            let pb = if *coincident {
+                pa
+            } else {
+                PortalDef {
+                    body: body(*b, issued),
+                    anchor: -*anchor,
+                    direction: Vec2::new(1.0, 0.0),
+                    half_width: 1.0,
+                }
+            };
+            let mut def = PortalPairDef::new(pa, pb);
+            def.eta = *eta;
+            let h = w.create_portal_pair(&def)?;
+            issued.pairs.push(h);
+            Ok(())
+        }
+        Op::DestroyPortalPair(k) => match issued.pairs.get(*k % issued.pairs.len().max(1)) {
+            Some(p) => w.destroy_portal_pair(*p),
+            None => Err(WorldError::StalePortal),
+        },
+        Op::SetVelocity(k, v, aw) => {
+            let b = body(*k, issued);
+            if k % 2 == 0 {
+                w.set_linear_velocity(b, *v)
+            } else {
+                w.set_angular_velocity(b, *aw)
+            }
+        }
+        Op::SetTransform(k, p, a) => w.set_transform(body(*k, issued), *p, *a),
+        Op::SetMass(k, m, i) => w.set_mass(body(*k, issued), BodyMass::new(*m, *i)),
+        Op::SetBodyType(k, t) => w.set_body_type(body(*k, issued), body_type(*t)),
+        Op::Force(k, f) => w.apply_force_to_center(body(*k, issued), *f),
+        Op::Impulse(k, i, p) => w.apply_linear_impulse(body(*k, issued), *i, *p),
+        Op::Torque(k, t) => w.apply_torque(body(*k, issued), *t),
+        Op::Settings {
+            hertz,
+            damping,
+            substeps,
+        } => w.set_settings(SolverSettings {
+            contact_hertz: *hertz,
+            contact_damping_ratio: *damping,
+            substeps: *substeps,
+            ..SolverSettings::default()
+        }),
+        Op::Gravity(g) => w.set_gravity(*g),
+        Op::Sleep {
+            enabled,
+            threshold,
+            time,
+        } => w.set_sleep_settings(SleepSettings {
+            enabled: *enabled,
+            linear_threshold: *threshold,
+            time_to_sleep: *time,
+        }),
+        Op::Step(dt) => w.step(*dt),
+        Op::StepMany => {
+            for _ in 0..30 {
+                w.step(1.0 / 60.0)?;
+            }
+            Ok(())
+        }
+        Op::Snapshot => {
+            *saved = Some(w.snapshot());
+            Ok(())
+        }
+        Op::Restore => {
+            if let Some(s) = saved {
+                w.restore(s);
+            }
+            Ok(())
+        }
+    }
+}
+
+fn cases() -> u32 {
+    std::env::var("JANUS_STATE_MACHINE_CASES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(48)
+}
+
+/// Operations run and accepted, over every case (printed at the end).
+static RAN: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+static ACCEPTED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+static STEPS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// The world a case starts from: a ground box, the portal drop scene, or
+/// a small pyramid (with their bodies among the issued handles).
+fn start(scene: u8) -> World {
+    let def = janus2d_testbed::scenes::shared_settings();
+    match scene % 3 {
+        0 => {
+            let mut world = World::new(WorldDef::default()).unwrap();
+            let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+            world
+                .create_shape(ground, &ShapeDef::default(), Polygon::make_box(8.0, 0.5))
+                .unwrap();
+            world
+        }
+        1 => janus2d_testbed::scenes::portal_drop(&def).0.world,
+        _ => janus2d_testbed::scenes::large_pyramid(&def, 4).world,
+    }
+}
+
+fn run(scene: u8, ops: &[Op]) -> Result<(), TestCaseError> {
+    use std::sync::atomic::Ordering::Relaxed;
+    let mut other = World::new(WorldDef::default()).unwrap();
+    let fb = other.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    let fb2 = other.create_body(&BodyDef::dynamic(Vec2::ONE)).unwrap();
+    let fs = other
+        .create_shape(
+            fb,
+            &ShapeDef::default(),
+            Circle::new(Vec2::ZERO, 0.5).unwrap(),
+        )
+        .unwrap();
+    let fj = other
+        .create_revolute_joint(&RevoluteJointDef::new(fb, fb2, Vec2::ZERO, Vec2::ZERO))
+        .unwrap();
+    let mut issued = Issued {
+        bodies: Vec::new(),
+        shapes: Vec::new(),
+        joints: Vec::new(),
+        pairs: Vec::new(),
+        foreign_body: fb,
+        foreign_shape: fs,
+        foreign_joint: fj,
+    };
+    let mut world = start(scene);
+    issued.bodies.extend(world.body_handles());
+    for b in issued.bodies.clone() {
+        issued.shapes.extend(world.body_shapes(b).unwrap());
+    }
+    issued.joints.extend(world.joint_handles().iter().copied());
+    issued.pairs.extend(world.portal_pairs().map(|(h, _)| h));
+    let mut saved = None;
+    for (i, op) in ops.iter().enumerate() {
+        let before = fingerprint(&world);
+        let result = apply(&mut world, &mut issued, &mut saved, op);
+        RAN.fetch_add(1, Relaxed);
+        if result.is_ok() {
+            ACCEPTED.fetch_add(1, Relaxed);
+            if matches!(op, Op::Step(_)) {
+                STEPS.fetch_add(1, Relaxed);
+            }
+        }
+        if let Err(e) = &result {
+            prop_assert_eq!(
+                fingerprint(&world),
+                before,
+                "op {} {:?} failed with {:?} and changed the world",
+                i,
+                op,
+                e
+            );
+        }
+        if let Err(e) = world.validate() {
+            return Err(TestCaseError::fail(format!(
+                "after op {i} {op:?} ({result:?}): {e}"
+            )));
+        }
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: cases(),
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    })]
+
+    /// Random API sequences never panic, never change the world on an
+    /// error, and always leave a valid world.
+    #[test]
+    fn api_sequences_keep_the_world_valid(
+        scene in 0u8..3,
+        ops in proptest::collection::vec(op(), 1..48),
+    ) {
+        run(scene, &ops)?;
+    }
+}
+
+/// Runs after the property (alphabetical order is not guaranteed, so it
+/// only reports): the operation counts of this process.
+#[test]
+fn z_report_counts() {
+    use std::sync::atomic::Ordering::Relaxed;
+    eprintln!(
+        "state machine: {} operations, {} accepted, {} steps",
+        RAN.load(Relaxed),
+        ACCEPTED.load(Relaxed),
+        STEPS.load(Relaxed)
+    );
+}

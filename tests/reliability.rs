@@ -1,0 +1,588 @@
+//! Regression tests of issue 14's findings: each is named after what it
+//! guards. Every rejected call leaves the world unchanged (state hash,
+//! counts) and [`World::validate`] passes after every call.
+
+use janus2d::base::body::BodyError;
+use janus2d::base::geometry::GeometryError;
+use janus2d::base::limits;
+use janus2d::prelude::*;
+use janus2d::world::SleepSettings;
+
+const DT: Real = 1.0 / 60.0;
+
+fn ground_and_box() -> (World, BodyHandle, BodyHandle) {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    world
+        .create_shape(ground, &ShapeDef::default(), Polygon::make_box(10.0, 0.5))
+        .unwrap();
+    let b = world
+        .create_body(&BodyDef::dynamic(Vec2::new(0.0, 2.0)))
+        .unwrap();
+    world
+        .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    world.step(DT).unwrap();
+    (world, ground, b)
+}
+
+/// Runs `f` (which must fail) and checks nothing changed.
+fn unchanged(
+    world: &mut World,
+    f: impl FnOnce(&mut World) -> Result<(), WorldError>,
+) -> WorldError {
+    let before = (
+        world.state_hash(),
+        world.body_count(),
+        world.shape_count(),
+        world.joint_count(),
+        world.sleeping_body_count(),
+    );
+    let err = f(world).expect_err("the call must be refused");
+    let after = (
+        world.state_hash(),
+        world.body_count(),
+        world.shape_count(),
+        world.joint_count(),
+        world.sleeping_body_count(),
+    );
+    assert_eq!(before, after, "refused call {err:?} changed the world");
+    world.validate().unwrap();
+    err
+}
+
+fn out_of_bounds(field: &'static str) -> impl Fn(&WorldError) -> bool {
+    move |e| match e {
+        WorldError::OutOfBounds { field: f, .. } => *f == field,
+        WorldError::Body(BodyError::OutOfBounds { field: f, .. }) => *f == field,
+        _ => false,
+    }
+}
+
+#[test]
+fn huge_finite_shape_coordinates_never_reach_the_broadphase() {
+    let (mut world, ground, b) = ground_and_box();
+    let far = Vec2::new(3e38, 3e38);
+    let e = unchanged(&mut world, |w| {
+        let c = Capsule {
+            center1: far,
+            center2: far + Vec2::new(1e37, 0.0),
+            radius: 1.0,
+        };
+        w.create_shape(b, &ShapeDef::default(), c).map(|_| ())
+    });
+    assert_eq!(
+        e,
+        WorldError::Geometry(GeometryError::ExtentTooLarge {
+            max: limits::MAX_EXTENT
+        })
+    );
+    let e = unchanged(&mut world, |w| {
+        w.create_shape(
+            ground,
+            &ShapeDef::default(),
+            Circle::new(Vec2::ZERO, 1e20).unwrap(),
+        )
+        .map(|_| ())
+    });
+    assert!(matches!(
+        e,
+        WorldError::Geometry(GeometryError::ExtentTooLarge { .. })
+    ));
+    let e = unchanged(&mut world, |w| {
+        w.create_body(&BodyDef::dynamic(far)).map(|_| ())
+    });
+    assert!(out_of_bounds("position")(&e), "{e:?}");
+    let e = unchanged(&mut world, |w| w.set_transform(b, far, 0.0));
+    assert!(out_of_bounds("transform")(&e), "{e:?}");
+    let e = unchanged(&mut world, |w| {
+        w.set_target_transform(b, Transform::new(far, 0.0), DT)
+    });
+    assert!(out_of_bounds("target")(&e), "{e:?}");
+    // At the limits themselves everything is accepted, steps and validates.
+    let edge = Vec2::splat(limits::MAX_COORDINATE);
+    let e_body = world.create_body(&BodyDef::fixed(edge)).unwrap();
+    world
+        .create_shape(
+            e_body,
+            &ShapeDef::default(),
+            Circle::new(Vec2::ZERO, limits::MAX_EXTENT).unwrap(),
+        )
+        .unwrap();
+    let d_body = world.create_body(&BodyDef::dynamic(-edge)).unwrap();
+    world
+        .create_shape(
+            d_body,
+            &ShapeDef::default(),
+            Circle::new(Vec2::ZERO, 1.0).unwrap(),
+        )
+        .unwrap();
+    for _ in 0..3 {
+        world.step(DT).unwrap();
+        world.validate().unwrap();
+    }
+}
+
+#[test]
+fn a_pose_carried_out_of_the_world_is_reset_and_reported() {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let start = Vec2::new(limits::MAX_COORDINATE, 0.0);
+    let k = world
+        .create_body(&BodyDef::kinematic(start).with_velocity(Vec2::new(limits::MAX_SPEED, 0.0)))
+        .unwrap();
+    world
+        .create_shape(
+            k,
+            &ShapeDef::default(),
+            Circle::new(Vec2::ZERO, 1.0).unwrap(),
+        )
+        .unwrap();
+    let mut reported = None;
+    for step in 0..1000 {
+        let before = world.position(k).unwrap();
+        world.step(DT).unwrap();
+        world.validate().unwrap();
+        if world.events().non_finite_bodies.contains(&k) {
+            reported = Some(step);
+            // Put back where the step started, at rest.
+            assert_eq!(world.position(k).unwrap(), before);
+            assert_eq!(world.linear_velocity(k).unwrap(), Vec2::ZERO);
+            break;
+        }
+    }
+    let step = reported.expect("the body leaving the world is reported");
+    // 1e9 m more at 1e9 m/s: after about 60 steps.
+    assert!((55..=65).contains(&step), "reported at step {step}");
+}
+
+#[test]
+fn a_step_of_huge_dt_keeps_every_number_finite() {
+    let (mut world, _, b) = ground_and_box();
+    world.step(1e30).unwrap();
+    world.validate().unwrap();
+    let p = world.position(b).unwrap();
+    assert!(p.is_finite() && p.x.abs() <= 2.0 * limits::MAX_COORDINATE);
+    assert!(p.y.abs() <= 2.0 * limits::MAX_COORDINATE, "{p:?}");
+    world.step(DT).unwrap();
+    world.validate().unwrap();
+}
+
+#[cfg(feature = "portals")]
+#[test]
+fn destroying_a_clone_cancels_its_crossing_and_leaves_a_valid_world() {
+    let def = janus2d_testbed::scenes::shared_settings();
+    let (mut scene, _) = janus2d_testbed::scenes::portal_drop(&def);
+    let world = &mut scene.world;
+    let mut crossing = None;
+    for _ in 0..600 {
+        world.step(DT).unwrap();
+        crossing = world
+            .body_handles()
+            .find_map(|b| world.clone_of(b).map(|c| (b, c)));
+        if crossing.is_some() {
+            break;
+        }
+    }
+    let (original, clone) = crossing.expect("a body starts a crossing");
+    let bodies = world.body_count();
+    assert_eq!(world.destroy_body(clone), Ok(()));
+    assert_eq!(world.body_count(), bodies - 1);
+    assert_eq!(world.position(clone), Err(WorldError::StaleBody));
+    assert!(world.position(original).is_ok());
+    assert_eq!(world.clone_of(original), None);
+    world.validate().unwrap();
+    // A second destroy of the same handle is a clean error.
+    let e = unchanged(world, |w| w.destroy_body(clone));
+    assert_eq!(e, WorldError::StaleBody);
+    for _ in 0..30 {
+        world.step(DT).unwrap();
+        world.validate().unwrap();
+    }
+}
+
+#[test]
+fn degenerate_masses_and_inertias_are_refused() {
+    let (mut world, _, b) = ground_and_box();
+    let e = unchanged(&mut world, |w| {
+        w.create_body(&BodyDef::dynamic(Vec2::ZERO).with_mass(1e-40, 1.0))
+            .map(|_| ())
+    });
+    assert!(out_of_bounds("mass")(&e), "{e:?}");
+    let e = unchanged(&mut world, |w| {
+        w.create_body(&BodyDef::dynamic(Vec2::ZERO).with_mass(1.0, 1e-42))
+            .map(|_| ())
+    });
+    assert!(out_of_bounds("rotational_inertia")(&e), "{e:?}");
+    let e = unchanged(&mut world, |w| w.set_mass(b, BodyMass::new(1e30, 1.0)));
+    assert!(out_of_bounds("mass")(&e), "{e:?}");
+    // The limits themselves are accepted.
+    let (lo, _) = limits::MASS_RANGE;
+    let (ilo, _) = limits::INERTIA_RANGE;
+    world.set_mass(b, BodyMass::new(lo, ilo)).unwrap();
+    world.step(DT).unwrap();
+    world.validate().unwrap();
+}
+
+#[test]
+fn a_shape_whose_mass_overflows_is_refused() {
+    let (mut world, _, b) = ground_and_box();
+    let e = unchanged(&mut world, |w| {
+        let def = ShapeDef {
+            density: 1e38,
+            ..ShapeDef::default()
+        };
+        w.create_shape(b, &def, Circle::new(Vec2::ZERO, 1e6).unwrap())
+            .map(|_| ())
+    });
+    assert!(out_of_bounds("density")(&e), "{e:?}");
+    let s = world.body_shapes(b).unwrap()[0];
+    let e = unchanged(&mut world, |w| w.set_shape_density(s, 1e38));
+    assert!(
+        out_of_bounds("density")(&e) || out_of_bounds("rotational_inertia")(&e),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn a_tiny_density_gives_a_clamped_finite_mass_and_the_body_falls() {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let b = world
+        .create_body(&BodyDef::dynamic(Vec2::new(0.0, 5.0)))
+        .unwrap();
+    let def = ShapeDef {
+        density: 1e-40,
+        ..ShapeDef::default()
+    };
+    world
+        .create_shape(b, &def, Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    assert_eq!(world.mass(b).unwrap(), limits::MASS_RANGE.0);
+    for _ in 0..30 {
+        world.step(DT).unwrap();
+    }
+    world.validate().unwrap();
+    assert!(world.position(b).unwrap().y < 4.0);
+    assert!(!world.is_sleeping(b));
+}
+
+#[test]
+fn infinite_contact_stiffness_or_damping_is_refused() {
+    let (mut world, _, _) = ground_and_box();
+    for (s, name) in [
+        (
+            SolverSettings {
+                contact_hertz: Real::INFINITY,
+                ..SolverSettings::default()
+            },
+            "contact_hertz",
+        ),
+        (
+            SolverSettings {
+                contact_damping_ratio: Real::INFINITY,
+                ..SolverSettings::default()
+            },
+            "contact_damping_ratio",
+        ),
+        (
+            SolverSettings {
+                joint_hertz: Real::INFINITY,
+                ..SolverSettings::default()
+            },
+            "joint_hertz",
+        ),
+    ] {
+        let e = unchanged(&mut world, |w| w.set_settings(s.clone()));
+        assert_eq!(e, WorldError::NonFinite(name));
+        assert!(
+            World::new(WorldDef {
+                solver: s,
+                ..WorldDef::default()
+            })
+            .is_err()
+        );
+    }
+    let e = unchanged(&mut world, |w| {
+        w.set_settings(SolverSettings {
+            contact_damping_ratio: 1e30,
+            ..SolverSettings::default()
+        })
+    });
+    assert!(out_of_bounds("contact_damping_ratio")(&e), "{e:?}");
+}
+
+#[test]
+fn contact_stiffness_above_a_quarter_of_the_substep_rate_is_capped() {
+    let stack = |hertz: Real| {
+        let mut world = World::new(WorldDef {
+            solver: SolverSettings {
+                contact_hertz: hertz,
+                ..SolverSettings::default()
+            },
+            ..WorldDef::default()
+        })
+        .unwrap();
+        let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+        world
+            .create_shape(ground, &ShapeDef::default(), Polygon::make_box(10.0, 0.5))
+            .unwrap();
+        let mut top = ground;
+        for i in 0..3 {
+            top = world
+                .create_body(&BodyDef::dynamic(Vec2::new(0.0, 1.0 + i as Real)))
+                .unwrap();
+            world
+                .create_shape(top, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+                .unwrap();
+        }
+        for _ in 0..120 {
+            world.step(DT).unwrap();
+        }
+        world.validate().unwrap();
+        (world.step_context(DT), world.position(top).unwrap().y)
+    };
+    // 4 substeps at 60 Hz: 240 Hz, a quarter is 60 Hz.
+    let (capped, y_huge) = stack(1e30);
+    let (at_cap, y_cap) = stack(60.0);
+    assert_eq!(capped.contact_softness, at_cap.contact_softness);
+    assert_eq!(capped.static_softness, at_cap.static_softness);
+    assert_eq!(y_huge, y_cap);
+    // The stack stands (it sank 0.36 m before the cap).
+    assert!((y_huge - 3.0).abs() < 0.02, "top at {y_huge}");
+}
+
+#[test]
+fn negative_time_to_sleep_is_refused() {
+    let (mut world, _, _) = ground_and_box();
+    let bad = SleepSettings {
+        time_to_sleep: -1.0,
+        ..SleepSettings::default()
+    };
+    let e = unchanged(&mut world, |w| w.set_sleep_settings(bad));
+    assert_eq!(e, WorldError::OutOfRange("time_to_sleep"));
+    assert!(
+        World::new(WorldDef {
+            sleep: bad,
+            ..WorldDef::default()
+        })
+        .is_err()
+    );
+}
+
+#[test]
+fn huge_gravity_is_refused_and_the_largest_allowed_moves_bodies() {
+    let (mut world, _, _) = ground_and_box();
+    let e = unchanged(&mut world, |w| w.set_gravity(Vec2::new(0.0, -1e22)));
+    assert!(out_of_bounds("gravity")(&e), "{e:?}");
+    assert!(
+        World::new(WorldDef {
+            gravity: Vec2::new(1e22, 0.0),
+            ..WorldDef::default()
+        })
+        .is_err()
+    );
+    let mut world = World::new(WorldDef {
+        gravity: Vec2::new(0.0, -limits::MAX_GRAVITY),
+        ..WorldDef::default()
+    })
+    .unwrap();
+    let b = world
+        .create_body(&BodyDef {
+            max_linear_speed: limits::MAX_SPEED,
+            ..BodyDef::dynamic(Vec2::ZERO)
+        })
+        .unwrap();
+    world.step(DT).unwrap();
+    // v = g dt exactly in the first step (no cap reached, not zeroed).
+    let v = world.linear_velocity(b).unwrap().y;
+    assert!(
+        (v + limits::MAX_GRAVITY * DT).abs() < 1e-3 * limits::MAX_GRAVITY * DT,
+        "v = {v}"
+    );
+}
+
+#[test]
+fn hand_built_polygon_with_inward_normals_is_refused() {
+    let (mut world, _, b) = ground_and_box();
+    let mut p = Polygon::make_box(0.5, 0.5);
+    for k in 0..p.count {
+        p.normals[k] = -p.normals[k];
+    }
+    let e = unchanged(&mut world, |w| {
+        w.create_shape(b, &ShapeDef::default(), p).map(|_| ())
+    });
+    assert_eq!(
+        e,
+        WorldError::Geometry(GeometryError::BadNormal { edge: 0 })
+    );
+    let mut p = Polygon::make_box(0.5, 0.5);
+    p.centroid = Vec2::new(5.0, 0.0);
+    let e = unchanged(&mut world, |w| {
+        w.create_shape(b, &ShapeDef::default(), p).map(|_| ())
+    });
+    assert_eq!(e, WorldError::Geometry(GeometryError::CentroidOutside));
+}
+
+#[test]
+fn zero_length_capsule_literal_is_refused() {
+    let (mut world, _, b) = ground_and_box();
+    let c = Capsule {
+        center1: Vec2::ZERO,
+        center2: Vec2::ZERO,
+        radius: 0.5,
+    };
+    let e = unchanged(&mut world, |w| {
+        w.create_shape(b, &ShapeDef::default(), c).map(|_| ())
+    });
+    assert_eq!(e, WorldError::Geometry(GeometryError::DegenerateSegment));
+    let core = Polygon::make_capsule(Vec2::ZERO, Vec2::ZERO, 0.5);
+    let e = unchanged(&mut world, |w| {
+        w.create_shape(b, &ShapeDef::default(), core).map(|_| ())
+    });
+    assert_eq!(e, WorldError::Geometry(GeometryError::DegenerateSegment));
+}
+
+#[test]
+fn kinematic_body_created_asleep_with_a_velocity_moves() {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let k = world
+        .create_body(&BodyDef {
+            awake: false,
+            ..BodyDef::kinematic(Vec2::ZERO).with_velocity(Vec2::new(1.0, 0.0))
+        })
+        .unwrap();
+    world
+        .create_shape(k, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    for _ in 0..60 {
+        world.step(DT).unwrap();
+    }
+    assert!(!world.is_sleeping(k));
+    assert!((world.position(k).unwrap().x - 1.0).abs() < 1e-4);
+    // Without a velocity, `awake: false` still creates it asleep.
+    let still = world
+        .create_body(&BodyDef {
+            awake: false,
+            ..BodyDef::kinematic(Vec2::ZERO)
+        })
+        .unwrap();
+    world.step(DT).unwrap();
+    assert!(world.is_sleeping(still));
+    world.validate().unwrap();
+}
+
+/// An API call under test.
+type Call = Box<dyn Fn(&mut World) -> Result<(), WorldError>>;
+
+#[test]
+fn velocity_and_force_calls_on_static_bodies_are_refused() {
+    let (mut world, ground, _) = ground_and_box();
+    let one = Vec2::new(1.0, 0.0);
+    let cases: [(&str, Call, WorldError); 7] = [
+        (
+            "linear velocity",
+            Box::new(move |w| w.set_linear_velocity(ground, one)),
+            WorldError::NotMovable,
+        ),
+        (
+            "angular velocity",
+            Box::new(move |w| w.set_angular_velocity(ground, 1.0)),
+            WorldError::NotMovable,
+        ),
+        (
+            "force",
+            Box::new(move |w| w.apply_force(ground, one, Vec2::ZERO)),
+            WorldError::NotDynamic,
+        ),
+        (
+            "force at centre",
+            Box::new(move |w| w.apply_force_to_center(ground, one)),
+            WorldError::NotDynamic,
+        ),
+        (
+            "torque",
+            Box::new(move |w| w.apply_torque(ground, 1.0)),
+            WorldError::NotDynamic,
+        ),
+        (
+            "impulse",
+            Box::new(move |w| w.apply_linear_impulse(ground, one, Vec2::ZERO)),
+            WorldError::NotDynamic,
+        ),
+        (
+            "angular impulse",
+            Box::new(move |w| w.apply_angular_impulse(ground, 1.0)),
+            WorldError::NotDynamic,
+        ),
+    ];
+    for (what, call, expected) in cases {
+        let e = unchanged(&mut world, |w| call(w));
+        assert_eq!(e, expected, "{what}");
+    }
+    // Forces on a kinematic body do nothing: refused too.
+    let k = world.create_body(&BodyDef::kinematic(Vec2::ZERO)).unwrap();
+    let e = unchanged(&mut world, |w| w.apply_force_to_center(k, one));
+    assert_eq!(e, WorldError::NotDynamic);
+    world.set_linear_velocity(k, one).unwrap();
+}
+
+#[test]
+fn huge_velocities_are_refused_with_the_limit() {
+    let (mut world, _, b) = ground_and_box();
+    let e = unchanged(&mut world, |w| {
+        w.set_linear_velocity(b, Vec2::new(1e30, 0.0))
+    });
+    assert_eq!(
+        e,
+        WorldError::Body(BodyError::OutOfBounds {
+            field: "linear_velocity",
+            min: -limits::MAX_SPEED,
+            max: limits::MAX_SPEED
+        })
+    );
+    let e = unchanged(&mut world, |w| w.set_angular_velocity(b, -1e30));
+    assert!(out_of_bounds("angular_velocity")(&e), "{e:?}");
+    let e = unchanged(&mut world, |w| {
+        w.create_body(&BodyDef {
+            max_linear_speed: 1e30,
+            ..BodyDef::dynamic(Vec2::ZERO)
+        })
+        .map(|_| ())
+    });
+    assert!(out_of_bounds("max_linear_speed")(&e), "{e:?}");
+    assert!(e.to_string().contains("1e9"), "{e}");
+}
+
+/// Found by the `hull` fuzz target: a thin hull 3 km from its body origin
+/// lost its area to rounding in `validate` (which summed cross products
+/// about the origin) and was refused although `from_hull` built it.
+#[test]
+fn a_hull_far_from_the_body_origin_passes_validation() {
+    let points = [
+        Vec2::new(3156.3293, 3156.3293),
+        Vec2::new(3157.9607, 3156.3293),
+        Vec2::new(3156.3293, 3156.3591),
+    ];
+    let p = Polygon::from_hull(&points, 0.0).unwrap();
+    assert_eq!(Shape::Polygon(p).validate(), Ok(()));
+    let far = [
+        Vec2::new(-413252.72, -411206.25),
+        Vec2::new(-411206.25, -411206.25),
+        Vec2::new(0.0, -411200.0),
+    ];
+    let p = Polygon::from_hull(&far, 0.0).unwrap();
+    assert_eq!(Shape::Polygon(p).validate(), Ok(()));
+}
+
+/// Found by the `hull` fuzz target: a sliver reaching 2e5 m has its
+/// centroid on its long edges to within the rounding of such coordinates;
+/// `validate` allows for that rounding.
+#[test]
+fn a_far_reaching_sliver_hull_passes_validation() {
+    let points = [
+        Vec2::new(-0.024015777, -0.022949569),
+        Vec2::new(0.0, -0.023925781),
+        Vec2::new(131362.94, 205089.13),
+    ];
+    let p = Polygon::from_hull(&points, 0.0).unwrap();
+    assert_eq!(Shape::Polygon(p).validate(), Ok(()));
+}
