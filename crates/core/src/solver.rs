@@ -39,6 +39,16 @@ pub const DEFAULT_CONTACT_MASS_RATIO_CAP: Real = 1.3;
 /// [`SolverSettings::joint_mass_ratio_cap`].
 pub const DEFAULT_JOINT_MASS_RATIO_CAP: Real = 1.3;
 
+/// Largest contact stiffness as a fraction of the substep rate
+/// (dimensionless, 1/8: 30 Hz at 240 Hz substeps). See
+/// [`SolverSettings::effective_hertz`].
+pub const CONTACT_HERTZ_PER_SUBSTEP_RATE: Real = 0.125;
+
+/// Largest joint stiffness (Gauss–Seidel rows) as a fraction of the
+/// substep rate (dimensionless, 1/4: 60 Hz at 240 Hz substeps). See
+/// [`SolverSettings::effective_hertz`].
+pub const JOINT_HERTZ_PER_SUBSTEP_RATE: Real = 0.25;
+
 /// Default stiffness of the point rows solved directly, Hz (usual 240).
 /// See [`SolverSettings::direct_joint_hertz`].
 pub const DEFAULT_DIRECT_JOINT_HERTZ: Real = 240.0;
@@ -57,13 +67,15 @@ pub struct SolverSettings {
     pub velocity_iterations: u32,
     /// Baumgarte factor β of the PGS baseline (dimensionless), usual 0.2.
     pub baumgarte: Real,
-    /// Contact stiffness, Hz (usual 30).
+    /// Contact stiffness, Hz (usual 30; at most 1/8 of the substep rate is
+    /// used, see [`SolverSettings::effective_hertz`]).
     pub contact_hertz: Real,
     /// Contact damping ratio (usual 10).
     pub contact_damping_ratio: Real,
     /// Maximum contact push-out speed, m/s (usual 3).
     pub contact_push_max_velocity: Real,
-    /// Joint stiffness, Hz (usual 60).
+    /// Joint stiffness, Hz (usual 60; at most 1/4 of the substep rate is
+    /// used, see [`SolverSettings::effective_hertz`]).
     pub joint_hertz: Real,
     /// Joint damping ratio (usual 2).
     pub joint_damping_ratio: Real,
@@ -198,6 +210,34 @@ impl SolverSettings {
         Ok(())
     }
 
+    /// The contact and joint stiffness a substep of `h` seconds solves
+    /// with, Hz: the settings' `contact_hertz` and `joint_hertz`, capped at
+    /// [`CONTACT_HERTZ_PER_SUBSTEP_RATE`] and [`JOINT_HERTZ_PER_SUBSTEP_RATE`]
+    /// of the substep rate `1/h`. At 60 Hz and 4 or more substeps the caps
+    /// (30 and 60 Hz) leave the usual settings as they are; with fewer
+    /// substeps a spring that stiff against one iteration per substep
+    /// overshoots (the base-100 pyramid collapses at 2 substeps with
+    /// 30 Hz contacts and stands with 15 Hz; Box2D softens the same way).
+    ///
+    /// ```
+    /// use janus2d_core::solver::SolverSettings;
+    /// let s = SolverSettings::default();
+    /// assert_eq!(s.effective_hertz(1.0 / 240.0), (30.0, 60.0));
+    /// assert_eq!(s.effective_hertz(1.0 / 120.0), (15.0, 30.0));
+    /// ```
+    #[must_use]
+    pub fn effective_hertz(&self, h: Real) -> (Real, Real) {
+        if h <= 0.0 {
+            return (self.contact_hertz, self.joint_hertz);
+        }
+        let rate = 1.0 / h;
+        (
+            self.contact_hertz
+                .min(CONTACT_HERTZ_PER_SUBSTEP_RATE * rate),
+            self.joint_hertz.min(JOINT_HERTZ_PER_SUBSTEP_RATE * rate),
+        )
+    }
+
     /// Builds the per-step context.
     pub fn context(&self, dt: Real, gravity: Vec2) -> StepContext {
         let (substeps, h) = match self.mode {
@@ -207,11 +247,12 @@ impl SolverSettings {
             }
             SolverMode::PgsBaumgarte => (1, dt),
         };
+        let (contact_hertz, joint_hertz) = self.effective_hertz(h);
         let (joint_softness, contact_softness, static_softness) = match self.mode {
             SolverMode::SoftStep => (
-                Softness::new(self.joint_hertz, self.joint_damping_ratio, h),
-                Softness::new(self.contact_hertz, self.contact_damping_ratio, h),
-                Softness::new(2.0 * self.contact_hertz, self.contact_damping_ratio, h),
+                Softness::new(joint_hertz, self.joint_damping_ratio, h),
+                Softness::new(contact_hertz, self.contact_damping_ratio, h),
+                Softness::new(2.0 * contact_hertz, self.contact_damping_ratio, h),
             ),
             SolverMode::PgsBaumgarte => {
                 let s = Softness::baumgarte(self.baumgarte, dt);
@@ -231,9 +272,9 @@ impl SolverSettings {
             contact_push_max_velocity: self.contact_push_max_velocity,
             joint_max_correction_speed: self.joint_max_correction_speed,
             restitution_threshold: self.restitution_threshold,
-            contact_hertz: self.contact_hertz,
+            contact_hertz,
             contact_damping_ratio: self.contact_damping_ratio,
-            joint_hertz: self.joint_hertz,
+            joint_hertz,
             joint_damping_ratio: self.joint_damping_ratio,
             warm_starting: self.warm_starting,
             mode: self.mode,
