@@ -230,7 +230,8 @@ fn high_mass_ratio_3_big_box_on_small_boxes_box_ground() {
 /// explosion, peak joint gap ≤ 0.1 m [Box2D: 0.24 m].
 ///
 /// The chain is a tree of joints, so its point rows are solved exactly
-/// (`janus2d_constraints::joint_tree`, 240 Hz): measured 0.022 m in f32.
+/// (`janus2d_constraints::joint_tree`, 500 Hz): measured 6 mm in f32
+/// (0.022 m at 240 Hz).
 /// Solved by Gauss–Seidel instead (`direct_joints = false`) the gap is the
 /// soft joint's static deflection `F / (ρ ω² m_eff)` under the ball's pull
 /// through 3 kg links, 0.22 m; `ball_and_chain_gauss_seidel_reference`
@@ -375,4 +376,93 @@ fn hard_cases_by_substeps() {
             );
         }
     }
+}
+
+/// The mass-ratio cases at ratios 10, 100, 1000, 1e4, 1e5: prints each
+/// figure and whether it passes (the bounds are for 1000:1, see the tests
+/// below). Ignored: `cargo test --test hard_cases -- --ignored --nocapture
+/// mass_ratio_sweep`.
+#[test]
+#[ignore = "report: mass-ratio cases over ratios 10 to 1e5"]
+fn mass_ratio_sweep() {
+    for ratio in std::env::var("RATIOS")
+        .ok()
+        .map(|v| {
+            v.split(',')
+                .filter_map(|s| s.parse().ok())
+                .collect::<Vec<f64>>()
+        })
+        .unwrap_or_else(|| vec![10.0, 100.0, 1000.0, 3000.0, 1e4, 3e4, 1e5])
+    {
+        for case in [
+            hard::mass_ratio_stack(ratio),
+            hard::mass_ratio_chain(1, ratio),
+            hard::mass_ratio_chain(20, ratio),
+        ] {
+            let outcome = case.run::<Janus>().unwrap();
+            let f = case.bounds[0].figure();
+            eprintln!(
+                "{:<18} {ratio:>8}: {} {} {:.5}",
+                case.name,
+                if outcome.pass { "pass" } else { "FAIL" },
+                f.name(),
+                outcome.figures.get(f)
+            );
+        }
+    }
+}
+
+/// Pyramid of base 100 at 2 substeps, 10 s: stands (top drifts ≤ 0.5 m,
+/// top speed over the last second ≤ 0.05 m/s) and the top sinks ≤ 3 m
+/// [Box2D v3.1 at 2 substeps: sinks 2.9 m and stands]. The contacts solve at
+/// 1/8 of the substep rate, 15 Hz (`SolverSettings::effective_hertz`); at
+/// 30 Hz the pyramid collapsed (sink 38 m).
+#[test]
+fn large_pyramid_stands_at_2_substeps() {
+    let mut case = hard::large_pyramid();
+    case.desc.settings.substeps = 2;
+    case.bounds = vec![
+        hard::Bound::AtMost(hard::Figure::Sink, 3.0),
+        hard::Bound::AtMost(hard::Figure::Drift, 0.5),
+        hard::Bound::AtMost(hard::Figure::LateProbeSpeed, 0.05),
+    ];
+    assert_case(case);
+}
+
+/// 40 circles with 1 m of error at every joint: every joint back within
+/// 1 cm over the last second of 10 s, and no more speed than the chain
+/// reaches by swinging alone (the whip, 67 m/s + 5%). The tree's
+/// correction is capped at 2 m/s per joint at 500 Hz.
+#[test]
+fn stretched_chain_correction_adds_no_speed() {
+    assert_case(hard::stretched_chain());
+}
+
+/// A bob of 1000:1 on a single light link (1 m, 1 kg), swinging down from
+/// horizontal: both joints within 1 cm over 10 s (500 Hz tree solve:
+/// 3 mm; first fails at 1e4:1, 0.37 m).
+#[test]
+fn mass_ratio_bob_1000_to_1_keeps_joints_within_1_cm() {
+    assert_case(hard::mass_ratio_chain(1, 1000.0));
+}
+
+/// A 1000:1 load at the end of a 20-link chain of light links, swinging
+/// down from horizontal: every joint within 1 cm. Open (issue 15): the
+/// middle joints open to 1.6 m as the chain swings taut; the 20-link
+/// chain already reaches 1.0–1.5 cm at 10:1 and fails intermittently from
+/// 150:1.
+#[test]
+#[ignore = "joints open to 1.6 m at 1000:1 (issue 15)"]
+fn mass_ratio_chain_1000_to_1_keeps_joints_within_1_cm() {
+    assert_case(hard::mass_ratio_chain(20, 1000.0));
+}
+
+/// A light box under a 1000:1 heavy box (0.1 m off centre) on the ground:
+/// the light box moves ≤ 5 cm sideways. Open (issue 15): both soft
+/// contacts give under the load (penetration 29 cm) and the pair tilts,
+/// 8.6 cm; passes up to 500:1 (3.7 cm).
+#[test]
+#[ignore = "the light box moves 8.6 cm at 1000:1 (issue 15)"]
+fn mass_ratio_stack_1000_to_1_light_box_not_squeezed_out() {
+    assert_case(hard::mass_ratio_stack(1000.0));
 }
