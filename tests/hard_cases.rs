@@ -138,12 +138,11 @@ fn vertical_stack_of_15_meets_box2d() {
     );
 }
 
-/// 20 rows must stand at least Box2D's 6.5 s (goal: 60 s). Built as the
-/// spec defines it (x −0.01 on even rows, ground μ 0.6 and half-width 100),
-/// the stack falls at 5.8 s: open in issue 15, so the bound stays and the
-/// test is ignored until the solver meets it.
+/// 20 rows must stand at least Box2D's 6.5 s (goal: 60 s, open). Built as
+/// the spec defines it (x −0.01 on even rows, ground μ 0.6 and half-width
+/// 100). With the manifolds' two normal rows solved as one block the stack
+/// stands 8.3 s (f32; Gauss–Seidel point by point: 4.9 s).
 #[test]
-#[ignore = "falls at 5.8 s < Box2D's 6.5 s as the spec builds it (issue 15)"]
 fn vertical_stack_of_20_meets_box2d() {
     let fell20 = vertical_stack(20, 60);
     if report() {
@@ -205,10 +204,9 @@ fn confined_circles_stay_inside_and_settle() {
 /// Three pyramids of base 10 with 2 m boxes on a segment, heavy single top
 /// boxes (100, 200, 300 times denser, 2 m higher): no box ends more than
 /// 0.5 m sideways, penetration over the last second ≤ 6 cm [Box2D: stands,
-/// 4.4 cm]. Built as the spec defines it, a pyramid gives way: open in
-/// issue 15.
+/// 4.4 cm]. Measured with the block solve of the normal rows: 0.32 m,
+/// 3.8 cm (point by point a pyramid gave way, 1.04 m).
 #[test]
-#[ignore = "a pyramid gives way (a box ends ~1 m sideways) as the spec builds it (issue 15)"]
 fn high_mass_ratio_1_pyramids_hold_heavy_tops() {
     assert_case(hard::high_mass_ratio_1());
 }
@@ -232,7 +230,8 @@ fn high_mass_ratio_3_big_box_on_small_boxes_box_ground() {
 /// explosion, peak joint gap ≤ 0.1 m [Box2D: 0.24 m].
 ///
 /// The chain is a tree of joints, so its point rows are solved exactly
-/// (`janus2d_constraints::joint_tree`, 240 Hz): measured 0.022 m in f32.
+/// (`janus2d_constraints::joint_tree`, 500 Hz): measured 6 mm in f32
+/// (0.022 m at 240 Hz).
 /// Solved by Gauss–Seidel instead (`direct_joints = false`) the gap is the
 /// soft joint's static deflection `F / (ρ ω² m_eff)` under the ball's pull
 /// through 3 kg links, 0.22 m; `ball_and_chain_gauss_seidel_reference`
@@ -320,4 +319,150 @@ fn joint_grid_40_peak_gap() {
             .iter()
             .all(|j| !w.revolute_joint(*j).unwrap().in_tree())
     );
+}
+
+/// Every shared hard case on janus2d at 1, 2, 4 and 8 substeps: prints each
+/// case's bounded figures and whether it passes, and asserts that nothing
+/// goes non-finite. A report, not a bound (the bounds are for 4 substeps);
+/// minutes of work, so ignored: run it with
+/// `cargo test --test hard_cases -- --ignored --nocapture hard_cases_by_substeps`
+/// (`JANUS2D_CASES=a,b` picks cases, `JANUS2D_SUBSTEPS=1,2` substep counts).
+#[test]
+#[ignore = "report: every hard case at 1, 2, 4, 8 substeps (minutes)"]
+fn hard_cases_by_substeps() {
+    let pick = |var: &str| {
+        std::env::var(var)
+            .ok()
+            .map(|s| s.split(',').map(str::to_owned).collect::<Vec<_>>())
+    };
+    let names = pick("JANUS2D_CASES");
+    let substeps: Vec<u32> = pick("JANUS2D_SUBSTEPS")
+        .map(|v| v.iter().filter_map(|s| s.parse().ok()).collect())
+        .unwrap_or_else(|| vec![1, 2, 4, 8]);
+    for mut case in hard::all() {
+        if names
+            .as_ref()
+            .is_some_and(|n| !n.iter().any(|n| n == case.name))
+        {
+            continue;
+        }
+        for &n in &substeps {
+            case.desc.settings.substeps = n;
+            let outcome = case.run::<Janus>().unwrap();
+            let figures: Vec<String> = case
+                .bounds
+                .iter()
+                .map(|b| {
+                    format!(
+                        "{} {:.4}",
+                        b.figure().name(),
+                        outcome.figures.get(b.figure())
+                    )
+                })
+                .collect();
+            eprintln!(
+                "{:<20} {n} substeps: {} {}  (peak speed {:.2} m/s, penetration {:.4} m)",
+                case.name,
+                if outcome.pass { "pass" } else { "FAIL" },
+                figures.join(", "),
+                outcome.figures.get(hard::Figure::PeakSpeed),
+                outcome.figures.get(hard::Figure::Penetration),
+            );
+            assert_eq!(
+                outcome.figures.get(hard::Figure::NonFinite),
+                0.0,
+                "{} at {n}",
+                case.name
+            );
+        }
+    }
+}
+
+/// The mass-ratio cases at ratios 10, 100, 1000, 1e4, 1e5: prints each
+/// figure and whether it passes (the bounds are for 1000:1, see the tests
+/// below). Ignored: `cargo test --test hard_cases -- --ignored --nocapture
+/// mass_ratio_sweep`.
+#[test]
+#[ignore = "report: mass-ratio cases over ratios 10 to 1e5"]
+fn mass_ratio_sweep() {
+    for ratio in std::env::var("RATIOS")
+        .ok()
+        .map(|v| {
+            v.split(',')
+                .filter_map(|s| s.parse().ok())
+                .collect::<Vec<f64>>()
+        })
+        .unwrap_or_else(|| vec![10.0, 100.0, 1000.0, 3000.0, 1e4, 3e4, 1e5])
+    {
+        for case in [
+            hard::mass_ratio_stack(ratio),
+            hard::mass_ratio_chain(1, ratio),
+            hard::mass_ratio_chain(20, ratio),
+        ] {
+            let outcome = case.run::<Janus>().unwrap();
+            let f = case.bounds[0].figure();
+            eprintln!(
+                "{:<18} {ratio:>8}: {} {} {:.5}",
+                case.name,
+                if outcome.pass { "pass" } else { "FAIL" },
+                f.name(),
+                outcome.figures.get(f)
+            );
+        }
+    }
+}
+
+/// Pyramid of base 100 at 2 substeps, 10 s: stands (top drifts ≤ 0.5 m,
+/// top speed over the last second ≤ 0.05 m/s) and the top sinks ≤ 3 m
+/// [Box2D v3.1 at 2 substeps: sinks 2.9 m and stands]. The contacts solve at
+/// 1/8 of the substep rate, 15 Hz (`SolverSettings::effective_hertz`); at
+/// 30 Hz the pyramid collapsed (sink 38 m).
+#[test]
+fn large_pyramid_stands_at_2_substeps() {
+    let mut case = hard::large_pyramid();
+    case.desc.settings.substeps = 2;
+    case.bounds = vec![
+        hard::Bound::AtMost(hard::Figure::Sink, 3.0),
+        hard::Bound::AtMost(hard::Figure::Drift, 0.5),
+        hard::Bound::AtMost(hard::Figure::LateProbeSpeed, 0.05),
+    ];
+    assert_case(case);
+}
+
+/// 40 circles with 1 m of error at every joint: every joint back within
+/// 1 cm over the last second of 10 s, and no more speed than the chain
+/// reaches by swinging alone (the whip, 67 m/s + 5%). The tree's
+/// correction is capped at 2 m/s per joint at 500 Hz.
+#[test]
+fn stretched_chain_correction_adds_no_speed() {
+    assert_case(hard::stretched_chain());
+}
+
+/// A bob of 1000:1 on a single light link (1 m, 1 kg), swinging down from
+/// horizontal: both joints within 1 cm over 10 s (500 Hz tree solve:
+/// 3 mm; first fails at 1e4:1, 0.37 m).
+#[test]
+fn mass_ratio_bob_1000_to_1_keeps_joints_within_1_cm() {
+    assert_case(hard::mass_ratio_chain(1, 1000.0));
+}
+
+/// A 1000:1 load at the end of a 20-link chain of light links, swinging
+/// down from horizontal: every joint within 1 cm. Open (issue 15): the
+/// middle joints open to 1.6 m as the chain swings taut; the 20-link
+/// chain already reaches 1.0–1.5 cm at 10:1 and fails intermittently from
+/// 150:1.
+#[test]
+#[ignore = "joints open to 1.6 m at 1000:1 (issue 15)"]
+fn mass_ratio_chain_1000_to_1_keeps_joints_within_1_cm() {
+    assert_case(hard::mass_ratio_chain(20, 1000.0));
+}
+
+/// A light box under a 1000:1 heavy box (0.1 m off centre) on the ground:
+/// the light box moves ≤ 5 cm sideways. Open (issue 15): both soft
+/// contacts give under the load (penetration 29 cm) and the pair tilts,
+/// 8.6 cm; passes up to 500:1 (3.7 cm).
+#[test]
+#[ignore = "the light box moves 8.6 cm at 1000:1 (issue 15)"]
+fn mass_ratio_stack_1000_to_1_light_box_not_squeezed_out() {
+    assert_case(hard::mass_ratio_stack(1000.0));
 }

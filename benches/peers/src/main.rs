@@ -13,7 +13,7 @@
 //! |-----------|------------------------------------------------------------------------|
 //! | `all`     | per scene and engine: ms/step, ratio to Box2D, touching, awake, bodies, probe pose, bodies outside the container; figures off Box2D's flagged |
 //! | `profile` | per-stage ms/step side by side, averaged over the timed steps          |
-//! | `hard`    | every hard case on every engine, measured by the shared metric code    |
+//! | `hard`    | every hard case on every engine, measured by the shared metric code (`--substeps N`: at N substeps instead of 4) |
 //! | `sweep`   | error against ms/step at 1, 2, 4, 8 substeps, per engine (CSV + SVG)   |
 //! | `chart`   | `chart RUN.csv CHART.svg`: the ratio chart redrawn from an `all --csv` file |
 //!
@@ -48,6 +48,7 @@ struct Args {
     threads: Vec<usize>,
     repeats: usize,
     steps: Option<usize>,
+    substeps: Option<u32>,
     engines: Vec<String>,
     csv: Option<PathBuf>,
     svg: Option<PathBuf>,
@@ -62,6 +63,7 @@ fn parse_args() -> Args {
         threads: vec![1, 2],
         repeats: 2,
         steps: None,
+        substeps: None,
         engines: ENGINES.iter().map(|s| s.to_string()).collect(),
         csv: None,
         svg: None,
@@ -89,6 +91,7 @@ fn parse_args() -> Args {
                 args.repeats = it.next().and_then(|v| v.parse().ok()).expect("--repeats N")
             }
             "--steps" | "-s" => args.steps = it.next().and_then(|v| v.parse().ok()),
+            "--substeps" => args.substeps = it.next().and_then(|v| v.parse().ok()),
             "--scenes" => args.names = list(it.next()),
             "--engines" => args.engines = list(it.next()),
             "--csv" => args.csv = it.next().map(PathBuf::from),
@@ -570,10 +573,19 @@ fn cmd_hard(args: &Args) {
     let cases: Vec<HardCase> = hard::all()
         .into_iter()
         .filter(|c| args.names.is_empty() || args.names.iter().any(|n| n == c.name))
+        .map(|mut c| {
+            if let Some(n) = args.substeps {
+                c.desc.settings.substeps = n;
+            }
+            c
+        })
         .collect();
     let mut passes = vec![0usize; args.engines.len()];
     let mut failed: Vec<Vec<&str>> = vec![Vec::new(); args.engines.len()];
-    println!("hard cases: 4 substeps, 1/60 s, sleep off; one metric code for every engine");
+    println!(
+        "hard cases: {} substeps, 1/60 s, sleep off; one metric code for every engine",
+        args.substeps.unwrap_or(4)
+    );
     for case in &cases {
         println!("\n{} [Box2D v3.1: {}]", case.name, case.box2d);
         for (k, engine) in args.engines.iter().enumerate() {

@@ -16,7 +16,8 @@
 //!            …
 //!            overflow: c9 c40 …
 //!
-//! prepare    lane-wise: K, the mass-ratio softness, the approach speed;
+//! prepare    lane-wise: K (and the normal rows' 2×2 block), the mass-ratio
+//!            softness, the approach speed;
 //!            overflow scalar, then the object-mass hook on it
 //! warm start, solve (bias), relax (no bias), restitution
 //!            colour by colour (solve and relax reversed on alternate
@@ -40,7 +41,7 @@
 use janus2d_core::body::{BodyHandle, BodySet, BodyState};
 use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
 use janus2d_core::math::{Real, Vec2, cross};
-use wide::{CmpEq, CmpGt, CmpLt, CmpNe};
+use wide::{CmpEq, CmpGe, CmpGt, CmpLt, CmpNe};
 
 use crate::contact::{ContactConstraint, ContactPointInput, MAX_MANIFOLD_POINTS, ROWS};
 
@@ -57,6 +58,12 @@ type W = wide::f32x8;
 type W = wide::f64x4;
 
 pub use janus2d_core::graph::COLOURS;
+
+/// Largest condition number `k₀₀² / det K` at which a manifold's two normal
+/// rows are solved as one block (Box2D v2.4's block solver uses the same
+/// bound); above it the points are nearly redundant and Gauss–Seidel takes
+/// them one by one.
+pub const BLOCK_CONDITION: Real = 1000.0;
 use janus2d_core::graph::ColourGraph;
 
 /// A dynamic body that stands for a whole object (a copy crossing a
@@ -119,10 +126,13 @@ struct WideContact {
     jb: [W; ROWS],
     /// Rigid effective mass per row, kg.
     mass: [W; ROWS],
-    /// Soft effective mass per normal row, kg.
-    soft_mass: [W; MAX_MANIFOLD_POINTS],
     /// Soft impulse scale per normal row.
     impulse_scale: [W; MAX_MANIFOLD_POINTS],
+    /// Diagonal `[k₀₀, k₁₁]` of the two normal rows' `K`, 1/kg.
+    block_k: [W; 2],
+    /// Mask: the lane's two normal rows are solved as one block (two
+    /// points and a well-conditioned `K`).
+    block: W,
     /// Separation at zero deltas, m.
     base_separation: [W; MAX_MANIFOLD_POINTS],
     /// Friction coefficient.
@@ -522,8 +532,9 @@ impl WideContact {
             ja: [z; ROWS],
             jb: [z; ROWS],
             mass: [z; ROWS],
-            soft_mass: [z; MAX_MANIFOLD_POINTS],
             impulse_scale: [z; MAX_MANIFOLD_POINTS],
+            block_k: [z; 2],
+            block: z,
             base_separation: [z; MAX_MANIFOLD_POINTS],
             friction: z,
             bias_rate: z,
@@ -599,26 +610,32 @@ impl WideContact {
             let k = k_a + k_b;
             let normal_mass = k.cmp_gt(zero).blend(one / k, zero) * keep[i];
             // Softness::with_mass_ratio on lanes: ρ = min(k / min(k_a, k_b), ρ_max).
-            let (mut mass_scale, mut impulse_scale) =
-                (splat(sc.mass_scale), splat(sc.impulse_scale));
+            // Only the impulse scale is kept: the mass scale is 1 − s_i.
+            let mut impulse_scale = splat(sc.impulse_scale);
             if stiffen {
                 let k_heavy = k_a.fast_min(k_b);
                 let rho = (k / k_heavy).fast_min(splat(rho_max));
                 let stiffer = k_heavy.cmp_gt(zero) & rho.cmp_gt(one);
                 let scaled = one / (one + rho * splat(a2));
                 impulse_scale = stiffer.blend(scaled, impulse_scale);
-                mass_scale = stiffer.blend(one - scaled, mass_scale);
             }
-            let mass_scale = static_pair.blend(splat(ss.mass_scale), mass_scale);
             let impulse_scale = static_pair.blend(splat(ss.impulse_scale), impulse_scale);
             self.mass[i] = normal_mass;
-            self.soft_mass[i] = normal_mass * mass_scale;
             self.impulse_scale[i] = impulse_scale;
             let k_t = m_a + m_b + i_a * rt_a * rt_a + i_b * rt_b * rt_b;
             self.mass[i + 2] = k_t.cmp_gt(zero).blend(one / k_t, zero) * keep[i];
             self.relative_velocity[i] = dvn + (w_b * rn_b - w_a * rn_a);
             self.max_normal_impulse[i] = zero;
         }
+        // The block of the two normal rows: K = [[k00, k01], [k01, k11]].
+        let (ja, jb) = (self.ja, self.jb);
+        let k00 = m_a + m_b + i_a * ja[0] * ja[0] + i_b * jb[0] * jb[0];
+        let k11 = m_a + m_b + i_a * ja[1] * ja[1] + i_b * jb[1] * jb[1];
+        let k01 = m_a + m_b + i_a * ja[0] * ja[1] + i_b * jb[0] * jb[1];
+        let det = k00 * k11 - k01 * k01;
+        let well_conditioned = (k00 * k00).cmp_lt(splat(BLOCK_CONDITION) * det) & det.cmp_gt(zero);
+        self.block = well_conditioned & self.second.cmp_gt(zero);
+        self.block_k = [k00, k11];
         if !ctx.warm_starting {
             self.impulse = [zero; ROWS];
         }
@@ -734,9 +751,31 @@ impl WideContact {
         let k23 = m_sum + (ka2 * ja[3] + kb2 * jb[3]);
 
         let (inv_h, push_max) = (splat(inv_h), splat(push_max));
-        let d0 = self.normal_row::<USE_BIAS>(0, c0, dpn, &a, &b, inv_h, push_max);
-        let c1 = c1 + k01 * d0;
-        let d1 = self.normal_row::<USE_BIAS>(1, c1, dpn, &a, &b, inv_h, push_max);
+        let zero = W::splat(0.0);
+        let (b0, ms0, is0) = self.normal_terms::<USE_BIAS>(0, dpn, &a, &b, inv_h, push_max);
+        let (b1, ms1, is1) = self.normal_terms::<USE_BIAS>(1, dpn, &a, &b, inv_h, push_max);
+        let (old0, old1) = (self.impulse[0], self.impulse[1]);
+        // Gauss–Seidel: point 0, then point 1.
+        let g0 = (zero - self.mass[0] * ms0 * (c0 + b0) - is0 * old0).fast_max(zero - old0);
+        let g1 =
+            (zero - self.mass[1] * ms1 * ((c1 + k01 * g0) + b1) - is1 * old1).fast_max(zero - old1);
+        // Both points at once, each its own soft spring: with s_m + s_i = 1
+        // the per-point step is (k_ii / s_m) λ' = k_ii λ − (Ċ + b), so the
+        // pair solves K' λ' = K λ − (Ċ + b), K' = K + diag(k_ii (1/s_m − 1)).
+        let [k00, k11] = self.block_k;
+        let q0 = (c0 + b0) - (k00 * old0 + k01 * old1);
+        let q1 = (c1 + b1) - (k01 * old0 + k11 * old1);
+        let (kp00, kp11) = (k00 / ms0, k11 / ms1);
+        let inv_det = W::splat(1.0) / (kp00 * kp11 - k01 * k01);
+        let x0 = (k01 * q1 - kp11 * q0) * inv_det - old0;
+        let x1 = (k01 * q0 - kp00 * q1) * inv_det - old1;
+        let block = self.block & (old0 + x0).cmp_ge(zero) & (old1 + x1).cmp_ge(zero);
+        let d0 = block.blend(x0, g0);
+        let d1 = block.blend(x1, g1);
+        self.impulse[0] = old0 + d0;
+        self.impulse[1] = old1 + d1;
+        self.max_normal_impulse[0] = d0.fast_max(self.max_normal_impulse[0]);
+        self.max_normal_impulse[1] = d1.fast_max(self.max_normal_impulse[1]);
         let c2 = (c2 + k02 * d0) + k12 * d1;
         let d2 = self.friction_row(2, c2);
         let c3 = ((c3 + k03 * d0) + k13 * d1) + k23 * d2;
@@ -764,44 +803,41 @@ impl WideContact {
         );
     }
 
-    /// The normal row of point `i` on every lane; returns the increment.
+    /// The terms of point `i`'s normal row on every lane: the bias `b`
+    /// (m/s), the mass scale `s_m` and the impulse scale `s_i` of
+    /// `Δλ = −m s_m (Ċ + b) − s_i λ`: speculative (`s > 0`) rigid with
+    /// `b = s / h`, soft push-out with `b = max(β s, −v_push)`, relax rigid
+    /// with `b = max(s / h, 0)`.
     #[inline(always)]
-    fn normal_row<const USE_BIAS: bool>(
-        &mut self,
+    fn normal_terms<const USE_BIAS: bool>(
+        &self,
         i: usize,
-        c_dot: W,
         dpn: W,
         a: &WideBody,
         b: &WideBody,
         inv_h: W,
         push_max: W,
-    ) -> W {
+    ) -> (W, W, W) {
         let (ja, jb) = (&self.ja, &self.jb);
         // n · (dq r) = (r × n) sin − (r × t) cos.
         let s = self.base_separation[i]
             + dpn
             + (b.q_s * jb[i] - b.q_c * jb[i + 2])
             + (a.q_c * ja[i + 2] - a.q_s * ja[i]);
-        let old = self.impulse[i];
-        let rigid = self.mass[i];
         let zero = W::splat(0.0);
-        let (mass, offset) = if USE_BIAS {
+        let one = W::splat(1.0);
+        if USE_BIAS {
             let speculative = s.cmp_gt(zero);
-            let soft = self.soft_mass[i];
-            let bias = (self.bias_rate * s).fast_max(zero - push_max);
-            let soft_offset = zero - soft * bias - self.impulse_scale[i] * old;
-            let rigid_offset = zero - rigid * (s * inv_h);
+            let soft_bias = (self.bias_rate * s).fast_max(zero - push_max);
             (
-                speculative.blend(rigid, soft),
-                speculative.blend(rigid_offset, soft_offset),
+                speculative.blend(s * inv_h, soft_bias),
+                // s_m + s_i = 1 (Softness).
+                speculative.blend(one, one - self.impulse_scale[i]),
+                speculative.blend(zero, self.impulse_scale[i]),
             )
         } else {
-            (rigid, zero - rigid * (s * inv_h).fast_max(zero))
-        };
-        let d = (offset - mass * c_dot).fast_max(zero - old);
-        self.impulse[i] = old + d;
-        self.max_normal_impulse[i] = d.fast_max(self.max_normal_impulse[i]);
-        d
+            ((s * inv_h).fast_max(zero), one, zero)
+        }
     }
 
     /// Friction row `i` (2 or 3) on every lane; returns the increment.

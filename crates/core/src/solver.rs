@@ -39,9 +39,19 @@ pub const DEFAULT_CONTACT_MASS_RATIO_CAP: Real = 1.3;
 /// [`SolverSettings::joint_mass_ratio_cap`].
 pub const DEFAULT_JOINT_MASS_RATIO_CAP: Real = 1.3;
 
-/// Default stiffness of the point rows solved directly, Hz (usual 240).
+/// Largest contact stiffness as a fraction of the substep rate
+/// (dimensionless, 1/8: 30 Hz at 240 Hz substeps). See
+/// [`SolverSettings::effective_hertz`].
+pub const CONTACT_HERTZ_PER_SUBSTEP_RATE: Real = 0.125;
+
+/// Largest joint stiffness (Gauss–Seidel rows) as a fraction of the
+/// substep rate (dimensionless, 1/4: 60 Hz at 240 Hz substeps). See
+/// [`SolverSettings::effective_hertz`].
+pub const JOINT_HERTZ_PER_SUBSTEP_RATE: Real = 0.25;
+
+/// Default stiffness of the point rows solved directly, Hz (usual 500).
 /// See [`SolverSettings::direct_joint_hertz`].
-pub const DEFAULT_DIRECT_JOINT_HERTZ: Real = 240.0;
+pub const DEFAULT_DIRECT_JOINT_HERTZ: Real = 500.0;
 
 /// Accuracy and softness settings of the solver. Every knob that trades
 /// accuracy for time lives here.
@@ -57,13 +67,15 @@ pub struct SolverSettings {
     pub velocity_iterations: u32,
     /// Baumgarte factor β of the PGS baseline (dimensionless), usual 0.2.
     pub baumgarte: Real,
-    /// Contact stiffness, Hz (usual 30).
+    /// Contact stiffness, Hz (usual 30; at most 1/8 of the substep rate is
+    /// used, see [`SolverSettings::effective_hertz`]).
     pub contact_hertz: Real,
     /// Contact damping ratio (usual 10).
     pub contact_damping_ratio: Real,
     /// Maximum contact push-out speed, m/s (usual 3).
     pub contact_push_max_velocity: Real,
-    /// Joint stiffness, Hz (usual 60).
+    /// Joint stiffness, Hz (usual 60; at most 1/4 of the substep rate is
+    /// used, see [`SolverSettings::effective_hertz`]).
     pub joint_hertz: Real,
     /// Joint damping ratio (usual 2).
     pub joint_damping_ratio: Real,
@@ -97,17 +109,22 @@ pub struct SolverSettings {
     /// that close a loop stay iterative. See `janus2d_constraints::joint_tree`.
     pub direct_joints: bool,
     /// Stiffness of the point rows in the direct joint solve, Hz (usual
-    /// 240, the substep rate at 60 Hz × 4). A joint's static stretch under
-    /// a load is `F K / ω²` per unit effective mass: 240 Hz holds a 670:1
-    /// ball on a chain of light links within ~1 cm where 60 Hz lets it
-    /// stretch ~16×; an exact solve is stable at any stiffness.
+    /// 500). A joint's static stretch under a load is `F K / ω²` per unit
+    /// effective mass, so the stiffness sets how heavy a load a light link
+    /// holds: a 1 m link of 1 kg swinging a bob from horizontal stays within
+    /// 1 cm up to a 3,000:1 bob at 500 Hz (1,000:1: 3 mm; at 240 Hz
+    /// 1,000:1 stretched it 1.3 cm); the 670:1 ball and chain's peak gap is
+    /// 6 mm (240 Hz: 2.2 cm). An exact solve is stable at any stiffness,
+    /// but its rounding grows with it (at 1000 Hz the tree solve's momentum
+    /// property failed in f32).
     pub direct_joint_hertz: Real,
     /// Largest position-correction speed of one directly solved joint, m/s
-    /// (usual 5). The exact solve corrects every joint of a chain at once,
+    /// (usual 2). The exact solve corrects every joint of a chain at once,
     /// so the speeds add up along it: uncapped, a chain stretched by 1 m at
-    /// each of 40 joints flings its end at 600 m/s; at 5 m/s it recovers in
-    /// 0.52 s peaking at 111 m/s. Iterative joints keep
-    /// `joint_max_correction_speed`.
+    /// each of 40 joints flings its end at 600 m/s; at 2 m/s (500 Hz) it
+    /// peaks at 68 m/s, about the 67 m/s the same chain reaches by swinging
+    /// alone (5 m/s: 138 m/s), and every joint is back within 1 cm.
+    /// Iterative joints keep `joint_max_correction_speed`.
     pub direct_joint_max_correction_speed: Real,
 }
 
@@ -131,7 +148,7 @@ impl Default for SolverSettings {
             joint_mass_ratio_cap: DEFAULT_JOINT_MASS_RATIO_CAP,
             direct_joints: true,
             direct_joint_hertz: DEFAULT_DIRECT_JOINT_HERTZ,
-            direct_joint_max_correction_speed: 5.0,
+            direct_joint_max_correction_speed: 2.0,
         }
     }
 }
@@ -198,6 +215,34 @@ impl SolverSettings {
         Ok(())
     }
 
+    /// The contact and joint stiffness a substep of `h` seconds solves
+    /// with, Hz: the settings' `contact_hertz` and `joint_hertz`, capped at
+    /// [`CONTACT_HERTZ_PER_SUBSTEP_RATE`] and [`JOINT_HERTZ_PER_SUBSTEP_RATE`]
+    /// of the substep rate `1/h`. At 60 Hz and 4 or more substeps the caps
+    /// (30 and 60 Hz) leave the usual settings as they are; with fewer
+    /// substeps a spring that stiff against one iteration per substep
+    /// overshoots (the base-100 pyramid collapses at 2 substeps with
+    /// 30 Hz contacts and stands with 15 Hz; Box2D softens the same way).
+    ///
+    /// ```
+    /// use janus2d_core::solver::SolverSettings;
+    /// let s = SolverSettings::default();
+    /// assert_eq!(s.effective_hertz(1.0 / 240.0), (30.0, 60.0));
+    /// assert_eq!(s.effective_hertz(1.0 / 120.0), (15.0, 30.0));
+    /// ```
+    #[must_use]
+    pub fn effective_hertz(&self, h: Real) -> (Real, Real) {
+        if h <= 0.0 {
+            return (self.contact_hertz, self.joint_hertz);
+        }
+        let rate = 1.0 / h;
+        (
+            self.contact_hertz
+                .min(CONTACT_HERTZ_PER_SUBSTEP_RATE * rate),
+            self.joint_hertz.min(JOINT_HERTZ_PER_SUBSTEP_RATE * rate),
+        )
+    }
+
     /// Builds the per-step context.
     pub fn context(&self, dt: Real, gravity: Vec2) -> StepContext {
         let (substeps, h) = match self.mode {
@@ -207,11 +252,12 @@ impl SolverSettings {
             }
             SolverMode::PgsBaumgarte => (1, dt),
         };
+        let (contact_hertz, joint_hertz) = self.effective_hertz(h);
         let (joint_softness, contact_softness, static_softness) = match self.mode {
             SolverMode::SoftStep => (
-                Softness::new(self.joint_hertz, self.joint_damping_ratio, h),
-                Softness::new(self.contact_hertz, self.contact_damping_ratio, h),
-                Softness::new(2.0 * self.contact_hertz, self.contact_damping_ratio, h),
+                Softness::new(joint_hertz, self.joint_damping_ratio, h),
+                Softness::new(contact_hertz, self.contact_damping_ratio, h),
+                Softness::new(2.0 * contact_hertz, self.contact_damping_ratio, h),
             ),
             SolverMode::PgsBaumgarte => {
                 let s = Softness::baumgarte(self.baumgarte, dt);
@@ -231,9 +277,9 @@ impl SolverSettings {
             contact_push_max_velocity: self.contact_push_max_velocity,
             joint_max_correction_speed: self.joint_max_correction_speed,
             restitution_threshold: self.restitution_threshold,
-            contact_hertz: self.contact_hertz,
+            contact_hertz,
             contact_damping_ratio: self.contact_damping_ratio,
-            joint_hertz: self.joint_hertz,
+            joint_hertz,
             joint_damping_ratio: self.joint_damping_ratio,
             warm_starting: self.warm_starting,
             mode: self.mode,

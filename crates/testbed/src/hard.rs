@@ -751,3 +751,71 @@ pub fn all() -> Vec<HardCase> {
         joint_grid_40(),
     ]
 }
+
+/// A light 1 m box (density 1, μ 0.6) on a ground box, under a 1 m box
+/// `ratio` times denser placed 0.1 m off centre with a 1 cm gap, 10 s.
+/// Bound: the light box moves at most 5 cm sideways (it is not squeezed
+/// out). Probe: the light box.
+#[must_use]
+pub fn mass_ratio_stack(ratio: f64) -> HardCase {
+    let mut d = SceneDesc::new("mass_ratio_stack", 600);
+    d.add(ground_box(50.0, 0.6));
+    let light =
+        d.add(BodyDesc::dynamic(v(0.0, 0.5)).with(ShapeDesc::new(square(0.5, 0.5)).friction(0.6)));
+    d.add(
+        BodyDesc::dynamic(v(0.1, 1.51)).with(
+            ShapeDesc::new(square(0.5, 0.5))
+                .friction(0.6)
+                .density(ratio),
+        ),
+    );
+    d.probe = Some(light);
+    d.probe_label = "light box";
+    HardCase {
+        name: "mass_ratio_stack",
+        desc: d,
+        steps: 600,
+        bounds: vec![Bound::AtMost(Figure::Drift, 0.05)],
+        rest: None,
+        box2d: "",
+    }
+}
+
+/// A chain of `links` light links (1 m, mass 1, I = 1/12, no shapes)
+/// hinged end to end from a static pin at the origin, horizontal, with a
+/// bob of mass `ratio` (I = ratio / 32, a disc of r 0.25) hinged at the
+/// last link's free end; it swings down under gravity for 10 s. Bound:
+/// every joint within 1 cm over the run. Probe: the bob.
+#[must_use]
+pub fn mass_ratio_chain(links: usize, ratio: f64) -> HardCase {
+    let mut d = SceneDesc::new("mass_ratio_chain", 600);
+    let pin = d.add(BodyDesc::fixed(DVec2::ZERO));
+    let mut prev = pin;
+    let mut prev_anchor = DVec2::ZERO;
+    for i in 0..links {
+        let mut link = BodyDesc::dynamic(v(0.5 + i as f64, 0.0));
+        link.mass = Some((1.0, 1.0 / 12.0));
+        let b = d.add(link);
+        d.join(RevoluteDesc::new(prev, b, prev_anchor, v(-0.5, 0.0)));
+        prev = b;
+        prev_anchor = v(0.5, 0.0);
+    }
+    let mut bob = BodyDesc::dynamic(v(links as f64, 0.0));
+    bob.mass = Some((ratio, ratio / 32.0));
+    let bob = d.add(bob);
+    d.join(RevoluteDesc::new(prev, bob, prev_anchor, DVec2::ZERO));
+    d.probe = Some(bob);
+    d.probe_label = "bob";
+    HardCase {
+        name: if links == 1 {
+            "mass_ratio_bob"
+        } else {
+            "mass_ratio_chain"
+        },
+        desc: d,
+        steps: 600,
+        bounds: vec![Bound::AtMost(Figure::JointGap, 0.01)],
+        rest: None,
+        box2d: "",
+    }
+}
