@@ -228,7 +228,8 @@ impl SolverSettings {
     /// use janus2d_core::solver::SolverSettings;
     /// let s = SolverSettings::default();
     /// assert_eq!(s.effective_hertz(1.0 / 240.0), (30.0, 60.0));
-    /// assert_eq!(s.effective_hertz(1.0 / 120.0), (15.0, 30.0));
+    /// let (contact, joint) = s.effective_hertz(1.0 / 120.0);
+    /// assert!((contact - 15.0).abs() < 1e-4 && (joint - 30.0).abs() < 1e-4);
     /// ```
     #[must_use]
     pub fn effective_hertz(&self, h: Real) -> (Real, Real) {
@@ -236,10 +237,20 @@ impl SolverSettings {
             return (self.contact_hertz, self.joint_hertz);
         }
         let rate = 1.0 / h;
+        // A setting at the cap (30 Hz at 240 Hz substeps) is kept exactly:
+        // `1 / h` is not exact in f32, and a cap a rounding below the
+        // setting would change every result at the default settings.
+        let capped = |hertz: Real, fraction: Real| {
+            let cap = fraction * rate;
+            if hertz <= cap * (1.0 + 1e-5) {
+                hertz
+            } else {
+                cap
+            }
+        };
         (
-            self.contact_hertz
-                .min(CONTACT_HERTZ_PER_SUBSTEP_RATE * rate),
-            self.joint_hertz.min(JOINT_HERTZ_PER_SUBSTEP_RATE * rate),
+            capped(self.contact_hertz, CONTACT_HERTZ_PER_SUBSTEP_RATE),
+            capped(self.joint_hertz, JOINT_HERTZ_PER_SUBSTEP_RATE),
         )
     }
 
