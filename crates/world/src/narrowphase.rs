@@ -241,13 +241,21 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
         + body_a.state.w.abs() * reach(&sa.aabb, sim_a.center)
         + body_b.state.w.abs() * reach(&sb.aabb, sim_b.center);
     let speculative = SPECULATIVE_DISTANCE + input.dt * approach;
-    let manifold = collide(
-        &sa.geometry,
-        &sim_a.transform,
-        &sb.geometry,
-        &sim_b.transform,
-        speculative,
-    );
+    // The tight boxes (of the current poses) apart by more than the
+    // speculative distance along x or y: the shapes are too, no point can
+    // come within it, and the manifold is empty without computing it.
+    let gap = (sa.aabb.lower - sb.aabb.upper).max(sb.aabb.lower - sa.aabb.upper);
+    let manifold = if gap.x > speculative || gap.y > speculative {
+        Manifold::default()
+    } else {
+        collide(
+            &sa.geometry,
+            &sim_a.transform,
+            &sb.geometry,
+            &sim_b.transform,
+            speculative,
+        )
+    };
     let offset = [
         sim_a.transform.p - sim_a.center,
         sim_b.transform.p - sim_b.center,

@@ -1684,6 +1684,13 @@ impl World {
         if self.bodies.swap_identity(a, b).is_ok() {
             self.collision.swap_body_shapes(a, b);
             self.islands.swap_bodies(a, b);
+            // The shapes' tight boxes follow their new bodies' poses now
+            // (the narrowphase culls pairs by them).
+            for body in [a, b] {
+                if let Some(xf) = self.bodies.sim(body).map(|s| s.transform) {
+                    self.collision.refresh_body(body, &xf);
+                }
+            }
         }
     }
 
