@@ -214,13 +214,20 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
         + body_a.state.w.abs() * reach(&sa.aabb, sim_a.center)
         + body_b.state.w.abs() * reach(&sb.aabb, sim_b.center);
     let speculative = SPECULATIVE_DISTANCE + input.dt * approach;
-    let manifold = collide(
+    let mut manifold = collide(
         &sa.geometry,
         &sim_a.transform,
         &sb.geometry,
         &sim_b.transform,
         speculative,
     );
+    if !input.clipping.is_empty() {
+        // Before the manifold is stored, so that points made at aperture
+        // edges warm-start by their ids like any other.
+        input
+            .clipping
+            .clip_manifold(c.body_a, c.body_b, &mut manifold);
+    }
     let offset = [
         sim_a.transform.p - sim_a.center,
         sim_b.transform.p - sim_b.center,
@@ -228,9 +235,6 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
     let was_touching = c.touching;
     update_manifold(c, &manifold, offset);
     c.still = [body_a.state_index == 0, body_b.state_index == 0];
-    if !input.clipping.is_empty() {
-        input.clipping.apply(c);
-    }
     c.touching = c.point_count > 0;
     ContactUpdate::Updated { was_touching }
 }

@@ -25,5 +25,6 @@ pub(crate) use noop::PortalStage;
 pub(crate) use stage::PortalStage;
 #[cfg(feature = "portals")]
 pub use stage::{
-    F_MIN, MassModel, PortalCounters, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle,
+    CrossingRole, F_MIN, MassModel, PlaneSide, PortalCounters, PortalDef, PortalEvent,
+    PortalPairDef, PortalPairHandle, PortalSide,
 };
