@@ -69,6 +69,10 @@ pub struct ApertureClip {
     pub half_width: Real,
     /// True for a hole in a wall, false for a crossing copy.
     pub hole: bool,
+    /// Which aperture it is (`2 × pair slot + portal`, 0: a, 1: b): a
+    /// crossing copy collides with the holes of every other aperture as
+    /// solid wall (see [`ContactClipping::copies`]).
+    pub aperture: u32,
 }
 
 impl ApertureClip {
@@ -133,6 +137,7 @@ fn open_range(f0: Real, f1: Real, lo: Real, hi: Real) -> (Real, Real) {
 pub static NO_CLIPPING: ContactClipping = ContactClipping {
     clips: Vec::new(),
     ignored_pairs: Vec::new(),
+    copies: Vec::new(),
 };
 
 /// What the portal stage asks the narrowphase to drop.
@@ -142,6 +147,11 @@ pub struct ContactClipping {
     pub clips: Vec<ApertureClip>,
     /// Pairs of bodies that never touch (a crossing copy and its twin).
     pub ignored_pairs: Vec<(BodyHandle, BodyHandle)>,
+    /// Each crossing copy with the aperture it passes through. A body
+    /// crosses one portal at a time, so the hole of any other aperture is
+    /// solid wall to it: a long body that reaches a second aperture while
+    /// crossing a first is held there, never falls in.
+    pub copies: Vec<(BodyHandle, u32)>,
 }
 
 impl ContactClipping {
@@ -151,13 +161,33 @@ impl ContactClipping {
         self.clips.is_empty() && self.ignored_pairs.is_empty()
     }
 
-    /// True when `p` lies in the hole of an aperture on `body` (a point the
-    /// narrowphase would drop from a contact with that body).
+    /// True when `p` lies in a hole of an aperture on `body` that is open
+    /// to `other` (a point the narrowphase would drop from a contact
+    /// between them; see [`ContactClipping::copies`]).
     #[cfg_attr(not(feature = "portals"), allow(dead_code))]
-    pub(crate) fn in_hole(&self, body: BodyHandle, p: Vec2) -> bool {
-        self.clips
-            .iter()
-            .any(|clip| clip.hole && clip.body == body && clip.drops(p))
+    pub(crate) fn in_hole_for(&self, body: BodyHandle, other: BodyHandle, p: Vec2) -> bool {
+        self.clips.iter().any(|clip| {
+            clip.hole
+                && clip.body == body
+                && clip.drops(p)
+                && self.hole_open_to(other, clip.aperture)
+        })
+    }
+
+    /// True when the hole of `aperture` lets `body` in: always, unless the
+    /// body is a crossing copy passing through another aperture.
+    #[inline]
+    fn hole_open_to(&self, body: BodyHandle, aperture: u32) -> bool {
+        let mut crossing = false;
+        for &(copy, through) in &self.copies {
+            if copy == body {
+                if through == aperture {
+                    return true;
+                }
+                crossing = true;
+            }
+        }
+        !crossing
     }
 
     /// True when the pair `(a, b)` never touches (a crossing copy and its twin).
@@ -189,8 +219,10 @@ impl ContactClipping {
     ///         normal: Vec2::Y,
     ///         half_width: 0.5,
     ///         hole: true,
+    ///         aperture: 0,
     ///     }],
     ///     ignored_pairs: vec![],
+    ///     copies: vec![],
     /// };
     /// let point = |x: Real| ManifoldPoint {
     ///     point: Vec2::new(x, 0.0),
@@ -216,7 +248,16 @@ impl ContactClipping {
             m.point_count = 0;
             return;
         }
-        let involved = |clip: &&ApertureClip| clip.body == body_a || clip.body == body_b;
+        let involved = |clip: &&ApertureClip| {
+            let other = if clip.body == body_a {
+                body_b
+            } else if clip.body == body_b {
+                body_a
+            } else {
+                return false;
+            };
+            !clip.hole || self.hole_open_to(other, clip.aperture)
+        };
         if !self.clips.iter().any(|c| involved(&c)) {
             return;
         }
@@ -308,15 +349,18 @@ mod tests {
         ContactClipping {
             clips: centres
                 .iter()
-                .map(|&x| ApertureClip {
+                .enumerate()
+                .map(|(k, &x)| ApertureClip {
                     body: handle(1),
                     point: Vec2::new(x, 0.0),
                     normal: Vec2::Y,
                     half_width: w,
                     hole: true,
+                    aperture: 2 * k as u32,
                 })
                 .collect(),
             ignored_pairs: vec![],
+            copies: vec![],
         }
     }
 
@@ -386,5 +430,20 @@ mod tests {
         let mut m = footprint(-0.4, 0.4, 0.0, 0.0);
         clipping.clip_manifold(handle(3), handle(2), &mut m);
         assert_eq!(m.point_count, 2);
+    }
+
+    #[test]
+    fn a_copy_crossing_elsewhere_finds_the_hole_solid() {
+        let mut clipping = floor_with(&[0.0], 0.5);
+        // Body 2 crosses aperture 5 (another pair): the floor's hole holds it.
+        clipping.copies.push((handle(2), 5));
+        let mut m = footprint(-0.4, 0.4, 0.0, 0.0);
+        clipping.clip_manifold(handle(1), handle(2), &mut m);
+        assert_eq!(m.point_count, 2);
+        // Crossing through this very aperture: the hole is open.
+        clipping.copies.push((handle(2), 0));
+        let mut m = footprint(-0.4, 0.4, 0.0, 0.0);
+        clipping.clip_manifold(handle(1), handle(2), &mut m);
+        assert_eq!(m.point_count, 0);
     }
 }

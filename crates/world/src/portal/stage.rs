@@ -344,7 +344,8 @@ impl PortalStage {
         let mut clipping = std::mem::take(&mut self.clipping);
         clipping.clips.clear();
         clipping.ignored_pairs.clear();
-        for (_, d) in self.pairs.iter() {
+        clipping.copies.clear();
+        for (index, d) in self.pairs.iter() {
             for k in 0..2 {
                 let f = frame_in(bodies, &d.portals[k], &d.local[k]);
                 clipping.clips.push(ApertureClip {
@@ -353,6 +354,7 @@ impl PortalStage {
                     normal: f.normal,
                     half_width: d.local[k].half_width,
                     hole: true,
+                    aperture: 2 * index + k as u32,
                 });
             }
         }
@@ -367,7 +369,9 @@ impl PortalStage {
                     normal: f.normal,
                     half_width: d.local[side].half_width,
                     hole: false,
+                    aperture: 2 * c.pair + side as u32,
                 });
+                clipping.copies.push((body, 2 * c.pair + side as u32));
             }
             clipping.ignored_pairs.push((c.original, c.clone));
         }
