@@ -224,9 +224,15 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
     if !input.clipping.is_empty() {
         // Before the manifold is stored, so that points made at aperture
         // edges warm-start by their ids like any other.
+        let motion = crate::portal::PairMotion {
+            center: [sim_a.center, sim_b.center],
+            velocity: [body_a.state.v, body_b.state.v],
+            angular_velocity: [body_a.state.w, body_b.state.w],
+            dt: input.dt,
+        };
         input
             .clipping
-            .clip_manifold(c.body_a, c.body_b, &mut manifold);
+            .clip_manifold(c.body_a, c.body_b, &motion, &mut manifold);
     }
     let offset = [
         sim_a.transform.p - sim_a.center,

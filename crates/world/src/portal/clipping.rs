@@ -30,10 +30,49 @@
 //! | `Behind` | a crossing copy | `|t| < w` | `s < 0` (that part of the object is on the other side) |
 //!
 //! A one-point manifold keeps its point unless a region covers it.
+//!
+//! **Speculative points land where the body will arrive.** A speculative
+//! point (separation > 0) acts for the whole step, so what matters is where
+//! the body's point meets the wall, not where it is at the start of the
+//! step: against a hole, each point is also tested at its arrival
+//! `p' = p + τ u` (dropped when either lies in the hole), with `u` the point's velocity relative to the wall and
+//! `τ = separation / approach speed` (when `τ ≤ 1.5 dt`; a point that
+//! arrives later does not act this step and stays put). A fast body entering
+//! at a shallow angle, still over a lip at the start of the step but over
+//! the aperture when it reaches the wall's plane, gets no point that would
+//! stop it: it crosses in that step.
+//!
+//! ```text
+//!   start of step   ▣ ─ ─ ─ ─ ─ ─▶ p'            (u: grazing, fast)
+//!   wall ─────────────●     p' in the aperture   ●────────
+//!                    lip   → the point is dropped  lip
+//! ```
 
 use janus2d_core::body::BodyHandle;
 use janus2d_core::geometry::{Manifold, ManifoldPoint};
 use janus2d_core::math::{Real, Vec2};
+
+/// How the two bodies of a contact move at the start of the step (what the
+/// speculative points of a manifold are computed for).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PairMotion {
+    /// Centres of mass of body a and body b, m.
+    pub center: [Vec2; 2],
+    /// Linear velocities, m/s.
+    pub velocity: [Vec2; 2],
+    /// Angular velocities, rad/s.
+    pub angular_velocity: [Real; 2],
+    /// The step, s.
+    pub dt: Real,
+}
+
+impl PairMotion {
+    /// Velocity of the material point of body `k` at `p`.
+    #[inline]
+    fn velocity_at(&self, k: usize, p: Vec2) -> Vec2 {
+        self.velocity[k] + self.angular_velocity[k] * (p - self.center[k]).perp()
+    }
+}
 
 /// Feature id of a point made where the footprint's low end (point 0's
 /// side) leaves a region (chosen above every polygon feature id).
@@ -206,7 +245,7 @@ impl ContactClipping {
     /// use janus2d_core::body::BodyHandle;
     /// use janus2d_core::geometry::{Manifold, ManifoldPoint};
     /// use janus2d_core::math::{Real, Vec2};
-    /// use janus2d_world::portal::{ApertureClip, ContactClipping};
+    /// use janus2d_world::portal::{ApertureClip, ContactClipping, PairMotion};
     ///
     /// // A floor at y = 0 with a 1 m aperture at the origin; a plank's
     /// // footprint from x = −0.3 (over the aperture) to x = 3.
@@ -234,13 +273,20 @@ impl ContactClipping {
     ///     points: [point(-0.3), point(3.0)],
     ///     point_count: 2,
     /// };
-    /// clipping.clip_manifold(wall, plank, &mut m);
+    /// // Both at rest: the points are clipped where they are.
+    /// clipping.clip_manifold(wall, plank, &PairMotion::default(), &mut m);
     /// assert_eq!(m.point_count, 2);
     /// // The end over the aperture moved to the lip at x = 0.5.
     /// assert!((m.points[0].point.x - 0.5).abs() < 1e-5);
     /// assert!((m.points[1].point.x - 3.0).abs() < 1e-5);
     /// ```
-    pub fn clip_manifold(&self, body_a: BodyHandle, body_b: BodyHandle, m: &mut Manifold) {
+    pub fn clip_manifold(
+        &self,
+        body_a: BodyHandle,
+        body_b: BodyHandle,
+        motion: &PairMotion,
+        m: &mut Manifold,
+    ) {
         if m.point_count == 0 {
             return;
         }
@@ -261,25 +307,58 @@ impl ContactClipping {
         if !self.clips.iter().any(|c| involved(&c)) {
             return;
         }
+        // Where each point meets a hole's wall (its own place when it
+        // touches already or does not approach).
+        let arrival = |clip: &ApertureClip, p: &ManifoldPoint| -> Vec2 {
+            if p.separation <= 0.0 {
+                return p.point;
+            }
+            let (wall, other) = if clip.body == body_a { (0, 1) } else { (1, 0) };
+            let u = motion.velocity_at(other, p.point) - motion.velocity_at(wall, p.point);
+            let approach = -u.dot(clip.normal);
+            if approach <= 0.0 {
+                return p.point;
+            }
+            // A point that arrives just after the step still acts in its
+            // last substeps, so its true arrival decides; one that arrives
+            // later does not act this step and is left where it is.
+            let tau = p.separation / approach;
+            if tau > 1.5 * motion.dt {
+                return p.point;
+            }
+            p.point + tau * u
+        };
+        // A hole covers a point where it is and where it arrives: the
+        // arrival only ever drops a point (a point over the aperture now is
+        // never held by the lip it is heading for).
         if m.point_count == 1 {
-            let p = m.points[0].point;
-            if self.clips.iter().filter(involved).any(|c| c.drops(p)) {
+            let p = m.points[0];
+            let dropped = self
+                .clips
+                .iter()
+                .filter(involved)
+                .any(|c| c.drops(p.point) || (c.hole && c.drops(arrival(c, &p))));
+            if dropped {
                 m.point_count = 0;
             }
             return;
         }
         let (p0, p1) = (m.points[0], m.points[1]);
         let intervals = || {
-            self.clips
-                .iter()
-                .filter(involved)
-                .map(|c| c.segment_interval(p0.point, p1.point))
-                .filter(|&(lo, hi)| lo < hi)
+            self.clips.iter().filter(involved).flat_map(|c| {
+                let now = c.segment_interval(p0.point, p1.point);
+                let later = if c.hole {
+                    c.segment_interval(arrival(c, &p0), arrival(c, &p1))
+                } else {
+                    (1.0, 0.0)
+                };
+                [now, later].into_iter().filter(|&(lo, hi)| lo < hi)
+            })
         };
         // Lowest solid parameter: step past every region covering it.
         let mut u_low: Real = 0.0;
         let mut u_high: Real = 1.0;
-        for _ in 0..=self.clips.len() {
+        for _ in 0..=2 * self.clips.len() {
             let mut moved = false;
             for (lo, hi) in intervals() {
                 if lo < u_low && u_low < hi {
@@ -383,7 +462,7 @@ mod tests {
     fn end_over_an_aperture_moves_to_the_lip_with_interpolated_data() {
         let clipping = floor_with(&[0.0], 0.5);
         let mut m = footprint(-0.3, 3.7, -0.01, -0.03);
-        clipping.clip_manifold(handle(1), handle(2), &mut m);
+        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), &mut m);
         assert_eq!(m.point_count, 2);
         let u = 0.8 / 4.0;
         let q = m.points[0];
@@ -399,7 +478,7 @@ mod tests {
     fn strip_between_two_apertures_keeps_both_lips() {
         let clipping = floor_with(&[-1.0, 1.0], 0.7);
         let mut m = footprint(-0.6, 0.6, 0.0, 0.0);
-        clipping.clip_manifold(handle(2), handle(1), &mut m);
+        clipping.clip_manifold(handle(2), handle(1), &PairMotion::default(), &mut m);
         assert_eq!(m.point_count, 2);
         assert!((m.points[0].point.x + 0.3).abs() < 1e-5);
         assert!((m.points[1].point.x - 0.3).abs() < 1e-5);
@@ -410,12 +489,12 @@ mod tests {
     fn footprint_within_an_aperture_keeps_nothing() {
         let clipping = floor_with(&[0.0], 0.5);
         let mut m = footprint(-0.4, 0.4, 0.0, 0.0);
-        clipping.clip_manifold(handle(1), handle(2), &mut m);
+        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), &mut m);
         assert_eq!(m.point_count, 0);
         // Spanning two touching apertures: nothing solid in between.
         let clipping = floor_with(&[-0.5, 0.5], 0.5);
         let mut m = footprint(-0.8, 0.8, 0.0, 0.0);
-        clipping.clip_manifold(handle(1), handle(2), &mut m);
+        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), &mut m);
         assert_eq!(m.point_count, 0);
     }
 
@@ -424,11 +503,35 @@ mod tests {
         let clipping = floor_with(&[0.0], 0.5);
         let mut m = footprint(-2.0, 2.0, 0.0, 0.0);
         let before = m;
-        clipping.clip_manifold(handle(1), handle(2), &mut m);
+        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), &mut m);
         assert_eq!(m, before);
         // Another pair of bodies is not clipped at all.
         let mut m = footprint(-0.4, 0.4, 0.0, 0.0);
-        clipping.clip_manifold(handle(3), handle(2), &mut m);
+        clipping.clip_manifold(handle(3), handle(2), &PairMotion::default(), &mut m);
+        assert_eq!(m.point_count, 2);
+    }
+
+    #[test]
+    fn speculative_points_are_clipped_where_they_arrive() {
+        let clipping = floor_with(&[0.0], 0.5);
+        // Over the lip at x ∈ [−0.7, −0.6], 0.1 m up, moving at (10, −1):
+        // it reaches the floor after 0.1 s, 1 m further on, in the aperture.
+        let mut m = footprint(-0.7, -0.6, 0.1, 0.1);
+        let motion = |v: Vec2| PairMotion {
+            center: [Vec2::new(0.0, -0.5), Vec2::new(-0.65, 0.2)],
+            velocity: [Vec2::ZERO, v],
+            angular_velocity: [0.0, 0.0],
+            dt: 0.2,
+        };
+        clipping.clip_manifold(handle(1), handle(2), &motion(Vec2::new(10.0, -1.0)), &mut m);
+        assert_eq!(m.point_count, 0);
+        // Slower, it lands on the lip: kept.
+        let mut m = footprint(-0.7, -0.6, 0.1, 0.1);
+        clipping.clip_manifold(handle(1), handle(2), &motion(Vec2::new(0.5, -1.0)), &mut m);
+        assert_eq!(m.point_count, 2);
+        // Moving away: where it is (over the lip), kept.
+        let mut m = footprint(-0.7, -0.6, 0.1, 0.1);
+        clipping.clip_manifold(handle(1), handle(2), &motion(Vec2::new(10.0, 1.0)), &mut m);
         assert_eq!(m.point_count, 2);
     }
 
@@ -438,12 +541,12 @@ mod tests {
         // Body 2 crosses aperture 5 (another pair): the floor's hole holds it.
         clipping.copies.push((handle(2), 5));
         let mut m = footprint(-0.4, 0.4, 0.0, 0.0);
-        clipping.clip_manifold(handle(1), handle(2), &mut m);
+        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), &mut m);
         assert_eq!(m.point_count, 2);
         // Crossing through this very aperture: the hole is open.
         clipping.copies.push((handle(2), 0));
         let mut m = footprint(-0.4, 0.4, 0.0, 0.0);
-        clipping.clip_manifold(handle(1), handle(2), &mut m);
+        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), &mut m);
         assert_eq!(m.point_count, 0);
     }
 }
