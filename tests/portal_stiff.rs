@@ -206,3 +206,96 @@ fn blocked_body_does_not_drift_sideways() {
     assert!(worst <= 1e-3, "|C| {worst} m");
     assert!(drift <= 0.005, "drifts at {drift} m/s");
 }
+
+/// Dynamic turning portal bodies with both copies dynamic (gravity 0, sleep
+/// off): two heavy slabs carrying the portals spin in opposite senses while
+/// a box is pushed through. The pair stays bounded (no copy runs away) and
+/// the total linear and angular momentum of all bodies is conserved
+/// (relative 1e-5 in f32).
+#[test]
+fn turning_dynamic_portal_bodies_stay_bounded_and_conserve_momentum() {
+    let mut def = WorldDef {
+        gravity: Vec2::ZERO,
+        ..Default::default()
+    };
+    def.sleep.enabled = false;
+    let mut world = World::new(def).unwrap();
+    let slab = |world: &mut World, p: Vec2, w: Real| {
+        let b = world
+            .create_body(&BodyDef {
+                angular_velocity: w,
+                ..BodyDef::dynamic(p)
+            })
+            .unwrap();
+        world
+            .create_shape(
+                b,
+                &ShapeDef::default().with_density(20.0),
+                Polygon::make_box(0.25, 1.5),
+            )
+            .unwrap();
+        b
+    };
+    let a = slab(&mut world, Vec2::ZERO, 0.6);
+    let b = slab(&mut world, Vec2::new(20.0, 5.0), -0.8);
+    world
+        .create_portal_pair(&PortalPairDef::new(
+            portal(a, Vec2::new(-0.25, 0.0), -Vec2::X, 1.0),
+            portal(b, Vec2::new(0.25, 0.0), Vec2::X, 1.0),
+        ))
+        .unwrap();
+    let body = body_box(
+        &mut world,
+        &BodyDef::dynamic(Vec2::new(-0.8, 0.0)).with_velocity(Vec2::new(2.0, 0.0)),
+        0.3,
+        0.3,
+    );
+    let momentum = |world: &World| {
+        let (mut p, mut l, mut top) = (Vec2::ZERO, 0.0 as Real, 0.0 as Real);
+        for h in world.body_handles() {
+            if world.body_type(h).unwrap() != BodyType::Dynamic {
+                continue;
+            }
+            let m = world.mass(h).unwrap();
+            let v = world.linear_velocity(h).unwrap();
+            let x = world.center_of_mass(h).unwrap();
+            p += m * v;
+            l += m * x.perp_dot(v)
+                + world.rotational_inertia(h).unwrap() * world.angular_velocity(h).unwrap();
+            top = top.max(v.length());
+        }
+        (p, l, top)
+    };
+    let (p0, l0, _) = momentum(&world);
+    let scale_p = p0.length();
+    let scale_l = l0.abs().max(scale_p * 20.0);
+    let (mut worst_p, mut worst_l, mut top, mut crossing) =
+        (0.0 as Real, 0.0 as Real, 0.0 as Real, 0);
+    let mut worst_c: Real = 0.0;
+    for _ in 0..180 {
+        world.step(DT).unwrap();
+        if world.crossing_count() > 0 {
+            crossing += 1;
+            worst_c = worst_c.max(world.max_portal_error());
+        }
+        let (p, l, t) = momentum(&world);
+        worst_p = worst_p.max((p - p0).length() / scale_p);
+        worst_l = worst_l.max((l - l0).abs() / scale_l);
+        top = top.max(t);
+    }
+    if report() {
+        eprintln!(
+            "turning dynamic portals: momentum error linear {worst_p:.3e}, angular {worst_l:.3e}; fastest body {top:.3} m/s; |C| {:.3} mm over {crossing} steps",
+            worst_c * 1000.0
+        );
+    }
+    assert!(crossing > 0, "never crossed");
+    assert!(world.position(body).unwrap().is_finite());
+    assert!(top < 10.0, "a body ran away at {top} m/s");
+    #[cfg(not(feature = "f64"))]
+    let tol = 1e-5;
+    #[cfg(feature = "f64")]
+    let tol = 1e-10;
+    assert!(worst_p <= tol, "linear momentum error {worst_p}");
+    assert!(worst_l <= tol, "angular momentum error {worst_l}");
+}
