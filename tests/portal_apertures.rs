@@ -290,3 +290,20 @@ fn body_at_two_portals_is_held_by_the_second_wall() {
         "exit velocity {v}"
     );
 }
+
+#[allow(dead_code)]
+#[path = "../examples/portal_plank.rs"]
+mod portal_plank;
+
+/// The plank example: the plank rests within the slop, level, never
+/// crossing; the box beside it goes through and leaves the wall portal.
+#[test]
+fn plank_example_rests_and_the_box_goes_through() {
+    let r = portal_plank::run().unwrap();
+    assert!(r.plank_sink <= LINEAR_SLOP, "sink {}", r.plank_sink);
+    assert!(r.plank_angle.abs() < 0.01, "angle {}", r.plank_angle);
+    assert!(!r.plank_crossed);
+    assert!(r.box_through);
+    // Out of the wall portal (x = −29.5, facing +x) and fallen below it.
+    assert!(r.box_end.x > -29.5 && r.box_end.y < -5.0, "box at {}", r.box_end);
+}

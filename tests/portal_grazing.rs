@@ -173,3 +173,26 @@ fn grazing_entries_full_grid() {
         9,
     );
 }
+
+#[allow(dead_code)]
+#[path = "../examples/portal_grazing.rs"]
+mod portal_grazing;
+
+/// The grazing example: through within a few steps, out within 1% of the
+/// entry speed and 0.5° of the mapped direction.
+#[test]
+fn grazing_example_crosses_at_its_speed() {
+    let r = portal_grazing::run().unwrap();
+    let v = r.exit_velocity;
+    let off = r
+        .expected_direction
+        .perp_dot(v)
+        .atan2(r.expected_direction.dot(v))
+        .to_degrees();
+    assert!(r.crossed_at.is_some_and(|s| s < 10), "{:?}", r.crossed_at);
+    assert!(
+        (v.length() - r.entry_speed).abs() <= 0.01 * r.entry_speed,
+        "{v}"
+    );
+    assert!(off.abs() <= 0.5, "{off} deg");
+}
