@@ -305,5 +305,72 @@ fn plank_example_rests_and_the_box_goes_through() {
     assert!(!r.plank_crossed);
     assert!(r.box_through);
     // Out of the wall portal (x = −29.5, facing +x) and fallen below it.
-    assert!(r.box_end.x > -29.5 && r.box_end.y < -5.0, "box at {}", r.box_end);
+    assert!(
+        r.box_end.x > -29.5 && r.box_end.y < -5.0,
+        "box at {}",
+        r.box_end
+    );
+}
+
+/// A ball wider than the aperture (1.4 m across a 1 m aperture) has one
+/// contact point, over the aperture: it rests on the two lips instead
+/// (points where its footprint meets the lips), never starts a crossing.
+#[test]
+fn ball_wider_than_the_aperture_rests_on_the_lips() {
+    let (mut world, _) = floor_with_apertures(&[0.0], 0.5);
+    let ball = world
+        .create_body(&BodyDef::dynamic(Vec2::new(0.05, 1.0)))
+        .unwrap();
+    world
+        .create_shape(
+            ball,
+            &ShapeDef::default(),
+            Circle::new(Vec2::ZERO, 0.7).unwrap(),
+        )
+        .unwrap();
+    let (_, speed, started) = settle(&mut world, ball, 240);
+    // Resting on the lip corners at x = ±0.5: centre at √(0.7² − 0.5²) up.
+    let rest = (0.7 as Real * 0.7 - 0.25).sqrt();
+    let p = world.position(ball).unwrap();
+    if report() {
+        eprintln!("wide ball: rests at {p} (on the lips: y = {rest:.4}), speed {speed:.5}");
+    }
+    assert!(!started, "the ball began crossing");
+    assert!(speed < 0.01, "still moving at {speed}");
+    assert!(
+        p.y > rest - LINEAR_SLOP && p.y < rest + LINEAR_SLOP,
+        "not on the lips: {p}"
+    );
+}
+
+/// A ball that fits (0.8 m in a 1 m aperture) falls in.
+#[test]
+fn ball_within_the_aperture_enters() {
+    let (mut world, _) = floor_with_apertures(&[0.0], 0.5);
+    let ball = world
+        .create_body(&BodyDef::dynamic(Vec2::new(0.05, 1.0)))
+        .unwrap();
+    world
+        .create_shape(
+            ball,
+            &ShapeDef::default(),
+            Circle::new(Vec2::ZERO, 0.4).unwrap(),
+        )
+        .unwrap();
+    let mut completed = false;
+    for _ in 0..120 {
+        world.step(DT).unwrap();
+        completed |= world
+            .portal_events()
+            .iter()
+            .any(|e| matches!(e, PortalEvent::CrossingCompleted { .. }));
+        if completed {
+            break;
+        }
+    }
+    assert!(completed, "the ball never went through");
+    assert!(
+        world.position(ball).unwrap().x < -35.0,
+        "not at the exit wall"
+    );
 }

@@ -230,9 +230,14 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
             angular_velocity: [body_a.state.w, body_b.state.w],
             dt: input.dt,
         };
+        let shapes = crate::portal::PairShapes {
+            shapes: [&sa.geometry, &sb.geometry],
+            transforms: [sim_a.transform, sim_b.transform],
+            speculative,
+        };
         input
             .clipping
-            .clip_manifold(c.body_a, c.body_b, &motion, &mut manifold);
+            .clip_manifold(c.body_a, c.body_b, &motion, Some(&shapes), &mut manifold);
     }
     let offset = [
         sim_a.transform.p - sim_a.center,

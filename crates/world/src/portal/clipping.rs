@@ -49,8 +49,8 @@
 //! ```
 
 use janus2d_core::body::BodyHandle;
-use janus2d_core::geometry::{Manifold, ManifoldPoint};
-use janus2d_core::math::{Real, Vec2};
+use janus2d_core::geometry::{Manifold, ManifoldPoint, RayInput, Shape};
+use janus2d_core::math::{Real, Transform, Vec2};
 
 /// How the two bodies of a contact move at the start of the step (what the
 /// speculative points of a manifold are computed for).
@@ -72,6 +72,18 @@ impl PairMotion {
     fn velocity_at(&self, k: usize, p: Vec2) -> Vec2 {
         self.velocity[k] + self.angular_velocity[k] * (p - self.center[k]).perp()
     }
+}
+
+/// The two shapes of a contact where they are, for the lip points of a
+/// lone point that a hole drops ([`ContactClipping::clip_manifold`]).
+#[derive(Clone, Copy, Debug)]
+pub struct PairShapes<'a> {
+    /// Shape a and shape b.
+    pub shapes: [&'a Shape; 2],
+    /// Their bodies' transforms.
+    pub transforms: [Transform; 2],
+    /// The contact's speculative distance, m.
+    pub speculative: Real,
 }
 
 /// Feature id of a point made where the footprint's low end (point 0's
@@ -229,6 +241,56 @@ impl ContactClipping {
         !crossing
     }
 
+    /// The points where the other body's footprint lies over the lips of
+    /// `clip` (a hole on one of the two bodies): for each lip corner
+    /// `L = P ± w t` the other shape is cast along the face normal from
+    /// below its lowest point through `L`; where it meets the shape within
+    /// the speculative distance of the face, a point at `L` with that
+    /// separation (normal: the face's). A lone point (a circle, a corner)
+    /// dropped in the aperture so leaves a body wider than the aperture
+    /// resting on the lips; one within the span gets none and falls in.
+    fn lip_points(
+        &self,
+        clip: &ApertureClip,
+        body_a: BodyHandle,
+        shapes: &PairShapes<'_>,
+        m: &mut Manifold,
+    ) {
+        let (wall, other) = if clip.body == body_a { (0, 1) } else { (1, 0) };
+        let (shape, xf) = (shapes.shapes[other], &shapes.transforms[other]);
+        let n = clip.normal;
+        let (low, _) = shape.support_extent(xf, n);
+        let low = low - clip.point.dot(n);
+        if low > shapes.speculative {
+            return;
+        }
+        let tangent = n.perp();
+        let margin = 0.1 * clip.half_width + crate::collision::SPECULATIVE_DISTANCE;
+        m.normal = if wall == 0 { n } else { -n };
+        m.point_count = 0;
+        for (side, id) in [(-1.0, LIP_ID_LOW), (1.0, LIP_ID_HIGH)] {
+            let lip = clip.point + side * clip.half_width * tangent;
+            let origin = lip + (low - margin) * n;
+            let ray = RayInput::new(origin, (shapes.speculative - low + margin) * n);
+            let Some(hit) = shape.ray_cast(xf, &ray) else {
+                continue;
+            };
+            let separation = (hit.point - lip).dot(n);
+            if separation >= shapes.speculative {
+                continue;
+            }
+            let point = lip + 0.5 * separation * n;
+            m.points[m.point_count] = ManifoldPoint {
+                point,
+                anchor_a: point - shapes.transforms[0].p,
+                anchor_b: point - shapes.transforms[1].p,
+                separation,
+                id,
+            };
+            m.point_count += 1;
+        }
+    }
+
     /// True when the pair `(a, b)` never touches (a crossing copy and its twin).
     pub(crate) fn ignores(&self, a: BodyHandle, b: BodyHandle) -> bool {
         self.ignored_pairs
@@ -274,7 +336,7 @@ impl ContactClipping {
     ///     point_count: 2,
     /// };
     /// // Both at rest: the points are clipped where they are.
-    /// clipping.clip_manifold(wall, plank, &PairMotion::default(), &mut m);
+    /// clipping.clip_manifold(wall, plank, &PairMotion::default(), None, &mut m);
     /// assert_eq!(m.point_count, 2);
     /// // The end over the aperture moved to the lip at x = 0.5.
     /// assert!((m.points[0].point.x - 0.5).abs() < 1e-5);
@@ -285,6 +347,7 @@ impl ContactClipping {
         body_a: BodyHandle,
         body_b: BodyHandle,
         motion: &PairMotion,
+        shapes: Option<&PairShapes<'_>>,
         m: &mut Manifold,
     ) {
         if m.point_count == 0 {
@@ -337,9 +400,14 @@ impl ContactClipping {
                 .clips
                 .iter()
                 .filter(involved)
-                .any(|c| c.drops(p.point) || (c.hole && c.drops(arrival(c, &p))));
-            if dropped {
+                .find(|c| c.drops(p.point) || (c.hole && c.drops(arrival(c, &p))));
+            if let Some(clip) = dropped {
                 m.point_count = 0;
+                if clip.hole
+                    && let Some(shapes) = shapes
+                {
+                    self.lip_points(clip, body_a, shapes, m);
+                }
             }
             return;
         }
@@ -462,7 +530,7 @@ mod tests {
     fn end_over_an_aperture_moves_to_the_lip_with_interpolated_data() {
         let clipping = floor_with(&[0.0], 0.5);
         let mut m = footprint(-0.3, 3.7, -0.01, -0.03);
-        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), &mut m);
+        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), None, &mut m);
         assert_eq!(m.point_count, 2);
         let u = 0.8 / 4.0;
         let q = m.points[0];
@@ -478,7 +546,7 @@ mod tests {
     fn strip_between_two_apertures_keeps_both_lips() {
         let clipping = floor_with(&[-1.0, 1.0], 0.7);
         let mut m = footprint(-0.6, 0.6, 0.0, 0.0);
-        clipping.clip_manifold(handle(2), handle(1), &PairMotion::default(), &mut m);
+        clipping.clip_manifold(handle(2), handle(1), &PairMotion::default(), None, &mut m);
         assert_eq!(m.point_count, 2);
         assert!((m.points[0].point.x + 0.3).abs() < 1e-5);
         assert!((m.points[1].point.x - 0.3).abs() < 1e-5);
@@ -489,12 +557,12 @@ mod tests {
     fn footprint_within_an_aperture_keeps_nothing() {
         let clipping = floor_with(&[0.0], 0.5);
         let mut m = footprint(-0.4, 0.4, 0.0, 0.0);
-        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), &mut m);
+        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), None, &mut m);
         assert_eq!(m.point_count, 0);
         // Spanning two touching apertures: nothing solid in between.
         let clipping = floor_with(&[-0.5, 0.5], 0.5);
         let mut m = footprint(-0.8, 0.8, 0.0, 0.0);
-        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), &mut m);
+        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), None, &mut m);
         assert_eq!(m.point_count, 0);
     }
 
@@ -503,11 +571,11 @@ mod tests {
         let clipping = floor_with(&[0.0], 0.5);
         let mut m = footprint(-2.0, 2.0, 0.0, 0.0);
         let before = m;
-        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), &mut m);
+        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), None, &mut m);
         assert_eq!(m, before);
         // Another pair of bodies is not clipped at all.
         let mut m = footprint(-0.4, 0.4, 0.0, 0.0);
-        clipping.clip_manifold(handle(3), handle(2), &PairMotion::default(), &mut m);
+        clipping.clip_manifold(handle(3), handle(2), &PairMotion::default(), None, &mut m);
         assert_eq!(m.point_count, 2);
     }
 
@@ -523,15 +591,33 @@ mod tests {
             angular_velocity: [0.0, 0.0],
             dt: 0.2,
         };
-        clipping.clip_manifold(handle(1), handle(2), &motion(Vec2::new(10.0, -1.0)), &mut m);
+        clipping.clip_manifold(
+            handle(1),
+            handle(2),
+            &motion(Vec2::new(10.0, -1.0)),
+            None,
+            &mut m,
+        );
         assert_eq!(m.point_count, 0);
         // Slower, it lands on the lip: kept.
         let mut m = footprint(-0.7, -0.6, 0.1, 0.1);
-        clipping.clip_manifold(handle(1), handle(2), &motion(Vec2::new(0.5, -1.0)), &mut m);
+        clipping.clip_manifold(
+            handle(1),
+            handle(2),
+            &motion(Vec2::new(0.5, -1.0)),
+            None,
+            &mut m,
+        );
         assert_eq!(m.point_count, 2);
         // Moving away: where it is (over the lip), kept.
         let mut m = footprint(-0.7, -0.6, 0.1, 0.1);
-        clipping.clip_manifold(handle(1), handle(2), &motion(Vec2::new(10.0, 1.0)), &mut m);
+        clipping.clip_manifold(
+            handle(1),
+            handle(2),
+            &motion(Vec2::new(10.0, 1.0)),
+            None,
+            &mut m,
+        );
         assert_eq!(m.point_count, 2);
     }
 
@@ -541,12 +627,12 @@ mod tests {
         // Body 2 crosses aperture 5 (another pair): the floor's hole holds it.
         clipping.copies.push((handle(2), 5));
         let mut m = footprint(-0.4, 0.4, 0.0, 0.0);
-        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), &mut m);
+        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), None, &mut m);
         assert_eq!(m.point_count, 2);
         // Crossing through this very aperture: the hole is open.
         clipping.copies.push((handle(2), 0));
         let mut m = footprint(-0.4, 0.4, 0.0, 0.0);
-        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), &mut m);
+        clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), None, &mut m);
         assert_eq!(m.point_count, 0);
     }
 }

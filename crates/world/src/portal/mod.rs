@@ -18,7 +18,7 @@ mod noop;
 #[cfg(feature = "portals")]
 mod stage;
 
-pub use clipping::{ApertureClip, ContactClipping, NO_CLIPPING, PairMotion};
+pub use clipping::{ApertureClip, ContactClipping, NO_CLIPPING, PairMotion, PairShapes};
 #[cfg(not(feature = "portals"))]
 pub(crate) use noop::PortalStage;
 #[cfg(feature = "portals")]
