@@ -282,11 +282,18 @@ fn body_at_two_portals_is_held_by_the_second_wall() {
         worst <= LINEAR_SLOP,
         "sank {worst} m into the second aperture"
     );
+    // Half a second on, sliding on the exit floor at its speed.
+    for _ in 0..30 {
+        world.step(DT).unwrap();
+    }
     let p = world.position(plank).unwrap();
     let v = world.linear_velocity(plank).unwrap();
+    if report() {
+        eprintln!("two portals: out at {p}, velocity {v}");
+    }
     assert!(p.x > 31.0 && p.y.abs() < 0.3, "not out of the exit: {p}");
     assert!(
-        (v.x - 4.0).abs() < 0.2 && v.y.abs() < 0.2,
+        (v.x - 4.0).abs() < 0.2 && v.y.abs() < 0.05,
         "exit velocity {v}"
     );
 }
