@@ -22,14 +22,18 @@
 //! | straddle  | every step                                                  | masses and inertias weighted by `f₁`, `f₂` (clamped to `[F_MIN, 1 − F_MIN]`) |
 //! | handover  | the original is entirely behind the entry plane            | the handle moves to the clone's body, the original's body is removed, [`PortalEvent::CrossingCompleted`] |
 //! | cancel    | the clone is entirely behind the exit plane (backed out)   | clone removed, [`PortalEvent::CrossingCancelled`] |
+//! | restart   | a copy's shapes changed (one destroyed or added)            | clone removed; the original may start again at once with its shapes |
 //!
-//! Contacts: the aperture is a hole in the body that carries the portal
-//! (the lips still collide); a crossing copy drops its contact points that
-//! lie behind its own portal plane within the aperture; a copy never touches
-//! its twin. A body takes part in at most one crossing: while it crosses it
-//! ignores every other portal. A joint attached to a body that hands over
-//! would span the portal: it is disabled and reported
-//! ([`PortalEvent::JointDisabled`]).
+//! Contacts: the wall that carries a portal collides as its solid parts
+//! (manifolds clipped to them, with points at the lips; see [`super::clipping`]);
+//! a crossing copy drops its contact points that lie behind its own portal
+//! plane within the aperture; a copy never touches its twin. A body takes
+//! part in at most one crossing: while it crosses it ignores every other
+//! portal, whose hole is solid wall to it. A joint attached to a body that
+//! hands over would span the portal: it is disabled and reported
+//! ([`PortalEvent::JointDisabled`]), as is a joint between the two copies.
+//! `η` lies in [`ETA_MIN`](janus2d_constraints::portal_map::ETA_MIN) to
+//! [`ETA_MAX`](janus2d_constraints::portal_map::ETA_MAX).
 //!
 //! The whole stage is skipped when the world has no portal pair.
 
