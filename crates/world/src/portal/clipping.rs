@@ -429,20 +429,15 @@ impl ContactClipping {
         for _ in 0..=2 * self.clips.len() {
             let mut moved = false;
             for (lo, hi) in intervals() {
-                if lo < u_low && u_low < hi {
+                // A region covers the parameter where a search coming from
+                // outside enters it (two regions that touch leave nothing
+                // solid between them) but not where it leaves it (that
+                // edge, the lip, is solid).
+                if lo <= u_low && u_low < hi {
                     u_low = hi;
                     moved = true;
                 }
-                if lo < u_high && u_high < hi {
-                    u_high = lo;
-                    moved = true;
-                }
-                // Closed ends: a region that starts exactly at an end.
-                if u_low == 0.0 && lo <= 0.0 && hi > 0.0 {
-                    u_low = hi;
-                    moved = true;
-                }
-                if u_high == 1.0 && hi >= 1.0 && lo < 1.0 {
+                if lo < u_high && u_high <= hi {
                     u_high = lo;
                     moved = true;
                 }
