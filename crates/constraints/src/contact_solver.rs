@@ -391,6 +391,10 @@ impl ContactSolver {
                 let (m_a, i_a) = oa.map_or((m_a, i_a), |o| (o.inv_mass, o.inv_inertia));
                 let (m_b, i_b) = ob.map_or((m_b, i_b), |o| (o.inv_mass, o.inv_inertia));
                 c.prepare_rows(ctx, bodies, [m_a, i_a, m_b, i_b]);
+                // The object masses stand for the copy and its twin joined
+                // by the portal rows, not for the copy alone: the two points
+                // are solved one by one, not as one block.
+                c.block = false;
             }
         }
     }

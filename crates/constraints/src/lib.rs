@@ -25,7 +25,7 @@ pub mod revolute;
 pub use contact::{ContactConstraint, ContactPointInput};
 pub use contact_solver::{ContactBatch, ContactSolver, ObjectMass, PointImpulse};
 pub use joint_tree::{JointForest, RevoluteBatch};
-pub use portal::{PortalConstraint, PortalConstraintDef};
+pub use portal::{PortalBatch, PortalConstraint, PortalConstraintDef};
 pub use portal_map::{Portal, PortalError, PortalMap, PortalPair};
 pub use revolute::{RevoluteJoint, RevoluteJointDef};
 

@@ -142,7 +142,9 @@
 //! ```
 
 use janus2d_core::body::{BodyHandle, BodySet, BodySim, BodyState, BodyType};
-use janus2d_core::constraint::{Block, BodyJacobian, Constraint, ConstraintRows, Row, StepContext};
+use janus2d_core::constraint::{
+    Block, BodyJacobian, Constraint, ConstraintBatch, ConstraintRows, Row, SolverMode, StepContext,
+};
 use janus2d_core::math::{Mat3, PI, Real, Vec2, cross, cross_sv, wrap_angle};
 use janus2d_core::softness::Softness;
 use smallvec::SmallVec;
@@ -678,6 +680,85 @@ impl PortalConstraint {
             ),
             eta: self.def.eta,
         }
+    }
+}
+
+/// Stiffness of the late portal pass, Hz: the substep rate at 60 Hz × 4.
+/// Its own constant rather than the direct joints' (those are solved
+/// exactly and stand far stiffer springs, 500 Hz; portal rows that stiff in
+/// Gauss–Seidel let a blocked straddling body slide off its crossing).
+pub const PORTAL_STIFF_HERTZ: Real = 240.0;
+
+impl PortalConstraint {
+    /// The late, stiff pass ([`PortalBatch`]): one more solve of the rows
+    /// after every other batch in the same sweep, at [`PORTAL_STIFF_HERTZ`]
+    /// with the joint damping ratio, so that the contacts pushing a copy
+    /// cannot leave the two copies apart.
+    pub fn solve_stiff(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
+        if !self.enabled {
+            return;
+        }
+        let stiff = Softness::new(PORTAL_STIFF_HERTZ, ctx.joint_damping_ratio, ctx.h);
+        self.part.solve(
+            states,
+            self.ix,
+            stiff,
+            ctx.joint_max_correction_speed,
+            use_bias,
+            self.fast,
+            self.merged_ab,
+        );
+    }
+}
+
+/// The portal constraints as the solver's batch.
+///
+/// | stage | what |
+/// |-------|------|
+/// | `solve` | the soft solve of every constraint (joint softness), with the other batches |
+/// | `solve_late` | in the soft step, a second solve at [`PORTAL_STIFF_HERTZ`], after the contacts: the portal rows have the last word, as the exact joint tree does |
+///
+/// A contact that presses one copy hard (the portal bodies landing, a
+/// stack on a straddling body, a copy pressed into a wall) then leaves
+/// `|C|` under a millimetre instead of the soft rows' few millimetres.
+#[derive(Debug)]
+pub struct PortalBatch<'a> {
+    /// The constraints, one per crossing.
+    pub constraints: &'a mut Vec<PortalConstraint>,
+}
+
+impl ConstraintBatch for PortalBatch<'_> {
+    fn count(&self) -> usize {
+        self.constraints.count()
+    }
+    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
+        self.constraints.prepare(ctx, bodies);
+    }
+    fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+        self.constraints.warm_start(ctx, states);
+    }
+    fn solve(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+    ) {
+        ConstraintBatch::solve(self.constraints, ctx, states, use_bias, reverse);
+    }
+    fn solve_late(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
+        if ctx.mode != SolverMode::SoftStep {
+            return;
+        }
+        for c in self.constraints.iter_mut() {
+            c.solve_stiff(ctx, states, use_bias);
+        }
+    }
+    fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+        self.constraints.apply_restitution(ctx, states);
+    }
+    fn store_impulses(&mut self) {
+        self.constraints.store_impulses();
     }
 }
 

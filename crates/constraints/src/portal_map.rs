@@ -83,6 +83,11 @@ use janus2d_core::math::{Real, Rot, Transform, Vec2, cross, cross_sv, vec_is_fin
 pub enum PortalError {
     /// The scale `η` is ≤ 0, NaN or infinite.
     InvalidScale,
+    /// The scale `η` is finite and positive but outside
+    /// [`ETA_MIN`, `ETA_MAX`]: beyond it a crossing's clone is so large or
+    /// small against the original that the pair cannot be solved well
+    /// (`η = 1e30` made the portal a hole; `η = 1e3` left a crossing hanging).
+    ScaleOutOfRange,
     /// A portal direction is zero (or too short to normalise).
     ZeroDirection,
     /// A portal half-width is ≤ 0.
@@ -98,6 +103,9 @@ impl std::fmt::Display for PortalError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             PortalError::InvalidScale => write!(f, "portal scale η must be finite and > 0"),
+            PortalError::ScaleOutOfRange => {
+                write!(f, "portal scale η must lie in [{ETA_MIN}, {ETA_MAX}]")
+            }
             PortalError::ZeroDirection => write!(f, "portal direction must be non-zero"),
             PortalError::NonPositiveHalfWidth => write!(f, "portal half-width must be > 0"),
             PortalError::NonFinite(field) => write!(f, "portal field `{field}` is not finite"),
@@ -111,12 +119,32 @@ impl std::fmt::Display for PortalError {
 
 impl std::error::Error for PortalError {}
 
-/// Checks a portal scale `η`: finite and > 0.
+/// Smallest portal scale `η` accepted (dimensionless): the clone of a body
+/// is at least a hundredth of its size.
+pub const ETA_MIN: Real = 1e-2;
+/// Largest portal scale `η` accepted (dimensionless): the clone of a body
+/// is at most a hundred times its size (`1/ETA_MIN`, so the inverse map of
+/// an accepted pair is accepted too).
+pub const ETA_MAX: Real = 1e2;
+
+/// Checks a portal scale `η`: finite, > 0 ([`PortalError::InvalidScale`])
+/// and within [`ETA_MIN`, `ETA_MAX`] ([`PortalError::ScaleOutOfRange`]).
+///
+/// ```
+/// use janus2d_constraints::portal_map::{PortalError, validate_eta};
+/// assert!(validate_eta(2.0).is_ok());
+/// assert_eq!(validate_eta(-1.0), Err(PortalError::InvalidScale));
+/// assert_eq!(validate_eta(1e3), Err(PortalError::ScaleOutOfRange));
+/// ```
 pub fn validate_eta(eta: Real) -> Result<(), PortalError> {
-    if eta.is_finite() && eta > 0.0 {
-        Ok(())
-    } else {
+    if !(eta.is_finite() && eta > 0.0) {
         Err(PortalError::InvalidScale)
+    } else if eta.max(1.0 / eta) > ETA_MAX * (1.0 + 16.0 * Real::EPSILON) {
+        // Symmetric in η and 1/η (a pair is crossed both ways), with a few
+        // ulps of room so that the inverse of an accepted scale passes.
+        Err(PortalError::ScaleOutOfRange)
+    } else {
+        Ok(())
     }
 }
 
@@ -467,6 +495,16 @@ mod tests {
             PortalPair::new(p, p, Real::INFINITY),
             Err(PortalError::InvalidScale)
         );
+        for eta in [1e3, 1e30, 1e-3, 100.5, 0.0099] {
+            assert_eq!(
+                PortalPair::new(p, p, eta),
+                Err(PortalError::ScaleOutOfRange),
+                "η {eta}"
+            );
+        }
+        for eta in [ETA_MIN, ETA_MAX, 1.0 / ETA_MIN, 1.0 / ETA_MAX, 1.0] {
+            assert!(PortalPair::new(p, p, eta).is_ok(), "η {eta}");
+        }
         assert_eq!(
             Portal::new(Vec2::new(Real::NAN, 0.0), Vec2::X, 1.0),
             Err(PortalError::NonFinite("anchor"))

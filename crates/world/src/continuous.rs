@@ -317,7 +317,7 @@ impl ContinuousStage {
                         &hit_proxy,
                         &sweep.transform_at(fraction),
                     );
-                    if input.clipping.in_hole(other.body, d.point_a) {
+                    if input.clipping.in_hole_for(other.body, body, d.point_a) {
                         continue;
                     }
                 }

@@ -56,7 +56,10 @@ pub use islands::SleepSettings;
 pub use joints::{JointHandle, JointKind, JointSet};
 pub use narrowphase::{PreSolve, PreSolveFn};
 #[cfg(feature = "portals")]
-pub use portal::{MassModel, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle};
+pub use portal::{
+    CrossingRole, MassModel, PlaneSide, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle,
+    PortalSide,
+};
 pub use profile::{StepCounters, StepProfile};
 pub use query::{PortalHop, QueryFilter, QueryProblem, RayHit, ShapeOverlap};
 pub use shapes::{Filter, ShapeData, ShapeDef, ShapeHandle};

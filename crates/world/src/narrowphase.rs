@@ -245,7 +245,7 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
     // speculative distance along x or y: the shapes are too, no point can
     // come within it, and the manifold is empty without computing it.
     let gap = (sa.aabb.lower - sb.aabb.upper).max(sb.aabb.lower - sa.aabb.upper);
-    let manifold = if gap.x > speculative || gap.y > speculative {
+    let mut manifold = if gap.x > speculative || gap.y > speculative {
         Manifold::default()
     } else {
         collide(
@@ -256,6 +256,24 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
             speculative,
         )
     };
+    if !input.clipping.is_empty() {
+        // Before the manifold is stored, so that points made at aperture
+        // edges warm-start by their ids like any other.
+        let motion = crate::portal::PairMotion {
+            center: [sim_a.center, sim_b.center],
+            velocity: [body_a.state.v, body_b.state.v],
+            angular_velocity: [body_a.state.w, body_b.state.w],
+            dt: input.dt,
+        };
+        let shapes = crate::portal::PairShapes {
+            shapes: [&sa.geometry, &sb.geometry],
+            transforms: [sim_a.transform, sim_b.transform],
+            speculative,
+        };
+        input
+            .clipping
+            .clip_manifold(c.body_a, c.body_b, &motion, Some(&shapes), &mut manifold);
+    }
     let offset = [
         sim_a.transform.p - sim_a.center,
         sim_b.transform.p - sim_b.center,
@@ -263,9 +281,6 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
     let was_touching = c.touching;
     update_manifold(c, &manifold, offset);
     c.still = [body_a.state_index == 0, body_b.state_index == 0];
-    if !input.clipping.is_empty() {
-        input.clipping.apply(c);
-    }
     c.touching = c.point_count > 0;
     let wake = c.touching && {
         let other = if c.still[0] {

@@ -1485,8 +1485,11 @@ impl World {
             solver: &mut self.contact_solver,
             object_masses: &self.object_masses,
         };
+        let mut portals = janus2d_constraints::PortalBatch {
+            constraints: self.portals.constraints_mut(),
+        };
         let mut batches: [&mut dyn ConstraintBatch; 3] =
-            [&mut revolute, &mut contacts, self.portals.constraints_mut()];
+            [&mut revolute, &mut contacts, &mut portals];
         let mut report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
         // The solver checks velocities and deltas; a pose they carried out
         // of the world (or to inf) is put back here, before any box is

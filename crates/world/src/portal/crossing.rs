@@ -4,6 +4,7 @@
 //!
 //! ```text
 //! review (crossings in progress, in order)
+//!   a copy's shapes changed (one destroyed or added) → Restart(original)
 //!   original entirely behind the entry plane   → Complete(original)
 //!   clone entirely behind the exit plane       → Cancel(original)
 //!   otherwise                                  → Weigh(original)
@@ -25,7 +26,7 @@ use janus2d_core::math::{Real, cross};
 
 use super::stage::{PairData, PortalStage};
 use crate::broadphase::BroadPhase;
-use crate::shapes::ShapeStore;
+use crate::shapes::{ShapeHandle, ShapeStore};
 
 /// What the world does for the crossing stage, in order.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,6 +37,10 @@ pub(crate) enum PortalCommand {
     Cancel(BodyHandle),
     /// Both copies straddle: re-weigh their masses by area in front.
     Weigh(BodyHandle),
+    /// A copy's shapes changed since the clone was made: the clone is
+    /// removed and the original may start again in the same step, with
+    /// the shapes it has now.
+    Restart(BodyHandle),
     /// A body enters portal `entry` (0: a, 1: b) of pair slot `pair`.
     Start {
         /// Pair slot.
@@ -58,7 +63,12 @@ impl PortalStage {
             let behind = |body, f: &PortalFrame| {
                 extents_in(bodies, shapes, body, f).is_some_and(|e| e.1 < 0.0)
             };
-            out.push(if behind(c.original, &f_entry) {
+            let owner = bodies.owner();
+            let changed = shape_handles(shapes, c.original, owner) != c.original_shapes
+                || shape_handles(shapes, c.clone, owner) != c.clone_shapes;
+            out.push(if changed {
+                PortalCommand::Restart(c.original)
+            } else if behind(c.original, &f_entry) {
                 PortalCommand::Complete(c.original)
             } else if behind(c.clone, &f_exit) {
                 PortalCommand::Cancel(c.original)
@@ -128,6 +138,16 @@ fn frame(bodies: &BodySet, d: &PairData, k: usize) -> PortalFrame {
         &bodies.solver_body(d.portals[k].body).sim.transform,
         &d.local[k],
     )
+}
+
+/// The handles of a body's shapes, in the store's order (generations
+/// tell a shape made in a freed slot from the one that was there).
+pub(crate) fn shape_handles(shapes: &ShapeStore, body: BodyHandle, owner: u32) -> Vec<ShapeHandle> {
+    shapes
+        .of_body(body)
+        .iter()
+        .map(|&s| shapes.handle_of(s, owner))
+        .collect()
 }
 
 /// Extents `(min_n, max_n, min_t, max_t)` of a body's shapes in a portal

@@ -5,7 +5,7 @@
 //! | `stage.rs` | pairs, crossings, clones, handover, weights; the portal API on `World`, and where the world applies the stage's commands (with the `portals` feature) |
 //! | `crossing.rs` | the crossing stage's decisions, read from bodies, shapes and the broadphase, returned as commands |
 //! | `noop.rs` | the stage's twin without the feature: no state, every step call does nothing |
-//! | [`clipping`] | aperture regions where the narrowphase drops contact points |
+//! | [`clipping`] | apertures as geometry: manifolds clipped to a wall's solid parts (points at the lips, speculative points tested where they arrive), copies' far sides, ignored pairs |
 //!
 //! The world calls the stage in the same places with or without the
 //! feature; only which twin is compiled changes.
@@ -18,12 +18,13 @@ mod noop;
 #[cfg(feature = "portals")]
 mod stage;
 
-pub use clipping::{ApertureClip, ContactClipping, NO_CLIPPING};
+pub use clipping::{ApertureClip, ContactClipping, NO_CLIPPING, PairMotion, PairShapes};
 #[cfg(not(feature = "portals"))]
 pub(crate) use noop::PortalStage;
 #[cfg(feature = "portals")]
 pub(crate) use stage::PortalStage;
 #[cfg(feature = "portals")]
 pub use stage::{
-    F_MIN, MassModel, PortalCounters, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle,
+    CrossingRole, F_MIN, MassModel, PlaneSide, PortalCounters, PortalDef, PortalEvent,
+    PortalPairDef, PortalPairHandle, PortalSide,
 };

@@ -22,14 +22,18 @@
 //! | straddle  | every step                                                  | masses and inertias weighted by `f₁`, `f₂` (clamped to `[F_MIN, 1 − F_MIN]`) |
 //! | handover  | the original is entirely behind the entry plane            | the handle moves to the clone's body, the original's body is removed, [`PortalEvent::CrossingCompleted`] |
 //! | cancel    | the clone is entirely behind the exit plane (backed out)   | clone removed, [`PortalEvent::CrossingCancelled`] |
+//! | restart   | a copy's shapes changed (one destroyed or added)            | clone removed; the original may start again at once with its shapes |
 //!
-//! Contacts: the aperture is a hole in the body that carries the portal
-//! (the lips still collide); a crossing copy drops its contact points that
-//! lie behind its own portal plane within the aperture; a copy never touches
-//! its twin. A body takes part in at most one crossing: while it crosses it
-//! ignores every other portal. A joint attached to a body that hands over
-//! would span the portal: it is disabled and reported
-//! ([`PortalEvent::JointDisabled`]).
+//! Contacts: the wall that carries a portal collides as its solid parts
+//! (manifolds clipped to them, with points at the lips; see [`super::clipping`]);
+//! a crossing copy drops its contact points that lie behind its own portal
+//! plane within the aperture; a copy never touches its twin. A body takes
+//! part in at most one crossing: while it crosses it ignores every other
+//! portal, whose hole is solid wall to it. A joint attached to a body that
+//! hands over would span the portal: it is disabled and reported
+//! ([`PortalEvent::JointDisabled`]), as is a joint between the two copies.
+//! `η` lies in [`ETA_MIN`](janus2d_constraints::portal_map::ETA_MIN) to
+//! [`ETA_MAX`](janus2d_constraints::portal_map::ETA_MAX).
 //!
 //! The whole stage is skipped when the world has no portal pair.
 
@@ -40,9 +44,10 @@ use janus2d_core::math::{Real, Rot, Vec2};
 use janus2d_core::slots::Slots;
 
 use super::clipping::{ApertureClip, ContactClipping};
-use super::crossing::{PortalCommand, extents_in, front_fraction};
+use super::crossing::{PortalCommand, extents_in, front_fraction, shape_handles};
 use crate::error::WorldError;
 use crate::joints::JointHandle;
+use crate::shapes::ShapeHandle;
 use crate::world::World;
 use janus2d_core::body::BodySet;
 use janus2d_core::handle::{Handle, PortalPairTag};
@@ -109,7 +114,26 @@ pub struct PortalPairDef {
 }
 
 impl PortalPairDef {
-    /// A pair with `η = w_b / w_a` and the same-material mass model.
+    /// A pair with `η = w_b / w_a` and the same-material mass model; set
+    /// either with [`with_eta`](Self::with_eta) and
+    /// [`with_mass_model`](Self::with_mass_model).
+    ///
+    /// ```
+    /// use janus2d_core::body::BodyDef;
+    /// use janus2d_core::math::Vec2;
+    /// use janus2d_world::{MassModel, PortalDef, PortalPairDef, World, WorldDef};
+    ///
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let floor = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    /// let wall = world.create_body(&BodyDef::fixed(Vec2::new(10.0, 0.0))).unwrap();
+    /// let at = |body| PortalDef { body, anchor: Vec2::ZERO, direction: Vec2::Y, half_width: 0.5 };
+    /// let def = PortalPairDef::new(at(floor), at(wall))
+    ///     .with_eta(2.0)
+    ///     .with_mass_model(MassModel::EnergyPreserving);
+    /// let pair = world.create_portal_pair(&def).unwrap();
+    /// assert_eq!(world.portal_map(pair).unwrap().eta, 2.0);
+    /// ```
+    #[must_use]
     pub fn new(portal_a: PortalDef, portal_b: PortalDef) -> Self {
         PortalPairDef {
             portal_a,
@@ -118,6 +142,68 @@ impl PortalPairDef {
             mass_model: MassModel::SameMaterial,
         }
     }
+
+    /// The same pair with scale `eta` from a to b (instead of `w_b / w_a`);
+    /// checked by [`World::create_portal_pair`] (finite, within
+    /// [`ETA_MIN`](janus2d_constraints::portal_map::ETA_MIN) to
+    /// [`ETA_MAX`](janus2d_constraints::portal_map::ETA_MAX)).
+    #[must_use]
+    pub fn with_eta(self, eta: Real) -> Self {
+        PortalPairDef {
+            eta: Some(eta),
+            ..self
+        }
+    }
+
+    /// The same pair with mass model `mass_model` for its clones.
+    #[must_use]
+    pub fn with_mass_model(self, mass_model: MassModel) -> Self {
+        PortalPairDef { mass_model, ..self }
+    }
+}
+
+/// Where a body is against one portal's plane (its shapes' extent along
+/// the outward normal).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlaneSide {
+    /// Entirely in front of the plane (the side it is entered from).
+    Front,
+    /// Partly in front, partly behind.
+    Straddling,
+    /// Entirely behind the plane.
+    Behind,
+}
+
+/// A body's role in a crossing through a pair.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CrossingRole {
+    /// Not crossing through this pair.
+    None,
+    /// The original, entering portal `entry` (0: a, 1: b).
+    Original {
+        /// The portal it entered.
+        entry: usize,
+    },
+    /// The clone, emerging from the partner of portal `entry`.
+    Clone {
+        /// The portal the original entered.
+        entry: usize,
+    },
+}
+
+/// Where a body is against a portal pair (see [`World::portal_side`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PortalSide {
+    /// Against portal a's plane.
+    pub a: PlaneSide,
+    /// Against portal b's plane.
+    pub b: PlaneSide,
+    /// Within the aperture's span along the plane (`|t| ≤ w`), per portal:
+    /// a body that straddles a plane while within the span is in the
+    /// aperture; outside it, it is in the wall or beside it.
+    pub within: [bool; 2],
+    /// Its part in a crossing through the pair.
+    pub crossing: CrossingRole,
 }
 
 /// A generational handle to a portal pair.
@@ -191,6 +277,10 @@ pub(crate) struct Crossing {
     pub(crate) clone: BodyHandle,
     pub(crate) mass_original: BodyMass,
     pub(crate) mass_clone: BodyMass,
+    /// The original's shapes when the clone was made.
+    pub(crate) original_shapes: Vec<ShapeHandle>,
+    /// The clone's shapes (the original's, scaled).
+    pub(crate) clone_shapes: Vec<ShapeHandle>,
 }
 
 /// The portal stage: pairs, crossings and their constraints, the clipping
@@ -258,7 +348,8 @@ impl PortalStage {
         let mut clipping = std::mem::take(&mut self.clipping);
         clipping.clips.clear();
         clipping.ignored_pairs.clear();
-        for (_, d) in self.pairs.iter() {
+        clipping.copies.clear();
+        for (index, d) in self.pairs.iter() {
             for k in 0..2 {
                 let f = frame_in(bodies, &d.portals[k], &d.local[k]);
                 clipping.clips.push(ApertureClip {
@@ -267,6 +358,7 @@ impl PortalStage {
                     normal: f.normal,
                     half_width: d.local[k].half_width,
                     hole: true,
+                    aperture: 2 * index + k as u32,
                 });
             }
         }
@@ -281,7 +373,9 @@ impl PortalStage {
                     normal: f.normal,
                     half_width: d.local[side].half_width,
                     hole: false,
+                    aperture: 2 * c.pair + side as u32,
                 });
+                clipping.copies.push((body, 2 * c.pair + side as u32));
             }
             clipping.ignored_pairs.push((c.original, c.clone));
         }
@@ -549,6 +643,75 @@ impl World {
         &self.portals.constraints
     }
 
+    /// The pair's map from portal a to portal b at the portal bodies'
+    /// present poses: `T(x) = P_b + η Q (x − P_a)` ([`PortalMap::map_point`]),
+    /// `Q` ([`PortalMap::rotation`]) and `η`. Its
+    /// [`inverse`](PortalMap::inverse) maps b to a.
+    pub fn portal_map(&self, pair: PortalPairHandle) -> Result<PortalMap, WorldError> {
+        let index = self.pair_slot(pair)?;
+        let d = self.portals.pairs.at(index).expect("live pair");
+        Ok(PortalMap {
+            frame1: frame_of(self, &d.portals[0], &d.local[0]),
+            frame2: frame_of(self, &d.portals[1], &d.local[1]),
+            eta: d.eta,
+        })
+    }
+
+    /// Where `body` is against the two portals of `pair` (from its shapes'
+    /// extents; a body without shapes reads as at its centre of mass) and
+    /// its part in a crossing through the pair.
+    ///
+    /// Errors: a stale or foreign body or pair handle.
+    pub fn portal_side(
+        &self,
+        body: BodyHandle,
+        pair: PortalPairHandle,
+    ) -> Result<PortalSide, WorldError> {
+        self.check_body(body)?;
+        let index = self.pair_slot(pair)?;
+        let d = self.portals.pairs.at(index).expect("live pair");
+        let shapes = &self.collision_ref().shapes;
+        let center = self.bodies().sim(body).map_or(Vec2::ZERO, |s| s.center);
+        let mut sides = [PlaneSide::Front; 2];
+        let mut within = [false; 2];
+        for k in 0..2 {
+            let f = frame_of(self, &d.portals[k], &d.local[k]);
+            let (n0, n1, t0, t1) =
+                extents_in(self.bodies(), shapes, body, &f).unwrap_or_else(|| {
+                    let s = (center - f.point).dot(f.normal);
+                    let t = (center - f.point).dot(f.tangent);
+                    (s, s, t, t)
+                });
+            sides[k] = if n0 >= 0.0 {
+                PlaneSide::Front
+            } else if n1 <= 0.0 {
+                PlaneSide::Behind
+            } else {
+                PlaneSide::Straddling
+            };
+            let w = d.local[k].half_width;
+            within[k] = t0 >= -w && t1 <= w;
+        }
+        let crossing = self
+            .portals
+            .crossings
+            .iter()
+            .find(|c| c.pair == index && (c.original == body || c.clone == body))
+            .map_or(CrossingRole::None, |c| {
+                if c.original == body {
+                    CrossingRole::Original { entry: c.entry }
+                } else {
+                    CrossingRole::Clone { entry: c.entry }
+                }
+            });
+        Ok(PortalSide {
+            a: sides[0],
+            b: sides[1],
+            within,
+            crossing,
+        })
+    }
+
     /// The current map (T, Q, η) of a crossing's portal constraint, at the
     /// portal bodies' present poses.
     pub fn portal_constraint_map(&self, constraint: &PortalConstraint) -> PortalMap {
@@ -625,6 +788,9 @@ impl World {
         self.portals.events.clear();
         let mut counters = PortalCounters::default();
         let mut crossed: Vec<BodyHandle> = Vec::new();
+        // 0. A joint between the two copies of one object would hold it
+        // against its own map: disabled, so that the crossing can end.
+        self.unjoin_copies();
         // 1. Crossings in progress: hand over, cancel, or re-weight.
         let review = self
             .portals
@@ -644,6 +810,33 @@ impl World {
         }
         counters.active_crossings = self.portals.crossings.len();
         self.portals.counters = counters;
+    }
+
+    /// Disables every enabled joint between a crossing's two copies and
+    /// reports it ([`PortalEvent::JointDisabled`]).
+    fn unjoin_copies(&mut self) {
+        for k in 0..self.portals.crossings.len() {
+            let (original, clone, index) = {
+                let c = &self.portals.crossings[k];
+                (c.original, c.clone, c.pair)
+            };
+            let between: Vec<JointHandle> = self
+                .joints_attached_to(original)
+                .into_iter()
+                .filter(|j| {
+                    self.joints.bodies_of(*j).is_ok_and(|(a, b)| {
+                        (a == original && b == clone) || (a == clone && b == original)
+                    })
+                })
+                .collect();
+            let pair = self.pair_handle(index);
+            for joint in between {
+                self.disable_joint(joint);
+                self.portals
+                    .events
+                    .push(PortalEvent::JointDisabled { joint, pair });
+            }
+        }
     }
 
     /// Applies one command of the crossing stage.
@@ -674,6 +867,21 @@ impl World {
                     self.cancel_crossing(k);
                     counters.cancelled += 1;
                     crossed.push(original);
+                }
+            }
+            PortalCommand::Restart(original) => {
+                if let Some(k) = self.portals.crossing_of(original) {
+                    self.cancel_crossing(k);
+                    counters.cancelled += 1;
+                    // The mass it had at the start is stale: its shapes
+                    // give it now (unless the user set one).
+                    let follows = self
+                        .bodies()
+                        .record(original)
+                        .is_some_and(|r| !r.mass_override);
+                    if follows && self.bodies().body_type(original) == Some(BodyType::Dynamic) {
+                        self.update_mass_from_shapes(original);
+                    }
                 }
             }
             PortalCommand::Weigh(original) => {
@@ -767,6 +975,9 @@ impl World {
             }
             self.add_shape_unchecked(clone, def, geometry);
         }
+        let owner = self.bodies().owner();
+        let original_shapes = shape_handles(&self.collision_ref().shapes, body, owner);
+        let clone_shapes = shape_handles(&self.collision_ref().shapes, clone, owner);
         self.apply_mass_keep_velocity(clone, mass_clone);
         self.set_velocity_unchecked(
             clone,
@@ -793,6 +1004,8 @@ impl World {
             clone,
             mass_original: full,
             mass_clone,
+            original_shapes,
+            clone_shapes,
         });
         self.portals.constraints.push(constraint);
         let pair = self.pair_handle(index);
