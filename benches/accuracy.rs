@@ -354,8 +354,11 @@ fn knobs() -> Vec<Knob> {
             name: "contact_hertz",
             needs: Needs::Shapes,
             color: RGBColor(44, 160, 44),
+            // The cap at a fraction of the substep rate lifted, so that the
+            // knob sets the stiffness the contacts solve with.
             values: vary(&[15.0, 30.0, 60.0, 120.0], &|s, v| {
-                s.contact_hertz = v as Real
+                s.contact_hertz = v as Real;
+                s.contact_hertz_fraction = Real::INFINITY;
             }),
         },
         Knob {
@@ -363,7 +366,8 @@ fn knobs() -> Vec<Knob> {
             needs: Needs::Joints,
             color: RGBColor(148, 103, 189),
             values: vary(&[15.0, 30.0, 60.0, 120.0], &|s, v| {
-                s.joint_hertz = v as Real
+                s.joint_hertz = v as Real;
+                s.joint_hertz_fraction = Real::INFINITY;
             }),
         },
         Knob {
