@@ -33,7 +33,11 @@ struct PyramidFigures {
 }
 
 fn run_pyramid(base: usize, seconds: usize) -> PyramidFigures {
-    let mut scene = scenes::large_pyramid(&scenes::shared_settings(), base);
+    run_pyramid_with(&scenes::shared_settings(), base, seconds)
+}
+
+fn run_pyramid_with(def: &WorldDef, base: usize, seconds: usize) -> PyramidFigures {
+    let mut scene = scenes::large_pyramid(def, base);
     let top0 = scene.world.position(scene.probe).unwrap();
     let steps = seconds * 60;
     let mut f = PyramidFigures {
@@ -419,14 +423,18 @@ fn mass_ratio_sweep() {
 /// 30 Hz the pyramid collapsed (sink 38 m).
 #[test]
 fn large_pyramid_stands_at_2_substeps() {
-    let mut case = hard::large_pyramid();
-    case.desc.settings.substeps = 2;
-    case.bounds = vec![
-        hard::Bound::AtMost(hard::Figure::Sink, 3.0),
-        hard::Bound::AtMost(hard::Figure::Drift, 0.5),
-        hard::Bound::AtMost(hard::Figure::LateProbeSpeed, 0.05),
-    ];
-    assert_case(case);
+    let mut def = scenes::shared_settings();
+    def.solver.substeps = 2;
+    let f = run_pyramid_with(&def, 100, 10);
+    if report() {
+        eprintln!(
+            "large pyramid, 2 substeps: sink {:.4} m, drift {:.4} m, last-second speed {:.5} m/s",
+            f.sink, f.drift, f.last_second_speed
+        );
+    }
+    assert!(f.sink <= 3.0, "sink {}", f.sink);
+    assert!(f.drift <= 0.5, "drift {}", f.drift);
+    assert!(f.last_second_speed <= 0.05, "speed {}", f.last_second_speed);
 }
 
 /// 40 circles with 1 m of error at every joint: every joint back within
