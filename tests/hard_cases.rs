@@ -33,7 +33,11 @@ struct PyramidFigures {
 }
 
 fn run_pyramid(base: usize, seconds: usize) -> PyramidFigures {
-    let mut scene = scenes::large_pyramid(&scenes::shared_settings(), base);
+    run_pyramid_with(&scenes::shared_settings(), base, seconds)
+}
+
+fn run_pyramid_with(def: &WorldDef, base: usize, seconds: usize) -> PyramidFigures {
+    let mut scene = scenes::large_pyramid(def, base);
     let top0 = scene.world.position(scene.probe).unwrap();
     let steps = seconds * 60;
     let mut f = PyramidFigures {
@@ -419,14 +423,18 @@ fn mass_ratio_sweep() {
 /// 30 Hz the pyramid collapsed (sink 38 m).
 #[test]
 fn large_pyramid_stands_at_2_substeps() {
-    let mut case = hard::large_pyramid();
-    case.desc.settings.substeps = 2;
-    case.bounds = vec![
-        hard::Bound::AtMost(hard::Figure::Sink, 3.0),
-        hard::Bound::AtMost(hard::Figure::Drift, 0.5),
-        hard::Bound::AtMost(hard::Figure::LateProbeSpeed, 0.05),
-    ];
-    assert_case(case);
+    let mut def = scenes::shared_settings();
+    def.solver.substeps = 2;
+    let f = run_pyramid_with(&def, 100, 10);
+    if report() {
+        eprintln!(
+            "large pyramid, 2 substeps: sink {:.4} m, drift {:.4} m, last-second speed {:.5} m/s",
+            f.sink, f.drift, f.last_second_speed
+        );
+    }
+    assert!(f.sink <= 3.0, "sink {}", f.sink);
+    assert!(f.drift <= 0.5, "drift {}", f.drift);
+    assert!(f.last_second_speed <= 0.05, "speed {}", f.last_second_speed);
 }
 
 /// 40 circles with 1 m of error at every joint: every joint back within
@@ -448,11 +456,11 @@ fn mass_ratio_bob_1000_to_1_keeps_joints_within_1_cm() {
 
 /// A 1000:1 load at the end of a 20-link chain of light links, swinging
 /// down from horizontal: every joint within 1 cm. Open (issue 15): the
-/// middle joints open to 1.6 m as the chain swings taut; the 20-link
-/// chain already reaches 1.0–1.5 cm at 10:1 and fails intermittently from
-/// 150:1.
+/// middle joints open to 1.75 m as the chain swings taut; the chain holds
+/// from 200:1 to 500:1 and fails for good from 700:1 (it also misses by a
+/// few mm at 10:1 and 150:1, where the light links whip).
 #[test]
-#[ignore = "joints open to 1.6 m at 1000:1 (issue 15)"]
+#[ignore = "joints open to 1.75 m at 1000:1 (issue 15)"]
 fn mass_ratio_chain_1000_to_1_keeps_joints_within_1_cm() {
     assert_case(hard::mass_ratio_chain(20, 1000.0));
 }

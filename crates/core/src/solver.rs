@@ -39,14 +39,14 @@ pub const DEFAULT_CONTACT_MASS_RATIO_CAP: Real = 1.3;
 /// [`SolverSettings::joint_mass_ratio_cap`].
 pub const DEFAULT_JOINT_MASS_RATIO_CAP: Real = 1.3;
 
-/// Largest contact stiffness as a fraction of the substep rate
+/// Default largest contact stiffness as a fraction of the substep rate
 /// (dimensionless, 1/8: 30 Hz at 240 Hz substeps). See
-/// [`SolverSettings::effective_hertz`].
+/// [`SolverSettings::contact_hertz_fraction`].
 pub const CONTACT_HERTZ_PER_SUBSTEP_RATE: Real = 0.125;
 
-/// Largest joint stiffness (Gauss–Seidel rows) as a fraction of the
-/// substep rate (dimensionless, 1/4: 60 Hz at 240 Hz substeps). See
-/// [`SolverSettings::effective_hertz`].
+/// Default largest joint stiffness (Gauss–Seidel rows) as a fraction of
+/// the substep rate (dimensionless, 1/4: 60 Hz at 240 Hz substeps). See
+/// [`SolverSettings::joint_hertz_fraction`].
 pub const JOINT_HERTZ_PER_SUBSTEP_RATE: Real = 0.25;
 
 /// Default stiffness of the point rows solved directly, Hz (usual 500).
@@ -67,16 +67,31 @@ pub struct SolverSettings {
     pub velocity_iterations: u32,
     /// Baumgarte factor β of the PGS baseline (dimensionless), usual 0.2.
     pub baumgarte: Real,
-    /// Contact stiffness, Hz (usual 30; at most 1/8 of the substep rate is
-    /// used, see [`SolverSettings::effective_hertz`]).
+    /// Contact stiffness, Hz (usual 30; at most `contact_hertz_fraction`
+    /// of the substep rate is used, see [`SolverSettings::effective_hertz`]).
     pub contact_hertz: Real,
+    /// Largest contact stiffness as a fraction of the substep rate
+    /// (dimensionless, usual 1/8; `Real::INFINITY`: no cap). A contact
+    /// spring much stiffer than the substep rate overshoots with one
+    /// iteration per substep: the base-100 pyramid collapses at 2 substeps
+    /// with 30 Hz contacts and stands with 15 Hz (Box2D softens its contacts
+    /// the same way when substeps are few). At 4 substeps and 1/60 s the
+    /// cap is 30 Hz: raise it to use stiffer contacts there.
+    pub contact_hertz_fraction: Real,
     /// Contact damping ratio (usual 10).
     pub contact_damping_ratio: Real,
     /// Maximum contact push-out speed, m/s (usual 3).
     pub contact_push_max_velocity: Real,
-    /// Joint stiffness, Hz (usual 60; at most 1/4 of the substep rate is
-    /// used, see [`SolverSettings::effective_hertz`]).
+    /// Joint stiffness, Hz (usual 60; at most `joint_hertz_fraction` of
+    /// the substep rate is used, see [`SolverSettings::effective_hertz`]).
     pub joint_hertz: Real,
+    /// Largest stiffness of Gauss–Seidel joint rows as a fraction of the
+    /// substep rate (dimensionless, usual 1/4; `Real::INFINITY`: no cap):
+    /// the 40×40 joint grid diverges at 2 substeps with 60 Hz joints and
+    /// holds (1.4 m peak gap) at 30 Hz. Joint trees use
+    /// `direct_joint_hertz` uncapped (an exact solve is stable at any
+    /// stiffness).
+    pub joint_hertz_fraction: Real,
     /// Joint damping ratio (usual 2).
     pub joint_damping_ratio: Real,
     /// Maximum correction speed of a joint solved by Gauss–Seidel, m/s
@@ -137,9 +152,11 @@ impl Default for SolverSettings {
             velocity_iterations: 8,
             baumgarte: 0.2,
             contact_hertz: 30.0,
+            contact_hertz_fraction: CONTACT_HERTZ_PER_SUBSTEP_RATE,
             contact_damping_ratio: 10.0,
             contact_push_max_velocity: 3.0,
             joint_hertz: 60.0,
+            joint_hertz_fraction: JOINT_HERTZ_PER_SUBSTEP_RATE,
             joint_damping_ratio: 2.0,
             joint_max_correction_speed: Real::MAX,
             restitution_threshold: 1.0,
@@ -178,9 +195,11 @@ impl SolverSettings {
         let reals = [
             (self.baumgarte, "baumgarte"),
             (self.contact_hertz, "contact_hertz"),
+            (self.contact_hertz_fraction, "contact_hertz_fraction"),
             (self.contact_damping_ratio, "contact_damping_ratio"),
             (self.contact_push_max_velocity, "contact_push_max_velocity"),
             (self.joint_hertz, "joint_hertz"),
+            (self.joint_hertz_fraction, "joint_hertz_fraction"),
             (self.joint_damping_ratio, "joint_damping_ratio"),
             (
                 self.joint_max_correction_speed,
@@ -216,20 +235,20 @@ impl SolverSettings {
     }
 
     /// The contact and joint stiffness a substep of `h` seconds solves
-    /// with, Hz: the settings' `contact_hertz` and `joint_hertz`, capped at
-    /// [`CONTACT_HERTZ_PER_SUBSTEP_RATE`] and [`JOINT_HERTZ_PER_SUBSTEP_RATE`]
-    /// of the substep rate `1/h`. At 60 Hz and 4 or more substeps the caps
-    /// (30 and 60 Hz) leave the usual settings as they are; with fewer
-    /// substeps a spring that stiff against one iteration per substep
-    /// overshoots (the base-100 pyramid collapses at 2 substeps with
-    /// 30 Hz contacts and stands with 15 Hz; Box2D softens the same way).
+    /// with, Hz: `contact_hertz` and `joint_hertz`, capped at
+    /// `contact_hertz_fraction` and `joint_hertz_fraction` of the substep
+    /// rate `1/h`. With the usual settings at 60 Hz and 4 or more substeps
+    /// the caps (30 and 60 Hz) leave them as they are; with fewer substeps
+    /// the springs soften with the substep rate.
     ///
     /// ```
     /// use janus2d_core::solver::SolverSettings;
     /// let s = SolverSettings::default();
     /// assert_eq!(s.effective_hertz(1.0 / 240.0), (30.0, 60.0));
     /// let (contact, joint) = s.effective_hertz(1.0 / 120.0);
-    /// assert!((contact - 15.0).abs() < 1e-4 && (joint - 30.0).abs() < 1e-4);
+    /// assert!((contact - 15.0).abs() < 1e-3 && (joint - 30.0).abs() < 1e-3);
+    /// let uncapped = SolverSettings { contact_hertz: 60.0, contact_hertz_fraction: f32::INFINITY as _, ..s };
+    /// assert_eq!(uncapped.effective_hertz(1.0 / 240.0).0, 60.0);
     /// ```
     #[must_use]
     pub fn effective_hertz(&self, h: Real) -> (Real, Real) {
@@ -237,20 +256,19 @@ impl SolverSettings {
             return (self.contact_hertz, self.joint_hertz);
         }
         let rate = 1.0 / h;
-        // A setting at the cap (30 Hz at 240 Hz substeps) is kept exactly:
-        // `1 / h` is not exact in f32, and a cap a rounding below the
-        // setting would change every result at the default settings.
+        // A stiffness within rounding of its cap is left exactly as set
+        // (30 Hz at 1/240 s: 1/h rounds to 239.99998 in f32).
         let capped = |hertz: Real, fraction: Real| {
             let cap = fraction * rate;
-            if hertz <= cap * (1.0 + 1e-5) {
+            if hertz <= cap * (1.0 + 1.0e-4) {
                 hertz
             } else {
                 cap
             }
         };
         (
-            capped(self.contact_hertz, CONTACT_HERTZ_PER_SUBSTEP_RATE),
-            capped(self.joint_hertz, JOINT_HERTZ_PER_SUBSTEP_RATE),
+            capped(self.contact_hertz, self.contact_hertz_fraction),
+            capped(self.joint_hertz, self.joint_hertz_fraction),
         )
     }
 
