@@ -951,6 +951,7 @@ impl World {
     /// use janus2d_world::{ShapeDef, World, WorldDef};
     /// use janus2d_core::{BodyDef, Vec2};
     /// use janus2d_core::geometry::Polygon;
+    /// use janus2d_core::math::Real;
     /// let mut world = World::new(WorldDef::default()).unwrap();
     /// let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
     /// world.create_shape(ground, &ShapeDef::default(), Polygon::make_box(5.0, 0.5)).unwrap();
@@ -960,7 +961,7 @@ impl World {
     ///     world.step(1.0 / 60.0).unwrap();
     /// }
     /// // The ground carries the box: m g over the step.
-    /// let push: f32 = world.body_contacts(b).unwrap().map(|c| c.total_normal_impulse()).sum();
+    /// let push: Real = world.body_contacts(b).unwrap().map(|c| c.total_normal_impulse()).sum();
     /// let weight_impulse = world.mass(b).unwrap() * 9.81 / 60.0;
     /// assert!((push - weight_impulse).abs() < 0.02 * weight_impulse);
     /// ```
