@@ -5,7 +5,8 @@
 //! unchanged (state hash and counts); [`World::validate`] passes (which
 //! includes every stored number being finite).
 //!
-//! CI runs 48 cases of up to 48 operations. A longer run:
+//! CI runs 48 cases of up to 48 operations, each from one of three
+//! starting worlds (a ground box, the portal drop, a small pyramid). A longer run:
 //!
 //! ```text
 //! JANUS_STATE_MACHINE_CASES=5000 cargo test --release --test api_state_machine
@@ -128,6 +129,8 @@ enum Op {
         time: Real,
     },
     Step(Real),
+    /// Thirty steps of 1/60 s (bodies fall, touch, cross portals, sleep).
+    StepMany,
     Snapshot,
     Restore,
 }
@@ -163,6 +166,7 @@ fn op() -> impl Strategy<Value = Op> {
         1 => (any::<bool>(), prop_oneof![2 => Just(0.05 as Real), 1 => real()], prop_oneof![2 => Just(0.5 as Real), 1 => real()])
             .prop_map(|(enabled, threshold, time)| Op::Sleep { enabled, threshold, time }),
         8 => prop_oneof![6 => Just(1.0 as Real / 60.0), 1 => Just(1.0 as Real / 240.0), 1 => Just(0.1 as Real), 1 => real()].prop_map(Op::Step),
+        2 => Just(Op::StepMany),
         1 => Just(Op::Snapshot),
         1 => Just(Op::Restore),
     ]
@@ -376,6 +380,12 @@ fn apply(
             time_to_sleep: *time,
         }),
         Op::Step(dt) => w.step(*dt),
+        Op::StepMany => {
+            for _ in 0..30 {
+                w.step(1.0 / 60.0)?;
+            }
+            Ok(())
+        }
         Op::Snapshot => {
             *saved = Some(w.snapshot());
             Ok(())
@@ -401,7 +411,25 @@ static RAN: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new
 static ACCEPTED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 static STEPS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
-fn run(ops: &[Op]) -> Result<(), TestCaseError> {
+/// The world a case starts from: a ground box, the portal drop scene, or
+/// a small pyramid (with their bodies among the issued handles).
+fn start(scene: u8) -> World {
+    let def = janus2d_testbed::scenes::shared_settings();
+    match scene % 3 {
+        0 => {
+            let mut world = World::new(WorldDef::default()).unwrap();
+            let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+            world
+                .create_shape(ground, &ShapeDef::default(), Polygon::make_box(8.0, 0.5))
+                .unwrap();
+            world
+        }
+        1 => janus2d_testbed::scenes::portal_drop(&def).0.world,
+        _ => janus2d_testbed::scenes::large_pyramid(&def, 4).world,
+    }
+}
+
+fn run(scene: u8, ops: &[Op]) -> Result<(), TestCaseError> {
     use std::sync::atomic::Ordering::Relaxed;
     let mut other = World::new(WorldDef::default()).unwrap();
     let fb = other.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
@@ -425,12 +453,13 @@ fn run(ops: &[Op]) -> Result<(), TestCaseError> {
         foreign_shape: fs,
         foreign_joint: fj,
     };
-    let mut world = World::new(WorldDef::default()).unwrap();
-    let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
-    world
-        .create_shape(ground, &ShapeDef::default(), Polygon::make_box(8.0, 0.5))
-        .unwrap();
-    issued.bodies.push(ground);
+    let mut world = start(scene);
+    issued.bodies.extend(world.body_handles());
+    for b in issued.bodies.clone() {
+        issued.shapes.extend(world.body_shapes(b).unwrap());
+    }
+    issued.joints.extend(world.joint_handles().iter().copied());
+    issued.pairs.extend(world.portal_pairs().map(|(h, _)| h));
     let mut saved = None;
     for (i, op) in ops.iter().enumerate() {
         let before = fingerprint(&world);
@@ -471,8 +500,11 @@ proptest! {
     /// Random API sequences never panic, never change the world on an
     /// error, and always leave a valid world.
     #[test]
-    fn api_sequences_keep_the_world_valid(ops in proptest::collection::vec(op(), 1..48)) {
-        run(&ops)?;
+    fn api_sequences_keep_the_world_valid(
+        scene in 0u8..3,
+        ops in proptest::collection::vec(op(), 1..48),
+    ) {
+        run(scene, &ops)?;
     }
 }
 

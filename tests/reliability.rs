@@ -551,3 +551,38 @@ fn huge_velocities_are_refused_with_the_limit() {
     assert!(out_of_bounds("max_linear_speed")(&e), "{e:?}");
     assert!(e.to_string().contains("1e9"), "{e}");
 }
+
+/// Found by the `hull` fuzz target: a thin hull 3 km from its body origin
+/// lost its area to rounding in `validate` (which summed cross products
+/// about the origin) and was refused although `from_hull` built it.
+#[test]
+fn a_hull_far_from_the_body_origin_passes_validation() {
+    let points = [
+        Vec2::new(3156.3293, 3156.3293),
+        Vec2::new(3157.9607, 3156.3293),
+        Vec2::new(3156.3293, 3156.3591),
+    ];
+    let p = Polygon::from_hull(&points, 0.0).unwrap();
+    assert_eq!(Shape::Polygon(p).validate(), Ok(()));
+    let far = [
+        Vec2::new(-413252.72, -411206.25),
+        Vec2::new(-411206.25, -411206.25),
+        Vec2::new(0.0, -411200.0),
+    ];
+    let p = Polygon::from_hull(&far, 0.0).unwrap();
+    assert_eq!(Shape::Polygon(p).validate(), Ok(()));
+}
+
+/// Found by the `hull` fuzz target: a sliver reaching 2e5 m has its
+/// centroid on its long edges to within the rounding of such coordinates;
+/// `validate` allows for that rounding.
+#[test]
+fn a_far_reaching_sliver_hull_passes_validation() {
+    let points = [
+        Vec2::new(-0.024015777, -0.022949569),
+        Vec2::new(0.0, -0.023925781),
+        Vec2::new(131362.94, 205089.13),
+    ];
+    let p = Polygon::from_hull(&points, 0.0).unwrap();
+    assert_eq!(Shape::Polygon(p).validate(), Ok(()));
+}

@@ -18,6 +18,9 @@
 //! | [`MAX_GRAVITY`]         | 1e6 m/s²           | the length of world gravity                            |
 //! | [`MAX_GRAVITY_SCALE`]   | 1e6                | the magnitude of a body's gravity scale                |
 //! | [`MAX_DAMPING_RATIO`]   | 1e4                | contact and joint damping ratios                        |
+//! | [`MAX_FRICTION`]        | 1e6                | a shape's friction coefficient                         |
+//! | [`MAX_RESTITUTION`]     | 1e3                | a shape's restitution                                  |
+//! | [`ETA_RANGE`]           | 1e-3 … 1e3         | a portal pair's scale η (a clone's mass goes as η², its inertia as η⁴) |
 //! | [`MAX_HERTZ_FRACTION`]  | 0.25               | contact and iterative joint stiffness are capped at this fraction of the substep rate, as Box2D caps them |
 
 use crate::math::Real;
@@ -51,6 +54,16 @@ pub const MAX_GRAVITY_SCALE: Real = 1e6;
 
 /// Largest contact or joint damping ratio (1e4).
 pub const MAX_DAMPING_RATIO: Real = 1e4;
+
+/// Largest friction coefficient of a shape (1e6: the friction impulse
+/// bound `μ λ_n` must stay finite).
+pub const MAX_FRICTION: Real = 1e6;
+
+/// Largest restitution of a shape (1e3).
+pub const MAX_RESTITUTION: Real = 1e3;
+
+/// Allowed scale η of a portal pair: `[1e-3, 1e3]`.
+pub const ETA_RANGE: (Real, Real) = (1e-3, 1e3);
 
 /// Contact stiffness and iterative joint stiffness are capped at this
 /// fraction of the substep rate `1 / h` (0.25, as Box2D caps

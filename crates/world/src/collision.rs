@@ -285,10 +285,14 @@ impl Collision {
     /// Copies solved impulses back into the contacts (for warm starting).
     pub(crate) fn store_impulses(&mut self, solver: &ContactSolver) {
         let contacts = &mut self.contacts;
+        // A non-finite impulse (a solve that blew up) is not kept for warm
+        // starting: the contact starts cold next step instead of carrying
+        // NaN into it.
+        let finite = |x: Real| if x.is_finite() { x } else { 0.0 };
         solver.for_each_impulse(|index, point, normal, tangent| {
             let p = &mut contacts.awake_mut(index as usize).points[point];
-            p.normal_impulse = normal;
-            p.tangent_impulse = tangent;
+            p.normal_impulse = finite(normal);
+            p.tangent_impulse = finite(tangent);
         });
     }
 

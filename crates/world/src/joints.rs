@@ -335,6 +335,7 @@ impl JointSet {
         if !speed.is_finite() {
             return Err(WorldError::NonFinite("motor_speed"));
         }
+        check_motor_speed(speed)?;
         self.edit(joint, |d| d.motor_speed = speed)
     }
 
@@ -375,6 +376,7 @@ impl JointSet {
         if hertz < 0.0 || damping_ratio < 0.0 {
             return Err(WorldError::OutOfRange("spring"));
         }
+        check_spring(hertz, damping_ratio)?;
         self.edit(joint, |d| {
             d.hertz = hertz;
             d.damping_ratio = damping_ratio;
@@ -411,4 +413,63 @@ impl JointSet {
             .map(RevoluteJoint::row_count)
             .sum()
     }
+}
+
+/// The world's limits on a joint definition, beyond
+/// [`RevoluteJointDef::validate`]: local anchors within
+/// [`MAX_EXTENT`](janus2d_core::limits::MAX_EXTENT), the motor speed
+/// within [`MAX_ANGULAR_SPEED`](janus2d_core::limits::MAX_ANGULAR_SPEED),
+/// the spring within [`MAX_SPRING_HERTZ`] and
+/// [`MAX_DAMPING_RATIO`](janus2d_core::limits::MAX_DAMPING_RATIO).
+pub(crate) fn check_joint_limits(def: &RevoluteJointDef) -> Result<(), WorldError> {
+    let max = janus2d_core::limits::MAX_EXTENT;
+    for (a, field) in [
+        (def.local_anchor_a, "local_anchor_a"),
+        (def.local_anchor_b, "local_anchor_b"),
+    ] {
+        if a.x.abs() > max || a.y.abs() > max {
+            return Err(WorldError::OutOfBounds {
+                field,
+                min: -max,
+                max,
+            });
+        }
+    }
+    check_motor_speed(def.motor_speed)?;
+    check_spring(def.hertz, def.damping_ratio)
+}
+
+/// Largest joint spring stiffness, Hz (1e6: a stiffer spring's softness
+/// overflows).
+pub const MAX_SPRING_HERTZ: Real = 1e6;
+
+fn check_motor_speed(speed: Real) -> Result<(), WorldError> {
+    let max = janus2d_core::limits::MAX_ANGULAR_SPEED;
+    if speed.abs() > max {
+        return Err(WorldError::OutOfBounds {
+            field: "motor_speed",
+            min: -max,
+            max,
+        });
+    }
+    Ok(())
+}
+
+fn check_spring(hertz: Real, damping_ratio: Real) -> Result<(), WorldError> {
+    if hertz > MAX_SPRING_HERTZ {
+        return Err(WorldError::OutOfBounds {
+            field: "hertz",
+            min: 0.0,
+            max: MAX_SPRING_HERTZ,
+        });
+    }
+    let max = janus2d_core::limits::MAX_DAMPING_RATIO;
+    if damping_ratio > max {
+        return Err(WorldError::OutOfBounds {
+            field: "damping_ratio",
+            min: 0.0,
+            max,
+        });
+    }
+    Ok(())
 }

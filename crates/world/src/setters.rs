@@ -29,7 +29,7 @@ fn check_material(v: Real, name: &'static str) -> Result<(), WorldError> {
     if v < 0.0 {
         return Err(WorldError::OutOfRange(name));
     }
-    Ok(())
+    crate::shapes::check_material_limit(v, name)
 }
 
 impl World {

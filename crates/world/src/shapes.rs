@@ -142,8 +142,29 @@ impl ShapeDef {
                 return Err(WorldError::OutOfRange(name));
             }
         }
-        Ok(())
+        check_material_limit(self.friction, "friction")?;
+        check_material_limit(self.restitution, "restitution")
     }
+}
+
+/// Friction and restitution within
+/// [`MAX_FRICTION`](janus2d_core::limits::MAX_FRICTION) and
+/// [`MAX_RESTITUTION`](janus2d_core::limits::MAX_RESTITUTION) (other names
+/// pass).
+pub(crate) fn check_material_limit(v: Real, name: &'static str) -> Result<(), WorldError> {
+    let max = match name {
+        "friction" => janus2d_core::limits::MAX_FRICTION,
+        "restitution" => janus2d_core::limits::MAX_RESTITUTION,
+        _ => return Ok(()),
+    };
+    if v > max {
+        return Err(WorldError::OutOfBounds {
+            field: name,
+            min: 0.0,
+            max,
+        });
+    }
+    Ok(())
 }
 
 /// A shape attached to a body.
@@ -300,7 +321,8 @@ impl ShapeStore {
                     "shape {index}: listed {listed} times under its body"
                 ));
             }
-            if let Err(e) = shape.geometry.validate() {
+            // Portal clones carry scaled copies: cores may be short.
+            if let Err(e) = shape.geometry.validate_scaled() {
                 return Err(format!("shape {index}: geometry invalid: {e}"));
             }
             let a = &shape.aabb;

@@ -588,6 +588,7 @@ impl World {
         def: &RevoluteJointDef,
     ) -> Result<JointHandle, WorldError> {
         def.validate()?;
+        crate::joints::check_joint_limits(def)?;
         self.check_body(def.body_a)?;
         self.check_body(def.body_b)?;
         self.wake_body(def.body_a);

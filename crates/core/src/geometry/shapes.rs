@@ -681,7 +681,20 @@ impl Shape {
     /// [`WELD_DISTANCE`]; every coordinate and radius within
     /// [`MAX_EXTENT`](crate::limits::MAX_EXTENT).
     pub fn validate(&self) -> Result<(), GeometryError> {
-        self.validate_form()?;
+        self.validate_form(WELD_DISTANCE)?;
+        self.validate_extent()
+    }
+
+    /// [`validate`](Self::validate) for a shape the engine scaled (a portal
+    /// clone's copy): segment, chain and capsule cores need only a
+    /// non-zero length, since a valid core scaled by `η < 1` may be
+    /// shorter than [`WELD_DISTANCE`].
+    pub fn validate_scaled(&self) -> Result<(), GeometryError> {
+        self.validate_form(0.0)?;
+        self.validate_extent()
+    }
+
+    fn validate_extent(&self) -> Result<(), GeometryError> {
         let max = crate::limits::MAX_EXTENT;
         let small = |v: Real| v.abs() <= max;
         let ok = match self {
@@ -712,8 +725,9 @@ impl Shape {
         }
     }
 
-    /// The checks of [`validate`](Self::validate) but the extent.
-    fn validate_form(&self) -> Result<(), GeometryError> {
+    /// The checks of [`validate`](Self::validate) but the extent, with
+    /// cores longer than `min_core`.
+    fn validate_form(&self, min_core: Real) -> Result<(), GeometryError> {
         use GeometryError as E;
         let finite = |pts: &[Vec2]| pts.iter().all(|p| vec_is_finite(*p));
         match self {
@@ -732,7 +746,7 @@ impl Shape {
                 if c.radius <= 0.0 {
                     return Err(E::NonPositiveRadius);
                 }
-                if (c.center2 - c.center1).length() <= WELD_DISTANCE {
+                if (c.center2 - c.center1).length() <= min_core {
                     return Err(E::DegenerateSegment);
                 }
             }
@@ -740,7 +754,7 @@ impl Shape {
                 if !finite(&[s.point1, s.point2]) {
                     return Err(E::NonFinite);
                 }
-                if (s.point2 - s.point1).length() <= WELD_DISTANCE {
+                if (s.point2 - s.point1).length() <= min_core {
                     return Err(E::DegenerateSegment);
                 }
             }
@@ -748,7 +762,7 @@ impl Shape {
                 if !finite(&[c.ghost1, c.segment.point1, c.segment.point2, c.ghost2]) {
                     return Err(E::NonFinite);
                 }
-                if (c.segment.point2 - c.segment.point1).length() <= WELD_DISTANCE {
+                if (c.segment.point2 - c.segment.point1).length() <= min_core {
                     return Err(E::DegenerateSegment);
                 }
             }
@@ -774,7 +788,7 @@ impl Shape {
                         return Err(E::NonPositiveRadius);
                     }
                     let edge = p.vertices[1] - p.vertices[0];
-                    if edge.length() <= WELD_DISTANCE {
+                    if edge.length() <= min_core {
                         return Err(E::DegenerateSegment);
                     }
                     let side = right_perp(edge.normalize());
@@ -791,7 +805,11 @@ impl Shape {
                         needed: 3,
                     });
                 }
+                // Twice the area, about the first vertex (not the origin:
+                // a small polygon far from its body origin would lose the
+                // area to rounding).
                 let mut area2 = 0.0;
+                let o = p.vertices[0];
                 for i in 0..n {
                     let a = p.vertices[i];
                     let b = p.vertices[(i + 1) % n];
@@ -799,7 +817,7 @@ impl Shape {
                     if cross(b - a, c - b) <= 0.0 {
                         return Err(E::DegeneratePolygon);
                     }
-                    area2 += cross(a, b);
+                    area2 += cross(a - o, b - o);
                 }
                 if area2 <= 0.0 {
                     return Err(E::DegeneratePolygon);
@@ -815,9 +833,17 @@ impl Shape {
                     }
                 }
                 // The centroid (the centre of mass) lies inside the core,
-                // with a tolerance of the weld distance.
+                // with a tolerance of the weld distance plus the rounding of
+                // coordinates this large (a sliver far out has its centroid
+                // on an edge to within a few ulps).
+                let scale = p.vertices[..n]
+                    .iter()
+                    .fold(p.centroid.abs().max_element(), |m, v| {
+                        m.max(v.abs().max_element())
+                    });
+                let tolerance = WELD_DISTANCE + 16.0 * EPSILON * scale;
                 for i in 0..n {
-                    if p.normals[i].dot(p.centroid - p.vertices[i]) > WELD_DISTANCE {
+                    if p.normals[i].dot(p.centroid - p.vertices[i]) > tolerance {
                         return Err(E::CentroidOutside);
                     }
                 }

@@ -444,7 +444,9 @@ impl World {
     /// Creates a linked pair of portals.
     ///
     /// Rejects stale body handles, non-finite values, a zero direction, a
-    /// non-positive half-width and `η ≤ 0`.
+    /// non-positive half-width, `η ≤ 0` and an `η` outside
+    /// [`ETA_RANGE`](janus2d_core::limits::ETA_RANGE); a body that is
+    /// crossing a portal ([`WorldError::PortalBody`]).
     pub fn create_portal_pair(
         &mut self,
         def: &PortalPairDef,
@@ -458,6 +460,11 @@ impl World {
                     WorldError::ForeignHandle
                 });
             }
+            // A copy in a crossing may be destroyed by the stage at any
+            // step: it cannot carry a portal.
+            if self.portals.crossing_of(p.body).is_some() {
+                return Err(WorldError::PortalBody);
+            }
             local.push(
                 Portal::new(p.anchor, p.direction, p.half_width)
                     .map_err(WorldError::Portal)?
@@ -467,6 +474,14 @@ impl World {
         let local = [local[0], local[1]];
         let eta = def.eta.unwrap_or(local[1].half_width / local[0].half_width);
         janus2d_constraints::portal_map::validate_eta(eta).map_err(WorldError::Portal)?;
+        let (lo, hi) = janus2d_core::limits::ETA_RANGE;
+        if !(lo..=hi).contains(&eta) {
+            return Err(WorldError::OutOfBounds {
+                field: "eta",
+                min: lo,
+                max: hi,
+            });
+        }
         let data = PairData {
             portals: [def.portal_a, def.portal_b],
             local,

@@ -1,0 +1,224 @@
+//! The API as a byte-coded sequence of calls (bodies, shapes, joints,
+//! portal pairs, velocities, transforms, masses, types, forces, settings,
+//! steps, snapshot and restore), valid and invalid values mixed. After each
+//! call: no panic, an `Err` left the world unchanged, `World::validate`
+//! passes.
+#![no_main]
+
+use janus2d::base::geometry::{Capsule, Circle, Polygon, Segment, Shape};
+use janus2d::prelude::*;
+use janus2d::world::{PortalDef, PortalPairDef, PortalPairHandle, SleepSettings, Snapshot};
+use libfuzzer_sys::fuzz_target;
+
+struct Bytes<'a>(&'a [u8]);
+
+impl Bytes<'_> {
+    fn byte(&mut self) -> u8 {
+        let (b, rest) = self.0.split_first().map_or((0, &[][..]), |(b, r)| (*b, r));
+        self.0 = rest;
+        b
+    }
+    fn real(&mut self) -> Real {
+        match self.byte() {
+            0 => Real::NAN,
+            1 => Real::INFINITY,
+            2 => Real::NEG_INFINITY,
+            3 => 1e30,
+            4 => -1e30,
+            5 => -0.0,
+            6 => 0.0,
+            7 => 1e-40,
+            8 => 1e9,
+            9 => -1.0,
+            b => (Real::from(b) - 132.0) / 16.0,
+        }
+    }
+    fn vec(&mut self) -> Vec2 {
+        Vec2::new(self.real(), self.real())
+    }
+}
+
+struct Issued {
+    bodies: Vec<BodyHandle>,
+    shapes: Vec<ShapeHandle>,
+    joints: Vec<JointHandle>,
+    pairs: Vec<PortalPairHandle>,
+    foreign: BodyHandle,
+}
+
+fn pick<T: Copy>(list: &[T], k: u8, foreign: T) -> T {
+    if list.is_empty() || k == 255 { foreign } else { list[k as usize % list.len()] }
+}
+
+fn body_type(t: u8) -> BodyType {
+    [BodyType::Static, BodyType::Kinematic, BodyType::Dynamic][(t % 3) as usize]
+}
+
+fn shape(b: &mut Bytes) -> Option<Shape> {
+    Some(match b.byte() % 6 {
+        0 => Shape::Circle(Circle { center: b.vec() * 0.1, radius: b.real() }),
+        1 => Shape::Polygon(Polygon::try_make_box(b.real(), b.real()).ok()?),
+        2 => Shape::Capsule(Capsule { center1: b.vec() * 0.2, center2: b.vec() * 0.2, radius: b.real() }),
+        3 => {
+            let n = (b.byte() % 9) as usize;
+            let pts: Vec<Vec2> = (0..n).map(|_| b.vec() * 0.3).collect();
+            Shape::Polygon(Polygon::from_hull(&pts, b.real().abs() * 0.1).ok()?)
+        }
+        4 => Shape::Segment(Segment { point1: b.vec(), point2: b.vec() }),
+        _ => {
+            let mut p = Polygon::make_box(0.5, 0.5);
+            let k = (b.byte() % 4) as usize;
+            p.normals[k] = b.vec();
+            Shape::Polygon(p)
+        }
+    })
+}
+
+fn fingerprint(w: &World) -> [u64; 7] {
+    [
+        w.state_hash(),
+        w.body_count() as u64,
+        w.shape_count() as u64,
+        w.joint_count() as u64,
+        w.contact_count() as u64,
+        w.sleeping_body_count() as u64,
+        w.portal_pair_count() as u64,
+    ]
+}
+
+fn call(w: &mut World, i: &mut Issued, saved: &mut Option<Snapshot>, b: &mut Bytes) -> Result<(), WorldError> {
+    let f = i.foreign;
+    match b.byte() % 20 {
+        0 | 1 => {
+            let ty = body_type(b.byte());
+            let def = BodyDef {
+                body_type: ty,
+                position: b.vec(),
+                linear_velocity: if b.byte() % 2 == 0 { Vec2::ZERO } else { b.vec() },
+                angular_velocity: b.real(),
+                mass: if b.byte() % 4 == 0 { Some(BodyMass::new(b.real(), b.real())) } else { None },
+                awake: b.byte() % 4 != 0,
+                bullet: b.byte() % 4 == 0,
+                ..BodyDef::default()
+            };
+            i.bodies.push(w.create_body(&def)?);
+            Ok(())
+        }
+        2 => w.destroy_body(pick(&i.bodies, b.byte(), f)),
+        3 | 4 => {
+            let body = pick(&i.bodies, b.byte(), f);
+            let def = ShapeDef { density: b.real(), friction: b.real(), ..ShapeDef::default() };
+            let s = shape(b).ok_or(WorldError::OutOfRange("constructor"))?;
+            i.shapes.push(w.create_shape(body, &def, s)?);
+            Ok(())
+        }
+        5 => match i.shapes.get(b.byte() as usize % i.shapes.len().max(1)) {
+            Some(s) => w.destroy_shape(*s),
+            None => Err(WorldError::StaleShape),
+        },
+        6 => {
+            let (ba, bb) = (pick(&i.bodies, b.byte(), f), pick(&i.bodies, b.byte(), f));
+            let anchor = b.vec();
+            let mut def = RevoluteJointDef::new(ba, bb, anchor, -anchor);
+            if b.byte() % 2 == 0 {
+                def = def.with_limits(b.real(), b.real());
+            }
+            i.joints.push(w.create_revolute_joint(&def)?);
+            Ok(())
+        }
+        7 => match i.joints.get(b.byte() as usize % i.joints.len().max(1)) {
+            Some(j) => w.destroy_joint(*j),
+            None => Err(WorldError::StaleJoint),
+        },
+        8 => {
+            let pa = PortalDef {
+                body: pick(&i.bodies, b.byte(), f),
+                anchor: b.vec(),
+                direction: b.vec(),
+                half_width: b.real(),
+            };
+            let pb = if b.byte() % 4 == 0 {
+                pa
+            } else {
+                PortalDef { body: pick(&i.bodies, b.byte(), f), anchor: b.vec(), direction: b.vec(), half_width: b.real() }
+            };
+            let mut def = PortalPairDef::new(pa, pb);
+            if b.byte() % 2 == 0 {
+                def.eta = Some(b.real());
+            }
+            i.pairs.push(w.create_portal_pair(&def)?);
+            Ok(())
+        }
+        9 => match i.pairs.get(b.byte() as usize % i.pairs.len().max(1)) {
+            Some(p) => w.destroy_portal_pair(*p),
+            None => Err(WorldError::StalePortal),
+        },
+        10 => w.set_linear_velocity(pick(&i.bodies, b.byte(), f), b.vec()),
+        11 => w.set_angular_velocity(pick(&i.bodies, b.byte(), f), b.real()),
+        12 => w.set_transform(pick(&i.bodies, b.byte(), f), b.vec(), b.real()),
+        13 => w.set_mass(pick(&i.bodies, b.byte(), f), BodyMass::new(b.real(), b.real())),
+        14 => w.set_body_type(pick(&i.bodies, b.byte(), f), body_type(b.byte())),
+        15 => match b.byte() % 3 {
+            0 => w.apply_force_to_center(pick(&i.bodies, b.byte(), f), b.vec()),
+            1 => w.apply_linear_impulse(pick(&i.bodies, b.byte(), f), b.vec(), b.vec()),
+            _ => w.apply_torque(pick(&i.bodies, b.byte(), f), b.real()),
+        },
+        16 => match b.byte() % 3 {
+            0 => w.set_settings(SolverSettings {
+                contact_hertz: b.real(),
+                contact_damping_ratio: b.real(),
+                joint_hertz: b.real(),
+                substeps: u32::from(b.byte() % 10),
+                ..SolverSettings::default()
+            }),
+            1 => w.set_gravity(b.vec()),
+            _ => w.set_sleep_settings(SleepSettings {
+                enabled: b.byte() % 2 == 0,
+                linear_threshold: b.real(),
+                time_to_sleep: b.real(),
+            }),
+        },
+        17 => {
+            *saved = Some(w.snapshot());
+            Ok(())
+        }
+        18 => {
+            if let Some(s) = saved {
+                w.restore(s);
+            }
+            Ok(())
+        }
+        _ => {
+            let dt = match b.byte() % 6 {
+                0 => b.real(),
+                1 => 1.0 / 240.0,
+                2 => 0.1,
+                _ => 1.0 / 60.0,
+            };
+            w.step(dt)
+        }
+    }
+}
+
+fuzz_target!(|data: &[u8]| {
+    let mut other = World::new(WorldDef::default()).unwrap();
+    let foreign = other.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    let mut w = World::new(WorldDef::default()).unwrap();
+    let ground = w.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    w.create_shape(ground, &ShapeDef::default(), Polygon::make_box(8.0, 0.5)).unwrap();
+    let mut issued = Issued { bodies: vec![ground], shapes: Vec::new(), joints: Vec::new(), pairs: Vec::new(), foreign };
+    let mut saved = None;
+    let mut b = Bytes(data);
+    let mut n = 0;
+    while !b.0.is_empty() && n < 256 {
+        n += 1;
+        let before = fingerprint(&w);
+        let r = call(&mut w, &mut issued, &mut saved, &mut b);
+        if let Err(e) = &r {
+            assert_eq!(fingerprint(&w), before, "error {e:?} changed the world");
+        }
+        if let Err(e) = w.validate() {
+            panic!("after call {n} ({r:?}): {e}");
+        }
+    }
+});

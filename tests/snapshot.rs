@@ -1,0 +1,168 @@
+//! Snapshot and restore: a world restored from a snapshot continues with
+//! bit-identical states (same state hash) on the determinism scenes and the
+//! hard cases, and passes `World::validate` on the way.
+//!
+//! CI runs each scene for a few dozen steps after the snapshot; the full
+//! check (1,000 steps after it, every hard case):
+//!
+//! ```text
+//! cargo test --release --test snapshot -- --ignored
+//! ```
+
+use janus2d::prelude::*;
+use janus2d_testbed::{hard, scenes};
+
+const DT: Real = 1.0 / 60.0;
+
+/// The three hinged chains of `tests/determinism.rs`.
+fn chains() -> World {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    for chain in 0..3 {
+        let x0 = 20.0 * chain as Real;
+        let mut prev = ground;
+        for i in 0..12 {
+            let pos = Vec2::new(x0 + i as Real + 0.5, 0.3 * chain as Real);
+            let b = world
+                .create_body(&BodyDef::dynamic(pos).with_mass(1.0 + 0.1 * i as Real, 0.1))
+                .unwrap();
+            let anchor_a = if i == 0 {
+                Vec2::new(x0, 0.3 * chain as Real)
+            } else {
+                Vec2::new(0.5, 0.0)
+            };
+            let mut def = RevoluteJointDef::new(prev, b, anchor_a, Vec2::new(-0.5, 0.0));
+            def = match chain {
+                0 => def.with_limits(-0.4, 0.4),
+                1 => def.with_spring(4.0, 0.3),
+                _ => def.with_motor(1.0 + 0.1 * i as Real, 20.0),
+            };
+            world.create_revolute_joint(&def).unwrap();
+            prev = b;
+        }
+    }
+    world
+}
+
+/// Steps `world` `warm` times, snapshots, steps the original `after`
+/// times, restores the snapshot into a fresh world and steps it as many
+/// times: the hashes agree (and differ from the snapshot's unless the
+/// scene is at rest).
+fn continues_bit_exactly(name: &str, mut world: World, warm: usize, after: usize) {
+    for _ in 0..warm {
+        world.step(DT).unwrap();
+    }
+    world.validate().unwrap_or_else(|e| panic!("{name}: {e}"));
+    let saved = world.snapshot();
+    assert_eq!(saved.state_hash(), world.state_hash());
+    for _ in 0..after {
+        world.step(DT).unwrap();
+    }
+    let mut restored = saved.to_world();
+    assert_eq!(restored.step_count(), world.step_count() - after as u64);
+    for k in 0..after {
+        restored.step(DT).unwrap();
+        if k % 16 == 0 {
+            restored
+                .validate()
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+        }
+    }
+    assert_eq!(
+        restored.state_hash(),
+        world.state_hash(),
+        "{name}: the restored world diverged"
+    );
+    // Restoring in place (onto the world that ran on) gives the same again.
+    world.restore(&saved);
+    assert_eq!(world.state_hash(), saved.state_hash());
+    for _ in 0..after {
+        world.step(DT).unwrap();
+    }
+    assert_eq!(
+        restored.state_hash(),
+        world.state_hash(),
+        "{name}: in place"
+    );
+}
+
+fn hard_case_world(case: &hard::HardCase) -> World {
+    scenes::build(&case.desc, &scenes::shared_settings()).world
+}
+
+#[test]
+fn restored_snapshot_continues_bit_exactly_on_the_determinism_scenes() {
+    continues_bit_exactly("chains", chains(), 40, 80);
+    let def = scenes::shared_settings();
+    continues_bit_exactly("pyramid 20", scenes::large_pyramid(&def, 20).world, 40, 60);
+    #[cfg(feature = "portals")]
+    {
+        // Through the drop: crossings start, go on and complete after
+        // the snapshot.
+        let (drop, _) = scenes::portal_drop(&def);
+        continues_bit_exactly("portal drop", drop.world, 30, 90);
+    }
+}
+
+#[test]
+fn restored_snapshot_continues_bit_exactly_on_the_small_hard_cases() {
+    for case in [
+        hard::single_box(),
+        hard::vertical_stack(12),
+        hard::double_domino(),
+        hard::confined(),
+        hard::high_mass_ratio_1(),
+        hard::high_mass_ratio_drop(false),
+        hard::bridge(),
+        hard::ball_and_chain(),
+    ] {
+        continues_bit_exactly(case.name, hard_case_world(&case), 20, 40);
+    }
+}
+
+/// The full run: 1,000 steps after the snapshot on every determinism scene
+/// and every hard case (minutes in release).
+#[test]
+#[ignore = "long: cargo test --release --test snapshot -- --ignored"]
+fn restored_snapshot_continues_bit_exactly_for_1000_steps_everywhere() {
+    let def = scenes::shared_settings();
+    continues_bit_exactly("chains", chains(), 100, 1000);
+    continues_bit_exactly(
+        "pyramid 20",
+        scenes::large_pyramid(&def, 20).world,
+        100,
+        1000,
+    );
+    #[cfg(feature = "portals")]
+    {
+        let (drop, _) = scenes::portal_drop(&def);
+        continues_bit_exactly("portal drop", drop.world, 30, 1000);
+    }
+    for case in hard::all() {
+        continues_bit_exactly(case.name, hard_case_world(&case), 100, 1000);
+    }
+}
+
+/// A snapshot keeps the pre-solve hook out: restore leaves the world's own.
+#[test]
+fn restore_keeps_the_pre_solve_hook_of_the_world() {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    world
+        .create_shape(ground, &ShapeDef::default(), Polygon::make_box(5.0, 0.5))
+        .unwrap();
+    let b = world
+        .create_body(&BodyDef::dynamic(Vec2::new(0.0, 1.2)))
+        .unwrap();
+    world
+        .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    let saved = world.snapshot();
+    // Every contact ignored: the box falls through the ground.
+    world.set_pre_solve(Some(Box::new(|_| false)));
+    world.restore(&saved);
+    for _ in 0..60 {
+        world.step(DT).unwrap();
+    }
+    assert!(world.position(b).unwrap().y < 0.0, "the hook was lost");
+}
