@@ -61,6 +61,7 @@ pub type PreSolveFn = Box<dyn FnMut(&PreSolve) -> bool + Send>;
 /// Phase-1 outcome of the narrowphase for one contact (its manifold is
 /// already updated in place).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 enum ContactUpdate {
     /// Both bodies asleep or static: the contact is kept as it is.
     Asleep,
@@ -75,6 +76,7 @@ enum ContactUpdate {
 
 /// The narrowphase's reused buffers.
 #[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub(crate) struct Narrowphase {
     results: Vec<ContactUpdate>,
     /// The contacts solved this step, in contact order.
@@ -83,6 +85,7 @@ pub(crate) struct Narrowphase {
 
 /// A contact the solve takes this step, as the build's first pass found it.
 #[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct SolvedContact {
     /// Index in the awake list.
     index: u32,

@@ -17,6 +17,7 @@ use janus2d_core::solver::SolverProfile;
 
 /// Stage timings of the last step, seconds.
 #[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StepProfile {
     /// Broadphase (pair finding and proxy updates).
     pub broadphase: f64,
@@ -37,6 +38,7 @@ pub struct StepProfile {
 
 /// Work counters of the last step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StepCounters {
     /// The collision stages ran (the world has shapes).
     pub collision_ran: bool,

@@ -26,6 +26,7 @@ use crate::contacts::Contact;
 ///   plane within the aperture are dropped (that part of the object is on
 ///   the other side).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ApertureClip {
     /// The body whose contacts are clipped (the wall, or the crossing copy).
     pub body: BodyHandle,
@@ -67,6 +68,7 @@ pub static NO_CLIPPING: ContactClipping = ContactClipping {
 
 /// What the portal stage asks the narrowphase to drop.
 #[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ContactClipping {
     /// Aperture regions.
     pub clips: Vec<ApertureClip>,
