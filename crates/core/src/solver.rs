@@ -46,7 +46,6 @@ pub const DEFAULT_DIRECT_JOINT_HERTZ: Real = 240.0;
 /// Accuracy and softness settings of the solver. Every knob that trades
 /// accuracy for time lives here.
 #[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SolverSettings {
     /// Soft step (default) or the PGS-with-Baumgarte baseline.
     pub mode: SolverMode,
@@ -260,7 +259,6 @@ impl SolverSettings {
 
 /// Time spent in each solver stage during the last step, seconds.
 #[derive(Clone, Debug, Default, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SolverProfile {
     /// Preparing bodies and constraints.
     pub prepare: f64,

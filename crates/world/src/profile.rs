@@ -17,7 +17,6 @@ use janus2d_core::solver::SolverProfile;
 
 /// Stage timings of the last step, seconds.
 #[derive(Clone, Debug, Default, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StepProfile {
     /// Broadphase (pair finding and proxy updates).
     pub broadphase: f64,

@@ -85,6 +85,7 @@ pub struct StepEvents {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct World {
     gravity: Vec2,
+    #[cfg_attr(feature = "serde", serde(with = "crate::snapshot::SettingsDef"))]
     settings: SolverSettings,
     pub(crate) bodies: BodySet,
     pub(crate) joints: JointSet,
@@ -108,6 +109,8 @@ pub struct World {
     pub(crate) sleep_settings: SleepSettings,
     wake_list: Vec<BodyHandle>,
     events: StepEvents,
+    /// Timings of the last step (not state: not serialized).
+    #[cfg_attr(feature = "serde", serde(skip))]
     step_profile: crate::profile::StepProfile,
     counters: crate::profile::StepCounters,
     step_count: u64,
