@@ -219,6 +219,46 @@ mod bytes {
         }
     }
 
+    /// Bytes written here, read by a fresh process (this test binary run
+    /// again with `JANUS_SNAPSHOT_CHILD` set), stepped 60 times there: the
+    /// child's state hash equals this process's continuation.
+    #[test]
+    fn snapshot_bytes_continue_bit_exactly_in_a_fresh_process() {
+        const NAME: &str = "bytes::snapshot_bytes_continue_bit_exactly_in_a_fresh_process";
+        if let Ok(path) = std::env::var("JANUS_SNAPSHOT_CHILD") {
+            let bytes = std::fs::read(&path).unwrap();
+            let mut world = Snapshot::from_bytes(&bytes).unwrap().to_world();
+            for _ in 0..60 {
+                world.step(DT).unwrap();
+            }
+            std::fs::write(format!("{path}.hash"), world.state_hash().to_string()).unwrap();
+            return;
+        }
+        #[cfg(feature = "portals")]
+        let mut world = scenes::portal_drop(&scenes::shared_settings()).0.world;
+        #[cfg(not(feature = "portals"))]
+        let mut world = small_world();
+        for _ in 0..40 {
+            world.step(DT).unwrap();
+        }
+        let path = std::env::temp_dir().join(format!("janus2d-snapshot-{}.bin", std::process::id()));
+        std::fs::write(&path, world.snapshot().to_bytes()).unwrap();
+        let status = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([NAME, "--exact", "--test-threads", "1"])
+            .env("JANUS_SNAPSHOT_CHILD", &path)
+            .status()
+            .unwrap();
+        assert!(status.success());
+        for _ in 0..60 {
+            world.step(DT).unwrap();
+        }
+        let hash_path = format!("{}.hash", path.display());
+        let child: u64 = std::fs::read_to_string(&hash_path).unwrap().parse().unwrap();
+        let _ = std::fs::remove_file(&path);
+        let _ = std::fs::remove_file(&hash_path);
+        assert_eq!(child, world.state_hash());
+    }
+
     #[test]
     fn truncated_snapshot_bytes_are_a_typed_error() {
         let bytes = small_world().snapshot().to_bytes();
