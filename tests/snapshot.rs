@@ -241,7 +241,8 @@ mod bytes {
         for _ in 0..40 {
             world.step(DT).unwrap();
         }
-        let path = std::env::temp_dir().join(format!("janus2d-snapshot-{}.bin", std::process::id()));
+        let path =
+            std::env::temp_dir().join(format!("janus2d-snapshot-{}.bin", std::process::id()));
         std::fs::write(&path, world.snapshot().to_bytes()).unwrap();
         let status = std::process::Command::new(std::env::current_exe().unwrap())
             .args([NAME, "--exact", "--test-threads", "1"])
@@ -253,7 +254,10 @@ mod bytes {
             world.step(DT).unwrap();
         }
         let hash_path = format!("{}.hash", path.display());
-        let child: u64 = std::fs::read_to_string(&hash_path).unwrap().parse().unwrap();
+        let child: u64 = std::fs::read_to_string(&hash_path)
+            .unwrap()
+            .parse()
+            .unwrap();
         let _ = std::fs::remove_file(&path);
         let _ = std::fs::remove_file(&hash_path);
         assert_eq!(child, world.state_hash());
