@@ -586,3 +586,158 @@ fn a_far_reaching_sliver_hull_passes_validation() {
     let p = Polygon::from_hull(&points, 0.0).unwrap();
     assert_eq!(Shape::Polygon(p).validate(), Ok(()));
 }
+
+/// Found by the API state machine: an impulse of 1e30 N·s at 1e30 m gave
+/// an infinite angular velocity.
+#[test]
+fn an_impulse_whose_velocity_overflows_is_refused() {
+    let (mut world, _, b) = ground_and_box();
+    let e = unchanged(&mut world, |w| {
+        w.apply_linear_impulse(b, Vec2::new(1e30, 0.0), Vec2::new(1e30, 1e30))
+    });
+    assert!(out_of_bounds("impulse")(&e), "{e:?}");
+    let e = unchanged(&mut world, |w| w.apply_angular_impulse(b, 1e30));
+    assert!(out_of_bounds("impulse")(&e), "{e:?}");
+    // A torque sum that would overflow: the first is kept, the second refused.
+    world.apply_torque(b, Real::MAX).unwrap();
+    let e = unchanged(&mut world, |w| w.apply_torque(b, Real::MAX));
+    assert!(out_of_bounds("torque")(&e), "{e:?}");
+}
+
+/// Found by the API state machine: a joint anchored 1e9 m from its body
+/// made the joint rows overflow.
+#[test]
+fn a_joint_anchor_beyond_the_shape_extent_is_refused() {
+    let (mut world, ground, b) = ground_and_box();
+    let e = unchanged(&mut world, |w| {
+        w.create_revolute_joint(&RevoluteJointDef::new(
+            ground,
+            b,
+            Vec2::new(1e9, 0.0),
+            Vec2::ZERO,
+        ))
+        .map(|_| ())
+    });
+    assert!(out_of_bounds("local_anchor_a")(&e), "{e:?}");
+    let j = world
+        .create_revolute_joint(&RevoluteJointDef::new(ground, b, Vec2::ZERO, Vec2::ZERO))
+        .unwrap();
+    let e = unchanged(&mut world, |w| w.set_joint_spring(j, 1e30, 1.0));
+    assert!(out_of_bounds("hertz")(&e), "{e:?}");
+    let e = unchanged(&mut world, |w| w.set_joint_motor_speed(j, 1e30));
+    assert!(out_of_bounds("motor_speed")(&e), "{e:?}");
+}
+
+/// Found by the API state machine: a friction of 1e30 made the friction
+/// impulse bound overflow.
+#[test]
+fn friction_and_restitution_above_their_limits_are_refused() {
+    let (mut world, _, b) = ground_and_box();
+    let e = unchanged(&mut world, |w| {
+        w.create_shape(
+            b,
+            &ShapeDef::default().with_friction(1e30),
+            Circle::new(Vec2::ZERO, 0.5).unwrap(),
+        )
+        .map(|_| ())
+    });
+    assert!(out_of_bounds("friction")(&e), "{e:?}");
+    let s = world.body_shapes(b).unwrap()[0];
+    let e = unchanged(&mut world, |w| w.set_shape_restitution(s, 1e30));
+    assert!(out_of_bounds("restitution")(&e), "{e:?}");
+}
+
+#[cfg(feature = "portals")]
+mod portals {
+    use super::*;
+    use janus2d::world::{PortalDef, PortalPairDef};
+
+    fn pair_on(a: BodyHandle, b: BodyHandle, half_a: Real) -> PortalPairDef {
+        PortalPairDef::new(
+            PortalDef {
+                body: a,
+                anchor: Vec2::new(0.5, 0.0),
+                direction: Vec2::new(0.0, 1.0),
+                half_width: half_a,
+            },
+            PortalDef {
+                body: b,
+                anchor: Vec2::new(-0.5, 0.0),
+                direction: Vec2::new(1.0, 0.0),
+                half_width: 1.0,
+            },
+        )
+    }
+
+    #[test]
+    fn a_portal_scale_outside_its_range_is_refused() {
+        let (mut world, ground, b) = ground_and_box();
+        for eta in [1e-4, 1e4] {
+            let mut def = pair_on(ground, b, 1.0);
+            def.eta = Some(eta);
+            let e = unchanged(&mut world, |w| w.create_portal_pair(&def).map(|_| ()));
+            // The portal map's own range check answers first (the same
+            // range as `limits::ETA_RANGE`).
+            assert!(
+                matches!(
+                    e,
+                    WorldError::Portal(janus2d::constraints::PortalError::ScaleOutOfRange)
+                ) || out_of_bounds("eta")(&e),
+                "{e:?}"
+            );
+        }
+    }
+
+    /// Found by the API state machine: a portal placed on a crossing's
+    /// clone outlived the clone (destroyed when the crossing ended).
+    #[test]
+    fn a_portal_on_a_crossing_copy_is_refused() {
+        let def = janus2d_testbed::scenes::shared_settings();
+        let (mut scene, _) = janus2d_testbed::scenes::portal_drop(&def);
+        let world = &mut scene.world;
+        let mut crossing = None;
+        for _ in 0..600 {
+            world.step(DT).unwrap();
+            crossing = world
+                .body_handles()
+                .find_map(|b| world.clone_of(b).map(|c| (b, c)));
+            if crossing.is_some() {
+                break;
+            }
+        }
+        let (original, clone) = crossing.expect("a body starts a crossing");
+        let other = world
+            .body_handles()
+            .find(|&b| b != original && b != clone)
+            .unwrap();
+        for body in [original, clone] {
+            let e = unchanged(world, |w| {
+                w.create_portal_pair(&pair_on(body, other, 1.0)).map(|_| ())
+            });
+            assert_eq!(e, WorldError::PortalBody);
+        }
+    }
+
+    /// Found by the API state machine: two portals on one box of a small
+    /// pyramid (η = 20) make the boxes explode; the solve's non-finite
+    /// impulses are no longer kept for warm starting, so the world stays
+    /// valid (every stored number finite).
+    #[test]
+    fn exploding_portal_contacts_store_no_non_finite_impulses() {
+        let def = janus2d_testbed::scenes::shared_settings();
+        let mut world = janus2d_testbed::scenes::large_pyramid(&def, 4).world;
+        let b: Vec<BodyHandle> = world.body_handles().collect();
+        world
+            .create_portal_pair(&pair_on(b[5], b[5], 0.05))
+            .unwrap();
+        for _ in 0..60 {
+            world.step(DT).unwrap();
+            world.validate().unwrap();
+        }
+        for c in world.contacts() {
+            for p in &c.points[..c.point_count] {
+                assert!(p.normal_impulse.is_finite() && p.tangent_impulse.is_finite());
+            }
+        }
+    }
+}

@@ -47,7 +47,11 @@ struct Issued {
 }
 
 fn pick<T: Copy>(list: &[T], k: u8, foreign: T) -> T {
-    if list.is_empty() || k == 255 { foreign } else { list[k as usize % list.len()] }
+    if list.is_empty() || k == 255 {
+        foreign
+    } else {
+        list[k as usize % list.len()]
+    }
 }
 
 fn body_type(t: u8) -> BodyType {
@@ -56,15 +60,25 @@ fn body_type(t: u8) -> BodyType {
 
 fn shape(b: &mut Bytes) -> Option<Shape> {
     Some(match b.byte() % 6 {
-        0 => Shape::Circle(Circle { center: b.vec() * 0.1, radius: b.real() }),
+        0 => Shape::Circle(Circle {
+            center: b.vec() * 0.1,
+            radius: b.real(),
+        }),
         1 => Shape::Polygon(Polygon::try_make_box(b.real(), b.real()).ok()?),
-        2 => Shape::Capsule(Capsule { center1: b.vec() * 0.2, center2: b.vec() * 0.2, radius: b.real() }),
+        2 => Shape::Capsule(Capsule {
+            center1: b.vec() * 0.2,
+            center2: b.vec() * 0.2,
+            radius: b.real(),
+        }),
         3 => {
             let n = (b.byte() % 9) as usize;
             let pts: Vec<Vec2> = (0..n).map(|_| b.vec() * 0.3).collect();
             Shape::Polygon(Polygon::from_hull(&pts, b.real().abs() * 0.1).ok()?)
         }
-        4 => Shape::Segment(Segment { point1: b.vec(), point2: b.vec() }),
+        4 => Shape::Segment(Segment {
+            point1: b.vec(),
+            point2: b.vec(),
+        }),
         _ => {
             let mut p = Polygon::make_box(0.5, 0.5);
             let k = (b.byte() % 4) as usize;
@@ -86,7 +100,12 @@ fn fingerprint(w: &World) -> [u64; 7] {
     ]
 }
 
-fn call(w: &mut World, i: &mut Issued, saved: &mut Option<Snapshot>, b: &mut Bytes) -> Result<(), WorldError> {
+fn call(
+    w: &mut World,
+    i: &mut Issued,
+    saved: &mut Option<Snapshot>,
+    b: &mut Bytes,
+) -> Result<(), WorldError> {
     let f = i.foreign;
     match b.byte() % 20 {
         0 | 1 => {
@@ -94,11 +113,19 @@ fn call(w: &mut World, i: &mut Issued, saved: &mut Option<Snapshot>, b: &mut Byt
             let def = BodyDef {
                 body_type: ty,
                 position: b.vec(),
-                linear_velocity: if b.byte() % 2 == 0 { Vec2::ZERO } else { b.vec() },
+                linear_velocity: if b.byte().is_multiple_of(2) {
+                    Vec2::ZERO
+                } else {
+                    b.vec()
+                },
                 angular_velocity: b.real(),
-                mass: if b.byte() % 4 == 0 { Some(BodyMass::new(b.real(), b.real())) } else { None },
-                awake: b.byte() % 4 != 0,
-                bullet: b.byte() % 4 == 0,
+                mass: if b.byte().is_multiple_of(4) {
+                    Some(BodyMass::new(b.real(), b.real()))
+                } else {
+                    None
+                },
+                awake: !b.byte().is_multiple_of(4),
+                bullet: b.byte().is_multiple_of(4),
                 ..BodyDef::default()
             };
             i.bodies.push(w.create_body(&def)?);
@@ -107,7 +134,11 @@ fn call(w: &mut World, i: &mut Issued, saved: &mut Option<Snapshot>, b: &mut Byt
         2 => w.destroy_body(pick(&i.bodies, b.byte(), f)),
         3 | 4 => {
             let body = pick(&i.bodies, b.byte(), f);
-            let def = ShapeDef { density: b.real(), friction: b.real(), ..ShapeDef::default() };
+            let def = ShapeDef {
+                density: b.real(),
+                friction: b.real(),
+                ..ShapeDef::default()
+            };
             let s = shape(b).ok_or(WorldError::OutOfRange("constructor"))?;
             i.shapes.push(w.create_shape(body, &def, s)?);
             Ok(())
@@ -120,7 +151,7 @@ fn call(w: &mut World, i: &mut Issued, saved: &mut Option<Snapshot>, b: &mut Byt
             let (ba, bb) = (pick(&i.bodies, b.byte(), f), pick(&i.bodies, b.byte(), f));
             let anchor = b.vec();
             let mut def = RevoluteJointDef::new(ba, bb, anchor, -anchor);
-            if b.byte() % 2 == 0 {
+            if b.byte().is_multiple_of(2) {
                 def = def.with_limits(b.real(), b.real());
             }
             i.joints.push(w.create_revolute_joint(&def)?);
@@ -137,13 +168,18 @@ fn call(w: &mut World, i: &mut Issued, saved: &mut Option<Snapshot>, b: &mut Byt
                 direction: b.vec(),
                 half_width: b.real(),
             };
-            let pb = if b.byte() % 4 == 0 {
+            let pb = if b.byte().is_multiple_of(4) {
                 pa
             } else {
-                PortalDef { body: pick(&i.bodies, b.byte(), f), anchor: b.vec(), direction: b.vec(), half_width: b.real() }
+                PortalDef {
+                    body: pick(&i.bodies, b.byte(), f),
+                    anchor: b.vec(),
+                    direction: b.vec(),
+                    half_width: b.real(),
+                }
             };
             let mut def = PortalPairDef::new(pa, pb);
-            if b.byte() % 2 == 0 {
+            if b.byte().is_multiple_of(2) {
                 def.eta = Some(b.real());
             }
             i.pairs.push(w.create_portal_pair(&def)?);
@@ -156,7 +192,10 @@ fn call(w: &mut World, i: &mut Issued, saved: &mut Option<Snapshot>, b: &mut Byt
         10 => w.set_linear_velocity(pick(&i.bodies, b.byte(), f), b.vec()),
         11 => w.set_angular_velocity(pick(&i.bodies, b.byte(), f), b.real()),
         12 => w.set_transform(pick(&i.bodies, b.byte(), f), b.vec(), b.real()),
-        13 => w.set_mass(pick(&i.bodies, b.byte(), f), BodyMass::new(b.real(), b.real())),
+        13 => w.set_mass(
+            pick(&i.bodies, b.byte(), f),
+            BodyMass::new(b.real(), b.real()),
+        ),
         14 => w.set_body_type(pick(&i.bodies, b.byte(), f), body_type(b.byte())),
         15 => match b.byte() % 3 {
             0 => w.apply_force_to_center(pick(&i.bodies, b.byte(), f), b.vec()),
@@ -173,7 +212,7 @@ fn call(w: &mut World, i: &mut Issued, saved: &mut Option<Snapshot>, b: &mut Byt
             }),
             1 => w.set_gravity(b.vec()),
             _ => w.set_sleep_settings(SleepSettings {
-                enabled: b.byte() % 2 == 0,
+                enabled: b.byte().is_multiple_of(2),
                 linear_threshold: b.real(),
                 time_to_sleep: b.real(),
             }),
@@ -205,8 +244,15 @@ fuzz_target!(|data: &[u8]| {
     let foreign = other.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
     let mut w = World::new(WorldDef::default()).unwrap();
     let ground = w.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
-    w.create_shape(ground, &ShapeDef::default(), Polygon::make_box(8.0, 0.5)).unwrap();
-    let mut issued = Issued { bodies: vec![ground], shapes: Vec::new(), joints: Vec::new(), pairs: Vec::new(), foreign };
+    w.create_shape(ground, &ShapeDef::default(), Polygon::make_box(8.0, 0.5))
+        .unwrap();
+    let mut issued = Issued {
+        bodies: vec![ground],
+        shapes: Vec::new(),
+        joints: Vec::new(),
+        pairs: Vec::new(),
+        foreign,
+    };
     let mut saved = None;
     let mut b = Bytes(data);
     let mut n = 0;

@@ -39,28 +39,47 @@ impl Bytes<'_> {
 
 fn shape(b: &mut Bytes) -> Shape {
     match b.byte() % 6 {
-        0 => Shape::Circle(Circle { center: b.vec(), radius: b.real() }),
-        1 => Shape::Capsule(Capsule { center1: b.vec(), center2: b.vec(), radius: b.real() }),
+        0 => Shape::Circle(Circle {
+            center: b.vec(),
+            radius: b.real(),
+        }),
+        1 => Shape::Capsule(Capsule {
+            center1: b.vec(),
+            center2: b.vec(),
+            radius: b.real(),
+        }),
         2 => {
             let n = 3 + (b.byte() % 6) as usize;
             let pts: Vec<Vec2> = (0..n).map(|_| b.vec()).collect();
             let r = b.real().abs() * 0.1;
-            Polygon::from_hull(&pts, r).map_or(Shape::Circle(Circle { center: Vec2::ZERO, radius: 0.5 }), Shape::Polygon)
+            Polygon::from_hull(&pts, r).map_or(
+                Shape::Circle(Circle {
+                    center: Vec2::ZERO,
+                    radius: 0.5,
+                }),
+                Shape::Polygon,
+            )
         }
-        3 => Shape::Segment(Segment { point1: b.vec(), point2: b.vec() }),
+        3 => Shape::Segment(Segment {
+            point1: b.vec(),
+            point2: b.vec(),
+        }),
         4 => Shape::ChainSegment(ChainSegment {
             ghost1: b.vec(),
-            segment: Segment { point1: b.vec(), point2: b.vec() },
+            segment: Segment {
+                point1: b.vec(),
+                point2: b.vec(),
+            },
             ghost2: b.vec(),
         }),
         _ => {
             // A hand-built polygon: a box with fuzzed vertices and normals.
             let mut p = Polygon::make_box(0.5, 0.5);
             for k in 0..4 {
-                if b.byte() % 2 == 0 {
+                if b.byte().is_multiple_of(2) {
                     p.vertices[k] = b.vec();
                 }
-                if b.byte() % 4 == 0 {
+                if b.byte().is_multiple_of(4) {
                     p.normals[k] = b.vec();
                 }
             }
@@ -89,7 +108,10 @@ fuzz_target!(|data: &[u8]| {
         return;
     }
     let fine = |x: &Transform| {
-        x.p.is_finite() && x.q.is_finite() && x.p.x.abs() <= MAX_COORDINATE && x.p.y.abs() <= MAX_COORDINATE
+        x.p.is_finite()
+            && x.q.is_finite()
+            && x.p.x.abs() <= MAX_COORDINATE
+            && x.p.y.abs() <= MAX_COORDINATE
     };
     if !fine(&xa) || !fine(&xb) {
         return;
@@ -99,11 +121,18 @@ fuzz_target!(|data: &[u8]| {
         assert!(m.point_count <= 2, "{} points", m.point_count);
         if m.point_count > 0 {
             assert!(m.normal.is_finite(), "normal {:?}", m.normal);
-            assert!((m.normal.length() - 1.0).abs() < 1e-3, "normal {:?}", m.normal);
+            assert!(
+                (m.normal.length() - 1.0).abs() < 1e-3,
+                "normal {:?}",
+                m.normal
+            );
         }
         for p in m.points() {
             assert!(
-                p.point.is_finite() && p.separation.is_finite() && p.anchor_a.is_finite() && p.anchor_b.is_finite(),
+                p.point.is_finite()
+                    && p.separation.is_finite()
+                    && p.anchor_a.is_finite()
+                    && p.anchor_b.is_finite(),
                 "{m:?}"
             );
         }

@@ -91,6 +91,7 @@ const NONE: u32 = u32::MAX;
 
 /// One node of the elimination tree: a moving body or a joint.
 #[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct Node {
     /// Body: its state index. Joint: its index in the joint slice.
     index: u32,
@@ -110,6 +111,7 @@ struct Node {
 /// and kinematic bodies are the fixed ends), solved in every solve and relax
 /// iteration. Deterministic: joints are visited in storage order.
 #[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct JointForest {
     /// Nodes, parents first (breadth-first from each root).
     nodes: Vec<Node>,

@@ -62,6 +62,7 @@ pub fn clamp_length(v: Vec2, max: Real) -> Vec2 {
 
 /// Two rows that hold an anchor on body a at an anchor on body b.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PointPart {
     /// Anchor on a relative to a's centre at the start of the step (world frame), m.
     pub frame_a: Vec2,
@@ -184,6 +185,7 @@ impl AxisPart {
 
 /// One row on the relative angle of two bodies (springs, motors, limits).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct AnglePart {
     /// Effective mass `1 / (1/I_a + 1/I_b)`, kg·m².
     pub mass: Real,

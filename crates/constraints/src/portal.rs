@@ -154,6 +154,7 @@ use crate::portal_map::{Portal, PortalError, PortalFrame, PortalMap, validate_et
 
 /// Everything needed to create a portal constraint.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PortalConstraintDef {
     /// Body 1: the body that passes through portal 1.
     pub body: BodyHandle,
@@ -213,6 +214,7 @@ impl PortalConstraintDef {
 
 /// State indices of the four bodies, in the order body, clone, A, B.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PortalIndices {
     /// Body 1.
     pub body: u32,
@@ -227,6 +229,7 @@ pub struct PortalIndices {
 /// One side of the portal (a body and the portal body it passes through)
 /// at the start of the step, in world axes.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PortalSide {
     /// Portal anchor relative to the portal body's centre, `p₀`, m.
     pub frame: Vec2,
@@ -467,6 +470,7 @@ pub fn solve_block(k: &Mat3, b: [Real; 3]) -> [Real; 3] {
 /// The portal rows as a part: start-of-step geometry, the scale and the
 /// accumulated impulse, with the warm start and solve stages.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PortalPart {
     /// Side 1 at the start of the step.
     pub side1: PortalSide,
@@ -570,6 +574,7 @@ fn load(states: &[BodyState], ix: PortalIndices) -> (BodyState, BodyState, BodyS
 
 /// A portal constraint in solver form.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PortalConstraint {
     def: PortalConstraintDef,
     /// False when the constraint is disabled (skipped by the solver).

@@ -154,6 +154,7 @@ pub fn validate_eta(eta: Real) -> Result<(), PortalError> {
 /// the direction. Code that fills the fields directly should call
 /// [`Portal::validate`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Portal {
     /// Centre of the aperture in the body frame (relative to the body
     /// origin, like joint anchors), m.

@@ -43,6 +43,7 @@ use crate::parts::{AnglePart, PointPart, load_pair, store_pair};
 
 /// Everything needed to create a revolute joint.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct RevoluteJointDef {
     /// First body.
     pub body_a: BodyHandle,
@@ -156,6 +157,7 @@ impl RevoluteJointDef {
 
 /// A revolute joint in solver form.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct RevoluteJoint {
     /// The definition it was made from (limits, motor and spring settings).
     pub def: RevoluteJointDef,

@@ -37,6 +37,7 @@ pub const DEFAULT_MAX_ROTATION: Real = 0.25 * crate::math::PI;
 
 /// How a body moves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum BodyType {
     /// Never moves; infinite mass.
     #[default]
@@ -60,6 +61,7 @@ pub fn next_owner_id() -> u32 {
 
 /// Mass properties set directly on a body.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BodyMass {
     /// Mass, kg (> 0 for a dynamic body).
     pub mass: Real,
@@ -265,6 +267,7 @@ impl std::error::Error for BodyError {}
 /// The solver's hot per-body state: everything a constraint reads or writes
 /// in every iteration.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BodyState {
     /// Linear velocity of the centre of mass, m/s.
     pub v: Vec2,
@@ -294,6 +297,7 @@ impl BodyState {
 
 /// Per-body data the solver touches once per step or substep.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BodySim {
     /// Body origin and rotation.
     pub transform: Transform,
@@ -372,6 +376,7 @@ impl BodySim {
 
 /// Where a live body's data sits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum BodyLocation {
     /// Index into `sims`/`states` (≥ 1).
     Moving(u32),
@@ -386,6 +391,7 @@ pub enum BodyLocation {
 /// Bookkeeping for one live body (its slot's generation is kept by the
 /// [`Slots`] that hold the records).
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BodyRecord {
     /// Where the body lives.
     pub location: BodyLocation,
@@ -410,6 +416,7 @@ pub struct SolverBody<'a> {
 
 /// Storage of every body, with generational handles.
 #[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BodySet {
     owner: u32,
     records: Slots<BodyRecord>,

@@ -34,6 +34,7 @@ use crate::softness::Softness;
 
 /// How the velocity solver treats position error.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum SolverMode {
     /// Box2D v3's soft step: substeps, soft constraints, relax iterations.
     #[default]

@@ -24,6 +24,8 @@ use std::hash::{Hash, Hasher};
 use std::marker::PhantomData;
 
 /// A generational handle to something of kind `K` in one world.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(bound = ""))]
 pub struct Handle<K> {
     /// Slot index.
     pub index: u32,
@@ -31,6 +33,7 @@ pub struct Handle<K> {
     pub generation: u32,
     /// Id of the world that issued the handle.
     pub owner: u32,
+    #[cfg_attr(feature = "serde", serde(skip))]
     kind: PhantomData<fn() -> K>,
 }
 

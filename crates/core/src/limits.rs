@@ -20,7 +20,7 @@
 //! | [`MAX_DAMPING_RATIO`]   | 1e4                | contact and joint damping ratios                        |
 //! | [`MAX_FRICTION`]        | 1e6                | a shape's friction coefficient                         |
 //! | [`MAX_RESTITUTION`]     | 1e3                | a shape's restitution                                  |
-//! | [`ETA_RANGE`]           | 1e-3 … 1e3         | a portal pair's scale η (a clone's mass goes as η², its inertia as η⁴) |
+//! | [`ETA_RANGE`]           | 1e-2 … 1e2         | a portal pair's scale η (a clone's mass goes as η², its inertia as η⁴) |
 //! | [`MAX_HERTZ_FRACTION`]  | 0.25               | contact and iterative joint stiffness are capped at this fraction of the substep rate, as Box2D caps them |
 
 use crate::math::Real;
@@ -62,8 +62,9 @@ pub const MAX_FRICTION: Real = 1e6;
 /// Largest restitution of a shape (1e3).
 pub const MAX_RESTITUTION: Real = 1e3;
 
-/// Allowed scale η of a portal pair: `[1e-3, 1e3]`.
-pub const ETA_RANGE: (Real, Real) = (1e-3, 1e3);
+/// Allowed scale η of a portal pair: `[1e-2, 1e2]` (the portal map's
+/// `ETA_MIN` and `ETA_MAX`).
+pub const ETA_RANGE: (Real, Real) = (1e-2, 1e2);
 
 /// Contact stiffness and iterative joint stiffness are capped at this
 /// fraction of the substep rate `1 / h` (0.25, as Box2D caps

@@ -84,6 +84,7 @@ pub fn vec_is_finite(v: Vec2) -> bool {
 
 /// A rotation stored as cosine and sine (unit length).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Rot {
     /// Cosine of the angle.
     pub c: Real,
@@ -192,6 +193,7 @@ impl Rot {
 
 /// A rigid transform: rotation then translation.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Transform {
     /// Translation (the body origin in world space).
     pub p: Vec2,

@@ -11,6 +11,7 @@
 
 /// Values in generational slots.
 #[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Slots<T> {
     entries: Vec<(u32, Option<T>)>,
     free: Vec<u32>,

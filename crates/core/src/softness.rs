@@ -46,6 +46,7 @@ use crate::math::{Real, TAU};
 
 /// Coefficients of a soft constraint row for one substep length.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Softness {
     /// Position error feedback rate, 1/s.
     pub bias_rate: Real,

@@ -58,6 +58,7 @@ const BULK_DIVISOR: usize = 4;
 
 /// Per-proxy record of the [`BroadPhase`].
 #[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct ProxySlot {
     /// The fat box of the leaf, kept here too so that the narrowphase's
     /// overlap test per contact reads one slot instead of slot and node.
@@ -91,6 +92,7 @@ struct ProxySlot {
 ///    [`test_overlap`](Self::test_overlap). Pair persistence is the caller's
 ///    job, as in Box2D: the broadphase keeps no pair set.
 #[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BroadPhase {
     dynamic_tree: DynamicTree,
     static_tree: DynamicTree,

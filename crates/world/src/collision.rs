@@ -45,6 +45,7 @@ pub use crate::dynamic_tree::DEFAULT_AABB_MARGIN as AABB_MARGIN;
 
 /// Counters of the last collision pass.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct CollisionCounters {
     /// Shape pairs whose manifolds were computed.
     pub pairs_tested: usize,
@@ -62,6 +63,7 @@ pub struct CollisionCounters {
 
 /// Shapes, broadphase and contacts of a world.
 #[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub(crate) struct Collision {
     pub(crate) owner: u32,
     pub(crate) shapes: ShapeStore,

@@ -27,6 +27,7 @@ use crate::shapes::ShapeHandle;
 
 /// One manifold point with its warm-starting data.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ContactPointData {
     /// World point, m.
     pub point: Vec2,
@@ -55,6 +56,7 @@ pub struct ContactPointData {
 
 /// A persistent contact between two shapes whose fat boxes overlap.
 #[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Contact {
     /// Stable id for the contact's whole life.
     pub id: u32,
@@ -126,6 +128,7 @@ impl Contact {
 
 /// Two shapes that began or stopped touching.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ShapePairEvent {
     /// One shape.
     pub shape_a: ShapeHandle,
@@ -138,6 +141,7 @@ pub struct ShapePairEvent {
 /// Events of contacts that end because a body or shape was destroyed
 /// between steps are kept and reported with the next step's.
 #[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct CollisionEvents {
     /// Solid contacts that began touching.
     pub contact_begin: Vec<ShapePairEvent>,
@@ -155,6 +159,7 @@ pub struct CollisionEvents {
 /// A contact that hit hard enough (see `ShapeDef::enable_hit_events` and
 /// `WorldDef::hit_event_threshold`): its fastest-approaching point.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct HitEvent {
     /// Shape a of the contact.
     pub shape_a: ShapeHandle,
@@ -187,6 +192,7 @@ impl CollisionEvents {
 
 /// Which list a contact id lives in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 enum Place {
     Free,
     Awake(u32),
@@ -201,6 +207,7 @@ pub(crate) fn pair_key(a: u32, b: u32) -> (u32, u32) {
 
 /// Every contact of a world, awake or asleep, with per-body adjacency.
 #[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ContactSet {
     /// Awake contacts (the narrowphase and constraint building visit these).
     pub(crate) awake: Vec<Contact>,

@@ -44,6 +44,7 @@ pub const FAST_FRACTION: Real = 0.5;
 
 /// Work of the last continuous pass.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ContinuousCounters {
     /// Fast bodies swept (bullets included).
     pub toi_bodies: usize,
@@ -64,6 +65,7 @@ pub(crate) struct ContinuousInput<'a> {
 
 /// The continuous stage: the switch, its scratch lists and its counters.
 #[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub(crate) struct ContinuousStage {
     pub(crate) enabled: bool,
     counters: ContinuousCounters,

@@ -119,6 +119,7 @@ impl NodeStack {
 
 /// One node of the tree: a leaf (a proxy) or an internal node.
 #[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct Node {
     /// Fat box of a leaf, or the union of the children of an internal node.
     aabb: Aabb,
@@ -176,6 +177,7 @@ enum Rotation {
 /// [`move_proxy`](Self::move_proxy) calls. All operations are deterministic:
 /// the same sequence of calls builds the same tree.
 #[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct DynamicTree {
     nodes: Vec<Node>,
     root: u32,

@@ -41,6 +41,7 @@ use crate::shapes::ShapeStore;
 
 /// When bodies fall asleep.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SleepSettings {
     /// Sleep on (default, as Box2D and Rapier) or off.
     pub enabled: bool,
@@ -91,6 +92,7 @@ const NONE: u32 = u32::MAX;
 
 /// A group of dynamic bodies linked by touching contacts and joints.
 #[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct Island {
     members: Vec<BodyHandle>,
     /// Links removed since the island was built or last split: it may
@@ -114,6 +116,7 @@ struct Island {
 ///   time_to_sleep             the awake lists
 /// ```
 #[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub(crate) struct Islands {
     /// Island of each body slot.
     island_of: Vec<u32>,

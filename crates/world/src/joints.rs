@@ -30,6 +30,7 @@ pub type JointHandle = Handle<JointTag>;
 
 /// The joint types.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum JointKind {
     /// A pin: two anchors coincide; optional limit, motor and spring.
     Revolute,
@@ -37,6 +38,7 @@ pub enum JointKind {
 
 /// Where a joint lives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct JointSlot {
     kind: JointKind,
     index: u32,
@@ -47,7 +49,9 @@ struct JointSlot {
 /// `collide_connected = false` keeps from colliding, with how many such
 /// joints join them.
 #[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct NoCollide {
+    #[cfg_attr(feature = "serde", serde(with = "crate::snapshot::sorted_map"))]
     pairs: HashMap<(u32, u32), u32>,
 }
 
@@ -82,6 +86,7 @@ impl NoCollide {
 
 /// Every joint of a world.
 #[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct JointSet {
     owner: u32,
     slots: Slots<JointSlot>,

@@ -64,5 +64,7 @@ pub use profile::{StepCounters, StepProfile};
 pub use query::{PortalHop, QueryFilter, QueryProblem, RayHit, ShapeOverlap};
 pub use shapes::{Filter, ShapeData, ShapeDef, ShapeHandle};
 pub use snapshot::Snapshot;
+#[cfg(feature = "serde")]
+pub use snapshot::bytes::{SNAPSHOT_MAGIC, SNAPSHOT_VERSION, SnapshotError};
 pub use validate::{Invariant, InvariantError};
 pub use world::{StepEvents, World, WorldDef};

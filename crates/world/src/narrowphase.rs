@@ -61,6 +61,7 @@ pub type PreSolveFn = Box<dyn FnMut(&PreSolve) -> bool + Send>;
 /// Phase-1 outcome of the narrowphase for one contact (its manifold is
 /// already updated in place).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 enum ContactUpdate {
     /// Both bodies asleep or static: the contact is kept as it is.
     Asleep,
@@ -82,6 +83,7 @@ enum ContactUpdate {
 
 /// The narrowphase's reused buffers.
 #[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub(crate) struct Narrowphase {
     results: Vec<ContactUpdate>,
     /// Awake positions of the contacts that touched solidly at the last
@@ -97,6 +99,7 @@ pub(crate) struct Narrowphase {
 
 /// A contact the solve takes this step, as the build's first pass found it.
 #[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct SolvedContact {
     /// Index in the awake list.
     index: u32,

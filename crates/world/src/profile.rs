@@ -37,6 +37,7 @@ pub struct StepProfile {
 
 /// Work counters of the last step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StepCounters {
     /// The collision stages ran (the world has shapes).
     pub collision_ran: bool,

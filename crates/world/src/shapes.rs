@@ -27,6 +27,7 @@ pub type ShapeHandle = Handle<ShapeTag>;
 /// `(a.category & b.mask) != 0 && (b.category & a.mask) != 0`, unless they
 /// share a non-zero group index (positive: always collide; negative: never).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Filter {
     /// The categories this shape belongs to (usual 1).
     pub category_bits: u64,
@@ -66,6 +67,7 @@ impl Filter {
 
 /// Everything needed to create a shape besides its geometry.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ShapeDef {
     /// Density, kg/m² (usual 1).
     pub density: Real,
@@ -169,6 +171,7 @@ pub(crate) fn check_material_limit(v: Real, name: &'static str) -> Result<(), Wo
 
 /// A shape attached to a body.
 #[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ShapeData {
     /// The body it is attached to.
     pub body: BodyHandle,
@@ -185,6 +188,7 @@ pub struct ShapeData {
 /// The size figures of a body's solid shapes that continuous collision
 /// reads (kept up to date as shapes come and go).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BodyExtent {
     /// Smallest [`min_extent`](janus2d_core::geometry::ShapeExtent::min_extent)
     /// of the body's solid shapes, m (`Real::MAX` without one).
@@ -205,6 +209,7 @@ impl Default for BodyExtent {
 
 /// Shapes of a world, in generational slots, with each body's list.
 #[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ShapeStore {
     slots: Slots<ShapeData>,
     body_shapes: Vec<SmallVec<[u32; 2]>>,

@@ -86,3 +86,236 @@ impl World {
         self.set_pre_solve(hook);
     }
 }
+
+/// Serde for [`SolverSettings`](janus2d_core::solver::SolverSettings),
+/// field by field (the solver's file carries no serde attribute).
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(remote = "janus2d_core::solver::SolverSettings")]
+pub(crate) struct SettingsDef {
+    mode: janus2d_core::SolverMode,
+    substeps: u32,
+    relax_iterations: u32,
+    velocity_iterations: u32,
+    baumgarte: janus2d_core::math::Real,
+    contact_hertz: janus2d_core::math::Real,
+    contact_hertz_fraction: janus2d_core::math::Real,
+    contact_damping_ratio: janus2d_core::math::Real,
+    contact_push_max_velocity: janus2d_core::math::Real,
+    joint_hertz: janus2d_core::math::Real,
+    joint_hertz_fraction: janus2d_core::math::Real,
+    joint_damping_ratio: janus2d_core::math::Real,
+    joint_max_correction_speed: janus2d_core::math::Real,
+    restitution_threshold: janus2d_core::math::Real,
+    warm_starting: bool,
+    contact_mass_ratio_cap: janus2d_core::math::Real,
+    joint_mass_ratio_cap: janus2d_core::math::Real,
+    direct_joints: bool,
+    direct_joint_hertz: janus2d_core::math::Real,
+    direct_joint_max_correction_speed: janus2d_core::math::Real,
+}
+
+/// Serde for the world's hash maps as key-sorted sequences: the bytes of
+/// a snapshot do not depend on a map's iteration order.
+#[cfg(feature = "serde")]
+pub(crate) mod sorted_map {
+    use std::collections::{BTreeMap, HashMap};
+    use std::hash::Hash;
+
+    /// Writes the map in key order.
+    pub(crate) fn serialize<K, V, S>(map: &HashMap<K, V>, s: S) -> Result<S::Ok, S::Error>
+    where
+        K: serde::Serialize + Ord,
+        V: serde::Serialize,
+        S: serde::Serializer,
+    {
+        let sorted: BTreeMap<&K, &V> = map.iter().collect();
+        serde::Serialize::serialize(&sorted, s)
+    }
+
+    /// Reads a map written by [`serialize`].
+    pub(crate) fn deserialize<'de, K, V, D>(d: D) -> Result<HashMap<K, V>, D::Error>
+    where
+        K: serde::Deserialize<'de> + Eq + Hash + Ord,
+        V: serde::Deserialize<'de>,
+        D: serde::Deserializer<'de>,
+    {
+        let sorted: BTreeMap<K, V> = serde::Deserialize::deserialize(d)?;
+        Ok(sorted.into_iter().collect())
+    }
+}
+
+/// The bytes of a snapshot (with the `serde` feature): a versioned header,
+/// then the world in [postcard](https://docs.rs/postcard)'s compact
+/// encoding.
+///
+/// | bytes   | what                                                         |
+/// |---------|--------------------------------------------------------------|
+/// | 0..4    | magic `JNS2`                                                 |
+/// | 4..6    | format version, little endian ([`SNAPSHOT_VERSION`](bytes::SNAPSHOT_VERSION)) |
+/// | 6       | bytes per real: 4 (f32 build) or 8 (`f64` feature)           |
+/// | 7       | 1 with the `portals` feature, else 0                         |
+/// | 8..16   | payload length, little endian                                |
+/// | 16..24  | FNV-1a 64 of the payload                                     |
+/// | 24..    | payload: the world (postcard)                                |
+///
+/// Decoding checks every field of the header and the checksum before it
+/// decodes, then runs [`World::validate`] on the result: truncated,
+/// corrupted or foreign bytes are a [`SnapshotError`](bytes::SnapshotError), never a panic.
+#[cfg(feature = "serde")]
+pub mod bytes {
+    use super::Snapshot;
+    use crate::world::World;
+
+    /// The magic at the start of every snapshot.
+    pub const SNAPSHOT_MAGIC: [u8; 4] = *b"JNS2";
+    /// The format version this build writes and reads.
+    pub const SNAPSHOT_VERSION: u16 = 1;
+    const HEADER: usize = 24;
+
+    /// Why bytes are not a snapshot this build can restore.
+    #[derive(Clone, Debug, PartialEq, Eq)]
+    pub enum SnapshotError {
+        /// Fewer bytes than the header, or than the payload length says.
+        Truncated {
+            /// Bytes needed.
+            needed: usize,
+            /// Bytes given.
+            found: usize,
+        },
+        /// The bytes do not start with [`SNAPSHOT_MAGIC`].
+        BadMagic,
+        /// Written by another format version.
+        WrongVersion {
+            /// The version in the bytes.
+            found: u16,
+            /// [`SNAPSHOT_VERSION`].
+            expected: u16,
+        },
+        /// Written by a build with another real type or feature set.
+        WrongBuild {
+            /// Bytes per real in the snapshot.
+            real_bytes: u8,
+            /// Portals feature in the snapshot.
+            portals: bool,
+        },
+        /// The payload's checksum does not match (corrupted bytes).
+        Checksum,
+        /// The payload does not decode (says where, in words).
+        Decode(String),
+        /// The payload decodes to a world that breaks an invariant.
+        Invalid(crate::validate::InvariantError),
+    }
+
+    impl std::fmt::Display for SnapshotError {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            match self {
+                SnapshotError::Truncated { needed, found } => {
+                    write!(f, "snapshot truncated: {found} bytes, {needed} needed")
+                }
+                SnapshotError::BadMagic => write!(f, "not a janus2d snapshot"),
+                SnapshotError::WrongVersion { found, expected } => {
+                    write!(f, "snapshot version {found}, this build reads {expected}")
+                }
+                SnapshotError::WrongBuild {
+                    real_bytes,
+                    portals,
+                } => write!(
+                    f,
+                    "snapshot of a build with {real_bytes}-byte reals, portals {portals}"
+                ),
+                SnapshotError::Checksum => write!(f, "snapshot checksum mismatch"),
+                SnapshotError::Decode(e) => write!(f, "snapshot does not decode: {e}"),
+                SnapshotError::Invalid(e) => write!(f, "snapshot world invalid: {e}"),
+            }
+        }
+    }
+
+    impl std::error::Error for SnapshotError {}
+
+    fn fnv(bytes: &[u8]) -> u64 {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for b in bytes {
+            h ^= u64::from(*b);
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        h
+    }
+
+    fn build_bytes() -> (u8, u8) {
+        (
+            std::mem::size_of::<janus2d_core::math::Real>() as u8,
+            u8::from(cfg!(feature = "portals")),
+        )
+    }
+
+    impl Snapshot {
+        /// The snapshot as bytes (header and postcard payload; see
+        /// [`crate::snapshot::bytes`]).
+        #[must_use]
+        pub fn to_bytes(&self) -> Vec<u8> {
+            let payload =
+                postcard::to_allocvec(&*self.world).expect("every field of a world serializes");
+            let (real, portals) = build_bytes();
+            let mut out = Vec::with_capacity(HEADER + payload.len());
+            out.extend_from_slice(&SNAPSHOT_MAGIC);
+            out.extend_from_slice(&SNAPSHOT_VERSION.to_le_bytes());
+            out.push(real);
+            out.push(portals);
+            out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+            out.extend_from_slice(&fnv(&payload).to_le_bytes());
+            out.extend_from_slice(&payload);
+            out
+        }
+
+        /// A snapshot from [`to_bytes`](Self::to_bytes)' output, checked
+        /// (header, checksum, decoding, [`World::validate`]).
+        pub fn from_bytes(bytes: &[u8]) -> Result<Snapshot, SnapshotError> {
+            if bytes.len() < HEADER {
+                return Err(SnapshotError::Truncated {
+                    needed: HEADER,
+                    found: bytes.len(),
+                });
+            }
+            if bytes[0..4] != SNAPSHOT_MAGIC {
+                return Err(SnapshotError::BadMagic);
+            }
+            let version = u16::from_le_bytes([bytes[4], bytes[5]]);
+            if version != SNAPSHOT_VERSION {
+                return Err(SnapshotError::WrongVersion {
+                    found: version,
+                    expected: SNAPSHOT_VERSION,
+                });
+            }
+            if (bytes[6], bytes[7]) != build_bytes() {
+                return Err(SnapshotError::WrongBuild {
+                    real_bytes: bytes[6],
+                    portals: bytes[7] != 0,
+                });
+            }
+            let word = |k: usize| {
+                let mut w = [0u8; 8];
+                w.copy_from_slice(&bytes[k..k + 8]);
+                u64::from_le_bytes(w)
+            };
+            let len = usize::try_from(word(8)).unwrap_or(usize::MAX);
+            let payload = &bytes[HEADER..];
+            if payload.len() < len {
+                return Err(SnapshotError::Truncated {
+                    needed: HEADER.saturating_add(len),
+                    found: bytes.len(),
+                });
+            }
+            let payload = &payload[..len];
+            if fnv(payload) != word(16) {
+                return Err(SnapshotError::Checksum);
+            }
+            let world: World =
+                postcard::from_bytes(payload).map_err(|e| SnapshotError::Decode(e.to_string()))?;
+            world.validate().map_err(SnapshotError::Invalid)?;
+            Ok(Snapshot {
+                world: Box::new(world),
+            })
+        }
+    }
+}

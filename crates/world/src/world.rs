@@ -71,6 +71,7 @@ impl Default for WorldDef {
 
 /// Events of the last step, read after `step`.
 #[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StepEvents {
     /// Bodies whose state went non-finite during the step. Each was put back
     /// at its start-of-step pose, at rest, instead of spreading NaN.
@@ -81,16 +82,21 @@ pub struct StepEvents {
 
 /// The simulation world: it owns one value of each stage and calls them
 /// in order, passing each what it reads.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct World {
     gravity: Vec2,
+    #[cfg_attr(feature = "serde", serde(with = "crate::snapshot::SettingsDef"))]
     settings: SolverSettings,
     pub(crate) bodies: BodySet,
     pub(crate) joints: JointSet,
     pub(crate) collision: Collision,
     /// The step's contact constraints in their colours and lanes (the
-    /// contact solve's own data).
+    /// contact solve's own data; rebuilt at every step, so not serialized).
+    #[cfg_attr(feature = "serde", serde(skip))]
     contact_solver: ContactSolver,
-    /// The contact-modification hook's data for this step (portal copies).
+    /// The contact-modification hook's data for this step (portal copies;
+    /// rebuilt at every step, so not serialized).
+    #[cfg_attr(feature = "serde", serde(skip))]
     object_masses: Vec<ObjectMass>,
     pub(crate) portals: PortalStage,
     pub(crate) islands: Islands,
@@ -98,10 +104,13 @@ pub struct World {
     /// Approach speed above which hit events are reported, m/s.
     hit_event_threshold: Real,
     /// The user's pre-solve hook, if any (called per touching contact).
+    #[cfg_attr(feature = "serde", serde(skip))]
     pre_solve: Option<crate::narrowphase::PreSolveFn>,
     pub(crate) sleep_settings: SleepSettings,
     wake_list: Vec<BodyHandle>,
     events: StepEvents,
+    /// Timings of the last step (not state: not serialized).
+    #[cfg_attr(feature = "serde", serde(skip))]
     step_profile: crate::profile::StepProfile,
     counters: crate::profile::StepCounters,
     step_count: u64,

@@ -4,6 +4,7 @@ use crate::math::{Real, Vec2};
 
 /// An axis-aligned bounding box given by its lower and upper corners.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Aabb {
     /// Lower corner (minimum x and y).
     pub lower: Vec2,

@@ -127,6 +127,7 @@ pub(crate) fn normalize_or(v: Vec2, fallback: Vec2) -> Vec2 {
 
 /// A solid disc.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Circle {
     /// Centre in the body frame, metres.
     pub center: Vec2,
@@ -150,6 +151,7 @@ impl Circle {
 /// A solid capsule: all points within `radius` of the core segment
 /// `center1`–`center2`.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Capsule {
     /// First end of the core segment (body frame), metres.
     pub center1: Vec2,
@@ -189,6 +191,7 @@ impl Capsule {
 
 /// A two-sided line segment without area (usually on static bodies).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Segment {
     /// First end point (body frame), metres.
     pub point1: Vec2,
@@ -225,6 +228,7 @@ impl Segment {
 /// neighbour": that end is an exposed, rounded corner. [`make_chain`] sets
 /// ghosts this way at the two ends of an open chain.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ChainSegment {
     /// The chain point before `segment.point1` (or `point1` itself at an open end).
     pub ghost1: Vec2,
@@ -301,6 +305,7 @@ pub fn make_chain(points: &[Vec2], closed_loop: bool) -> Result<Vec<ChainSegment
 /// `vertices[(i + 1) % count]`. Entries at `count..` are unused (zero). A
 /// polygon with `count == 2` is a capsule core (see [`Polygon::make_capsule`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Polygon {
     /// Vertices (body frame, counter-clockwise), metres.
     pub vertices: [Vec2; MAX_POLYGON_VERTICES],
@@ -660,6 +665,7 @@ fn normal_matches(n: Vec2, expected: Vec2) -> bool {
 /// Any collision shape, in its body's local frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[allow(clippy::large_enum_variant)] // a Box would add an indirection to every collision
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Shape {
     /// A disc.
     Circle(Circle),

@@ -109,6 +109,7 @@ pub const LIP_ID_HIGH: u16 = 0xFFF1;
 ///   plane within the aperture are dropped (that part of the object is on
 ///   the other side).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ApertureClip {
     /// The body whose contacts are clipped (the wall, or the crossing copy).
     pub body: BodyHandle,
@@ -193,6 +194,7 @@ pub static NO_CLIPPING: ContactClipping = ContactClipping {
 
 /// What the portal stage asks the narrowphase to drop.
 #[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ContactClipping {
     /// Aperture regions.
     pub clips: Vec<ApertureClip>,

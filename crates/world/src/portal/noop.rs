@@ -10,6 +10,7 @@ use crate::world::World;
 
 /// The no-op portal stage.
 #[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub(crate) struct PortalStage {
     /// Always empty: the solver's third batch.
     constraints: Vec<PortalConstraint>,

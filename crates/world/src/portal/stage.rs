@@ -59,6 +59,7 @@ pub const F_MIN: Real = 0.1;
 
 /// How a clone's mass follows from the original's.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum MassModel {
     /// Density unchanged: `m₂ = η² m₁`, `I₂ = η⁴ I₁` (what a game expects).
     #[default]
@@ -89,6 +90,7 @@ impl MassModel {
 
 /// One portal: an aperture on a body.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PortalDef {
     /// The body carrying the portal.
     pub body: BodyHandle,
@@ -211,6 +213,7 @@ pub type PortalPairHandle = Handle<PortalPairTag>;
 
 /// What happened at the portals during the last step.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum PortalEvent {
     /// A body entered a portal: its clone was created.
     CrossingStarted {
@@ -246,6 +249,7 @@ pub enum PortalEvent {
 
 /// Counters of the last portal stage.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PortalCounters {
     /// Crossings in progress after the step.
     pub active_crossings: usize,
@@ -260,6 +264,7 @@ pub struct PortalCounters {
 }
 
 #[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub(crate) struct PairData {
     pub(crate) portals: [PortalDef; 2],
     pub(crate) local: [Portal; 2],
@@ -269,6 +274,7 @@ pub(crate) struct PairData {
 
 /// A crossing in progress.
 #[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub(crate) struct Crossing {
     pub(crate) pair: u32,
     /// 0: entered portal a; 1: entered portal b.
@@ -286,6 +292,7 @@ pub(crate) struct Crossing {
 /// The portal stage: pairs, crossings and their constraints, the clipping
 /// it hands the narrowphase, and its events.
 #[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub(crate) struct PortalStage {
     /// Portal pair handle slots.
     pub(crate) pairs: Slots<PairData>,
