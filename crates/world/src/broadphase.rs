@@ -407,28 +407,45 @@ impl BroadPhase {
 
     /// Validates both trees and the proxy table; panics on inconsistency.
     pub fn validate(&self) {
-        self.dynamic_tree.validate();
-        self.static_tree.validate();
+        if let Err(e) = self.check() {
+            panic!("{e}");
+        }
+    }
+
+    /// [`validate`](Self::validate) without panicking, also on corrupt
+    /// indices (a decoded snapshot): both trees, each live proxy's leaf
+    /// link and fat box, the counts.
+    pub fn check(&self) -> Result<(), String> {
+        self.dynamic_tree
+            .check()
+            .map_err(|e| format!("dynamic tree: {e}"))?;
+        self.static_tree
+            .check()
+            .map_err(|e| format!("static tree: {e}"))?;
         let mut live = [0usize; 2];
         for (id, s) in self.proxies.iter().enumerate() {
             if !s.alive {
                 continue;
             }
             live[usize::from(s.is_static)] += 1;
-            assert_eq!(
-                self.tree(s.is_static).user_data(s.leaf) as usize,
-                id,
-                "proxy {id} leaf link"
-            );
-            assert_eq!(
-                self.tree(s.is_static).fat_aabb(s.leaf),
-                s.fat,
-                "proxy {id} fat box"
-            );
+            match self.tree(s.is_static).leaf(s.leaf) {
+                Some((user, fat)) if user as usize == id && fat == s.fat => {}
+                Some(_) => return Err(format!("proxy {id}: leaf link or fat box")),
+                None => return Err(format!("proxy {id}: leaf {} is not a leaf", s.leaf)),
+            }
         }
-        assert_eq!(live[0], self.dynamic_tree.proxy_count(), "dynamic count");
-        assert_eq!(live[1], self.static_tree.proxy_count(), "static count");
-        assert_eq!(live[0] + live[1], self.proxy_count(), "free list");
+        if live[0] != self.dynamic_tree.proxy_count() || live[1] != self.static_tree.proxy_count() {
+            return Err("proxy counts differ from the trees'".into());
+        }
+        let listed = self.proxies.len().checked_sub(self.free_proxies.len());
+        if listed != Some(live[0] + live[1]) {
+            return Err("free list".into());
+        }
+        let in_range = |&p: &u32| (p as usize) < self.proxies.len();
+        if !self.free_proxies.iter().all(in_range) || !self.move_buffer.iter().all(in_range) {
+            return Err("a free or moved proxy id out of range".into());
+        }
+        Ok(())
     }
 
     // ---- internals ----------------------------------------------------

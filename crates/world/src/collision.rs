@@ -121,6 +121,7 @@ impl Collision {
     /// of its body's type, and its fat box contains the shape's box at the
     /// body's current pose; no other proxy is live.
     pub(crate) fn check_proxies(&self, bodies: &BodySet) -> Result<(), String> {
+        self.broadphase.check()?;
         let mut count = 0usize;
         for body in bodies.handles() {
             let Some(sim) = bodies.sim(body) else {

@@ -321,6 +321,16 @@ impl DynamicTree {
         self.nodes[id as usize].user_data
     }
 
+    /// The payload and fat box of leaf `id`, or `None` when `id` is not an
+    /// allocated leaf (never panics; for checks).
+    #[must_use]
+    pub fn leaf(&self, id: u32) -> Option<(u32, Aabb)> {
+        self.nodes
+            .get(id as usize)
+            .filter(|n| n.allocated && n.is_leaf())
+            .map(|n| (n.user_data, n.aabb))
+    }
+
     /// Calls `callback(user_data)` for every proxy whose fat box overlaps
     /// `aabb` (touching counts), until the callback returns `false`.
     ///
@@ -396,66 +406,88 @@ impl DynamicTree {
         }
     }
 
-    /// Checks every structural invariant and panics on the first violation:
-    /// parent/child links, heights, internal boxes equal to the union of their
-    /// children, leaf and free-list counts. Meant for tests and debugging.
+    /// Checks every structural invariant and panics on the first violation
+    /// (see [`DynamicTree::check`]). Meant for tests and debugging.
     pub fn validate(&self) {
+        if let Err(e) = self.check() {
+            panic!("{e}");
+        }
+    }
+
+    /// Checks every structural invariant without panicking, also on a tree
+    /// whose indices are corrupt (a decoded snapshot): indices in range,
+    /// parent/child links, heights, internal boxes equal to the union of
+    /// their children, leaf and free-list counts, no cycle.
+    pub fn check(&self) -> Result<(), String> {
+        let node_at = |index: u32| {
+            self.nodes
+                .get(index as usize)
+                .ok_or_else(|| format!("node index {index} out of range"))
+        };
         let mut reachable = 0usize;
         let mut leaves = 0usize;
         if self.root != NULL_NODE {
-            assert_eq!(
-                self.nodes[self.root as usize].parent, NULL_NODE,
-                "root has a parent"
-            );
+            if node_at(self.root)?.parent != NULL_NODE {
+                return Err("root has a parent".into());
+            }
             let mut stack: Vec<u32> = vec![self.root];
             while let Some(index) = stack.pop() {
-                let node = &self.nodes[index as usize];
-                assert!(node.allocated, "node {index} reachable but free");
+                let node = node_at(index)?;
+                if !node.allocated {
+                    return Err(format!("node {index} reachable but free"));
+                }
                 reachable += 1;
+                if reachable > self.nodes.len() {
+                    return Err("the tree has a cycle".into());
+                }
                 if node.is_leaf() {
-                    assert_eq!(node.child2, NULL_NODE, "leaf {index} has child2");
-                    assert_eq!(node.height, 0, "leaf {index} height");
+                    if node.child2 != NULL_NODE || node.height != 0 {
+                        return Err(format!("leaf {index}: child2 or height"));
+                    }
                     leaves += 1;
                     continue;
                 }
                 let (c1, c2) = (node.child1, node.child2);
-                assert!(c2 != NULL_NODE && c1 != c2, "node {index} children");
-                let n1 = &self.nodes[c1 as usize];
-                let n2 = &self.nodes[c2 as usize];
-                assert_eq!(n1.parent, index, "child {c1} parent link");
-                assert_eq!(n2.parent, index, "child {c2} parent link");
-                assert_eq!(
-                    node.height,
-                    1 + n1.height.max(n2.height),
-                    "node {index} height"
-                );
-                assert!(
-                    node.aabb.contains(&n1.aabb) && node.aabb.contains(&n2.aabb),
-                    "node {index} does not contain its children"
-                );
-                assert_eq!(
-                    node.aabb,
-                    n1.aabb.union(&n2.aabb),
-                    "node {index} box is not tight"
-                );
+                if c2 == NULL_NODE || c1 == c2 {
+                    return Err(format!("node {index} children"));
+                }
+                let (n1, n2) = (node_at(c1)?, node_at(c2)?);
+                if n1.parent != index || n2.parent != index {
+                    return Err(format!("node {index}: a child's parent link"));
+                }
+                if node.height != 1 + n1.height.max(n2.height) {
+                    return Err(format!("node {index} height"));
+                }
+                if node.aabb != n1.aabb.union(&n2.aabb) {
+                    return Err(format!("node {index} box is not its children's union"));
+                }
                 stack.push(c1);
                 stack.push(c2);
             }
         }
-        assert_eq!(leaves, self.proxy_count as usize, "leaf count");
-        if leaves > 0 {
-            assert_eq!(reachable, 2 * leaves - 1, "node count");
+        if leaves != self.proxy_count as usize {
+            return Err(format!("{leaves} leaves, {} proxies", self.proxy_count));
+        }
+        if leaves > 0 && reachable != 2 * leaves - 1 {
+            return Err(format!("{reachable} nodes for {leaves} leaves"));
         }
         let mut free = 0usize;
         let mut index = self.free_list;
         while index != NULL_NODE {
-            let node = &self.nodes[index as usize];
-            assert!(!node.allocated, "free node {index} marked allocated");
+            let node = node_at(index)?;
+            if node.allocated {
+                return Err(format!("free node {index} marked allocated"));
+            }
             free += 1;
-            assert!(free <= self.nodes.len(), "free list has a cycle");
+            if free > self.nodes.len() {
+                return Err("free list has a cycle".into());
+            }
             index = node.parent;
         }
-        assert_eq!(reachable + free, self.nodes.len(), "leaked nodes");
+        if reachable + free != self.nodes.len() {
+            return Err("leaked nodes".into());
+        }
+        Ok(())
     }
 
     /// Calls `f(user_a, user_b)` exactly once for every unordered pair of
@@ -933,6 +965,29 @@ pub(crate) mod test_util {
 mod tests {
     use super::test_util::{Lcg, boxed, random_box, translate};
     use super::*;
+
+    /// A tree decoded from crafted bytes may hold any index: the check
+    /// reports it instead of panicking on it (and a sound tree passes).
+    #[test]
+    fn check_reports_corrupt_indices_without_panicking() {
+        let mut tree = DynamicTree::new();
+        for i in 0..20u32 {
+            tree.create_proxy(boxed(i as Real, 0.0, 0.4, 0.4), i);
+        }
+        assert_eq!(tree.check(), Ok(()));
+        let internal = tree.root as usize;
+        for corrupt in [u32::MAX - 1, 1_000_000, tree.root] {
+            let mut bad = tree.clone();
+            bad.nodes[internal].child1 = corrupt;
+            assert!(bad.check().is_err(), "child index {corrupt} passed");
+        }
+        let mut bad = tree.clone();
+        bad.root = 999;
+        assert!(bad.check().is_err());
+        let mut bad = tree.clone();
+        bad.free_list = 12345;
+        assert!(bad.check().is_err());
+    }
 
     #[test]
     fn sorted_insertion_stays_balanced_and_removal_validates() {
