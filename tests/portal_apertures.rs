@@ -6,30 +6,10 @@
 
 use janus2d::base::geometry::LINEAR_SLOP;
 use janus2d::prelude::*;
-use janus2d::world::{PortalDef, PortalEvent, PortalPairDef};
+use janus2d::world::{PortalEvent, PortalPairDef};
+use janus2d_testbed::support::{portal_def as portal, report, wall};
 
 const DT: Real = 1.0 / 60.0;
-
-fn report() -> bool {
-    std::env::var("JANUS2D_REPORT").is_ok()
-}
-
-fn wall(world: &mut World, center: Vec2, hx: Real, hy: Real) -> BodyHandle {
-    let b = world.create_body(&BodyDef::fixed(center)).unwrap();
-    world
-        .create_shape(b, &ShapeDef::default(), Polygon::make_box(hx, hy))
-        .unwrap();
-    b
-}
-
-fn portal(body: BodyHandle, anchor: Vec2, direction: Vec2, half_width: Real) -> PortalDef {
-    PortalDef {
-        body,
-        anchor,
-        direction,
-        half_width,
-    }
-}
 
 fn dynamic_box(world: &mut World, pos: Vec2, hx: Real, hy: Real) -> BodyHandle {
     let b = world.create_body(&BodyDef::dynamic(pos)).unwrap();

@@ -4,27 +4,9 @@
 
 use janus2d::constraints::PortalError;
 use janus2d::prelude::*;
-use janus2d::world::{
-    CrossingRole, MassModel, PlaneSide, PortalDef, PortalEvent, PortalPairDef, PortalSide,
-};
+use janus2d::world::{CrossingRole, MassModel, PlaneSide, PortalEvent, PortalPairDef, PortalSide};
 use janus2d_testbed::scenes::{self, DT};
-
-fn wall(world: &mut World, center: Vec2, hx: Real, hy: Real) -> BodyHandle {
-    let b = world.create_body(&BodyDef::fixed(center)).unwrap();
-    world
-        .create_shape(b, &ShapeDef::default(), Polygon::make_box(hx, hy))
-        .unwrap();
-    b
-}
-
-fn portal(body: BodyHandle, anchor: Vec2, direction: Vec2, half_width: Real) -> PortalDef {
-    PortalDef {
-        body,
-        anchor,
-        direction,
-        half_width,
-    }
-}
+use janus2d_testbed::support::{portal_def as portal, wall};
 
 /// Steps the portal drop until its box is crossing; returns the clone.
 fn until_crossing(world: &mut World, body: BodyHandle) -> BodyHandle {

@@ -13,24 +13,13 @@
 
 use janus2d::prelude::*;
 use janus2d::world::{PortalDef, PortalEvent, PortalPairDef};
+use janus2d_testbed::support::{report, wall};
 
 const DT: Real = 1.0 / 60.0;
 /// Half-width of both apertures, m.
 const W: Real = 1.5;
 /// Half size of the thrown box, m.
 const H: Real = 0.1;
-
-fn report() -> bool {
-    std::env::var("JANUS2D_REPORT").is_ok()
-}
-
-fn wall(world: &mut World, center: Vec2, hx: Real, hy: Real) -> BodyHandle {
-    let b = world.create_body(&BodyDef::fixed(center)).unwrap();
-    world
-        .create_shape(b, &ShapeDef::default(), Polygon::make_box(hx, hy))
-        .unwrap();
-    b
-}
 
 /// The outcome of one throw.
 #[derive(Debug)]

@@ -3,12 +3,9 @@
 #![cfg(feature = "portals")]
 
 use janus2d::prelude::*;
-use janus2d::world::{MassModel, PortalDef, PortalEvent, PortalPairDef};
+use janus2d::world::{MassModel, PortalEvent, PortalPairDef};
 use janus2d_testbed::scenes::{self, DT};
-
-fn report() -> bool {
-    std::env::var("JANUS2D_REPORT").is_ok()
-}
+use janus2d_testbed::support::{portal_def as portal, report, wall};
 
 fn dynamic_count(world: &World) -> usize {
     world
@@ -34,23 +31,6 @@ fn extent(world: &World, b: BodyHandle, dir: Vec2) -> Real {
         hi = hi.max(z);
     }
     hi - lo
-}
-
-fn wall(world: &mut World, center: Vec2, hx: Real, hy: Real) -> BodyHandle {
-    let b = world.create_body(&BodyDef::fixed(center)).unwrap();
-    world
-        .create_shape(b, &ShapeDef::default(), Polygon::make_box(hx, hy))
-        .unwrap();
-    b
-}
-
-fn portal(body: BodyHandle, anchor: Vec2, direction: Vec2, half_width: Real) -> PortalDef {
-    PortalDef {
-        body,
-        anchor,
-        direction,
-        half_width,
-    }
 }
 
 /// A square box of half size `half` at `pos` moving at `velocity`.

@@ -10,6 +10,7 @@ use janus2d_constraints::portal_map::Portal;
 use janus2d_core::body::BodyType;
 use janus2d_core::math::{EPSILON, PI, Real, TAU, Vec2, cross};
 use janus2d_core::solver::{SolverSettings, solve_step};
+use janus2d_testbed::support::report;
 use janus2d_testbed::support::*;
 
 const DT: Real = 1.0 / 60.0;
@@ -22,10 +23,6 @@ const MOMENTUM_TOL: f64 = 1e-5;
 
 /// Position error bound, m.
 const MAX_C: Real = 1.0e-3;
-
-fn report() -> bool {
-    std::env::var("JANUS2D_REPORT").is_ok()
-}
 
 /// SplitMix64: a small deterministic generator for the random impulses.
 struct Rng(u64);

@@ -4,13 +4,10 @@
 #![cfg(feature = "portals")]
 
 use janus2d::prelude::*;
-use janus2d::world::{PortalDef, PortalPairDef};
+use janus2d::world::PortalPairDef;
+use janus2d_testbed::support::{portal_def as portal, report};
 
 const DT: Real = 1.0 / 60.0;
-
-fn report() -> bool {
-    std::env::var("JANUS2D_REPORT").is_ok()
-}
 
 fn body_box(world: &mut World, def: &BodyDef, hx: Real, hy: Real) -> BodyHandle {
     let b = world.create_body(def).unwrap();
@@ -22,15 +19,6 @@ fn body_box(world: &mut World, def: &BodyDef, hx: Real, hy: Real) -> BodyHandle 
 
 fn wall(world: &mut World, center: Vec2, hx: Real, hy: Real) -> BodyHandle {
     body_box(world, &BodyDef::fixed(center), hx, hy)
-}
-
-fn portal(body: BodyHandle, anchor: Vec2, direction: Vec2, half_width: Real) -> PortalDef {
-    PortalDef {
-        body,
-        anchor,
-        direction,
-        half_width,
-    }
 }
 
 /// Steps `steps` times; returns the largest |C| while a crossing is in

@@ -475,6 +475,40 @@ pub fn portal_case(
 #[allow(clippy::unnecessary_cast)] // `Real` is f64 with the feature (a const: no fn call)
 pub const EPS: f64 = EPSILON as f64;
 
+/// A static body with one box shape of half extents `hx`, `hy` centred at
+/// `center`: the walls and floors of the portal tests.
+pub fn wall(world: &mut janus2d_world::World, center: Vec2, hx: Real, hy: Real) -> BodyHandle {
+    let b = world
+        .create_body(&BodyDef::fixed(center))
+        .expect("a wall at a finite place");
+    world
+        .create_shape(
+            b,
+            &janus2d_world::ShapeDef::default(),
+            janus2d_core::geometry::Polygon::make_box(hx, hy),
+        )
+        .expect("a wall of positive size");
+    b
+}
+
+/// A portal on `body` at `anchor` (body frame), facing `direction`, with
+/// half-width `half_width`.
+#[cfg(feature = "portals")]
+#[must_use]
+pub fn portal_def(
+    body: BodyHandle,
+    anchor: Vec2,
+    direction: Vec2,
+    half_width: Real,
+) -> janus2d_world::PortalDef {
+    janus2d_world::PortalDef {
+        body,
+        anchor,
+        direction,
+        half_width,
+    }
+}
+
 /// Whether `JANUS2D_REPORT` is set: the tests then print their measured
 /// worst figures.
 pub fn report() -> bool {
