@@ -886,9 +886,8 @@ fn collide_chain_polygon(
 /// The manifold of a polygon against chain segment `a` with the segment's
 /// front normal as the reference face: the polygon's edge most
 /// anti-parallel to it, clipped to the segment's extent (empty when the
-/// polygon does not lie over the segment). `xf` places the polygon in the
-/// segment's frame. Feature ids: `(0, i22)` and `(1, i21)`, as a reference
-/// edge `0 → 1`.
+/// polygon does not lie over the segment). Feature ids: `(0, i22)` and
+/// `(1, i21)`, as a reference edge `0 → 1`.
 fn chain_face_manifold(
     a: &ChainSegment,
     xf_a: &Transform,
