@@ -249,6 +249,7 @@ impl Collision {
                 hit_events: sa.def.enable_hit_events || sb.def.enable_hit_events,
                 enabled: true,
                 still: [false, false],
+                solve_bodies: [(0, [0.0; 2]); 2],
             };
             self.contacts.insert(contact);
             created += 1;

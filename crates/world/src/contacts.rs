@@ -91,6 +91,10 @@ pub struct Contact {
     /// Whether each body read as static (static or asleep) at the last
     /// narrowphase; both true: the contact sleeps and is not solved.
     pub still: [bool; 2],
+    /// What the narrowphase read of each body for this step's solve, so
+    /// that constraint building gathers nothing again: its state index
+    /// (0: static or asleep) and `[m⁻¹, I⁻¹]` (zero for state 0).
+    pub(crate) solve_bodies: [(u32, [Real; 2]); 2],
 }
 
 impl Contact {

@@ -284,6 +284,7 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
     let was_touching = c.touching;
     update_manifold(c, &manifold, offset);
     c.still = [body_a.state_index == 0, body_b.state_index == 0];
+    c.solve_bodies = [solve_body(&body_a), solve_body(&body_b)];
     c.touching = c.point_count > 0;
     let wake = c.touching && {
         let other = if c.still[0] {
@@ -300,6 +301,17 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
         touching: c.touching,
         solid: c.is_solid_touching(),
         wake,
+    }
+}
+
+/// A body's state index and inverse masses as the solve takes them (zero
+/// masses for the static identity state 0).
+#[inline]
+fn solve_body(b: &janus2d_core::body::SolverBody<'_>) -> (u32, [Real; 2]) {
+    if b.state_index == 0 {
+        (0, [0.0; 2])
+    } else {
+        (b.state_index, [b.sim.inv_mass, b.sim.inv_inertia])
     }
 }
 
@@ -365,6 +377,8 @@ pub(crate) fn build_constraints(
         .map(|&k| k as usize)
         .chain(woken);
     if woke {
+        // Woken bodies have new state indices, and woken contacts were not
+        // read by this step's narrowphase: read their bodies again.
         for k in candidates.clone() {
             let c = contacts.awake_mut(k);
             if c.still == [true, true] {
@@ -373,18 +387,16 @@ pub(crate) fn build_constraints(
                     bodies.state_index(c.body_b) == Some(0),
                 ];
             }
+            c.solve_bodies = [
+                solve_body(&bodies.solver_body(c.body_a)),
+                solve_body(&bodies.solver_body(c.body_b)),
+            ];
         }
     }
     // The state index of a body (0: static or asleep) and whether the
-    // solve moves it (dynamic and awake).
-    let state_of = |body: BodyHandle| -> (u32, bool) {
-        let i = bodies.state_index(body).unwrap_or(0);
-        let moving = i != 0
-            && bodies
-                .sims
-                .get(i as usize)
-                .is_some_and(|sim| sim.inv_mass > 0.0 || sim.inv_inertia > 0.0);
-        (i, moving)
+    // solve moves it (dynamic and awake), as the narrowphase read them.
+    let state_of = |(i, [m, inertia]): (u32, [Real; 2])| -> (u32, bool) {
+        (i, i != 0 && (m > 0.0 || inertia > 0.0))
     };
     // A portal copy: its contacts take the object-mass hook, in the overflow.
     let is_copy = |body: BodyHandle| objects.iter().any(|o| o.body == body);
@@ -421,8 +433,8 @@ pub(crate) fn build_constraints(
                 continue;
             }
         }
-        let (ia, moving_a) = state_of(c.body_a);
-        let (ib, moving_b) = state_of(c.body_b);
+        let (ia, moving_a) = state_of(c.solve_bodies[0]);
+        let (ib, moving_b) = state_of(c.solve_bodies[1]);
         let copy = !objects.is_empty() && (is_copy(c.body_a) || is_copy(c.body_b));
         solved.push(SolvedContact {
             index: k as u32,
@@ -463,15 +475,8 @@ pub(crate) fn build_constraints(
                 tangent_impulse: p.tangent_impulse,
             };
         }
-        let masses = |i: u32| {
-            bodies
-                .sims
-                .get(i as usize)
-                .filter(|_| i != 0)
-                .map_or((0.0, 0.0), |sim| (sim.inv_mass, sim.inv_inertia))
-        };
         let [ia, ib] = s.state;
-        let ((m_a, i_a), (m_b, i_b)) = (masses(ia), masses(ib));
+        let [(_, [m_a, i_a]), (_, [m_b, i_b])] = c.solve_bodies;
         let lane = ContactLane {
             body_a: c.body_a,
             body_b: c.body_b,
