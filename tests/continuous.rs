@@ -261,10 +261,14 @@ fn spinner_loop_holds_flung_bodies_for_60_steps() {
 /// without continuous collision; 11 with it, boxes and a capsule the pile
 /// pressed through the loop's concave vertices; none since a chain segment
 /// that rejects a deep polygon's axis still holds it along its own face).
-/// Slow: run with
-/// `cargo test --test continuous -- --ignored` (the test profile is optimised).
+/// About 10 s in the (optimised) test profile: CI runs it in the f32 run;
+/// with `f64` run it with `cargo test --features f64 --test continuous --
+/// --ignored`.
 #[test]
-#[ignore = "500 steps of 6,078 bodies (about 25 s): run with --ignored"]
+#[cfg_attr(
+    feature = "f64",
+    ignore = "500 steps of 6,078 bodies: the f32 run carries it; run with --ignored"
+)]
 fn spinner_loop_holds_flung_bodies_for_500_steps() {
     let desc = spinner();
     let mut e = Janus::new(&desc).unwrap();
