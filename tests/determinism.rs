@@ -1,36 +1,10 @@
 //! Determinism: the same inputs give bit-identical state. The golden hashes
 //! pin the exact arithmetic; a change that alters them must say why.
 
-use janus2d::prelude::*;
-
-/// Three chains of 12 hinged bodies: one with limits, one with springs, one
-/// with motors; 500 steps.
+/// The three hinged chains of the testbed's support module (limits,
+/// springs, motors), 500 steps.
 fn build_and_run() -> u64 {
-    let mut world = World::new(WorldDef::default()).unwrap();
-    let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
-    for chain in 0..3 {
-        let x0 = 20.0 * chain as Real;
-        let mut prev = ground;
-        for i in 0..12 {
-            let pos = Vec2::new(x0 + i as Real + 0.5, 0.3 * chain as Real);
-            let b = world
-                .create_body(&BodyDef::dynamic(pos).with_mass(1.0 + 0.1 * i as Real, 0.1))
-                .unwrap();
-            let anchor_a = if i == 0 {
-                Vec2::new(x0, 0.3 * chain as Real)
-            } else {
-                Vec2::new(0.5, 0.0)
-            };
-            let mut def = RevoluteJointDef::new(prev, b, anchor_a, Vec2::new(-0.5, 0.0));
-            def = match chain {
-                0 => def.with_limits(-0.4, 0.4),
-                1 => def.with_spring(4.0, 0.3),
-                _ => def.with_motor(1.0 + 0.1 * i as Real, 20.0),
-            };
-            world.create_revolute_joint(&def).unwrap();
-            prev = b;
-        }
-    }
+    let mut world = janus2d_testbed::support::hinged_chains();
     for _ in 0..500 {
         world.step(1.0 / 60.0).unwrap();
     }

@@ -509,6 +509,44 @@ pub fn portal_def(
     }
 }
 
+/// The determinism scene: three chains of 12 hinged bodies from a static
+/// ground, one with joint limits, one with springs, one with motors
+/// (`tests/determinism.rs` pins its state hash after 500 steps; the
+/// snapshot tests continue it from a copy).
+#[must_use]
+pub fn hinged_chains() -> janus2d_world::World {
+    use janus2d_constraints::RevoluteJointDef;
+    let mut world =
+        janus2d_world::World::new(janus2d_world::WorldDef::default()).expect("the default world");
+    let ground = world
+        .create_body(&BodyDef::fixed(Vec2::ZERO))
+        .expect("a static ground");
+    for chain in 0..3 {
+        let x0 = 20.0 * chain as Real;
+        let mut prev = ground;
+        for i in 0..12 {
+            let pos = Vec2::new(x0 + i as Real + 0.5, 0.3 * chain as Real);
+            let b = world
+                .create_body(&BodyDef::dynamic(pos).with_mass(1.0 + 0.1 * i as Real, 0.1))
+                .expect("a link");
+            let anchor_a = if i == 0 {
+                Vec2::new(x0, 0.3 * chain as Real)
+            } else {
+                Vec2::new(0.5, 0.0)
+            };
+            let mut def = RevoluteJointDef::new(prev, b, anchor_a, Vec2::new(-0.5, 0.0));
+            def = match chain {
+                0 => def.with_limits(-0.4, 0.4),
+                1 => def.with_spring(4.0, 0.3),
+                _ => def.with_motor(1.0 + 0.1 * i as Real, 20.0),
+            };
+            world.create_revolute_joint(&def).expect("a hinge");
+            prev = b;
+        }
+    }
+    world
+}
+
 /// Whether `JANUS2D_REPORT` is set: the tests then print their measured
 /// worst figures.
 pub fn report() -> bool {
