@@ -336,12 +336,6 @@ impl ContactConstraint {
         (self.impulse[i], self.impulse[i + MAX_MANIFOLD_POINTS])
     }
 
-    /// Accumulated normal impulse of the points summed (what one substep
-    /// applies at warm start), N·s.
-    pub fn total_normal_impulse(&self) -> Real {
-        self.impulse[..self.point_count()].iter().sum()
-    }
-
     /// The kept and step-total impulses of point `i`.
     #[must_use]
     pub fn point_impulse(&self, i: usize) -> crate::contact_solver::PointImpulse {
