@@ -41,6 +41,7 @@
 use janus2d_core::body::{BodyHandle, BodySet, BodyState};
 use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
 use janus2d_core::math::{Real, Vec2, cross};
+use janus2d_core::parallel::Team;
 use wide::{CmpEq, CmpGe, CmpGt, CmpLt, CmpNe};
 
 use crate::contact::{ContactConstraint, ContactPointInput, MAX_MANIFOLD_POINTS, ROWS};
@@ -146,6 +147,13 @@ struct WideContact {
     /// Step totals less the current impulse: `Σ_warm starts λ − λ_prepare`
     /// per row, N·s (see [`PointImpulse`]).
     step_base: [W; ROWS],
+    /// The velocities a stage computed for body a and body b of every lane
+    /// (`v_x, v_y, w`), written back to the states by
+    /// [`WideContact::scatter_out`].
+    out_a: [W; 3],
+    out_b: [W; 3],
+    /// True when the last parallel stage left velocities in the outputs.
+    written: bool,
 }
 
 /// The impulses of one manifold point after a step, N·s.
@@ -375,9 +383,20 @@ impl ContactSolver {
         &self.overflow
     }
 
-    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet, objects: &[ObjectMass]) {
-        for chunk in self.colours.iter_mut().flatten() {
-            chunk.prepare(ctx, &bodies.states);
+    fn prepare(
+        &mut self,
+        ctx: &StepContext,
+        bodies: &BodySet,
+        objects: &[ObjectMass],
+        team: &Team,
+    ) {
+        let states = &bodies.states[..];
+        for chunks in &mut self.colours {
+            team.for_each_chunk_mut(chunks, CHUNKS_PER_BLOCK, |_, block| {
+                for chunk in block {
+                    chunk.prepare(ctx, states);
+                }
+            });
         }
         for c in &mut self.overflow {
             c.prepare(ctx, bodies);
@@ -399,9 +418,12 @@ impl ContactSolver {
         }
     }
 
-    fn warm_start(&mut self, states: &mut [BodyState]) {
-        for chunk in self.colours.iter_mut().flatten() {
-            chunk.warm_start(states);
+    fn warm_start(&mut self, states: &mut [BodyState], team: &Team) {
+        for chunks in &mut self.colours {
+            colour_stage(team, chunks, states, |chunk, states| {
+                chunk.warm_start(states);
+                true
+            });
         }
         for c in &mut self.overflow {
             c.apply_warm_start(states);
@@ -414,17 +436,23 @@ impl ContactSolver {
         states: &mut [BodyState],
         use_bias: bool,
         reverse: bool,
+        team: &Team,
     ) {
         let (inv_h, push_max) = (ctx.inv_h, ctx.contact_push_max_velocity);
         let colours = self.colours.len();
         for k in 0..colours {
             let colour = if reverse { colours - 1 - k } else { k };
-            for chunk in &mut self.colours[colour] {
-                if use_bias {
+            let chunks = &mut self.colours[colour];
+            if use_bias {
+                colour_stage(team, chunks, states, |chunk, states| {
                     chunk.solve::<true>(states, inv_h, push_max);
-                } else {
+                    true
+                });
+            } else {
+                colour_stage(team, chunks, states, |chunk, states| {
                     chunk.solve::<false>(states, inv_h, push_max);
-                }
+                    true
+                });
             }
         }
         for c in &mut self.overflow {
@@ -436,13 +464,58 @@ impl ContactSolver {
         }
     }
 
-    fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+    fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState], team: &Team) {
         let threshold = splat(ctx.restitution_threshold);
-        for chunk in self.colours.iter_mut().flatten() {
-            chunk.apply_restitution(states, threshold);
+        for chunks in &mut self.colours {
+            colour_stage(team, chunks, states, |chunk, states| {
+                chunk.apply_restitution(states, threshold)
+            });
         }
         for c in &mut self.overflow {
             c.apply_restitution(ctx, states);
+        }
+    }
+}
+
+/// Chunks of a colour per block of a parallel stage (4 chunks: 32 contacts
+/// in f32).
+const CHUNKS_PER_BLOCK: usize = 4;
+
+/// One stage over the chunks of one colour: `stage(chunk, states)` computes
+/// each chunk's new velocities from the states (returning false when it
+/// has none), then they are written back.
+///
+/// On a serial team each chunk writes back at once. On a team of several
+/// threads the chunks are computed in blocks on the team, reading the
+/// states only, and written back on the leader afterwards: within a colour
+/// no dynamic body appears twice, so every chunk reads the same states
+/// either way and the results are bit-identical.
+#[inline(always)]
+fn colour_stage(
+    team: &Team,
+    chunks: &mut [WideContact],
+    states: &mut [BodyState],
+    stage: impl Fn(&mut WideContact, &[BodyState]) -> bool + Sync,
+) {
+    if team.threads() == 1 || chunks.len() <= CHUNKS_PER_BLOCK {
+        for chunk in chunks.iter_mut() {
+            if stage(chunk, states) {
+                chunk.scatter_out(states);
+            }
+        }
+        return;
+    }
+    {
+        let states = &*states;
+        team.for_each_chunk_mut(chunks, CHUNKS_PER_BLOCK, |_, block| {
+            for chunk in block {
+                chunk.written = stage(chunk, states);
+            }
+        });
+    }
+    for chunk in chunks.iter() {
+        if chunk.written {
+            chunk.scatter_out(states);
         }
     }
 }
@@ -545,6 +618,9 @@ impl WideContact {
             impulse: [z; ROWS],
             max_normal_impulse: [z; MAX_MANIFOLD_POINTS],
             step_base: [z; ROWS],
+            out_a: [z; 3],
+            out_b: [z; 3],
+            written: false,
         }
     }
 
@@ -648,10 +724,12 @@ impl WideContact {
 
     /// Restitution lane-wise, point 0 then point 1: where a point approached
     /// faster than the threshold and pushed, drive `Ċ` to `−e · Ċ_before`.
-    fn apply_restitution(&mut self, states: &mut [BodyState], threshold: W) {
+    /// Returns false (and leaves the outputs as they were) when no lane
+    /// has restitution.
+    fn apply_restitution(&mut self, states: &[BodyState], threshold: W) -> bool {
         let zero = W::splat(0.0);
         if self.restitution.cmp_gt(zero).none() {
-            return;
+            return false;
         }
         let (mut v_xa, mut v_ya, mut w_a) = gather_velocity(states, &self.state_a);
         let (mut v_xb, mut v_yb, mut w_b) = gather_velocity(states, &self.state_b);
@@ -681,13 +759,25 @@ impl WideContact {
             v_yb += self.inv_mass_b * p_y;
             w_b += self.inv_inertia_b * applied * rn_b;
         }
-        scatter(states, &self.state_a, v_xa, v_ya, w_a);
-        scatter(states, &self.state_b, v_xb, v_yb, w_b);
+        self.out_a = [v_xa, v_ya, w_a];
+        self.out_b = [v_xb, v_yb, w_b];
+        true
+    }
+
+    /// Writes the velocities the last stage computed back to the states.
+    /// Lanes on the identity state, on a static or on a kinematic body
+    /// write what they read.
+    #[inline(always)]
+    fn scatter_out(&self, states: &mut [BodyState]) {
+        let [v_x, v_y, w] = self.out_a;
+        scatter(states, &self.state_a, v_x, v_y, w);
+        let [v_x, v_y, w] = self.out_b;
+        scatter(states, &self.state_b, v_x, v_y, w);
     }
 
     /// Applies the kept impulses: `Δv = M⁻¹ Jᵀ λ`.
     #[inline(always)]
-    fn warm_start(&mut self, states: &mut [BodyState]) {
+    fn warm_start(&mut self, states: &[BodyState]) {
         let (n_x, n_y) = (self.n_x, self.n_y);
         let lambda = &self.impulse;
         for (base, &l) in self.step_base.iter_mut().zip(lambda) {
@@ -700,32 +790,23 @@ impl WideContact {
         let l_a = dot_rows(lambda, &self.ja);
         let l_b = dot_rows(lambda, &self.jb);
         let (v_x, v_y, w) = gather_velocity(states, &self.state_a);
-        scatter(
-            states,
-            &self.state_a,
+        self.out_a = [
             v_x - self.inv_mass_a * p_x,
             v_y - self.inv_mass_a * p_y,
             w - self.inv_inertia_a * l_a,
-        );
+        ];
         let (v_x, v_y, w) = gather_velocity(states, &self.state_b);
-        scatter(
-            states,
-            &self.state_b,
+        self.out_b = [
             v_x + self.inv_mass_b * p_x,
             v_y + self.inv_mass_b * p_y,
             w + self.inv_inertia_b * l_b,
-        );
+        ];
     }
 
     /// One velocity iteration on every lane: the arithmetic of
     /// `ContactConstraint::solve_rows`, lane by lane.
     #[inline(always)]
-    fn solve<const USE_BIAS: bool>(
-        &mut self,
-        states: &mut [BodyState],
-        inv_h: Real,
-        push_max: Real,
-    ) {
+    fn solve<const USE_BIAS: bool>(&mut self, states: &[BodyState], inv_h: Real, push_max: Real) {
         let a = gather(states, &self.state_a);
         let b = gather(states, &self.state_b);
         let (n_x, n_y) = (self.n_x, self.n_y);
@@ -791,20 +872,16 @@ impl WideContact {
         let p_y = pn * n_y - pt * n_x;
         let l_a = dot_rows(&d, &ja);
         let l_b = dot_rows(&d, &jb);
-        scatter(
-            states,
-            &self.state_a,
+        self.out_a = [
             a.v_x - self.inv_mass_a * p_x,
             a.v_y - self.inv_mass_a * p_y,
             a.w - i_a * l_a,
-        );
-        scatter(
-            states,
-            &self.state_b,
+        ];
+        self.out_b = [
             b.v_x + self.inv_mass_b * p_x,
             b.v_y + self.inv_mass_b * p_y,
             b.w + i_b * l_b,
-        );
+        ];
     }
 
     /// The terms of point `i`'s normal row on every lane: the bias `b`
@@ -884,11 +961,12 @@ impl ConstraintBatch for ContactBatch<'_> {
     }
 
     fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
-        self.solver.prepare(ctx, bodies, self.object_masses);
+        self.solver
+            .prepare(ctx, bodies, self.object_masses, &Team::serial());
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        self.solver.warm_start(states);
+        self.solver.warm_start(states, &Team::serial());
     }
 
     fn solve(
@@ -898,12 +976,36 @@ impl ConstraintBatch for ContactBatch<'_> {
         use_bias: bool,
         reverse: bool,
     ) {
-        self.solver.solve(ctx, states, use_bias, reverse);
+        self.solver
+            .solve(ctx, states, use_bias, reverse, &Team::serial());
     }
 
     fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
-        self.solver.apply_restitution(ctx, states);
+        self.solver.apply_restitution(ctx, states, &Team::serial());
     }
 
     fn store_impulses(&mut self) {}
+
+    fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
+        self.solver.prepare(ctx, bodies, self.object_masses, team);
+    }
+
+    fn warm_start_on(&mut self, _ctx: &StepContext, states: &mut [BodyState], team: &Team) {
+        self.solver.warm_start(states, team);
+    }
+
+    fn solve_on(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+        team: &Team,
+    ) {
+        self.solver.solve(ctx, states, use_bias, reverse, team);
+    }
+
+    fn apply_restitution_on(&mut self, ctx: &StepContext, states: &mut [BodyState], team: &Team) {
+        self.solver.apply_restitution(ctx, states, team);
+    }
 }

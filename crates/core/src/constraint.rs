@@ -30,6 +30,7 @@ use smallvec::SmallVec;
 
 use crate::body::{BodyHandle, BodySet, BodyState};
 use crate::math::{Real, Vec2};
+use crate::parallel::Team;
 use crate::softness::Softness;
 
 /// How the velocity solver treats position error.
@@ -246,7 +247,12 @@ pub trait Constraint {
 
 /// A homogeneous collection of constraints driven by the solver: one
 /// dynamic call per stage, a monomorphic loop inside.
-pub trait ConstraintBatch {
+///
+/// The solver calls the `*_on` stages, which receive the step's worker
+/// [`Team`]; their defaults run the serial stage on the leader. A batch
+/// whose data splits into independent blocks (the contact colours)
+/// overrides them to spread the blocks over the team.
+pub trait ConstraintBatch: Send {
     /// Number of constraints.
     fn count(&self) -> usize;
     /// Prepare every constraint.
@@ -264,9 +270,32 @@ pub trait ConstraintBatch {
     fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]);
     /// Store impulses of every constraint.
     fn store_impulses(&mut self);
+    /// [`ConstraintBatch::prepare`] on the step's team.
+    fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, _team: &Team) {
+        self.prepare(ctx, bodies);
+    }
+    /// [`ConstraintBatch::warm_start`] on the step's team.
+    fn warm_start_on(&mut self, ctx: &StepContext, states: &mut [BodyState], _team: &Team) {
+        self.warm_start(ctx, states);
+    }
+    /// [`ConstraintBatch::solve`] on the step's team.
+    fn solve_on(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+        _team: &Team,
+    ) {
+        self.solve(ctx, states, use_bias, reverse);
+    }
+    /// [`ConstraintBatch::apply_restitution`] on the step's team.
+    fn apply_restitution_on(&mut self, ctx: &StepContext, states: &mut [BodyState], _team: &Team) {
+        self.apply_restitution(ctx, states);
+    }
 }
 
-impl<C: Constraint> ConstraintBatch for Vec<C> {
+impl<C: Constraint + Send> ConstraintBatch for Vec<C> {
     fn count(&self) -> usize {
         self.len()
     }

@@ -10,6 +10,7 @@
 //! | [`softness`]   | the one softness type of every soft row                    |
 //! | [`constraint`] | the constraint trait, rows, blocks, the step context        |
 //! | [`solver`]     | the soft step and the PGS baseline                          |
+//! | [`parallel`]   | the step's worker team (the one module that uses `unsafe`)  |
 //! | [`geometry`]   | shapes, mass properties, bounding boxes, manifolds          |
 //! | [`limits`]     | the stated finite range of every input value                |
 //! | [`handle`]     | one generational handle type for every kind of object       |
@@ -25,6 +26,7 @@ pub mod graph;
 pub mod handle;
 pub mod limits;
 pub mod math;
+pub mod parallel;
 pub mod slots;
 pub mod softness;
 pub mod solver;

@@ -27,6 +27,7 @@ use std::time::Instant;
 use crate::body::{BodyHandle, BodySet, BodyState, BodyType};
 use crate::constraint::{ConstraintBatch, SolverMode, StepContext};
 use crate::math::{Real, Vec2, vec_is_finite};
+use crate::parallel::{Team, with_team};
 use crate::softness::Softness;
 
 /// Default largest stiffening factor of a contact between two moving
@@ -463,10 +464,22 @@ fn velocity_terms(ctx: &StepContext, bodies: &BodySet) -> Vec<VelocityTerms> {
     terms
 }
 
-/// [`integrate_velocities`] from precomputed terms.
-fn integrate_velocity_terms(terms: &[VelocityTerms], states: &mut [BodyState]) {
+/// [`integrate_velocities`] from precomputed terms (one per state, in
+/// state order: block `i` of the states meets the terms of its own bodies).
+fn integrate_velocity_terms(terms: &[VelocityTerms], states: &mut [BodyState], team: &Team) {
+    team.for_each_chunk_mut(states, BODY_BLOCK, |i, block| {
+        let start = i * BODY_BLOCK;
+        let end = start + block.len();
+        // Terms are sorted by state index: the ones of this block.
+        let from = terms.partition_point(|t| (t.state as usize) < start);
+        let to = terms.partition_point(|t| (t.state as usize) < end);
+        integrate_terms(&terms[from..to], block, start);
+    });
+}
+
+fn integrate_terms(terms: &[VelocityTerms], states: &mut [BodyState], offset: usize) {
     for t in terms {
-        let state = &mut states[t.state as usize];
+        let state = &mut states[t.state as usize - offset];
         let mut v = t.linear_damping * (state.v + t.dv);
         let mut w = t.angular_damping * (state.w + t.dw);
         let v2 = v.length_squared();
@@ -488,6 +501,19 @@ pub fn integrate_positions(ctx: &StepContext, bodies: &mut BodySet) {
         state.dq = state.dq.integrate(h * state.w);
         state.dp += h * state.v;
     }
+}
+
+/// [`integrate_positions`] on the team, in blocks of bodies.
+fn integrate_positions_on(ctx: &StepContext, states: &mut [BodyState], team: &Team) {
+    let h = ctx.h;
+    team.for_each_chunk_mut(states, BODY_BLOCK, |i, block| {
+        // State 0 is the static identity: it never moves.
+        let skip = usize::from(i == 0);
+        for state in block.iter_mut().skip(skip) {
+            state.dq = state.dq.integrate(h * state.w);
+            state.dp += h * state.v;
+        }
+    });
 }
 
 fn finalize_bodies(bodies: &mut BodySet, report: &mut SolveReport) {
@@ -517,18 +543,36 @@ fn finalize_bodies(bodies: &mut BodySet, report: &mut SolveReport) {
 /// Advances the bodies by one step, solving every batch of constraints.
 ///
 /// `batches` holds one entry per constraint type (each a `Vec<C>`).
+///
+/// With the `parallel` feature the stages run on the step's worker team
+/// ([`crate::parallel`]): one rayon broadcast for the whole step, the
+/// stages' blocks claimed through atomics; the result does not depend on
+/// the number of threads.
 pub fn solve_step(
     settings: &SolverSettings,
     ctx: &StepContext,
     bodies: &mut BodySet,
     batches: &mut [&mut dyn ConstraintBatch],
 ) -> SolveReport {
+    with_team(|team| solve_step_on(settings, ctx, bodies, batches, team))
+}
+
+/// Bodies per block of the integration stages.
+const BODY_BLOCK: usize = 256;
+
+fn solve_step_on(
+    settings: &SolverSettings,
+    ctx: &StepContext,
+    bodies: &mut BodySet,
+    batches: &mut [&mut dyn ConstraintBatch],
+    team: &Team,
+) -> SolveReport {
     let mut report = SolveReport::default();
     let mut t = Instant::now();
     prepare_bodies(bodies);
     let terms = velocity_terms(ctx, bodies);
     for b in batches.iter_mut() {
-        b.prepare(ctx, bodies);
+        b.prepare_on(ctx, bodies, team);
     }
     report.profile.prepare += lap(&mut t);
 
@@ -545,28 +589,28 @@ pub fn solve_step(
     // of creation leaves no sideways bias.
     for substep in 0..substeps {
         let flip = substep % 2 == 1;
-        integrate_velocity_terms(&terms, &mut bodies.states);
+        integrate_velocity_terms(&terms, &mut bodies.states, team);
         report.profile.integrate += lap(&mut t);
         if ctx.warm_starting {
             for &i in &active {
-                batches[i].warm_start(ctx, &mut bodies.states);
+                batches[i].warm_start_on(ctx, &mut bodies.states, team);
             }
         }
         report.profile.warm_start += lap(&mut t);
         for _ in 0..solve_iterations {
             for &i in &active {
-                batches[i].solve(ctx, &mut bodies.states, true, flip);
+                batches[i].solve_on(ctx, &mut bodies.states, true, flip, team);
             }
             for &i in &active {
                 batches[i].solve_late(ctx, &mut bodies.states, true);
             }
         }
         report.profile.solve += lap(&mut t);
-        integrate_positions(ctx, bodies);
+        integrate_positions_on(ctx, &mut bodies.states, team);
         report.profile.integrate += lap(&mut t);
         for _ in 0..relax_iterations {
             for &i in &active {
-                batches[i].solve(ctx, &mut bodies.states, false, !flip);
+                batches[i].solve_on(ctx, &mut bodies.states, false, !flip, team);
             }
             for &i in &active {
                 batches[i].solve_late(ctx, &mut bodies.states, false);
@@ -576,7 +620,7 @@ pub fn solve_step(
     }
     if ctx.restitution {
         for &i in &active {
-            batches[i].apply_restitution(ctx, &mut bodies.states);
+            batches[i].apply_restitution_on(ctx, &mut bodies.states, team);
         }
         report.profile.restitution += lap(&mut t);
     }

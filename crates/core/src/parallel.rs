@@ -1,0 +1,367 @@
+//! The step's worker team: one rayon broadcast per step, stages split into
+//! blocks that the workers claim through atomics.
+//!
+//! ```text
+//! solve_step ── with_team ── rayon::broadcast (once per step) ─────────────┐
+//!   thread 0 (leader)                  threads 1..n (followers)            │
+//!   runs the stage sequence            wait for a job (spin, then yield)   │
+//!   ├ team.run(blocks, job) ─publish─▶ claim block i (fetch_add) → job(i)  │
+//!   │   claims blocks itself            … until every block is claimed     │
+//!   │   waits: done == blocks                                              │
+//!   │   retires the job, waits until no follower holds it                  │
+//!   ├ serial work (joints, trees, overflow): followers spin                │
+//!   ├ team.run(...) …                                                      │
+//!   └ stop ─────────────────────────▶ return to rayon ─────────────────────┘
+//! ```
+//!
+//! A stage is one job: no fork–join per colour, one atomic increment per
+//! claimed block. Whatever a job computes for block `i` must not depend on
+//! which thread runs it; the solver's jobs write disjoint data per block, so
+//! results are bit-identical for any thread count.
+//!
+//! Without the `parallel` feature, or in a pool of one thread, the team is
+//! serial: [`Team::run`] calls the job for blocks `0, 1, …` in order on the
+//! caller.
+//!
+//! # Safety
+//!
+//! This is the one module of `janus2d-core` that uses `unsafe` (the rest of
+//! the crate denies it). It does two things safe Rust cannot express here:
+//!
+//! 1. **A borrowed job handed to threads that outlive the call.** The
+//!    followers are started once per step, but every job borrows stage data
+//!    that lives only during [`Team::run`]. The job's reference is stored
+//!    with its lifetime erased; [`Team::run`] does not return before (a)
+//!    every block has finished (`done == blocks`) and (b) no follower holds
+//!    the job any more (`active == 0` after the job was retired). A follower
+//!    increments `active` *before* re-reading the epoch and reads the job
+//!    only if the epoch still names it; all these operations are `SeqCst`,
+//!    so in their single total order either the follower's increment comes
+//!    before the leader's check of `active` (and the leader waits for the
+//!    matching decrement, which the follower makes after its last use of
+//!    the job), or the follower's re-read comes after the retiring store
+//!    and it never touches the job. So no job is used after `run` returns.
+//!    The job cell itself is written only by the leader while the epoch is
+//!    idle and `active == 0`, when no follower reads it.
+//! 2. **Disjoint mutable blocks of one slice** ([`Team::for_each_chunk_mut`]).
+//!    Block `i` is the sub-slice `[i·len, min((i+1)·len, n))`; the claim
+//!    counter hands each block index to exactly one thread exactly once per
+//!    job, so the `&mut` sub-slices never alias, and they do not outlive the
+//!    job (hence not the `&mut` borrow `for_each_chunk_mut` holds).
+//!
+//! Memory ordering of the data: a block's writes happen before its
+//! `done.fetch_add` (a release RMW); the leader's acquire load that sees the
+//! final count synchronises with every such RMW (they form one release
+//! sequence), and the next job is published with a release store that the
+//! followers acquire. So each stage sees all writes of the stage before.
+
+#![allow(unsafe_code)]
+
+use std::cell::UnsafeCell;
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering::SeqCst};
+
+/// A stage's job: called once for every block index.
+type Job<'a> = &'a (dyn Fn(usize) + Sync + 'a);
+
+/// The epoch value that tells followers to leave.
+#[cfg_attr(not(feature = "parallel"), allow(dead_code))]
+const STOP: u64 = u64::MAX;
+
+/// What the leader shares with the followers. The epoch is odd while a job
+/// is published and even while the team is idle.
+struct Shared {
+    epoch: AtomicU64,
+    /// The published job, lifetime erased (see the module's safety proof).
+    job: UnsafeCell<Option<Job<'static>>>,
+    blocks: AtomicUsize,
+    next: AtomicUsize,
+    done: AtomicUsize,
+    /// Followers currently holding the published job.
+    active: AtomicUsize,
+    /// Set when a block panicked on a follower.
+    panicked: AtomicBool,
+}
+
+// SAFETY: `job` is written only by the leader while no follower can read it
+// and read by followers only while the leader does not write it (module
+// docs, point 1); every other field is atomic.
+unsafe impl Sync for Shared {}
+
+impl Shared {
+    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
+    fn new() -> Self {
+        Shared {
+            epoch: AtomicU64::new(0),
+            job: UnsafeCell::new(None),
+            blocks: AtomicUsize::new(0),
+            next: AtomicUsize::new(0),
+            done: AtomicUsize::new(0),
+            active: AtomicUsize::new(0),
+            panicked: AtomicBool::new(false),
+        }
+    }
+
+    /// Claims and runs blocks of the published job until none is left.
+    fn work(&self, job: Job<'_>, blocks: usize) {
+        loop {
+            let i = self.next.fetch_add(1, SeqCst);
+            if i >= blocks {
+                return;
+            }
+            // Counted even if the block panics, so the leader never waits
+            // for a block that will not finish.
+            struct Done<'s>(&'s AtomicUsize);
+            impl Drop for Done<'_> {
+                fn drop(&mut self) {
+                    self.0.fetch_add(1, SeqCst);
+                }
+            }
+            let _done = Done(&self.done);
+            job(i);
+        }
+    }
+}
+
+/// Waits a little, then lets other threads run: a follower may share its
+/// core with the leader (more threads than cores).
+#[inline]
+fn backoff(spins: &mut u32) {
+    if *spins < 64 {
+        std::hint::spin_loop();
+        *spins += 1;
+    } else {
+        std::thread::yield_now();
+    }
+}
+
+/// The step's workers, as seen by the stage code (which runs on the
+/// leader). See the module docs.
+pub struct Team<'t> {
+    shared: Option<&'t Shared>,
+    threads: usize,
+}
+
+impl Team<'static> {
+    /// A team of one: every job runs on the caller, blocks in order.
+    #[must_use]
+    pub fn serial() -> Self {
+        Team {
+            shared: None,
+            threads: 1,
+        }
+    }
+}
+
+impl Team<'_> {
+    /// Number of threads that run jobs (1 for a serial team).
+    #[must_use]
+    pub fn threads(&self) -> usize {
+        self.threads
+    }
+
+    /// Runs `job(i)` for every block `i` in `0..blocks`, spread over the
+    /// team, and returns when every block has finished. The blocks run in
+    /// any order and concurrently: `job` must give the same result for
+    /// block `i` whoever runs it.
+    pub fn run(&self, blocks: usize, job: &(dyn Fn(usize) + Sync)) {
+        let Some(shared) = self.shared.filter(|_| blocks > 1) else {
+            for i in 0..blocks {
+                job(i);
+            }
+            return;
+        };
+        let epoch = shared.epoch.load(SeqCst);
+        debug_assert!(epoch.is_multiple_of(2), "a job is published while another runs");
+        // SAFETY: only the lifetime is erased; the module docs (point 1)
+        // prove the reference is not used after this call returns.
+        let erased: Job<'static> = unsafe { std::mem::transmute::<Job<'_>, Job<'static>>(job) };
+        // SAFETY: the epoch is even and `active == 0` (the last `run`
+        // waited for it): no follower reads the cell now.
+        unsafe { *shared.job.get() = Some(erased) };
+        shared.blocks.store(blocks, SeqCst);
+        shared.next.store(0, SeqCst);
+        shared.done.store(0, SeqCst);
+        shared.epoch.store(epoch + 1, SeqCst);
+        // Retire the job even if a block of the leader's panics.
+        struct Retire<'s>(&'s Shared, u64, usize);
+        impl Drop for Retire<'_> {
+            fn drop(&mut self) {
+                let (shared, epoch, blocks) = (self.0, self.1, self.2);
+                let mut spins = 0;
+                while shared.done.load(SeqCst) < blocks {
+                    backoff(&mut spins);
+                }
+                shared.epoch.store(epoch + 2, SeqCst);
+                let mut spins = 0;
+                while shared.active.load(SeqCst) != 0 {
+                    backoff(&mut spins);
+                }
+            }
+        }
+        let retire = Retire(shared, epoch, blocks);
+        shared.work(job, blocks);
+        drop(retire);
+        if shared.panicked.load(SeqCst) {
+            panic!("a block of a parallel stage panicked on a worker thread");
+        }
+    }
+
+    /// Calls `f(i, block)` for the blocks of `items` of `len` items each
+    /// (the last one shorter), spread over the team; `i` is the block's
+    /// index, so block `i` starts at item `i · len`.
+    pub fn for_each_chunk_mut<T: Send>(
+        &self,
+        items: &mut [T],
+        len: usize,
+        f: impl Fn(usize, &mut [T]) + Sync,
+    ) {
+        let len = len.max(1);
+        let n = items.len();
+        let blocks = n.div_ceil(len);
+        if self.shared.is_none() || blocks <= 1 {
+            for (i, chunk) in items.chunks_mut(len).enumerate() {
+                f(i, chunk);
+            }
+            return;
+        }
+        /// The slice's base pointer, shared by the blocks.
+        struct Base<T>(*mut T);
+        // SAFETY: the blocks built from it are disjoint (module docs, point
+        // 2) and `T: Send`, so handing them to other threads is sound.
+        unsafe impl<T: Send> Sync for Base<T> {}
+        let base = Base(items.as_mut_ptr());
+        let base = &base;
+        self.run(blocks, &|i| {
+            let start = i * len;
+            let count = len.min(n - start);
+            // SAFETY: `start + count ≤ n`, block `i` is claimed once, and
+            // blocks do not overlap (module docs, point 2); `items` stays
+            // mutably borrowed until `run` returns.
+            let chunk = unsafe { std::slice::from_raw_parts_mut(base.0.add(start), count) };
+            f(i, chunk);
+        });
+    }
+}
+
+/// Runs `leader` with the step's team: with the `parallel` feature in a
+/// rayon pool of more than one thread, `leader` runs on the pool's thread 0
+/// while the others serve its jobs; otherwise it runs here with a serial
+/// team.
+pub fn with_team<R: Send>(leader: impl FnOnce(&Team) -> R + Send) -> R {
+    #[cfg(feature = "parallel")]
+    {
+        let threads = rayon::current_num_threads();
+        if threads > 1 {
+            return broadcast_team(threads, leader);
+        }
+    }
+    leader(&Team::serial())
+}
+
+#[cfg(feature = "parallel")]
+fn broadcast_team<R: Send>(threads: usize, leader: impl FnOnce(&Team) -> R + Send) -> R {
+    use std::sync::Mutex;
+    let shared = Shared::new();
+    let leader = Mutex::new(Some(leader));
+    let result = Mutex::new(None);
+    rayon::broadcast(|ctx| {
+        if ctx.index() == 0 {
+            // Followers leave when the leader is done, or unwinds.
+            struct Stop<'s>(&'s Shared);
+            impl Drop for Stop<'_> {
+                fn drop(&mut self) {
+                    self.0.epoch.store(STOP, SeqCst);
+                }
+            }
+            let _stop = Stop(&shared);
+            let team = Team {
+                shared: Some(&shared),
+                threads: ctx.num_threads(),
+            };
+            let f = leader
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .take()
+                .expect("thread 0 runs the leader once");
+            let r = f(&team);
+            *result.lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
+        } else {
+            follow(&shared);
+        }
+    });
+    debug_assert_eq!(threads, threads.max(1));
+    result
+        .into_inner()
+        .unwrap_or_else(|e| e.into_inner())
+        .expect("the leader ran")
+}
+
+/// A follower's loop: serve published jobs until the leader stops.
+#[cfg(feature = "parallel")]
+fn follow(shared: &Shared) {
+    let mut seen = 0;
+    let mut spins = 0;
+    loop {
+        let epoch = shared.epoch.load(SeqCst);
+        if epoch == STOP {
+            return;
+        }
+        if epoch.is_multiple_of(2) || epoch == seen {
+            backoff(&mut spins);
+            continue;
+        }
+        spins = 0;
+        seen = epoch;
+        shared.active.fetch_add(1, SeqCst);
+        struct Release<'s>(&'s Shared);
+        impl Drop for Release<'_> {
+            fn drop(&mut self) {
+                if std::thread::panicking() {
+                    self.0.panicked.store(true, SeqCst);
+                }
+                self.0.active.fetch_sub(1, SeqCst);
+            }
+        }
+        let _release = Release(shared);
+        if shared.epoch.load(SeqCst) != epoch {
+            continue;
+        }
+        // SAFETY: the epoch still names this job and `active` counts this
+        // follower, so the leader neither rewrites the cell nor returns from
+        // `run` until the guard above is dropped (module docs, point 1).
+        let Some(job) = (unsafe { *shared.job.get() }) else {
+            continue;
+        };
+        let blocks = shared.blocks.load(SeqCst);
+        shared.work(job, blocks);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn serial_team_runs_every_block_in_order() {
+        let seen = std::sync::Mutex::new(Vec::new());
+        Team::serial().run(5, &|i| seen.lock().unwrap().push(i));
+        assert_eq!(*seen.lock().unwrap(), vec![0, 1, 2, 3, 4]);
+    }
+
+    #[test]
+    fn chunks_cover_the_slice_once() {
+        let mut items = vec![0u32; 1003];
+        with_team(|team| {
+            for _ in 0..50 {
+                team.for_each_chunk_mut(&mut items, 16, |i, chunk| {
+                    for (k, x) in chunk.iter_mut().enumerate() {
+                        *x += (i * 16 + k) as u32 % 7 + 1;
+                    }
+                });
+            }
+        });
+        for (k, &x) in items.iter().enumerate() {
+            assert_eq!(x, 50 * (k as u32 % 7 + 1), "item {k}");
+        }
+    }
+}
