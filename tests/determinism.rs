@@ -71,3 +71,44 @@ fn contact_scene_is_identical_for_any_thread_count() {
     assert_eq!(run(2), one);
     assert_eq!(run(4), one);
 }
+
+/// Benchmark scenes large enough that every parallel stage takes its
+/// threaded path (colours of many chunks, more than 1,024 bodies, hundreds
+/// of moved proxies and new pairs): tumbler, rain (joints and spawning) and
+/// the washer, `steps` steps each, a hash per scene.
+#[cfg(feature = "parallel")]
+fn benchmark_scene_hashes(steps: usize) -> Vec<u64> {
+    use janus2d_testbed::engine::Engine;
+    let mut hashes = Vec::new();
+    for name in ["tumbler", "rain", "washer"] {
+        let desc = janus2d_testbed::benchmarks::by_name(name).expect("a benchmark scene");
+        let mut engine = janus2d_testbed::janus::Janus::new(&desc).expect("scene builds");
+        let mut actions = Vec::new();
+        for step in 0..steps {
+            desc.script.actions(step, desc.settings.dt, &mut actions);
+            for a in &actions {
+                engine.apply(a);
+            }
+            engine.step();
+        }
+        hashes.push(engine.world.state_hash());
+    }
+    hashes
+}
+
+/// The whole step on the worker team (solver colours, integration, pair
+/// search, proxy boxes, narrowphase): bit-identical for 1, 2 and 4 threads.
+#[cfg(feature = "parallel")]
+#[test]
+fn benchmark_scenes_are_identical_for_any_thread_count() {
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| benchmark_scene_hashes(40))
+    };
+    let one = run(1);
+    assert_eq!(run(2), one, "2 threads");
+    assert_eq!(run(4), one, "4 threads");
+}

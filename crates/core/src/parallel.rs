@@ -171,7 +171,10 @@ impl Team<'_> {
             return;
         };
         let epoch = shared.epoch.load(SeqCst);
-        debug_assert!(epoch.is_multiple_of(2), "a job is published while another runs");
+        debug_assert!(
+            epoch.is_multiple_of(2),
+            "a job is published while another runs"
+        );
         // SAFETY: only the lifetime is erased; the module docs (point 1)
         // prove the reference is not used after this call returns.
         let erased: Job<'static> = unsafe { std::mem::transmute::<Job<'_>, Job<'static>>(job) };

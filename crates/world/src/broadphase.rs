@@ -56,6 +56,11 @@ pub use crate::dynamic_tree::{DEFAULT_AABB_MARGIN, DynamicTree, NULL_NODE};
 /// moved.
 const BULK_DIVISOR: usize = 4;
 
+/// Fewest moved proxies for which the pair search runs on rayon (with the
+/// `parallel` feature).
+#[cfg(feature = "parallel")]
+const PARALLEL_MOVES: usize = 256;
+
 /// Per-proxy record of the [`BroadPhase`].
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -350,6 +355,29 @@ impl BroadPhase {
                 out.push((a, b));
             }
         };
+        #[cfg(feature = "parallel")]
+        if rayon::current_num_threads() > 1 && moves.len() >= PARALLEL_MOVES {
+            self.find_pairs_parallel(bulk, &moves, &mut |a, b| report(a, b));
+        } else {
+            self.find_pairs_serial(bulk, &moves, &mut report);
+        }
+        #[cfg(not(feature = "parallel"))]
+        self.find_pairs_serial(bulk, &moves, &mut report);
+
+        for &m in &moves {
+            self.proxies[m as usize].moved = false;
+        }
+        moves.clear();
+        self.move_buffer = moves;
+        // Sorting packed keys is the same order as sorting the tuples.
+        out.sort_unstable_by_key(|&(a, b)| (u64::from(a) << 32) | u64::from(b));
+        out.dedup();
+    }
+
+    /// The candidate pairs of [`BroadPhase::update_pairs`], reported as
+    /// payload pairs in any order (with duplicates).
+    fn find_pairs_serial(&mut self, bulk: bool, moves: &[u32], report: &mut impl FnMut(u32, u32)) {
+        let proxies = &self.proxies;
         if bulk {
             // Every overlapping pair is visited once; keep those with a
             // moved member.
@@ -364,7 +392,7 @@ impl BroadPhase {
             self.dynamic_tree
                 .for_each_cross_pair(&self.static_tree, stack, &mut visit);
         } else {
-            for &m in &moves {
+            for &m in moves {
                 let slot = proxies[m as usize];
                 let fat = slot.fat;
                 let mut visit = |other: u32| {
@@ -381,15 +409,77 @@ impl BroadPhase {
                 }
             }
         }
+    }
 
-        for &m in &moves {
-            self.proxies[m as usize].moved = false;
+    /// [`BroadPhase::find_pairs_serial`] on rayon: the moved proxies' queries
+    /// (or the seeds of the bulk descent) in blocks, each block's pairs
+    /// collected on its own, then reported in block order. The pairs are
+    /// sorted afterwards, so the result is the serial one.
+    #[cfg(feature = "parallel")]
+    fn find_pairs_parallel(
+        &mut self,
+        bulk: bool,
+        moves: &[u32],
+        report: &mut impl FnMut(u32, u32),
+    ) {
+        use rayon::prelude::*;
+        let proxies = &self.proxies;
+        let (dynamic, fixed) = (&self.dynamic_tree, &self.static_tree);
+        let found: Vec<Vec<(u32, u32)>> = if bulk {
+            let want = 64 * rayon::current_num_threads();
+            let mut seeds = Vec::new();
+            dynamic.pair_seeds(None, want, &mut seeds);
+            let mut cross = Vec::new();
+            dynamic.pair_seeds(Some(fixed), want, &mut cross);
+            let tasks: Vec<(bool, (u32, u32))> = seeds
+                .into_iter()
+                .map(|s| (false, s))
+                .chain(cross.into_iter().map(|s| (true, s)))
+                .collect();
+            tasks
+                .par_chunks(8)
+                .map(|block| {
+                    let mut pairs = Vec::new();
+                    let mut stack = Vec::new();
+                    for &(is_cross, seed) in block {
+                        let other = is_cross.then_some(fixed);
+                        dynamic.for_each_pair_from(other, seed, &mut stack, |x, y| {
+                            let (sx, sy) = (&proxies[x as usize], &proxies[y as usize]);
+                            if sx.moved || sy.moved {
+                                pairs.push((sx.payload, sy.payload));
+                            }
+                        });
+                    }
+                    pairs
+                })
+                .collect()
+        } else {
+            moves
+                .par_chunks(PARALLEL_MOVES / 4)
+                .map(|block| {
+                    let mut pairs = Vec::new();
+                    for &m in block {
+                        let slot = proxies[m as usize];
+                        let fat = slot.fat;
+                        let mut visit = |other: u32| {
+                            let o = &proxies[other as usize];
+                            if other != m && !(o.moved && other < m) {
+                                pairs.push((slot.payload, o.payload));
+                            }
+                            true
+                        };
+                        dynamic.query(&fat, &mut visit);
+                        if !slot.is_static {
+                            fixed.query(&fat, &mut visit);
+                        }
+                    }
+                    pairs
+                })
+                .collect()
+        };
+        for (a, b) in found.into_iter().flatten() {
+            report(a, b);
         }
-        moves.clear();
-        self.move_buffer = moves;
-        // Sorting packed keys is the same order as sorting the tuples.
-        out.sort_unstable_by_key(|&(a, b)| (u64::from(a) << 32) | u64::from(b));
-        out.dedup();
     }
 
     /// Translates every box by `-new_origin` (see
@@ -564,6 +654,39 @@ mod tests {
                 .iter()
                 .all(|(a, b)| !(statics.contains(a) && statics.contains(b)))
         );
+    }
+
+    /// The pair search on rayon (both strategies) reports each pair once,
+    /// the same pairs as brute force, with 2 and 4 threads.
+    #[cfg(feature = "parallel")]
+    #[test]
+    fn parallel_pair_search_matches_brute_force() {
+        let mut rng = Lcg(3);
+        let (bp, ids) = random_scene(&mut rng);
+        let expected: Vec<(u32, u32)> = brute_force(&bp, &ids).into_iter().collect();
+        for threads in [2, 4] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            for bulk in [false, true] {
+                let mut copy = bp.clone();
+                let mut pairs = Vec::new();
+                let mut calls = 0usize;
+                pool.install(|| {
+                    copy.update_pairs_with(
+                        bulk,
+                        |_, _| {
+                            calls += 1;
+                            true
+                        },
+                        &mut pairs,
+                    )
+                });
+                assert_eq!(pairs, expected, "threads {threads}, bulk = {bulk}");
+                assert_eq!(calls, expected.len(), "threads {threads}, bulk = {bulk}");
+            }
+        }
     }
 
     #[test]

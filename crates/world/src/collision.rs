@@ -222,12 +222,28 @@ impl Collision {
         let mut candidates = std::mem::take(&mut self.candidates);
         candidates.clear();
         self.broadphase.update_pairs(|_, _| true, &mut candidates);
+        // The candidates are distinct pairs, so whether one is new does not
+        // depend on the others: with the `parallel` feature the test runs
+        // on rayon (in order-keeping blocks), then the contacts are created
+        // here in candidate order either way.
+        let keep = |&(a, b): &(u32, u32)| {
+            let (a, b) = crate::contacts::pair_key(a, b);
+            !self.contacts.has_pair(a, b) && self.should_pair(bodies, no_collide, a, b)
+        };
+        #[cfg(feature = "parallel")]
+        if rayon::current_num_threads() > 1 && candidates.len() >= 512 {
+            use rayon::prelude::*;
+            let kept: Vec<bool> = candidates.par_iter().map(keep).collect();
+            let mut flags = kept.into_iter();
+            candidates.retain(|_| flags.next().unwrap_or(false));
+        } else {
+            candidates.retain(keep);
+        }
+        #[cfg(not(feature = "parallel"))]
+        candidates.retain(keep);
         let mut created = 0;
         for &(a, b) in &candidates {
             let (a, b) = crate::contacts::pair_key(a, b);
-            if self.contacts.has_pair(a, b) || !self.should_pair(bodies, no_collide, a, b) {
-                continue;
-            }
             let (sa, sb) = (self.shapes.at(a), self.shapes.at(b));
             let contact = Contact {
                 id: 0,
@@ -313,6 +329,11 @@ impl Collision {
     /// A fast body's proxy box covers the shape now and where its velocity
     /// takes it within `dt`, so pairs exist before it arrives.
     pub(crate) fn update_proxies(&mut self, bodies: &BodySet, dt: Real) {
+        #[cfg(feature = "parallel")]
+        if rayon::current_num_threads() > 1 && bodies.sims.len() > 1024 {
+            self.update_proxies_parallel(bodies, dt);
+            return;
+        }
         let mut moved = 0;
         for (sim, state) in bodies.sims.iter().zip(&bodies.states).skip(1) {
             // Only a body that travels more than half the fat margin in a
@@ -335,6 +356,49 @@ impl Collision {
                 if self.broadphase.move_proxy(shape.proxy, bounded(aabb)) {
                     moved += 1;
                 }
+            }
+        }
+        self.counters.proxies_moved = moved;
+    }
+
+    /// [`Collision::update_proxies`] with the boxes computed on rayon, in
+    /// blocks of bodies; the proxies are then moved here, in body order, as
+    /// the serial version does.
+    #[cfg(feature = "parallel")]
+    fn update_proxies_parallel(&mut self, bodies: &BodySet, dt: Real) {
+        use rayon::prelude::*;
+        let shapes = &self.shapes;
+        let margin2 = (0.5 * AABB_MARGIN) * (0.5 * AABB_MARGIN);
+        let blocks: Vec<Vec<(u32, Aabb, Aabb)>> = bodies.sims[1..]
+            .par_chunks(256)
+            .zip(bodies.states[1..].par_chunks(256))
+            .map(|(sims, states)| {
+                let mut out = Vec::with_capacity(sims.len());
+                for (sim, state) in sims.iter().zip(states) {
+                    let sweep = dt * state.v;
+                    let fast = sweep.length_squared() > margin2;
+                    for &s in shapes.of_body(sim.handle) {
+                        let tight = shapes.at(s).geometry.compute_aabb(&sim.transform);
+                        let query = if fast {
+                            Aabb::new(
+                                tight.lower + sweep.min(Vec2::ZERO),
+                                tight.upper + sweep.max(Vec2::ZERO),
+                            )
+                        } else {
+                            tight
+                        };
+                        out.push((s, tight, query));
+                    }
+                }
+                out
+            })
+            .collect();
+        let mut moved = 0;
+        for (s, tight, query) in blocks.into_iter().flatten() {
+            let shape = self.shapes.at_mut(s);
+            shape.aabb = tight;
+            if self.broadphase.move_proxy(shape.proxy, bounded(query)) {
+                moved += 1;
             }
         }
         self.counters.proxies_moved = moved;

@@ -543,6 +543,99 @@ impl DynamicTree {
         }
     }
 
+    /// Starting points of the simultaneous descent that
+    /// [`DynamicTree::for_each_self_pair`] (`other: None`) or
+    /// [`DynamicTree::for_each_cross_pair`] makes: the descent is expanded
+    /// breadth first until at least `want` node pairs are left (or nothing
+    /// splits further). Descending from every seed with
+    /// [`DynamicTree::for_each_pair_from`] reports every overlapping leaf
+    /// pair exactly once, so the seeds can be shared out between threads.
+    pub(crate) fn pair_seeds(
+        &self,
+        other: Option<&DynamicTree>,
+        want: usize,
+        seeds: &mut Vec<(u32, u32)>,
+    ) {
+        seeds.clear();
+        let b_tree = other.unwrap_or(self);
+        if self.root == NULL_NODE || b_tree.root == NULL_NODE {
+            return;
+        }
+        let mut queue = std::collections::VecDeque::new();
+        queue.push_back((self.root, b_tree.root));
+        // Leaf pairs and pairs that cannot split are kept as they are.
+        while queue.len() + seeds.len() < want {
+            let Some((a, b)) = queue.pop_front() else {
+                break;
+            };
+            let na = &self.nodes[a as usize];
+            if other.is_none() && a == b {
+                if !na.is_leaf() {
+                    queue.push_back((na.child1, na.child1));
+                    queue.push_back((na.child2, na.child2));
+                    queue.push_back((na.child1, na.child2));
+                }
+                continue;
+            }
+            let nb = &b_tree.nodes[b as usize];
+            if !na.aabb.overlaps(&nb.aabb) {
+                continue;
+            }
+            match (na.is_leaf(), nb.is_leaf()) {
+                (true, true) => seeds.push((a, b)),
+                (false, true) => {
+                    queue.push_back((na.child1, b));
+                    queue.push_back((na.child2, b));
+                }
+                (true, false) => {
+                    queue.push_back((a, nb.child1));
+                    queue.push_back((a, nb.child2));
+                }
+                (false, false) => {
+                    if na.aabb.perimeter() >= nb.aabb.perimeter() {
+                        queue.push_back((na.child1, b));
+                        queue.push_back((na.child2, b));
+                    } else {
+                        queue.push_back((a, nb.child1));
+                        queue.push_back((a, nb.child2));
+                    }
+                }
+            }
+        }
+        seeds.extend(queue);
+    }
+
+    /// The descent of [`DynamicTree::for_each_self_pair`] (`other: None`)
+    /// or [`DynamicTree::for_each_cross_pair`] from one seed of
+    /// [`DynamicTree::pair_seeds`].
+    pub(crate) fn for_each_pair_from<F: FnMut(u32, u32)>(
+        &self,
+        other: Option<&DynamicTree>,
+        seed: (u32, u32),
+        stack: &mut Vec<(u32, u32)>,
+        mut f: F,
+    ) {
+        let b_tree = other.unwrap_or(self);
+        stack.clear();
+        stack.push(seed);
+        while let Some((a, b)) = stack.pop() {
+            let na = &self.nodes[a as usize];
+            if other.is_none() && a == b {
+                if !na.is_leaf() {
+                    stack.push((na.child1, na.child2));
+                    stack.push((na.child2, na.child2));
+                    stack.push((na.child1, na.child1));
+                }
+                continue;
+            }
+            let nb = &b_tree.nodes[b as usize];
+            if !na.aabb.overlaps(&nb.aabb) {
+                continue;
+            }
+            Self::descend(na, a, nb, b, stack, &mut f);
+        }
+    }
+
     /// One step of a simultaneous descent of two overlapping nodes: report
     /// two leaves, otherwise split the larger internal node.
     #[inline(always)]
