@@ -230,6 +230,8 @@ pub struct ContactSolver {
     graph: ColourGraph,
     /// Number of contacts pushed since [`ContactSolver::begin`].
     len: usize,
+    /// Scratch of [`ContactSolver::push_all`]: the contacts of each colour.
+    lists: Vec<Vec<u32>>,
 }
 
 /// The slot of the overflow in [`ContactSolver::assign`]'s answers.
@@ -315,6 +317,65 @@ impl ContactSolver {
         }
         let chunk = chunks.last_mut().expect("a chunk with a free lane");
         chunk.push(lane, count);
+    }
+
+    /// [`ContactSolver::push`] for many contacts at once: contact `i` goes
+    /// into colour `colours[i]` with the lane data `lane(i)`. The result is
+    /// the one of pushing them in order; with the `parallel` feature the
+    /// chunks are filled on rayon (each chunk from its own contacts, so the
+    /// order within a colour is kept).
+    pub fn push_all<F>(&mut self, colours: &[u8], lane: F)
+    where
+        F: Fn(usize) -> ContactLane + Sync,
+    {
+        if self.colours.len() < COLOURS {
+            self.colours.resize_with(COLOURS, Vec::new);
+        }
+        if self.colours.iter().any(|c| !c.is_empty()) {
+            // Open chunks: keep push's order exactly.
+            for (i, &colour) in colours.iter().enumerate() {
+                self.push(colour, &lane(i));
+            }
+            return;
+        }
+        let mut lists = std::mem::take(&mut self.lists);
+        lists.resize_with(COLOURS, Vec::new);
+        for list in &mut lists {
+            list.clear();
+        }
+        for (i, &colour) in colours.iter().enumerate() {
+            if colour >= OVERFLOW {
+                self.push(colour, &lane(i));
+            } else {
+                lists[colour as usize].push(i as u32);
+            }
+        }
+        let mut jobs: Vec<(&mut WideContact, &[u32])> = Vec::new();
+        for (chunks, list) in self.colours.iter_mut().zip(&lists) {
+            chunks.resize_with(list.len().div_ceil(LANES), WideContact::empty);
+            jobs.extend(chunks.iter_mut().zip(list.chunks(LANES)));
+        }
+        let fill = |(chunk, items): &mut (&mut WideContact, &[u32])| {
+            for &i in items.iter() {
+                let lane = lane(i as usize);
+                let count = lane.point_count.min(MAX_MANIFOLD_POINTS);
+                chunk.push(&lane, count);
+            }
+        };
+        #[cfg(feature = "parallel")]
+        {
+            use rayon::prelude::*;
+            if rayon::current_num_threads() > 1 && jobs.len() > 16 {
+                jobs.par_iter_mut().with_min_len(8).for_each(fill);
+            } else {
+                jobs.iter_mut().for_each(fill);
+            }
+        }
+        #[cfg(not(feature = "parallel"))]
+        jobs.iter_mut().for_each(fill);
+        drop(jobs);
+        self.len += lists.iter().map(Vec::len).sum::<usize>();
+        self.lists = lists;
     }
 
     /// Calls `store(contact_index, point, impulses)` for every point of

@@ -550,6 +550,7 @@ impl DynamicTree {
     /// splits further). Descending from every seed with
     /// [`DynamicTree::for_each_pair_from`] reports every overlapping leaf
     /// pair exactly once, so the seeds can be shared out between threads.
+    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
     pub(crate) fn pair_seeds(
         &self,
         other: Option<&DynamicTree>,
@@ -608,6 +609,7 @@ impl DynamicTree {
     /// The descent of [`DynamicTree::for_each_self_pair`] (`other: None`)
     /// or [`DynamicTree::for_each_cross_pair`] from one seed of
     /// [`DynamicTree::pair_seeds`].
+    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
     pub(crate) fn for_each_pair_from<F: FnMut(u32, u32)>(
         &self,
         other: Option<&DynamicTree>,
@@ -1080,6 +1082,47 @@ mod tests {
         let mut bad = tree.clone();
         bad.free_list = 12345;
         assert!(bad.check().is_err());
+    }
+
+    /// Descending from the seeds reports the same pairs as the full
+    /// descent, each once, for any number of seeds (self and cross pairs).
+    #[test]
+    fn seeded_descent_reports_every_pair_once() {
+        let mut rng = Lcg(7);
+        let mut a = DynamicTree::new();
+        let mut b = DynamicTree::new();
+        for i in 0..1500u32 {
+            a.create_proxy(random_box(&mut rng, 60.0), i);
+            if i % 3 == 0 {
+                b.create_proxy(random_box(&mut rng, 60.0), 10_000 + i);
+            }
+        }
+        let mut stack = Vec::new();
+        for other in [None, Some(&b)] {
+            let mut full = Vec::new();
+            match other {
+                None => a.for_each_self_pair(&mut stack, |x, y| full.push((x.min(y), x.max(y)))),
+                Some(o) => a.for_each_cross_pair(o, &mut stack, |x, y| full.push((x, y))),
+            }
+            full.sort_unstable();
+            assert!(full.len() > 1000, "too few pairs: {}", full.len());
+            for want in [1, 7, 64, 500] {
+                let mut seeds = Vec::new();
+                a.pair_seeds(other, want, &mut seeds);
+                let mut seeded = Vec::new();
+                for &seed in &seeds {
+                    a.for_each_pair_from(other, seed, &mut stack, |x, y| {
+                        seeded.push(if other.is_none() {
+                            (x.min(y), x.max(y))
+                        } else {
+                            (x, y)
+                        });
+                    });
+                }
+                seeded.sort_unstable();
+                assert_eq!(seeded, full, "want {want}, {} seeds", seeds.len());
+            }
+        }
     }
 
     #[test]

@@ -95,6 +95,8 @@ pub(crate) struct Narrowphase {
     scanned: usize,
     /// The contacts solved this step, in contact order.
     solved: Vec<SolvedContact>,
+    /// Their colours, in the same order (the solver's `push_all` input).
+    colours: Vec<u8>,
 }
 
 /// A contact the solve takes this step, as the build's first pass found it.
@@ -460,11 +462,19 @@ pub(crate) fn build_constraints(
     }
     // Pass 2: each contact into its colour, in contact order.
     let (mut rows, mut bouncy) = (0, 0);
+    let colours = &mut narrowphase.colours;
+    colours.clear();
     for s in solved.iter() {
-        let k = s.index as usize;
-        let c = &awake[k];
+        let c = &awake[s.index as usize];
         rows += 2 * c.point_count;
         bouncy += usize::from(c.restitution > 0.0);
+        colours.push(s.colour);
+    }
+    let solved = &*solved;
+    solver.push_all(colours, |i| {
+        let s = &solved[i];
+        let k = s.index as usize;
+        let c = &awake[k];
         let mut points = [ContactPointInput::default(); 2];
         for (input, p) in points.iter_mut().zip(&c.points[..c.point_count]) {
             *input = ContactPointInput {
@@ -477,7 +487,7 @@ pub(crate) fn build_constraints(
         }
         let [ia, ib] = s.state;
         let [(_, [m_a, i_a]), (_, [m_b, i_b])] = c.solve_bodies;
-        let lane = ContactLane {
+        ContactLane {
             body_a: c.body_a,
             body_b: c.body_b,
             state_a: ia,
@@ -489,9 +499,8 @@ pub(crate) fn build_constraints(
             friction: c.friction,
             restitution: c.restitution,
             contact_index: k as u32,
-        };
-        solver.push(s.colour, &lane);
-    }
+        }
+    });
     counters.contact_rows = rows;
     counters.restitution_contacts = bouncy;
 }
