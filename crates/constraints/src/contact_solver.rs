@@ -41,7 +41,7 @@
 use janus2d_core::body::{BodyHandle, BodySet, BodyState};
 use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
 use janus2d_core::math::{Real, Vec2, cross};
-use janus2d_core::parallel::Team;
+use janus2d_core::parallel::{PlannedStates, StatePlan, Team};
 use wide::{CmpEq, CmpGe, CmpGt, CmpLt, CmpNe};
 
 use crate::contact::{ContactConstraint, ContactPointInput, MAX_MANIFOLD_POINTS, ROWS};
@@ -147,13 +147,10 @@ struct WideContact {
     /// Step totals less the current impulse: `Σ_warm starts λ − λ_prepare`
     /// per row, N·s (see [`PointImpulse`]).
     step_base: [W; ROWS],
-    /// The velocities a stage computed for body a and body b of every lane
-    /// (`v_x, v_y, w`), written back to the states by
-    /// [`WideContact::scatter_out`].
-    out_a: [W; 3],
-    out_b: [W; 3],
-    /// True when the last parallel stage left velocities in the outputs.
-    written: bool,
+    /// Bit `k`: lane `k`'s body a is moved by the solve (dynamic and
+    /// awake); bit `LANES + k`: its body b. The parallel stages write only
+    /// these.
+    moving: u32,
 }
 
 /// The impulses of one manifold point after a step, N·s.
@@ -232,6 +229,9 @@ pub struct ContactSolver {
     len: usize,
     /// Scratch of [`ContactSolver::push_all`]: the contacts of each colour.
     lists: Vec<Vec<u32>>,
+    /// Which states each chunk reads and writes, one group per colour,
+    /// verified at prepare (parallel stages only).
+    plan: StatePlan<PLAN_SLOTS>,
 }
 
 /// The slot of the overflow in [`ContactSolver::assign`]'s answers.
@@ -453,11 +453,28 @@ impl ContactSolver {
     ) {
         let states = &bodies.states[..];
         for chunks in &mut self.colours {
-            team.for_each_chunk_mut(chunks, CHUNKS_PER_BLOCK, |_, block| {
+            let per_block = block_len(team, chunks.len());
+            team.for_each_chunk_mut(chunks, per_block, |_, block| {
                 for chunk in block {
                     chunk.prepare(ctx, states);
                 }
             });
+        }
+        self.plan.clear();
+        if team.threads() > 1 {
+            for chunks in &self.colours {
+                self.plan.begin_group();
+                for chunk in chunks {
+                    let mut slots = [0; PLAN_SLOTS];
+                    slots[..LANES].copy_from_slice(&chunk.state_a);
+                    slots[LANES..].copy_from_slice(&chunk.state_b);
+                    self.plan.push(slots, chunk.moving);
+                }
+            }
+            // A plan that does not hold (it always should: the colouring
+            // keeps moving bodies apart) leaves the stages serial.
+            let verified = self.plan.verify(states.len());
+            debug_assert!(verified, "a colour holds a moving body twice");
         }
         for c in &mut self.overflow {
             c.prepare(ctx, bodies);
@@ -480,11 +497,8 @@ impl ContactSolver {
     }
 
     fn warm_start(&mut self, states: &mut [BodyState], team: &Team) {
-        for chunks in &mut self.colours {
-            colour_stage(team, chunks, states, |chunk, states| {
-                chunk.warm_start(states);
-                true
-            });
+        for (colour, chunks) in self.colours.iter_mut().enumerate() {
+            colour_stage(team, &self.plan, colour, chunks, states, Stage::WarmStart);
         }
         for c in &mut self.overflow {
             c.apply_warm_start(states);
@@ -503,18 +517,13 @@ impl ContactSolver {
         let colours = self.colours.len();
         for k in 0..colours {
             let colour = if reverse { colours - 1 - k } else { k };
+            let stage = Stage::Solve {
+                use_bias,
+                inv_h,
+                push_max,
+            };
             let chunks = &mut self.colours[colour];
-            if use_bias {
-                colour_stage(team, chunks, states, |chunk, states| {
-                    chunk.solve::<true>(states, inv_h, push_max);
-                    true
-                });
-            } else {
-                colour_stage(team, chunks, states, |chunk, states| {
-                    chunk.solve::<false>(states, inv_h, push_max);
-                    true
-                });
-            }
+            colour_stage(team, &self.plan, colour, chunks, states, stage);
         }
         for c in &mut self.overflow {
             if use_bias {
@@ -527,10 +536,9 @@ impl ContactSolver {
 
     fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState], team: &Team) {
         let threshold = splat(ctx.restitution_threshold);
-        for chunks in &mut self.colours {
-            colour_stage(team, chunks, states, |chunk, states| {
-                chunk.apply_restitution(states, threshold)
-            });
+        let stage = Stage::Restitution { threshold };
+        for (colour, chunks) in self.colours.iter_mut().enumerate() {
+            colour_stage(team, &self.plan, colour, chunks, states, stage);
         }
         for c in &mut self.overflow {
             c.apply_restitution(ctx, states);
@@ -538,47 +546,80 @@ impl ContactSolver {
     }
 }
 
-/// Chunks of a colour per block of a parallel stage (4 chunks: 32 contacts
-/// in f32).
+/// Fewest chunks of a colour per block of a parallel stage (4 chunks: 32
+/// contacts in f32).
 const CHUNKS_PER_BLOCK: usize = 4;
 
-/// One stage over the chunks of one colour: `stage(chunk, states)` computes
-/// each chunk's new velocities from the states (returning false when it
-/// has none), then they are written back.
+/// Chunks per block for `chunks` chunks on `team`: about four blocks per
+/// thread (each claim is an atomic increment on a shared line), at least
+/// [`CHUNKS_PER_BLOCK`].
+fn block_len(team: &Team, chunks: usize) -> usize {
+    chunks.div_ceil(4 * team.threads()).max(CHUNKS_PER_BLOCK)
+}
+
+/// A velocity stage of the contact chunks.
+#[derive(Clone, Copy)]
+enum Stage {
+    WarmStart,
+    Solve {
+        use_bias: bool,
+        inv_h: Real,
+        push_max: Real,
+    },
+    Restitution {
+        threshold: W,
+    },
+}
+
+impl WideContact {
+    #[inline(always)]
+    fn run<S: LaneStates>(&mut self, stage: Stage, states: &mut S) {
+        match stage {
+            Stage::WarmStart => self.warm_start(states),
+            Stage::Solve {
+                use_bias: true,
+                inv_h,
+                push_max,
+            } => self.solve::<S, true>(states, inv_h, push_max),
+            Stage::Solve {
+                use_bias: false,
+                inv_h,
+                push_max,
+            } => self.solve::<S, false>(states, inv_h, push_max),
+            Stage::Restitution { threshold } => self.apply_restitution(states, threshold),
+        }
+    }
+}
+
+/// One stage over the chunks of colour `colour`.
 ///
-/// On a serial team each chunk writes back at once. On a team of several
-/// threads the chunks are computed in blocks on the team, reading the
-/// states only, and written back on the leader afterwards: within a colour
-/// no dynamic body appears twice, so every chunk reads the same states
-/// either way and the results are bit-identical.
-#[inline(always)]
+/// On a serial team (or a short colour) the chunks run in order here. On a
+/// team of several threads they run in blocks on the team, each reading
+/// and writing the states through the verified plan: within a colour no
+/// moving body appears twice, so every chunk sees the same states either
+/// way and the results are bit-identical.
 fn colour_stage(
     team: &Team,
+    plan: &StatePlan<PLAN_SLOTS>,
+    colour: usize,
     chunks: &mut [WideContact],
     states: &mut [BodyState],
-    stage: impl Fn(&mut WideContact, &[BodyState]) -> bool + Sync,
+    stage: Stage,
 ) {
-    if team.threads() == 1 || chunks.len() <= CHUNKS_PER_BLOCK {
+    if team.threads() == 1 || chunks.len() <= CHUNKS_PER_BLOCK || colour >= plan.group_count() {
         for chunk in chunks.iter_mut() {
-            if stage(chunk, states) {
-                chunk.scatter_out(states);
-            }
+            let mut direct = Direct {
+                index: [chunk.state_a, chunk.state_b],
+                states: &mut *states,
+            };
+            chunk.run(stage, &mut direct);
         }
         return;
     }
-    {
-        let states = &*states;
-        team.for_each_chunk_mut(chunks, CHUNKS_PER_BLOCK, |_, block| {
-            for chunk in block {
-                chunk.written = stage(chunk, states);
-            }
-        });
-    }
-    for chunk in chunks.iter() {
-        if chunk.written {
-            chunk.scatter_out(states);
-        }
-    }
+    let per_block = block_len(team, chunks.len());
+    team.for_each_planned(plan, colour, chunks, states, per_block, |chunk, view| {
+        chunk.run(stage, view)
+    });
 }
 
 #[inline(always)]
@@ -592,8 +633,58 @@ fn clamp_w(x: W, lo: W, hi: W) -> W {
     x.fast_max(lo).fast_min(hi)
 }
 
+/// Side a of a lane (its first body).
+const A: usize = 0;
+/// Side b of a lane.
+const B: usize = 1;
+
+/// The body states as the lanes of one chunk see them: the state of side
+/// `side` (a or b) of lane `k`, and its velocities written back.
+trait LaneStates {
+    fn load(&self, side: usize, k: usize) -> BodyState;
+    fn store(&mut self, side: usize, k: usize, v: Vec2, w: Real);
+}
+
+/// The serial view: the whole state slice and the chunk's state indices.
+/// Lanes on the identity state, on a static or on a kinematic body write
+/// what they read.
+struct Direct<'s> {
+    states: &'s mut [BodyState],
+    index: [[u32; LANES]; 2],
+}
+
+impl LaneStates for Direct<'_> {
+    #[inline(always)]
+    fn load(&self, side: usize, k: usize) -> BodyState {
+        self.states[self.index[side][k] as usize]
+    }
+    #[inline(always)]
+    fn store(&mut self, side: usize, k: usize, v: Vec2, w: Real) {
+        let s = &mut self.states[self.index[side][k] as usize];
+        s.v = v;
+        s.w = w;
+    }
+}
+
+/// Slots per chunk in the parallel stages' plan: both bodies of every lane.
+const PLAN_SLOTS: usize = 2 * LANES;
+
+/// The parallel view: the chunk's slots of the verified plan (slot `k`:
+/// body a of lane `k`, slot `LANES + k`: body b); only moving bodies are
+/// written.
+impl LaneStates for PlannedStates<'_, PLAN_SLOTS> {
+    #[inline(always)]
+    fn load(&self, side: usize, k: usize) -> BodyState {
+        self.get(side * LANES + k)
+    }
+    #[inline(always)]
+    fn store(&mut self, side: usize, k: usize, v: Vec2, w: Real) {
+        self.set_velocity(side * LANES + k, v, w);
+    }
+}
+
 #[inline(always)]
-fn gather(states: &[BodyState], index: &[u32; LANES]) -> WideBody {
+fn load<S: LaneStates>(states: &S, side: usize) -> WideBody {
     let mut v_x = [0.0; LANES];
     let mut v_y = [0.0; LANES];
     let mut w = [0.0; LANES];
@@ -602,7 +693,7 @@ fn gather(states: &[BodyState], index: &[u32; LANES]) -> WideBody {
     let mut q_c = [0.0; LANES];
     let mut q_s = [0.0; LANES];
     for k in 0..LANES {
-        let s = &states[index[k] as usize];
+        let s = states.load(side, k);
         v_x[k] = s.v.x;
         v_y[k] = s.v.y;
         w[k] = s.w;
@@ -624,6 +715,30 @@ fn gather(states: &[BodyState], index: &[u32; LANES]) -> WideBody {
 
 /// The lanes' velocities only (the warm start needs no position deltas).
 #[inline(always)]
+fn load_velocity<S: LaneStates>(states: &S, side: usize) -> (W, W, W) {
+    let mut v_x = [0.0; LANES];
+    let mut v_y = [0.0; LANES];
+    let mut w = [0.0; LANES];
+    for k in 0..LANES {
+        let s = states.load(side, k);
+        v_x[k] = s.v.x;
+        v_y[k] = s.v.y;
+        w[k] = s.w;
+    }
+    (W::from(v_x), W::from(v_y), W::from(w))
+}
+
+/// Writes the lanes' velocities back.
+#[inline(always)]
+fn store<S: LaneStates>(states: &mut S, side: usize, v_x: W, v_y: W, w: W) {
+    let (v_x, v_y, w) = (v_x.to_array(), v_y.to_array(), w.to_array());
+    for k in 0..LANES {
+        states.store(side, k, Vec2::new(v_x[k], v_y[k]), w[k]);
+    }
+}
+
+/// The lanes' velocities from the state slice (prepare).
+#[inline(always)]
 fn gather_velocity(states: &[BodyState], index: &[u32; LANES]) -> (W, W, W) {
     let mut v_x = [0.0; LANES];
     let mut v_y = [0.0; LANES];
@@ -635,18 +750,6 @@ fn gather_velocity(states: &[BodyState], index: &[u32; LANES]) -> (W, W, W) {
         w[k] = s.w;
     }
     (W::from(v_x), W::from(v_y), W::from(w))
-}
-
-/// Writes the lanes' velocities back. Lanes on the identity state, on a
-/// static or on a kinematic body write what they read.
-#[inline(always)]
-fn scatter(states: &mut [BodyState], index: &[u32; LANES], v_x: W, v_y: W, w: W) {
-    let (v_x, v_y, w) = (v_x.to_array(), v_y.to_array(), w.to_array());
-    for k in 0..LANES {
-        let s = &mut states[index[k] as usize];
-        s.v = Vec2::new(v_x[k], v_y[k]);
-        s.w = w[k];
-    }
 }
 
 impl WideContact {
@@ -679,9 +782,7 @@ impl WideContact {
             impulse: [z; ROWS],
             max_normal_impulse: [z; MAX_MANIFOLD_POINTS],
             step_base: [z; ROWS],
-            out_a: [z; 3],
-            out_b: [z; 3],
-            written: false,
+            moving: 0,
         }
     }
 
@@ -693,6 +794,13 @@ impl WideContact {
         self.len += 1;
         self.state_a[k] = lane.state_a;
         self.state_b[k] = lane.state_b;
+        let [m_a, i_a, m_b, i_b] = lane.inv_masses;
+        if lane.state_a != 0 && (m_a > 0.0 || i_a > 0.0) {
+            self.moving |= 1 << k;
+        }
+        if lane.state_b != 0 && (m_b > 0.0 || i_b > 0.0) {
+            self.moving |= 1 << (LANES + k);
+        }
         self.contact[k] = lane.contact_index;
         let [m_a, i_a, m_b, i_b] = lane.inv_masses;
         self.inv_mass_a.as_array_mut()[k] = m_a;
@@ -787,13 +895,13 @@ impl WideContact {
     /// faster than the threshold and pushed, drive `Ċ` to `−e · Ċ_before`.
     /// Returns false (and leaves the outputs as they were) when no lane
     /// has restitution.
-    fn apply_restitution(&mut self, states: &[BodyState], threshold: W) -> bool {
+    fn apply_restitution<S: LaneStates>(&mut self, states: &mut S, threshold: W) {
         let zero = W::splat(0.0);
         if self.restitution.cmp_gt(zero).none() {
-            return false;
+            return;
         }
-        let (mut v_xa, mut v_ya, mut w_a) = gather_velocity(states, &self.state_a);
-        let (mut v_xb, mut v_yb, mut w_b) = gather_velocity(states, &self.state_b);
+        let (mut v_xa, mut v_ya, mut w_a) = load_velocity(states, A);
+        let (mut v_xb, mut v_yb, mut w_b) = load_velocity(states, B);
         let (n_x, n_y) = (self.n_x, self.n_y);
         let e = self.restitution;
         for i in 0..MAX_MANIFOLD_POINTS {
@@ -820,25 +928,13 @@ impl WideContact {
             v_yb += self.inv_mass_b * p_y;
             w_b += self.inv_inertia_b * applied * rn_b;
         }
-        self.out_a = [v_xa, v_ya, w_a];
-        self.out_b = [v_xb, v_yb, w_b];
-        true
-    }
-
-    /// Writes the velocities the last stage computed back to the states.
-    /// Lanes on the identity state, on a static or on a kinematic body
-    /// write what they read.
-    #[inline(always)]
-    fn scatter_out(&self, states: &mut [BodyState]) {
-        let [v_x, v_y, w] = self.out_a;
-        scatter(states, &self.state_a, v_x, v_y, w);
-        let [v_x, v_y, w] = self.out_b;
-        scatter(states, &self.state_b, v_x, v_y, w);
+        store(states, A, v_xa, v_ya, w_a);
+        store(states, B, v_xb, v_yb, w_b);
     }
 
     /// Applies the kept impulses: `Δv = M⁻¹ Jᵀ λ`.
     #[inline(always)]
-    fn warm_start(&mut self, states: &[BodyState]) {
+    fn warm_start<S: LaneStates>(&mut self, states: &mut S) {
         let (n_x, n_y) = (self.n_x, self.n_y);
         let lambda = &self.impulse;
         for (base, &l) in self.step_base.iter_mut().zip(lambda) {
@@ -850,26 +946,35 @@ impl WideContact {
         let p_y = pn * n_y - pt * n_x;
         let l_a = dot_rows(lambda, &self.ja);
         let l_b = dot_rows(lambda, &self.jb);
-        let (v_x, v_y, w) = gather_velocity(states, &self.state_a);
-        self.out_a = [
+        let (v_x, v_y, w) = load_velocity(states, A);
+        store(
+            states,
+            A,
             v_x - self.inv_mass_a * p_x,
             v_y - self.inv_mass_a * p_y,
             w - self.inv_inertia_a * l_a,
-        ];
-        let (v_x, v_y, w) = gather_velocity(states, &self.state_b);
-        self.out_b = [
+        );
+        let (v_x, v_y, w) = load_velocity(states, B);
+        store(
+            states,
+            B,
             v_x + self.inv_mass_b * p_x,
             v_y + self.inv_mass_b * p_y,
             w + self.inv_inertia_b * l_b,
-        ];
+        );
     }
 
     /// One velocity iteration on every lane: the arithmetic of
     /// `ContactConstraint::solve_rows`, lane by lane.
     #[inline(always)]
-    fn solve<const USE_BIAS: bool>(&mut self, states: &[BodyState], inv_h: Real, push_max: Real) {
-        let a = gather(states, &self.state_a);
-        let b = gather(states, &self.state_b);
+    fn solve<S: LaneStates, const USE_BIAS: bool>(
+        &mut self,
+        states: &mut S,
+        inv_h: Real,
+        push_max: Real,
+    ) {
+        let a = load(states, A);
+        let b = load(states, B);
         let (n_x, n_y) = (self.n_x, self.n_y);
         let (ja, jb) = (self.ja, self.jb);
         let dpn = (b.dp_x - a.dp_x) * n_x + (b.dp_y - a.dp_y) * n_y;
@@ -933,16 +1038,20 @@ impl WideContact {
         let p_y = pn * n_y - pt * n_x;
         let l_a = dot_rows(&d, &ja);
         let l_b = dot_rows(&d, &jb);
-        self.out_a = [
+        store(
+            states,
+            A,
             a.v_x - self.inv_mass_a * p_x,
             a.v_y - self.inv_mass_a * p_y,
             a.w - i_a * l_a,
-        ];
-        self.out_b = [
+        );
+        store(
+            states,
+            B,
             b.v_x + self.inv_mass_b * p_x,
             b.v_y + self.inv_mass_b * p_y,
             b.w + i_b * l_b,
-        ];
+        );
     }
 
     /// The terms of point `i`'s normal row on every lane: the bias `b`

@@ -48,6 +48,18 @@
 //!    counter hands each block index to exactly one thread exactly once per
 //!    job, so the `&mut` sub-slices never alias, and they do not outlive the
 //!    job (hence not the `&mut` borrow `for_each_chunk_mut` holds).
+//! 3. **Body states written by several threads at once**
+//!    ([`Team::for_each_planned`]). A [`StatePlan`] lists, per item of a
+//!    group (a colour's chunk), the state indices it reads and the subset
+//!    it writes; [`StatePlan::verify`] checks once that they are in bounds,
+//!    that no state is written by two slots of a group, and that no state
+//!    written by one item is read by another. A job runs one group, each
+//!    item by exactly one thread (point 2), through [`PlannedStates`],
+//!    which reaches only that item's slots. So every state is either
+//!    written by one item and touched by no other, or only read, during the
+//!    job: no data race. A plan runs on threads only if it was verified
+//!    against the very slice length it is given; otherwise it runs
+//!    serially.
 //!
 //! Memory ordering of the data: a block's writes happen before its
 //! `done.fetch_add` (a release RMW); the leader's acquire load that sees the
@@ -58,6 +70,9 @@
 #![allow(unsafe_code)]
 
 use std::cell::UnsafeCell;
+
+use crate::body::BodyState;
+use crate::math::{Real, Vec2};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering::SeqCst};
 
 /// A stage's job: called once for every block index.
@@ -74,12 +89,26 @@ struct Shared {
     /// The published job, lifetime erased (see the module's safety proof).
     job: UnsafeCell<Option<Job<'static>>>,
     blocks: AtomicUsize,
-    next: AtomicUsize,
-    done: AtomicUsize,
+    /// The claim counter, the finished count and the holders each on a
+    /// cache line of their own: claims do not slow the followers' polling.
+    next: Line<AtomicUsize>,
+    done: Line<AtomicUsize>,
     /// Followers currently holding the published job.
-    active: AtomicUsize,
+    active: Line<AtomicUsize>,
     /// Set when a block panicked on a follower.
     panicked: AtomicBool,
+}
+
+/// A value alone on its cache line (128 bytes: two lines on x86, whose
+/// prefetcher pairs them).
+#[repr(align(128))]
+struct Line<T>(T);
+
+impl<T> std::ops::Deref for Line<T> {
+    type Target = T;
+    fn deref(&self) -> &T {
+        &self.0
+    }
 }
 
 // SAFETY: `job` is written only by the leader while no follower can read it
@@ -94,29 +123,33 @@ impl Shared {
             epoch: AtomicU64::new(0),
             job: UnsafeCell::new(None),
             blocks: AtomicUsize::new(0),
-            next: AtomicUsize::new(0),
-            done: AtomicUsize::new(0),
-            active: AtomicUsize::new(0),
+            next: Line(AtomicUsize::new(0)),
+            done: Line(AtomicUsize::new(0)),
+            active: Line(AtomicUsize::new(0)),
             panicked: AtomicBool::new(false),
         }
     }
 
     /// Claims and runs blocks of the published job until none is left.
     fn work(&self, job: Job<'_>, blocks: usize) {
+        // The blocks this thread started, added to `done` once at the end,
+        // even if a block panics, so the leader never waits for a block
+        // that will not finish.
+        struct Done<'s>(&'s AtomicUsize, usize);
+        impl Drop for Done<'_> {
+            fn drop(&mut self) {
+                if self.1 > 0 {
+                    self.0.fetch_add(self.1, SeqCst);
+                }
+            }
+        }
+        let mut done = Done(&self.done, 0);
         loop {
             let i = self.next.fetch_add(1, SeqCst);
             if i >= blocks {
                 return;
             }
-            // Counted even if the block panics, so the leader never waits
-            // for a block that will not finish.
-            struct Done<'s>(&'s AtomicUsize);
-            impl Drop for Done<'_> {
-                fn drop(&mut self) {
-                    self.0.fetch_add(1, SeqCst);
-                }
-            }
-            let _done = Done(&self.done);
+            done.1 += 1;
             job(i);
         }
     }
@@ -227,11 +260,6 @@ impl Team<'_> {
             }
             return;
         }
-        /// The slice's base pointer, shared by the blocks.
-        struct Base<T>(*mut T);
-        // SAFETY: the blocks built from it are disjoint (module docs, point
-        // 2) and `T: Send`, so handing them to other threads is sound.
-        unsafe impl<T: Send> Sync for Base<T> {}
         let base = Base(items.as_mut_ptr());
         let base = &base;
         self.run(blocks, &|i| {
@@ -245,6 +273,218 @@ impl Team<'_> {
         });
     }
 }
+
+/// Which body states each item of a stage reads and writes, checked once so
+/// that the items can then run on the team and write the states directly.
+///
+/// Items come in groups (the contact colours); an item has `N` slots, each
+/// a state index, and a mask of the slots it writes. [`StatePlan::verify`]
+/// checks, per group, that no state is written by two slots and that no
+/// state one item writes is read by another item of the group. Then
+/// [`Team::for_each_planned`] runs a group's items concurrently, each
+/// seeing only its own slots.
+#[derive(Clone, Debug, Default)]
+pub struct StatePlan<const N: usize> {
+    slots: Vec<[u32; N]>,
+    writes: Vec<u32>,
+    /// First item of each group, and the item count at the end.
+    group_start: Vec<usize>,
+    /// The state count the plan was verified against (`None`: not verified,
+    /// or verification failed).
+    verified: Option<usize>,
+    // Verification scratch: per state, the generation of the group that
+    // writes it and the writing item.
+    writer_generation: Vec<u32>,
+    writer_item: Vec<u32>,
+    generation: u32,
+}
+
+impl<const N: usize> StatePlan<N> {
+    /// Forgets every item and group.
+    pub fn clear(&mut self) {
+        const { assert!(N <= 32, "a write mask has 32 bits") };
+        self.slots.clear();
+        self.writes.clear();
+        self.group_start.clear();
+        self.verified = None;
+    }
+
+    /// Starts a new group; the items pushed next belong to it.
+    pub fn begin_group(&mut self) {
+        self.group_start.push(self.slots.len());
+        self.verified = None;
+    }
+
+    /// Adds an item to the current group: its state indices, and a mask
+    /// whose bit `k` says slot `k` is written.
+    pub fn push(&mut self, slots: [u32; N], writes: u32) {
+        if self.group_start.is_empty() {
+            self.group_start.push(0);
+        }
+        self.slots.push(slots);
+        self.writes.push(writes);
+        self.verified = None;
+    }
+
+    /// Number of groups.
+    #[must_use]
+    pub fn group_count(&self) -> usize {
+        self.group_start.len()
+    }
+
+    fn group(&self, g: usize) -> std::ops::Range<usize> {
+        let start = self.group_start[g];
+        let end = self
+            .group_start
+            .get(g + 1)
+            .copied()
+            .unwrap_or(self.slots.len());
+        start..end
+    }
+
+    /// Checks the plan against `state_count` states: every index in range,
+    /// within each group no state written twice and none written by one
+    /// item and read by another. Returns whether it holds; only a verified
+    /// plan runs on several threads.
+    pub fn verify(&mut self, state_count: usize) -> bool {
+        self.verified = None;
+        if self.writer_generation.len() < state_count {
+            self.writer_generation.resize(state_count, 0);
+            self.writer_item.resize(state_count, 0);
+        }
+        for g in 0..self.group_count() {
+            if self.generation == u32::MAX {
+                self.writer_generation.fill(0);
+                self.generation = 0;
+            }
+            self.generation += 1;
+            let generation = self.generation;
+            let range = self.group(g);
+            for item in range.clone() {
+                let (slots, writes) = (&self.slots[item], self.writes[item]);
+                for (k, &index) in slots.iter().enumerate() {
+                    let i = index as usize;
+                    if i >= state_count {
+                        return false;
+                    }
+                    if writes & (1 << k) == 0 {
+                        continue;
+                    }
+                    if self.writer_generation[i] == generation {
+                        return false;
+                    }
+                    self.writer_generation[i] = generation;
+                    self.writer_item[i] = item as u32;
+                }
+            }
+            for item in range {
+                let (slots, writes) = (&self.slots[item], self.writes[item]);
+                for (k, &index) in slots.iter().enumerate() {
+                    let i = index as usize;
+                    if writes & (1 << k) == 0
+                        && self.writer_generation[i] == generation
+                        && self.writer_item[i] != item as u32
+                    {
+                        return false;
+                    }
+                }
+            }
+        }
+        self.verified = Some(state_count);
+        true
+    }
+}
+
+/// The states one planned item may touch: its slots of the plan.
+pub struct PlannedStates<'p, const N: usize> {
+    base: *mut BodyState,
+    len: usize,
+    slots: &'p [u32; N],
+    writes: u32,
+}
+
+impl<const N: usize> PlannedStates<'_, N> {
+    /// The state in slot `k`.
+    #[inline(always)]
+    #[must_use]
+    pub fn get(&self, k: usize) -> BodyState {
+        let i = self.slots[k] as usize;
+        assert!(i < self.len, "planned state index out of range");
+        // SAFETY: `i` is in bounds of the slice `base` points into, which
+        // `for_each_planned` holds mutably borrowed; no other item of the
+        // group writes it (point 3 of the module's proof).
+        unsafe { self.base.add(i).read() }
+    }
+
+    /// Sets the velocities of slot `k`'s state when the plan lets this item
+    /// write it; otherwise does nothing (a slot on a state the stage does
+    /// not move).
+    #[inline(always)]
+    pub fn set_velocity(&mut self, k: usize, v: Vec2, w: Real) {
+        let i = self.slots[k] as usize;
+        assert!(i < self.len, "planned state index out of range");
+        if self.writes & (1 << k) != 0 {
+            // SAFETY: as in `get`; and this item is the only one of the
+            // group that reads or writes state `i` (point 3).
+            unsafe {
+                let state = self.base.add(i);
+                (*state).v = v;
+                (*state).w = w;
+            }
+        }
+    }
+}
+
+impl Team<'_> {
+    /// Runs `f(item, states)` for the items of group `group` of a verified
+    /// `plan` (`items[i]` is the group's `i`-th item), `per_block` items per
+    /// block, on the team; each call sees the states of its own slots. An
+    /// unverified plan, a plan verified for another state count or a serial
+    /// team runs the items in order on the caller, with the same result.
+    pub fn for_each_planned<T: Send, const N: usize>(
+        &self,
+        plan: &StatePlan<N>,
+        group: usize,
+        items: &mut [T],
+        states: &mut [BodyState],
+        per_block: usize,
+        f: impl Fn(&mut T, &mut PlannedStates<'_, N>) + Sync,
+    ) {
+        let range = plan.group(group);
+        assert_eq!(range.len(), items.len(), "one item per planned item");
+        let slots = &plan.slots[range.clone()];
+        let writes = &plan.writes[range];
+        let len = states.len();
+        let base = Base(states.as_mut_ptr());
+        let base = &base;
+        let run_item = |item: &mut T, k: usize| {
+            let mut view = PlannedStates {
+                base: base.0,
+                len,
+                slots: &slots[k],
+                writes: writes[k],
+            };
+            f(item, &mut view);
+        };
+        if plan.verified != Some(len) || self.shared.is_none() {
+            for (k, item) in items.iter_mut().enumerate() {
+                run_item(item, k);
+            }
+            return;
+        }
+        self.for_each_chunk_mut(items, per_block, |block, chunk| {
+            for (j, item) in chunk.iter_mut().enumerate() {
+                run_item(item, block * per_block.max(1) + j);
+            }
+        });
+    }
+}
+
+/// A slice's base pointer, shared by the blocks of a job.
+struct Base<T>(*mut T);
+// SAFETY: the blocks built from it are disjoint (module docs, points 2 and
+// 3) and `T: Send`, so handing them to other threads is sound.
+unsafe impl<T: Send> Sync for Base<T> {}
 
 /// Runs `leader` with the step's team: with the `parallel` feature in a
 /// rayon pool of more than one thread, `leader` runs on the pool's thread 0
