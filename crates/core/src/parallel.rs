@@ -155,11 +155,16 @@ impl Shared {
     }
 }
 
+/// Spins before a waiting thread starts yielding its core (a few µs):
+/// long enough to cover the leader's serial work between two jobs of a
+/// stage, short enough not to starve a leader that shares a core.
+const SPINS_BEFORE_YIELD: u32 = 1 << 10;
+
 /// Waits a little, then lets other threads run: a follower may share its
 /// core with the leader (more threads than cores).
 #[inline]
 fn backoff(spins: &mut u32) {
-    if *spins < 64 {
+    if *spins < SPINS_BEFORE_YIELD {
         std::hint::spin_loop();
         *spins += 1;
     } else {
