@@ -233,6 +233,17 @@ impl RevoluteJoint {
         }
     }
 
+    /// Carries the accumulated impulses through a portal when both ends of
+    /// the joint move to the other side: the point impulse (world frame)
+    /// becomes `scale · rotation · P` (`rotation = Q`, `scale = 1/η`: an
+    /// impulse `P` on side 1 moves the object as `Q P / η` does on side 2,
+    /// since the portal rows keep `p₁ + η Qᵀ p₂`); the angle rows' impulses
+    /// are unchanged (the rows keep `I₁ω₁ + I₂ω₂`, and `r × P` is the same
+    /// on both sides).
+    pub fn carry_impulses(&mut self, rotation: janus2d_core::math::Rot, scale: Real) {
+        self.point.impulse = scale * rotation.rotate(self.point.impulse);
+    }
+
     /// The world anchors on a and b (their distance is the joint gap).
     pub fn world_anchors(&self, bodies: &BodySet) -> (Vec2, Vec2) {
         let a = bodies.solver_body(self.def.body_a).sim;

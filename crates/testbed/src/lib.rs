@@ -37,6 +37,8 @@ pub mod hard;
 pub mod janus;
 pub mod measure;
 pub mod metrics;
+#[cfg(feature = "portals")]
+pub mod portal_joints;
 pub mod run;
 pub mod scenes;
 pub mod support;

@@ -295,6 +295,58 @@ impl JointSet {
         Ok((a, b, freed))
     }
 
+    /// Moves one end of a joint from body `from` to body `to`, with the
+    /// local anchor `anchor` in `to`'s frame (the portal stage's re-pointing
+    /// of a joint to the other copy of a crossing object). Updates the
+    /// body lists and the no-collide pairs; returns the joint's bodies
+    /// before and after, or `None` when `from` is not one of its ends.
+    #[cfg_attr(not(feature = "portals"), allow(dead_code))]
+    pub(crate) fn repoint(
+        &mut self,
+        joint: JointHandle,
+        from: BodyHandle,
+        to: BodyHandle,
+        anchor: janus2d_core::math::Vec2,
+    ) -> Option<((BodyHandle, BodyHandle), (BodyHandle, BodyHandle))> {
+        let j = self.revolute_mut(joint).ok()?;
+        let old = (j.def.body_a, j.def.body_b);
+        if j.def.body_a == from {
+            j.def.body_a = to;
+            j.def.local_anchor_a = anchor;
+        } else if j.def.body_b == from {
+            j.def.body_b = to;
+            j.def.local_anchor_b = anchor;
+        } else {
+            return None;
+        }
+        let new = (j.def.body_a, j.def.body_b);
+        let collide = j.def.collide_connected;
+        if let Some(list) = self.body_joints.get_mut(from.index as usize)
+            && let Some(k) = list.iter().position(|h| *h == joint)
+        {
+            list.remove(k);
+        }
+        let b = to.index as usize;
+        if self.body_joints.len() <= b {
+            self.body_joints.resize(b + 1, SmallVec::new());
+        }
+        self.body_joints[b].push(joint);
+        if !collide {
+            self.no_collide.remove(old.0, old.1);
+            self.no_collide.add(new.0, new.1);
+        }
+        Some((old, new))
+    }
+
+    /// A joint, mutable (the portal stage carries its impulses through).
+    #[cfg_attr(not(feature = "portals"), allow(dead_code))]
+    pub(crate) fn revolute_joint_mut(
+        &mut self,
+        joint: JointHandle,
+    ) -> Result<&mut RevoluteJoint, WorldError> {
+        self.revolute_mut(joint)
+    }
+
     /// Changes a joint's definition through `edit`, keeping the change only
     /// when the result validates. Returns the joint's bodies (to wake).
     fn edit(

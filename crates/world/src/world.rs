@@ -1689,6 +1689,42 @@ impl World {
         debug_assert!(switched.is_ok(), "the portal stage passes live joints");
     }
 
+    /// Moves one end of a joint from body `from` to body `to` with the
+    /// local anchor `anchor` in `to`'s frame (the portal stage re-points
+    /// joints to the copy of a crossing object on their other body's side):
+    /// the islands link the new pair, a no-collide joint ends its new
+    /// pair's contacts, and the new bodies wake.
+    #[cfg_attr(not(feature = "portals"), allow(dead_code))]
+    pub(crate) fn repoint_joint(
+        &mut self,
+        joint: JointHandle,
+        from: BodyHandle,
+        to: BodyHandle,
+        anchor: Vec2,
+    ) {
+        let Some((old, new)) = self.joints.repoint(joint, from, to, anchor) else {
+            return;
+        };
+        let (enabled, collide) = self
+            .joints
+            .revolute(joint)
+            .map_or((false, true), |j| (j.enabled, j.def.collide_connected));
+        if !collide {
+            self.collision.remove_contacts_between(new.0, new.1);
+            let freed = !self.joints.no_collide.contains(old.0, old.1);
+            if freed {
+                self.collision.refind_pairs_of(old.0);
+                self.collision.refind_pairs_of(old.1);
+            }
+        }
+        self.islands.note_removed(old.0);
+        if enabled {
+            self.wake_body(new.0);
+            self.wake_body(new.1);
+            self.islands.link(new.0, new.1, &self.bodies);
+        }
+    }
+
     /// Exchanges two bodies' identities (see `BodySet::swap_identity`),
     /// moving their shapes along and dropping their contacts.
     pub(crate) fn swap_body_identity(&mut self, a: BodyHandle, b: BodyHandle) {

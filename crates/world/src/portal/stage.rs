@@ -864,16 +864,29 @@ impl World {
         match command {
             PortalCommand::Complete(original) => {
                 if let Some(k) = self.portals.crossing_of(original) {
-                    self.complete_crossing(k);
-                    counters.completed += 1;
-                    crossed.push(original);
+                    if self.joints_can_follow(k, true) {
+                        self.complete_crossing(k);
+                        counters.completed += 1;
+                        crossed.push(original);
+                    } else {
+                        // A joint on the original has no copy of its other
+                        // body on the exit side yet: the crossing goes on
+                        // (the joint acts through the portal rows).
+                        let (f_entry, f_exit) = frames(self, k);
+                        self.weigh_crossing(k, &f_entry, &f_exit);
+                    }
                 }
             }
             PortalCommand::Cancel(original) => {
                 if let Some(k) = self.portals.crossing_of(original) {
-                    self.cancel_crossing(k);
-                    counters.cancelled += 1;
-                    crossed.push(original);
+                    if self.joints_can_follow(k, false) {
+                        self.cancel_crossing(k);
+                        counters.cancelled += 1;
+                        crossed.push(original);
+                    } else {
+                        let (f_entry, f_exit) = frames(self, k);
+                        self.weigh_crossing(k, &f_entry, &f_exit);
+                    }
                 }
             }
             PortalCommand::Restart(original) => {
@@ -909,7 +922,7 @@ impl World {
                 let through =
                     extents_in(self.bodies(), &self.collision_ref().shapes, body, &f_entry)
                         .is_some_and(|e| e.1 < 0.0);
-                if through {
+                if through && self.joints_can_follow(k, true) {
                     self.complete_crossing(k);
                     counters.completed += 1;
                 } else {
@@ -1111,14 +1124,25 @@ impl World {
             self.exchange_with_portal(c.original, (b.mass, b.inertia), (0.0, 0.0), entry_body);
         }
         let pair = self.pair_handle(c.pair);
-        // Joints on the original would now span the portal.
-        for joint in self.joints_attached_to(c.original) {
-            self.disable_joint(joint);
-            self.portals
-                .events
-                .push(PortalEvent::JointDisabled { joint, pair });
-        }
+        // Joints on the original move to the exit side with it: their
+        // other bodies to their copies there (checked by
+        // `joints_can_follow`; one that has none is disabled).
+        let on_original = self.joints_attached_to(c.original);
+        let on_clone = self.joints_attached_to(c.clone);
+        let q = self.crossing_rotation(&c);
+        let eta = self.crossing_eta(&c);
         self.swap_body_identity(c.original, c.clone);
+        // The handle `original` is now the exit copy (the clone's frame:
+        // the original's scaled by η about the centre of mass).
+        for joint in on_original {
+            self.carry_joint(joint, &c, c.original, c.original, eta, q, 1.0 / eta);
+        }
+        // Joints on the clone follow its body, which `original` now names.
+        for joint in on_clone {
+            if let Some(anchor) = self.anchor_on(joint, c.clone) {
+                self.repoint_joint(joint, c.clone, c.original, anchor);
+            }
+        }
         self.destroy_body_unchecked(c.clone);
         self.portals.events.push(PortalEvent::CrossingCompleted {
             body: c.original,
@@ -1137,6 +1161,16 @@ impl World {
         if self.bodies().contains(c.original) {
             self.set_copy_mass(c.original, c.mass_original, entry_body);
         }
+        if self.bodies().contains(c.original) && self.bodies().contains(c.clone) {
+            // Joints on the clone move back to the original, their other
+            // bodies to their copies on the entry side.
+            // Qᵀ: back from the exit side to the entry side.
+            let q = self.crossing_rotation(&c).inv_mul(Rot::IDENTITY);
+            let eta = self.crossing_eta(&c);
+            for joint in self.joints_attached_to(c.clone) {
+                self.carry_joint(joint, &c, c.clone, c.original, 1.0 / eta, q, eta);
+            }
+        }
         if self.bodies().contains(c.clone) {
             if let Some(b) = self.bodies().sim(c.clone).copied() {
                 self.exchange_with_portal(c.clone, (b.mass, b.inertia), (0.0, 0.0), exit_body);
@@ -1148,5 +1182,128 @@ impl World {
             body: c.original,
             pair,
         });
+    }
+
+    /// True when every enabled joint on the copy that crossing `k` would
+    /// remove (the original when it completes, `complete`, the clone when
+    /// it backs out) can follow the object: its other body has a copy on
+    /// the side that stays. A joint between the two copies does not count
+    /// (it is disabled at the start of the stage).
+    fn joints_can_follow(&self, k: usize, complete: bool) -> bool {
+        let c = &self.portals.crossings[k];
+        let (leaving, staying) = if complete {
+            (c.original, c.clone)
+        } else {
+            (c.clone, c.original)
+        };
+        let leaving_side = if complete { c.entry } else { 1 - c.entry };
+        self.joints_attached_to(leaving).into_iter().all(|joint| {
+            self.joints.bodies_of(joint).is_ok_and(|(a, b)| {
+                let other = if a == leaving { b } else { a };
+                other == staying || self.twin_across(other, c.pair, leaving_side).is_some()
+            })
+        })
+    }
+
+    /// The other copy of `body` through pair slot `pair`, when `body` is
+    /// the copy in front of portal `side` of a crossing through it: the
+    /// twin, and the scale from `body`'s frame to the twin's about their
+    /// common local centre of mass (`(twin, centre, scale)`).
+    fn twin_across(&self, body: BodyHandle, pair: u32, side: usize) -> Option<(BodyHandle, Vec2, Real)> {
+        self.portals
+            .crossings
+            .iter()
+            .zip(&self.portals.constraints)
+            .find_map(|(m, pc)| {
+                if m.pair != pair {
+                    return None;
+                }
+                let eta = pc.def().eta;
+                if m.original == body && m.entry == side {
+                    Some((m.clone, m.mass_original.center, eta))
+                } else if m.clone == body && 1 - m.entry == side {
+                    Some((m.original, m.mass_original.center, 1.0 / eta))
+                } else {
+                    None
+                }
+            })
+    }
+
+    /// The scale `η` of crossing `c` (entry to exit).
+    fn crossing_eta(&self, c: &Crossing) -> Real {
+        let d = self.portals.pairs.at(c.pair).expect("live pair");
+        if c.entry == 0 { d.eta } else { 1.0 / d.eta }
+    }
+
+    /// The rotation `Q` of crossing `c`'s map (entry to exit), now.
+    fn crossing_rotation(&self, c: &Crossing) -> Rot {
+        let d = self.portals.pairs.at(c.pair).expect("live pair");
+        let f1 = frame_of(self, &d.portals[c.entry], &d.local[c.entry]);
+        let f2 = frame_of(self, &d.portals[1 - c.entry], &d.local[1 - c.entry]);
+        PortalMap {
+            frame1: f1,
+            frame2: f2,
+            eta: 1.0,
+        }
+        .rotation()
+    }
+
+    /// A joint's local anchor on `body` (`None` when `body` is neither end).
+    fn anchor_on(&self, joint: JointHandle, body: BodyHandle) -> Option<Vec2> {
+        let j = self.joints.revolute(joint).ok()?;
+        if j.def.body_a == body {
+            Some(j.def.local_anchor_a)
+        } else if j.def.body_b == body {
+            Some(j.def.local_anchor_b)
+        } else {
+            None
+        }
+    }
+
+    /// Carries joint `joint` through crossing `c`: its end on `from` moves
+    /// to `to` (anchor scaled by `scale` about the object's local centre of
+    /// mass), its other end to that body's copy on the same side (scaled
+    /// the same way), and its impulses turn by `q` and scale by
+    /// `impulse_scale`. Its other body having no copy there (a forced end
+    /// of the crossing), the joint is disabled and reported.
+    #[allow(clippy::too_many_arguments)]
+    fn carry_joint(
+        &mut self,
+        joint: JointHandle,
+        c: &Crossing,
+        from: BodyHandle,
+        to: BodyHandle,
+        scale: Real,
+        q: Rot,
+        impulse_scale: Real,
+    ) {
+        let Ok((a, b)) = self.joints.bodies_of(joint) else {
+            return;
+        };
+        let other = if a == from { b } else { a };
+        let leaving_side = if from == c.original { c.entry } else { 1 - c.entry };
+        let twin = self.twin_across(other, c.pair, leaving_side);
+        let center = c.mass_original.center;
+        if let Some(anchor) = self.anchor_on(joint, from) {
+            self.repoint_joint(joint, from, to, center + scale * (anchor - center));
+        }
+        match twin {
+            Some((other_twin, other_center, other_scale)) => {
+                if let Some(anchor) = self.anchor_on(joint, other) {
+                    let anchor = other_center + other_scale * (anchor - other_center);
+                    self.repoint_joint(joint, other, other_twin, anchor);
+                }
+                if let Ok(j) = self.joints.revolute_joint_mut(joint) {
+                    j.carry_impulses(q, impulse_scale);
+                }
+            }
+            None => {
+                self.disable_joint(joint);
+                let pair = self.pair_handle(c.pair);
+                self.portals
+                    .events
+                    .push(PortalEvent::JointDisabled { joint, pair });
+            }
+        }
     }
 }
