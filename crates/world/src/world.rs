@@ -1487,6 +1487,7 @@ impl World {
         }
         // No restitution anywhere: no restitution pass.
         ctx.restitution = has_shapes && self.collision.counters.restitution_contacts > 0;
+        let couple = has_portals && self.portals.copies_carry_joints(&self.joints);
         let mut revolute = janus2d_constraints::RevoluteBatch {
             joints: &mut self.joints.revolute,
             forest: &mut self.joints.forest,
@@ -1498,9 +1499,23 @@ impl World {
         let mut portals = janus2d_constraints::PortalBatch {
             constraints: self.portals.constraints_mut(),
         };
-        let mut batches: [&mut dyn ConstraintBatch; 3] =
-            [&mut revolute, &mut contacts, &mut portals];
-        let mut report = solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches);
+        let passes = if couple {
+            crate::portal::coupling::COUPLING_PASSES
+        } else {
+            0
+        };
+        let mut report = if passes > 0 {
+            let mut coupled = crate::portal::coupling::CoupledBatches {
+                batches: [&mut revolute, &mut contacts, &mut portals],
+                passes,
+            };
+            let mut batches: [&mut dyn ConstraintBatch; 1] = [&mut coupled];
+            solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches)
+        } else {
+            let mut batches: [&mut dyn ConstraintBatch; 3] =
+                [&mut revolute, &mut contacts, &mut portals];
+            solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches)
+        };
         // The solver checks velocities and deltas; a pose they carried out
         // of the world (or to inf) is put back here, before any box is
         // computed from it.

@@ -5,12 +5,14 @@
 //! | `stage.rs` | pairs, crossings, clones, handover, weights; the portal API on `World`, and where the world applies the stage's commands (with the `portals` feature) |
 //! | `crossing.rs` | the crossing stage's decisions, read from bodies, shapes and the broadphase, returned as commands |
 //! | `noop.rs` | the stage's twin without the feature: no state, every step call does nothing |
+//! | `coupling.rs` | joints and portal rows solved together while a crossing copy carries a joint |
 //! | [`clipping`] | apertures as geometry: manifolds clipped to a wall's solid parts (points at the lips, speculative points tested where they arrive), copies' far sides, ignored pairs |
 //!
 //! The world calls the stage in the same places with or without the
 //! feature; only which twin is compiled changes.
 
 pub mod clipping;
+pub(crate) mod coupling;
 #[cfg(feature = "portals")]
 mod crossing;
 #[cfg(not(feature = "portals"))]
@@ -25,6 +27,6 @@ pub(crate) use noop::PortalStage;
 pub(crate) use stage::PortalStage;
 #[cfg(feature = "portals")]
 pub use stage::{
-    CrossingRole, F_MIN, MassModel, PlaneSide, PortalCounters, PortalDef, PortalEvent,
+    CrossingRole, F_JOINTED, F_MIN, MassModel, PlaneSide, PortalCounters, PortalDef, PortalEvent,
     PortalPairDef, PortalPairHandle, PortalSide,
 };

@@ -40,6 +40,9 @@ impl PortalStage {
     pub(crate) fn check(&self, _bodies: &BodySet) -> Result<(), String> {
         Ok(())
     }
+    pub(crate) fn copies_carry_joints(&self, _joints: &crate::joints::JointSet) -> bool {
+        false
+    }
     pub(crate) fn object_masses(&self, _bodies: &BodySet, out: &mut Vec<ObjectMass>) {
         out.clear();
     }

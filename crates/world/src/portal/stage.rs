@@ -20,8 +20,8 @@
 //! |-----------|-------------------------------------------------------------|--------|
 //! | start     | a body's shapes straddle an aperture and fit its width, or its centre swept through the aperture during the step | clone created, constraint linked, [`PortalEvent::CrossingStarted`] |
 //! | straddle  | every step                                                  | masses and inertias weighted by `f₁`, `f₂` (clamped to `[F_MIN, 1 − F_MIN]`) |
-//! | handover  | the original is entirely behind the entry plane            | the handle moves to the clone's body, the original's body is removed, [`PortalEvent::CrossingCompleted`] |
-//! | cancel    | the clone is entirely behind the exit plane (backed out)   | clone removed, [`PortalEvent::CrossingCancelled`] |
+//! | handover  | the original is entirely behind the entry plane (and its joints can follow) | the handle moves to the clone's body, the original's body is removed, joints re-pointed, [`PortalEvent::CrossingCompleted`] |
+//! | cancel    | the clone is entirely behind the exit plane (backed out; its joints can follow) | clone removed, joints re-pointed, [`PortalEvent::CrossingCancelled`] |
 //! | restart   | a copy's shapes changed (one destroyed or added)            | clone removed; the original may start again at once with its shapes |
 //!
 //! Contacts: the wall that carries a portal collides as its solid parts
@@ -29,9 +29,25 @@
 //! a crossing copy drops its contact points that lie behind its own portal
 //! plane within the aperture; a copy never touches its twin. A body takes
 //! part in at most one crossing: while it crosses it ignores every other
-//! portal, whose hole is solid wall to it. A joint attached to a body that
-//! hands over would span the portal: it is disabled and reported
-//! ([`PortalEvent::JointDisabled`]), as is a joint between the two copies.
+//! portal, whose hole is solid wall to it.
+//!
+//! Joints follow the object: a joint always joins two bodies on the same
+//! side, and acts across the portal through the portal rows of the crossing
+//! copy it is attached to. When the original hands over, each joint on it
+//! moves to the exit side: its end on the original to the clone (the same
+//! handle, anchor `c + η (l − c)` about the local centre of mass), its
+//! other end to that body's copy on the exit side (its clone, or the
+//! original of a crossing the other way), impulses turned by `Q` and scaled
+//! by `1/η`; joints on the clone stay on that body. A backing-out clone
+//! hands its joints back the same way. A crossing whose joints could not
+//! follow (the other body has no copy on the side that stays: it has not
+//! reached the aperture yet) goes on, however far the copy is behind its
+//! plane, until they can. While a copy carries a joint it keeps at least
+//! [`F_JOINTED`] of the mass, and the step solves the joints and the
+//! portal rows together ([`super::coupling`]). Only a crossing that is
+//! ended by force (its pair or a copy's shapes changed) disables the joints
+//! that cannot follow, and reports them ([`PortalEvent::JointDisabled`]), as
+//! is a joint between the two copies.
 //! `η` lies in [`ETA_MIN`](janus2d_constraints::portal_map::ETA_MIN) to
 //! [`ETA_MAX`](janus2d_constraints::portal_map::ETA_MAX).
 //!
@@ -56,6 +72,15 @@ use janus2d_core::handle::{Handle, PortalPairTag};
 /// 0.1): a copy that has barely appeared is never thousands of times
 /// lighter than what it touches.
 pub const F_MIN: Real = 0.1;
+
+/// Smallest mass fraction a straddling copy keeps while it carries a joint
+/// to another body (dimensionless, 0.5; when both copies carry one, each
+/// keeps half). The joint's load reaches the other copy through the portal
+/// rows, and those move a light copy away from what it is jointed to: with
+/// [`F_MIN`] the rope of `tests/portal_joints.rs` opened 6.2 mm (η = 1) and
+/// 24 mm (η = 2) across the portal, with this floor 1.4 and 13 mm (and
+/// with the coupled passes of the joint and portal solves 0.8 and 7.7 mm).
+pub const F_JOINTED: Real = 0.5;
 
 /// How a clone's mass follows from the original's.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -238,7 +263,8 @@ pub enum PortalEvent {
         /// The pair.
         pair: PortalPairHandle,
     },
-    /// A joint would have spanned the portal: it is disabled.
+    /// A joint could not follow a crossing that was ended by force (or
+    /// joined the two copies of one object): it is disabled.
     JointDisabled {
         /// The joint.
         joint: JointHandle,
@@ -452,6 +478,19 @@ impl PortalStage {
                 inv_inertia,
             });
         }
+    }
+
+    /// True when a crossing copy carries an enabled joint (the step then
+    /// solves joints and portal rows together, see [`super::coupling`]).
+    pub(crate) fn copies_carry_joints(&self, joints: &crate::joints::JointSet) -> bool {
+        self.crossings.iter().any(|c| {
+            [c.original, c.clone].iter().any(|&b| {
+                joints
+                    .of_body(b)
+                    .iter()
+                    .any(|&h| joints.revolute(h).is_ok_and(|j| j.enabled))
+            })
+        })
     }
 
     /// True when `body` carries a portal or is crossing one.
@@ -1042,7 +1081,23 @@ impl World {
         let a = front_fraction(self.bodies(), shapes, c.original, f_entry);
         let b = front_fraction(self.bodies(), shapes, c.clone, f_exit);
         let f = if a + b > 0.0 { a / (a + b) } else { 0.5 };
-        let f = f.clamp(F_MIN, 1.0 - F_MIN);
+        let mut f = f.clamp(F_MIN, 1.0 - F_MIN);
+        // A copy that carries a joint keeps at least F_JOINTED of the
+        // object: the joint's load passes through the portal rows, which
+        // move a light copy away from what it is jointed to.
+        let jointed = |copy: BodyHandle, twin: BodyHandle| {
+            self.joints_attached_to(copy).iter().any(|&j| {
+                self.joints
+                    .bodies_of(j)
+                    .is_ok_and(|(a, b)| a != twin && b != twin)
+            })
+        };
+        match (jointed(c.original, c.clone), jointed(c.clone, c.original)) {
+            (true, false) => f = f.max(F_JOINTED),
+            (false, true) => f = f.min(1.0 - F_JOINTED),
+            (true, true) => f = f.clamp(F_JOINTED.min(0.5), (1.0 - F_JOINTED).max(0.5)),
+            (false, false) => {}
+        }
         let scale = |m: BodyMass, f: Real| BodyMass {
             mass: f * m.mass,
             rotational_inertia: f * m.rotational_inertia,
