@@ -36,6 +36,7 @@ fn run(
     let mut r = Run::default();
     for step in 0..steps {
         world.step(DT).unwrap();
+        world.validate().unwrap();
         r.disabled += world
             .portal_events()
             .iter()
@@ -119,4 +120,120 @@ fn ragdoll_thrown_through_a_portal_keeps_its_joints() {
     assert_eq!(r.disabled, 0, "joint-disabled events");
     assert!(r.steps_to_through.is_some(), "the ragdoll did not come out whole");
     assert!(r.worst_gap <= 0.02, "worst gap through the map {} m", r.worst_gap);
+}
+
+/// Two boxes hinged one above the other (gravity 0) go down into the floor
+/// portal; once the first is through and the second is crossing, every copy
+/// is sent back. The second cannot back out while its clone's joint has no
+/// copy of the first on the entry side: it waits until the first starts
+/// crossing back, then the joint moves to the first's copy on the entry side
+/// and both come back out of the floor portal, joined, the joint never
+/// disabled, its gap through the map under 1 mm.
+#[test]
+fn jointed_pair_backs_out_whole() {
+    let (mut world, pair) = jointed_portal_world(1.0);
+    world.set_gravity(Vec2::ZERO).unwrap();
+    let make = |world: &mut World, y: Real| {
+        let b = world
+            .create_body(&BodyDef::dynamic(Vec2::new(20.0, y)).with_velocity(Vec2::new(0.0, -3.0)))
+            .unwrap();
+        world
+            .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.3, 0.3))
+            .unwrap();
+        b
+    };
+    let (a, b) = (make(&mut world, 1.0), make(&mut world, 1.8));
+    let joint = world
+        .create_revolute_joint(&RevoluteJointDef::new(
+            a,
+            b,
+            Vec2::new(0.0, 0.4),
+            Vec2::new(0.0, -0.4),
+        ))
+        .unwrap();
+    let mut reversed = false;
+    let mut cancelled_after_restart = false;
+    let mut a_restarted = false;
+    let mut r = Run::default();
+    for _ in 0..240 {
+        world.step(DT).unwrap();
+        world.validate().unwrap();
+        for e in world.portal_events() {
+            match e {
+                PortalEvent::JointDisabled { .. } => r.disabled += 1,
+                PortalEvent::CrossingStarted { body, .. } if reversed && *body == a => {
+                    a_restarted = true
+                }
+                PortalEvent::CrossingCancelled { body, .. } if *body == b => {
+                    cancelled_after_restart = a_restarted
+                }
+                _ => {}
+            }
+        }
+        r.worst_gap = r.worst_gap.max(gap_through_map(&world, joint, pair));
+        let a_out = world.clone_of(a).is_none() && world.position(a).unwrap().x < 0.0;
+        if !reversed && a_out && world.clone_of(b).is_some() {
+            reversed = true;
+            for body in [a, b, world.clone_of(b).unwrap()] {
+                let v = world.linear_velocity(body).unwrap();
+                world.set_linear_velocity(body, -v).unwrap();
+            }
+        }
+    }
+    if report() {
+        eprintln!(
+            "backing out: worst gap through the map {:.3} mm, {} disabled",
+            1e3 * r.worst_gap,
+            r.disabled
+        );
+    }
+    assert!(reversed, "the first box never went through");
+    assert!(cancelled_after_restart, "the second backed out before the first turned back");
+    assert_eq!(r.disabled, 0);
+    assert_eq!(world.crossing_count(), 0);
+    let j = world.revolute_joint(joint).unwrap();
+    assert!(j.enabled);
+    assert_eq!((j.def.body_a, j.def.body_b), (a, b));
+    // Both back above the floor portal, moving up.
+    for body in [a, b] {
+        let p = world.position(body).unwrap();
+        assert!(p.x > 15.0 && p.y > 1.0, "a box at {p}");
+    }
+    assert!(r.worst_gap < 1e-3, "worst gap through the map {} m", r.worst_gap);
+}
+
+/// Destroying the pair while the rope crosses ends every crossing by force:
+/// the joints that cannot follow are disabled and reported, the rest stay,
+/// every joint handle stays valid and the world stays consistent.
+#[test]
+fn destroying_the_pair_under_a_crossing_rope_disables_only_what_cannot_follow() {
+    let (mut world, pair) = jointed_portal_world(1.0);
+    let (links, joints) = rope(&mut world, 20);
+    // Until the first links are through and the next ones crossing.
+    for _ in 0..120 {
+        world.step(DT).unwrap();
+        if world.position(links[2]).unwrap().x < 0.0 && world.crossing_count() > 0 {
+            break;
+        }
+    }
+    assert!(world.crossing_count() > 0, "no crossing to end");
+    world.destroy_portal_pair(pair).unwrap();
+    world.validate().unwrap();
+    let reported = world
+        .portal_events()
+        .iter()
+        .filter(|e| matches!(e, PortalEvent::JointDisabled { .. }))
+        .count();
+    let disabled = joints
+        .iter()
+        .filter(|&&j| !world.revolute_joint(j).unwrap().enabled)
+        .count();
+    assert_eq!(world.crossing_count(), 0);
+    assert!(disabled >= 1, "a joint across the portal stayed enabled");
+    assert_eq!(reported, disabled);
+    assert!(disabled < joints.len());
+    for _ in 0..30 {
+        world.step(DT).unwrap();
+        world.validate().unwrap();
+    }
 }
