@@ -237,3 +237,22 @@ fn destroying_the_pair_under_a_crossing_rope_disables_only_what_cannot_follow() 
         world.validate().unwrap();
     }
 }
+
+#[allow(dead_code)]
+#[path = "../examples/portal_rope.rs"]
+mod portal_rope;
+
+/// The rope example: with η = 1 and η = 2 all 20 links go through, no
+/// joint is disabled, the worst gap through the map is under 2 cm and the
+/// first link ends beyond the wall portal.
+#[test]
+fn rope_example_comes_out_whole() {
+    for eta in [1.0, 2.0] {
+        let r = portal_rope::run(eta).unwrap();
+        assert_eq!(r.links_through, 20, "η = {eta}");
+        assert!(r.steps_to_through.is_some(), "η = {eta}");
+        assert_eq!(r.disabled, 0, "η = {eta}");
+        assert!(r.worst_gap <= 0.02, "η = {eta}: worst gap {}", r.worst_gap);
+        assert!(r.first_link.x > EXIT_FACE_X + 1.0, "η = {eta}: first link at {}", r.first_link);
+    }
+}
