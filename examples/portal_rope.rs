@@ -41,7 +41,8 @@ fn gap_through_map(world: &World, joint: JointHandle, pair: PortalPairHandle) ->
         (j.def.body_a, j.def.local_anchor_a),
         (j.def.body_b, j.def.local_anchor_b),
     ];
-    let anchor = |(b, l): (BodyHandle, Vec2)| world.transform(b).map_or(Vec2::ZERO, |xf| xf.apply(l));
+    let anchor =
+        |(b, l): (BodyHandle, Vec2)| world.transform(b).map_or(Vec2::ZERO, |xf| xf.apply(l));
     let mut gap = (anchor(ends[0]) - anchor(ends[1])).length();
     for k in 0..2 {
         let (body, local) = ends[k];
@@ -159,7 +160,8 @@ fn main() -> Result<(), WorldError> {
             "η = {}: {} of 20 links through (all out after {} steps), worst joint gap through the map {:.2} mm, {} joints disabled; first link now at ({:.1}, {:.1}), out of the wall portal at x = {EXIT_X}",
             r.eta,
             r.links_through,
-            r.steps_to_through.map_or("-".to_string(), |s| s.to_string()),
+            r.steps_to_through
+                .map_or("-".to_string(), |s| s.to_string()),
             r.worst_gap * 1000.0,
             r.disabled,
             r.first_link.x,

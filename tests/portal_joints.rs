@@ -69,7 +69,10 @@ fn rope_through(eta: Real) -> (Run, Real) {
         );
     }
     for &j in &joints {
-        assert!(world.revolute_joint(j).unwrap().enabled, "a joint was disabled");
+        assert!(
+            world.revolute_joint(j).unwrap().enabled,
+            "a joint was disabled"
+        );
     }
     (r, first_x)
 }
@@ -77,12 +80,19 @@ fn rope_through(eta: Real) -> (Run, Real) {
 fn check_rope(eta: Real) {
     let (r, first_x) = rope_through(eta);
     assert_eq!(r.disabled, 0, "joint-disabled events");
-    assert!(r.steps_to_through.is_some(), "the rope did not come out whole");
+    assert!(
+        r.steps_to_through.is_some(),
+        "the rope did not come out whole"
+    );
     assert!(
         first_x > EXIT_FACE_X + 1.0,
         "the first link is at x = {first_x}, not beyond the exit portal"
     );
-    assert!(r.worst_gap <= 0.02, "worst gap through the map {} m", r.worst_gap);
+    assert!(
+        r.worst_gap <= 0.02,
+        "worst gap through the map {} m",
+        r.worst_gap
+    );
 }
 
 /// A rope of 20 links poured through a floor portal comes out of a wall
@@ -118,8 +128,15 @@ fn ragdoll_thrown_through_a_portal_keeps_its_joints() {
         );
     }
     assert_eq!(r.disabled, 0, "joint-disabled events");
-    assert!(r.steps_to_through.is_some(), "the ragdoll did not come out whole");
-    assert!(r.worst_gap <= 0.02, "worst gap through the map {} m", r.worst_gap);
+    assert!(
+        r.steps_to_through.is_some(),
+        "the ragdoll did not come out whole"
+    );
+    assert!(
+        r.worst_gap <= 0.02,
+        "worst gap through the map {} m",
+        r.worst_gap
+    );
 }
 
 /// Two boxes hinged one above the other (gravity 0) go down into the floor
@@ -188,7 +205,10 @@ fn jointed_pair_backs_out_whole() {
         );
     }
     assert!(reversed, "the first box never went through");
-    assert!(cancelled_after_restart, "the second backed out before the first turned back");
+    assert!(
+        cancelled_after_restart,
+        "the second backed out before the first turned back"
+    );
     assert_eq!(r.disabled, 0);
     assert_eq!(world.crossing_count(), 0);
     let j = world.revolute_joint(joint).unwrap();
@@ -199,7 +219,11 @@ fn jointed_pair_backs_out_whole() {
         let p = world.position(body).unwrap();
         assert!(p.x > 15.0 && p.y > 1.0, "a box at {p}");
     }
-    assert!(r.worst_gap < 1e-3, "worst gap through the map {} m", r.worst_gap);
+    assert!(
+        r.worst_gap < 1e-3,
+        "worst gap through the map {} m",
+        r.worst_gap
+    );
 }
 
 /// Destroying the pair while the rope crosses ends every crossing by force:
@@ -253,6 +277,44 @@ fn rope_example_comes_out_whole() {
         assert!(r.steps_to_through.is_some(), "η = {eta}");
         assert_eq!(r.disabled, 0, "η = {eta}");
         assert!(r.worst_gap <= 0.02, "η = {eta}: worst gap {}", r.worst_gap);
-        assert!(r.first_link.x > EXIT_FACE_X + 1.0, "η = {eta}: first link at {}", r.first_link);
+        assert!(
+            r.first_link.x > EXIT_FACE_X + 1.0,
+            "η = {eta}: first link at {}",
+            r.first_link
+        );
     }
+}
+
+/// A rope drifting sideways onto the lip: the rope of the other tests,
+/// given 0.5 m/s along +x, reaches the aperture's edge while it pours; the
+/// links that no longer fit the aperture are dragged across the lip.
+/// Ignored: the bound is not met. Measured (f32): with 0.2, 0.3 and −0.5 m/s
+/// the worst gap through the map is 0.8 mm and no joint is disabled; with
+/// 0.5 m/s one joint is disabled (a held copy slid out of the span), a
+/// crossing copy pressed by both lips tears its portal rows (|C| 0.68 m in
+/// one step) and the worst enabled gap reaches 2.1 m at 140 m/s; with
+/// 0.7 m/s three joints are disabled and the worst gap is 0.34 m; with
+/// 1 m/s none is disabled and the worst gap is 81 mm.
+#[test]
+#[ignore = "a rope dragged across a lip: gaps of 0.08–2 m (see the doc comment)"]
+fn rope_drifting_onto_the_lip_keeps_its_joints() {
+    let (mut world, pair) = jointed_portal_world(1.0);
+    let (links, joints) = rope(&mut world, 20);
+    for &b in &links {
+        world.set_linear_velocity(b, Vec2::new(0.5, 0.0)).unwrap();
+    }
+    let r = run(&mut world, pair, &joints, 300, |w| w.crossing_count() == 0);
+    if report() {
+        eprintln!(
+            "drifting rope: worst gap {:.1} mm, {} disabled",
+            1e3 * r.worst_gap,
+            r.disabled
+        );
+    }
+    assert_eq!(r.disabled, 0);
+    assert!(
+        r.worst_gap <= 0.02,
+        "worst gap through the map {} m",
+        r.worst_gap
+    );
 }

@@ -1440,7 +1440,8 @@ impl World {
         let has_shapes = !self.collision.shapes.is_empty();
         let has_portals = self.portals.is_active();
         if has_portals {
-            self.portals.build_clipping(&self.bodies);
+            self.portals
+                .build_clipping(&self.bodies, &self.collision.shapes);
             sp.portals += lap();
         }
         if has_shapes {

@@ -46,7 +46,13 @@ impl ConstraintBatch for CoupledBatches<'_> {
             b.warm_start(ctx, states);
         }
     }
-    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool, reverse: bool) {
+    fn solve(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+    ) {
         for b in self.batches.iter_mut().filter(|b| b.count() > 0) {
             b.solve(ctx, states, use_bias, reverse);
         }

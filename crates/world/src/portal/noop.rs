@@ -33,7 +33,12 @@ impl PortalStage {
     pub(crate) fn keep_awake(&self) -> Vec<BodyHandle> {
         Vec::new()
     }
-    pub(crate) fn build_clipping(&mut self, _bodies: &BodySet) {}
+    pub(crate) fn build_clipping(
+        &mut self,
+        _bodies: &BodySet,
+        _shapes: &crate::shapes::ShapeStore,
+    ) {
+    }
     pub(crate) fn involves(&self, _body: BodyHandle) -> bool {
         false
     }

@@ -82,6 +82,10 @@ pub const F_MIN: Real = 0.1;
 /// with the coupled passes of the joint and portal solves 0.8 and 7.7 mm).
 pub const F_JOINTED: Real = 0.5;
 
+/// Half-width of the region behind a copy's plane that the clipping drops
+/// for a copy wholly behind it (m): beyond any coordinate a body can have.
+const HELD_HALF_WIDTH: Real = 4.0 * janus2d_core::limits::MAX_COORDINATE;
+
 /// How a clone's mass follows from the original's.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -377,7 +381,7 @@ impl PortalStage {
     }
 
     /// Builds the contact clipping for this step's narrowphase.
-    pub(crate) fn build_clipping(&mut self, bodies: &BodySet) {
+    pub(crate) fn build_clipping(&mut self, bodies: &BodySet, shapes: &crate::shapes::ShapeStore) {
         let mut clipping = std::mem::take(&mut self.clipping);
         clipping.clips.clear();
         clipping.ignored_pairs.clear();
@@ -400,11 +404,20 @@ impl PortalStage {
             let (entry, exit) = (c.entry, 1 - c.entry);
             for (body, side) in [(c.original, entry), (c.clone, exit)] {
                 let f = frame_in(bodies, &d.portals[side], &d.local[side]);
+                // A copy wholly behind its plane (a crossing held for its
+                // joints) is all on the other side: it touches nothing
+                // behind the plane, in the aperture's span or beside it
+                // (inside the wall that carries the portal).
+                let wholly_behind = extents_in(bodies, shapes, body, &f).is_some_and(|e| e.1 < 0.0);
                 clipping.clips.push(ApertureClip {
                     body,
                     point: f.point,
                     normal: f.normal,
-                    half_width: d.local[side].half_width,
+                    half_width: if wholly_behind {
+                        HELD_HALF_WIDTH
+                    } else {
+                        d.local[side].half_width
+                    },
                     hole: false,
                     aperture: 2 * c.pair + side as u32,
                 });
@@ -903,7 +916,7 @@ impl World {
         match command {
             PortalCommand::Complete(original) => {
                 if let Some(k) = self.portals.crossing_of(original) {
-                    if self.joints_can_follow(k, true) {
+                    if self.joints_can_follow(k, true) || !self.within_span(k, true) {
                         self.complete_crossing(k);
                         counters.completed += 1;
                         crossed.push(original);
@@ -918,7 +931,7 @@ impl World {
             }
             PortalCommand::Cancel(original) => {
                 if let Some(k) = self.portals.crossing_of(original) {
-                    if self.joints_can_follow(k, false) {
+                    if self.joints_can_follow(k, false) || !self.within_span(k, false) {
                         self.cancel_crossing(k);
                         counters.cancelled += 1;
                         crossed.push(original);
@@ -961,7 +974,7 @@ impl World {
                 let through =
                     extents_in(self.bodies(), &self.collision_ref().shapes, body, &f_entry)
                         .is_some_and(|e| e.1 < 0.0);
-                if through && self.joints_can_follow(k, true) {
+                if through && (self.joints_can_follow(k, true) || !self.within_span(k, true)) {
                     self.complete_crossing(k);
                     counters.completed += 1;
                 } else {
@@ -1260,11 +1273,36 @@ impl World {
         })
     }
 
+    /// True when the copy that crossing `k` would remove (the original when
+    /// it completes, `complete`, the clone when it backs out) lies within
+    /// its portal's span (`|t| ≤ w` for all its shapes): only such a copy
+    /// is held for its joints. One that has slid beside the aperture,
+    /// behind the wall, ends its crossing and its joints that cannot follow
+    /// are disabled.
+    fn within_span(&self, k: usize, complete: bool) -> bool {
+        let c = &self.portals.crossings[k];
+        let d = self.portals.pairs.at(c.pair).expect("live pair");
+        let (body, side) = if complete {
+            (c.original, c.entry)
+        } else {
+            (c.clone, 1 - c.entry)
+        };
+        let f = frame_of(self, &d.portals[side], &d.local[side]);
+        let w = d.local[side].half_width;
+        extents_in(self.bodies(), &self.collision_ref().shapes, body, &f)
+            .is_some_and(|(_, _, t0, t1)| t0 >= -w && t1 <= w)
+    }
+
     /// The other copy of `body` through pair slot `pair`, when `body` is
     /// the copy in front of portal `side` of a crossing through it: the
     /// twin, and the scale from `body`'s frame to the twin's about their
     /// common local centre of mass (`(twin, centre, scale)`).
-    fn twin_across(&self, body: BodyHandle, pair: u32, side: usize) -> Option<(BodyHandle, Vec2, Real)> {
+    fn twin_across(
+        &self,
+        body: BodyHandle,
+        pair: u32,
+        side: usize,
+    ) -> Option<(BodyHandle, Vec2, Real)> {
         self.portals
             .crossings
             .iter()
@@ -1336,7 +1374,11 @@ impl World {
             return;
         };
         let other = if a == from { b } else { a };
-        let leaving_side = if from == c.original { c.entry } else { 1 - c.entry };
+        let leaving_side = if from == c.original {
+            c.entry
+        } else {
+            1 - c.entry
+        };
         let twin = self.twin_across(other, c.pair, leaving_side);
         let center = c.mass_original.center;
         if let Some(anchor) = self.anchor_on(joint, from) {
