@@ -14,12 +14,14 @@
 //! the light copy, which opens the joint on it by about the velocity they
 //! corrected times the substep, every substep. Alternating the two exact
 //! blocks a few more times closes that (measured in `docs/portal.md`,
-//! *Joints through portals*). Every other phase runs the three batches in
-//! the order the world uses without coupling, so a world with no jointed
-//! crossing copy solves exactly as before.
+//! *Joints through portals*). Every other phase (and each phase's team
+//! form, `*_on`) runs the three batches in the order the world uses
+//! without coupling, so a world with no jointed crossing copy solves
+//! exactly as before.
 
 use janus2d_core::body::{BodySet, BodyState};
 use janus2d_core::constraint::{ConstraintBatch, StepContext};
+use janus2d_core::parallel::Team;
 
 /// Extra (trees, portal rows) passes of the coupled late pass.
 pub const COUPLING_PASSES: usize = 4;
@@ -78,6 +80,35 @@ impl ConstraintBatch for CoupledBatches<'_> {
     fn store_impulses(&mut self) {
         for b in self.batches.iter_mut().filter(|b| b.count() > 0) {
             b.store_impulses();
+        }
+    }
+    // The team stages forward to each batch's own, so the contacts keep
+    // their colours spread over the team.
+    fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
+        for b in self.batches.iter_mut() {
+            b.prepare_on(ctx, bodies, team);
+        }
+    }
+    fn warm_start_on(&mut self, ctx: &StepContext, states: &mut [BodyState], team: &Team) {
+        for b in self.batches.iter_mut().filter(|b| b.count() > 0) {
+            b.warm_start_on(ctx, states, team);
+        }
+    }
+    fn solve_on(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+        team: &Team,
+    ) {
+        for b in self.batches.iter_mut().filter(|b| b.count() > 0) {
+            b.solve_on(ctx, states, use_bias, reverse, team);
+        }
+    }
+    fn apply_restitution_on(&mut self, ctx: &StepContext, states: &mut [BodyState], team: &Team) {
+        for b in self.batches.iter_mut().filter(|b| b.count() > 0) {
+            b.apply_restitution_on(ctx, states, team);
         }
     }
 }
