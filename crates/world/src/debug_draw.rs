@@ -541,10 +541,23 @@ fn draw_portals<D: DebugDraw + ?Sized>(world: &World, draw: &mut D, o: &DrawOpti
         }
     }
     if o.apertures {
+        let pairs: Vec<_> = world.portal_pairs().collect();
         for clip in &world.portal_clipping().clips {
             let n = clip.normal;
             let t = perp(n);
-            let w = clip.half_width;
+            // A copy wholly behind its plane clips the whole half-space
+            // behind it: drawn as wide as its aperture.
+            let aperture_width = pairs
+                .iter()
+                .find(|(h, _)| h.index == clip.aperture / 2)
+                .map(|(_, d)| {
+                    if clip.aperture % 2 == 0 {
+                        d.portal_a.half_width
+                    } else {
+                        d.portal_b.half_width
+                    }
+                });
+            let w = aperture_width.map_or(clip.half_width, |a| clip.half_width.min(a));
             let depth = if clip.hole { 2.0 * w } else { w };
             let c = clip.point;
             let quad = [
