@@ -397,7 +397,9 @@ fn recycle(
     let distance = (relative.p - cache.relative.p).length();
     let turn = relative.q.inv_mul(cache.relative.q).s.abs();
     let extent = reach(sim_a, aabb_a).max(reach(sim_b, aabb_b));
-    if !(distance + extent * turn < CONTACT_RECYCLE_DISTANCE) {
+    // (NaN poses recompute.)
+    let moved = distance + extent * turn;
+    if moved.is_nan() || moved >= CONTACT_RECYCLE_DISTANCE {
         return false;
     }
     let (dq_a, dq_b) = (cache.q_a.inv_mul(q_a), cache.q_b.inv_mul(q_b));
