@@ -59,7 +59,8 @@
 //! (light links alternately turning under a heavy load) then grows once
 //! `K_g / I > 4` with `K_g = h Σ max(0, ±λ · r)` summed over a body's
 //! joints (`λ` the kept per-substep impulse): a 1000:1 load on 20 links of
-//! 1 kg reaches `K_g / I ≈ 6`, and the middle joints opened to 1.75 m.
+//! 1 kg reaches `K_g / I ≈ 5` at the bottom of its swing, and the middle
+//! joints opened to 1.75 m.
 //! Treating that stiffness implicitly adds `K_g` to the body's inertia
 //! (the diagonal geometric stiffness of Andrews et al., *Geometric
 //! stiffness for real-time constrained multibody dynamics*, 2017); the tree
