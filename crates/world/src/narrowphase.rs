@@ -5,6 +5,9 @@
 //! phase 1 (parallel with `parallel`)   each awake contact alone, in place:
 //!     both bodies still      → Asleep (kept as is)
 //!     fat boxes apart        → Separated
+//!     moved little since the
+//!     manifold was computed  → Updated: the manifold kept, separations
+//!                              updated from its anchors (recycle)
 //!     else                   → Updated: collide(a, b, speculative) stored
 //!                              (impulses carried by feature id), aperture
 //!                              clipping applied, touching flag set
