@@ -266,6 +266,7 @@ impl Collision {
                 enabled: true,
                 still: [false, false],
                 solve_bodies: [(0, [0.0; 2]); 2],
+                recycle: crate::contacts::RecycleCache::default(),
             };
             self.contacts.insert(contact);
             created += 1;

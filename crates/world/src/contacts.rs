@@ -20,7 +20,7 @@
 //! wake, always the same way for the same inputs.
 
 use janus2d_core::body::{BodyHandle, BodySet};
-use janus2d_core::math::{Real, Vec2};
+use janus2d_core::math::{Real, Rot, Transform, Vec2};
 use smallvec::SmallVec;
 
 use crate::shapes::ShapeHandle;
@@ -95,6 +95,30 @@ pub struct Contact {
     /// that constraint building gathers nothing again: its state index
     /// (0: static or asleep) and `[m⁻¹, I⁻¹]` (zero for state 0).
     pub(crate) solve_bodies: [(u32, [Real; 2]); 2],
+    /// The poses and points the manifold was last computed at, for
+    /// recycling it (see the narrowphase).
+    pub(crate) recycle: RecycleCache,
+}
+
+/// What a contact keeps of the step its manifold was computed in, so that
+/// the narrowphase can keep the points on the same material points while
+/// the bodies move little relative to each other (recycling).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub(crate) struct RecycleCache {
+    /// The cache holds a touching manifold.
+    pub valid: bool,
+    /// Rotation of body a then.
+    pub q_a: Rot,
+    /// Rotation of body b then.
+    pub q_b: Rot,
+    /// Pose of b's centre of mass in a's centre frame then (`x_a⁻¹ x_b`).
+    pub relative: Transform,
+    /// Separation of each point then, m.
+    pub separation: [Real; 2],
+    /// Anchors `[r_a, r_b]` of each point then (world frame, from the
+    /// centres of mass), m.
+    pub anchors: [[Vec2; 2]; 2],
 }
 
 impl Contact {
