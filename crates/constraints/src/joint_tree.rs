@@ -72,7 +72,7 @@
 //!
 //! Body pivots stay positive definite and joint pivots negative definite,
 //! so the 3×3 block inverses need no pivoting. The elimination runs in f64
-//! whatever [`Real`](janus2d_core::math::Real) is: the pivots of a 670:1 chain cost about four digits,
+//! whatever [`Real`] is: the pivots of a 670:1 chain cost about four digits,
 //! which f32 does not have to spare (measured: 3e-3 relative residual in
 //! f32 arithmetic at a mass spread of 1e4, 1e-11 in f64), and scalar f64 costs
 //! the same as f32 here. A joint block has 2 rows; it
