@@ -102,9 +102,10 @@ use janus2d_core::body::BodySet;
 use janus2d_core::body::BodyState;
 use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
 use janus2d_core::math::{Real, Vec2, cross, cross_sv, from_f64, to_f64};
+use janus2d_core::parallel::Team;
 use janus2d_core::union_find::{find, union};
 
-use crate::parts::{clamp_length, load_pair, store_pair};
+use crate::parts::clamp_length;
 use crate::revolute::RevoluteJoint;
 
 const NONE: u32 = u32::MAX;
@@ -130,6 +131,49 @@ struct Node {
     side: f64,
 }
 
+/// One node's scratch in the tree solve.
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+struct NodeScratch {
+    /// The pivot `D_k` while eliminating, then `D_k⁻¹`.
+    d: Matrix3,
+    /// `L_k = E_k D_k⁻¹`.
+    l: Matrix3,
+    /// The right-hand side, then the solution.
+    b: Vec3,
+    /// Joint node: the arms `r_a`, `r_b` of this iteration.
+    arms: (Vec2, Vec2),
+    /// Body node: first the geometric stiffness term `K_g = h Σ max(0, ±λ ·
+    /// r)`, then the inertia added for it, `max(0, K_g / GEOMETRIC_RATIO −
+    /// I)` (see the module docs), kg·m².
+    geometric: f64,
+    /// Joint node: its child body node, tree-local (`NONE` for a fixed end).
+    child: u32,
+    /// Body node: a copy of its state while the tree is solved.
+    state: BodyState,
+    /// Joint node: a copy of its accumulated point impulse, N·s.
+    impulse: Vec2,
+}
+
+impl NodeScratch {
+    const ZERO: NodeScratch = NodeScratch {
+        d: Matrix3::ZERO,
+        l: Matrix3::ZERO,
+        b: Vec3::ZERO,
+        arms: (Vec2::ZERO, Vec2::ZERO),
+        geometric: 0.0,
+        child: NONE,
+        state: BodyState::IDENTITY,
+        impulse: Vec2::ZERO,
+    };
+}
+
+impl Default for NodeScratch {
+    fn default() -> Self {
+        Self::ZERO
+    }
+}
+
 /// The joint forest of one step and the scratch space of its solve.
 ///
 /// Built in `prepare` from the joints' state indices (so sleeping, static
@@ -140,20 +184,10 @@ struct Node {
 pub struct JointForest {
     /// Nodes, parents first (breadth-first from each root).
     nodes: Vec<Node>,
-    /// Per node: the pivot `D_k` while eliminating, then `D_k⁻¹`.
-    d: Vec<Matrix3>,
-    /// Per node: `L_k = E_k D_k⁻¹`.
-    l: Vec<Matrix3>,
-    /// Per node: the right-hand side, then the solution.
-    b: Vec<Vec3>,
-    /// Per joint node: the arms `r_a`, `r_b` of this iteration.
-    arms: Vec<(Vec2, Vec2)>,
-    /// Per body node: first the geometric stiffness term
-    /// `K_g = h Σ max(0, ±λ · r)`, then the inertia added for it,
-    /// `max(0, K_g / GEOMETRIC_RATIO − I)` (see the module docs), kg·m².
-    geometric: Vec<f64>,
-    /// Per joint node: its child body node (`NONE` for a fixed end).
-    child: Vec<u32>,
+    /// First node of each tree (a tree's nodes are contiguous).
+    trees: Vec<u32>,
+    /// Per node: the solve's scratch.
+    scratch: Vec<NodeScratch>,
     /// Per joint: its moving ends this step (see `moving_pair`).
     pairs: Vec<[u32; 3]>,
     /// The pairs and switch the forest was last built from.
@@ -289,6 +323,7 @@ impl JointForest {
 
     fn rebuild(&mut self, joints: &mut [RevoluteJoint], n: usize, enabled: bool) {
         self.nodes.clear();
+        self.trees.clear();
         self.tree_joints.clear();
         for j in joints.iter_mut() {
             j.in_tree = false;
@@ -361,18 +396,14 @@ impl JointForest {
             }
         }
         let count = self.nodes.len();
-        self.d.resize(count, Matrix3::ZERO);
-        self.l.resize(count, Matrix3::ZERO);
-        self.b.resize(count, Vec3::ZERO);
-        self.arms.resize(count, (Vec2::ZERO, Vec2::ZERO));
-        self.geometric.resize(count, 0.0);
-        self.child.resize(count, NONE);
+        self.scratch.resize(count, NodeScratch::ZERO);
     }
 
     /// Breadth-first from `root`, appending nodes parents first.
     fn grow(&mut self, root: u32) {
         self.visited[root as usize] = true;
         let mut next = self.nodes.len();
+        self.trees.push(next as u32);
         self.nodes.push(Node {
             index: root,
             parent: NONE,
@@ -427,33 +458,6 @@ impl JointForest {
         }
     }
 
-    /// The body nodes at ends a and b of joint node `k` (`NONE` for a
-    /// fixed end).
-    #[inline(always)]
-    fn ends(&self, k: usize) -> (u32, u32) {
-        let (parent, child) = (self.nodes[k].parent, self.child[k]);
-        if self.nodes[k].side > 0.0 {
-            (child, parent)
-        } else {
-            (parent, child)
-        }
-    }
-
-    /// `Ĩ⁻¹ − I⁻¹` of body node `body` (state `st`): how much the
-    /// geometric stiffness term lowers its inverse inertia (≤ 0).
-    #[inline(always)]
-    fn inertia_change(&self, st: &BodyState, body: u32) -> Real {
-        if body == NONE || st.inv_inertia <= 0.0 {
-            return 0.0;
-        }
-        let g = self.geometric[body as usize];
-        if g == 0.0 {
-            return 0.0;
-        }
-        let inv = to_f64(st.inv_inertia);
-        from_f64(1.0 / (1.0 / inv + g) - inv)
-    }
-
     /// One exact solve of every tree's point rows (see the module docs):
     /// with `use_bias` the soft rows with position feedback, without it the
     /// relax rows.
@@ -464,180 +468,321 @@ impl JointForest {
         states: &mut [BodyState],
         use_bias: bool,
     ) {
+        self.solve_on(ctx, joints, states, use_bias, &Team::serial());
+    }
+
+    /// [`JointForest::solve`] with the trees spread over the step's team.
+    /// Each tree is solved on a copy of its own bodies' states and joints'
+    /// impulses (its nodes' scratch), reading only fixed ends from the
+    /// shared states; the copies are written back in node order afterwards.
+    /// Trees share no moving body, so the result is the same for any number
+    /// of threads.
+    pub fn solve_on(
+        &mut self,
+        ctx: &StepContext,
+        joints: &mut [RevoluteJoint],
+        states: &mut [BodyState],
+        use_bias: bool,
+        team: &Team,
+    ) {
         if self.nodes.is_empty() {
             return;
         }
         let softness = ctx.direct_joint_softness;
-        let compliance = if softness.mass_scale > 0.0 {
-            to_f64(softness.impulse_scale) / to_f64(softness.mass_scale)
-        } else {
-            0.0
+        let params = TreeParams {
+            softness,
+            compliance: if softness.mass_scale > 0.0 {
+                to_f64(softness.impulse_scale) / to_f64(softness.mass_scale)
+            } else {
+                0.0
+            },
+            h: to_f64(ctx.h),
+            max_correction_speed: ctx.direct_joint_max_correction_speed,
+            use_bias,
         };
-        let h = to_f64(ctx.h);
-        // Arms of every joint and the geometric stiffness each body takes
-        // from its joints (one from the parent joint, one per child joint).
-        self.geometric.fill(0.0);
-        self.child.fill(NONE);
-        for (k, node) in self.nodes.iter().enumerate() {
-            if !node.is_joint {
-                continue;
-            }
-            let j = &joints[node.index as usize];
-            let (sa, sb) = (&states[j.state_a as usize], &states[j.state_b as usize]);
-            let (r_a, r_b, _) = j.point.arms(sa, sb);
-            self.arms[k] = (r_a, r_b);
-            self.geometric[node.parent as usize] +=
-                geometric_stiffness(h, wide(j.point.impulse), (r_a, r_b), node.side);
-        }
-        for k in 0..self.nodes.len() {
-            let node = self.nodes[k];
-            if node.is_joint || node.parent == NONE {
-                continue;
-            }
-            let p = node.parent as usize;
-            self.child[p] = k as u32;
-            let lambda = wide(joints[self.nodes[p].index as usize].point.impulse);
-            self.geometric[k] += geometric_stiffness(h, lambda, self.arms[p], node.side);
-        }
-        // Ĩ = max(I, K_g / GEOMETRIC_RATIO): only the inertia the limit
-        // needs is added.
-        for k in 0..self.nodes.len() {
-            let node = self.nodes[k];
+        for (node, sc) in self.nodes.iter().zip(self.scratch.iter_mut()) {
             if node.is_joint {
-                continue;
+                sc.impulse = joints[node.index as usize].point.impulse;
+            } else {
+                sc.state = states[node.index as usize];
             }
-            let (m, _, _) = body_mass(&states[node.index as usize]);
-            self.geometric[k] = (self.geometric[k] / GEOMETRIC_RATIO - m.z_axis.z).max(0.0);
         }
-        if use_bias {
-            // The warm start applied the kept impulses through the bodies'
-            // own inertia; re-weight their torque to the solve's inertia.
-            for k in 0..self.nodes.len() {
-                let node = self.nodes[k];
-                if !node.is_joint {
-                    continue;
+        {
+            let (nodes, joints, states) = (&self.nodes[..], &*joints, &*states);
+            let mut rest = &mut self.scratch[..];
+            let mut trees = Vec::with_capacity(self.trees.len());
+            for (t, &start) in self.trees.iter().enumerate() {
+                let end = self.trees.get(t + 1).map_or(nodes.len(), |&e| e as usize);
+                let (tree, tail) = rest.split_at_mut(end - start as usize);
+                rest = tail;
+                trees.push((start as usize, tree));
+            }
+            let per_block = trees.len().div_ceil(4 * team.threads()).max(1);
+            team.for_each_chunk_mut(&mut trees, per_block, |_, block| {
+                for (start, tree) in block.iter_mut() {
+                    solve_tree(nodes, *start, tree, joints, states, &params);
                 }
-                let j = &joints[node.index as usize];
-                let impulse = j.point.impulse;
-                let (r_a, r_b) = self.arms[k];
-                let (body_a, body_b) = self.ends(k);
-                let (sa, sb) = (j.state_a as usize, j.state_b as usize);
-                let (wa, wb) = (
-                    self.inertia_change(&states[sa], body_a),
-                    self.inertia_change(&states[sb], body_b),
-                );
-                states[sa].w -= wa * cross(r_a, impulse);
-                states[sb].w += wb * cross(r_b, impulse);
-            }
+            });
         }
-        // Joint rows: right-hand sides and pivots.
-        for (k, node) in self.nodes.iter().enumerate() {
-            if !node.is_joint {
-                continue;
-            }
-            let j = &joints[node.index as usize];
-            let (sa, sb) = (&states[j.state_a as usize], &states[j.state_b as usize]);
-            let (r_a, r_b, c) = j.point.arms(sa, sb);
-            let c_dot = (sb.v + cross_sv(sb.w, r_b)) - (sa.v + cross_sv(sa.w, r_a));
-            let (k11, k12, k22) = crate::parts::PointPart::effective_mass(sa, sb, r_a, r_b);
-            let (k11, k12, k22) = (to_f64(k11), to_f64(k12), to_f64(k22));
-            let gamma = Matrix3::from_cols(
-                Vec3::new(k11, k12, 0.0) * compliance,
-                Vec3::new(k12, k22, 0.0) * compliance,
-                Vec3::new(0.0, 0.0, 1.0),
-            );
-            let rhs = if use_bias {
-                let bias = clamp_length(
-                    softness.bias_rate * c,
-                    ctx.direct_joint_max_correction_speed,
-                );
-                let lambda = wide(j.point.impulse);
-                let held = DVec2::new(
-                    k11 * lambda.x + k12 * lambda.y,
-                    k12 * lambda.x + k22 * lambda.y,
-                ) * compliance;
-                -(wide(c_dot + bias) + held)
-            } else {
-                -wide(c_dot)
-            };
-            self.d[k] = -gamma;
-            self.b[k] = Vec3::new(rhs.x, rhs.y, 0.0);
-        }
-        // Body pivots: mass and inertia plus the geometric stiffness.
-        for k in 0..self.nodes.len() {
-            let node = self.nodes[k];
+        for (node, sc) in self.nodes.iter().zip(&self.scratch) {
             if node.is_joint {
-                continue;
-            }
-            let (mut m, _, ang) = body_mass(&states[node.index as usize]);
-            m.z_axis.z += ang * self.geometric[k];
-            self.d[k] = m;
-            self.b[k] = Vec3::ZERO;
-        }
-        // Eliminate leaves first.
-        for k in (0..self.nodes.len()).rev() {
-            let node = self.nodes[k];
-            let d_inv = pivot_inverse(&self.d[k]);
-            self.d[k] = d_inv;
-            if node.parent == NONE {
-                continue;
-            }
-            let p = node.parent as usize;
-            // E_k = H_parent,k.
-            let e = if node.is_joint {
-                let (lin, ang) = {
-                    let (_, lin, ang) = body_mass(&states[self.nodes[p].index as usize]);
-                    (lin, ang)
-                };
-                let (r_a, r_b) = self.arms[k];
-                let r = if node.side > 0.0 { r_b } else { r_a };
-                jacobian(node.side, r, lin, ang).transpose()
+                joints[node.index as usize].point.impulse = sc.impulse;
             } else {
-                let (_, lin, ang) = body_mass(&states[node.index as usize]);
-                let (r_a, r_b) = self.arms[p];
-                let r = if node.side > 0.0 { r_b } else { r_a };
-                jacobian(node.side, r, lin, ang)
-            };
-            let l = e * d_inv;
-            self.l[k] = l;
-            self.d[p] -= l * e.transpose();
-            let b_k = self.b[k];
-            self.b[p] -= l * b_k;
-        }
-        // Back substitution, parents first.
-        for k in 0..self.nodes.len() {
-            let node = self.nodes[k];
-            let mut x = self.d[k] * self.b[k];
-            if node.parent != NONE {
-                x -= self.l[k].transpose() * self.b[node.parent as usize];
+                let st = &mut states[node.index as usize];
+                st.v = sc.state.v;
+                st.w = sc.state.w;
             }
-            self.b[k] = x;
         }
-        // Apply Δλ = −μ through each joint (equal and opposite at its
-        // anchors), so linear momentum holds to rounding whatever the
-        // pivots' size; the bodies' own Δv is the same change up to the
-        // solve's precision. The angular part acts with the inertia the
-        // solve used (the body's plus its geometric stiffness term).
-        for (k, node) in self.nodes.iter().enumerate() {
-            if !node.is_joint {
+    }
+}
+
+/// The step constants of one tree solve.
+struct TreeParams {
+    softness: janus2d_core::softness::Softness,
+    /// `Γ / K = impulse_scale / mass_scale`.
+    compliance: f64,
+    /// Substep, s.
+    h: f64,
+    /// Largest correction speed, m/s.
+    max_correction_speed: Real,
+    use_bias: bool,
+}
+
+/// The body nodes at ends a and b of joint node `k` (`NONE` for a fixed
+/// end), as tree-local indices.
+#[inline(always)]
+fn ends(nodes: &[Node], tree: &[NodeScratch], start: usize, k: usize) -> (u32, u32) {
+    let parent = nodes[start + k].parent - start as u32;
+    let child = tree[k].child;
+    if nodes[start + k].side > 0.0 {
+        (child, parent)
+    } else {
+        (parent, child)
+    }
+}
+
+/// `Ĩ⁻¹ − I⁻¹` of tree-local body node `body` (state `st`): how much the
+/// geometric stiffness term lowers its inverse inertia (≤ 0).
+#[inline(always)]
+fn inertia_change(tree: &[NodeScratch], st: &BodyState, body: u32) -> Real {
+    if body == NONE || st.inv_inertia <= 0.0 {
+        return 0.0;
+    }
+    let g = tree[body as usize].geometric;
+    if g == 0.0 {
+        return 0.0;
+    }
+    let inv = to_f64(st.inv_inertia);
+    from_f64(1.0 / (1.0 / inv + g) - inv)
+}
+
+/// The state of end `body` (tree-local, `NONE` for a fixed end, then read
+/// from the shared states at `index`).
+#[inline(always)]
+fn end_state(tree: &[NodeScratch], states: &[BodyState], body: u32, index: u32) -> BodyState {
+    if body == NONE {
+        states[index as usize]
+    } else {
+        tree[body as usize].state
+    }
+}
+
+/// One tree's exact solve on its nodes `start..start + tree.len()`: the
+/// arithmetic of the module docs on the tree's scratch (its bodies' states,
+/// its joints' impulses), reading fixed ends from `states`.
+fn solve_tree(
+    nodes: &[Node],
+    start: usize,
+    tree: &mut [NodeScratch],
+    joints: &[RevoluteJoint],
+    states: &[BodyState],
+    params: &TreeParams,
+) {
+    let n = tree.len();
+    let node_at = |k: usize| nodes[start + k];
+    let local = |k: u32| k as usize - start;
+    let TreeParams {
+        softness,
+        compliance,
+        h,
+        max_correction_speed,
+        use_bias,
+    } = *params;
+    // Arms of every joint and the geometric stiffness each body takes from
+    // its joints (one from the parent joint, one per child joint).
+    for sc in tree.iter_mut() {
+        sc.geometric = 0.0;
+        sc.child = NONE;
+    }
+    for k in 0..n {
+        let node = node_at(k);
+        if node.is_joint || node.parent == NONE {
+            continue;
+        }
+        tree[local(node.parent)].child = k as u32;
+    }
+    for k in 0..n {
+        let node = node_at(k);
+        if !node.is_joint {
+            continue;
+        }
+        let j = &joints[node.index as usize];
+        let (body_a, body_b) = ends(nodes, tree, start, k);
+        let sa = end_state(tree, states, body_a, j.state_a);
+        let sb = end_state(tree, states, body_b, j.state_b);
+        let (r_a, r_b, _) = j.point.arms(&sa, &sb);
+        tree[k].arms = (r_a, r_b);
+        let lambda = wide(tree[k].impulse);
+        tree[local(node.parent)].geometric += geometric_stiffness(h, lambda, (r_a, r_b), node.side);
+    }
+    for k in 0..n {
+        let node = node_at(k);
+        if node.is_joint || node.parent == NONE {
+            continue;
+        }
+        let p = local(node.parent);
+        let lambda = wide(tree[p].impulse);
+        let arms = tree[p].arms;
+        tree[k].geometric += geometric_stiffness(h, lambda, arms, node.side);
+    }
+    // Ĩ = max(I, K_g / GEOMETRIC_RATIO): only the inertia the limit needs
+    // is added.
+    for sc in tree.iter_mut().zip(0..n) {
+        let (sc, k) = sc;
+        if node_at(k).is_joint {
+            continue;
+        }
+        let (m, _, _) = body_mass(&sc.state);
+        sc.geometric = (sc.geometric / GEOMETRIC_RATIO - m.z_axis.z).max(0.0);
+    }
+    if use_bias {
+        // The warm start applied the kept impulses through the bodies' own
+        // inertia; re-weight their torque to the solve's inertia.
+        for k in 0..n {
+            if !node_at(k).is_joint {
                 continue;
             }
-            let x = self.b[k];
-            let impulse = -Vec2::new(from_f64(x.x), from_f64(x.y));
-            let j = &mut joints[node.index as usize];
-            j.point.impulse += impulse;
-            let (r_a, r_b) = self.arms[k];
-            let (mut sa, mut sb) = load_pair(states, j.state_a, j.state_b);
-            let (body_a, body_b) = self.ends(k);
-            let (i_a, i_b) = (
-                sa.inv_inertia + self.inertia_change(&sa, body_a),
-                sb.inv_inertia + self.inertia_change(&sb, body_b),
-            );
-            sa.v -= sa.inv_mass * impulse;
-            sa.w -= i_a * cross(r_a, impulse);
-            sb.v += sb.inv_mass * impulse;
-            sb.w += i_b * cross(r_b, impulse);
-            store_pair(states, j.state_a, j.state_b, &sa, &sb);
+            let impulse = tree[k].impulse;
+            let (r_a, r_b) = tree[k].arms;
+            let (body_a, body_b) = ends(nodes, tree, start, k);
+            if body_a != NONE {
+                let st = tree[body_a as usize].state;
+                let wa = inertia_change(tree, &st, body_a);
+                tree[body_a as usize].state.w -= wa * cross(r_a, impulse);
+            }
+            if body_b != NONE {
+                let st = tree[body_b as usize].state;
+                let wb = inertia_change(tree, &st, body_b);
+                tree[body_b as usize].state.w += wb * cross(r_b, impulse);
+            }
+        }
+    }
+    // Joint rows: right-hand sides and pivots.
+    for k in 0..n {
+        let node = node_at(k);
+        if !node.is_joint {
+            continue;
+        }
+        let j = &joints[node.index as usize];
+        let (body_a, body_b) = ends(nodes, tree, start, k);
+        let sa = end_state(tree, states, body_a, j.state_a);
+        let sb = end_state(tree, states, body_b, j.state_b);
+        let (r_a, r_b, c) = j.point.arms(&sa, &sb);
+        let c_dot = (sb.v + cross_sv(sb.w, r_b)) - (sa.v + cross_sv(sa.w, r_a));
+        let (k11, k12, k22) = crate::parts::PointPart::effective_mass(&sa, &sb, r_a, r_b);
+        let (k11, k12, k22) = (to_f64(k11), to_f64(k12), to_f64(k22));
+        let gamma = Matrix3::from_cols(
+            Vec3::new(k11, k12, 0.0) * compliance,
+            Vec3::new(k12, k22, 0.0) * compliance,
+            Vec3::new(0.0, 0.0, 1.0),
+        );
+        let rhs = if use_bias {
+            let bias = clamp_length(softness.bias_rate * c, max_correction_speed);
+            let lambda = wide(tree[k].impulse);
+            let held = DVec2::new(
+                k11 * lambda.x + k12 * lambda.y,
+                k12 * lambda.x + k22 * lambda.y,
+            ) * compliance;
+            -(wide(c_dot + bias) + held)
+        } else {
+            -wide(c_dot)
+        };
+        tree[k].d = -gamma;
+        tree[k].b = Vec3::new(rhs.x, rhs.y, 0.0);
+    }
+    // Body pivots: mass and inertia plus the geometric stiffness.
+    for k in 0..n {
+        if node_at(k).is_joint {
+            continue;
+        }
+        let (mut m, _, ang) = body_mass(&tree[k].state);
+        m.z_axis.z += ang * tree[k].geometric;
+        tree[k].d = m;
+        tree[k].b = Vec3::ZERO;
+    }
+    // Eliminate leaves first.
+    for k in (0..n).rev() {
+        let node = node_at(k);
+        let d_inv = pivot_inverse(&tree[k].d);
+        tree[k].d = d_inv;
+        if node.parent == NONE {
+            continue;
+        }
+        let p = local(node.parent);
+        // E_k = H_parent,k.
+        let e = if node.is_joint {
+            let (_, lin, ang) = body_mass(&tree[p].state);
+            let (r_a, r_b) = tree[k].arms;
+            let r = if node.side > 0.0 { r_b } else { r_a };
+            jacobian(node.side, r, lin, ang).transpose()
+        } else {
+            let (_, lin, ang) = body_mass(&tree[k].state);
+            let (r_a, r_b) = tree[p].arms;
+            let r = if node.side > 0.0 { r_b } else { r_a };
+            jacobian(node.side, r, lin, ang)
+        };
+        let l = e * d_inv;
+        tree[k].l = l;
+        tree[p].d -= l * e.transpose();
+        let b_k = tree[k].b;
+        tree[p].b -= l * b_k;
+    }
+    // Back substitution, parents first.
+    for k in 0..n {
+        let node = node_at(k);
+        let mut x = tree[k].d * tree[k].b;
+        if node.parent != NONE {
+            x -= tree[k].l.transpose() * tree[local(node.parent)].b;
+        }
+        tree[k].b = x;
+    }
+    // Apply Δλ = −μ through each joint (equal and opposite at its anchors),
+    // so linear momentum holds to rounding whatever the pivots' size; the
+    // bodies' own Δv is the same change up to the solve's precision. The
+    // angular part acts with the inertia the solve used (the body's plus
+    // its geometric stiffness term). Fixed ends do not move.
+    for k in 0..n {
+        if !node_at(k).is_joint {
+            continue;
+        }
+        let x = tree[k].b;
+        let impulse = -Vec2::new(from_f64(x.x), from_f64(x.y));
+        tree[k].impulse += impulse;
+        let (r_a, r_b) = tree[k].arms;
+        let (body_a, body_b) = ends(nodes, tree, start, k);
+        if body_a != NONE {
+            let sa = tree[body_a as usize].state;
+            let i_a = sa.inv_inertia + inertia_change(tree, &sa, body_a);
+            let st = &mut tree[body_a as usize].state;
+            st.v -= sa.inv_mass * impulse;
+            st.w -= i_a * cross(r_a, impulse);
+        }
+        if body_b != NONE {
+            let sb = tree[body_b as usize].state;
+            let i_b = sb.inv_inertia + inertia_change(tree, &sb, body_b);
+            let st = &mut tree[body_b as usize].state;
+            st.v += sb.inv_mass * impulse;
+            st.w += i_b * cross(r_b, impulse);
         }
     }
 }
@@ -684,6 +829,16 @@ impl ConstraintBatch for RevoluteBatch<'_> {
     }
     fn solve_late(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
         self.forest.solve(ctx, self.joints, states, use_bias);
+    }
+    fn solve_late_on(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        team: &Team,
+    ) {
+        self.forest
+            .solve_on(ctx, self.joints, states, use_bias, team);
     }
     fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
         self.joints.apply_restitution(ctx, states);

@@ -289,6 +289,16 @@ pub trait ConstraintBatch: Send {
     ) {
         self.solve(ctx, states, use_bias, reverse);
     }
+    /// [`ConstraintBatch::solve_late`] on the step's team.
+    fn solve_late_on(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        _team: &Team,
+    ) {
+        self.solve_late(ctx, states, use_bias);
+    }
     /// [`ConstraintBatch::apply_restitution`] on the step's team.
     fn apply_restitution_on(&mut self, ctx: &StepContext, states: &mut [BodyState], _team: &Team) {
         self.apply_restitution(ctx, states);

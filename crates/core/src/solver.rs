@@ -602,7 +602,7 @@ fn solve_step_on(
                 batches[i].solve_on(ctx, &mut bodies.states, true, flip, team);
             }
             for &i in &active {
-                batches[i].solve_late(ctx, &mut bodies.states, true);
+                batches[i].solve_late_on(ctx, &mut bodies.states, true, team);
             }
         }
         report.profile.solve += lap(&mut t);
@@ -613,7 +613,7 @@ fn solve_step_on(
                 batches[i].solve_on(ctx, &mut bodies.states, false, !flip, team);
             }
             for &i in &active {
-                batches[i].solve_late(ctx, &mut bodies.states, false);
+                batches[i].solve_late_on(ctx, &mut bodies.states, false, team);
             }
         }
         report.profile.relax += lap(&mut t);

@@ -106,6 +106,25 @@ impl ConstraintBatch for CoupledBatches<'_> {
             b.solve_on(ctx, states, use_bias, reverse, team);
         }
     }
+    fn solve_late_on(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        team: &Team,
+    ) {
+        for b in self.batches.iter_mut().filter(|b| b.count() > 0) {
+            b.solve_late_on(ctx, states, use_bias, team);
+        }
+        let [joints, _, portals] = &mut self.batches;
+        if joints.count() == 0 || portals.count() == 0 {
+            return;
+        }
+        for _ in 0..self.passes {
+            joints.solve_late_on(ctx, states, use_bias, team);
+            portals.solve_late_on(ctx, states, use_bias, team);
+        }
+    }
     fn apply_restitution_on(&mut self, ctx: &StepContext, states: &mut [BodyState], team: &Team) {
         for b in self.batches.iter_mut().filter(|b| b.count() > 0) {
             b.apply_restitution_on(ctx, states, team);
