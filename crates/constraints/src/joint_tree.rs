@@ -587,6 +587,26 @@ fn end_state(tree: &[NodeScratch], states: &[BodyState], body: u32, index: u32) 
     }
 }
 
+/// Joint node `k`'s joint and the states of its ends a and b (tree copies,
+/// or the shared states for a fixed end).
+#[inline(always)]
+fn joint_states<'j>(
+    nodes: &[Node],
+    start: usize,
+    tree: &[NodeScratch],
+    joints: &'j [RevoluteJoint],
+    states: &[BodyState],
+    k: usize,
+) -> (&'j RevoluteJoint, BodyState, BodyState) {
+    let j = &joints[nodes[start + k].index as usize];
+    let (body_a, body_b) = ends(nodes, tree, start, k);
+    (
+        j,
+        end_state(tree, states, body_a, j.state_a),
+        end_state(tree, states, body_b, j.state_b),
+    )
+}
+
 /// One tree's exact solve on its nodes `start..start + tree.len()`: the
 /// arithmetic of the module docs on the tree's scratch (its bodies' states,
 /// its joints' impulses), reading fixed ends from `states`.
@@ -626,10 +646,7 @@ fn solve_tree(
         if !node.is_joint {
             continue;
         }
-        let j = &joints[node.index as usize];
-        let (body_a, body_b) = ends(nodes, tree, start, k);
-        let sa = end_state(tree, states, body_a, j.state_a);
-        let sb = end_state(tree, states, body_b, j.state_b);
+        let (j, sa, sb) = joint_states(nodes, start, tree, joints, states, k);
         let (r_a, r_b, _) = j.point.arms(&sa, &sb);
         tree[k].arms = (r_a, r_b);
         let lambda = wide(tree[k].impulse);
@@ -683,10 +700,7 @@ fn solve_tree(
         if !node.is_joint {
             continue;
         }
-        let j = &joints[node.index as usize];
-        let (body_a, body_b) = ends(nodes, tree, start, k);
-        let sa = end_state(tree, states, body_a, j.state_a);
-        let sb = end_state(tree, states, body_b, j.state_b);
+        let (j, sa, sb) = joint_states(nodes, start, tree, joints, states, k);
         let (r_a, r_b, c) = j.point.arms(&sa, &sb);
         let c_dot = (sb.v + cross_sv(sb.w, r_b)) - (sa.v + cross_sv(sa.w, r_a));
         let (k11, k12, k22) = crate::parts::PointPart::effective_mass(&sa, &sb, r_a, r_b);

@@ -604,6 +604,27 @@ mod tests {
         set
     }
 
+    /// Both search strategies (per-proxy queries and bulk descent) on a
+    /// copy of `bp` report exactly `expected`, each pair once (payloads are
+    /// unique).
+    fn check_both_strategies(bp: &BroadPhase, expected: &[(u32, u32)], label: &str) {
+        for bulk in [false, true] {
+            let mut copy = bp.clone();
+            let mut pairs = Vec::new();
+            let mut calls = 0usize;
+            copy.update_pairs_with(
+                bulk,
+                |_, _| {
+                    calls += 1;
+                    true
+                },
+                &mut pairs,
+            );
+            assert_eq!(pairs, expected, "{label}, bulk = {bulk}");
+            assert_eq!(calls, expected.len(), "{label}, bulk = {bulk}");
+        }
+    }
+
     /// 2000 random proxies, one in ten static.
     fn random_scene(rng: &mut Lcg) -> (BroadPhase, Vec<u32>) {
         let mut bp = BroadPhase::new();
@@ -621,22 +642,7 @@ mod tests {
         let expected: Vec<(u32, u32)> = brute_force(&bp, &ids).into_iter().collect();
         assert!(expected.len() > 500, "scene too sparse: {}", expected.len());
         // Both search strategies (per-proxy queries and bulk descent).
-        for bulk in [false, true] {
-            let mut copy = bp.clone();
-            let mut pairs = Vec::new();
-            let mut calls = 0usize;
-            copy.update_pairs_with(
-                bulk,
-                |_, _| {
-                    calls += 1;
-                    true
-                },
-                &mut pairs,
-            );
-            assert_eq!(pairs, expected, "bulk = {bulk}");
-            // Each pair was found exactly once (payloads are unique).
-            assert_eq!(calls, expected.len(), "bulk = {bulk}");
-        }
+        check_both_strategies(&bp, &expected, "serial");
         let mut pairs = Vec::new();
         bp.update_pairs(|_, _| true, &mut pairs);
         assert_eq!(pairs, expected);
@@ -669,23 +675,8 @@ mod tests {
                 .num_threads(threads)
                 .build()
                 .unwrap();
-            for bulk in [false, true] {
-                let mut copy = bp.clone();
-                let mut pairs = Vec::new();
-                let mut calls = 0usize;
-                pool.install(|| {
-                    copy.update_pairs_with(
-                        bulk,
-                        |_, _| {
-                            calls += 1;
-                            true
-                        },
-                        &mut pairs,
-                    )
-                });
-                assert_eq!(pairs, expected, "threads {threads}, bulk = {bulk}");
-                assert_eq!(calls, expected.len(), "threads {threads}, bulk = {bulk}");
-            }
+            let label = format!("{threads} threads");
+            pool.install(|| check_both_strategies(&bp, &expected, &label));
         }
     }
 
