@@ -350,30 +350,30 @@ impl ContactSolver {
                 lists[colour as usize].push(i as u32);
             }
         }
-        let mut jobs: Vec<(&mut WideContact, &[u32])> = Vec::new();
-        for (chunks, list) in self.colours.iter_mut().zip(&lists) {
-            chunks.resize_with(list.len().div_ceil(LANES), WideContact::empty);
-            jobs.extend(chunks.iter_mut().zip(list.chunks(LANES)));
-        }
-        let fill = |(chunk, items): &mut (&mut WideContact, &[u32])| {
-            for &i in items.iter() {
+        // Each chunk is made and filled from its own contacts, so the
+        // chunks of a colour can be built at once (no serial zeroing of
+        // the chunks first).
+        let build = |items: &[u32]| {
+            let mut chunk = WideContact::empty();
+            for &i in items {
                 let lane = lane(i as usize);
                 let count = lane.point_count.min(MAX_MANIFOLD_POINTS);
                 chunk.push(&lane, count);
             }
+            chunk
         };
-        #[cfg(feature = "parallel")]
-        {
-            use rayon::prelude::*;
-            if rayon::current_num_threads() > 1 && jobs.len() > 16 {
-                jobs.par_iter_mut().with_min_len(8).for_each(fill);
-            } else {
-                jobs.iter_mut().for_each(fill);
+        for (chunks, list) in self.colours.iter_mut().zip(&lists) {
+            #[cfg(feature = "parallel")]
+            if rayon::current_num_threads() > 1 && list.len() > 16 * LANES {
+                use rayon::prelude::*;
+                list.par_chunks(LANES)
+                    .with_min_len(8)
+                    .map(build)
+                    .collect_into_vec(chunks);
+                continue;
             }
+            chunks.extend(list.chunks(LANES).map(build));
         }
-        #[cfg(not(feature = "parallel"))]
-        jobs.iter_mut().for_each(fill);
-        drop(jobs);
         self.len += lists.iter().map(Vec::len).sum::<usize>();
         self.lists = lists;
     }
