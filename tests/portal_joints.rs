@@ -328,31 +328,7 @@ fn rope_drifting_onto_the_lip_keeps_its_joints() {
 /// under 1 mm.
 #[test]
 fn jointed_pair_through_dynamic_portal_bodies_conserves_momentum() {
-    let mut def = WorldDef {
-        gravity: Vec2::ZERO,
-        ..Default::default()
-    };
-    def.sleep.enabled = false;
-    let mut world = World::new(def).unwrap();
-    let slab = |world: &mut World, p: Vec2| {
-        let b = world.create_body(&BodyDef::dynamic(p)).unwrap();
-        world
-            .create_shape(
-                b,
-                &ShapeDef::default().with_density(20.0),
-                Polygon::make_box(0.25, 1.5),
-            )
-            .unwrap();
-        b
-    };
-    let a = slab(&mut world, Vec2::ZERO);
-    let b = slab(&mut world, Vec2::new(20.0, 5.0));
-    let pair = world
-        .create_portal_pair(&janus2d::world::PortalPairDef::new(
-            janus2d_testbed::support::portal_def(a, Vec2::new(-0.25, 0.0), -Vec2::X, 1.0),
-            janus2d_testbed::support::portal_def(b, Vec2::new(0.25, 0.0), Vec2::X, 1.0),
-        ))
-        .unwrap();
+    let (mut world, _, _, pair) = janus2d_testbed::support::free_slab_portals();
     let make = |world: &mut World, x: Real| {
         let body = world
             .create_body(&BodyDef::dynamic(Vec2::new(x, 0.1)).with_velocity(Vec2::new(4.0, 0.0)))

@@ -341,33 +341,8 @@ fn portal_turning_bodies_keep_error_below_a_millimetre() {
 /// linear and angular momentum conserved (relative 1e-5 in f32, 1e-10 in f64).
 #[test]
 fn portal_dynamic_bodies_conserve_momentum() {
-    // Sleep off: a sleeping island is put at rest, which is a deliberate
-    // loss of its (tiny) momentum; this test measures the constraints.
-    let mut def = WorldDef {
-        gravity: Vec2::ZERO,
-        ..Default::default()
-    };
-    def.sleep.enabled = false;
-    let mut world = World::new(def).unwrap();
-    let mk = |world: &mut World, p: Vec2| {
-        let b = world.create_body(&BodyDef::dynamic(p)).unwrap();
-        world
-            .create_shape(
-                b,
-                &ShapeDef::default().with_density(20.0),
-                Polygon::make_box(0.25, 1.5),
-            )
-            .unwrap();
-        b
-    };
-    let a = mk(&mut world, Vec2::ZERO);
-    let b = mk(&mut world, Vec2::new(20.0, 5.0));
-    world
-        .create_portal_pair(&PortalPairDef::new(
-            portal(a, Vec2::new(-0.25, 0.0), -Vec2::X, 1.0),
-            portal(b, Vec2::new(0.25, 0.0), Vec2::X, 1.0),
-        ))
-        .unwrap();
+    // Sleep off (see the scene): this test measures the constraints.
+    let (mut world, _, _, _) = janus2d_testbed::support::free_slab_portals();
     launched_box(&mut world, Vec2::new(-1.0, 0.1), Vec2::new(4.0, 0.0), 0.3);
     let momentum = |world: &World| {
         let (mut p, mut l) = (Vec2::ZERO, 0.0 as Real);

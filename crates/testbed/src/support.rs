@@ -491,6 +491,49 @@ pub fn wall(world: &mut janus2d_world::World, center: Vec2, hx: Real, hy: Real) 
     b
 }
 
+/// The free-slab portal scene of the momentum tests: gravity 0, sleep off
+/// (a sleeping island is put at rest, a deliberate loss of momentum), two
+/// dynamic slabs (0.5 × 3 m, density 20) at the origin and at (20, 5),
+/// each carrying one portal of half-width 1 on its face (the first facing
+/// −x, the second +x). Returns the world, the two slabs and the pair.
+#[cfg(feature = "portals")]
+#[must_use]
+pub fn free_slab_portals() -> (
+    janus2d_world::World,
+    BodyHandle,
+    BodyHandle,
+    janus2d_world::PortalPairHandle,
+) {
+    use janus2d_core::geometry::Polygon;
+    use janus2d_world::{PortalPairDef, ShapeDef, World, WorldDef};
+    let mut def = WorldDef {
+        gravity: Vec2::ZERO,
+        ..Default::default()
+    };
+    def.sleep.enabled = false;
+    let mut world = World::new(def).expect("a valid world");
+    let slab = |world: &mut World, p: Vec2| {
+        let b = world.create_body(&BodyDef::dynamic(p)).expect("a slab");
+        world
+            .create_shape(
+                b,
+                &ShapeDef::default().with_density(20.0),
+                Polygon::make_box(0.25, 1.5),
+            )
+            .expect("a slab shape");
+        b
+    };
+    let a = slab(&mut world, Vec2::ZERO);
+    let b = slab(&mut world, Vec2::new(20.0, 5.0));
+    let pair = world
+        .create_portal_pair(&PortalPairDef::new(
+            portal_def(a, Vec2::new(-0.25, 0.0), -Vec2::X, 1.0),
+            portal_def(b, Vec2::new(0.25, 0.0), Vec2::X, 1.0),
+        ))
+        .expect("a valid portal pair");
+    (world, a, b, pair)
+}
+
 /// A portal on `body` at `anchor` (body frame), facing `direction`, with
 /// half-width `half_width`.
 #[cfg(feature = "portals")]
