@@ -347,18 +347,7 @@ fn jointed_pair_through_dynamic_portal_bodies_conserves_momentum() {
             Vec2::new(0.4, 0.0),
         ))
         .unwrap();
-    let momentum = |world: &World| {
-        let (mut p, mut l) = (Vec2::ZERO, 0.0 as Real);
-        for h in world.body_handles() {
-            let m = world.mass(h).unwrap();
-            let v = world.linear_velocity(h).unwrap();
-            let x = world.center_of_mass(h).unwrap();
-            p += m * v;
-            l += m * janus2d::base::math::cross(x, v)
-                + world.rotational_inertia(h).unwrap() * world.angular_velocity(h).unwrap();
-        }
-        (p, l)
-    };
+    let momentum = janus2d_testbed::support::world_momentum;
     let (p0, l0) = momentum(&world);
     let scale_p = p0.length();
     let scale_l = l0.abs().max(scale_p * 20.0);

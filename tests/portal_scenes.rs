@@ -344,21 +344,7 @@ fn portal_dynamic_bodies_conserve_momentum() {
     // Sleep off (see the scene): this test measures the constraints.
     let (mut world, _, _, _) = janus2d_testbed::support::free_slab_portals();
     launched_box(&mut world, Vec2::new(-1.0, 0.1), Vec2::new(4.0, 0.0), 0.3);
-    let momentum = |world: &World| {
-        let (mut p, mut l) = (Vec2::ZERO, 0.0 as Real);
-        for h in world.body_handles() {
-            if world.body_type(h).unwrap() != BodyType::Dynamic {
-                continue;
-            }
-            let m = world.mass(h).unwrap();
-            let v = world.linear_velocity(h).unwrap();
-            let x = world.center_of_mass(h).unwrap();
-            p += m * v;
-            l += m * janus2d::base::math::cross(x, v)
-                + world.rotational_inertia(h).unwrap() * world.angular_velocity(h).unwrap();
-        }
-        (p, l)
-    };
+    let momentum = janus2d_testbed::support::world_momentum;
     let (p0, l0) = momentum(&world);
     let scale_p = p0.length();
     let scale_l = l0.abs().max(scale_p * 20.0);

@@ -510,19 +510,27 @@ impl JointForest {
         {
             let (nodes, joints, states) = (&self.nodes[..], &*joints, &*states);
             let mut rest = &mut self.scratch[..];
-            let mut trees = Vec::with_capacity(self.trees.len());
-            for (t, &start) in self.trees.iter().enumerate() {
-                let end = self.trees.get(t + 1).map_or(nodes.len(), |&e| e as usize);
-                let (tree, tail) = rest.split_at_mut(end - start as usize);
+            let bounds = &self.trees;
+            let split = bounds.iter().enumerate().map(move |(t, &start)| {
+                let end = bounds.get(t + 1).map_or(nodes.len(), |&e| e as usize);
+                let (tree, tail) = std::mem::take(&mut rest).split_at_mut(end - start as usize);
                 rest = tail;
-                trees.push((start as usize, tree));
-            }
-            let per_block = trees.len().div_ceil(4 * team.threads()).max(1);
-            team.for_each_chunk_mut(&mut trees, per_block, |_, block| {
-                for (start, tree) in block.iter_mut() {
-                    solve_tree(nodes, *start, tree, joints, states, &params);
-                }
+                (start as usize, tree)
             });
+            if team.threads() == 1 {
+                // Tree by tree, without collecting the split.
+                for (start, tree) in split {
+                    solve_tree(nodes, start, tree, joints, states, &params);
+                }
+            } else {
+                let mut trees: Vec<_> = split.collect();
+                let per_block = trees.len().div_ceil(4 * team.threads()).max(1);
+                team.for_each_chunk_mut(&mut trees, per_block, |_, block| {
+                    for (start, tree) in block.iter_mut() {
+                        solve_tree(nodes, *start, tree, joints, states, &params);
+                    }
+                });
+            }
         }
         for (node, sc) in self.nodes.iter().zip(&self.scratch) {
             if node.is_joint {

@@ -500,14 +500,14 @@ pub fn with_team<R: Send>(leader: impl FnOnce(&Team) -> R + Send) -> R {
     {
         let threads = rayon::current_num_threads();
         if threads > 1 {
-            return broadcast_team(threads, leader);
+            return broadcast_team(leader);
         }
     }
     leader(&Team::serial())
 }
 
 #[cfg(feature = "parallel")]
-fn broadcast_team<R: Send>(threads: usize, leader: impl FnOnce(&Team) -> R + Send) -> R {
+fn broadcast_team<R: Send>(leader: impl FnOnce(&Team) -> R + Send) -> R {
     use std::sync::Mutex;
     let shared = Shared::new();
     let leader = Mutex::new(Some(leader));
@@ -537,7 +537,6 @@ fn broadcast_team<R: Send>(threads: usize, leader: impl FnOnce(&Team) -> R + Sen
             follow(&shared);
         }
     });
-    debug_assert_eq!(threads, threads.max(1));
     result
         .into_inner()
         .unwrap_or_else(|e| e.into_inner())

@@ -30,7 +30,7 @@ use janus2d_constraints::portal_map::{
 use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodySet, BodyType};
 use std::cell::Cell;
 
-use janus2d_core::math::{EPSILON, Real, Rot, Transform, Vec2, cross_sv};
+use janus2d_core::math::{EPSILON, Real, Rot, Transform, Vec2, cross, cross_sv};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestCaseError, TestError, TestRunner};
 
@@ -489,6 +489,30 @@ pub fn wall(world: &mut janus2d_world::World, center: Vec2, hx: Real, hy: Real) 
         )
         .expect("a wall of positive size");
     b
+}
+
+/// Total linear momentum (kg·m/s) and angular momentum about the origin
+/// (kg·m²/s) of a world's dynamic bodies, read through the public API.
+#[must_use]
+pub fn world_momentum(world: &janus2d_world::World) -> (Vec2, Real) {
+    let (mut p, mut l) = (Vec2::ZERO, 0.0 as Real);
+    for h in world.body_handles() {
+        if world.body_type(h) != Ok(BodyType::Dynamic) {
+            continue;
+        }
+        let (Ok(m), Ok(v), Ok(x), Ok(i), Ok(w)) = (
+            world.mass(h),
+            world.linear_velocity(h),
+            world.center_of_mass(h),
+            world.rotational_inertia(h),
+            world.angular_velocity(h),
+        ) else {
+            continue;
+        };
+        p += m * v;
+        l += m * cross(x, v) + i * w;
+    }
+    (p, l)
 }
 
 /// The free-slab portal scene of the momentum tests: gravity 0, sleep off
