@@ -180,6 +180,20 @@ pub struct PointImpulse {
     pub total_tangent: Real,
 }
 
+/// Where a pushed contact lives in the solver: a lane of a colour's chunk,
+/// or a place in the overflow. [`ContactSolver::push_all`] reports one per
+/// contact, so that the pipeline can read each contact's impulses back in
+/// its own order ([`ContactSolver::point_impulse_at`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LanePlace {
+    /// The colour ([`OVERFLOW`] for the overflow).
+    pub colour: u8,
+    /// The lane within its chunk (0 in the overflow).
+    pub lane: u8,
+    /// The chunk within its colour, or the index in the overflow.
+    pub chunk: u32,
+}
+
 /// What the collision pipeline hands over for one contact: everything a
 /// lane (or an overflow constraint) is built from.
 #[derive(Clone, Copy, Debug)]
@@ -290,10 +304,15 @@ impl ContactSolver {
 
     /// Adds a contact to the colour [`ContactSolver::assign`] gave it
     /// ([`OVERFLOW`]: solved scalar).
-    pub fn push(&mut self, colour: u8, lane: &ContactLane) {
+    pub fn push(&mut self, colour: u8, lane: &ContactLane) -> LanePlace {
         self.len += 1;
         let count = lane.point_count.min(MAX_MANIFOLD_POINTS);
         if colour >= OVERFLOW {
+            let place = LanePlace {
+                colour: OVERFLOW,
+                lane: 0,
+                chunk: self.overflow.len() as u32,
+            };
             let mut c = ContactConstraint::new(
                 lane.body_a,
                 lane.body_b,
@@ -306,7 +325,7 @@ impl ContactSolver {
             c.state_a = lane.state_a;
             c.state_b = lane.state_b;
             self.overflow.push(c);
-            return;
+            return place;
         }
         if self.colours.len() < COLOURS {
             self.colours.resize_with(COLOURS, Vec::new);
@@ -315,26 +334,42 @@ impl ContactSolver {
         if chunks.last().is_none_or(|c| c.len == LANES) {
             chunks.push(WideContact::empty());
         }
+        let place = LanePlace {
+            colour,
+            lane: chunks.last().map_or(0, |c| c.len as u8),
+            chunk: chunks.len() as u32 - 1,
+        };
         let chunk = chunks.last_mut().expect("a chunk with a free lane");
         chunk.push(lane, count);
+        place
     }
 
     /// [`ContactSolver::push`] for many contacts at once: contact `i` goes
-    /// into colour `colours[i]` with the lane data `lane(i)`. The result is
-    /// the one of pushing them in order; with the `parallel` feature the
-    /// chunks are filled on rayon (each chunk from its own contacts, so the
-    /// order within a colour is kept).
-    pub fn push_all<F>(&mut self, colours: &[u8], lane: F)
+    /// into colour `colours[i]` with the lane data `lane(i)`, and its place
+    /// into `places[i]`. The result is the one of pushing them in order;
+    /// with the `parallel` feature and more than one thread the chunks are
+    /// filled on rayon (each chunk from its own contacts, so the order
+    /// within a colour is kept).
+    pub fn push_all<F>(&mut self, colours: &[u8], lane: F, places: &mut Vec<LanePlace>)
     where
         F: Fn(usize) -> ContactLane + Sync,
     {
+        places.clear();
         if self.colours.len() < COLOURS {
             self.colours.resize_with(COLOURS, Vec::new);
         }
-        if self.colours.iter().any(|c| !c.is_empty()) {
+        // One thread (or open chunks): push in contact order. The contacts
+        // are then read in order and the open chunks (one per colour) stay
+        // in cache; the per-colour lists below read the contacts out of
+        // order, which only pays when threads share the filling.
+        #[cfg(feature = "parallel")]
+        let serial = rayon::current_num_threads() == 1;
+        #[cfg(not(feature = "parallel"))]
+        let serial = true;
+        if serial || self.colours.iter().any(|c| !c.is_empty()) {
             // Open chunks: keep push's order exactly.
             for (i, &colour) in colours.iter().enumerate() {
-                self.push(colour, &lane(i));
+                places.push(self.push(colour, &lane(i)));
             }
             return;
         }
@@ -345,9 +380,16 @@ impl ContactSolver {
         }
         for (i, &colour) in colours.iter().enumerate() {
             if colour >= OVERFLOW {
-                self.push(colour, &lane(i));
+                places.push(self.push(colour, &lane(i)));
             } else {
-                lists[colour as usize].push(i as u32);
+                // The j-th contact of a colour goes to chunk j / LANES.
+                let list = &mut lists[colour as usize];
+                places.push(LanePlace {
+                    colour,
+                    lane: (list.len() % LANES) as u8,
+                    chunk: (list.len() / LANES) as u32,
+                });
+                list.push(i as u32);
             }
         }
         // Each chunk is made and filled from its own contacts, so the
@@ -376,6 +418,26 @@ impl ContactSolver {
         }
         self.len += lists.iter().map(Vec::len).sum::<usize>();
         self.lists = lists;
+    }
+
+    /// The impulses of point `point` of the contact at `place` (as
+    /// [`ContactSolver::for_each_impulse`] reports them).
+    #[must_use]
+    #[inline]
+    pub fn point_impulse_at(&self, place: LanePlace, point: usize) -> PointImpulse {
+        if place.colour >= OVERFLOW {
+            return self.overflow[place.chunk as usize].point_impulse(point);
+        }
+        let chunk = &self.colours[place.colour as usize][place.chunk as usize];
+        let k = place.lane as usize;
+        let lane = |w: &W| w.as_array_ref()[k];
+        let (n, t) = (lane(&chunk.impulse[point]), lane(&chunk.impulse[point + 2]));
+        PointImpulse {
+            normal: n,
+            tangent: t,
+            total_normal: lane(&chunk.step_base[point]) + n,
+            total_tangent: lane(&chunk.step_base[point + 2]) + t,
+        }
     }
 
     /// Calls `store(contact_index, point, impulses)` for every point of

@@ -25,6 +25,9 @@
 
 use janus2d_constraints::ContactSolver;
 use janus2d_constraints::contact::{mix_friction, mix_restitution};
+#[cfg(feature = "parallel")]
+use janus2d_constraints::contact_solver::LanePlace;
+use janus2d_constraints::contact_solver::PointImpulse;
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::geometry::{Aabb, Shape};
 use janus2d_core::math::{Real, Transform, Vec2};
@@ -33,6 +36,8 @@ use crate::broadphase::BroadPhase;
 pub use crate::contacts::{CollisionEvents, ShapePairEvent};
 use crate::contacts::{Contact, ContactPointData, ContactSet};
 use crate::joints::NoCollide;
+#[cfg(feature = "parallel")]
+use crate::narrowphase::Narrowphase;
 use crate::shapes::{ShapeData, ShapeDef, ShapeHandle, ShapeStore};
 
 /// Speculative distance, m (0.02 = 4 × linear slop): contact points exist
@@ -315,12 +320,45 @@ impl Collision {
         // starting: the contact starts cold next step instead of carrying
         // NaN into it.
         let finite = |x: Real| if x.is_finite() { x } else { 0.0 };
-        solver.for_each_impulse(|index, point, impulse| {
-            let p = &mut contacts.awake_mut(index as usize).points[point];
+        let keep = |p: &mut crate::contacts::ContactPointData, impulse: PointImpulse| {
             p.normal_impulse = finite(impulse.normal);
             p.tangent_impulse = finite(impulse.tangent);
             p.total_normal_impulse = finite(impulse.total_normal);
             p.total_tangent_impulse = finite(impulse.total_tangent);
+        };
+        #[cfg(feature = "parallel")]
+        {
+            let places = self.narrowphase.places();
+            if rayon::current_num_threads() > 1
+                && places.len() > 4096
+                && places.len() == contacts.awake().len()
+            {
+                // On the threads, in contact order: each contact written
+                // once, in place, reading its lanes from the chunks. (On one
+                // thread the scatter below measured faster: 6.8% of
+                // many_pyramids' samples against 10.2% for this gather.)
+                use rayon::prelude::*;
+                let store = |(c, place): (&mut Contact, &LanePlace)| {
+                    if Narrowphase::is_solved(place) {
+                        for i in 0..c.point_count {
+                            keep(&mut c.points[i], solver.point_impulse_at(*place, i));
+                        }
+                    }
+                };
+                contacts
+                    .awake_slice_mut()
+                    .par_iter_mut()
+                    .zip(places.par_iter())
+                    .with_min_len(1024)
+                    .for_each(store);
+                return;
+            }
+        }
+        solver.for_each_impulse(|index, point, impulse| {
+            keep(
+                &mut contacts.awake_mut(index as usize).points[point],
+                impulse,
+            );
         });
     }
 

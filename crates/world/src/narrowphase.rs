@@ -22,7 +22,7 @@
 
 use janus2d_constraints::ContactPointInput;
 use janus2d_constraints::ObjectMass;
-use janus2d_constraints::contact_solver::{ContactLane, ContactSolver, OVERFLOW};
+use janus2d_constraints::contact_solver::{ContactLane, ContactSolver, LanePlace, OVERFLOW};
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::geometry::{Aabb, Manifold, collide};
 use janus2d_core::math::{Real, Rot, Transform, Vec2};
@@ -100,6 +100,96 @@ pub(crate) struct Narrowphase {
     solved: Vec<SolvedContact>,
     /// Their colours, in the same order (the solver's `push_all` input).
     colours: Vec<u8>,
+    /// What the solve takes of each awake contact, by awake position,
+    /// written by phase 1 while the contact is in cache (valid where the
+    /// contact touches solidly). Constraint building reads these compact
+    /// records instead of the contacts themselves (about half their size).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    staged: Vec<StagedContact>,
+    /// Where the solver put each solved contact, in `solved` order.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    places: Vec<LanePlace>,
+    /// The same by awake position ([`UNSOLVED`] for a contact the solve
+    /// does not take), for storing the impulses back in contact order.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    place_of: Vec<LanePlace>,
+}
+
+/// [`Narrowphase::place_of`] of a contact that is not solved this step.
+#[cfg_attr(not(feature = "parallel"), allow(dead_code))]
+const UNSOLVED: LanePlace = LanePlace {
+    colour: u8::MAX,
+    lane: 0,
+    chunk: 0,
+};
+
+/// What constraint building needs of one awake contact: its lane (the
+/// solver's input, state indices and inverse masses included) and whether
+/// each body read as still.
+#[derive(Clone, Copy, Debug)]
+struct StagedContact {
+    /// The solver's lane data (`contact_index` is set at push).
+    lane: ContactLane,
+    /// [`Contact::still`] when staged.
+    still: [bool; 2],
+}
+
+impl Default for StagedContact {
+    fn default() -> Self {
+        Self {
+            lane: empty_lane(),
+            still: [true, true],
+        }
+    }
+}
+
+/// A lane with no points (the filler of unstaged records).
+fn empty_lane() -> ContactLane {
+    ContactLane {
+        body_a: BodyHandle::new(u32::MAX, 0, 0),
+        body_b: BodyHandle::new(u32::MAX, 0, 0),
+        state_a: 0,
+        state_b: 0,
+        inv_masses: [0.0; 4],
+        normal: Vec2::ZERO,
+        points: [ContactPointInput::default(); 2],
+        point_count: 0,
+        friction: 0.0,
+        restitution: 0.0,
+        contact_index: 0,
+    }
+}
+
+/// Stages a contact: its lane and stillness as the solve takes them.
+#[inline]
+fn stage(c: &Contact) -> StagedContact {
+    let mut points = [ContactPointInput::default(); 2];
+    for (input, p) in points.iter_mut().zip(&c.points[..c.point_count]) {
+        *input = ContactPointInput {
+            anchor_a: p.anchor_a,
+            anchor_b: p.anchor_b,
+            separation: p.separation,
+            normal_impulse: p.normal_impulse,
+            tangent_impulse: p.tangent_impulse,
+        };
+    }
+    let [(state_a, [m_a, i_a]), (state_b, [m_b, i_b])] = c.solve_bodies;
+    StagedContact {
+        lane: ContactLane {
+            body_a: c.body_a,
+            body_b: c.body_b,
+            state_a,
+            state_b,
+            inv_masses: [m_a, i_a, m_b, i_b],
+            normal: c.normal,
+            points,
+            point_count: c.point_count,
+            friction: c.friction,
+            restitution: c.restitution,
+            contact_index: 0,
+        },
+        still: c.still,
+    }
 }
 
 /// A contact the solve takes this step, as the build's first pass found it.
@@ -130,6 +220,19 @@ pub(crate) struct NarrowphaseInput<'a> {
 }
 
 impl Narrowphase {
+    /// Where the solver holds each awake contact's impulses this step, by
+    /// awake position (as the last constraint building left them).
+    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
+    pub(crate) fn places(&self) -> &[LanePlace] {
+        &self.place_of
+    }
+
+    /// Whether a place holds a solved contact.
+    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
+    pub(crate) fn is_solved(place: &LanePlace) -> bool {
+        *place != UNSOLVED
+    }
+
     /// Updates every awake contact's manifold; destroys contacts whose fat
     /// boxes separated; records begin/end events.
     ///
@@ -150,19 +253,37 @@ impl Narrowphase {
     ) {
         let mut results = std::mem::take(&mut self.results);
         results.clear();
+        let staged = &mut self.staged;
+        let n = contacts.awake().len();
+        if staged.len() < n {
+            staged.resize(n, StagedContact::default());
+        }
         {
-            let compute = |c: &mut Contact| update_in_place(c, input);
+            let compute = |(c, s): (&mut Contact, &mut StagedContact)| {
+                let update = update_in_place(c, input);
+                if let ContactUpdate::Updated { solid: true, .. } = update {
+                    *s = stage(c);
+                }
+                update
+            };
             #[cfg(feature = "parallel")]
             {
                 use rayon::prelude::*;
                 contacts
                     .awake_slice_mut()
                     .par_iter_mut()
+                    .zip(staged[..n].par_iter_mut())
                     .map(compute)
                     .collect_into_vec(&mut results);
             }
             #[cfg(not(feature = "parallel"))]
-            results.extend(contacts.awake_slice_mut().iter_mut().map(compute));
+            results.extend(
+                contacts
+                    .awake_slice_mut()
+                    .iter_mut()
+                    .zip(staged[..n].iter_mut())
+                    .map(compute),
+            );
         }
         // Serial pass over the results: a contact is read again only when
         // it is destroyed, begins or ends touching, or wakes a body, and a
@@ -180,6 +301,8 @@ impl Narrowphase {
                     continue;
                 }
                 ContactUpdate::Separated => {
+                    // The last awake contact moves to k: so does its record.
+                    staged.swap(k, contacts.awake().len() - 1);
                     contacts.destroy_awake_at(k, events);
                     results.swap_remove(k);
                     continue;
@@ -198,6 +321,7 @@ impl Narrowphase {
                 wake.push(other);
                 // Woken before the solve: it moves this step.
                 c.still = [false, false];
+                staged[k].still = [false, false];
             }
             if touching {
                 touching_count += 1;
@@ -484,9 +608,15 @@ pub(crate) fn build_constraints(
     counters: &mut CollisionCounters,
 ) {
     let solved = &mut narrowphase.solved;
+    let staged = &mut narrowphase.staged;
     // The contacts to look at: those the narrowphase found touching, then
     // any woken (appended) since.
-    let woken = narrowphase.scanned.min(contacts.awake().len())..contacts.awake().len();
+    let n = contacts.awake().len();
+    let scanned = narrowphase.scanned.min(n);
+    let woken = scanned..n;
+    if staged.len() < n {
+        staged.resize(n, StagedContact::default());
+    }
     let candidates = narrowphase
         .touching
         .iter()
@@ -507,6 +637,12 @@ pub(crate) fn build_constraints(
                 solve_body(&bodies.solver_body(c.body_a)),
                 solve_body(&bodies.solver_body(c.body_b)),
             ];
+            staged[k] = stage(c);
+        }
+    } else {
+        // Contacts woken after the narrowphase were not staged by it.
+        for k in scanned..n {
+            staged[k] = stage(&contacts.awake()[k]);
         }
     }
     // The state index of a body (0: static or asleep) and whether the
@@ -523,12 +659,13 @@ pub(crate) fn build_constraints(
     let awake = contacts.awake();
     solved.clear();
     for k in candidates {
-        let c = &awake[k];
-        let [sa, sb] = c.still;
-        if !c.is_solid_touching() || (sa && sb) {
+        let record = &staged[k];
+        let [sa, sb] = record.still;
+        if (sa && sb) || (k >= scanned && !awake[k].is_solid_touching()) {
             continue;
         }
         if let Some(hook) = pre_solve.as_mut() {
+            let c = &awake[k];
             let velocity = |b| bodies.state(b).map_or(Vec2::ZERO, |s| s.v);
             let mut separations = [0.0; 2];
             for (s, p) in separations.iter_mut().zip(&c.points[..c.point_count]) {
@@ -549,9 +686,11 @@ pub(crate) fn build_constraints(
                 continue;
             }
         }
-        let (ia, moving_a) = state_of(c.solve_bodies[0]);
-        let (ib, moving_b) = state_of(c.solve_bodies[1]);
-        let copy = !objects.is_empty() && (is_copy(c.body_a) || is_copy(c.body_b));
+        let lane = &record.lane;
+        let [m_a, i_a, m_b, i_b] = lane.inv_masses;
+        let (ia, moving_a) = state_of((lane.state_a, [m_a, i_a]));
+        let (ib, moving_b) = state_of((lane.state_b, [m_b, i_b]));
+        let copy = !objects.is_empty() && (is_copy(lane.body_a) || is_copy(lane.body_b));
         solved.push(SolvedContact {
             index: k as u32,
             state: [ia, ib],
@@ -579,42 +718,35 @@ pub(crate) fn build_constraints(
     let colours = &mut narrowphase.colours;
     colours.clear();
     for s in solved.iter() {
-        let c = &awake[s.index as usize];
-        rows += 2 * c.point_count;
-        bouncy += usize::from(c.restitution > 0.0);
+        let lane = &staged[s.index as usize].lane;
+        rows += 2 * lane.point_count;
+        bouncy += usize::from(lane.restitution > 0.0);
         colours.push(s.colour);
     }
-    let solved = &*solved;
-    solver.push_all(colours, |i| {
-        let s = &solved[i];
-        let k = s.index as usize;
-        let c = &awake[k];
-        let mut points = [ContactPointInput::default(); 2];
-        for (input, p) in points.iter_mut().zip(&c.points[..c.point_count]) {
-            *input = ContactPointInput {
-                anchor_a: p.anchor_a,
-                anchor_b: p.anchor_b,
-                separation: p.separation,
-                normal_impulse: p.normal_impulse,
-                tangent_impulse: p.tangent_impulse,
-            };
+    let (solved, staged) = (&*solved, &*staged);
+    let places = &mut narrowphase.places;
+    solver.push_all(
+        colours,
+        |i| {
+            let k = solved[i].index;
+            ContactLane {
+                contact_index: k,
+                ..staged[k as usize].lane
+            }
+        },
+        places,
+    );
+    // By contact, for storing the impulses on the threads (one thread
+    // stores by the solver's order and needs none of it).
+    let place_of = &mut narrowphase.place_of;
+    place_of.clear();
+    #[cfg(feature = "parallel")]
+    if rayon::current_num_threads() > 1 {
+        place_of.resize(n, UNSOLVED);
+        for (s, &place) in solved.iter().zip(places.iter()) {
+            place_of[s.index as usize] = place;
         }
-        let [ia, ib] = s.state;
-        let [(_, [m_a, i_a]), (_, [m_b, i_b])] = c.solve_bodies;
-        ContactLane {
-            body_a: c.body_a,
-            body_b: c.body_b,
-            state_a: ia,
-            state_b: ib,
-            inv_masses: [m_a, i_a, m_b, i_b],
-            normal: c.normal,
-            points,
-            point_count: c.point_count,
-            friction: c.friction,
-            restitution: c.restitution,
-            contact_index: k as u32,
-        }
-    });
+    }
     counters.contact_rows = rows;
     counters.restitution_contacts = bouncy;
 }
