@@ -412,6 +412,8 @@ pub struct SolverBody<'a> {
     pub sim: &'a BodySim,
     /// The body's current state (velocities, inverse mass).
     pub state: &'a BodyState,
+    /// The body is asleep (state index 0, with a sleeping body's data).
+    pub sleeping: bool,
 }
 
 /// Storage of every body, with generational handles.
@@ -1098,21 +1100,25 @@ impl BodySet {
                 state_index: i,
                 sim: &self.sims[i as usize],
                 state: &self.states[i as usize],
+                sleeping: false,
             },
             Some(BodyLocation::Static(j)) => SolverBody {
                 state_index: 0,
                 sim: &self.static_sims[j as usize],
                 state: &self.states[0],
+                sleeping: false,
             },
             Some(BodyLocation::Sleeping(j)) => SolverBody {
                 state_index: 0,
                 sim: &self.sleeping_sims[j as usize],
                 state: &self.states[0],
+                sleeping: true,
             },
             None => SolverBody {
                 state_index: 0,
                 sim: &self.identity_sim,
                 state: &self.states[0],
+                sleeping: false,
             },
         }
     }

@@ -320,7 +320,7 @@ impl BroadPhase {
     /// called once per candidate proxy pair; returning `false` drops it. Two
     /// distinct proxies with the same payload yield a pair `(p, p)`, which the
     /// filter may reject.
-    pub fn update_pairs<F: FnMut(u32, u32) -> bool>(
+    pub fn update_pairs<F: Fn(u32, u32) -> bool + Sync>(
         &mut self,
         filter: F,
         out: &mut Vec<(u32, u32)>,
@@ -333,10 +333,10 @@ impl BroadPhase {
     /// by the caller: one tree query per moved proxy, or (`bulk`) one
     /// simultaneous descent of the trees, cheaper when most proxies moved.
     /// Both report the same pairs.
-    fn update_pairs_with<F: FnMut(u32, u32) -> bool>(
+    fn update_pairs_with<F: Fn(u32, u32) -> bool + Sync>(
         &mut self,
         bulk: bool,
-        mut filter: F,
+        filter: F,
         out: &mut Vec<(u32, u32)>,
     ) {
         out.clear();
@@ -349,20 +349,24 @@ impl BroadPhase {
             s.alive && s.moved
         });
 
-        let mut report = |pa: u32, pb: u32| {
-            let (a, b) = (pa.min(pb), pa.max(pb));
-            if filter(a, b) {
-                out.push((a, b));
-            }
-        };
         #[cfg(feature = "parallel")]
-        if rayon::current_num_threads() > 1 && moves.len() >= PARALLEL_MOVES {
-            self.find_pairs_parallel(bulk, &moves, &mut |a, b| report(a, b));
+        let threads = rayon::current_num_threads() > 1 && moves.len() >= PARALLEL_MOVES;
+        #[cfg(not(feature = "parallel"))]
+        let threads = false;
+        if threads {
+            // The filter runs on the threads; the kept pairs come back in
+            // block order.
+            #[cfg(feature = "parallel")]
+            self.find_pairs_parallel(bulk, &moves, &filter, out);
         } else {
+            let mut report = |pa: u32, pb: u32| {
+                let (a, b) = (pa.min(pb), pa.max(pb));
+                if filter(a, b) {
+                    out.push((a, b));
+                }
+            };
             self.find_pairs_serial(bulk, &moves, &mut report);
         }
-        #[cfg(not(feature = "parallel"))]
-        self.find_pairs_serial(bulk, &moves, &mut report);
 
         for &m in &moves {
             self.proxies[m as usize].moved = false;
@@ -413,18 +417,26 @@ impl BroadPhase {
 
     /// [`BroadPhase::find_pairs_serial`] on rayon: the moved proxies' queries
     /// (or the seeds of the bulk descent) in blocks, each block's pairs
-    /// collected on its own, then reported in block order. The pairs are
-    /// sorted afterwards, so the result is the serial one.
+    /// (ordered, and kept by `filter`) collected on its own, then appended
+    /// to `out` in block order. The pairs are sorted afterwards, so the
+    /// result is the serial one.
     #[cfg(feature = "parallel")]
     fn find_pairs_parallel(
         &mut self,
         bulk: bool,
         moves: &[u32],
-        report: &mut impl FnMut(u32, u32),
+        filter: &(impl Fn(u32, u32) -> bool + Sync),
+        out: &mut Vec<(u32, u32)>,
     ) {
         use rayon::prelude::*;
         let proxies = &self.proxies;
         let (dynamic, fixed) = (&self.dynamic_tree, &self.static_tree);
+        let keep_pair = |pairs: &mut Vec<(u32, u32)>, pa: u32, pb: u32| {
+            let (a, b) = (pa.min(pb), pa.max(pb));
+            if filter(a, b) {
+                pairs.push((a, b));
+            }
+        };
         let found: Vec<Vec<(u32, u32)>> = if bulk {
             let want = 64 * rayon::current_num_threads();
             let mut seeds = Vec::new();
@@ -446,7 +458,7 @@ impl BroadPhase {
                         dynamic.for_each_pair_from(other, seed, &mut stack, |x, y| {
                             let (sx, sy) = (&proxies[x as usize], &proxies[y as usize]);
                             if sx.moved || sy.moved {
-                                pairs.push((sx.payload, sy.payload));
+                                keep_pair(&mut pairs, sx.payload, sy.payload);
                             }
                         });
                     }
@@ -464,7 +476,7 @@ impl BroadPhase {
                         let mut visit = |other: u32| {
                             let o = &proxies[other as usize];
                             if other != m && !(o.moved && other < m) {
-                                pairs.push((slot.payload, o.payload));
+                                keep_pair(&mut pairs, slot.payload, o.payload);
                             }
                             true
                         };
@@ -477,8 +489,8 @@ impl BroadPhase {
                 })
                 .collect()
         };
-        for (a, b) in found.into_iter().flatten() {
-            report(a, b);
+        for pairs in found {
+            out.extend(pairs);
         }
     }
 
@@ -611,17 +623,17 @@ mod tests {
         for bulk in [false, true] {
             let mut copy = bp.clone();
             let mut pairs = Vec::new();
-            let mut calls = 0usize;
+            let calls = std::sync::atomic::AtomicUsize::new(0);
             copy.update_pairs_with(
                 bulk,
                 |_, _| {
-                    calls += 1;
+                    calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                     true
                 },
                 &mut pairs,
             );
             assert_eq!(pairs, expected, "{label}, bulk = {bulk}");
-            assert_eq!(calls, expected.len(), "{label}, bulk = {bulk}");
+            assert_eq!(calls.into_inner(), expected.len(), "{label}, bulk = {bulk}");
         }
     }
 
@@ -727,17 +739,18 @@ mod tests {
         let mut results = Vec::new();
         for bulk in [false, true] {
             let mut copy = bp.clone();
-            let mut counts: BTreeMap<(u32, u32), u32> = BTreeMap::new();
+            let counts = std::sync::Mutex::new(BTreeMap::<(u32, u32), u32>::new());
             let mut pairs = Vec::new();
             copy.update_pairs_with(
                 bulk,
                 |a, b| {
                     assert!(a <= b);
-                    *counts.entry((a, b)).or_default() += 1;
+                    *counts.lock().unwrap().entry((a, b)).or_default() += 1;
                     true
                 },
                 &mut pairs,
             );
+            let counts = counts.into_inner().unwrap();
             assert!(counts.values().all(|&c| c == 1), "a pair was found twice");
             assert_eq!(counts.len(), pairs.len());
             results.push(pairs);

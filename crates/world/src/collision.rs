@@ -206,46 +206,20 @@ impl Collision {
         self.refind_pairs_of(b);
     }
 
-    fn should_pair(&self, bodies: &BodySet, no_collide: &NoCollide, a: u32, b: u32) -> bool {
-        let (sa, sb) = (self.shapes.at(a), self.shapes.at(b));
-        if sa.body == sb.body {
-            return false;
-        }
-        if !sa.def.filter.should_collide(&sb.def.filter) {
-            return false;
-        }
-        let ta = bodies.body_type(sa.body).unwrap_or(BodyType::Static);
-        let tb = bodies.body_type(sb.body).unwrap_or(BodyType::Static);
-        if ta != BodyType::Dynamic && tb != BodyType::Dynamic {
-            return false;
-        }
-        !no_collide.contains(sa.body, sb.body)
-    }
-
     /// Finds new pairs among moved proxies and creates their contacts.
     pub(crate) fn update_pairs(&mut self, bodies: &BodySet, no_collide: &NoCollide) {
         let mut candidates = std::mem::take(&mut self.candidates);
         candidates.clear();
-        self.broadphase.update_pairs(|_, _| true, &mut candidates);
-        // The candidates are distinct pairs, so whether one is new does not
-        // depend on the others: with the `parallel` feature the test runs
-        // on rayon (in order-keeping blocks), then the contacts are created
-        // here in candidate order either way.
-        let keep = |&(a, b): &(u32, u32)| {
+        // Only new pairs are kept, as the broadphase finds them (on the
+        // threads with `parallel`): most pairs a moved proxy overlaps
+        // already have a contact and are dropped before they are collected
+        // and sorted. The contacts are created here in pair order.
+        let (shapes, contacts) = (&self.shapes, &self.contacts);
+        let keep = |a: u32, b: u32| {
             let (a, b) = crate::contacts::pair_key(a, b);
-            !self.contacts.has_pair(a, b) && self.should_pair(bodies, no_collide, a, b)
+            !contacts.has_pair(a, b) && should_pair(shapes, bodies, no_collide, a, b)
         };
-        #[cfg(feature = "parallel")]
-        if rayon::current_num_threads() > 1 && candidates.len() >= 512 {
-            use rayon::prelude::*;
-            let kept: Vec<bool> = candidates.par_iter().map(keep).collect();
-            let mut flags = kept.into_iter();
-            candidates.retain(|_| flags.next().unwrap_or(false));
-        } else {
-            candidates.retain(keep);
-        }
-        #[cfg(not(feature = "parallel"))]
-        candidates.retain(keep);
+        self.broadphase.update_pairs(keep, &mut candidates);
         let mut created = 0;
         for &(a, b) in &candidates {
             let (a, b) = crate::contacts::pair_key(a, b);
@@ -328,7 +302,7 @@ impl Collision {
         };
         #[cfg(feature = "parallel")]
         {
-            let places = self.narrowphase.places();
+            let places = self.narrowphase.places_by_contact();
             if rayon::current_num_threads() > 1
                 && places.len() > 4096
                 && places.len() == contacts.awake().len()
@@ -501,4 +475,29 @@ pub fn bounded(aabb: Aabb) -> Aabb {
         Vec2::new(lx.min(ux), ly.min(uy)),
         Vec2::new(lx.max(ux), ly.max(uy)),
     )
+}
+
+/// Whether shapes `a` and `b` (slot indices) may have a contact: on
+/// different bodies, passing each other's filter, one of them dynamic,
+/// and their bodies not jointed with collision off.
+fn should_pair(
+    shapes: &ShapeStore,
+    bodies: &BodySet,
+    no_collide: &NoCollide,
+    a: u32,
+    b: u32,
+) -> bool {
+    let (sa, sb) = (shapes.at(a), shapes.at(b));
+    if sa.body == sb.body {
+        return false;
+    }
+    if !sa.def.filter.should_collide(&sb.def.filter) {
+        return false;
+    }
+    let ta = bodies.body_type(sa.body).unwrap_or(BodyType::Static);
+    let tb = bodies.body_type(sb.body).unwrap_or(BodyType::Static);
+    if ta != BodyType::Dynamic && tb != BodyType::Dynamic {
+        return false;
+    }
+    !no_collide.contains(sa.body, sb.body)
 }

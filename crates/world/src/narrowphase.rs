@@ -217,13 +217,15 @@ pub(crate) struct NarrowphaseInput<'a> {
     pub(crate) bodies: &'a BodySet,
     pub(crate) dt: Real,
     pub(crate) clipping: &'a ContactClipping,
+    /// `clipping.is_empty()`, read once per step rather than per contact.
+    pub(crate) unclipped: bool,
 }
 
 impl Narrowphase {
     /// Where the solver holds each awake contact's impulses this step, by
     /// awake position (as the last constraint building left them).
     #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
-    pub(crate) fn places(&self) -> &[LanePlace] {
+    pub(crate) fn places_by_contact(&self) -> &[LanePlace] {
         &self.place_of
     }
 
@@ -369,15 +371,24 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
             .max((aabb.upper - center).abs())
             .length()
     };
+    let (reach_a, reach_b) = (reach(&sa.aabb, sim_a.center), reach(&sb.aabb, sim_b.center));
     let approach = (body_b.state.v - body_a.state.v).length()
-        + body_a.state.w.abs() * reach(&sa.aabb, sim_a.center)
-        + body_b.state.w.abs() * reach(&sb.aabb, sim_b.center);
+        + body_a.state.w.abs() * reach_a
+        + body_b.state.w.abs() * reach_b;
     let speculative = SPECULATIVE_DISTANCE + input.dt * approach;
     // Not where a portal clips manifolds or a sleeping body may need waking.
-    let recyclable = input.clipping.is_empty()
-        && !input.bodies.is_sleeping(c.body_a)
-        && !input.bodies.is_sleeping(c.body_b);
-    if recyclable && recycle(c, &body_a, &body_b, &sa.aabb, &sb.aabb) {
+    let recyclable = input.unclipped && !body_a.sleeping && !body_b.sleeping;
+    // How far a turn of either body moves its shape (static bodies turn
+    // not at all).
+    let turning_reach = |sim: &janus2d_core::body::BodySim, reach: Real| {
+        if sim.body_type == BodyType::Static {
+            0.0
+        } else {
+            reach
+        }
+    };
+    let extent = turning_reach(sim_a, reach_a).max(turning_reach(sim_b, reach_b));
+    if recyclable && recycle(c, &body_a, &body_b, extent) {
         c.still = [body_a.state_index == 0, body_b.state_index == 0];
         c.solve_bodies = [solve_body(&body_a), solve_body(&body_b)];
         return ContactUpdate::Updated {
@@ -402,7 +413,7 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
             speculative,
         )
     };
-    if !input.clipping.is_empty() {
+    if !input.unclipped {
         // Before the manifold is stored, so that points made at aperture
         // edges warm-start by their ids like any other.
         let motion = crate::portal::PairMotion {
@@ -440,16 +451,13 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
     c.still = [body_a.state_index == 0, body_b.state_index == 0];
     c.solve_bodies = [solve_body(&body_a), solve_body(&body_b)];
     c.touching = c.point_count > 0;
-    let wake = c.touching && {
-        let other = if c.still[0] {
-            Some(c.body_a)
-        } else if c.still[1] {
-            Some(c.body_b)
+    // The still body (if any) is asleep: it wakes.
+    let wake = c.touching
+        && if c.still[0] {
+            body_a.sleeping
         } else {
-            None
+            c.still[1] && body_b.sleeping
         };
-        other.is_some_and(|b| input.bodies.is_sleeping(b))
-    };
     ContactUpdate::Updated {
         was_touching,
         touching: c.touching,
@@ -486,7 +494,7 @@ fn centre_frame(sim: &janus2d_core::body::BodySim) -> Transform {
 /// anchors reach the same world point), and the reported point follows
 /// body a. "Little": both rotations within [`CONTACT_RECYCLE_COS_ANGLE`]
 /// and the relative pose's motion (its translation plus the rotation swept
-/// at the moving shapes' reach) under [`CONTACT_RECYCLE_DISTANCE`]. The
+/// at the moving shapes' reach, `extent`) under [`CONTACT_RECYCLE_DISTANCE`]. The
 /// ids and kept impulses stay as they are. Returns false (recompute)
 /// otherwise.
 ///
@@ -499,8 +507,7 @@ fn recycle(
     c: &mut Contact,
     body_a: &janus2d_core::body::SolverBody<'_>,
     body_b: &janus2d_core::body::SolverBody<'_>,
-    aabb_a: &Aabb,
-    aabb_b: &Aabb,
+    extent: Real,
 ) -> bool {
     let cache = c.recycle;
     if !cache.valid || !c.touching {
@@ -512,20 +519,9 @@ fn recycle(
     if relative_cos(q_a, cache.q_a).min(relative_cos(q_b, cache.q_b)) <= CONTACT_RECYCLE_COS_ANGLE {
         return false;
     }
-    let reach = |sim: &janus2d_core::body::BodySim, aabb: &Aabb| {
-        if sim.body_type == BodyType::Static {
-            0.0
-        } else {
-            (aabb.lower - sim.center)
-                .abs()
-                .max((aabb.upper - sim.center).abs())
-                .length()
-        }
-    };
     let relative = centre_frame(sim_a).inv_mul(&centre_frame(sim_b));
     let distance = (relative.p - cache.relative.p).length();
     let turn = relative.q.inv_mul(cache.relative.q).s.abs();
-    let extent = reach(sim_a, aabb_a).max(reach(sim_b, aabb_b));
     // (NaN poses recompute.)
     let moved = distance + extent * turn;
     if moved.is_nan() || moved >= CONTACT_RECYCLE_DISTANCE {

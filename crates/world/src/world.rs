@@ -1457,6 +1457,7 @@ impl World {
                 bodies: &self.bodies,
                 dt,
                 clipping: self.portals.clipping(),
+                unclipped: self.portals.clipping().is_empty(),
             };
             c.narrowphase.run(
                 &input,
