@@ -106,6 +106,9 @@ pub struct BroadPhase {
     move_buffer: Vec<u32>,
     /// Scratch stack of the simultaneous tree descent.
     pair_stack: Vec<(u32, u32)>,
+    /// Scratch of the dynamic tree's partial rebuild.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    rebuild_items: Vec<u32>,
 }
 
 impl Default for BroadPhase {
@@ -131,6 +134,7 @@ impl BroadPhase {
             free_proxies: Vec::new(),
             move_buffer: Vec::new(),
             pair_stack: Vec::new(),
+            rebuild_items: Vec::new(),
         }
     }
 
@@ -225,6 +229,33 @@ impl BroadPhase {
             self.mark_moved(proxy);
         }
         reinserted
+    }
+
+    /// [`move_proxy`](Self::move_proxy) for one of a batch of moves: a
+    /// movable proxy's tree is not restructured per move (see
+    /// [`DynamicTree::enlarge_proxy`]); [`finish_moves`](Self::finish_moves)
+    /// must follow the batch, before any query or pair search.
+    pub fn move_proxy_in_batch(&mut self, proxy: u32, aabb: Aabb) -> bool {
+        let slot = self.slot(proxy);
+        if slot.fat.contains(&aabb) {
+            return false;
+        }
+        if slot.is_static {
+            return self.move_proxy(proxy, aabb);
+        }
+        let moved = self.dynamic_tree.enlarge_proxy(slot.leaf, aabb);
+        if moved {
+            self.proxies[proxy as usize].fat = self.dynamic_tree.fat_aabb(slot.leaf);
+            self.mark_moved(proxy);
+        }
+        moved
+    }
+
+    /// Ends a batch of [`move_proxy_in_batch`](Self::move_proxy_in_batch):
+    /// one partial rebuild of the movable proxies' tree
+    /// ([`DynamicTree::rebuild`]).
+    pub fn finish_moves(&mut self) {
+        self.dynamic_tree.rebuild(&mut self.rebuild_items);
     }
 
     /// True when `proxy` names a live proxy (never panics; for checks).

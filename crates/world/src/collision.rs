@@ -366,11 +366,15 @@ impl Collision {
                         aabb.upper + sweep.max(Vec2::ZERO),
                     );
                 }
-                if self.broadphase.move_proxy(shape.proxy, bounded(aabb)) {
+                if self
+                    .broadphase
+                    .move_proxy_in_batch(shape.proxy, bounded(aabb))
+                {
                     moved += 1;
                 }
             }
         }
+        self.broadphase.finish_moves();
         self.counters.proxies_moved = moved;
     }
 
@@ -410,10 +414,14 @@ impl Collision {
         for (s, tight, query) in blocks.into_iter().flatten() {
             let shape = self.shapes.at_mut(s);
             shape.aabb = tight;
-            if self.broadphase.move_proxy(shape.proxy, bounded(query)) {
+            if self
+                .broadphase
+                .move_proxy_in_batch(shape.proxy, bounded(query))
+            {
                 moved += 1;
             }
         }
+        self.broadphase.finish_moves();
         self.counters.proxies_moved = moved;
     }
 
