@@ -557,6 +557,19 @@ impl ContactSet {
         }
     }
 
+    /// Moves the awake contact at position `i`, whose bodies are both still
+    /// (asleep, or asleep and static), into the sleeping list, as
+    /// [`ContactSet::sleep_body`] does when a body falls asleep: a contact
+    /// found between bodies that were created asleep. The last awake
+    /// contact moves to `i`.
+    pub(crate) fn sleep_awake_at(&mut self, i: usize) {
+        let id = self.awake[i].id;
+        let mut c = self.unlink(id).expect("listed contact");
+        c.still = [true, true];
+        self.place[id as usize] = Place::Sleeping(self.sleeping.len() as u32);
+        self.sleeping.push(c);
+    }
+
     /// Moves the sleeping contacts of a body that woke back to the awake
     /// list (appended, in the body's list order).
     pub fn wake_body(&mut self, body: BodyHandle) {

@@ -11,7 +11,8 @@
 //!     else                   → Updated: collide(a, b, speculative) stored
 //!                              (impulses carried by feature id), aperture
 //!                              clipping applied, touching flag set
-//! phase 2 (contact order)    destroy separated, begin/end events, list
+//! phase 2 (contact order)    destroy separated, move asleep ones to the
+//!                            sleeping list, begin/end events, list
 //!                            bodies to wake
 //! build                      one ContactConstraint per touching solid
 //!                            contact: moving pairs first, static ones last
@@ -299,7 +300,14 @@ impl Narrowphase {
         while k < contacts.awake().len() {
             let (was_touching, touching, solid, wakes) = match results[k] {
                 ContactUpdate::Asleep => {
-                    k += 1;
+                    // Between bodies that sleep (or sleep and are static):
+                    // no step reads it until one of them wakes, which
+                    // brings it back. (Contacts found between bodies
+                    // created asleep come here; the rest go when a body
+                    // falls asleep.)
+                    staged.swap(k, contacts.awake().len() - 1);
+                    contacts.sleep_awake_at(k);
+                    results.swap_remove(k);
                     continue;
                 }
                 ContactUpdate::Separated => {
