@@ -251,6 +251,21 @@ pub struct ContactSet {
     /// Body pairs whose solid contact stopped touching or was destroyed
     /// while touching (their islands may split).
     pub(crate) ended: Vec<(BodyHandle, BodyHandle)>,
+    /// By contact id: its bodies and whether it touches solidly, kept as
+    /// contacts come, go and begin or stop touching, so that an island
+    /// split walks a body's links without reading the contacts themselves
+    /// (junkyard: half of the sleep stage was that read).
+    links: Vec<ContactLink>,
+}
+
+/// What an island split needs of a contact (see [`ContactSet::links_of`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+struct ContactLink {
+    /// Body a, body b.
+    bodies: [BodyHandle; 2],
+    /// Touching, not a sensor, enabled.
+    solid: bool,
 }
 
 impl ContactSet {
@@ -275,6 +290,21 @@ impl ContactSet {
     /// Every contact: awake ones first, then sleeping ones.
     pub fn iter(&self) -> impl Iterator<Item = &Contact> {
         self.awake.iter().chain(&self.sleeping)
+    }
+
+    /// The bodies that `body`'s solid touching contacts link it to, in the
+    /// body's contact order.
+    pub(crate) fn links_of(&self, body: BodyHandle) -> impl Iterator<Item = BodyHandle> + '_ {
+        self.of_body(body).iter().filter_map(move |&id| {
+            let link = self.links.get(id as usize)?;
+            link.solid.then(|| {
+                if link.bodies[0] == body {
+                    link.bodies[1]
+                } else {
+                    link.bodies[0]
+                }
+            })
+        })
     }
 
     /// True when shapes `a` and `b` (slots) have a contact.
@@ -352,6 +382,13 @@ impl ContactSet {
                 };
                 if self.place.get(c.id as usize) != Some(&expected) {
                     return Err(format!("contact {}: place is not {expected:?}", c.id));
+                }
+                let link = ContactLink {
+                    bodies: [c.body_a, c.body_b],
+                    solid: c.is_solid_touching(),
+                };
+                if self.links.get(c.id as usize) != Some(&link) {
+                    return Err(format!("contact {}: its island link is stale", c.id));
                 }
                 for (shape, other) in [(c.shape_a, c.shape_b), (c.shape_b, c.shape_a)] {
                     let list = self
@@ -433,6 +470,14 @@ impl ContactSet {
             }
         };
         c.id = id;
+        let link = ContactLink {
+            bodies: [c.body_a, c.body_b],
+            solid: c.is_solid_touching(),
+        };
+        if self.links.len() <= id as usize {
+            self.links.resize(id as usize + 1, link);
+        }
+        self.links[id as usize] = link;
         for (shape, other) in [(c.shape_a, c.shape_b), (c.shape_b, c.shape_a)] {
             let s = shape as usize;
             if self.shape_pairs.len() <= s {
@@ -478,6 +523,9 @@ impl ContactSet {
         let Some(c) = self.unlink(id) else {
             return;
         };
+        if let Some(link) = self.links.get_mut(id as usize) {
+            link.solid = false;
+        }
         for shape in [c.shape_a, c.shape_b] {
             if let Some(list) = self.shape_pairs.get_mut(shape as usize)
                 && let Some(k) = list.iter().position(|&(_, x)| x == id)
@@ -503,7 +551,15 @@ impl ContactSet {
 
     /// Records that a solid contact between two bodies began (`true`) or
     /// stopped touching, for the islands.
-    pub(crate) fn note_touch_change(&mut self, pair: (BodyHandle, BodyHandle), touching: bool) {
+    pub(crate) fn note_touch_change(
+        &mut self,
+        id: u32,
+        pair: (BodyHandle, BodyHandle),
+        touching: bool,
+    ) {
+        if let Some(link) = self.links.get_mut(id as usize) {
+            link.solid = touching;
+        }
         if touching {
             self.began.push(pair);
         } else {

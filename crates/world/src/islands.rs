@@ -539,10 +539,7 @@ impl Islands {
             self.stack.push(start);
             while let Some(b) = self.stack.pop() {
                 part.push(b);
-                let via_contacts = contacts.of_body(b).iter().filter_map(|&c| {
-                    let c = contacts.get(c)?;
-                    c.is_solid_touching().then(|| c.other(b))
-                });
+                let via_contacts = contacts.links_of(b);
                 let via_joints = joints.of_body(b).iter().filter_map(|&j| {
                     let joint = joints.revolute(j).ok()?;
                     joint.enabled.then(|| {

@@ -343,8 +343,8 @@ impl Narrowphase {
                 let c = contacts.awake_mut(k);
                 events.push(c, touching);
                 if !c.sensor && c.enabled {
-                    let pair = (c.body_a, c.body_b);
-                    contacts.note_touch_change(pair, touching);
+                    let (id, pair) = (c.id, (c.body_a, c.body_b));
+                    contacts.note_touch_change(id, pair, touching);
                 }
             }
             k += 1;

@@ -170,8 +170,9 @@ pub mod bytes {
     /// The magic at the start of every snapshot.
     pub const SNAPSHOT_MAGIC: [u8; 4] = *b"JNS2";
     /// The format version this build writes and reads (2: contacts keep
-    /// their recycling cache).
-    pub const SNAPSHOT_VERSION: u16 = 2;
+    /// their recycling cache; 3: the contact set keeps each contact's
+    /// island link).
+    pub const SNAPSHOT_VERSION: u16 = 3;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.
