@@ -256,6 +256,12 @@ pub struct ContactSet {
     /// split walks a body's links without reading the contacts themselves
     /// (junkyard: half of the sleep stage was that read).
     links: Vec<ContactLink>,
+    /// By contact id: its position in the pair list of shape a and of
+    /// shape b, so that destroying it scans neither list (a large shape,
+    /// washer's drum or a ground, lists thousands of contacts). Kept beside
+    /// the contacts, not in them: fixing the slot of the entry a removal
+    /// moves then touches this small array, not another contact.
+    pair_slots: Vec<[u32; 2]>,
 }
 
 /// What an island split needs of a contact (see [`ContactSet::links_of`]).
@@ -390,7 +396,13 @@ impl ContactSet {
                 if self.links.get(c.id as usize) != Some(&link) {
                     return Err(format!("contact {}: its island link is stale", c.id));
                 }
-                for (shape, other) in [(c.shape_a, c.shape_b), (c.shape_b, c.shape_a)] {
+                if c.shape_a >= c.shape_b {
+                    return Err(format!("contact {}: shapes out of order", c.id));
+                }
+                for (side, (shape, other)) in [(c.shape_a, c.shape_b), (c.shape_b, c.shape_a)]
+                    .into_iter()
+                    .enumerate()
+                {
                     let list = self
                         .shape_pairs
                         .get(shape as usize)
@@ -398,6 +410,13 @@ impl ContactSet {
                     if list.iter().filter(|&&e| e == (other, c.id)).count() != 1 {
                         return Err(format!(
                             "contact {}: not listed once under shape {shape}",
+                            c.id
+                        ));
+                    }
+                    let slot = self.pair_slots.get(c.id as usize).map(|s| s[side] as usize);
+                    if slot.and_then(|k| list.get(k)) != Some(&(other, c.id)) {
+                        return Err(format!(
+                            "contact {}: its slot under shape {shape} is stale",
                             c.id
                         ));
                     }
@@ -478,11 +497,18 @@ impl ContactSet {
             self.links.resize(id as usize + 1, link);
         }
         self.links[id as usize] = link;
-        for (shape, other) in [(c.shape_a, c.shape_b), (c.shape_b, c.shape_a)] {
+        if self.pair_slots.len() <= id as usize {
+            self.pair_slots.resize(id as usize + 1, [0; 2]);
+        }
+        for (side, (shape, other)) in [(c.shape_a, c.shape_b), (c.shape_b, c.shape_a)]
+            .into_iter()
+            .enumerate()
+        {
             let s = shape as usize;
             if self.shape_pairs.len() <= s {
                 self.shape_pairs.resize(s + 1, SmallVec::new());
             }
+            self.pair_slots[id as usize][side] = self.shape_pairs[s].len() as u32;
             self.shape_pairs[s].push((other, id));
         }
         for body in [c.body_a, c.body_b] {
@@ -526,11 +552,28 @@ impl ContactSet {
         if let Some(link) = self.links.get_mut(id as usize) {
             link.solid = false;
         }
-        for shape in [c.shape_a, c.shape_b] {
-            if let Some(list) = self.shape_pairs.get_mut(shape as usize)
-                && let Some(k) = list.iter().position(|&(_, x)| x == id)
+        let slots = self.pair_slots.get(id as usize).copied();
+        for (side, shape) in [c.shape_a, c.shape_b].into_iter().enumerate() {
+            let Some(list) = self.shape_pairs.get_mut(shape as usize) else {
+                continue;
+            };
+            let k = match slots.map(|s| s[side] as usize) {
+                Some(k) if list.get(k).is_some_and(|&(_, x)| x == id) => k,
+                // Not where insert put it (only a decoded snapshot's lists
+                // could be; `check` reports them): find it.
+                _ => match list.iter().position(|&(_, x)| x == id) {
+                    Some(k) => k,
+                    None => continue,
+                },
+            };
+            list.swap_remove(k);
+            // The last entry moved into k: its contact's slot there. A
+            // contact's shape a is the smaller slot (pairs are created
+            // ordered), so the entry itself says which side this list is.
+            if let Some(&(other, moved)) = list.get(k)
+                && let Some(slot) = self.pair_slots.get_mut(moved as usize)
             {
-                list.swap_remove(k);
+                slot[usize::from(shape > other)] = k as u32;
             }
         }
         for body in [c.body_a, c.body_b] {
