@@ -380,10 +380,6 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
             .length()
     };
     let (reach_a, reach_b) = (reach(&sa.aabb, sim_a.center), reach(&sb.aabb, sim_b.center));
-    let approach = (body_b.state.v - body_a.state.v).length()
-        + body_a.state.w.abs() * reach_a
-        + body_b.state.w.abs() * reach_b;
-    let speculative = SPECULATIVE_DISTANCE + input.dt * approach;
     // Not where a portal clips manifolds or a sleeping body may need waking.
     let recyclable = input.unclipped && !body_a.sleeping && !body_b.sleeping;
     // How far a turn of either body moves its shape (static bodies turn
@@ -406,6 +402,12 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
             wake: false,
         };
     }
+    // (A recycled manifold needs no speculative distance, nor the bodies'
+    // velocities: their states are read only here.)
+    let approach = (body_b.state.v - body_a.state.v).length()
+        + body_a.state.w.abs() * reach_a
+        + body_b.state.w.abs() * reach_b;
+    let speculative = SPECULATIVE_DISTANCE + input.dt * approach;
     // The tight boxes (of the current poses) apart by more than the
     // speculative distance along x or y: the shapes are too, no point can
     // come within it, and the manifold is empty without computing it.
