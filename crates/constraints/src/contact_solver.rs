@@ -45,6 +45,7 @@ use janus2d_core::parallel::{PlannedStates, StatePlan, Team};
 use wide::{CmpEq, CmpGe, CmpGt, CmpLt, CmpNe};
 
 use crate::contact::{ContactConstraint, ContactPointInput, MAX_MANIFOLD_POINTS, ROWS};
+use crate::contact_group::{Groups, solve_group};
 
 /// Lanes of the SIMD type.
 #[cfg(not(feature = "f64"))]
@@ -221,8 +222,13 @@ pub struct ContactLane {
 pub struct ContactSolver {
     /// Chunks per colour; the last chunk of a colour may have free lanes.
     colours: Vec<Vec<WideContact>>,
-    /// Contacts solved one by one.
+    /// Contacts solved one by one (or in the coupled groups of light
+    /// bodies, see [`crate::contact_group`]).
     overflow: Vec<ContactConstraint>,
+    /// Per overflow contact: it builds on a portal object's masses.
+    hooked: Vec<bool>,
+    /// The coupled groups of the overflow's light bodies.
+    groups: Groups,
     /// The colouring of this step.
     graph: ColourGraph,
     /// Number of contacts pushed since [`ContactSolver::begin`].
@@ -476,13 +482,16 @@ impl ContactSolver {
             let verified = self.plan.verify(states.len());
             debug_assert!(verified, "a colour holds a moving body twice");
         }
+        self.hooked.clear();
         for c in &mut self.overflow {
             c.prepare(ctx, bodies);
             if objects.is_empty() {
+                self.hooked.push(false);
                 continue;
             }
             let find = |body| objects.iter().find(|o| o.body == body);
             let (oa, ob) = (find(c.body_a), find(c.body_b));
+            self.hooked.push(oa.is_some() || ob.is_some());
             if oa.is_some() || ob.is_some() {
                 let [m_a, i_a, m_b, i_b] = c.applied_masses;
                 let (m_a, i_a) = oa.map_or((m_a, i_a), |o| (o.inv_mass, o.inv_inertia));
@@ -494,6 +503,8 @@ impl ContactSolver {
                 c.block = false;
             }
         }
+        self.groups
+            .build(ctx, &mut self.overflow, &self.hooked, states.len());
     }
 
     fn warm_start(&mut self, states: &mut [BodyState], team: &Team) {
@@ -525,11 +536,44 @@ impl ContactSolver {
             let chunks = &mut self.colours[colour];
             colour_stage(team, &self.plan, colour, chunks, states, stage);
         }
-        for c in &mut self.overflow {
+        self.solve_overflow(states, use_bias, inv_h, push_max);
+    }
+
+    /// The overflow: its contacts one by one, then the coupled groups of
+    /// light bodies ([`crate::contact_group`]).
+    fn solve_overflow(
+        &mut self,
+        states: &mut [BodyState],
+        use_bias: bool,
+        inv_h: Real,
+        push_max: Real,
+    ) {
+        let grouped = &self.groups.grouped;
+        for (k, c) in self.overflow.iter_mut().enumerate() {
+            if grouped.get(k).copied().unwrap_or(false) {
+                continue;
+            }
             if use_bias {
                 c.solve_rows::<true>(states, inv_h, push_max);
             } else {
                 c.solve_rows::<false>(states, inv_h, push_max);
+            }
+        }
+        for g in &self.groups.groups {
+            let solved = if use_bias {
+                solve_group::<true>(g, &mut self.overflow, states, inv_h, push_max)
+            } else {
+                solve_group::<false>(g, &mut self.overflow, states, inv_h, push_max)
+            };
+            if !solved {
+                for &k in g.members() {
+                    let c = &mut self.overflow[k as usize];
+                    if use_bias {
+                        c.solve_rows::<true>(states, inv_h, push_max);
+                    } else {
+                        c.solve_rows::<false>(states, inv_h, push_max);
+                    }
+                }
             }
         }
     }

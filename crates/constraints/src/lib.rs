@@ -15,6 +15,7 @@
 //! without bias) and reports its rows through `Constraint::rows`.
 
 pub mod contact;
+pub mod contact_group;
 pub mod contact_solver;
 pub mod joint_tree;
 pub mod parts;
