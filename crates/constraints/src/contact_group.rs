@@ -84,7 +84,7 @@
 
 use janus2d_core::body::BodyState;
 use janus2d_core::constraint::StepContext;
-use janus2d_core::math::Real;
+use janus2d_core::math::{Real, from_f64, to_f64};
 
 use crate::contact::ContactConstraint;
 
@@ -135,13 +135,14 @@ pub(crate) struct Groups {
 }
 
 impl Groups {
-    /// Forms the groups of the overflow contacts (`hooked[c]`: the contact
-    /// builds on a portal object's masses and takes no part) and stiffens
-    /// their rows (module docs).
+    /// Forms the groups of the overflow contacts the pipeline marked
+    /// `coupled` (less those that build on a portal object's masses,
+    /// `hooked`) and stiffens their rows (module docs).
     pub(crate) fn build(
         &mut self,
         ctx: &StepContext,
         overflow: &mut [ContactConstraint],
+        coupled: &[bool],
         hooked: &[bool],
         state_count: usize,
     ) {
@@ -151,7 +152,13 @@ impl Groups {
         if overflow.is_empty() {
             return;
         }
-        let free = |c: usize| !hooked.get(c).copied().unwrap_or(false);
+        // Only the light bodies' own contacts: every one of a light body's
+        // contacts is marked, and each marked contact has its light body
+        // on one side, so the light bodies found among them are the
+        // pipeline's.
+        let free = |c: usize| {
+            coupled.get(c).copied().unwrap_or(false) && !hooked.get(c).copied().unwrap_or(false)
+        };
         self.heaviest.clear();
         self.heaviest.resize(state_count, [Real::INFINITY, 0.0]);
         self.lightest.clear();
@@ -262,24 +269,17 @@ pub(crate) fn solve_group<const USE_BIAS: bool>(
     let side = |k: usize, i: usize| {
         let c = &overflow[k];
         let [m_a, i_a, m_b, i_b] = c.applied_masses;
-        let (nx, ny) = (f64::from(c.normal.x), f64::from(c.normal.y));
+        let (nx, ny) = (to_f64(c.normal.x), to_f64(c.normal.y));
         [
             (
                 c.state_a,
                 -nx,
                 -ny,
-                -f64::from(c.ja[i]),
-                f64::from(m_a),
-                f64::from(i_a),
+                -to_f64(c.ja[i]),
+                to_f64(m_a),
+                to_f64(i_a),
             ),
-            (
-                c.state_b,
-                nx,
-                ny,
-                f64::from(c.jb[i]),
-                f64::from(m_b),
-                f64::from(i_b),
-            ),
+            (c.state_b, nx, ny, to_f64(c.jb[i]), to_f64(m_b), to_f64(i_b)),
         ]
     };
     let mut k_mat = [[0.0f64; GROUP_ROWS]; GROUP_ROWS];
@@ -311,9 +311,9 @@ pub(crate) fn solve_group<const USE_BIAS: bool>(
         let c_dot = (sb.v - sa.v).dot(nrm) + (sb.w * c.jb[i] - sa.w * c.ja[i]);
         let dpn = (sb.dp - sa.dp).dot(nrm);
         let (bias, ms, _) = c.normal_terms::<USE_BIAS>(i, dpn, sa.dq, sb.dq, inv_h, push_max);
-        old[r] = f64::from(c.impulse[i]);
-        rhs[r] = -(f64::from(c_dot) + f64::from(bias));
-        diag[r] = k_mat[r][r] / f64::from(ms);
+        old[r] = to_f64(c.impulse[i]);
+        rhs[r] = -(to_f64(c_dot) + to_f64(bias));
+        diag[r] = k_mat[r][r] / to_f64(ms);
     }
     for r in 0..n {
         for s in 0..n {
@@ -345,7 +345,7 @@ pub(crate) fn solve_group<const USE_BIAS: bool>(
         let (k, i) = rows[r];
         let c = &mut overflow[k];
         let new = if active[r] {
-            x[r].max(0.0) as Real
+            from_f64(x[r].max(0.0))
         } else {
             0.0
         };
@@ -397,7 +397,8 @@ fn cholesky_solve(
                 sum -= l[i][p] * l[j][p];
             }
             if i == j {
-                if !(sum > 1e-9 * a) {
+                // Also false for a NaN pivot.
+                if sum.is_nan() || sum <= 1e-9 * a {
                     return false;
                 }
                 l[i][i] = sum.sqrt();

@@ -208,6 +208,10 @@ pub struct ContactLane {
     pub restitution: Real,
     /// The pipeline's index of the contact (impulses are stored back by it).
     pub contact_index: u32,
+    /// A light body takes part: the contact goes to the overflow and is
+    /// solved with the body's other contacts as one block
+    /// ([`crate::contact_group`]).
+    pub coupled: bool,
 }
 
 /// A step's contact constraints in their colours and lanes: the contact
@@ -227,6 +231,8 @@ pub struct ContactSolver {
     overflow: Vec<ContactConstraint>,
     /// Per overflow contact: it builds on a portal object's masses.
     hooked: Vec<bool>,
+    /// Per overflow contact: a light body's (`ContactLane::coupled`).
+    coupled: Vec<bool>,
     /// The coupled groups of the overflow's light bodies.
     groups: Groups,
     /// The colouring of this step.
@@ -283,6 +289,7 @@ impl ContactSolver {
             chunks.clear();
         }
         self.overflow.clear();
+        self.coupled.clear();
         self.len = 0;
     }
 
@@ -312,6 +319,7 @@ impl ContactSolver {
             c.state_a = lane.state_a;
             c.state_b = lane.state_b;
             self.overflow.push(c);
+            self.coupled.push(lane.coupled);
             return;
         }
         if self.colours.len() < COLOURS {
@@ -503,8 +511,13 @@ impl ContactSolver {
                 c.block = false;
             }
         }
-        self.groups
-            .build(ctx, &mut self.overflow, &self.hooked, states.len());
+        self.groups.build(
+            ctx,
+            &mut self.overflow,
+            &self.coupled,
+            &self.hooked,
+            states.len(),
+        );
     }
 
     fn warm_start(&mut self, states: &mut [BodyState], team: &Team) {

@@ -646,6 +646,7 @@ pub(crate) fn build_constraints(
             friction: c.friction,
             restitution: c.restitution,
             contact_index: k as u32,
+            coupled: s.coupled,
         }
     });
     counters.contact_rows = rows;
