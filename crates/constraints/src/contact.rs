@@ -557,16 +557,16 @@ impl ContactConstraint {
         }
     }
 
-    /// Stiffens the normal rows of a contact whose side a (`light_is_a`)
-    /// or b is a light body of a coupled group, against a static or heavy
-    /// other side: each row's spring is built on the effective mass it
-    /// would have if the light body had the inverse mass and inertia
-    /// `heavy = [m_H⁻¹, i_H⁻¹]` of its heaviest neighbour (`contact_group`
-    /// docs), where that is stiffer than the row's own spring.
-    pub(crate) fn stiffen_for_light_side(
+    /// Stiffens the normal rows of a contact of a light cluster's group:
+    /// each row's spring is built on the effective mass it would have if
+    /// every side in the cluster (`in_cluster`) had the inverse mass and
+    /// inertia `heavy = [m_H⁻¹, i_H⁻¹]` of the heaviest body the cluster
+    /// touches (`contact_group` docs), where that is stiffer than the row's
+    /// own spring.
+    pub(crate) fn stiffen_for_group(
         &mut self,
         ctx: &StepContext,
-        light_is_a: bool,
+        in_cluster: [bool; 2],
         k_masses: [Real; 4],
         heavy: [Real; 2],
     ) {
@@ -582,16 +582,21 @@ impl ContactConstraint {
             let (rn_a, rn_b) = (self.ja[i], self.jb[i]);
             let k_a = m_a + i_a * rn_a * rn_a;
             let k_b = m_b + i_b * rn_b * rn_b;
-            let (k_light, k_other, rn_light) = if light_is_a {
-                (k_a, k_b, rn_a)
+            let k_group_a = if in_cluster[0] {
+                m_h + i_h * rn_a * rn_a
             } else {
-                (k_b, k_a, rn_b)
+                k_a
             };
-            let k_group = (m_h + i_h * rn_light * rn_light) + k_other;
+            let k_group_b = if in_cluster[1] {
+                m_h + i_h * rn_b * rn_b
+            } else {
+                k_b
+            };
+            let k_group = k_group_a + k_group_b;
             if k_group <= 0.0 {
                 continue;
             }
-            let rho_group = (k_light + k_other) / k_group;
+            let rho_group = (k_a + k_b) / k_group;
             let soft = softness.with_mass_ratio(rho_group);
             if soft.impulse_scale < self.impulse_scale[i] {
                 self.impulse_scale[i] = soft.impulse_scale;

@@ -208,10 +208,11 @@ pub struct ContactLane {
     pub restitution: Real,
     /// The pipeline's index of the contact (impulses are stored back by it).
     pub contact_index: u32,
-    /// A light body takes part: the contact goes to the overflow and is
-    /// solved with the body's other contacts as one block
-    /// ([`crate::contact_group`]).
-    pub coupled: bool,
+    /// The light cluster of each side ([`crate::contact_group::Clusters`],
+    /// [`NO_CLUSTER`](crate::contact_group::NO_CLUSTER) for none): a
+    /// contact with a side in a cluster goes to the overflow and is solved
+    /// with the cluster's other contacts as one block.
+    pub cluster: [u32; 2],
 }
 
 /// A step's contact constraints in their colours and lanes: the contact
@@ -231,8 +232,8 @@ pub struct ContactSolver {
     overflow: Vec<ContactConstraint>,
     /// Per overflow contact: it builds on a portal object's masses.
     hooked: Vec<bool>,
-    /// Per overflow contact: a light body's (`ContactLane::coupled`).
-    coupled: Vec<bool>,
+    /// Per overflow contact: its sides' light clusters (`ContactLane::cluster`).
+    clusters: Vec<[u32; 2]>,
     /// The coupled groups of the overflow's light bodies.
     groups: Groups,
     /// The colouring of this step.
@@ -289,7 +290,7 @@ impl ContactSolver {
             chunks.clear();
         }
         self.overflow.clear();
-        self.coupled.clear();
+        self.clusters.clear();
         self.len = 0;
     }
 
@@ -319,7 +320,7 @@ impl ContactSolver {
             c.state_a = lane.state_a;
             c.state_b = lane.state_b;
             self.overflow.push(c);
-            self.coupled.push(lane.coupled);
+            self.clusters.push(lane.cluster);
             return;
         }
         if self.colours.len() < COLOURS {
@@ -514,7 +515,7 @@ impl ContactSolver {
         self.groups.build(
             ctx,
             &mut self.overflow,
-            &self.coupled,
+            &self.clusters,
             &self.hooked,
             states.len(),
         );

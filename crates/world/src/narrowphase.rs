@@ -22,7 +22,7 @@
 
 use janus2d_constraints::ContactPointInput;
 use janus2d_constraints::ObjectMass;
-use janus2d_constraints::contact_group::is_light;
+use janus2d_constraints::contact_group::{Clusters, ContactBodies, NO_CLUSTER};
 use janus2d_constraints::contact_solver::{ContactLane, ContactSolver, OVERFLOW};
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::geometry::{Aabb, Manifold, collide};
@@ -101,10 +101,12 @@ pub(crate) struct Narrowphase {
     solved: Vec<SolvedContact>,
     /// Their colours, in the same order (the solver's `push_all` input).
     colours: Vec<u8>,
-    /// Per body state: the inverse mass of its lightest moving neighbour
-    /// (scratch of the build).
+    /// The light clusters of the solved contacts (scratch of the build).
     #[cfg_attr(feature = "serde", serde(skip))]
-    lightest: Vec<Real>,
+    clusters: Clusters,
+    /// Their clusters, per solved contact (scratch of the build).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    cluster_of: Vec<[u32; 2]>,
 }
 
 /// A contact the solve takes this step, as the build's first pass found it.
@@ -121,9 +123,9 @@ struct SolvedContact {
     with_static: bool,
     /// A portal copy takes part: the object-mass hook, in the overflow.
     copy: bool,
-    /// A light body takes part (`contact_group`): in the overflow, solved
-    /// with the body's other contacts as one block.
-    coupled: bool,
+    /// The light cluster of each side (`contact_group`): with one, in the
+    /// overflow, solved with the cluster's other contacts as one block.
+    cluster: [u32; 2],
     /// Its colour ([`OVERFLOW`]: solved scalar).
     colour: u8,
 }
@@ -566,38 +568,34 @@ pub(crate) fn build_constraints(
             moving: [moving_a, moving_b],
             with_static: sa || sb,
             copy,
-            coupled: false,
+            cluster: [NO_CLUSTER; 2],
             colour: OVERFLOW,
         });
     }
-    // Light bodies (`contact_group`): a body whose every moving neighbour
-    // is `LIGHT_RATIO` times heavier or more has all its contacts in the
-    // overflow, where the solver takes them as one coupled group.
-    let lightest = &mut narrowphase.lightest;
-    lightest.clear();
-    lightest.resize(bodies.states.len(), 0.0);
-    let inv_masses = |s: &SolvedContact| {
-        let [(_, [m_a, _]), (_, [m_b, _])] = awake[s.index as usize].solve_bodies;
-        [m_a, m_b]
-    };
-    for s in solved.iter() {
-        if s.moving == [true, true] {
-            let [m_a, m_b] = inv_masses(s);
-            let [ia, ib] = s.state.map(|i| i as usize);
-            lightest[ia] = lightest[ia].max(m_b);
-            lightest[ib] = lightest[ib].max(m_a);
-        }
-    }
-    for s in solved.iter_mut() {
-        let [m_a, m_b] = inv_masses(s);
-        let [ia, ib] = s.state.map(|i| i as usize);
-        s.coupled = (s.moving[0] && is_light(m_a, lightest[ia]))
-            || (s.moving[1] && is_light(m_b, lightest[ib]));
+    // Light clusters (`contact_group`): their contacts go to the overflow,
+    // where the solver takes each cluster's contacts as one block.
+    let cluster_of = &mut narrowphase.cluster_of;
+    narrowphase.clusters.assign(
+        bodies.states.len(),
+        solved.len(),
+        |k| {
+            let s = &solved[k];
+            let [(_, [m_a, _]), (_, [m_b, _])] = awake[s.index as usize].solve_bodies;
+            ContactBodies {
+                state: s.state,
+                moving: s.moving,
+                inv_mass: [m_a, m_b],
+            }
+        },
+        cluster_of,
+    );
+    for (s, ids) in solved.iter_mut().zip(cluster_of.iter()) {
+        s.cluster = *ids;
     }
     for static_pass in [false, true] {
         for s in solved.iter_mut() {
             if s.with_static == static_pass {
-                s.colour = if s.copy || s.coupled {
+                s.colour = if s.copy || s.cluster != [NO_CLUSTER; 2] {
                     OVERFLOW
                 } else {
                     let [ia, ib] = s.state;
@@ -646,7 +644,7 @@ pub(crate) fn build_constraints(
             friction: c.friction,
             restitution: c.restitution,
             contact_index: k as u32,
-            coupled: s.coupled,
+            cluster: s.cluster,
         }
     });
     counters.contact_rows = rows;
