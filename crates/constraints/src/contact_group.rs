@@ -148,7 +148,8 @@ pub struct Clusters {
 impl Clusters {
     /// The light cluster of each side of each of `n` contacts (`read(k)`:
     /// contact `k`'s bodies), into `out[k]`: a cluster id (the state index
-    /// of its root) or [`NO_CLUSTER`].
+    /// of its root) or [`NO_CLUSTER`]. Without a [`light_pair`] among the
+    /// contacts there is none: the pipeline then skips this.
     pub fn assign(
         &mut self,
         state_count: usize,
@@ -163,12 +164,6 @@ impl Clusters {
             (is_light(m_a, m_b), is_light(m_b, m_a))
         };
         let moving_pair = |c: &ContactBodies| c.moving == [true, true];
-        if !(0..n).any(|k| {
-            let c = read(k);
-            moving_pair(&c) && ratio(&c) != (false, false)
-        }) {
-            return;
-        }
         self.parent.clear();
         self.parent.extend(0..state_count as u32);
         for k in 0..n {
@@ -213,6 +208,15 @@ impl Clusters {
             }
         }
     }
+}
+
+/// Whether a contact's two bodies (`moving`, inverse masses in 1/kg) are
+/// both moved by the solve and one is light beside the other.
+#[inline]
+#[must_use]
+pub fn light_pair(moving: [bool; 2], inv_mass: [Real; 2]) -> bool {
+    let [m_a, m_b] = inv_mass;
+    moving == [true, true] && (is_light(m_a, m_b) || is_light(m_b, m_a))
 }
 
 /// One light cluster's contacts (indices into the overflow).

@@ -22,7 +22,7 @@
 
 use janus2d_constraints::ContactPointInput;
 use janus2d_constraints::ObjectMass;
-use janus2d_constraints::contact_group::{Clusters, ContactBodies, NO_CLUSTER};
+use janus2d_constraints::contact_group::{Clusters, ContactBodies, NO_CLUSTER, light_pair};
 use janus2d_constraints::contact_solver::{ContactLane, ContactSolver, OVERFLOW};
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::geometry::{Aabb, Manifold, collide};
@@ -497,6 +497,9 @@ pub(crate) fn build_constraints(
     // The contacts to look at: those the narrowphase found touching, then
     // any woken (appended) since.
     let woken = narrowphase.scanned.min(contacts.awake().len())..contacts.awake().len();
+    // Whether any moving pair is light beside the other (then the light
+    // clusters are looked for, below).
+    let mut any_light = false;
     let candidates = narrowphase
         .touching
         .iter()
@@ -561,6 +564,8 @@ pub(crate) fn build_constraints(
         }
         let (ia, moving_a) = state_of(c.solve_bodies[0]);
         let (ib, moving_b) = state_of(c.solve_bodies[1]);
+        let inv_masses = [c.solve_bodies[0].1[0], c.solve_bodies[1].1[0]];
+        any_light |= light_pair([moving_a, moving_b], inv_masses);
         let copy = !objects.is_empty() && (is_copy(c.body_a) || is_copy(c.body_b));
         solved.push(SolvedContact {
             index: k as u32,
@@ -575,22 +580,25 @@ pub(crate) fn build_constraints(
     // Light clusters (`contact_group`): their contacts go to the overflow,
     // where the solver takes each cluster's contacts as one block.
     let cluster_of = &mut narrowphase.cluster_of;
-    narrowphase.clusters.assign(
-        bodies.states.len(),
-        solved.len(),
-        |k| {
-            let s = &solved[k];
-            let [(_, [m_a, _]), (_, [m_b, _])] = awake[s.index as usize].solve_bodies;
-            ContactBodies {
-                state: s.state,
-                moving: s.moving,
-                inv_mass: [m_a, m_b],
-            }
-        },
-        cluster_of,
-    );
-    for (s, ids) in solved.iter_mut().zip(cluster_of.iter()) {
-        s.cluster = *ids;
+    cluster_of.clear();
+    if any_light {
+        narrowphase.clusters.assign(
+            bodies.states.len(),
+            solved.len(),
+            |k| {
+                let s = &solved[k];
+                let [(_, [m_a, _]), (_, [m_b, _])] = awake[s.index as usize].solve_bodies;
+                ContactBodies {
+                    state: s.state,
+                    moving: s.moving,
+                    inv_mass: [m_a, m_b],
+                }
+            },
+            cluster_of,
+        );
+        for (s, ids) in solved.iter_mut().zip(cluster_of.iter()) {
+            s.cluster = *ids;
+        }
     }
     for static_pass in [false, true] {
         for s in solved.iter_mut() {
