@@ -1,5 +1,5 @@
-//! Coupled contacts of a light body: every normal row of a body that
-//! touches a much heavier one, solved as one block.
+//! Coupled contacts of a light cluster: every normal row of the bodies
+//! that sit under (or between) a much heavier one, solved as one block.
 //!
 //! # Why
 //!
@@ -46,12 +46,12 @@
 //! static body) with `Softness::with_mass_ratio(ρ_group)` where that is
 //! stiffer than the row's own. The light boxes then deflect under the heavy
 //! box as the heavy box would on the ground (1000:1 stack: penetration
-//! 0.2 mm instead of 31 cm).
+//! 0.7 mm instead of 31 cm).
 //!
 //! # The block
 //!
-//! The group's normal rows `r = 1 … n` (one per manifold point, `n ≤ 8`)
-//! share `L`, and may share other bodies. With `J_r` each row's Jacobian,
+//! The group's normal rows `r = 1 … n` (one per manifold point, `n ≤ 32`)
+//! share the cluster's bodies, and may share others. With `J_r` each row's Jacobian,
 //! `K = J M⁻¹ Jᵀ`:
 //!
 //! ```text
@@ -90,7 +90,11 @@
 //! so far), and the block last: with the friction rows after it, the
 //! stiff block and the friction rows pushed the light box back and forth
 //! (up to `μ λ` on 1 kg each pass) and the 1000:1 stack blew apart; with
-//! the block last it stands (0.2 mm sideways).
+//! the block last it stands (0.05 mm sideways).
+//!
+//! Each body's velocity change `M⁻¹ Jᵀ Δλ` is summed over the rows in
+//! `f64` and added to its (`f32`) state once: a light body takes large
+//! opposite impulses whose sum is small.
 
 use janus2d_core::body::BodyState;
 use janus2d_core::constraint::StepContext;
@@ -104,7 +108,9 @@ use crate::contact::ContactConstraint;
 /// its contacts are solved as one coupled group.
 pub const LIGHT_RATIO: Real = 10.0;
 
-/// Most manifolds in one group (a light body with more keeps Gauss–Seidel).
+/// Most manifolds in one group (a light cluster with more contacts keeps
+/// the colours' Gauss–Seidel). A group of 14 (28 rows) costs about
+/// 0.1 ms/step: the dense solve grows as rows³.
 pub const GROUP_CONTACTS: usize = 16;
 
 const GROUP_ROWS: usize = 2 * GROUP_CONTACTS;
