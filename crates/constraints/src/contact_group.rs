@@ -182,34 +182,37 @@ impl Clusters {
         self.heavier.resize(state_count, false);
         self.count.clear();
         self.count.resize(state_count, 0);
-        for k in 0..n {
+        // Each side's root into `out` for now; the light ones stay.
+        for (k, roots) in out.iter_mut().enumerate() {
             let c = read(k);
-            let roots = [0, 1].map(|s| c.moving[s].then(|| find(&mut self.parent, c.state[s])));
-            if moving_pair(&c) {
-                match ratio(&c) {
-                    (true, _) => self.heavier[roots[0].unwrap_or(0) as usize] = true,
-                    (_, true) => self.heavier[roots[1].unwrap_or(0) as usize] = true,
-                    _ => {}
+            for s in 0..2 {
+                if c.moving[s] {
+                    roots[s] = find(&mut self.parent, c.state[s]);
                 }
             }
-            match roots {
-                [Some(a), Some(b)] if a == b => self.count[a as usize] += 1,
-                _ => {
-                    for r in roots.into_iter().flatten() {
-                        self.count[r as usize] += 1;
+            match ratio(&c) {
+                (true, _) if moving_pair(&c) => self.heavier[roots[0] as usize] = true,
+                (_, true) if moving_pair(&c) => self.heavier[roots[1] as usize] = true,
+                _ => {}
+            }
+            match *roots {
+                [a, b] if a == b && a != NO_CLUSTER => self.count[a as usize] += 1,
+                [a, b] => {
+                    for r in [a, b] {
+                        if r != NO_CLUSTER {
+                            self.count[r as usize] += 1;
+                        }
                     }
                 }
             }
         }
-        for (k, ids) in out.iter_mut().enumerate() {
-            let c = read(k);
-            for s in 0..2 {
-                if c.moving[s] {
-                    let r = find(&mut self.parent, c.state[s]);
-                    if self.heavier[r as usize] && self.count[r as usize] as usize <= GROUP_CONTACTS
-                    {
-                        ids[s] = r;
-                    }
+        for roots in out.iter_mut() {
+            for r in roots.iter_mut() {
+                if *r != NO_CLUSTER
+                    && !(self.heavier[*r as usize]
+                        && self.count[*r as usize] as usize <= GROUP_CONTACTS)
+                {
+                    *r = NO_CLUSTER;
                 }
             }
         }

@@ -123,8 +123,12 @@ struct SolvedContact {
     with_static: bool,
     /// A portal copy takes part: the object-mass hook, in the overflow.
     copy: bool,
+    /// Inverse mass of each body, 1/kg (0 for one the solve does not move).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    inv_mass: [Real; 2],
     /// The light cluster of each side (`contact_group`): with one, in the
     /// overflow, solved with the cluster's other contacts as one block.
+    #[cfg_attr(feature = "serde", serde(skip))]
     cluster: [u32; 2],
     /// Its colour ([`OVERFLOW`]: solved scalar).
     colour: u8,
@@ -573,6 +577,7 @@ pub(crate) fn build_constraints(
             moving: [moving_a, moving_b],
             with_static: sa || sb,
             copy,
+            inv_mass: inv_masses,
             cluster: [NO_CLUSTER; 2],
             colour: OVERFLOW,
         });
@@ -587,11 +592,10 @@ pub(crate) fn build_constraints(
             solved.len(),
             |k| {
                 let s = &solved[k];
-                let [(_, [m_a, _]), (_, [m_b, _])] = awake[s.index as usize].solve_bodies;
                 ContactBodies {
                     state: s.state,
                     moving: s.moving,
-                    inv_mass: [m_a, m_b],
+                    inv_mass: s.inv_mass,
                 }
             },
             cluster_of,
