@@ -7,9 +7,9 @@
 //!            already appears (static, kinematic and sleeping bodies take
 //!            no colour: the solve never changes their state)
 //!   push     each contact's lane data into the open chunk of its colour,
-//!            structure of arrays; the overflow (a body in every colour, or
-//!            a portal copy whose contacts need the object-mass hook) as
-//!            scalar ContactConstraints
+//!            structure of arrays; the overflow (a body in every colour, a
+//!            portal copy whose contacts need the object-mass hook, or a
+//!            light cluster's contact) as scalar ContactConstraints
 //!
 //!            colour 0: [c0 c3 c7 … ] [c12 … pad]     chunk = LANES lanes
 //!            colour 1: [c1 c4 … pad]
@@ -18,12 +18,14 @@
 //!
 //! prepare    lane-wise: K (and the normal rows' 2×2 block), the mass-ratio
 //!            softness, the approach speed;
-//!            overflow scalar, then the object-mass hook on it
+//!            overflow scalar, then the object-mass hook on it, then the
+//!            light clusters' groups (crate::contact_group)
 //! warm start, solve (bias), relax (no bias), restitution
 //!            colour by colour (solve and relax reversed on alternate
 //!            sweeps), chunk by chunk: gather the lanes' body states, the
 //!            row arithmetic of ContactConstraint on lanes, scatter the
-//!            velocities; then the overflow, scalar
+//!            velocities; then the overflow, scalar, and each light
+//!            cluster's group as one block
 //! store      the impulses of every lane and overflow constraint go back to
 //!            the pipeline's contacts, by contact index
 //! ```
@@ -228,13 +230,13 @@ pub struct ContactSolver {
     /// Chunks per colour; the last chunk of a colour may have free lanes.
     colours: Vec<Vec<WideContact>>,
     /// Contacts solved one by one (or in the coupled groups of light
-    /// bodies, see [`crate::contact_group`]).
+    /// clusters, see [`crate::contact_group`]).
     overflow: Vec<ContactConstraint>,
     /// Per overflow contact: it builds on a portal object's masses.
     hooked: Vec<bool>,
     /// Per overflow contact: its sides' light clusters (`ContactLane::cluster`).
     clusters: Vec<[u32; 2]>,
-    /// The coupled groups of the overflow's light bodies.
+    /// The coupled groups of the overflow's light clusters.
     groups: Groups,
     /// The colouring of this step.
     graph: ColourGraph,
@@ -554,7 +556,7 @@ impl ContactSolver {
     }
 
     /// The overflow: its contacts one by one, then the coupled groups of
-    /// light bodies ([`crate::contact_group`]).
+    /// light clusters ([`crate::contact_group`]).
     fn solve_overflow(
         &mut self,
         states: &mut [BodyState],
