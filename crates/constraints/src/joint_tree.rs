@@ -914,7 +914,8 @@ fn solve_tree(
         let st = &sc.state;
         let (inv_m, inv_i) = (to_f64(st.inv_mass), to_f64(st.inv_inertia));
         let (mut added, mut inv_i_tilde) = (0.0, inv_i);
-        if sc.ang > 0.0 && sc.geometric > 0.0 {
+        // K_g / GEOMETRIC_RATIO > I, without dividing where it is not.
+        if sc.ang > 0.0 && sc.geometric * inv_i > GEOMETRIC_RATIO {
             added = (sc.geometric / GEOMETRIC_RATIO - 1.0 / inv_i).max(0.0);
             if added > 0.0 {
                 inv_i_tilde = 1.0 / (1.0 / inv_i + added);

@@ -374,15 +374,14 @@ impl Constraint for RevoluteJoint {
             return;
         }
         let (mut sa, mut sb) = load_pair(states, self.state_a, self.state_b);
-        let spring = self.def.enable_spring && sa.inv_inertia + sb.inv_inertia > 0.0;
         // The angle depends on the rotations only, which the rows below do
         // not change: one atan2 for the spring and the limits.
-        let angle = if spring || self.def.enable_limit {
+        let angle = if self.def.enable_spring || self.def.enable_limit {
             self.current_angle(&sa, &sb)
         } else {
             0.0
         };
-        if spring {
+        if self.def.enable_spring && sa.inv_inertia + sb.inv_inertia > 0.0 {
             self.spring
                 .solve_soft(&mut sa, &mut sb, angle, self.spring_softness);
         }
