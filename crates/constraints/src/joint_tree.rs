@@ -83,12 +83,15 @@
 //!  substitute, root first:      x_k = D_k⁻¹ (b_k − J_kp x_p)      x_c = D_c⁻¹ (b_c − J_kcᵀ x_k)
 //! ```
 //!
-//! Body pivots are symmetric 3×3 and stay positive definite, joint pivots
-//! symmetric 2×2 and negative definite, so both are inverted by cofactors
-//! without pivoting; `J_ji = ±[I | perp(r)]`, so its products with a pivot
-//! are written out (about a third of the work of general 3×3 blocks). A
-//! leaf body (no joint below it) keeps the pivot `diag(m, m, Ĩ)`, whose
-//! inverse is its inverse mass and inertia, and its `b` stays zero. The
+//! Body pivots (3×3) stay positive definite and joint pivots (2×2)
+//! negative definite, so both are inverted by cofactors without pivoting.
+//! `J_ji = ±[I | perp(r)]` has a third of its entries zero and the others
+//! ±1 but two, so its products with a pivot are written out term by term:
+//! the same sums in the same order as general 3×3 blocks (a joint's padded
+//! with `−1` on its unused diagonal), with only the products by an exact 0
+//! or ±1 left out, so the result is bit for bit that of the general blocks
+//! in about half the operations. A leaf body's `b` stays zero and its
+//! solution is not needed, so both are skipped. The
 //! elimination runs in f64
 //! whatever [`Real`] is: the pivots of a 670:1 chain cost about four digits,
 //! which f32 does not have to spare (measured: 3e-3 relative residual in
@@ -114,7 +117,7 @@
 //! word drives its body through whatever it pushes (the spinner's paddle
 //! pressed bodies through the one-sided loop).
 
-use glam::{DVec2, DVec3};
+use glam::{DMat3 as Matrix3, DVec2, DVec3};
 use janus2d_core::body::BodySet;
 use janus2d_core::body::BodyState;
 use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
@@ -158,123 +161,60 @@ struct TreeStart {
     joints: u32,
 }
 
-/// A symmetric 3×3 matrix over `(v_x, v_y, ω)`: a body's pivot.
+/// A joint's pivot: a general 2×2 matrix, `m[row][col]`. It is symmetric
+/// up to rounding; both halves are kept so that the elimination repeats,
+/// bit for bit, the arithmetic of the padded 3×3 blocks (`[D 0; 0 −1]`)
+/// it replaces, with every product by an exact zero or one left out.
 #[derive(Clone, Copy, Debug, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-struct Sym3 {
-    xx: f64,
-    xy: f64,
-    xw: f64,
-    yy: f64,
-    yw: f64,
-    ww: f64,
+struct Mat2 {
+    m00: f64,
+    m01: f64,
+    m10: f64,
+    m11: f64,
 }
 
-impl Sym3 {
-    const ZERO: Sym3 = Sym3 {
-        xx: 0.0,
-        xy: 0.0,
-        xw: 0.0,
-        yy: 0.0,
-        yw: 0.0,
-        ww: 0.0,
-    };
-
-    #[inline(always)]
-    fn diagonal(m: f64, i: f64) -> Sym3 {
-        Sym3 {
-            xx: m,
-            yy: m,
-            ww: i,
-            ..Sym3::ZERO
-        }
-    }
-
-    #[inline(always)]
-    fn mul(&self, v: DVec3) -> DVec3 {
-        DVec3::new(
-            self.xx * v.x + self.xy * v.y + self.xw * v.z,
-            self.xy * v.x + self.yy * v.y + self.yw * v.z,
-            self.xw * v.x + self.yw * v.y + self.ww * v.z,
-        )
-    }
-
-    #[inline(always)]
-    fn sub_assign(&mut self, o: &Sym3) {
-        self.xx -= o.xx;
-        self.xy -= o.xy;
-        self.xw -= o.xw;
-        self.yy -= o.yy;
-        self.yw -= o.yw;
-        self.ww -= o.ww;
-    }
-
-    /// The inverse of a definite pivot (cofactors over the determinant);
-    /// zero when it is singular or not finite (its node then takes no
-    /// impulse this solve).
-    #[inline(always)]
-    fn inverse(&self) -> Sym3 {
-        let c_xx = self.yy * self.ww - self.yw * self.yw;
-        let c_xy = self.xw * self.yw - self.xy * self.ww;
-        let c_xw = self.xy * self.yw - self.xw * self.yy;
-        let det = self.xx * c_xx + self.xy * c_xy + self.xw * c_xw;
-        let scale = (self.xx * self.yy * self.ww).abs();
-        if !det.is_finite() || det.abs() <= PIVOT_TOLERANCE * scale || det == 0.0 {
-            return Sym3::ZERO;
-        }
-        let inv = 1.0 / det;
-        Sym3 {
-            xx: c_xx * inv,
-            xy: c_xy * inv,
-            xw: c_xw * inv,
-            yy: (self.xx * self.ww - self.xw * self.xw) * inv,
-            yw: (self.xy * self.xw - self.xx * self.yw) * inv,
-            ww: (self.xx * self.yy - self.xy * self.xy) * inv,
-        }
-    }
-}
-
-/// A symmetric 2×2 matrix over a joint's two rows: a joint's pivot.
-#[derive(Clone, Copy, Debug, Default)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-struct Sym2 {
-    xx: f64,
-    xy: f64,
-    yy: f64,
-}
-
-impl Sym2 {
-    const ZERO: Sym2 = Sym2 {
-        xx: 0.0,
-        xy: 0.0,
-        yy: 0.0,
+impl Mat2 {
+    const ZERO: Mat2 = Mat2 {
+        m00: 0.0,
+        m01: 0.0,
+        m10: 0.0,
+        m11: 0.0,
     };
 
     #[inline(always)]
     fn mul(&self, v: DVec2) -> DVec2 {
-        DVec2::new(self.xx * v.x + self.xy * v.y, self.xy * v.x + self.yy * v.y)
+        DVec2::new(
+            self.m00 * v.x + self.m01 * v.y,
+            self.m10 * v.x + self.m11 * v.y,
+        )
     }
 
-    /// As [`Sym3::inverse`].
+    /// `D⁻¹` of a definite pivot (the padded block's cofactors over its
+    /// determinant `x · (y × z) = −a d + c b`); zero when it is singular or
+    /// not finite (the joint then takes no impulse this solve).
     #[inline(always)]
-    fn inverse(&self) -> Sym2 {
-        let det = self.xx * self.yy - self.xy * self.xy;
-        let scale = (self.xx * self.yy).abs();
+    fn inverse(&self) -> Mat2 {
+        let (a, b, c, d) = (self.m00, self.m01, self.m10, self.m11);
+        let det = a * -d + c * b;
+        let scale = (a * d).abs();
         if !det.is_finite() || det.abs() <= PIVOT_TOLERANCE * scale || det == 0.0 {
-            return Sym2::ZERO;
+            return Mat2::ZERO;
         }
-        let inv = 1.0 / det;
-        Sym2 {
-            xx: self.yy * inv,
-            xy: -self.xy * inv,
-            yy: self.xx * inv,
+        let q = 1.0 / det;
+        Mat2 {
+            m00: -d * q,
+            m01: b * q,
+            m10: c * q,
+            m11: -a * q,
         }
     }
 }
 
-/// A joint's 2×3 block on one body without its sign (`J_ji = ±Ĵ`):
-/// `Ĵ = [l 0 p_x; 0 l p_y]`, `(p_x, p_y) = a (−r.y, r.x)`, with the body's
-/// axis masks `l`, `a` (1, or 0 on an axis it cannot move along).
+/// A joint's 2×3 block `J_ji` on one body, with its sign `side` (+1: the
+/// joint's body b) and the body's axis masks `l`, `a` (1, or 0 on an axis
+/// it cannot move along): `J = [s_l 0 p_x; 0 s_l p_y]`, `s_l = side l`,
+/// `(p_x, p_y) = side a (−r.y, r.x)`.
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct Jacobian {
@@ -291,80 +231,105 @@ impl Jacobian {
     };
 
     #[inline(always)]
-    fn new(r: Vec2, body: &BodyScratch) -> Jacobian {
+    fn new(side: f64, r: Vec2, body: &BodyScratch) -> Jacobian {
+        let s_a = side * body.ang;
         Jacobian {
-            lin: body.lin,
-            px: -body.ang * to_f64(r.y),
-            py: body.ang * to_f64(r.x),
+            lin: side * body.lin,
+            px: -s_a * to_f64(r.y),
+            py: s_a * to_f64(r.x),
         }
     }
 
-    /// `Ĵ v`.
+    /// Row `i` (0 or 1) of `L = J S` for a body's `S = D⁻¹`, at column `j`.
     #[inline(always)]
-    fn mul(&self, v: DVec3) -> DVec2 {
-        DVec2::new(
-            self.lin * v.x + self.px * v.z,
-            self.lin * v.y + self.py * v.z,
-        )
-    }
-
-    /// `Ĵᵀ y`.
-    #[inline(always)]
-    fn mul_t(&self, y: DVec2) -> DVec3 {
-        DVec3::new(
-            self.lin * y.x,
-            self.lin * y.y,
-            self.px * y.x + self.py * y.y,
-        )
-    }
-
-    /// `Ĵ S Ĵᵀ` (the sign cancels).
-    #[inline(always)]
-    fn sandwich3(&self, s: &Sym3) -> Sym2 {
-        let (l, px, py) = (self.lin, self.px, self.py);
-        // Rows of Ĵ S.
-        let g0 = DVec3::new(
-            l * s.xx + px * s.xw,
-            l * s.xy + px * s.yw,
-            l * s.xw + px * s.ww,
-        );
-        let g1y = l * s.yy + py * s.yw;
-        let g1w = l * s.yw + py * s.ww;
-        Sym2 {
-            xx: g0.x * l + g0.z * px,
-            xy: g0.y * l + g0.z * py,
-            yy: g1y * l + g1w * py,
+    fn js(&self, s: &Matrix3, i: usize, j: usize) -> f64 {
+        let col = s.col(j);
+        if i == 0 {
+            self.lin * col.x + self.px * col.z
+        } else {
+            self.lin * col.y + self.py * col.z
         }
     }
 
-    /// `Ĵ S Ĵᵀ` for a diagonal `S`.
+    /// A child body folded into its parent joint: `D_k −= L Jᵀ` and
+    /// `b_k −= L b_c` with `L = J D_c⁻¹` (`b_c` zero for a leaf).
     #[inline(always)]
-    fn sandwich_diagonal(&self, s: &Sym3) -> Sym2 {
-        let (l, px, py) = (self.lin, self.px, self.py);
-        let ll = l * l * s.xx;
-        Sym2 {
-            xx: ll + px * px * s.ww,
-            xy: px * py * s.ww,
-            yy: l * l * s.yy + py * py * s.ww,
+    fn fold_body(&self, s: &Matrix3, b_c: Option<DVec3>, d: &mut Mat2, b: &mut DVec2) {
+        let l0 = DVec3::new(self.js(s, 0, 0), self.js(s, 0, 1), self.js(s, 0, 2));
+        let l1 = DVec3::new(self.js(s, 1, 0), self.js(s, 1, 1), self.js(s, 1, 2));
+        d.m00 -= l0.x * self.lin + l0.z * self.px;
+        d.m01 -= l0.y * self.lin + l0.z * self.py;
+        d.m10 -= l1.x * self.lin + l1.z * self.px;
+        d.m11 -= l1.y * self.lin + l1.z * self.py;
+        if let Some(v) = b_c {
+            b.x -= l0.x * v.x + l0.y * v.y + l0.z * v.z;
+            b.y -= l1.x * v.x + l1.y * v.y + l1.z * v.z;
         }
     }
 
-    /// `Ĵᵀ T Ĵ` (the sign cancels).
+    /// The columns `j` = 0, 1 of `L = Jᵀ T` for a joint's `T = D⁻¹`, each as
+    /// its three rows.
     #[inline(always)]
-    fn sandwich2(&self, t: &Sym2) -> Sym3 {
-        let (l, px, py) = (self.lin, self.px, self.py);
-        let u0 = t.xx * px + t.xy * py;
-        let u1 = t.xy * px + t.yy * py;
-        let ll = l * l;
-        Sym3 {
-            xx: ll * t.xx,
-            xy: ll * t.xy,
-            xw: l * u0,
-            yy: ll * t.yy,
-            yw: l * u1,
-            ww: px * u0 + py * u1,
-        }
+    fn jt_t(&self, t: &Mat2) -> (DVec3, DVec3) {
+        let col = |t0: f64, t1: f64| {
+            DVec3::new(self.lin * t0, self.lin * t1, self.px * t0 + self.py * t1)
+        };
+        (col(t.m00, t.m10), col(t.m01, t.m11))
     }
+
+    /// A joint folded into its parent body: `D_p −= L J` and `b_p −= L b_k`
+    /// with `L = Jᵀ D_k⁻¹`.
+    #[inline(always)]
+    fn fold_joint(&self, t: &Mat2, b_k: DVec2, d: &mut Matrix3, b: &mut DVec3) {
+        let (c0, c1) = self.jt_t(t);
+        d.x_axis -= c0 * self.lin;
+        d.y_axis -= c1 * self.lin;
+        d.z_axis -= c0 * self.px + c1 * self.py;
+        *b -= c0 * b_k.x + c1 * b_k.y;
+    }
+
+    /// A joint's solution from its parent's: `x_k = D_k⁻¹ b_k − Lᵀ x_p`.
+    #[inline(always)]
+    fn joint_solution(&self, t: &Mat2, b_k: DVec2, x_p: DVec3) -> DVec2 {
+        let (c0, c1) = self.jt_t(t);
+        t.mul(b_k) - DVec2::new(c0.dot(x_p), c1.dot(x_p))
+    }
+
+    /// A child body's solution from its joint's: `x_c = D_c⁻¹ b_c − Lᵀ x_k`.
+    #[inline(always)]
+    fn body_solution(&self, s: &Matrix3, b_c: DVec3, x_k: DVec2) -> DVec3 {
+        let lt = |j: usize| self.js(s, 0, j) * x_k.x + self.js(s, 1, j) * x_k.y;
+        *s * b_c - DVec3::new(lt(0), lt(1), lt(2))
+    }
+}
+
+/// A moving body's pivot before elimination: `diag(m, m, Ĩ)` with
+/// placeholder 1 on an axis it cannot move along.
+#[inline(always)]
+fn body_mass(st: &BodyState, added: f64) -> Matrix3 {
+    let m = if st.inv_mass > 0.0 {
+        1.0 / to_f64(st.inv_mass)
+    } else {
+        1.0
+    };
+    let (i, ang) = if st.inv_inertia > 0.0 {
+        (1.0 / to_f64(st.inv_inertia), 1.0)
+    } else {
+        (1.0, 0.0)
+    };
+    Matrix3::from_diagonal(DVec3::new(m, m, i + ang * added))
+}
+
+/// `D⁻¹` of a definite body pivot; zero when it is singular or not finite
+/// (the body then takes no part this solve).
+#[inline(always)]
+fn pivot_inverse(d: &Matrix3) -> Matrix3 {
+    let det = d.determinant();
+    let scale = (d.x_axis.x * d.y_axis.y * d.z_axis.z).abs();
+    if !det.is_finite() || det.abs() <= PIVOT_TOLERANCE * scale || det == 0.0 {
+        return Matrix3::ZERO;
+    }
+    d.inverse()
 }
 
 /// A tree body's scratch in the tree solve.
@@ -374,20 +339,21 @@ struct BodyScratch {
     /// A copy of its state while the tree is solved.
     state: BodyState,
     /// The pivot `D_k` while eliminating, then `D_k⁻¹`.
-    d: Sym3,
+    d: Matrix3,
     /// The right-hand side, then the solution.
     b: DVec3,
     /// Axis masks: 1 where the body translates (rotates), else 0.
     lin: f64,
     ang: f64,
-    /// No joint of the tree has this body as its parent: its pivot stays
-    /// `diag(m, m, Ĩ)`, which `d` then holds inverted from the start, and
-    /// its right-hand side stays zero.
+    /// No joint of the tree has this body as its parent: its right-hand
+    /// side stays zero and its solution is not needed.
     leaf: bool,
     /// First the geometric stiffness term `K_g = h Σ max(0, ±λ · r)`, then
     /// the inertia added for it, `max(0, K_g / GEOMETRIC_RATIO − I)` (see
     /// the module docs), kg·m².
     geometric: f64,
+    /// The geometric stiffness term from its parent joint (added last).
+    geometric_up: f64,
     /// `Ĩ⁻¹ − I⁻¹` (≤ 0): how much the added inertia lowers the inverse
     /// inertia the solve's impulses act through.
     inertia_change: Real,
@@ -396,12 +362,13 @@ struct BodyScratch {
 impl BodyScratch {
     const ZERO: BodyScratch = BodyScratch {
         state: BodyState::IDENTITY,
-        d: Sym3::ZERO,
+        d: Matrix3::ZERO,
         b: DVec3::ZERO,
         lin: 0.0,
         ang: 0.0,
         leaf: true,
         geometric: 0.0,
+        geometric_up: 0.0,
         inertia_change: 0.0,
     };
 
@@ -438,7 +405,7 @@ struct JointScratch {
     /// The arms of its parent end and of its other end in this solve.
     r_parent: Vec2,
     r_other: Vec2,
-    /// `Ĵ` on its parent body and on its child body (if any).
+    /// `J` on its parent body and on its child body (if any).
     jac_parent: Jacobian,
     jac_child: Jacobian,
     /// The separation `C = (x_b + r_b) − (x_a + r_a)`, m.
@@ -448,7 +415,7 @@ struct JointScratch {
     /// The state index of its fixed end (read when it has no child body).
     fixed: u32,
     /// The pivot `D_k` while eliminating, then `D_k⁻¹`.
-    d: Sym2,
+    d: Mat2,
     /// The right-hand side, then the solution `μ`.
     b: DVec2,
 }
@@ -462,7 +429,7 @@ impl JointScratch {
         c: Vec2::ZERO,
         impulse: Vec2::ZERO,
         fixed: 0,
-        d: Sym2::ZERO,
+        d: Mat2::ZERO,
         b: DVec2::ZERO,
     };
 }
@@ -876,6 +843,7 @@ fn solve_tree(
         sc.ang = if st.inv_inertia > 0.0 { 1.0 } else { 0.0 };
         sc.leaf = true;
         sc.geometric = 0.0;
+        sc.geometric_up = 0.0;
     }
     // Arms, separations, Jacobians and impulses of the joints, and the
     // geometric stiffness each body takes from its joints.
@@ -895,7 +863,7 @@ fn solve_tree(
         row.c = from_f64(side) * ((parent.state.dp - other.dp) + (r_parent - r_other))
             + j.point.delta_center;
         (row.r_parent, row.r_other) = (r_parent, r_other);
-        row.jac_parent = Jacobian::new(r_parent, parent);
+        row.jac_parent = Jacobian::new(side, r_parent, parent);
         row.impulse = j.point.impulse;
         let lambda = wide(row.impulse);
         let parent = &mut bodies[tj.parent as usize];
@@ -903,41 +871,28 @@ fn solve_tree(
         parent.geometric += geometric_stiffness(h, lambda, r_parent, side);
         if tj.child != NONE {
             let child = &mut bodies[tj.child as usize];
-            row.jac_child = Jacobian::new(r_other, child);
-            child.geometric += geometric_stiffness(h, lambda, r_other, -side);
+            row.jac_child = Jacobian::new(-side, r_other, child);
+            child.geometric_up = geometric_stiffness(h, lambda, r_other, -side);
         }
     }
     // Ĩ = max(I, K_g / GEOMETRIC_RATIO): only the inertia the limit needs
     // is added. Body pivots start as diag(m, m, Ĩ), placeholder 1 on an
-    // axis the body cannot move along; a leaf's is inverted at once.
+    // axis the body cannot move along.
     for sc in bodies.iter_mut() {
         let st = &sc.state;
-        let (inv_m, inv_i) = (to_f64(st.inv_mass), to_f64(st.inv_inertia));
+        let inv_i = to_f64(st.inv_inertia);
         let (mut added, mut inv_i_tilde) = (0.0, inv_i);
-        // K_g / GEOMETRIC_RATIO > I, without dividing where it is not.
-        if sc.ang > 0.0 && sc.geometric * inv_i > GEOMETRIC_RATIO {
-            added = (sc.geometric / GEOMETRIC_RATIO - 1.0 / inv_i).max(0.0);
+        // Its child joints' terms first, then its parent joint's.
+        let geometric = sc.geometric + sc.geometric_up;
+        if sc.ang > 0.0 && geometric > 0.0 {
+            added = (geometric / GEOMETRIC_RATIO - 1.0 / inv_i).max(0.0);
             if added > 0.0 {
                 inv_i_tilde = 1.0 / (1.0 / inv_i + added);
             }
         }
         sc.inertia_change = from_f64(inv_i_tilde - inv_i);
         sc.geometric = added;
-        sc.d = if sc.leaf {
-            Sym3::diagonal(
-                if sc.lin > 0.0 { inv_m } else { 1.0 },
-                if sc.ang > 0.0 { inv_i_tilde } else { 1.0 },
-            )
-        } else {
-            Sym3::diagonal(
-                if sc.lin > 0.0 { 1.0 / inv_m } else { 1.0 },
-                if sc.ang > 0.0 {
-                    1.0 / inv_i + added
-                } else {
-                    1.0
-                },
-            )
-        };
+        sc.d = body_mass(st, added);
         sc.b = DVec3::ZERO;
     }
     if use_bias {
@@ -960,7 +915,12 @@ fn solve_tree(
         let other = other_end(tj, row.fixed, bodies, states);
         let c_dot = from_f64(side)
             * ((parent.v + cross_sv(parent.w, r_parent)) - (other.v + cross_sv(other.w, r_other)));
-        let (k11, k12, k22) = PointPart::effective_mass(parent, other, r_parent, r_other);
+        // K in the joint's own order (a, b), as the joint's rows sum it.
+        let (k11, k12, k22) = if side > 0.0 {
+            PointPart::effective_mass(other, parent, r_other, r_parent)
+        } else {
+            PointPart::effective_mass(parent, other, r_parent, r_other)
+        };
         let (k11, k12, k22) = (to_f64(k11), to_f64(k12), to_f64(k22));
         let rhs = if use_bias {
             let bias = clamp_length(softness.bias_rate * row.c, max_correction_speed);
@@ -974,36 +934,27 @@ fn solve_tree(
             -wide(c_dot)
         };
         // D_k = −Γ, Γ = K / a2.
-        let mut d = Sym2 {
-            xx: -(k11 * compliance),
-            xy: -(k12 * compliance),
-            yy: -(k22 * compliance),
+        let mut d = Mat2 {
+            m00: -(k11 * compliance),
+            m01: -(k12 * compliance),
+            m10: -(k12 * compliance),
+            m11: -(k22 * compliance),
         };
         let mut b = rhs;
         if tj.child != NONE {
-            // D_k −= J D_c⁻¹ Jᵀ,  b_k −= J D_c⁻¹ b_c  (J = −side Ĵ); a
-            // leaf's D_c⁻¹ is diagonal and its b_c zero.
+            // D_k −= J D_c⁻¹ Jᵀ,  b_k −= J D_c⁻¹ b_c  (a leaf's b_c is zero).
             let child = &mut bodies[tj.child as usize];
-            let jac = row.jac_child;
-            let s = if child.leaf {
-                jac.sandwich_diagonal(&child.d)
-            } else {
-                child.d = child.d.inverse();
-                b += side * jac.mul(child.d.mul(child.b));
-                jac.sandwich3(&child.d)
-            };
-            d.xx -= s.xx;
-            d.xy -= s.xy;
-            d.yy -= s.yy;
+            child.d = pivot_inverse(&child.d);
+            let b_c = if child.leaf { None } else { Some(child.b) };
+            row.jac_child.fold_body(&child.d, b_c, &mut d, &mut b);
         }
         let t = d.inverse();
         row.d = t;
         row.b = b;
-        // D_p −= Jᵀ D_k⁻¹ J,  b_p −= Jᵀ D_k⁻¹ b_k  (J = side Ĵ).
+        // D_p −= Jᵀ D_k⁻¹ J,  b_p −= Jᵀ D_k⁻¹ b_k.
         let parent = &mut bodies[tj.parent as usize];
-        let jac = row.jac_parent;
-        parent.d.sub_assign(&jac.sandwich2(&t));
-        parent.b -= side * jac.mul_t(t.mul(b));
+        row.jac_parent
+            .fold_joint(&t, b, &mut parent.d, &mut parent.b);
     }
     // Back substitution, root first: x_k = D_k⁻¹ (b_k − E_kᵀ x_parent).
     // Each joint's Δλ = −μ is applied as soon as it is known, equal and
@@ -1013,14 +964,12 @@ fn solve_tree(
     // solve used (the body's plus its geometric stiffness term). Fixed ends
     // do not move.
     let root = &mut bodies[0];
-    if !root.leaf {
-        root.d = root.d.inverse();
-    }
-    root.b = root.d.mul(root.b);
+    root.d = pivot_inverse(&root.d);
+    root.b = root.d * root.b;
     for (tj, row) in topology.iter().zip(rows.iter_mut()) {
         let side = tj.side;
         let parent = &mut bodies[tj.parent as usize];
-        let x = row.d.mul(row.b - side * row.jac_parent.mul(parent.b));
+        let x = row.jac_parent.joint_solution(&row.d, row.b, parent.b);
         row.b = x;
         let impulse = -Vec2::new(from_f64(x.x), from_f64(x.y));
         row.impulse += impulse;
@@ -1029,7 +978,7 @@ fn solve_tree(
             let child = &mut bodies[tj.child as usize];
             if !child.leaf {
                 // A leaf's solution is not needed: no joint below it.
-                child.b = child.d.mul(child.b + side * row.jac_child.mul_t(x));
+                child.b = row.jac_child.body_solution(&child.d, child.b, x);
             }
             child.apply(-side, row.r_other, impulse);
         }
