@@ -80,7 +80,8 @@
 //! ```text
 //!  eliminate, k last to first:  D_k = −Γ_k − J_kc D_c⁻¹ J_kcᵀ     b_k −= J_kc D_c⁻¹ b_c
 //!                               D_p −= J_kpᵀ D_k⁻¹ J_kp           b_p −= J_kpᵀ D_k⁻¹ b_k
-//!  substitute, root first:      x_k = D_k⁻¹ (b_k − J_kp x_p)      x_c = D_c⁻¹ (b_c − J_kcᵀ x_k)
+//!  substitute, root first:      x_k = D_k⁻¹ b_k − L_kᵀ x_p        x_c = D_c⁻¹ b_c − L_cᵀ x_k
+//!                               (L_k = J_kpᵀ D_k⁻¹,  L_c = J_kc D_c⁻¹)
 //! ```
 //!
 //! Body pivots (3×3) stay positive definite and joint pivots (2×2)
