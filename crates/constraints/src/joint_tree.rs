@@ -957,7 +957,7 @@ fn solve_tree(
         row.jac_parent
             .fold_joint(&t, b, &mut parent.d, &mut parent.b);
     }
-    // Back substitution, root first: x_k = D_k⁻¹ (b_k − E_kᵀ x_parent).
+    // Back substitution, root first: x_k = D_k⁻¹ b_k − L_kᵀ x_parent.
     // Each joint's Δλ = −μ is applied as soon as it is known, equal and
     // opposite at its anchors, so linear momentum holds to rounding
     // whatever the pivots' size; the bodies' own Δv is the same change up
