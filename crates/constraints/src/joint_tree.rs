@@ -70,13 +70,34 @@
 //! (linear momentum is untouched), and the bias pass first re-weights the
 //! warm start's torque `r × λ`, applied earlier through `I`, to `Ĩ`.
 //!
-//! Body pivots stay positive definite and joint pivots negative definite,
-//! so the 3×3 block inverses need no pivoting. The elimination runs in f64
+//! **Layout.** Each tree keeps its bodies and its joints breadth-first from
+//! a root body, in two flat arrays; a joint knows its parent body and its
+//! child body (none for a fixed end). Going through the joints backwards,
+//! joint `k` first folds in its child body `c` (whose own joints all come
+//! after `k`, so its pivot is complete), then is folded into its parent
+//! `p`; back substitution goes forwards:
+//!
+//! ```text
+//!  eliminate, k last to first:  D_k = −Γ_k − J_kc D_c⁻¹ J_kcᵀ     b_k −= J_kc D_c⁻¹ b_c
+//!                               D_p −= J_kpᵀ D_k⁻¹ J_kp           b_p −= J_kpᵀ D_k⁻¹ b_k
+//!  substitute, root first:      x_k = D_k⁻¹ b_k − L_kᵀ x_p        x_c = D_c⁻¹ b_c − L_cᵀ x_k
+//!                               (L_k = J_kpᵀ D_k⁻¹,  L_c = J_kc D_c⁻¹)
+//! ```
+//!
+//! Body pivots (3×3) stay positive definite and joint pivots (2×2)
+//! negative definite, so both are inverted by cofactors without pivoting.
+//! `J_ji = ±[I | perp(r)]` has a third of its entries zero and the others
+//! ±1 but two, so its products with a pivot are written out term by term:
+//! the same sums in the same order as general 3×3 blocks (a joint's padded
+//! with `−1` on its unused diagonal), with only the products by an exact 0
+//! or ±1 left out, so the result is bit for bit that of the general blocks
+//! in about half the operations. A leaf body's `b` stays zero and its
+//! solution is not needed, so both are skipped. The
+//! elimination runs in f64
 //! whatever [`Real`] is: the pivots of a 670:1 chain cost about four digits,
 //! which f32 does not have to spare (measured: 3e-3 relative residual in
 //! f32 arithmetic at a mass spread of 1e4, 1e-11 in f64), and scalar f64 costs
-//! the same as f32 here. A joint block has 2 rows; it
-//! is padded to 3×3 with `−1` on the unused diagonal. A body that cannot
+//! the same as f32 here. A body that cannot
 //! translate (or rotate) gets the placeholder mass 1 on that axis and a zero
 //! Jacobian column, so its `Δv` there is exactly zero.
 //!
@@ -97,7 +118,7 @@
 //! word drives its body through whatever it pushes (the spinner's paddle
 //! pressed bodies through the one-sided loop).
 
-use glam::{DMat3 as Matrix3, DVec2, DVec3 as Vec3};
+use glam::{DMat3 as Matrix3, DVec2, DVec3};
 use janus2d_core::body::BodySet;
 use janus2d_core::body::BodyState;
 use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
@@ -105,7 +126,7 @@ use janus2d_core::math::{Real, Vec2, cross, cross_sv, from_f64, to_f64};
 use janus2d_core::parallel::Team;
 use janus2d_core::union_find::{find, union};
 
-use crate::parts::clamp_length;
+use crate::parts::{PointPart, clamp_length};
 use crate::revolute::RevoluteJoint;
 
 const NONE: u32 = u32::MAX;
@@ -115,60 +136,306 @@ const NONE: u32 = u32::MAX;
 /// of a taut chain's zig-zag mode is stable below 4; 2.5 leaves a margin.
 const GEOMETRIC_RATIO: f64 = 2.5;
 
-/// One node of the elimination tree: a moving body or a joint.
+/// A joint of a tree. A tree's joints are in breadth-first order from its
+/// root body: a joint comes after its parent body's own parent joint and
+/// before its child body's other joints, so going through them backwards
+/// eliminates every subtree before the joint above it.
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-struct Node {
-    /// Body: its state index. Joint: its index in the joint slice.
+struct TreeJoint {
+    /// Its index in the joint slice.
     index: u32,
-    /// Parent node (`NONE` for a root). Parents come before children.
+    /// Its parent body, tree-local (the root is body 0).
     parent: u32,
-    /// True for a joint node.
-    is_joint: bool,
-    /// Which side of the joint the body is: +1 for body b, −1 for body a.
-    /// A body node: its side in its parent joint. A joint node: the side of
-    /// its parent body.
+    /// Its child body, tree-local; `NONE` where the other end is fixed.
+    child: u32,
+    /// The parent body's side of the joint: +1 where it is the joint's
+    /// body b, −1 where it is body a (the other end is on the other side).
     side: f64,
 }
 
-/// One node's scratch in the tree solve.
+/// Where a tree's bodies and joints start in the forest's arrays.
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-struct NodeScratch {
-    /// The pivot `D_k` while eliminating, then `D_k⁻¹`.
-    d: Matrix3,
-    /// `L_k = E_k D_k⁻¹`.
-    l: Matrix3,
-    /// The right-hand side, then the solution.
-    b: Vec3,
-    /// Joint node: the arms `r_a`, `r_b` of this iteration.
-    arms: (Vec2, Vec2),
-    /// Body node: first the geometric stiffness term `K_g = h Σ max(0, ±λ ·
-    /// r)`, then the inertia added for it, `max(0, K_g / GEOMETRIC_RATIO −
-    /// I)` (see the module docs), kg·m².
-    geometric: f64,
-    /// Joint node: its child body node, tree-local (`NONE` for a fixed end).
-    child: u32,
-    /// Body node: a copy of its state while the tree is solved.
-    state: BodyState,
-    /// Joint node: a copy of its accumulated point impulse, N·s.
-    impulse: Vec2,
+struct TreeStart {
+    bodies: u32,
+    joints: u32,
 }
 
-impl NodeScratch {
-    const ZERO: NodeScratch = NodeScratch {
-        d: Matrix3::ZERO,
-        l: Matrix3::ZERO,
-        b: Vec3::ZERO,
-        arms: (Vec2::ZERO, Vec2::ZERO),
-        geometric: 0.0,
-        child: NONE,
+/// A joint's pivot: a general 2×2 matrix, `m[row][col]`. It is symmetric
+/// up to rounding; both halves are kept so that the elimination repeats,
+/// bit for bit, the arithmetic of the padded 3×3 blocks (`[D 0; 0 −1]`)
+/// it replaces, with every product by an exact zero or one left out.
+#[derive(Clone, Copy, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+struct Mat2 {
+    m00: f64,
+    m01: f64,
+    m10: f64,
+    m11: f64,
+}
+
+impl Mat2 {
+    const ZERO: Mat2 = Mat2 {
+        m00: 0.0,
+        m01: 0.0,
+        m10: 0.0,
+        m11: 0.0,
+    };
+
+    #[inline(always)]
+    fn mul(&self, v: DVec2) -> DVec2 {
+        DVec2::new(
+            self.m00 * v.x + self.m01 * v.y,
+            self.m10 * v.x + self.m11 * v.y,
+        )
+    }
+
+    /// `D⁻¹` of a definite pivot (the padded block's cofactors over its
+    /// determinant `x · (y × z) = −a d + c b`); zero when it is singular or
+    /// not finite (the joint then takes no impulse this solve).
+    #[inline(always)]
+    fn inverse(&self) -> Mat2 {
+        let (a, b, c, d) = (self.m00, self.m01, self.m10, self.m11);
+        let det = a * -d + c * b;
+        let scale = (a * d).abs();
+        if !det.is_finite() || det.abs() <= PIVOT_TOLERANCE * scale || det == 0.0 {
+            return Mat2::ZERO;
+        }
+        let q = 1.0 / det;
+        Mat2 {
+            m00: -d * q,
+            m01: b * q,
+            m10: c * q,
+            m11: -a * q,
+        }
+    }
+}
+
+/// A joint's 2×3 block `J_ji` on one body, with its sign `side` (+1: the
+/// joint's body b) and the body's axis masks `l`, `a` (1, or 0 on an axis
+/// it cannot move along): `J = [s_l 0 p_x; 0 s_l p_y]`, `s_l = side l`,
+/// `(p_x, p_y) = side a (−r.y, r.x)`.
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+struct Jacobian {
+    lin: f64,
+    px: f64,
+    py: f64,
+}
+
+impl Jacobian {
+    const ZERO: Jacobian = Jacobian {
+        lin: 0.0,
+        px: 0.0,
+        py: 0.0,
+    };
+
+    #[inline(always)]
+    fn new(side: f64, r: Vec2, body: &BodyScratch) -> Jacobian {
+        let s_a = side * body.ang;
+        Jacobian {
+            lin: side * body.lin,
+            px: -s_a * to_f64(r.y),
+            py: s_a * to_f64(r.x),
+        }
+    }
+
+    /// Row `i` (0 or 1) of `L = J S` for a body's `S = D⁻¹`, at column `j`.
+    #[inline(always)]
+    fn js(&self, s: &Matrix3, i: usize, j: usize) -> f64 {
+        let col = s.col(j);
+        if i == 0 {
+            self.lin * col.x + self.px * col.z
+        } else {
+            self.lin * col.y + self.py * col.z
+        }
+    }
+
+    /// A child body folded into its parent joint: `D_k −= L Jᵀ` and
+    /// `b_k −= L b_c` with `L = J D_c⁻¹` (`b_c` zero for a leaf).
+    #[inline(always)]
+    fn fold_body(&self, s: &Matrix3, b_c: Option<DVec3>, d: &mut Mat2, b: &mut DVec2) {
+        let l0 = DVec3::new(self.js(s, 0, 0), self.js(s, 0, 1), self.js(s, 0, 2));
+        let l1 = DVec3::new(self.js(s, 1, 0), self.js(s, 1, 1), self.js(s, 1, 2));
+        d.m00 -= l0.x * self.lin + l0.z * self.px;
+        d.m01 -= l0.y * self.lin + l0.z * self.py;
+        d.m10 -= l1.x * self.lin + l1.z * self.px;
+        d.m11 -= l1.y * self.lin + l1.z * self.py;
+        if let Some(v) = b_c {
+            b.x -= l0.x * v.x + l0.y * v.y + l0.z * v.z;
+            b.y -= l1.x * v.x + l1.y * v.y + l1.z * v.z;
+        }
+    }
+
+    /// The columns `j` = 0, 1 of `L = Jᵀ T` for a joint's `T = D⁻¹`, each as
+    /// its three rows.
+    #[inline(always)]
+    fn jt_t(&self, t: &Mat2) -> (DVec3, DVec3) {
+        let col = |t0: f64, t1: f64| {
+            DVec3::new(self.lin * t0, self.lin * t1, self.px * t0 + self.py * t1)
+        };
+        (col(t.m00, t.m10), col(t.m01, t.m11))
+    }
+
+    /// A joint folded into its parent body: `D_p −= L J` and `b_p −= L b_k`
+    /// with `L = Jᵀ D_k⁻¹`.
+    #[inline(always)]
+    fn fold_joint(&self, t: &Mat2, b_k: DVec2, d: &mut Matrix3, b: &mut DVec3) {
+        let (c0, c1) = self.jt_t(t);
+        d.x_axis -= c0 * self.lin;
+        d.y_axis -= c1 * self.lin;
+        d.z_axis -= c0 * self.px + c1 * self.py;
+        *b -= c0 * b_k.x + c1 * b_k.y;
+    }
+
+    /// A joint's solution from its parent's: `x_k = D_k⁻¹ b_k − Lᵀ x_p`.
+    #[inline(always)]
+    fn joint_solution(&self, t: &Mat2, b_k: DVec2, x_p: DVec3) -> DVec2 {
+        let (c0, c1) = self.jt_t(t);
+        t.mul(b_k) - DVec2::new(c0.dot(x_p), c1.dot(x_p))
+    }
+
+    /// A child body's solution from its joint's: `x_c = D_c⁻¹ b_c − Lᵀ x_k`.
+    #[inline(always)]
+    fn body_solution(&self, s: &Matrix3, b_c: DVec3, x_k: DVec2) -> DVec3 {
+        let lt = |j: usize| self.js(s, 0, j) * x_k.x + self.js(s, 1, j) * x_k.y;
+        *s * b_c - DVec3::new(lt(0), lt(1), lt(2))
+    }
+}
+
+/// A moving body's pivot before elimination: `diag(m, m, Ĩ)` with
+/// placeholder 1 on an axis it cannot move along.
+#[inline(always)]
+fn body_mass(st: &BodyState, added: f64) -> Matrix3 {
+    let m = if st.inv_mass > 0.0 {
+        1.0 / to_f64(st.inv_mass)
+    } else {
+        1.0
+    };
+    let (i, ang) = if st.inv_inertia > 0.0 {
+        (1.0 / to_f64(st.inv_inertia), 1.0)
+    } else {
+        (1.0, 0.0)
+    };
+    Matrix3::from_diagonal(DVec3::new(m, m, i + ang * added))
+}
+
+/// `D⁻¹` of a definite body pivot; zero when it is singular or not finite
+/// (the body then takes no part this solve).
+#[inline(always)]
+fn pivot_inverse(d: &Matrix3) -> Matrix3 {
+    let det = d.determinant();
+    let scale = (d.x_axis.x * d.y_axis.y * d.z_axis.z).abs();
+    if !det.is_finite() || det.abs() <= PIVOT_TOLERANCE * scale || det == 0.0 {
+        return Matrix3::ZERO;
+    }
+    d.inverse()
+}
+
+/// A tree body's scratch in the tree solve.
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+struct BodyScratch {
+    /// A copy of its state while the tree is solved.
+    state: BodyState,
+    /// The pivot `D_k` while eliminating, then `D_k⁻¹`.
+    d: Matrix3,
+    /// The right-hand side, then the solution.
+    b: DVec3,
+    /// Axis masks: 1 where the body translates (rotates), else 0.
+    lin: f64,
+    ang: f64,
+    /// No joint of the tree has this body as its parent: its right-hand
+    /// side stays zero and its solution is not needed.
+    leaf: bool,
+    /// First the geometric stiffness term `K_g = h Σ max(0, ±λ · r)`, then
+    /// the inertia added for it, `max(0, K_g / GEOMETRIC_RATIO − I)` (see
+    /// the module docs), kg·m².
+    geometric: f64,
+    /// The geometric stiffness term from its parent joint (added last).
+    geometric_up: f64,
+    /// `Ĩ⁻¹ − I⁻¹` (≤ 0): how much the added inertia lowers the inverse
+    /// inertia the solve's impulses act through.
+    inertia_change: Real,
+}
+
+impl BodyScratch {
+    const ZERO: BodyScratch = BodyScratch {
         state: BodyState::IDENTITY,
+        d: Matrix3::ZERO,
+        b: DVec3::ZERO,
+        lin: 0.0,
+        ang: 0.0,
+        leaf: true,
+        geometric: 0.0,
+        geometric_up: 0.0,
+        inertia_change: 0.0,
+    };
+
+    /// Turns the body by an impulse `p` at arm `r` on `side` (+1: the
+    /// joint's body b) through the inertia added for the solve: the
+    /// re-weighting of a torque applied through `I` to `Ĩ`.
+    #[inline(always)]
+    fn reweight(&mut self, side: f64, r: Vec2, p: Vec2) {
+        self.state.w += (from_f64(side) * self.inertia_change) * cross(r, p);
+    }
+
+    /// Applies the impulse `p` at arm `r` on `side` (+1: the joint's body
+    /// b, which takes `+p`; −1: body a, `−p`), turning through `Ĩ`.
+    #[inline(always)]
+    fn apply(&mut self, side: f64, r: Vec2, p: Vec2) {
+        let st = &mut self.state;
+        let side = from_f64(side);
+        let inv_i = st.inv_inertia + self.inertia_change;
+        st.v += (side * st.inv_mass) * p;
+        st.w += (side * inv_i) * cross(r, p);
+    }
+}
+
+impl Default for BodyScratch {
+    fn default() -> Self {
+        Self::ZERO
+    }
+}
+
+/// A tree joint's scratch in the tree solve.
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+struct JointScratch {
+    /// The arms of its parent end and of its other end in this solve.
+    r_parent: Vec2,
+    r_other: Vec2,
+    /// `J` on its parent body and on its child body (if any).
+    jac_parent: Jacobian,
+    jac_child: Jacobian,
+    /// The separation `C = (x_b + r_b) − (x_a + r_a)`, m.
+    c: Vec2,
+    /// A copy of its accumulated point impulse, N·s.
+    impulse: Vec2,
+    /// The state index of its fixed end (read when it has no child body).
+    fixed: u32,
+    /// The pivot `D_k` while eliminating, then `D_k⁻¹`.
+    d: Mat2,
+    /// The right-hand side, then the solution `μ`.
+    b: DVec2,
+}
+
+impl JointScratch {
+    const ZERO: JointScratch = JointScratch {
+        r_parent: Vec2::ZERO,
+        r_other: Vec2::ZERO,
+        jac_parent: Jacobian::ZERO,
+        jac_child: Jacobian::ZERO,
+        c: Vec2::ZERO,
         impulse: Vec2::ZERO,
+        fixed: 0,
+        d: Mat2::ZERO,
+        b: DVec2::ZERO,
     };
 }
 
-impl Default for NodeScratch {
+impl Default for JointScratch {
     fn default() -> Self {
         Self::ZERO
     }
@@ -182,12 +449,17 @@ impl Default for NodeScratch {
 #[derive(Clone, Debug, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct JointForest {
-    /// Nodes, parents first (breadth-first from each root).
-    nodes: Vec<Node>,
-    /// First node of each tree (a tree's nodes are contiguous).
-    trees: Vec<u32>,
-    /// Per node: the solve's scratch.
-    scratch: Vec<NodeScratch>,
+    /// Per tree: its first body and first joint (a tree's bodies, and its
+    /// joints, are contiguous).
+    trees: Vec<TreeStart>,
+    /// The trees' bodies (state indices), each tree breadth-first from its
+    /// root.
+    bodies: Vec<u32>,
+    /// The trees' joints, in the same breadth-first order.
+    joints: Vec<TreeJoint>,
+    /// Per tree body and per tree joint: the solve's scratch.
+    body_scratch: Vec<BodyScratch>,
+    joint_scratch: Vec<JointScratch>,
     /// Per joint: its moving ends this step (see `moving_pair`).
     pairs: Vec<[u32; 3]>,
     /// The pairs and switch the forest was last built from.
@@ -200,6 +472,8 @@ pub struct JointForest {
     adjacency: Vec<u32>,
     visited: Vec<bool>,
     tree_joints: Vec<u32>,
+    /// Per tree body: its parent joint (an index into the joint slice).
+    parent_joint: Vec<u32>,
 }
 
 /// A body that the tree moves: dynamic (some inverse mass or inertia).
@@ -225,37 +499,6 @@ fn moving_pair(j: &RevoluteJoint, states: &[BodyState]) -> [u32; 3] {
     [end(j.state_a), end(j.state_b), flag]
 }
 
-/// The 2×3 block `J_ji` (rows 0 and 1 of a 3×3) of a joint on one body,
-/// with `side` ±1 and the body's axis masks (`lin`, `ang`: 1 or 0).
-#[inline(always)]
-fn jacobian(side: f64, r: Vec2, lin: f64, ang: f64) -> Matrix3 {
-    let r = wide(r);
-    let s_l = side * lin;
-    let s_a = side * ang;
-    Matrix3::from_cols(
-        Vec3::new(s_l, 0.0, 0.0),
-        Vec3::new(0.0, s_l, 0.0),
-        Vec3::new(-s_a * r.y, s_a * r.x, 0.0),
-    )
-}
-
-/// Mass matrix and axis masks of a moving body: `(diag(m, m, I), lin, ang)`
-/// with placeholder 1 on an axis it cannot move along.
-#[inline(always)]
-fn body_mass(st: &BodyState) -> (Matrix3, f64, f64) {
-    let (m, lin) = if st.inv_mass > 0.0 {
-        (1.0 / to_f64(st.inv_mass), 1.0)
-    } else {
-        (1.0, 0.0)
-    };
-    let (i, ang) = if st.inv_inertia > 0.0 {
-        (1.0 / to_f64(st.inv_inertia), 1.0)
-    } else {
-        (1.0, 0.0)
-    };
-    (Matrix3::from_diagonal(Vec3::new(m, m, i)), lin, ang)
-}
-
 /// Widens a vector to f64.
 #[inline(always)]
 fn wide(v: Vec2) -> DVec2 {
@@ -264,18 +507,6 @@ fn wide(v: Vec2) -> DVec2 {
 
 /// Relative size below which a pivot's determinant counts as zero.
 const PIVOT_TOLERANCE: f64 = 16.0 * f64::EPSILON;
-
-/// `D⁻¹` of a definite pivot; zero when it is singular or not finite (the
-/// node then takes no impulse this iteration).
-#[inline(always)]
-fn pivot_inverse(d: &Matrix3) -> Matrix3 {
-    let det = d.determinant();
-    let scale = (d.x_axis.x * d.y_axis.y * d.z_axis.z).abs();
-    if !det.is_finite() || det.abs() <= PIVOT_TOLERANCE * scale || det == 0.0 {
-        return Matrix3::ZERO;
-    }
-    d.inverse()
-}
 
 impl JointForest {
     /// Number of joints whose point rows the last build put in a tree.
@@ -322,8 +553,10 @@ impl JointForest {
     }
 
     fn rebuild(&mut self, joints: &mut [RevoluteJoint], n: usize, enabled: bool) {
-        self.nodes.clear();
         self.trees.clear();
+        self.bodies.clear();
+        self.joints.clear();
+        self.parent_joint.clear();
         self.tree_joints.clear();
         for j in joints.iter_mut() {
             j.in_tree = false;
@@ -395,34 +628,28 @@ impl JointForest {
                 }
             }
         }
-        let count = self.nodes.len();
-        self.scratch.resize(count, NodeScratch::ZERO);
+        self.body_scratch
+            .resize(self.bodies.len(), BodyScratch::ZERO);
+        self.joint_scratch
+            .resize(self.joints.len(), JointScratch::ZERO);
     }
 
-    /// Breadth-first from `root`, appending nodes parents first.
+    /// Breadth-first from `root`, appending the tree's bodies and joints.
     fn grow(&mut self, root: u32) {
         self.visited[root as usize] = true;
-        let mut next = self.nodes.len();
-        self.trees.push(next as u32);
-        self.nodes.push(Node {
-            index: root,
-            parent: NONE,
-            is_joint: false,
-            side: 1.0,
+        let first = self.bodies.len();
+        self.trees.push(TreeStart {
+            bodies: first as u32,
+            joints: self.joints.len() as u32,
         });
-        while next < self.nodes.len() {
-            let node = self.nodes[next];
-            let body_node = next as u32;
+        self.bodies.push(root);
+        self.parent_joint.push(NONE);
+        let mut next = first;
+        while next < self.bodies.len() {
+            let s = self.bodies[next];
+            let parent_joint = self.parent_joint[next];
+            let parent = (next - first) as u32;
             next += 1;
-            if node.is_joint {
-                continue;
-            }
-            let parent_joint = if node.parent == NONE {
-                NONE
-            } else {
-                self.nodes[node.parent as usize].index
-            };
-            let s = node.index;
             let (lo, hi) = (
                 self.adjacency_start[s as usize] as usize,
                 self.adjacency_start[s as usize + 1] as usize,
@@ -433,27 +660,21 @@ impl JointForest {
                     continue;
                 }
                 let [a, b, _] = self.pairs[ji as usize];
-                let (side, other, other_side) = if b == s {
-                    (1.0, a, -1.0)
-                } else {
-                    (-1.0, b, 1.0)
-                };
-                let joint_node = self.nodes.len() as u32;
-                self.nodes.push(Node {
-                    index: ji,
-                    parent: body_node,
-                    is_joint: true,
-                    side,
-                });
-                if other != 0 && !self.visited[other as usize] {
+                let (parent_is_b, other) = if b == s { (true, a) } else { (false, b) };
+                let child = if other != 0 && !self.visited[other as usize] {
                     self.visited[other as usize] = true;
-                    self.nodes.push(Node {
-                        index: other,
-                        parent: joint_node,
-                        is_joint: false,
-                        side: other_side,
-                    });
-                }
+                    self.bodies.push(other);
+                    self.parent_joint.push(ji);
+                    (self.bodies.len() - 1 - first) as u32
+                } else {
+                    NONE
+                };
+                self.joints.push(TreeJoint {
+                    index: ji,
+                    parent,
+                    child,
+                    side: if parent_is_b { 1.0 } else { -1.0 },
+                });
             }
         }
     }
@@ -473,8 +694,8 @@ impl JointForest {
 
     /// [`JointForest::solve`] with the trees spread over the step's team.
     /// Each tree is solved on a copy of its own bodies' states and joints'
-    /// impulses (its nodes' scratch), reading only fixed ends from the
-    /// shared states; the copies are written back in node order afterwards.
+    /// impulses (its scratch), reading only fixed ends from the shared
+    /// states; the copies are written back in tree order afterwards.
     /// Trees share no moving body, so the result is the same for any number
     /// of threads.
     pub fn solve_on(
@@ -485,7 +706,7 @@ impl JointForest {
         use_bias: bool,
         team: &Team,
     ) {
-        if self.nodes.is_empty() {
+        if self.trees.is_empty() {
             return;
         }
         let softness = ctx.direct_joint_softness;
@@ -500,46 +721,54 @@ impl JointForest {
             max_correction_speed: ctx.direct_joint_max_correction_speed,
             use_bias,
         };
-        for (node, sc) in self.nodes.iter().zip(self.scratch.iter_mut()) {
-            if node.is_joint {
-                sc.impulse = joints[node.index as usize].point.impulse;
-            } else {
-                sc.state = states[node.index as usize];
-            }
-        }
         {
-            let (nodes, joints, states) = (&self.nodes[..], &*joints, &*states);
-            let mut rest = &mut self.scratch[..];
-            let bounds = &self.trees;
-            let split = bounds.iter().enumerate().map(move |(t, &start)| {
-                let end = bounds.get(t + 1).map_or(nodes.len(), |&e| e as usize);
-                let (tree, tail) = std::mem::take(&mut rest).split_at_mut(end - start as usize);
-                rest = tail;
-                (start as usize, tree)
+            let (bodies, tree_joints) = (&self.bodies[..], &self.joints[..]);
+            let (joints, states) = (&*joints, &*states);
+            let mut rest_bodies = &mut self.body_scratch[..];
+            let mut rest_joints = &mut self.joint_scratch[..];
+            let starts = &self.trees;
+            let split = starts.iter().enumerate().map(move |(t, &start)| {
+                let end = starts.get(t + 1).copied().unwrap_or(TreeStart {
+                    bodies: bodies.len() as u32,
+                    joints: tree_joints.len() as u32,
+                });
+                let body_range = start.bodies as usize..end.bodies as usize;
+                let joint_range = start.joints as usize..end.joints as usize;
+                let (body_scratch, tail) =
+                    std::mem::take(&mut rest_bodies).split_at_mut(body_range.len());
+                rest_bodies = tail;
+                let (joint_scratch, tail) =
+                    std::mem::take(&mut rest_joints).split_at_mut(joint_range.len());
+                rest_joints = tail;
+                Tree {
+                    states: &bodies[body_range],
+                    joints: &tree_joints[joint_range],
+                    bodies: body_scratch,
+                    rows: joint_scratch,
+                }
             });
             if team.threads() == 1 {
                 // Tree by tree, without collecting the split.
-                for (start, tree) in split {
-                    solve_tree(nodes, start, tree, joints, states, &params);
+                for mut tree in split {
+                    solve_tree(&mut tree, joints, states, &params);
                 }
             } else {
                 let mut trees: Vec<_> = split.collect();
                 let per_block = trees.len().div_ceil(4 * team.threads()).max(1);
                 team.for_each_chunk_mut(&mut trees, per_block, |_, block| {
-                    for (start, tree) in block.iter_mut() {
-                        solve_tree(nodes, *start, tree, joints, states, &params);
+                    for tree in block.iter_mut() {
+                        solve_tree(tree, joints, states, &params);
                     }
                 });
             }
         }
-        for (node, sc) in self.nodes.iter().zip(&self.scratch) {
-            if node.is_joint {
-                joints[node.index as usize].point.impulse = sc.impulse;
-            } else {
-                let st = &mut states[node.index as usize];
-                st.v = sc.state.v;
-                st.w = sc.state.w;
-            }
+        for (&s, sc) in self.bodies.iter().zip(&self.body_scratch) {
+            let st = &mut states[s as usize];
+            st.v = sc.state.v;
+            st.w = sc.state.w;
+        }
+        for (tj, row) in self.joints.iter().zip(&self.joint_scratch) {
+            joints[tj.index as usize].point.impulse = row.impulse;
         }
     }
 }
@@ -556,79 +785,44 @@ struct TreeParams {
     use_bias: bool,
 }
 
-/// The body nodes at ends a and b of joint node `k` (`NONE` for a fixed
-/// end), as tree-local indices.
+/// One tree's share of the forest: its topology and its scratch.
+struct Tree<'a> {
+    /// Its bodies' state indices, breadth-first from the root.
+    states: &'a [u32],
+    /// Its joints, breadth-first.
+    joints: &'a [TreeJoint],
+    /// Per body and per joint: the solve's scratch.
+    bodies: &'a mut [BodyScratch],
+    rows: &'a mut [JointScratch],
+}
+
+/// The state of tree joint `tj`'s other end: the tree's copy of its child
+/// body, or the shared state `fixed` for a fixed end.
 #[inline(always)]
-fn ends(nodes: &[Node], tree: &[NodeScratch], start: usize, k: usize) -> (u32, u32) {
-    let parent = nodes[start + k].parent - start as u32;
-    let child = tree[k].child;
-    if nodes[start + k].side > 0.0 {
-        (child, parent)
+fn other_end<'s>(
+    tj: &TreeJoint,
+    fixed: u32,
+    bodies: &'s [BodyScratch],
+    states: &'s [BodyState],
+) -> &'s BodyState {
+    if tj.child == NONE {
+        &states[fixed as usize]
     } else {
-        (parent, child)
+        &bodies[tj.child as usize].state
     }
 }
 
-/// `Ĩ⁻¹ − I⁻¹` of tree-local body node `body` (state `st`): how much the
-/// geometric stiffness term lowers its inverse inertia (≤ 0).
-#[inline(always)]
-fn inertia_change(tree: &[NodeScratch], st: &BodyState, body: u32) -> Real {
-    if body == NONE || st.inv_inertia <= 0.0 {
-        return 0.0;
-    }
-    let g = tree[body as usize].geometric;
-    if g == 0.0 {
-        return 0.0;
-    }
-    let inv = to_f64(st.inv_inertia);
-    from_f64(1.0 / (1.0 / inv + g) - inv)
-}
-
-/// The state of end `body` (tree-local, `NONE` for a fixed end, then read
-/// from the shared states at `index`).
-#[inline(always)]
-fn end_state(tree: &[NodeScratch], states: &[BodyState], body: u32, index: u32) -> BodyState {
-    if body == NONE {
-        states[index as usize]
-    } else {
-        tree[body as usize].state
-    }
-}
-
-/// Joint node `k`'s joint and the states of its ends a and b (tree copies,
-/// or the shared states for a fixed end).
-#[inline(always)]
-fn joint_states<'j>(
-    nodes: &[Node],
-    start: usize,
-    tree: &[NodeScratch],
-    joints: &'j [RevoluteJoint],
-    states: &[BodyState],
-    k: usize,
-) -> (&'j RevoluteJoint, BodyState, BodyState) {
-    let j = &joints[nodes[start + k].index as usize];
-    let (body_a, body_b) = ends(nodes, tree, start, k);
-    (
-        j,
-        end_state(tree, states, body_a, j.state_a),
-        end_state(tree, states, body_b, j.state_b),
-    )
-}
-
-/// One tree's exact solve on its nodes `start..start + tree.len()`: the
-/// arithmetic of the module docs on the tree's scratch (its bodies' states,
-/// its joints' impulses), reading fixed ends from `states`.
+/// One tree's exact solve: the arithmetic of the module docs on the tree's
+/// scratch (its bodies' states, its joints' impulses), reading the fixed
+/// ends from `states`. Each joint is seen from its parent body: `C` and `Ċ`
+/// are `side ((x_p + r_p) − (x_o + r_o))`, with `o` its other end (child or
+/// fixed) and `side` +1 where the parent is the joint's body b.
 fn solve_tree(
-    nodes: &[Node],
-    start: usize,
-    tree: &mut [NodeScratch],
+    tree: &mut Tree<'_>,
     joints: &[RevoluteJoint],
     states: &[BodyState],
     params: &TreeParams,
 ) {
-    let n = tree.len();
-    let node_at = |k: usize| nodes[start + k];
-    let local = |k: u32| k as usize - start;
     let TreeParams {
         softness,
         compliance,
@@ -636,91 +830,102 @@ fn solve_tree(
         max_correction_speed,
         use_bias,
     } = *params;
-    // Arms of every joint and the geometric stiffness each body takes from
-    // its joints (one from the parent joint, one per child joint).
-    for sc in tree.iter_mut() {
+    let Tree {
+        states: indices,
+        joints: topology,
+        bodies,
+        rows,
+    } = tree;
+    let (topology, bodies, rows) = (&**topology, &mut **bodies, &mut **rows);
+    for (sc, &s) in bodies.iter_mut().zip(indices.iter()) {
+        let st = states[s as usize];
+        sc.state = st;
+        sc.lin = if st.inv_mass > 0.0 { 1.0 } else { 0.0 };
+        sc.ang = if st.inv_inertia > 0.0 { 1.0 } else { 0.0 };
+        sc.leaf = true;
         sc.geometric = 0.0;
-        sc.child = NONE;
+        sc.geometric_up = 0.0;
     }
-    for k in 0..n {
-        let node = node_at(k);
-        if node.is_joint || node.parent == NONE {
-            continue;
+    // Arms, separations, Jacobians and impulses of the joints, and the
+    // geometric stiffness each body takes from its joints.
+    for (tj, row) in topology.iter().zip(rows.iter_mut()) {
+        let j = &joints[tj.index as usize];
+        let side = tj.side;
+        let (frame_parent, frame_other, fixed) = if side > 0.0 {
+            (j.point.frame_b, j.point.frame_a, j.state_a)
+        } else {
+            (j.point.frame_a, j.point.frame_b, j.state_b)
+        };
+        row.fixed = fixed;
+        let parent = &bodies[tj.parent as usize];
+        let other = other_end(tj, fixed, bodies, states);
+        let r_parent = parent.state.dq.rotate(frame_parent);
+        let r_other = other.dq.rotate(frame_other);
+        row.c = from_f64(side) * ((parent.state.dp - other.dp) + (r_parent - r_other))
+            + j.point.delta_center;
+        (row.r_parent, row.r_other) = (r_parent, r_other);
+        row.jac_parent = Jacobian::new(side, r_parent, parent);
+        row.impulse = j.point.impulse;
+        let lambda = wide(row.impulse);
+        let parent = &mut bodies[tj.parent as usize];
+        parent.leaf = false;
+        parent.geometric += geometric_stiffness(h, lambda, r_parent, side);
+        if tj.child != NONE {
+            let child = &mut bodies[tj.child as usize];
+            row.jac_child = Jacobian::new(-side, r_other, child);
+            child.geometric_up = geometric_stiffness(h, lambda, r_other, -side);
         }
-        tree[local(node.parent)].child = k as u32;
-    }
-    for k in 0..n {
-        let node = node_at(k);
-        if !node.is_joint {
-            continue;
-        }
-        let (j, sa, sb) = joint_states(nodes, start, tree, joints, states, k);
-        let (r_a, r_b, _) = j.point.arms(&sa, &sb);
-        tree[k].arms = (r_a, r_b);
-        let lambda = wide(tree[k].impulse);
-        tree[local(node.parent)].geometric += geometric_stiffness(h, lambda, (r_a, r_b), node.side);
-    }
-    for k in 0..n {
-        let node = node_at(k);
-        if node.is_joint || node.parent == NONE {
-            continue;
-        }
-        let p = local(node.parent);
-        let lambda = wide(tree[p].impulse);
-        let arms = tree[p].arms;
-        tree[k].geometric += geometric_stiffness(h, lambda, arms, node.side);
     }
     // Ĩ = max(I, K_g / GEOMETRIC_RATIO): only the inertia the limit needs
-    // is added.
-    for sc in tree.iter_mut().zip(0..n) {
-        let (sc, k) = sc;
-        if node_at(k).is_joint {
-            continue;
+    // is added. Body pivots start as diag(m, m, Ĩ), placeholder 1 on an
+    // axis the body cannot move along.
+    for sc in bodies.iter_mut() {
+        let st = &sc.state;
+        let inv_i = to_f64(st.inv_inertia);
+        let (mut added, mut inv_i_tilde) = (0.0, inv_i);
+        // Its child joints' terms first, then its parent joint's.
+        let geometric = sc.geometric + sc.geometric_up;
+        if sc.ang > 0.0 && geometric > 0.0 {
+            added = (geometric / GEOMETRIC_RATIO - 1.0 / inv_i).max(0.0);
+            if added > 0.0 {
+                inv_i_tilde = 1.0 / (1.0 / inv_i + added);
+            }
         }
-        let (m, _, _) = body_mass(&sc.state);
-        sc.geometric = (sc.geometric / GEOMETRIC_RATIO - m.z_axis.z).max(0.0);
+        sc.inertia_change = from_f64(inv_i_tilde - inv_i);
+        sc.geometric = added;
+        sc.d = body_mass(st, added);
+        sc.b = DVec3::ZERO;
     }
     if use_bias {
         // The warm start applied the kept impulses through the bodies' own
         // inertia; re-weight their torque to the solve's inertia.
-        for k in 0..n {
-            if !node_at(k).is_joint {
-                continue;
-            }
-            let impulse = tree[k].impulse;
-            let (r_a, r_b) = tree[k].arms;
-            let (body_a, body_b) = ends(nodes, tree, start, k);
-            if body_a != NONE {
-                let st = tree[body_a as usize].state;
-                let wa = inertia_change(tree, &st, body_a);
-                tree[body_a as usize].state.w -= wa * cross(r_a, impulse);
-            }
-            if body_b != NONE {
-                let st = tree[body_b as usize].state;
-                let wb = inertia_change(tree, &st, body_b);
-                tree[body_b as usize].state.w += wb * cross(r_b, impulse);
+        for (tj, row) in topology.iter().zip(rows.iter()) {
+            bodies[tj.parent as usize].reweight(tj.side, row.r_parent, row.impulse);
+            if tj.child != NONE {
+                bodies[tj.child as usize].reweight(-tj.side, row.r_other, row.impulse);
             }
         }
     }
-    // Joint rows: right-hand sides and pivots.
-    for k in 0..n {
-        let node = node_at(k);
-        if !node.is_joint {
-            continue;
-        }
-        let (j, sa, sb) = joint_states(nodes, start, tree, joints, states, k);
-        let (r_a, r_b, c) = j.point.arms(&sa, &sb);
-        let c_dot = (sb.v + cross_sv(sb.w, r_b)) - (sa.v + cross_sv(sa.w, r_a));
-        let (k11, k12, k22) = crate::parts::PointPart::effective_mass(&sa, &sb, r_a, r_b);
+    // Leaves first: each joint's row and pivot, its child body's subtree
+    // folded in (that body's pivot is complete: its other joints come
+    // later), then the joint folded into its parent body.
+    for (tj, row) in topology.iter().zip(rows.iter_mut()).rev() {
+        let side = tj.side;
+        let (r_parent, r_other) = (row.r_parent, row.r_other);
+        let parent = &bodies[tj.parent as usize].state;
+        let other = other_end(tj, row.fixed, bodies, states);
+        let c_dot = from_f64(side)
+            * ((parent.v + cross_sv(parent.w, r_parent)) - (other.v + cross_sv(other.w, r_other)));
+        // K in the joint's own order (a, b), as the joint's rows sum it.
+        let (k11, k12, k22) = if side > 0.0 {
+            PointPart::effective_mass(other, parent, r_other, r_parent)
+        } else {
+            PointPart::effective_mass(parent, other, r_parent, r_other)
+        };
         let (k11, k12, k22) = (to_f64(k11), to_f64(k12), to_f64(k22));
-        let gamma = Matrix3::from_cols(
-            Vec3::new(k11, k12, 0.0) * compliance,
-            Vec3::new(k12, k22, 0.0) * compliance,
-            Vec3::new(0.0, 0.0, 1.0),
-        );
         let rhs = if use_bias {
-            let bias = clamp_length(softness.bias_rate * c, max_correction_speed);
-            let lambda = wide(tree[k].impulse);
+            let bias = clamp_length(softness.bias_rate * row.c, max_correction_speed);
+            let lambda = wide(row.impulse);
             let held = DVec2::new(
                 k11 * lambda.x + k12 * lambda.y,
                 k12 * lambda.x + k22 * lambda.y,
@@ -729,93 +934,64 @@ fn solve_tree(
         } else {
             -wide(c_dot)
         };
-        tree[k].d = -gamma;
-        tree[k].b = Vec3::new(rhs.x, rhs.y, 0.0);
-    }
-    // Body pivots: mass and inertia plus the geometric stiffness.
-    for k in 0..n {
-        if node_at(k).is_joint {
-            continue;
-        }
-        let (mut m, _, ang) = body_mass(&tree[k].state);
-        m.z_axis.z += ang * tree[k].geometric;
-        tree[k].d = m;
-        tree[k].b = Vec3::ZERO;
-    }
-    // Eliminate leaves first.
-    for k in (0..n).rev() {
-        let node = node_at(k);
-        let d_inv = pivot_inverse(&tree[k].d);
-        tree[k].d = d_inv;
-        if node.parent == NONE {
-            continue;
-        }
-        let p = local(node.parent);
-        // E_k = H_parent,k.
-        let e = if node.is_joint {
-            let (_, lin, ang) = body_mass(&tree[p].state);
-            let (r_a, r_b) = tree[k].arms;
-            let r = if node.side > 0.0 { r_b } else { r_a };
-            jacobian(node.side, r, lin, ang).transpose()
-        } else {
-            let (_, lin, ang) = body_mass(&tree[k].state);
-            let (r_a, r_b) = tree[p].arms;
-            let r = if node.side > 0.0 { r_b } else { r_a };
-            jacobian(node.side, r, lin, ang)
+        // D_k = −Γ, Γ = K / a2.
+        let mut d = Mat2 {
+            m00: -(k11 * compliance),
+            m01: -(k12 * compliance),
+            m10: -(k12 * compliance),
+            m11: -(k22 * compliance),
         };
-        let l = e * d_inv;
-        tree[k].l = l;
-        tree[p].d -= l * e.transpose();
-        let b_k = tree[k].b;
-        tree[p].b -= l * b_k;
-    }
-    // Back substitution, parents first.
-    for k in 0..n {
-        let node = node_at(k);
-        let mut x = tree[k].d * tree[k].b;
-        if node.parent != NONE {
-            x -= tree[k].l.transpose() * tree[local(node.parent)].b;
+        let mut b = rhs;
+        if tj.child != NONE {
+            // D_k −= J D_c⁻¹ Jᵀ,  b_k −= J D_c⁻¹ b_c  (a leaf's b_c is zero).
+            let child = &mut bodies[tj.child as usize];
+            child.d = pivot_inverse(&child.d);
+            let b_c = if child.leaf { None } else { Some(child.b) };
+            row.jac_child.fold_body(&child.d, b_c, &mut d, &mut b);
         }
-        tree[k].b = x;
+        let t = d.inverse();
+        row.d = t;
+        row.b = b;
+        // D_p −= Jᵀ D_k⁻¹ J,  b_p −= Jᵀ D_k⁻¹ b_k.
+        let parent = &mut bodies[tj.parent as usize];
+        row.jac_parent
+            .fold_joint(&t, b, &mut parent.d, &mut parent.b);
     }
-    // Apply Δλ = −μ through each joint (equal and opposite at its anchors),
-    // so linear momentum holds to rounding whatever the pivots' size; the
-    // bodies' own Δv is the same change up to the solve's precision. The
-    // angular part acts with the inertia the solve used (the body's plus
-    // its geometric stiffness term). Fixed ends do not move.
-    for k in 0..n {
-        if !node_at(k).is_joint {
-            continue;
-        }
-        let x = tree[k].b;
+    // Back substitution, root first: x_k = D_k⁻¹ b_k − L_kᵀ x_parent.
+    // Each joint's Δλ = −μ is applied as soon as it is known, equal and
+    // opposite at its anchors, so linear momentum holds to rounding
+    // whatever the pivots' size; the bodies' own Δv is the same change up
+    // to the solve's precision. The angular part acts with the inertia the
+    // solve used (the body's plus its geometric stiffness term). Fixed ends
+    // do not move.
+    let root = &mut bodies[0];
+    root.d = pivot_inverse(&root.d);
+    root.b = root.d * root.b;
+    for (tj, row) in topology.iter().zip(rows.iter_mut()) {
+        let side = tj.side;
+        let parent = &mut bodies[tj.parent as usize];
+        let x = row.jac_parent.joint_solution(&row.d, row.b, parent.b);
+        row.b = x;
         let impulse = -Vec2::new(from_f64(x.x), from_f64(x.y));
-        tree[k].impulse += impulse;
-        let (r_a, r_b) = tree[k].arms;
-        let (body_a, body_b) = ends(nodes, tree, start, k);
-        if body_a != NONE {
-            let sa = tree[body_a as usize].state;
-            let i_a = sa.inv_inertia + inertia_change(tree, &sa, body_a);
-            let st = &mut tree[body_a as usize].state;
-            st.v -= sa.inv_mass * impulse;
-            st.w -= i_a * cross(r_a, impulse);
-        }
-        if body_b != NONE {
-            let sb = tree[body_b as usize].state;
-            let i_b = sb.inv_inertia + inertia_change(tree, &sb, body_b);
-            let st = &mut tree[body_b as usize].state;
-            st.v += sb.inv_mass * impulse;
-            st.w += i_b * cross(r_b, impulse);
+        row.impulse += impulse;
+        parent.apply(side, row.r_parent, impulse);
+        if tj.child != NONE {
+            let child = &mut bodies[tj.child as usize];
+            if !child.leaf {
+                // A leaf's solution is not needed: no joint below it.
+                child.b = row.jac_child.body_solution(&child.d, child.b, x);
+            }
+            child.apply(-side, row.r_other, impulse);
         }
     }
 }
 
 /// The geometric stiffness term of a joint's impulse `λ` (on body b; −λ on
-/// a) on its body on `side` (+1: b, −1: a) over a substep of `h`:
-/// `h λ · r_b` for b, `−h λ · r_a` for a, where positive (a restoring
+/// a) on its body on `side` (+1: b, −1: a) with arm `r` over a substep of
+/// `h`: `h λ · r_b` for b, `−h λ · r_a` for a, where positive (a restoring
 /// torque: tension along the arm); zero otherwise.
 #[inline(always)]
-fn geometric_stiffness(h: f64, lambda: DVec2, arms: (Vec2, Vec2), side: f64) -> f64 {
-    let r = if side > 0.0 { arms.1 } else { arms.0 };
+fn geometric_stiffness(h: f64, lambda: DVec2, r: Vec2, side: f64) -> f64 {
     (h * side * lambda.dot(wide(r))).max(0.0)
 }
 

@@ -374,10 +374,16 @@ impl Constraint for RevoluteJoint {
             return;
         }
         let (mut sa, mut sb) = load_pair(states, self.state_a, self.state_b);
+        // The angle depends on the rotations only, which the rows below do
+        // not change: one atan2 for the spring and the limits.
+        let angle = if self.def.enable_spring || self.def.enable_limit {
+            self.current_angle(&sa, &sb)
+        } else {
+            0.0
+        };
         if self.def.enable_spring && sa.inv_inertia + sb.inv_inertia > 0.0 {
-            let c = self.current_angle(&sa, &sb);
             self.spring
-                .solve_soft(&mut sa, &mut sb, c, self.spring_softness);
+                .solve_soft(&mut sa, &mut sb, angle, self.spring_softness);
         }
         if self.def.enable_motor {
             let max_impulse = ctx.h * self.def.max_motor_torque;
@@ -385,7 +391,6 @@ impl Constraint for RevoluteJoint {
                 .solve_motor(&mut sa, &mut sb, self.def.motor_speed, max_impulse);
         }
         if self.def.enable_limit {
-            let angle = self.current_angle(&sa, &sb);
             let soft = ctx.joint_softness;
             self.lower.solve_limit(
                 &mut sa,
