@@ -282,6 +282,10 @@ fn bodies_created_asleep_cost_nothing_until_touched() {
         0,
         "touching sleeping boxes were tested"
     );
+    // The contacts found between them sleep too: no step visits them
+    // (they stayed in the awake list before, read at every step).
+    assert_eq!(world.contact_count(), 9, "neighbours' fat boxes overlap");
+    assert_eq!(world.awake_contact_count(), 0);
     let ball = world
         .create_body(&BodyDef::dynamic(Vec2::new(-3.0, 0.0)).with_velocity(Vec2::new(10.0, 0.0)))
         .unwrap();

@@ -59,41 +59,6 @@ fn sleeping_island_contacts_leave_the_awake_list_and_come_back_on_wake() {
     assert_eq!(world.counters().pairs_tested, 3);
 }
 
-/// Bodies created asleep side by side: the contacts the broadphase finds
-/// between them leave the awake list at the first narrowphase (before,
-/// they stayed in it and were read every step), and return when one of
-/// their bodies wakes.
-#[test]
-fn contacts_between_bodies_created_asleep_leave_the_awake_list() {
-    let mut world = World::new(WorldDef {
-        gravity: Vec2::ZERO,
-        ..WorldDef::default()
-    })
-    .unwrap();
-    let row: Vec<BodyHandle> = (0..4)
-        .map(|i| {
-            let mut def = BodyDef::dynamic(Vec2::new(0.4 * i as Real, 0.0));
-            def.awake = false;
-            let b = world.create_body(&def).unwrap();
-            world
-                .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.2, 0.2))
-                .unwrap();
-            b
-        })
-        .collect();
-    world.step(DT).unwrap();
-    assert_eq!(world.contact_count(), 3, "neighbours' fat boxes overlap");
-    assert_eq!(world.awake_contact_count(), 0, "all three sleep");
-    world.step(DT).unwrap();
-    assert_eq!(world.counters().pairs_tested, 0);
-    world
-        .apply_linear_impulse(row[0], Vec2::new(0.1, 0.0), Vec2::ZERO)
-        .unwrap();
-    assert_eq!(world.awake_contact_count(), 1, "the woken body's contact");
-    world.step(DT).unwrap();
-    assert_eq!(world.counters().pairs_tested, 1);
-}
-
 #[test]
 fn destroying_a_body_ends_its_contacts_only_and_reports_them_next_step() {
     let (mut world, _, boxes) = stack_on_ground(3);
