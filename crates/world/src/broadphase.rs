@@ -390,12 +390,7 @@ impl BroadPhase {
             #[cfg(feature = "parallel")]
             self.find_pairs_parallel(bulk, &moves, &filter, out);
         } else {
-            let mut report = |pa: u32, pb: u32| {
-                let (a, b) = (pa.min(pb), pa.max(pb));
-                if filter(a, b) {
-                    out.push((a, b));
-                }
-            };
+            let mut report = |pa: u32, pb: u32| keep_pair(&filter, out, pa, pb);
             self.find_pairs_serial(bulk, &moves, &mut report);
         }
 
@@ -462,12 +457,6 @@ impl BroadPhase {
         use rayon::prelude::*;
         let proxies = &self.proxies;
         let (dynamic, fixed) = (&self.dynamic_tree, &self.static_tree);
-        let keep_pair = |pairs: &mut Vec<(u32, u32)>, pa: u32, pb: u32| {
-            let (a, b) = (pa.min(pb), pa.max(pb));
-            if filter(a, b) {
-                pairs.push((a, b));
-            }
-        };
         let found: Vec<Vec<(u32, u32)>> = if bulk {
             let want = 64 * rayon::current_num_threads();
             let mut seeds = Vec::new();
@@ -489,7 +478,7 @@ impl BroadPhase {
                         dynamic.for_each_pair_from(other, seed, &mut stack, |x, y| {
                             let (sx, sy) = (&proxies[x as usize], &proxies[y as usize]);
                             if sx.moved || sy.moved {
-                                keep_pair(&mut pairs, sx.payload, sy.payload);
+                                keep_pair(filter, &mut pairs, sx.payload, sy.payload);
                             }
                         });
                     }
@@ -507,7 +496,7 @@ impl BroadPhase {
                         let mut visit = |other: u32| {
                             let o = &proxies[other as usize];
                             if other != m && !(o.moved && other < m) {
-                                keep_pair(&mut pairs, slot.payload, o.payload);
+                                keep_pair(filter, &mut pairs, slot.payload, o.payload);
                             }
                             true
                         };
@@ -615,6 +604,16 @@ impl BroadPhase {
             s.moved = true;
             self.move_buffer.push(proxy);
         }
+    }
+}
+
+/// Appends the pair of payloads `pa`, `pb` to `out`, smaller first, when
+/// `filter` keeps it (the pair search's report, serial or per block).
+#[inline]
+fn keep_pair(filter: &impl Fn(u32, u32) -> bool, out: &mut Vec<(u32, u32)>, pa: u32, pb: u32) {
+    let (a, b) = (pa.min(pb), pa.max(pb));
+    if filter(a, b) {
+        out.push((a, b));
     }
 }
 
