@@ -434,7 +434,7 @@ impl ContactConstraint {
     /// The terms of point `i`'s normal row: bias `b` (m/s), mass scale
     /// `s_m` and impulse scale `s_i` of `Δλ = −m s_m (Ċ + b) − s_i λ`.
     #[inline(always)]
-    fn normal_terms<const USE_BIAS: bool>(
+    pub(crate) fn normal_terms<const USE_BIAS: bool>(
         &self,
         i: usize,
         dpn: Real,
@@ -536,6 +536,73 @@ impl ContactConstraint {
         self.impulse[i] = old + d;
         self.max_normal_impulse[i] = max_or(d, self.max_normal_impulse[i]);
         d
+    }
+
+    /// The friction rows alone, one by one, from the bodies' velocities
+    /// (after a coupled group has solved the normal rows).
+    pub(crate) fn solve_friction_rows(&mut self, states: &mut [BodyState]) {
+        let (ia, ib) = (self.state_a as usize, self.state_b as usize);
+        let [m_a, i_a, m_b, i_b] = self.applied_masses;
+        let t = self.tangent();
+        for i in 0..self.point_count() {
+            let row = i + MAX_MANIFOLD_POINTS;
+            let (sa, sb) = (&states[ia], &states[ib]);
+            let c_dot = (sb.v - sa.v).dot(t) + (sb.w * self.jb[row] - sa.w * self.ja[row]);
+            let d = self.friction_row(row, c_dot);
+            let p = d * t;
+            states[ia].v -= m_a * p;
+            states[ia].w -= i_a * d * self.ja[row];
+            states[ib].v += m_b * p;
+            states[ib].w += i_b * d * self.jb[row];
+        }
+    }
+
+    /// Stiffens the normal rows of a contact of a light cluster's group:
+    /// each row's spring is built on the effective mass it would have if
+    /// every side in the cluster (`in_cluster`) had the inverse mass and
+    /// inertia `heavy = [m_H⁻¹, i_H⁻¹]` of the heaviest body the cluster
+    /// touches (`contact_group` docs), where that is stiffer than the row's
+    /// own spring.
+    pub(crate) fn stiffen_for_group(
+        &mut self,
+        ctx: &StepContext,
+        in_cluster: [bool; 2],
+        k_masses: [Real; 4],
+        heavy: [Real; 2],
+    ) {
+        let [m_a, i_a, m_b, i_b] = k_masses;
+        let static_pair = m_a == 0.0 || m_b == 0.0;
+        let softness = if static_pair {
+            ctx.static_softness
+        } else {
+            ctx.contact_softness
+        };
+        let [m_h, i_h] = heavy;
+        for i in 0..self.point_count() {
+            let (rn_a, rn_b) = (self.ja[i], self.jb[i]);
+            let k_a = m_a + i_a * rn_a * rn_a;
+            let k_b = m_b + i_b * rn_b * rn_b;
+            let k_group_a = if in_cluster[0] {
+                m_h + i_h * rn_a * rn_a
+            } else {
+                k_a
+            };
+            let k_group_b = if in_cluster[1] {
+                m_h + i_h * rn_b * rn_b
+            } else {
+                k_b
+            };
+            let k_group = k_group_a + k_group_b;
+            if k_group <= 0.0 {
+                continue;
+            }
+            let rho_group = (k_a + k_b) / k_group;
+            let soft = softness.with_mass_ratio(rho_group);
+            if soft.impulse_scale < self.impulse_scale[i] {
+                self.impulse_scale[i] = soft.impulse_scale;
+                self.soft_mass[i] = self.mass[i] * soft.mass_scale;
+            }
+        }
     }
 
     /// Friction row `i` (2 or 3) given its `Ċ`: accumulates the impulse,

@@ -7,9 +7,9 @@
 //!            already appears (static, kinematic and sleeping bodies take
 //!            no colour: the solve never changes their state)
 //!   push     each contact's lane data into the open chunk of its colour,
-//!            structure of arrays; the overflow (a body in every colour, or
-//!            a portal copy whose contacts need the object-mass hook) as
-//!            scalar ContactConstraints
+//!            structure of arrays; the overflow (a body in every colour, a
+//!            portal copy whose contacts need the object-mass hook, or a
+//!            light cluster's contact) as scalar ContactConstraints
 //!
 //!            colour 0: [c0 c3 c7 … ] [c12 … pad]     chunk = LANES lanes
 //!            colour 1: [c1 c4 … pad]
@@ -18,12 +18,14 @@
 //!
 //! prepare    lane-wise: K (and the normal rows' 2×2 block), the mass-ratio
 //!            softness, the approach speed;
-//!            overflow scalar, then the object-mass hook on it
+//!            overflow scalar, then the object-mass hook on it, then the
+//!            light clusters' groups (crate::contact_group)
 //! warm start, solve (bias), relax (no bias), restitution
 //!            colour by colour (solve and relax reversed on alternate
 //!            sweeps), chunk by chunk: gather the lanes' body states, the
 //!            row arithmetic of ContactConstraint on lanes, scatter the
-//!            velocities; then the overflow, scalar
+//!            velocities; then the overflow, scalar, and each light
+//!            cluster's group as one block
 //! store      the impulses of every lane and overflow constraint go back to
 //!            the pipeline's contacts, by contact index
 //! ```
@@ -45,6 +47,7 @@ use janus2d_core::parallel::{PlannedStates, StatePlan, Team};
 use wide::{CmpEq, CmpGe, CmpGt, CmpLt, CmpNe};
 
 use crate::contact::{ContactConstraint, ContactPointInput, MAX_MANIFOLD_POINTS, ROWS};
+use crate::contact_group::{Groups, solve_group};
 
 /// Lanes of the SIMD type.
 #[cfg(not(feature = "f64"))]
@@ -221,6 +224,11 @@ pub struct ContactLane {
     pub restitution: Real,
     /// The pipeline's index of the contact (impulses are stored back by it).
     pub contact_index: u32,
+    /// The light cluster of each side ([`crate::contact_group::Clusters`],
+    /// [`NO_CLUSTER`](crate::contact_group::NO_CLUSTER) for none): a
+    /// contact with a side in a cluster goes to the overflow and is solved
+    /// with the cluster's other contacts as one block.
+    pub cluster: [u32; 2],
 }
 
 /// A step's contact constraints in their colours and lanes: the contact
@@ -235,8 +243,15 @@ pub struct ContactLane {
 pub struct ContactSolver {
     /// Chunks per colour; the last chunk of a colour may have free lanes.
     colours: Vec<Vec<WideContact>>,
-    /// Contacts solved one by one.
+    /// Contacts solved one by one (or in the coupled groups of light
+    /// clusters, see [`crate::contact_group`]).
     overflow: Vec<ContactConstraint>,
+    /// Per overflow contact: it builds on a portal object's masses.
+    hooked: Vec<bool>,
+    /// Per overflow contact: its sides' light clusters (`ContactLane::cluster`).
+    clusters: Vec<[u32; 2]>,
+    /// The coupled groups of the overflow's light clusters.
+    groups: Groups,
     /// The colouring of this step.
     graph: ColourGraph,
     /// Number of contacts pushed since [`ContactSolver::begin`].
@@ -291,6 +306,7 @@ impl ContactSolver {
             chunks.clear();
         }
         self.overflow.clear();
+        self.clusters.clear();
         self.len = 0;
     }
 
@@ -325,6 +341,7 @@ impl ContactSolver {
             c.state_a = lane.state_a;
             c.state_b = lane.state_b;
             self.overflow.push(c);
+            self.clusters.push(lane.cluster);
             return place;
         }
         if self.colours.len() < COLOURS {
@@ -538,13 +555,16 @@ impl ContactSolver {
             let verified = self.plan.verify(states.len());
             debug_assert!(verified, "a colour holds a moving body twice");
         }
+        self.hooked.clear();
         for c in &mut self.overflow {
             c.prepare(ctx, bodies);
             if objects.is_empty() {
+                self.hooked.push(false);
                 continue;
             }
             let find = |body| objects.iter().find(|o| o.body == body);
             let (oa, ob) = (find(c.body_a), find(c.body_b));
+            self.hooked.push(oa.is_some() || ob.is_some());
             if oa.is_some() || ob.is_some() {
                 let [m_a, i_a, m_b, i_b] = c.applied_masses;
                 let (m_a, i_a) = oa.map_or((m_a, i_a), |o| (o.inv_mass, o.inv_inertia));
@@ -556,6 +576,13 @@ impl ContactSolver {
                 c.block = false;
             }
         }
+        self.groups.build(
+            ctx,
+            &mut self.overflow,
+            &self.clusters,
+            &self.hooked,
+            states.len(),
+        );
     }
 
     fn warm_start(&mut self, states: &mut [BodyState], team: &Team) {
@@ -587,11 +614,44 @@ impl ContactSolver {
             let chunks = &mut self.colours[colour];
             colour_stage(team, &self.plan, colour, chunks, states, stage);
         }
-        for c in &mut self.overflow {
+        self.solve_overflow(states, use_bias, inv_h, push_max);
+    }
+
+    /// The overflow: its contacts one by one, then the coupled groups of
+    /// light clusters ([`crate::contact_group`]).
+    fn solve_overflow(
+        &mut self,
+        states: &mut [BodyState],
+        use_bias: bool,
+        inv_h: Real,
+        push_max: Real,
+    ) {
+        let grouped = &self.groups.grouped;
+        for (k, c) in self.overflow.iter_mut().enumerate() {
+            if grouped.get(k).copied().unwrap_or(false) {
+                continue;
+            }
             if use_bias {
                 c.solve_rows::<true>(states, inv_h, push_max);
             } else {
                 c.solve_rows::<false>(states, inv_h, push_max);
+            }
+        }
+        for g in &self.groups.groups {
+            let solved = if use_bias {
+                solve_group::<true>(g, &mut self.overflow, states, inv_h, push_max)
+            } else {
+                solve_group::<false>(g, &mut self.overflow, states, inv_h, push_max)
+            };
+            if !solved {
+                for &k in g.members() {
+                    let c = &mut self.overflow[k as usize];
+                    if use_bias {
+                        c.solve_rows::<true>(states, inv_h, push_max);
+                    } else {
+                        c.solve_rows::<false>(states, inv_h, push_max);
+                    }
+                }
             }
         }
     }

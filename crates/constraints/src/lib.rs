@@ -9,12 +9,15 @@
 //! | [`contact::ContactConstraint`]| 2–4  | 2      | compact rows (normal, friction) |
 //!
 //! The point rows of joints that form a tree are solved exactly, the
-//! whole tree at once ([`joint_tree`]); the rest is Gauss–Seidel.
+//! whole tree at once ([`joint_tree`]); so are the normal rows of the
+//! contacts of a light cluster, bodies under (or between) bodies ten times
+//! heavier or more ([`contact_group`]); the rest is Gauss–Seidel.
 //!
 //! Every type follows the same stages (prepare, warm start, solve with or
 //! without bias) and reports its rows through `Constraint::rows`.
 
 pub mod contact;
+pub mod contact_group;
 pub mod contact_solver;
 pub mod joint_tree;
 pub mod parts;

@@ -23,6 +23,7 @@
 
 use janus2d_constraints::ContactPointInput;
 use janus2d_constraints::ObjectMass;
+use janus2d_constraints::contact_group::{Clusters, ContactBodies, NO_CLUSTER, light_pair};
 use janus2d_constraints::contact_solver::{ContactLane, ContactSolver, LanePlace, OVERFLOW};
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::geometry::{Aabb, Manifold, collide};
@@ -114,6 +115,12 @@ pub(crate) struct Narrowphase {
     /// does not take), for storing the impulses back in contact order.
     #[cfg_attr(feature = "serde", serde(skip))]
     place_of: Vec<LanePlace>,
+    /// The light clusters of the solved contacts (scratch of the build).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    clusters: Clusters,
+    /// Their clusters, per solved contact (scratch of the build).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    cluster_of: Vec<[u32; 2]>,
 }
 
 /// [`Narrowphase::place_of`] of a contact that is not solved this step.
@@ -158,6 +165,7 @@ fn empty_lane() -> ContactLane {
         friction: 0.0,
         restitution: 0.0,
         contact_index: 0,
+        cluster: [NO_CLUSTER; 2],
     }
 }
 
@@ -188,6 +196,7 @@ fn stage(c: &Contact) -> StagedContact {
             friction: c.friction,
             restitution: c.restitution,
             contact_index: 0,
+            cluster: [NO_CLUSTER; 2],
         },
         still: c.still,
     }
@@ -207,6 +216,13 @@ struct SolvedContact {
     with_static: bool,
     /// A portal copy takes part: the object-mass hook, in the overflow.
     copy: bool,
+    /// Inverse mass of each body, 1/kg (0 for one the solve does not move).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    inv_mass: [Real; 2],
+    /// The light cluster of each side (`contact_group`): with one, in the
+    /// overflow, solved with the cluster's other contacts as one block.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    cluster: [u32; 2],
     /// Its colour ([`OVERFLOW`]: solved scalar).
     colour: u8,
 }
@@ -623,6 +639,9 @@ pub(crate) fn build_constraints(
     if staged.len() < n {
         staged.resize(n, StagedContact::default());
     }
+    // Whether any moving pair is light beside the other (then the light
+    // clusters are looked for, below).
+    let mut any_light = false;
     let candidates = narrowphase
         .touching
         .iter()
@@ -696,6 +715,8 @@ pub(crate) fn build_constraints(
         let [m_a, i_a, m_b, i_b] = lane.inv_masses;
         let (ia, moving_a) = state_of((lane.state_a, [m_a, i_a]));
         let (ib, moving_b) = state_of((lane.state_b, [m_b, i_b]));
+        let inv_masses = [m_a, m_b];
+        any_light |= light_pair([moving_a, moving_b], inv_masses);
         let copy = !objects.is_empty() && (is_copy(lane.body_a) || is_copy(lane.body_b));
         solved.push(SolvedContact {
             index: k as u32,
@@ -703,13 +724,37 @@ pub(crate) fn build_constraints(
             moving: [moving_a, moving_b],
             with_static: sa || sb,
             copy,
+            inv_mass: inv_masses,
+            cluster: [NO_CLUSTER; 2],
             colour: OVERFLOW,
         });
+    }
+    // Light clusters (`contact_group`): their contacts go to the overflow,
+    // where the solver takes each cluster's contacts as one block.
+    let cluster_of = &mut narrowphase.cluster_of;
+    cluster_of.clear();
+    if any_light {
+        narrowphase.clusters.assign(
+            bodies.states.len(),
+            solved.len(),
+            |k| {
+                let s = &solved[k];
+                ContactBodies {
+                    state: s.state,
+                    moving: s.moving,
+                    inv_mass: s.inv_mass,
+                }
+            },
+            cluster_of,
+        );
+        for (s, ids) in solved.iter_mut().zip(cluster_of.iter()) {
+            s.cluster = *ids;
+        }
     }
     for static_pass in [false, true] {
         for s in solved.iter_mut() {
             if s.with_static == static_pass {
-                s.colour = if s.copy {
+                s.colour = if s.copy || s.cluster != [NO_CLUSTER; 2] {
                     OVERFLOW
                 } else {
                     let [ia, ib] = s.state;
@@ -734,10 +779,11 @@ pub(crate) fn build_constraints(
     solver.push_all(
         colours,
         |i| {
-            let k = solved[i].index;
+            let s = &solved[i];
             ContactLane {
-                contact_index: k,
-                ..staged[k as usize].lane
+                contact_index: s.index,
+                cluster: s.cluster,
+                ..staged[s.index as usize].lane
             }
         },
         places,
