@@ -149,6 +149,7 @@ pub struct Clusters {
     parent: Vec<u32>,
     heavier: Vec<bool>,
     count: Vec<u32>,
+    blocked: Vec<bool>,
 }
 
 impl Clusters {
@@ -156,11 +157,19 @@ impl Clusters {
     /// contact `k`'s bodies), into `out[k]`: a cluster id (the state index
     /// of its root) or [`NO_CLUSTER`]. Without a [`light_pair`] among the
     /// contacts there is none: the pipeline then skips this.
+    ///
+    /// `excluded` lists state indices of bodies a group cannot model: a
+    /// body a motor turns (the motor's torque, up to unbounded, is outside
+    /// the block, which would then press the light body through whatever is
+    /// behind it) and a portal object's bodies (their contacts build on the
+    /// whole object's masses through the portal rows). A cluster that has
+    /// such a body as a member or touches one keeps Gauss–Seidel.
     pub fn assign(
         &mut self,
         state_count: usize,
         n: usize,
         read: impl Fn(usize) -> ContactBodies,
+        excluded: &[u32],
         out: &mut Vec<[u32; 2]>,
     ) {
         out.clear();
@@ -201,6 +210,28 @@ impl Clusters {
                     for r in [a, b] {
                         if r != NO_CLUSTER {
                             self.count[r as usize] += 1;
+                        }
+                    }
+                }
+            }
+        }
+        // Excluded bodies, and every cluster one of them touches, are not
+        // light.
+        if !excluded.is_empty() {
+            self.blocked.clear();
+            self.blocked.resize(state_count, false);
+            for &i in excluded {
+                if (i as usize) < state_count {
+                    self.blocked[i as usize] = true;
+                }
+            }
+            for (k, roots) in out.iter().enumerate() {
+                let c = read(k);
+                let touches = (0..2).any(|s| c.moving[s] && self.blocked[c.state[s] as usize]);
+                if touches {
+                    for &r in roots {
+                        if r != NO_CLUSTER {
+                            self.heavier[r as usize] = false;
                         }
                     }
                 }
@@ -657,7 +688,8 @@ mod tests {
     }
 
     /// Two light boxes stacked under a heavy one on the ground form one
-    /// cluster; boxes of equal mass with nothing heavier form none.
+    /// cluster; boxes of equal mass with nothing heavier form none; nor
+    /// does a cluster that touches an excluded body.
     #[test]
     fn clusters_of_light_bodies_under_a_heavy_one() {
         let body = |state: [u32; 2], inv_mass: [Real; 2]| ContactBodies {
@@ -673,10 +705,16 @@ mod tests {
         ];
         let mut clusters = Clusters::default();
         let mut out = Vec::new();
-        clusters.assign(4, stack.len(), |k| stack[k], &mut out);
+        clusters.assign(4, stack.len(), |k| stack[k], &[], &mut out);
         assert_eq!(out, vec![[NO_CLUSTER, 1], [1, 1], [1, NO_CLUSTER]]);
+        // The heavy box turned by a motor (excluded): no cluster.
+        clusters.assign(4, stack.len(), |k| stack[k], &[3], &mut out);
+        assert_eq!(out, vec![[NO_CLUSTER; 2]; 3]);
+        // A member excluded (a portal object's body): none either.
+        clusters.assign(4, stack.len(), |k| stack[k], &[1], &mut out);
+        assert_eq!(out, vec![[NO_CLUSTER; 2]; 3]);
         let equal = [body([0, 1], [0.0, 1.0]), body([1, 2], [1.0, 1.0])];
-        clusters.assign(3, equal.len(), |k| equal[k], &mut out);
+        clusters.assign(3, equal.len(), |k| equal[k], &[], &mut out);
         assert_eq!(out, vec![[NO_CLUSTER; 2]; 2]);
     }
 }

@@ -390,6 +390,16 @@ impl JointSet {
         self.edit(joint, |d| d.enable_limit = on)
     }
 
+    /// The bodies an enabled motor (of nonzero torque) turns: both bodies
+    /// of each such joint, in joint order. The light clusters leave them
+    /// out (`janus2d_constraints::contact_group`).
+    pub(crate) fn driven_bodies(&self) -> impl Iterator<Item = BodyHandle> + '_ {
+        self.revolute
+            .iter()
+            .filter(|j| j.enabled && j.def.enable_motor && j.def.max_motor_torque > 0.0)
+            .flat_map(|j| [j.def.body_a, j.def.body_b])
+    }
+
     /// Sets the motor speed, rad/s.
     pub(crate) fn set_motor_speed(
         &mut self,

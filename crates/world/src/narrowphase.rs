@@ -121,6 +121,10 @@ pub(crate) struct Narrowphase {
     /// Their clusters, per solved contact (scratch of the build).
     #[cfg_attr(feature = "serde", serde(skip))]
     cluster_of: Vec<[u32; 2]>,
+    /// State indices of the bodies no cluster may hold (scratch of the
+    /// build).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    excluded: Vec<u32>,
 }
 
 /// [`Narrowphase::place_of`] of a contact that is not solved this step.
@@ -625,6 +629,7 @@ pub(crate) fn build_constraints(
     bodies: &BodySet,
     woke: bool,
     objects: &[ObjectMass],
+    driven: impl Iterator<Item = BodyHandle>,
     mut pre_solve: Option<&mut PreSolveFn>,
     solver: &mut ContactSolver,
     counters: &mut CollisionCounters,
@@ -734,6 +739,15 @@ pub(crate) fn build_constraints(
     let cluster_of = &mut narrowphase.cluster_of;
     cluster_of.clear();
     if any_light {
+        // A body a motor turns and a portal object's bodies take no part
+        // (`Clusters::assign`).
+        let excluded = &mut narrowphase.excluded;
+        excluded.clear();
+        for body in driven.chain(objects.iter().map(|o| o.body)) {
+            if let Some(i) = bodies.state_index(body).filter(|&i| i != 0) {
+                excluded.push(i);
+            }
+        }
         narrowphase.clusters.assign(
             bodies.states.len(),
             solved.len(),
@@ -745,6 +759,7 @@ pub(crate) fn build_constraints(
                     inv_mass: s.inv_mass,
                 }
             },
+            excluded,
             cluster_of,
         );
         for (s, ids) in solved.iter_mut().zip(cluster_of.iter()) {

@@ -1479,6 +1479,7 @@ impl World {
                 &self.bodies,
                 woke,
                 &self.object_masses,
+                self.joints.driven_bodies(),
                 self.pre_solve.as_mut(),
                 &mut self.contact_solver,
                 &mut self.collision.counters,
