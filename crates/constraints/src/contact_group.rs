@@ -28,7 +28,11 @@
 //! solver's scalar overflow, each tagged with its cluster; the solver
 //! solves each cluster's contacts as one group. A cluster too large for
 //! a group (the pyramids of "high mass ratio 1" under their heavy tops)
-//! keeps the colours' Gauss–Seidel.
+//! keeps the colours' Gauss–Seidel, and so does a cluster that holds or
+//! touches a body the block cannot model: one a motor turns (its torque,
+//! possibly unbounded, is outside the block, which then presses the light
+//! body through whatever lies behind it) or a portal object's body (its
+//! contacts build on the whole object's masses through the portal rows).
 //!
 //! # The springs of a group
 //!
