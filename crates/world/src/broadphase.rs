@@ -109,6 +109,10 @@ pub struct BroadPhase {
     /// Scratch of the dynamic tree's partial rebuild.
     #[cfg_attr(feature = "serde", serde(skip))]
     rebuild_items: Vec<u32>,
+    /// Scratch of the bulk pair search: per node of each tree (dynamic,
+    /// static), whether its subtree holds a moved proxy.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    moved_marks: [Vec<bool>; 2],
 }
 
 impl Default for BroadPhase {
@@ -133,6 +137,7 @@ impl BroadPhase {
             proxies: Vec::new(),
             free_proxies: Vec::new(),
             move_buffer: Vec::new(),
+            moved_marks: [Vec::new(), Vec::new()],
             pair_stack: Vec::new(),
             rebuild_items: Vec::new(),
         }
@@ -380,6 +385,23 @@ impl BroadPhase {
             s.alive && s.moved
         });
 
+        if bulk {
+            // The descents skip node pairs without a moved proxy below
+            // either node (only pairs with a moved member are kept).
+            for (is_static, marks) in [false, true].into_iter().zip(&mut self.moved_marks) {
+                let tree = if is_static {
+                    &self.static_tree
+                } else {
+                    &self.dynamic_tree
+                };
+                let leaves = moves
+                    .iter()
+                    .map(|&p| &proxies[p as usize])
+                    .filter(|slot| slot.is_static == is_static)
+                    .map(|slot| slot.leaf);
+                tree.mark_paths(leaves, marks);
+            }
+        }
         #[cfg(feature = "parallel")]
         let threads = rayon::current_num_threads() > 1 && moves.len() >= PARALLEL_MOVES;
         #[cfg(not(feature = "parallel"))]
@@ -417,10 +439,17 @@ impl BroadPhase {
                     report(sx.payload, sy.payload);
                 }
             };
+            let [dynamic_marks, static_marks] = &self.moved_marks;
             let stack = &mut self.pair_stack;
-            self.dynamic_tree.for_each_self_pair(stack, &mut visit);
             self.dynamic_tree
-                .for_each_cross_pair(&self.static_tree, stack, &mut visit);
+                .for_each_self_pair(dynamic_marks, stack, &mut visit);
+            self.dynamic_tree.for_each_cross_pair(
+                &self.static_tree,
+                dynamic_marks,
+                static_marks,
+                stack,
+                &mut visit,
+            );
         } else {
             for &m in moves {
                 let slot = proxies[m as usize];
@@ -457,6 +486,7 @@ impl BroadPhase {
         use rayon::prelude::*;
         let proxies = &self.proxies;
         let (dynamic, fixed) = (&self.dynamic_tree, &self.static_tree);
+        let [dynamic_marks, static_marks] = &self.moved_marks;
         let found: Vec<Vec<(u32, u32)>> = if bulk {
             let want = 64 * rayon::current_num_threads();
             let mut seeds = Vec::new();
@@ -474,13 +504,19 @@ impl BroadPhase {
                     let mut pairs = Vec::new();
                     let mut stack = Vec::new();
                     for &(is_cross, seed) in block {
-                        let other = is_cross.then_some(fixed);
-                        dynamic.for_each_pair_from(other, seed, &mut stack, |x, y| {
-                            let (sx, sy) = (&proxies[x as usize], &proxies[y as usize]);
-                            if sx.moved || sy.moved {
-                                keep_pair(filter, &mut pairs, sx.payload, sy.payload);
-                            }
-                        });
+                        let other = is_cross.then_some((fixed, &static_marks[..]));
+                        dynamic.for_each_pair_from(
+                            other,
+                            dynamic_marks,
+                            seed,
+                            &mut stack,
+                            |x, y| {
+                                let (sx, sy) = (&proxies[x as usize], &proxies[y as usize]);
+                                if sx.moved || sy.moved {
+                                    keep_pair(filter, &mut pairs, sx.payload, sy.payload);
+                                }
+                            },
+                        );
                     }
                     pairs
                 })

@@ -82,6 +82,13 @@ const STACK_INLINE: usize = 64;
 
 /// Depth-first traversal stack: a fixed array on the call stack with a heap
 /// fallback that only allocates if it overflows (never in practice).
+/// Whether node `n` is marked ([`DynamicTree::mark_paths`]); every node is
+/// when there are no marks.
+#[inline(always)]
+fn marked(marks: &[bool], n: u32) -> bool {
+    marks.get(n as usize).copied().unwrap_or(true)
+}
+
 struct NodeStack {
     inline: [u32; STACK_INLINE],
     len: usize,
@@ -636,11 +643,33 @@ impl DynamicTree {
         Ok(())
     }
 
+    /// Marks, per node, whether its subtree holds one of the `leaves`
+    /// (node ids of leaves): `marks[n]` for node `n`. Each leaf's path is
+    /// walked up to the first node already marked, so the cost is the
+    /// number of marked nodes. The pair descents take these marks to skip
+    /// node pairs with no marked leaf on either side.
+    pub(crate) fn mark_paths(&self, leaves: impl Iterator<Item = u32>, marks: &mut Vec<bool>) {
+        marks.clear();
+        marks.resize(self.nodes.len(), false);
+        for leaf in leaves {
+            let mut index = leaf;
+            while index != NULL_NODE && !marks[index as usize] {
+                marks[index as usize] = true;
+                index = self.nodes[index as usize].parent;
+            }
+        }
+    }
+
     /// Calls `f(user_a, user_b)` exactly once for every unordered pair of
     /// distinct proxies whose fat boxes overlap, by descending the tree
     /// against itself. `stack` is scratch space (cleared on entry).
+    ///
+    /// With `marks` (from [`DynamicTree::mark_paths`]; empty: none) only
+    /// the pairs with at least one marked leaf are reported: a node pair
+    /// with no mark on either side is not descended.
     pub(crate) fn for_each_self_pair<F: FnMut(u32, u32)>(
         &self,
+        marks: &[bool],
         stack: &mut Vec<(u32, u32)>,
         mut f: F,
     ) {
@@ -650,6 +679,9 @@ impl DynamicTree {
         }
         stack.push((self.root, self.root));
         while let Some((a, b)) = stack.pop() {
+            if !(marked(marks, a) || marked(marks, b)) {
+                continue;
+            }
             let na = &self.nodes[a as usize];
             if a == b {
                 if !na.is_leaf() {
@@ -668,10 +700,14 @@ impl DynamicTree {
     }
 
     /// Calls `f(user_self, user_other)` for every pair of a proxy of `self`
-    /// and a proxy of `other` whose fat boxes overlap.
+    /// and a proxy of `other` whose fat boxes overlap; with marks (`marks`
+    /// of `self`'s nodes, `other_marks` of `other`'s; empty: none), only
+    /// the pairs with a marked leaf on either side.
     pub(crate) fn for_each_cross_pair<F: FnMut(u32, u32)>(
         &self,
         other: &DynamicTree,
+        marks: &[bool],
+        other_marks: &[bool],
         stack: &mut Vec<(u32, u32)>,
         mut f: F,
     ) {
@@ -681,6 +717,9 @@ impl DynamicTree {
         }
         stack.push((self.root, other.root));
         while let Some((a, b)) = stack.pop() {
+            if !(marked(marks, a) || marked(other_marks, b)) {
+                continue;
+            }
             let na = &self.nodes[a as usize];
             let nb = &other.nodes[b as usize];
             if na.aabb.overlaps(&nb.aabb) {
@@ -758,15 +797,20 @@ impl DynamicTree {
     #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
     pub(crate) fn for_each_pair_from<F: FnMut(u32, u32)>(
         &self,
-        other: Option<&DynamicTree>,
+        other: Option<(&DynamicTree, &[bool])>,
+        marks: &[bool],
         seed: (u32, u32),
         stack: &mut Vec<(u32, u32)>,
         mut f: F,
     ) {
-        let b_tree = other.unwrap_or(self);
+        let (b_tree, b_marks) = other.unwrap_or((self, marks));
+        let other = other.map(|(tree, _)| tree);
         stack.clear();
         stack.push(seed);
         while let Some((a, b)) = stack.pop() {
+            if !(marked(marks, a) || marked(b_marks, b)) {
+                continue;
+            }
             let na = &self.nodes[a as usize];
             if other.is_none() && a == b {
                 if !na.is_leaf() {
@@ -1291,42 +1335,87 @@ mod tests {
     }
 
     /// Descending from the seeds reports the same pairs as the full
-    /// descent, each once, for any number of seeds (self and cross pairs).
+    /// descent, each once, for any number of seeds (self and cross pairs);
+    /// with marked leaves, every descent reports exactly the pairs with a
+    /// marked leaf.
     #[test]
     fn seeded_descent_reports_every_pair_once() {
         let mut rng = Lcg(7);
         let mut a = DynamicTree::new();
         let mut b = DynamicTree::new();
+        let (mut a_marked, mut b_marked) = (Vec::new(), Vec::new());
         for i in 0..1500u32 {
-            a.create_proxy(random_box(&mut rng, 60.0), i);
+            let leaf = a.create_proxy(random_box(&mut rng, 60.0), i);
+            if i % 5 == 0 {
+                a_marked.push((leaf, i));
+            }
             if i % 3 == 0 {
-                b.create_proxy(random_box(&mut rng, 60.0), 10_000 + i);
+                let leaf = b.create_proxy(random_box(&mut rng, 60.0), 10_000 + i);
+                if i % 7 == 0 {
+                    b_marked.push((leaf, 10_000 + i));
+                }
             }
         }
+        let (mut a_marks, mut b_marks) = (Vec::new(), Vec::new());
+        a.mark_paths(a_marked.iter().map(|m| m.0), &mut a_marks);
+        b.mark_paths(b_marked.iter().map(|m| m.0), &mut b_marks);
+        let is_marked = |user: u32| a_marked.iter().chain(&b_marked).any(|m| m.1 == user);
         let mut stack = Vec::new();
-        for other in [None, Some(&b)] {
-            let mut full = Vec::new();
-            match other {
-                None => a.for_each_self_pair(&mut stack, |x, y| full.push((x.min(y), x.max(y)))),
-                Some(o) => a.for_each_cross_pair(o, &mut stack, |x, y| full.push((x, y))),
-            }
-            full.sort_unstable();
-            assert!(full.len() > 1000, "too few pairs: {}", full.len());
-            for want in [1, 7, 64, 500] {
-                let mut seeds = Vec::new();
-                a.pair_seeds(other, want, &mut seeds);
-                let mut seeded = Vec::new();
-                for &seed in &seeds {
-                    a.for_each_pair_from(other, seed, &mut stack, |x, y| {
-                        seeded.push(if other.is_none() {
-                            (x.min(y), x.max(y))
-                        } else {
-                            (x, y)
-                        });
-                    });
+        for with_marks in [false, true] {
+            let (am, bm): (&[bool], &[bool]) = if with_marks {
+                (&a_marks, &b_marks)
+            } else {
+                (&[], &[])
+            };
+            for other in [None, Some(&b)] {
+                let mut full = Vec::new();
+                match other {
+                    None => a.for_each_self_pair(&[], &mut stack, |x, y| {
+                        full.push((x.min(y), x.max(y)));
+                    }),
+                    Some(o) => a.for_each_cross_pair(o, &[], &[], &mut stack, |x, y| {
+                        full.push((x, y));
+                    }),
                 }
-                seeded.sort_unstable();
-                assert_eq!(seeded, full, "want {want}, {} seeds", seeds.len());
+                full.sort_unstable();
+                assert!(full.len() > 1000, "too few pairs: {}", full.len());
+                if with_marks {
+                    full.retain(|&(x, y)| is_marked(x) || is_marked(y));
+                    assert!(full.len() > 100, "too few marked pairs: {}", full.len());
+                    let mut pruned = Vec::new();
+                    match other {
+                        None => a.for_each_self_pair(am, &mut stack, |x, y| {
+                            pruned.push((x.min(y), x.max(y)));
+                        }),
+                        Some(o) => a.for_each_cross_pair(o, am, bm, &mut stack, |x, y| {
+                            pruned.push((x, y));
+                        }),
+                    }
+                    pruned.sort_unstable();
+                    assert_eq!(pruned, full, "marked full descent");
+                }
+                for want in [1, 7, 64, 500] {
+                    let mut seeds = Vec::new();
+                    a.pair_seeds(other, want, &mut seeds);
+                    let mut seeded = Vec::new();
+                    for &seed in &seeds {
+                        a.for_each_pair_from(
+                            other.map(|o| (o, bm)),
+                            am,
+                            seed,
+                            &mut stack,
+                            |x, y| {
+                                seeded.push(if other.is_none() {
+                                    (x.min(y), x.max(y))
+                                } else {
+                                    (x, y)
+                                });
+                            },
+                        );
+                    }
+                    seeded.sort_unstable();
+                    assert_eq!(seeded, full, "want {want}, {} seeds", seeds.len());
+                }
             }
         }
     }
