@@ -295,8 +295,8 @@ pub struct BodyState {
     /// What the body is, for the solver: a set of [`BodyState::MOVES`],
     /// [`BodyState::KINEMATIC`], [`BodyState::BULLET`] and
     /// [`BodyState::LOCKED_ROTATION`] ([`BodySim::state_flags`]). Set when
-    /// a body is made, changes type or mass, and at every step's prepare;
-    /// 0 in the static identity state.
+    /// a body is made or changes type, mass or bullet, and at every step's
+    /// prepare; 0 in the static identity state.
     pub flags: u32,
     /// Displacement of the centre of mass since the step began, m.
     pub dp: Vec2,
@@ -1352,6 +1352,41 @@ mod tests {
         assert_eq!(set.sim(a).unwrap().inv_mass, 0.5);
         assert!(set.state(a).unwrap().moves());
         assert_eq!(set.moving_count(), 2);
+    }
+
+    #[test]
+    fn state_flags_follow_the_body() {
+        let mut set = BodySet::new();
+        let flags = |set: &BodySet, h| set.state(h).unwrap().flags;
+        let d = set.create(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+        let bullet = set
+            .create(&BodyDef::dynamic(Vec2::ONE).as_bullet())
+            .unwrap();
+        let locked = set
+            .create(&BodyDef {
+                fixed_rotation: true,
+                ..BodyDef::dynamic(Vec2::ONE)
+            })
+            .unwrap();
+        let k = set.create(&BodyDef::kinematic(Vec2::ONE)).unwrap();
+        let s = set.create(&BodyDef::fixed(Vec2::ONE)).unwrap();
+        assert_eq!(flags(&set, d), BodyState::MOVES);
+        assert_eq!(flags(&set, bullet), BodyState::MOVES | BodyState::BULLET);
+        assert_eq!(
+            flags(&set, locked),
+            BodyState::MOVES | BodyState::LOCKED_ROTATION
+        );
+        assert_eq!(flags(&set, k), BodyState::KINEMATIC);
+        assert_eq!(flags(&set, s), 0, "a static body reads the identity state");
+        assert_eq!(BodyState::IDENTITY.flags, 0);
+        set.set_body_type(d, BodyType::Kinematic).unwrap();
+        assert_eq!(flags(&set, d), BodyState::KINEMATIC);
+        set.set_body_type(k, BodyType::Dynamic).unwrap();
+        assert!(set.state(k).unwrap().moves());
+        assert_eq!(set.solver_body(k).inv_masses().inv_mass, 1.0);
+        assert_eq!(set.solver_body(s).inv_masses(), InvMass::ZERO);
+        set.sleep(k);
+        assert_eq!(set.solver_body(k).inv_masses(), InvMass::ZERO, "asleep");
     }
 
     #[test]
