@@ -433,7 +433,7 @@ fn portal_turn_scale(case: &PortalCase, built: &Built, i: usize, lambda: [Real; 
         let r = d((built.set.sim(copy).unwrap().center
             - built.set.sim(portal_body).unwrap().center)
             .length());
-        let inv_inertia = d(built.set.state(portal_body).unwrap().inv_inertia);
+        let inv_inertia = d(built.set.sim(portal_body).unwrap().inv_inertia);
         let j = if i < 2 { scale * r } else { 1.0 };
         j * inv_inertia * (r * scale * (l0 + l1) + l2)
     };

@@ -86,7 +86,7 @@
 //! results equal a row-by-row velocity update up to round-off, with a much
 //! shorter dependency chain from one row to the next.
 
-use janus2d_core::body::{BodyHandle, BodySet, BodyState};
+use janus2d_core::body::{BodyHandle, BodySet, BodyState, InvMass};
 use janus2d_core::constraint::{Block, BodyJacobian, Constraint, ConstraintRows, Row, StepContext};
 use janus2d_core::math::{Real, Rot, Vec2, cross};
 use janus2d_core::softness::Softness;
@@ -644,9 +644,9 @@ impl Constraint for ContactConstraint {
         // Static, sleeping and stale bodies read the identity state 0.
         self.state_a = bodies.state_index(self.body_a).unwrap_or(0);
         self.state_b = bodies.state_index(self.body_b).unwrap_or(0);
-        let sa = &bodies.states[self.state_a as usize];
-        let sb = &bodies.states[self.state_b as usize];
-        self.applied_masses = [sa.inv_mass, sa.inv_inertia, sb.inv_mass, sb.inv_inertia];
+        let ma = bodies.inv_masses_at(self.state_a);
+        let mb = bodies.inv_masses_at(self.state_b);
+        self.applied_masses = [ma.inv_mass, ma.inv_inertia, mb.inv_mass, mb.inv_inertia];
         self.prepare_rows(ctx, bodies, self.applied_masses);
         if !ctx.warm_starting {
             self.impulse = [0.0; ROWS];
@@ -673,7 +673,7 @@ impl Constraint for ContactConstraint {
         }
         let (ia, ib) = (self.state_a as usize, self.state_b as usize);
         let (sa, sb) = (&states[ia], &states[ib]);
-        let (m_a, i_a, m_b, i_b) = (sa.inv_mass, sa.inv_inertia, sb.inv_mass, sb.inv_inertia);
+        let [m_a, i_a, m_b, i_b] = self.applied_masses;
         let (mut v_a, mut w_a, mut v_b, mut w_b) = (sa.v, sa.w, sb.v, sb.w);
         let n = self.normal;
         let e = self.restitution;
@@ -707,7 +707,7 @@ impl Constraint for ContactConstraint {
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
         let a = bodies.solver_body(self.body_a);
         let b = bodies.solver_body(self.body_b);
-        let (sa, sb) = (a.state, b.state);
+        let (sa, sb) = (a.inv_masses(), b.inv_masses());
         let static_pair = sa.inv_mass == 0.0 || sb.inv_mass == 0.0;
         let softness = if static_pair {
             ctx.static_softness
@@ -715,7 +715,7 @@ impl Constraint for ContactConstraint {
             ctx.contact_softness
         };
         let mut out = ConstraintRows::default();
-        let entry = |body, linear: Vec2, angular, s: &BodyState| BodyJacobian {
+        let entry = |body, linear: Vec2, angular, s: &InvMass| BodyJacobian {
             body,
             linear,
             angular,
@@ -747,8 +747,8 @@ impl Constraint for ContactConstraint {
                 };
                 out.rows.push(Row {
                     jacobian: smallvec![
-                        entry(self.body_a, -axis, -j_a, sa),
-                        entry(self.body_b, axis, j_b, sb),
+                        entry(self.body_a, -axis, -j_a, &sa),
+                        entry(self.body_b, axis, j_b, &sb),
                     ],
                     c,
                     softness,

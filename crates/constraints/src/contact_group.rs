@@ -665,10 +665,12 @@ mod tests {
         groups.build(&ctx, &mut overflow, &clusters, &[false; 2], state_count);
         assert_eq!(groups.groups.len(), 1, "one light cluster");
         assert_eq!(groups.groups[0].members(), &[0, 1]);
+        let sims = &set.sims;
         let momentum = |states: &[BodyState]| {
             states[1..]
                 .iter()
-                .fold(Vec2::ZERO, |p, s| p + s.v / s.inv_mass)
+                .zip(&sims[1..])
+                .fold(Vec2::ZERO, |p, (s, sim)| p + s.v / sim.inv_mass)
         };
         let mut states = set.states.clone();
         let p0 = momentum(&states);

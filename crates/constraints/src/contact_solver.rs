@@ -73,7 +73,8 @@ use janus2d_core::graph::ColourGraph;
 /// A dynamic body that stands for a whole object (a copy crossing a
 /// portal): its contacts build their effective masses on the object's
 /// inverse mass and inertia, while their impulses still act on the copy
-/// (see the portal stage's contact-modification hook).
+/// (see the portal stage's contact-modification hook). Body states carry
+/// no masses: the object's are simply what these contacts load at prepare.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ObjectMass {
     /// The copy.

@@ -120,13 +120,13 @@
 
 use glam::{DMat3 as Matrix3, DVec2, DVec3};
 use janus2d_core::body::BodySet;
-use janus2d_core::body::BodyState;
+use janus2d_core::body::{BodyState, InvMass};
 use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
 use janus2d_core::math::{Real, Vec2, cross, cross_sv, from_f64, to_f64};
 use janus2d_core::parallel::Team;
 use janus2d_core::union_find::{find, union};
 
-use crate::parts::{PointPart, clamp_length};
+use crate::parts::{PairMass, PointPart, clamp_length};
 use crate::revolute::RevoluteJoint;
 
 const NONE: u32 = u32::MAX;
@@ -307,7 +307,7 @@ impl Jacobian {
 /// A moving body's pivot before elimination: `diag(m, m, Ĩ)` with
 /// placeholder 1 on an axis it cannot move along.
 #[inline(always)]
-fn body_mass(st: &BodyState, added: f64) -> Matrix3 {
+fn body_mass(st: &InvMass, added: f64) -> Matrix3 {
     let m = if st.inv_mass > 0.0 {
         1.0 / to_f64(st.inv_mass)
     } else {
@@ -339,6 +339,8 @@ fn pivot_inverse(d: &Matrix3) -> Matrix3 {
 struct BodyScratch {
     /// A copy of its state while the tree is solved.
     state: BodyState,
+    /// Its inverse mass and inertia (as its joints loaded them).
+    mass: InvMass,
     /// The pivot `D_k` while eliminating, then `D_k⁻¹`.
     d: Matrix3,
     /// The right-hand side, then the solution.
@@ -363,6 +365,7 @@ struct BodyScratch {
 impl BodyScratch {
     const ZERO: BodyScratch = BodyScratch {
         state: BodyState::IDENTITY,
+        mass: InvMass::ZERO,
         d: Matrix3::ZERO,
         b: DVec3::ZERO,
         lin: 0.0,
@@ -372,6 +375,14 @@ impl BodyScratch {
         geometric_up: 0.0,
         inertia_change: 0.0,
     };
+
+    /// Sets its inverse masses and the axis masks they give.
+    #[inline(always)]
+    fn set_mass(&mut self, mass: InvMass) {
+        self.mass = mass;
+        self.lin = if mass.inv_mass > 0.0 { 1.0 } else { 0.0 };
+        self.ang = if mass.inv_inertia > 0.0 { 1.0 } else { 0.0 };
+    }
 
     /// Turns the body by an impulse `p` at arm `r` on `side` (+1: the
     /// joint's body b) through the inertia added for the solve: the
@@ -387,8 +398,8 @@ impl BodyScratch {
     fn apply(&mut self, side: f64, r: Vec2, p: Vec2) {
         let st = &mut self.state;
         let side = from_f64(side);
-        let inv_i = st.inv_inertia + self.inertia_change;
-        st.v += (side * st.inv_mass) * p;
+        let inv_i = self.mass.inv_inertia + self.inertia_change;
+        st.v += (side * self.mass.inv_mass) * p;
         st.w += (side * inv_i) * cross(r, p);
     }
 }
@@ -415,6 +426,8 @@ struct JointScratch {
     impulse: Vec2,
     /// The state index of its fixed end (read when it has no child body).
     fixed: u32,
+    /// The joint's inverse masses (its bodies a and b).
+    masses: PairMass,
     /// The pivot `D_k` while eliminating, then `D_k⁻¹`.
     d: Mat2,
     /// The right-hand side, then the solution `μ`.
@@ -430,6 +443,7 @@ impl JointScratch {
         c: Vec2::ZERO,
         impulse: Vec2::ZERO,
         fixed: 0,
+        masses: PairMass::ZERO,
         d: Mat2::ZERO,
         b: DVec2::ZERO,
     };
@@ -476,13 +490,11 @@ pub struct JointForest {
     parent_joint: Vec<u32>,
 }
 
-/// A body that the tree moves: dynamic (some inverse mass or inertia).
+/// A body that the tree moves: dynamic (some inverse mass or inertia,
+/// [`BodyState::MOVES`]).
 #[inline]
 fn is_moving(states: &[BodyState], s: u32) -> bool {
-    s != 0 && {
-        let st = &states[s as usize];
-        st.inv_mass > 0.0 || st.inv_inertia > 0.0
-    }
+    s != 0 && states[s as usize].moves()
 }
 
 /// A joint's two state indices, 0 for an end the tree does not move
@@ -838,19 +850,25 @@ fn solve_tree(
     } = tree;
     let (topology, bodies, rows) = (&**topology, &mut **bodies, &mut **rows);
     for (sc, &s) in bodies.iter_mut().zip(indices.iter()) {
-        let st = states[s as usize];
-        sc.state = st;
-        sc.lin = if st.inv_mass > 0.0 { 1.0 } else { 0.0 };
-        sc.ang = if st.inv_inertia > 0.0 { 1.0 } else { 0.0 };
+        sc.state = states[s as usize];
         sc.leaf = true;
         sc.geometric = 0.0;
         sc.geometric_up = 0.0;
+    }
+    // The bodies' inverse masses as their joints loaded them: the root's
+    // from its first joint (the tree's first), every other body's from its
+    // parent joint (which comes before the body's own joints).
+    if let Some(first) = topology.first() {
+        debug_assert_eq!(first.parent, 0, "a tree's first joint hangs from its root");
+        let m = joints[first.index as usize].masses;
+        bodies[0].set_mass(if first.side > 0.0 { m.b } else { m.a });
     }
     // Arms, separations, Jacobians and impulses of the joints, and the
     // geometric stiffness each body takes from its joints.
     for (tj, row) in topology.iter().zip(rows.iter_mut()) {
         let j = &joints[tj.index as usize];
         let side = tj.side;
+        row.masses = j.masses;
         let (frame_parent, frame_other, fixed) = if side > 0.0 {
             (j.point.frame_b, j.point.frame_a, j.state_a)
         } else {
@@ -872,6 +890,7 @@ fn solve_tree(
         parent.geometric += geometric_stiffness(h, lambda, r_parent, side);
         if tj.child != NONE {
             let child = &mut bodies[tj.child as usize];
+            child.set_mass(if side > 0.0 { j.masses.a } else { j.masses.b });
             row.jac_child = Jacobian::new(-side, r_other, child);
             child.geometric_up = geometric_stiffness(h, lambda, r_other, -side);
         }
@@ -880,8 +899,7 @@ fn solve_tree(
     // is added. Body pivots start as diag(m, m, Ĩ), placeholder 1 on an
     // axis the body cannot move along.
     for sc in bodies.iter_mut() {
-        let st = &sc.state;
-        let inv_i = to_f64(st.inv_inertia);
+        let inv_i = to_f64(sc.mass.inv_inertia);
         let (mut added, mut inv_i_tilde) = (0.0, inv_i);
         // Its child joints' terms first, then its parent joint's.
         let geometric = sc.geometric + sc.geometric_up;
@@ -893,7 +911,7 @@ fn solve_tree(
         }
         sc.inertia_change = from_f64(inv_i_tilde - inv_i);
         sc.geometric = added;
-        sc.d = body_mass(st, added);
+        sc.d = body_mass(&sc.mass, added);
         sc.b = DVec3::ZERO;
     }
     if use_bias {
@@ -918,9 +936,9 @@ fn solve_tree(
             * ((parent.v + cross_sv(parent.w, r_parent)) - (other.v + cross_sv(other.w, r_other)));
         // K in the joint's own order (a, b), as the joint's rows sum it.
         let (k11, k12, k22) = if side > 0.0 {
-            PointPart::effective_mass(other, parent, r_other, r_parent)
+            PointPart::effective_mass(&row.masses, r_other, r_parent)
         } else {
-            PointPart::effective_mass(parent, other, r_parent, r_other)
+            PointPart::effective_mass(&row.masses, r_parent, r_other)
         };
         let (k11, k12, k22) = (to_f64(k11), to_f64(k12), to_f64(k22));
         let rhs = if use_bias {

@@ -14,13 +14,35 @@
 //! centre offset is `Δc + dp_b − dp_a`, so `C` is refreshed every substep
 //! without recomputing transforms.
 //!
-//! All parts read velocities and inverse masses from the hot
-//! [`BodyState`] only. A static body is the shared identity state (slot 0),
-//! whose zero inverse mass makes every impulse on it vanish without a branch.
+//! All parts read velocities from the hot [`BodyState`] and inverse masses
+//! from the [`PairMass`] their constraint loaded at prepare. A static body
+//! is the shared identity state (slot 0), whose zero inverse mass makes
+//! every impulse on it vanish without a branch.
 
-use janus2d_core::body::BodyState;
+use janus2d_core::body::{BodyState, InvMass};
 use janus2d_core::math::{Real, Vec2, cross, cross_sv, solve22};
 use janus2d_core::softness::Softness;
+
+/// The inverse masses of a constraint's two bodies (a, b), loaded at
+/// prepare ([`SolverBody::inv_masses`](janus2d_core::body::SolverBody::inv_masses)):
+/// the solve reads them with the constraint's own data, not from the
+/// bodies' states.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct PairMass {
+    /// Body a.
+    pub a: InvMass,
+    /// Body b.
+    pub b: InvMass,
+}
+
+impl PairMass {
+    /// Two bodies impulses do not move.
+    pub const ZERO: PairMass = PairMass {
+        a: InvMass::ZERO,
+        b: InvMass::ZERO,
+    };
+}
 
 /// Reads the velocity part of two states.
 #[inline(always)]
@@ -42,11 +64,19 @@ pub fn store_pair(states: &mut [BodyState], a: u32, b: u32, sa: &BodyState, sb: 
 /// Applies a linear impulse `p` at arms `r_a`, `r_b` (equal and opposite)
 /// plus an angular impulse `l` (positive on b).
 #[inline(always)]
-pub fn apply_pair(sa: &mut BodyState, sb: &mut BodyState, r_a: Vec2, r_b: Vec2, p: Vec2, l: Real) {
-    sa.v -= sa.inv_mass * p;
-    sa.w -= sa.inv_inertia * (cross(r_a, p) + l);
-    sb.v += sb.inv_mass * p;
-    sb.w += sb.inv_inertia * (cross(r_b, p) + l);
+pub fn apply_pair(
+    sa: &mut BodyState,
+    sb: &mut BodyState,
+    m: &PairMass,
+    r_a: Vec2,
+    r_b: Vec2,
+    p: Vec2,
+    l: Real,
+) {
+    sa.v -= m.a.inv_mass * p;
+    sa.w -= m.a.inv_inertia * (cross(r_a, p) + l);
+    sb.v += m.b.inv_mass * p;
+    sb.w += m.b.inv_inertia * (cross(r_b, p) + l);
 }
 
 /// Clamps the length of a bias velocity to `max` (m/s).
@@ -86,21 +116,16 @@ impl PointPart {
 
     /// Applies the accumulated impulse.
     #[inline(always)]
-    pub fn warm_start(&self, sa: &mut BodyState, sb: &mut BodyState) {
+    pub fn warm_start(&self, sa: &mut BodyState, sb: &mut BodyState, m: &PairMass) {
         let r_a = sa.dq.rotate(self.frame_a);
         let r_b = sb.dq.rotate(self.frame_b);
-        apply_pair(sa, sb, r_a, r_b, self.impulse, 0.0);
+        apply_pair(sa, sb, m, r_a, r_b, self.impulse, 0.0);
     }
 
     /// The 2×2 effective mass `K = J M⁻¹ Jᵀ` as `(k11, k12, k22)`.
     #[inline(always)]
-    pub fn effective_mass(
-        sa: &BodyState,
-        sb: &BodyState,
-        r_a: Vec2,
-        r_b: Vec2,
-    ) -> (Real, Real, Real) {
-        let (m_a, m_b, i_a, i_b) = (sa.inv_mass, sb.inv_mass, sa.inv_inertia, sb.inv_inertia);
+    pub fn effective_mass(m: &PairMass, r_a: Vec2, r_b: Vec2) -> (Real, Real, Real) {
+        let (m_a, m_b, i_a, i_b) = (m.a.inv_mass, m.b.inv_mass, m.a.inv_inertia, m.b.inv_inertia);
         let k11 = m_a + m_b + r_a.y * r_a.y * i_a + r_b.y * r_b.y * i_b;
         let k12 = -r_a.y * r_a.x * i_a - r_b.y * r_b.x * i_b;
         let k22 = m_a + m_b + r_a.x * r_a.x * i_a + r_b.x * r_b.x * i_b;
@@ -114,6 +139,7 @@ impl PointPart {
         &mut self,
         sa: &mut BodyState,
         sb: &mut BodyState,
+        m: &PairMass,
         softness: Softness,
         max_correction: Real,
         use_bias: bool,
@@ -129,11 +155,11 @@ impl PointPart {
         } else {
             (Vec2::ZERO, 1.0, 0.0)
         };
-        let (k11, k12, k22) = Self::effective_mass(sa, sb, r_a, r_b);
+        let (k11, k12, k22) = Self::effective_mass(m, r_a, r_b);
         let b = solve22(k11, k12, k22, c_dot + bias);
         let impulse = -mass_scale * b - impulse_scale * self.impulse;
         self.impulse += impulse;
-        apply_pair(sa, sb, r_a, r_b, impulse, 0.0);
+        apply_pair(sa, sb, m, r_a, r_b, impulse, 0.0);
     }
 }
 
@@ -150,10 +176,10 @@ pub struct AxisPart {
 impl AxisPart {
     /// `J M⁻¹ Jᵀ` of the row along `n` with arms `r_a`, `r_b`.
     #[inline(always)]
-    pub fn k(sa: &BodyState, sb: &BodyState, r_a: Vec2, r_b: Vec2, n: Vec2) -> Real {
+    pub fn k(m: &PairMass, r_a: Vec2, r_b: Vec2, n: Vec2) -> Real {
         let rn_a = cross(r_a, n);
         let rn_b = cross(r_b, n);
-        sa.inv_mass + sb.inv_mass + sa.inv_inertia * rn_a * rn_a + sb.inv_inertia * rn_b * rn_b
+        m.a.inv_mass + m.b.inv_mass + m.a.inv_inertia * rn_a * rn_a + m.b.inv_inertia * rn_b * rn_b
     }
 
     /// Sets the effective mass from `K` (zero when `K` is zero).
@@ -174,12 +200,13 @@ impl AxisPart {
     pub fn apply(
         sa: &mut BodyState,
         sb: &mut BodyState,
+        m: &PairMass,
         r_a: Vec2,
         r_b: Vec2,
         n: Vec2,
         lambda: Real,
     ) {
-        apply_pair(sa, sb, r_a, r_b, lambda * n, 0.0);
+        apply_pair(sa, sb, m, r_a, r_b, lambda * n, 0.0);
     }
 }
 
@@ -194,10 +221,10 @@ pub struct AnglePart {
 }
 
 impl AnglePart {
-    /// Sets the effective mass from the two states.
+    /// Sets the effective mass from the two bodies' inverse inertias.
     #[inline(always)]
-    pub fn prepare(&mut self, sa: &BodyState, sb: &BodyState) {
-        let k = sa.inv_inertia + sb.inv_inertia;
+    pub fn prepare(&mut self, m: &PairMass) {
+        let k = m.a.inv_inertia + m.b.inv_inertia;
         self.mass = if k > 0.0 { 1.0 / k } else { 0.0 };
     }
 
@@ -209,9 +236,9 @@ impl AnglePart {
 
     /// Applies an angular impulse (positive on b).
     #[inline(always)]
-    pub fn apply(sa: &mut BodyState, sb: &mut BodyState, lambda: Real) {
-        sa.w -= sa.inv_inertia * lambda;
-        sb.w += sb.inv_inertia * lambda;
+    pub fn apply(sa: &mut BodyState, sb: &mut BodyState, m: &PairMass, lambda: Real) {
+        sa.w -= m.a.inv_inertia * lambda;
+        sb.w += m.b.inv_inertia * lambda;
     }
 
     /// A soft equality row: drives `c` to zero with `softness`.
@@ -220,6 +247,7 @@ impl AnglePart {
         &mut self,
         sa: &mut BodyState,
         sb: &mut BodyState,
+        m: &PairMass,
         c: Real,
         softness: Softness,
     ) {
@@ -228,7 +256,7 @@ impl AnglePart {
         let lambda = -softness.mass_scale * self.mass * (c_dot + bias)
             - softness.impulse_scale * self.impulse;
         self.impulse += lambda;
-        Self::apply(sa, sb, lambda);
+        Self::apply(sa, sb, m, lambda);
     }
 
     /// A velocity row driving `ω_b − ω_a` to `target`, with the accumulated
@@ -238,6 +266,7 @@ impl AnglePart {
         &mut self,
         sa: &mut BodyState,
         sb: &mut BodyState,
+        m: &PairMass,
         target: Real,
         max_impulse: Real,
     ) {
@@ -245,7 +274,7 @@ impl AnglePart {
         let lambda = -self.mass * c_dot;
         let old = self.impulse;
         self.impulse = (old + lambda).clamp(-max_impulse, max_impulse);
-        Self::apply(sa, sb, self.impulse - old);
+        Self::apply(sa, sb, m, self.impulse - old);
     }
 
     /// A one-sided row `sign · c ≥ 0` (a limit): speculative when apart,
@@ -255,6 +284,7 @@ impl AnglePart {
         &mut self,
         sa: &mut BodyState,
         sb: &mut BodyState,
+        m: &PairMass,
         c: Real,
         sign: Real,
         softness: Softness,
@@ -276,6 +306,6 @@ impl AnglePart {
         let lambda = -self.mass * mass_scale * (c_dot + bias) - impulse_scale * self.impulse;
         let old = self.impulse;
         self.impulse = (old + lambda).max(0.0);
-        Self::apply(sa, sb, sign * (self.impulse - old));
+        Self::apply(sa, sb, m, sign * (self.impulse - old));
     }
 }

@@ -141,7 +141,7 @@
 //! assert!(vec_is_finite(bodies.linear_velocity(clone).unwrap()));
 //! ```
 
-use janus2d_core::body::{BodyHandle, BodySet, BodySim, BodyState, BodyType};
+use janus2d_core::body::{BodyHandle, BodySet, BodySim, BodyState, BodyType, InvMass};
 use janus2d_core::constraint::{
     Block, BodyJacobian, Constraint, ConstraintBatch, ConstraintRows, Row, SolverMode, StepContext,
 };
@@ -224,6 +224,21 @@ pub struct PortalIndices {
     pub a: u32,
     /// Portal body B.
     pub b: u32,
+}
+
+/// The inverse masses of the four bodies, in the order body, clone, A, B,
+/// loaded at prepare (zero for a body on the static identity state).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct PortalMasses {
+    /// Body 1.
+    pub body: InvMass,
+    /// Body 2 (the clone).
+    pub clone: InvMass,
+    /// Portal body A.
+    pub a: InvMass,
+    /// Portal body B.
+    pub b: InvMass,
 }
 
 /// One side of the portal (a body and the portal body it passes through)
@@ -373,14 +388,8 @@ impl PortalGeometry {
     /// The effective mass `K = J M⁻¹ Jᵀ` in closed form. `merged_ab` says
     /// that A and B are the same body (their columns add); the inverse
     /// masses of B are then ignored in favour of A's.
-    pub fn effective_mass(
-        &self,
-        s1: &BodyState,
-        s2: &BodyState,
-        sa: &BodyState,
-        sb: &BodyState,
-        merged_ab: bool,
-    ) -> Mat3 {
+    pub fn effective_mass(&self, m: &PortalMasses, merged_ab: bool) -> Mat3 {
+        let (s1, s2, sa, sb) = (&m.body, &m.clone, &m.a, &m.b);
         let (g1, g2, eta) = (&self.side1, &self.side2, self.eta);
         let (r1, n1, t1) = (g1.r, g1.n, g1.t);
         let (r2, n2, t2) = (g2.r, g2.n, g2.t);
@@ -425,31 +434,37 @@ impl PortalGeometry {
     /// bodies share slot 0; when A and B share a state its two columns are
     /// added first).
     #[inline(always)]
-    pub fn apply(&self, states: &mut [BodyState], ix: PortalIndices, lambda: [Real; 3]) {
+    pub fn apply(
+        &self,
+        states: &mut [BodyState],
+        ix: PortalIndices,
+        m: &PortalMasses,
+        lambda: [Real; 3],
+    ) {
         let (g1, g2, eta) = (&self.side1, &self.side2, self.eta);
         let p1 = eta * (lambda[0] * g1.n - lambda[1] * g1.t);
         let p2 = lambda[0] * g2.n - lambda[1] * g2.t;
         let l = lambda[2];
         let s = &mut states[ix.body as usize];
-        s.v += s.inv_mass * p1;
-        s.w += s.inv_inertia * l;
+        s.v += m.body.inv_mass * p1;
+        s.w += m.body.inv_inertia * l;
         let s = &mut states[ix.clone as usize];
-        s.v += s.inv_mass * p2;
-        s.w -= s.inv_inertia * l;
+        s.v += m.clone.inv_mass * p2;
+        s.w -= m.clone.inv_inertia * l;
         if ix.a == ix.b {
             // One portal body carries both portals: its columns add, and
             // the angular impulses ∓λ2 cancel exactly instead of being
             // applied one after the other (which would lose precision).
             let s = &mut states[ix.a as usize];
-            s.v -= s.inv_mass * (p1 + p2);
-            s.w -= s.inv_inertia * (cross(g1.r, p1) + cross(g2.r, p2));
+            s.v -= m.a.inv_mass * (p1 + p2);
+            s.w -= m.a.inv_inertia * (cross(g1.r, p1) + cross(g2.r, p2));
         } else {
             let s = &mut states[ix.a as usize];
-            s.v -= s.inv_mass * p1;
-            s.w -= s.inv_inertia * (cross(g1.r, p1) + l);
+            s.v -= m.a.inv_mass * p1;
+            s.w -= m.a.inv_inertia * (cross(g1.r, p1) + l);
             let s = &mut states[ix.b as usize];
-            s.v -= s.inv_mass * p2;
-            s.w -= s.inv_inertia * (cross(g2.r, p2) - l);
+            s.v -= m.b.inv_mass * p2;
+            s.w -= m.b.inv_inertia * (cross(g2.r, p2) - l);
         }
     }
 }
@@ -510,9 +525,9 @@ impl PortalPart {
 
     /// Applies the accumulated impulse at the current positions.
     #[inline(always)]
-    pub fn warm_start(&self, states: &mut [BodyState], ix: PortalIndices) {
+    pub fn warm_start(&self, states: &mut [BodyState], ix: PortalIndices, m: &PortalMasses) {
         let g = self.geometry(states, ix);
-        g.apply(states, ix, self.impulse);
+        g.apply(states, ix, m, self.impulse);
     }
 
     /// One soft iteration. `fast` selects the diagonal `K` (both portal
@@ -522,6 +537,7 @@ impl PortalPart {
         &mut self,
         states: &mut [BodyState],
         ix: PortalIndices,
+        m: &PortalMasses,
         softness: Softness,
         max_correction: Real,
         use_bias: bool,
@@ -545,12 +561,12 @@ impl PortalPart {
         let rhs = [c_dot[0] + bias[0], c_dot[1] + bias[1], c_dot[2] + bias[2]];
         let x = if fast {
             let eta = self.eta;
-            let k = eta * eta * s1.inv_mass + s2.inv_mass;
-            let k_angle = s1.inv_inertia + s2.inv_inertia;
+            let k = eta * eta * m.body.inv_mass + m.clone.inv_mass;
+            let k_angle = m.body.inv_inertia + m.clone.inv_inertia;
             let inv = |k: Real| if k > 0.0 { 1.0 / k } else { 0.0 };
             [rhs[0] * inv(k), rhs[1] * inv(k), rhs[2] * inv(k_angle)]
         } else {
-            let k = g.effective_mass(&s1, &s2, &sa, &sb, merged_ab);
+            let k = g.effective_mass(m, merged_ab);
             solve_block(&k, rhs)
         };
         let mut lambda = [0.0; 3];
@@ -558,7 +574,7 @@ impl PortalPart {
             lambda[i] = -mass_scale * x[i] - impulse_scale * self.impulse[i];
             self.impulse[i] += lambda[i];
         }
-        g.apply(states, ix, lambda);
+        g.apply(states, ix, m, lambda);
     }
 }
 
@@ -580,6 +596,8 @@ pub struct PortalConstraint {
     /// False when the constraint is disabled (skipped by the solver).
     pub enabled: bool,
     ix: PortalIndices,
+    /// The four bodies' inverse masses, loaded at prepare.
+    masses: PortalMasses,
     part: PortalPart,
     /// Both portal bodies have zero inverse mass and inertia: `K` is diagonal.
     fast: bool,
@@ -605,6 +623,7 @@ impl PortalConstraint {
             def,
             enabled: true,
             ix: PortalIndices::default(),
+            masses: PortalMasses::default(),
             fast: true,
             merged_ab: false,
         })
@@ -707,6 +726,7 @@ impl PortalConstraint {
         self.part.solve(
             states,
             self.ix,
+            &self.masses,
             stiff,
             ctx.joint_max_correction_speed,
             use_bias,
@@ -767,10 +787,6 @@ impl ConstraintBatch for PortalBatch<'_> {
     }
 }
 
-fn is_massless(s: &BodyState) -> bool {
-    s.inv_mass == 0.0 && s.inv_inertia == 0.0
-}
-
 impl Constraint for PortalConstraint {
     fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
         let d = &self.def;
@@ -792,7 +808,13 @@ impl Constraint for PortalConstraint {
         let theta1 = b1.sim.transform.q.angle();
         let theta2 = b2.sim.transform.q.angle();
         self.part.angle = wrap_angle((theta1 - alpha1) - (theta2 - alpha2) - PI);
-        self.fast = is_massless(a.state) && is_massless(b.state);
+        self.masses = PortalMasses {
+            body: b1.inv_masses(),
+            clone: b2.inv_masses(),
+            a: a.inv_masses(),
+            b: b.inv_masses(),
+        };
+        self.fast = self.masses.a.is_zero() && self.masses.b.is_zero();
         self.merged_ab = a.state_index == b.state_index
             && a.state_index != 0
             && a.sim.body_type == BodyType::Dynamic;
@@ -802,13 +824,14 @@ impl Constraint for PortalConstraint {
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        self.part.warm_start(states, self.ix);
+        self.part.warm_start(states, self.ix, &self.masses);
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
         self.part.solve(
             states,
             self.ix,
+            &self.masses,
             ctx.joint_softness,
             ctx.joint_max_correction_speed,
             use_bias,
@@ -820,7 +843,7 @@ impl Constraint for PortalConstraint {
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
         let d = &self.def;
         let handles = [d.body, d.clone, d.portal_body_a, d.portal_body_b];
-        let states = handles.map(|h| *bodies.solver_body(h).state);
+        let masses = handles.map(|h| bodies.solver_body(h).inv_masses());
         let g = self.geometry_now(bodies);
         let jacobian = g.jacobian();
         let c = self.error(bodies);
@@ -836,8 +859,8 @@ impl Constraint for PortalConstraint {
                         body: handles[k],
                         linear: cell.linear,
                         angular: cell.angular,
-                        inv_mass: states[k].inv_mass,
-                        inv_inertia: states[k].inv_inertia,
+                        inv_mass: masses[k].inv_mass,
+                        inv_inertia: masses[k].inv_inertia,
                     });
                 }
             }
@@ -851,7 +874,8 @@ impl Constraint for PortalConstraint {
             });
         }
         let merged_ab = d.portal_body_a == d.portal_body_b;
-        let k = g.effective_mass(&states[0], &states[1], &states[2], &states[3], merged_ab);
+        let [body, clone, a, b] = masses;
+        let k = g.effective_mass(&PortalMasses { body, clone, a, b }, merged_ab);
         out.blocks.push(Block {
             first_row: 0,
             len: 3,

@@ -39,7 +39,7 @@ use janus2d_core::softness::Softness;
 use smallvec::smallvec;
 
 use crate::JointError;
-use crate::parts::{AnglePart, PointPart, load_pair, store_pair};
+use crate::parts::{AnglePart, PairMass, PointPart, load_pair, store_pair};
 
 /// Everything needed to create a revolute joint.
 #[derive(Clone, Debug, PartialEq)]
@@ -165,6 +165,9 @@ pub struct RevoluteJoint {
     pub enabled: bool,
     pub(crate) state_a: u32,
     pub(crate) state_b: u32,
+    /// The bodies' inverse masses, loaded at prepare (zero for a body on
+    /// the static identity state).
+    pub(crate) masses: PairMass,
     pub(crate) point: PointPart,
     /// True while the point rows belong to the direct solve of a joint tree
     /// (set every step by [`JointForest`](crate::joint_tree::JointForest)).
@@ -190,9 +193,9 @@ pub struct RevoluteJoint {
 /// by the mass ratio `ρ = min((m_a⁻¹ + m_b⁻¹) / min(m_a⁻¹, m_b⁻¹), ρ_max)`
 /// (`ρ_max` when one body is static). Used by the solve and reported by
 /// `rows()`, so both see the same rows.
-fn point_softness(ctx: &StepContext, sa: &BodyState, sb: &BodyState) -> Softness {
-    let inv_mass_sum = sa.inv_mass + sb.inv_mass;
-    let inv_mass_heavy = sa.inv_mass.min(sb.inv_mass);
+fn point_softness(ctx: &StepContext, m: &PairMass) -> Softness {
+    let inv_mass_sum = m.a.inv_mass + m.b.inv_mass;
+    let inv_mass_heavy = m.a.inv_mass.min(m.b.inv_mass);
     let rho = if inv_mass_heavy > 0.0 {
         (inv_mass_sum / inv_mass_heavy).min(ctx.joint_mass_ratio_cap)
     } else {
@@ -219,6 +222,7 @@ impl RevoluteJoint {
             enabled: true,
             state_a: 0,
             state_b: 0,
+            masses: PairMass::default(),
             point: PointPart::default(),
             in_tree: false,
             delta_angle: 0.0,
@@ -327,17 +331,21 @@ impl Constraint for RevoluteJoint {
         self.point.delta_center = b.sim.center - a.sim.center;
         self.delta_angle =
             janus2d_core::math::wrap_angle(q_a.relative_angle(q_b) - self.def.reference_angle);
-        let (sa, sb) = (a.state, b.state);
+        self.masses = PairMass {
+            a: a.inv_masses(),
+            b: b.inv_masses(),
+        };
+        let m = &self.masses;
         for part in [
             &mut self.spring,
             &mut self.motor,
             &mut self.lower,
             &mut self.upper,
         ] {
-            part.prepare(sa, sb);
+            part.prepare(m);
         }
         self.spring_softness = Softness::new(self.def.hertz, self.def.damping_ratio, ctx.h);
-        self.point_softness = point_softness(ctx, sa, sb);
+        self.point_softness = point_softness(ctx, m);
         if !ctx.warm_starting {
             self.point.impulse = Vec2::ZERO;
             self.spring.impulse = 0.0;
@@ -362,10 +370,11 @@ impl Constraint for RevoluteJoint {
             return;
         }
         let (mut sa, mut sb) = load_pair(states, self.state_a, self.state_b);
+        let m = &self.masses;
         let axial =
             self.spring.impulse + self.motor.impulse + self.lower.impulse - self.upper.impulse;
-        AnglePart::apply(&mut sa, &mut sb, axial);
-        self.point.warm_start(&mut sa, &mut sb);
+        AnglePart::apply(&mut sa, &mut sb, m, axial);
+        self.point.warm_start(&mut sa, &mut sb, m);
         store_pair(states, self.state_a, self.state_b, &sa, &sb);
     }
 
@@ -374,6 +383,7 @@ impl Constraint for RevoluteJoint {
             return;
         }
         let (mut sa, mut sb) = load_pair(states, self.state_a, self.state_b);
+        let m = &self.masses;
         // The angle depends on the rotations only, which the rows below do
         // not change: one atan2 for the spring and the limits.
         let angle = if self.def.enable_spring || self.def.enable_limit {
@@ -381,20 +391,21 @@ impl Constraint for RevoluteJoint {
         } else {
             0.0
         };
-        if self.def.enable_spring && sa.inv_inertia + sb.inv_inertia > 0.0 {
+        if self.def.enable_spring && m.a.inv_inertia + m.b.inv_inertia > 0.0 {
             self.spring
-                .solve_soft(&mut sa, &mut sb, angle, self.spring_softness);
+                .solve_soft(&mut sa, &mut sb, m, angle, self.spring_softness);
         }
         if self.def.enable_motor {
             let max_impulse = ctx.h * self.def.max_motor_torque;
             self.motor
-                .solve_motor(&mut sa, &mut sb, self.def.motor_speed, max_impulse);
+                .solve_motor(&mut sa, &mut sb, m, self.def.motor_speed, max_impulse);
         }
         if self.def.enable_limit {
             let soft = ctx.joint_softness;
             self.lower.solve_limit(
                 &mut sa,
                 &mut sb,
+                m,
                 angle - self.def.lower_angle,
                 1.0,
                 soft,
@@ -404,6 +415,7 @@ impl Constraint for RevoluteJoint {
             self.upper.solve_limit(
                 &mut sa,
                 &mut sb,
+                m,
                 self.def.upper_angle - angle,
                 -1.0,
                 soft,
@@ -415,6 +427,7 @@ impl Constraint for RevoluteJoint {
             self.point.solve(
                 &mut sa,
                 &mut sb,
+                m,
                 self.point_softness,
                 ctx.joint_max_correction_speed,
                 use_bias,
@@ -437,12 +450,11 @@ impl Constraint for RevoluteJoint {
             .q
             .rotate(self.def.local_anchor_b - b.sim.local_center);
         let c = (b.sim.center + r_b) - (a.sim.center + r_a);
-        let (ima, iia, imb, iib) = (
-            a.state.inv_mass,
-            a.state.inv_inertia,
-            b.state.inv_mass,
-            b.state.inv_inertia,
-        );
+        let m = PairMass {
+            a: a.inv_masses(),
+            b: b.inv_masses(),
+        };
+        let (ima, iia, imb, iib) = (m.a.inv_mass, m.a.inv_inertia, m.b.inv_mass, m.b.inv_inertia);
         let entry = |body, linear: Vec2, angular, im, ii| BodyJacobian {
             body,
             linear,
@@ -454,7 +466,7 @@ impl Constraint for RevoluteJoint {
         let point_softness = if self.in_tree {
             ctx.direct_joint_softness
         } else {
-            point_softness(ctx, a.state, b.state)
+            point_softness(ctx, &m)
         };
         let point_row = |axis: Vec2, c: Real, impulse: Real| Row {
             jacobian: smallvec![
@@ -470,14 +482,14 @@ impl Constraint for RevoluteJoint {
         let mut out = ConstraintRows::default();
         out.rows.push(point_row(Vec2::X, c.x, self.point.impulse.x));
         out.rows.push(point_row(Vec2::Y, c.y, self.point.impulse.y));
-        let (k11, k12, k22) = PointPart::effective_mass(a.state, b.state, r_a, r_b);
+        let (k11, k12, k22) = PointPart::effective_mass(&m, r_a, r_b);
         out.blocks.push(Block {
             first_row: 0,
             len: 2,
             k: [[k11, k12, 0.0], [k12, k22, 0.0], [0.0; 3]],
         });
         let angle = self.angle(bodies);
-        let k_angle = a.state.inv_inertia + b.state.inv_inertia;
+        let k_angle = m.a.inv_inertia + m.b.inv_inertia;
         let mut angle_row =
             |sign: Real, c: Real, softness: Softness, lower: Real, upper: Real, impulse: Real| {
                 let first_row = out.rows.len();

@@ -15,14 +15,15 @@
 //!
 //! | array          | touched                    | contents                                      |
 //! |----------------|----------------------------|-----------------------------------------------|
-//! | `states`       | every solver iteration     | v, ω, position delta, rotation delta, 1/m, 1/I |
-//! | `sims`         | once per (sub)step         | transform, centre, forces, damping, limits   |
+//! | `states`       | every solver iteration     | v, ω, flags, position delta, rotation delta (32 bytes) |
+//! | `sims`         | once per (sub)step         | transform, centre, forces, damping, limits, 1/m, 1/I |
 //! | `records`      | on API calls               | generation, type, location, user data         |
 //!
 //! Slot 0 of `states` and `sims` is a sentinel with zero inverse mass and
 //! zero velocity: every static body maps to it, so constraints read a static
 //! body's state through the same code path as a moving body's, with no branch;
-//! impulses written to it are multiplied by zero inverse mass.
+//! impulses written to it are multiplied by the zero inverse mass the
+//! constraints loaded for it at prepare ([`BodySet::inv_masses_at`]).
 
 use crate::math::{Real, Rot, Transform, Vec2, vec_is_finite};
 use crate::slots::Slots;
@@ -265,34 +266,106 @@ impl std::fmt::Display for BodyError {
 impl std::error::Error for BodyError {}
 
 /// The solver's hot per-body state: everything a constraint reads or writes
-/// in every iteration.
+/// in every iteration, 32 bytes in f32 (64 in f64), two to a cache line.
+///
+/// | field   | what                                      | bytes (f32) | bytes (f64) |
+/// |---------|-------------------------------------------|-------------|-------------|
+/// | `v`     | linear velocity of the centre of mass      | 0..8        | 0..16       |
+/// | `w`     | angular velocity                          | 8..12       | 16..24      |
+/// | `flags` | what the body is ([`BodyState::MOVES`]…)   | 12..16      | 24..28 (+4 padding) |
+/// | `dp`    | displacement of the centre since the step began | 16..24 | 32..48      |
+/// | `dq`    | rotation since the step began             | 24..32      | 48..64      |
+///
+/// The inverse mass and inertia are not here: constraints load them at
+/// prepare (from the body's [`BodySim`], through
+/// [`SolverBody::inv_masses`] or [`BodySet::inv_masses_at`]) and keep them
+/// with their own data; the velocity integration reads them from the
+/// colder `sims`. A constraint can so act with masses other than the
+/// body's own (a portal copy's contacts use the whole object's).
+///
+/// The state is 32-byte aligned: a state never straddles two cache lines.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[repr(C, align(32))]
 pub struct BodyState {
     /// Linear velocity of the centre of mass, m/s.
     pub v: Vec2,
     /// Angular velocity, rad/s.
     pub w: Real,
-    /// Inverse mass, 1/kg (0 for static and kinematic bodies).
-    pub inv_mass: Real,
-    /// Inverse rotational inertia, 1/(kg·m²).
-    pub inv_inertia: Real,
+    /// What the body is, for the solver: a set of [`BodyState::MOVES`],
+    /// [`BodyState::KINEMATIC`], [`BodyState::BULLET`] and
+    /// [`BodyState::LOCKED_ROTATION`] ([`BodySim::state_flags`]). Set when
+    /// a body is made or changes type, mass or bullet, and at every step's
+    /// prepare; 0 in the static identity state.
+    pub flags: u32,
     /// Displacement of the centre of mass since the step began, m.
     pub dp: Vec2,
     /// Rotation since the step began.
     pub dq: Rot,
 }
 
+// The hot state is half a cache line in f32 (Box2D v3's body state is
+// the same 32 bytes), one line in f64.
+#[cfg(not(feature = "f64"))]
+const _: () = assert!(std::mem::size_of::<BodyState>() == 32);
+#[cfg(feature = "f64")]
+const _: () = assert!(std::mem::size_of::<BodyState>() == 64);
+
 impl BodyState {
-    /// The state every static body reads: at rest, infinite mass, not moved.
+    /// The state every static body reads: at rest, not moved, no flags.
     pub const IDENTITY: BodyState = BodyState {
         v: Vec2::ZERO,
         w: 0.0,
-        inv_mass: 0.0,
-        inv_inertia: 0.0,
+        flags: 0,
         dp: Vec2::ZERO,
         dq: Rot::IDENTITY,
     };
+
+    /// Flag: constraint impulses move the body (a dynamic body: positive
+    /// inverse mass or inverse inertia).
+    pub const MOVES: u32 = 1;
+    /// Flag: a kinematic body (moves at its own velocity, infinite mass).
+    pub const KINEMATIC: u32 = 1 << 1;
+    /// Flag: a bullet ([`BodyDef::bullet`]: swept against moving bodies
+    /// too).
+    pub const BULLET: u32 = 1 << 2;
+    /// Flag: a dynamic body that does not turn (zero inverse inertia:
+    /// [`BodyDef::fixed_rotation`]).
+    pub const LOCKED_ROTATION: u32 = 1 << 3;
+
+    /// True when constraint impulses move the body ([`BodyState::MOVES`]).
+    #[inline(always)]
+    #[must_use]
+    pub fn moves(&self) -> bool {
+        self.flags & Self::MOVES != 0
+    }
+}
+
+/// A body's inverse mass and inverse rotational inertia as the solver
+/// applies them: what a constraint loads at prepare and keeps (zero for
+/// static, kinematic and sleeping bodies).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct InvMass {
+    /// Inverse mass, 1/kg.
+    pub inv_mass: Real,
+    /// Inverse rotational inertia, 1/(kg·m²).
+    pub inv_inertia: Real,
+}
+
+impl InvMass {
+    /// Infinite mass and inertia: a body impulses do not move.
+    pub const ZERO: InvMass = InvMass {
+        inv_mass: 0.0,
+        inv_inertia: 0.0,
+    };
+
+    /// True when both are zero (impulses do not move the body).
+    #[inline(always)]
+    #[must_use]
+    pub fn is_zero(&self) -> bool {
+        self.inv_mass == 0.0 && self.inv_inertia == 0.0
+    }
 }
 
 /// Per-body data the solver touches once per step or substep.
@@ -346,6 +419,36 @@ pub struct BodySim {
 }
 
 impl BodySim {
+    /// The [`BodyState::flags`] of this body's state.
+    #[inline]
+    #[must_use]
+    pub fn state_flags(&self) -> u32 {
+        let mut flags = match self.body_type {
+            BodyType::Static => return 0,
+            BodyType::Kinematic => BodyState::KINEMATIC,
+            BodyType::Dynamic if self.inv_inertia == 0.0 => BodyState::LOCKED_ROTATION,
+            BodyType::Dynamic => 0,
+        };
+        // Only a dynamic body has a positive inverse mass or inertia.
+        if self.inv_mass > 0.0 || self.inv_inertia > 0.0 {
+            flags |= BodyState::MOVES;
+        }
+        if self.bullet {
+            flags |= BodyState::BULLET;
+        }
+        flags
+    }
+
+    /// The inverse mass and inertia of this body.
+    #[inline(always)]
+    #[must_use]
+    pub fn inv_masses(&self) -> InvMass {
+        InvMass {
+            inv_mass: self.inv_mass,
+            inv_inertia: self.inv_inertia,
+        }
+    }
+
     fn sentinel() -> BodySim {
         BodySim {
             transform: Transform::IDENTITY,
@@ -410,10 +513,25 @@ pub struct SolverBody<'a> {
     pub state_index: u32,
     /// The body's per-step data.
     pub sim: &'a BodySim,
-    /// The body's current state (velocities, inverse mass).
+    /// The body's current state (velocities, position deltas).
     pub state: &'a BodyState,
     /// The body is asleep (state index 0, with a sleeping body's data).
     pub sleeping: bool,
+}
+
+impl SolverBody<'_> {
+    /// The inverse mass and inertia the solve applies to the body: its own
+    /// for a body with a state, zero for the static identity state 0
+    /// (static, sleeping and stale bodies).
+    #[inline(always)]
+    #[must_use]
+    pub fn inv_masses(&self) -> InvMass {
+        if self.state_index == 0 {
+            InvMass::ZERO
+        } else {
+            self.sim.inv_masses()
+        }
+    }
 }
 
 /// Storage of every body, with generational handles.
@@ -716,6 +834,7 @@ impl BodySet {
             let state = BodyState {
                 v: def.linear_velocity,
                 w: def.angular_velocity,
+                flags: sim.state_flags(),
                 ..BodyState::IDENTITY
             };
             sim.center = transform.p;
@@ -766,9 +885,7 @@ impl BodySet {
         sim.local_center = m.center;
         sim.center = sim.transform.apply(m.center);
         sim.center0 = sim.center;
-        let st = &mut self.states[i as usize];
-        st.inv_mass = sim.inv_mass;
-        st.inv_inertia = sim.inv_inertia;
+        self.states[i as usize].flags = sim.state_flags();
     }
 
     /// Removes a body's data from the array `loc` names (the last entry
@@ -904,8 +1021,6 @@ impl BodySet {
                 sim.max_rotation,
                 sim.sleep_time,
                 state.w,
-                state.inv_mass,
-                state.inv_inertia,
             ];
             let vecs = [
                 sim.transform.p,
@@ -988,8 +1103,7 @@ impl BodySet {
         sim.center = sim.transform.p;
         sim.center0 = sim.center;
         sim.rotation0 = sim.transform.q;
-        state.inv_mass = 0.0;
-        state.inv_inertia = 0.0;
+        state.flags = sim.state_flags();
         state.dp = Vec2::ZERO;
         state.dq = Rot::IDENTITY;
         let location = if ty == BodyType::Static {
@@ -1082,6 +1196,19 @@ impl BodySet {
             BodyLocation::Moving(i) => self.states.get_mut(i as usize),
             BodyLocation::Static(_) => None,
             BodyLocation::Sleeping(j) => self.sleeping_states.get_mut(j as usize),
+        }
+    }
+
+    /// The inverse mass and inertia the solve applies to the body with
+    /// state index `i` (zero for the static identity state 0; the moving
+    /// body's own otherwise, from `sims`).
+    #[inline(always)]
+    #[must_use]
+    pub fn inv_masses_at(&self, i: u32) -> InvMass {
+        if i == 0 {
+            InvMass::ZERO
+        } else {
+            self.sims[i as usize].inv_masses()
         }
     }
 
@@ -1222,8 +1349,44 @@ mod tests {
         set.wake(a);
         assert!(!set.is_sleeping(a));
         assert_eq!(set.sim(a).unwrap().mass, 2.0);
-        assert_eq!(set.state(a).unwrap().inv_mass, 0.5);
+        assert_eq!(set.sim(a).unwrap().inv_mass, 0.5);
+        assert!(set.state(a).unwrap().moves());
         assert_eq!(set.moving_count(), 2);
+    }
+
+    #[test]
+    fn state_flags_follow_the_body() {
+        let mut set = BodySet::new();
+        let flags = |set: &BodySet, h| set.state(h).unwrap().flags;
+        let d = set.create(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+        let bullet = set
+            .create(&BodyDef::dynamic(Vec2::ONE).as_bullet())
+            .unwrap();
+        let locked = set
+            .create(&BodyDef {
+                fixed_rotation: true,
+                ..BodyDef::dynamic(Vec2::ONE)
+            })
+            .unwrap();
+        let k = set.create(&BodyDef::kinematic(Vec2::ONE)).unwrap();
+        let s = set.create(&BodyDef::fixed(Vec2::ONE)).unwrap();
+        assert_eq!(flags(&set, d), BodyState::MOVES);
+        assert_eq!(flags(&set, bullet), BodyState::MOVES | BodyState::BULLET);
+        assert_eq!(
+            flags(&set, locked),
+            BodyState::MOVES | BodyState::LOCKED_ROTATION
+        );
+        assert_eq!(flags(&set, k), BodyState::KINEMATIC);
+        assert_eq!(flags(&set, s), 0, "a static body reads the identity state");
+        assert_eq!(BodyState::IDENTITY.flags, 0);
+        set.set_body_type(d, BodyType::Kinematic).unwrap();
+        assert_eq!(flags(&set, d), BodyState::KINEMATIC);
+        set.set_body_type(k, BodyType::Dynamic).unwrap();
+        assert!(set.state(k).unwrap().moves());
+        assert_eq!(set.solver_body(k).inv_masses().inv_mass, 1.0);
+        assert_eq!(set.solver_body(s).inv_masses(), InvMass::ZERO);
+        set.sleep(k);
+        assert_eq!(set.solver_body(k).inv_masses(), InvMass::ZERO, "asleep");
     }
 
     #[test]

@@ -20,7 +20,9 @@
 //! ```
 //!
 //! The constraints only see [`BodyState`]s (hot data): slot 0 is the static
-//! identity state, which the solver resets after every step.
+//! identity state, which the solver resets after every step. Inverse masses
+//! are not in the states: each constraint loads its bodies' at prepare, and
+//! the velocity integration reads them from the bodies' `sims`.
 
 use std::time::Instant;
 
@@ -377,8 +379,7 @@ fn prepare_bodies(bodies: &mut BodySet) {
         sim.rotation0 = sim.transform.q;
         state.dp = Vec2::ZERO;
         state.dq = crate::math::Rot::IDENTITY;
-        state.inv_mass = sim.inv_mass;
-        state.inv_inertia = sim.inv_inertia;
+        state.flags = sim.state_flags();
     }
 }
 

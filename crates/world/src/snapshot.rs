@@ -171,8 +171,9 @@ pub mod bytes {
     pub const SNAPSHOT_MAGIC: [u8; 4] = *b"JNS2";
     /// The format version this build writes and reads (2: contacts keep
     /// their recycling cache; 3: the contact set keeps each contact's
-    /// island link).
-    pub const SNAPSHOT_VERSION: u16 = 3;
+    /// island link; 4: body states carry flags instead of inverse masses,
+    /// joints and portal constraints keep the masses they loaded).
+    pub const SNAPSHOT_VERSION: u16 = 4;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.
