@@ -126,6 +126,7 @@ use janus2d_core::math::{Real, Vec2, cross, cross_sv, from_f64, to_f64};
 use janus2d_core::parallel::Team;
 use janus2d_core::union_find::{find, union};
 
+use crate::joint_colour::JointColours;
 use crate::parts::{PointPart, clamp_length};
 use crate::revolute::RevoluteJoint;
 
@@ -995,15 +996,18 @@ fn geometric_stiffness(h: f64, lambda: DVec2, r: Vec2, side: f64) -> f64 {
     (h * side * lambda.dot(wide(r))).max(0.0)
 }
 
-/// The revolute joints of a world and their forest, driven by the solver as
-/// one batch: the iterative rows in the sweep with the other constraints
-/// (before the contacts), the direct tree solve in the late pass after
+/// The revolute joints of a world, their forest and their colours, driven
+/// by the solver as one batch: the iterative rows in the sweep with the
+/// other constraints (before the contacts), on the step's team
+/// ([`crate::joint_colour`]); the direct tree solve in the late pass after
 /// every batch (so the tree's joints have the last word).
 pub struct RevoluteBatch<'a> {
     /// The joints, in storage order.
     pub joints: &'a mut Vec<RevoluteJoint>,
     /// The forest found at `prepare`.
     pub forest: &'a mut JointForest,
+    /// The colours of the iterative rows, updated at `prepare`.
+    pub colours: &'a mut JointColours,
 }
 
 impl ConstraintBatch for RevoluteBatch<'_> {
@@ -1011,10 +1015,10 @@ impl ConstraintBatch for RevoluteBatch<'_> {
         self.joints.len()
     }
     fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
-        self.forest.prepare(self.joints, ctx, bodies);
+        self.prepare_on(ctx, bodies, &Team::serial());
     }
     fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
-        self.joints.warm_start(ctx, states);
+        self.warm_start_on(ctx, states, &Team::serial());
     }
     fn solve(
         &mut self,
@@ -1023,10 +1027,34 @@ impl ConstraintBatch for RevoluteBatch<'_> {
         use_bias: bool,
         reverse: bool,
     ) {
-        self.joints.solve(ctx, states, use_bias, reverse);
+        self.solve_on(ctx, states, use_bias, reverse, &Team::serial());
     }
     fn solve_late(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
         self.forest.solve(ctx, self.joints, states, use_bias);
+    }
+    fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+        self.colours.apply_restitution(ctx, self.joints, states);
+    }
+    fn store_impulses(&mut self) {
+        self.joints.store_impulses();
+    }
+    fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, _team: &Team) {
+        self.forest.prepare(self.joints, ctx, bodies);
+        self.colours.update(self.joints, &bodies.states);
+    }
+    fn warm_start_on(&mut self, _ctx: &StepContext, states: &mut [BodyState], team: &Team) {
+        self.colours.warm_start(self.joints, states, team);
+    }
+    fn solve_on(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+        team: &Team,
+    ) {
+        self.colours
+            .solve(ctx, self.joints, states, use_bias, reverse, team);
     }
     fn solve_late_on(
         &mut self,
@@ -1038,10 +1066,7 @@ impl ConstraintBatch for RevoluteBatch<'_> {
         self.forest
             .solve_on(ctx, self.joints, states, use_bias, team);
     }
-    fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
-        self.joints.apply_restitution(ctx, states);
-    }
-    fn store_impulses(&mut self) {
-        self.joints.store_impulses();
+    fn apply_restitution_on(&mut self, ctx: &StepContext, states: &mut [BodyState], _team: &Team) {
+        self.colours.apply_restitution(ctx, self.joints, states);
     }
 }
