@@ -996,6 +996,9 @@ fn geometric_stiffness(h: f64, lambda: DVec2, r: Vec2, side: f64) -> f64 {
     (h * side * lambda.dot(wide(r))).max(0.0)
 }
 
+/// Joints per block of the joints' prepare on the team.
+const PREPARE_BLOCK: usize = 256;
+
 /// The revolute joints of a world, their forest and their colours, driven
 /// by the solver as one batch: the iterative rows in the sweep with the
 /// other constraints (before the contacts), on the step's team
@@ -1038,8 +1041,17 @@ impl ConstraintBatch for RevoluteBatch<'_> {
     fn store_impulses(&mut self) {
         self.joints.store_impulses();
     }
-    fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, _team: &Team) {
-        self.forest.prepare(self.joints, ctx, bodies);
+    fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
+        // Each joint's prepare reads the bodies and writes only itself:
+        // blocks of joints on the team, then the forest and the colours
+        // from the prepared joints (the same as `JointForest::prepare`).
+        team.for_each_chunk_mut(self.joints, PREPARE_BLOCK, |_, block| {
+            for j in block.iter_mut().filter(|j| j.enabled) {
+                j.prepare(ctx, bodies);
+            }
+        });
+        self.forest
+            .build(self.joints, &bodies.states, ctx.direct_joints);
         self.colours.update(self.joints, &bodies.states);
     }
     fn warm_start_on(&mut self, _ctx: &StepContext, states: &mut [BodyState], team: &Team) {

@@ -309,12 +309,10 @@ impl RevoluteJoint {
     /// body's current arm. The arithmetic of [`Constraint::warm_start`] on
     /// that body (which applies both shares), so a body that takes the
     /// shares of its joints in storage order ends exactly as after the
-    /// joints' warm starts in storage order.
+    /// joints' warm starts in storage order. For a joint that is solved
+    /// this step (enabled and not resting, as the colours' lists hold).
     #[inline(always)]
     pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        if self.resting {
-            return;
-        }
         let axial =
             self.spring.impulse + self.motor.impulse + self.lower.impulse - self.upper.impulse;
         let p = self.point.impulse;
