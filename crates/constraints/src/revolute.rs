@@ -397,7 +397,7 @@ impl RevoluteJoint {
     /// True when the spring, the motor or the limits are on: the joint has
     /// angle rows, which the Gauss–Seidel pass solves even in a tree.
     #[inline(always)]
-    fn has_angle_rows(&self) -> bool {
+    pub(crate) fn has_angle_rows(&self) -> bool {
         self.def.enable_spring || self.def.enable_motor || self.def.enable_limit
     }
 
