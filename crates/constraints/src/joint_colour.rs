@@ -163,8 +163,19 @@ impl JointColours {
     /// colours the joints again if a key or the state count changed since
     /// the last colouring.
     pub fn update(&mut self, joints: &[RevoluteJoint], states: &[BodyState]) {
-        self.keys.clear();
-        self.keys.extend(joints.iter().map(|j| key(j, states)));
+        self.update_on(joints, states, &Team::serial());
+    }
+
+    /// [`JointColours::update`] with the keys read in blocks on the step's
+    /// team (a colouring, when needed, runs on the caller).
+    pub fn update_on(&mut self, joints: &[RevoluteJoint], states: &[BodyState], team: &Team) {
+        const BLOCK: usize = 1024;
+        self.keys.resize(joints.len(), [0; 3]);
+        team.for_each_chunk_mut(&mut self.keys, BLOCK, |i, block| {
+            for (k, j) in block.iter_mut().zip(&joints[i * BLOCK..]) {
+                *k = key(j, states);
+            }
+        });
         if self.keys == self.built_keys
             && states.len() == self.built_states
             && self.position.len() == joints.len()

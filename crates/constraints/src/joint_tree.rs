@@ -518,10 +518,27 @@ impl JointForest {
     /// Finds the joint forest among the enabled joints and marks its joints
     /// (`in_tree`). With `enabled` false every joint stays iterative.
     pub fn build(&mut self, joints: &mut [RevoluteJoint], states: &[BodyState], enabled: bool) {
-        self.pairs.clear();
-        for j in joints.iter() {
-            self.pairs.push(moving_pair(j, states));
-        }
+        self.build_on(joints, states, enabled, &Team::serial());
+    }
+
+    /// [`JointForest::build`] with the joints' moving ends read in blocks
+    /// on the step's team (the forest itself is found on the caller).
+    pub fn build_on(
+        &mut self,
+        joints: &mut [RevoluteJoint],
+        states: &[BodyState],
+        enabled: bool,
+        team: &Team,
+    ) {
+        const BLOCK: usize = 1024;
+        self.pairs.resize(joints.len(), [0; 3]);
+        let read = &*joints;
+        team.for_each_chunk_mut(&mut self.pairs, BLOCK, |i, block| {
+            let first = i * BLOCK;
+            for (pair, j) in block.iter_mut().zip(&read[first..]) {
+                *pair = moving_pair(j, states);
+            }
+        });
         self.update(joints, states.len(), enabled);
     }
 
@@ -1051,8 +1068,8 @@ impl ConstraintBatch for RevoluteBatch<'_> {
             }
         });
         self.forest
-            .build(self.joints, &bodies.states, ctx.direct_joints);
-        self.colours.update(self.joints, &bodies.states);
+            .build_on(self.joints, &bodies.states, ctx.direct_joints, team);
+        self.colours.update_on(self.joints, &bodies.states, team);
     }
     fn warm_start_on(&mut self, _ctx: &StepContext, states: &mut [BodyState], team: &Team) {
         self.colours.warm_start(self.joints, states, team);
