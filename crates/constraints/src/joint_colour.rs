@@ -301,9 +301,13 @@ impl JointColours {
         }
         let (start, list) = (&self.body_start[..], &self.body_joints[..]);
         let body = |s: usize, st: &mut BodyState| {
+            // A copy in registers, its velocities written back once.
+            let mut local = *st;
             for &e in &list[start[s] as usize..start[s + 1] as usize] {
-                joints[(e >> 1) as usize].warm_start_side(st, e & 1 == 1);
+                joints[(e >> 1) as usize].warm_start_side(&mut local, e & 1 == 1);
             }
+            st.v = local.v;
+            st.w = local.w;
         };
         if team.threads() == 1 || list.len() < 2 * WARM_START_BLOCK {
             for &s in &self.jointed {
