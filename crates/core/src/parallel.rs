@@ -9,7 +9,7 @@
 //!   │   claims blocks itself            … until every block is claimed     │
 //!   │   waits: done == blocks                                              │
 //!   │   retires the job, waits until no follower holds it                  │
-//!   ├ serial work (joints, trees, overflow): followers spin                │
+//!   ├ serial work (colourings, overflows, portals): followers spin         │
 //!   ├ team.run(...) …                                                      │
 //!   └ stop ─────────────────────────▶ return to rayon ─────────────────────┘
 //! ```
