@@ -317,7 +317,8 @@ fn joint_grid_40_peak_gap() {
     );
 }
 
-/// Every shared hard case on janus2d at 1, 2, 4 and 8 substeps: prints each
+/// Every shared hard case on janus2d (and the 1000:1 mass-ratio bob and
+/// chain) at 1, 2, 4 and 8 substeps: prints each
 /// case's bounded figures and whether it passes, and asserts that nothing
 /// goes non-finite. A report, not a bound (the bounds are for 4 substeps);
 /// minutes of work, so ignored: run it with
@@ -335,7 +336,12 @@ fn hard_cases_by_substeps() {
     let substeps: Vec<u32> = pick("JANUS2D_SUBSTEPS")
         .map(|v| v.iter().filter_map(|s| s.parse().ok()).collect())
         .unwrap_or_else(|| vec![1, 2, 4, 8]);
-    for mut case in hard::all() {
+    // The 1000:1 mass-ratio joint cases (their own tests below) too.
+    let cases = hard::all().into_iter().chain([
+        hard::mass_ratio_chain(1, 1000.0),
+        hard::mass_ratio_chain(20, 1000.0),
+    ]);
+    for mut case in cases {
         if names
             .as_ref()
             .is_some_and(|n| !n.iter().any(|n| n == case.name))

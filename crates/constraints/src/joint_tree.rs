@@ -126,6 +126,7 @@ use janus2d_core::math::{Real, Vec2, cross, cross_sv, from_f64, to_f64};
 use janus2d_core::parallel::Team;
 use janus2d_core::union_find::{find, union};
 
+use crate::joint_colour::JointColours;
 use crate::parts::{PairMass, PointPart, clamp_length};
 use crate::revolute::RevoluteJoint;
 
@@ -529,10 +530,27 @@ impl JointForest {
     /// Finds the joint forest among the enabled joints and marks its joints
     /// (`in_tree`). With `enabled` false every joint stays iterative.
     pub fn build(&mut self, joints: &mut [RevoluteJoint], states: &[BodyState], enabled: bool) {
-        self.pairs.clear();
-        for j in joints.iter() {
-            self.pairs.push(moving_pair(j, states));
-        }
+        self.build_on(joints, states, enabled, &Team::serial());
+    }
+
+    /// [`JointForest::build`] with the joints' moving ends read in blocks
+    /// on the step's team (the forest itself is found on the caller).
+    pub fn build_on(
+        &mut self,
+        joints: &mut [RevoluteJoint],
+        states: &[BodyState],
+        enabled: bool,
+        team: &Team,
+    ) {
+        const BLOCK: usize = 1024;
+        self.pairs.resize(joints.len(), [0; 3]);
+        let read = &*joints;
+        team.for_each_chunk_mut(&mut self.pairs, BLOCK, |i, block| {
+            let first = i * BLOCK;
+            for (pair, j) in block.iter_mut().zip(&read[first..]) {
+                *pair = moving_pair(j, states);
+            }
+        });
         self.update(joints, states.len(), enabled);
     }
 
@@ -1013,15 +1031,21 @@ fn geometric_stiffness(h: f64, lambda: DVec2, r: Vec2, side: f64) -> f64 {
     (h * side * lambda.dot(wide(r))).max(0.0)
 }
 
-/// The revolute joints of a world and their forest, driven by the solver as
-/// one batch: the iterative rows in the sweep with the other constraints
-/// (before the contacts), the direct tree solve in the late pass after
+/// Joints per block of the joints' prepare on the team.
+const PREPARE_BLOCK: usize = 256;
+
+/// The revolute joints of a world, their forest and their colours, driven
+/// by the solver as one batch: the iterative rows in the sweep with the
+/// other constraints (before the contacts), on the step's team
+/// ([`crate::joint_colour`]); the direct tree solve in the late pass after
 /// every batch (so the tree's joints have the last word).
 pub struct RevoluteBatch<'a> {
     /// The joints, in storage order.
     pub joints: &'a mut Vec<RevoluteJoint>,
     /// The forest found at `prepare`.
     pub forest: &'a mut JointForest,
+    /// The colours of the iterative rows, updated at `prepare`.
+    pub colours: &'a mut JointColours,
 }
 
 impl ConstraintBatch for RevoluteBatch<'_> {
@@ -1029,10 +1053,10 @@ impl ConstraintBatch for RevoluteBatch<'_> {
         self.joints.len()
     }
     fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
-        self.forest.prepare(self.joints, ctx, bodies);
+        self.prepare_on(ctx, bodies, &Team::serial());
     }
     fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
-        self.joints.warm_start(ctx, states);
+        self.warm_start_on(ctx, states, &Team::serial());
     }
     fn solve(
         &mut self,
@@ -1041,10 +1065,43 @@ impl ConstraintBatch for RevoluteBatch<'_> {
         use_bias: bool,
         reverse: bool,
     ) {
-        self.joints.solve(ctx, states, use_bias, reverse);
+        self.solve_on(ctx, states, use_bias, reverse, &Team::serial());
     }
     fn solve_late(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
         self.forest.solve(ctx, self.joints, states, use_bias);
+    }
+    fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+        self.colours.apply_restitution(ctx, self.joints, states);
+    }
+    fn store_impulses(&mut self) {
+        self.joints.store_impulses();
+    }
+    fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
+        // Each joint's prepare reads the bodies and writes only itself:
+        // blocks of joints on the team, then the forest and the colours
+        // from the prepared joints (the same as `JointForest::prepare`).
+        team.for_each_chunk_mut(self.joints, PREPARE_BLOCK, |_, block| {
+            for j in block.iter_mut().filter(|j| j.enabled) {
+                j.prepare(ctx, bodies);
+            }
+        });
+        self.forest
+            .build_on(self.joints, &bodies.states, ctx.direct_joints, team);
+        self.colours.update_on(self.joints, &bodies.states, team);
+    }
+    fn warm_start_on(&mut self, _ctx: &StepContext, states: &mut [BodyState], team: &Team) {
+        self.colours.warm_start(self.joints, states, team);
+    }
+    fn solve_on(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+        team: &Team,
+    ) {
+        self.colours
+            .solve(ctx, self.joints, states, use_bias, reverse, team);
     }
     fn solve_late_on(
         &mut self,
@@ -1056,10 +1113,7 @@ impl ConstraintBatch for RevoluteBatch<'_> {
         self.forest
             .solve_on(ctx, self.joints, states, use_bias, team);
     }
-    fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
-        self.joints.apply_restitution(ctx, states);
-    }
-    fn store_impulses(&mut self) {
-        self.joints.store_impulses();
+    fn apply_restitution_on(&mut self, ctx: &StepContext, states: &mut [BodyState], _team: &Team) {
+        self.colours.apply_restitution(ctx, self.joints, states);
     }
 }

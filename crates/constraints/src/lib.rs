@@ -9,7 +9,8 @@
 //! | [`contact::ContactConstraint`]| 2–4  | 2      | compact rows (normal, friction) |
 //!
 //! The point rows of joints that form a tree are solved exactly, the
-//! whole tree at once ([`joint_tree`]); so are the normal rows of the
+//! whole tree at once ([`joint_tree`]); the joints' Gauss–Seidel rows are
+//! solved colour by colour on the step's team ([`joint_colour`]); so are the normal rows of the
 //! contacts of a light cluster, bodies under (or between) bodies ten times
 //! heavier or more ([`contact_group`]); the rest is Gauss–Seidel.
 //!
@@ -19,6 +20,7 @@
 pub mod contact;
 pub mod contact_group;
 pub mod contact_solver;
+pub mod joint_colour;
 pub mod joint_tree;
 pub mod parts;
 pub mod portal;
@@ -27,6 +29,7 @@ pub mod revolute;
 
 pub use contact::{ContactConstraint, ContactPointInput};
 pub use contact_solver::{ContactBatch, ContactSolver, ObjectMass, PointImpulse};
+pub use joint_colour::JointColours;
 pub use joint_tree::{JointForest, RevoluteBatch};
 pub use portal::{PortalBatch, PortalConstraint, PortalConstraintDef};
 pub use portal_map::{Portal, PortalError, PortalMap, PortalPair};

@@ -21,6 +21,7 @@
 
 use janus2d_core::body::{BodyState, InvMass};
 use janus2d_core::math::{Real, Vec2, cross, cross_sv, solve22};
+use janus2d_core::parallel::PlannedStates;
 use janus2d_core::softness::Softness;
 
 /// The inverse masses of a constraint's two bodies (a, b), loaded at
@@ -59,6 +60,79 @@ pub fn store_pair(states: &mut [BodyState], a: u32, b: u32, sa: &BodyState, sb: 
     let tb = &mut states[b as usize];
     tb.v = sb.v;
     tb.w = sb.w;
+}
+
+/// Write mask of a [`PairOf`]: body a's state is written back.
+pub(crate) const WRITE_A: u8 = 1;
+/// Write mask of a [`PairOf`]: body b's state is written back.
+pub(crate) const WRITE_B: u8 = 2;
+/// Write mask of a [`PairOf`]: both states are written back.
+pub(crate) const BOTH: u8 = WRITE_A | WRITE_B;
+
+/// The two body states of a two-body constraint, as one stage sees them:
+/// read both, write back the velocities of those it may write.
+pub(crate) trait PairStates {
+    /// The states of body a and body b.
+    fn load(&self) -> (BodyState, BodyState);
+    /// Writes back the velocities (positions are untouched).
+    fn store(&mut self, sa: &BodyState, sb: &BodyState);
+}
+
+/// A pair in the whole state slice: its two indices and the states it
+/// writes back ([`BOTH`]: [`store_pair`]; the colour stages write only the
+/// bodies they move, as their parallel form must).
+pub(crate) struct PairOf<'s> {
+    states: &'s mut [BodyState],
+    a: u32,
+    b: u32,
+    writes: u8,
+}
+
+impl<'s> PairOf<'s> {
+    #[inline(always)]
+    pub(crate) fn new(states: &'s mut [BodyState], a: u32, b: u32, writes: u8) -> Self {
+        PairOf {
+            states,
+            a,
+            b,
+            writes,
+        }
+    }
+}
+
+impl PairStates for PairOf<'_> {
+    #[inline(always)]
+    fn load(&self) -> (BodyState, BodyState) {
+        load_pair(self.states, self.a, self.b)
+    }
+    #[inline(always)]
+    fn store(&mut self, sa: &BodyState, sb: &BodyState) {
+        if self.writes & WRITE_A != 0 {
+            let t = &mut self.states[self.a as usize];
+            t.v = sa.v;
+            t.w = sa.w;
+        }
+        if self.writes & WRITE_B != 0 {
+            let t = &mut self.states[self.b as usize];
+            t.v = sb.v;
+            t.w = sb.w;
+        }
+    }
+}
+
+/// A pair's slots of a verified [`StatePlan`](janus2d_core::parallel::StatePlan)
+/// (slot 0: body a, slot 1: body b), for the stages on the team; the plan's
+/// write mask says which velocities go back.
+impl PairStates for PlannedStates<'_, 2> {
+    #[inline(always)]
+    fn load(&self) -> (BodyState, BodyState) {
+        (self.get(0), self.get(1))
+    }
+    #[inline(always)]
+    fn store(&mut self, sa: &BodyState, sb: &BodyState) {
+        self.set_velocity(0, sa.v, sa.w);
+        self.set_velocity(1, sb.v, sb.w);
+    }
 }
 
 /// Applies a linear impulse `p` at arms `r_a`, `r_b` (equal and opposite)

@@ -39,7 +39,9 @@ use janus2d_core::softness::Softness;
 use smallvec::smallvec;
 
 use crate::JointError;
-use crate::parts::{AnglePart, PairMass, PointPart, load_pair, store_pair};
+use crate::parts::{
+    AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, load_pair, store_pair,
+};
 
 /// Everything needed to create a revolute joint.
 #[derive(Clone, Debug, PartialEq)]
@@ -308,6 +310,109 @@ impl RevoluteJoint {
         axial * self.inv_h
     }
 
+    /// The warm start's share on one of its bodies (`side_b`: body b, else
+    /// body a): the kept angle impulse, then the kept point impulse at the
+    /// body's current arm. The arithmetic of [`Constraint::warm_start`] on
+    /// that body (which applies both shares), so a body that takes the
+    /// shares of its joints in storage order ends exactly as after the
+    /// joints' warm starts in storage order. For a joint that is solved
+    /// this step (enabled and not resting, as the colours' lists hold).
+    #[inline(always)]
+    pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
+        let axial =
+            self.spring.impulse + self.motor.impulse + self.lower.impulse - self.upper.impulse;
+        let p = self.point.impulse;
+        // AnglePart::apply, then PointPart::warm_start (apply_pair with no
+        // angular impulse), one side of each.
+        if side_b {
+            let m_b = &self.masses.b;
+            st.w += m_b.inv_inertia * axial;
+            let r_b = st.dq.rotate(self.point.frame_b);
+            st.v += m_b.inv_mass * p;
+            st.w += m_b.inv_inertia * (cross(r_b, p) + 0.0);
+        } else {
+            let m_a = &self.masses.a;
+            st.w -= m_a.inv_inertia * axial;
+            let r_a = st.dq.rotate(self.point.frame_a);
+            st.v -= m_a.inv_mass * p;
+            st.w -= m_a.inv_inertia * (cross(r_a, p) + 0.0);
+        }
+    }
+
+    /// One velocity iteration on the joint's two states as `pair` holds
+    /// them. A tree joint without angle rows has nothing to do here (its
+    /// point rows are the tree's).
+    #[inline(always)]
+    pub(crate) fn solve_pair<P: PairStates>(
+        &mut self,
+        ctx: &StepContext,
+        pair: &mut P,
+        use_bias: bool,
+    ) {
+        if self.resting || (self.in_tree && !self.has_angle_rows()) {
+            return;
+        }
+        let (mut sa, mut sb) = pair.load();
+        let m = &self.masses;
+        // The angle depends on the rotations only, which the rows below do
+        // not change: one atan2 for the spring and the limits.
+        let angle = if self.def.enable_spring || self.def.enable_limit {
+            self.current_angle(&sa, &sb)
+        } else {
+            0.0
+        };
+        if self.def.enable_spring && m.a.inv_inertia + m.b.inv_inertia > 0.0 {
+            self.spring
+                .solve_soft(&mut sa, &mut sb, m, angle, self.spring_softness);
+        }
+        if self.def.enable_motor {
+            let max_impulse = ctx.h * self.def.max_motor_torque;
+            self.motor
+                .solve_motor(&mut sa, &mut sb, m, self.def.motor_speed, max_impulse);
+        }
+        if self.def.enable_limit {
+            let soft = ctx.joint_softness;
+            self.lower.solve_limit(
+                &mut sa,
+                &mut sb,
+                m,
+                angle - self.def.lower_angle,
+                1.0,
+                soft,
+                ctx.inv_h,
+                use_bias,
+            );
+            self.upper.solve_limit(
+                &mut sa,
+                &mut sb,
+                m,
+                self.def.upper_angle - angle,
+                -1.0,
+                soft,
+                ctx.inv_h,
+                use_bias,
+            );
+        }
+        if !self.in_tree {
+            self.point.solve(
+                &mut sa,
+                &mut sb,
+                m,
+                self.point_softness,
+                ctx.joint_max_correction_speed,
+                use_bias,
+            );
+        }
+        pair.store(&sa, &sb);
+    }
+
+    /// True when the spring, the motor or the limits are on: the joint has
+    /// angle rows, which the Gauss–Seidel pass solves even in a tree.
+    #[inline(always)]
+    pub(crate) fn has_angle_rows(&self) -> bool {
+        self.def.enable_spring || self.def.enable_motor || self.def.enable_limit
+    }
+
     fn current_angle(&self, sa: &BodyState, sb: &BodyState) -> Real {
         janus2d_core::math::wrap_angle(self.delta_angle + sa.dq.relative_angle(sb.dq))
     }
@@ -379,61 +484,8 @@ impl Constraint for RevoluteJoint {
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        if self.resting {
-            return;
-        }
-        let (mut sa, mut sb) = load_pair(states, self.state_a, self.state_b);
-        let m = &self.masses;
-        // The angle depends on the rotations only, which the rows below do
-        // not change: one atan2 for the spring and the limits.
-        let angle = if self.def.enable_spring || self.def.enable_limit {
-            self.current_angle(&sa, &sb)
-        } else {
-            0.0
-        };
-        if self.def.enable_spring && m.a.inv_inertia + m.b.inv_inertia > 0.0 {
-            self.spring
-                .solve_soft(&mut sa, &mut sb, m, angle, self.spring_softness);
-        }
-        if self.def.enable_motor {
-            let max_impulse = ctx.h * self.def.max_motor_torque;
-            self.motor
-                .solve_motor(&mut sa, &mut sb, m, self.def.motor_speed, max_impulse);
-        }
-        if self.def.enable_limit {
-            let soft = ctx.joint_softness;
-            self.lower.solve_limit(
-                &mut sa,
-                &mut sb,
-                m,
-                angle - self.def.lower_angle,
-                1.0,
-                soft,
-                ctx.inv_h,
-                use_bias,
-            );
-            self.upper.solve_limit(
-                &mut sa,
-                &mut sb,
-                m,
-                self.def.upper_angle - angle,
-                -1.0,
-                soft,
-                ctx.inv_h,
-                use_bias,
-            );
-        }
-        if !self.in_tree {
-            self.point.solve(
-                &mut sa,
-                &mut sb,
-                m,
-                self.point_softness,
-                ctx.joint_max_correction_speed,
-                use_bias,
-            );
-        }
-        store_pair(states, self.state_a, self.state_b, &sa, &sb);
+        let mut pair = PairOf::new(states, self.state_a, self.state_b, BOTH);
+        self.solve_pair(ctx, &mut pair, use_bias);
     }
 
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {

@@ -5,17 +5,20 @@
 //! solve_step ── with_team ── rayon::broadcast (once per step) ─────────────┐
 //!   thread 0 (leader)                  threads 1..n (followers)            │
 //!   runs the stage sequence            wait for a job (spin, then yield)   │
-//!   ├ team.run(blocks, job) ─publish─▶ claim block i (fetch_add) → job(i)  │
+//!   ├ team.run(blocks, job) ─publish─▶ claim block i (swap) → job(i)       │
 //!   │   claims blocks itself            … until every block is claimed     │
 //!   │   waits: done == blocks                                              │
 //!   │   retires the job, waits until no follower holds it                  │
-//!   ├ serial work (joints, trees, overflow): followers spin                │
+//!   ├ serial work (colourings, overflows, portals): followers spin         │
 //!   ├ team.run(...) …                                                      │
 //!   └ stop ─────────────────────────▶ return to rayon ─────────────────────┘
 //! ```
 //!
-//! A stage is one job: no fork–join per colour, one atomic increment per
-//! claimed block. Whatever a job computes for block `i` must not depend on
+//! A stage is one job: no fork–join per colour, one atomic swap per
+//! claimed block. Thread `t` of `n` starts claiming at block `t · blocks /
+//! n` (forward, then backward from there, see `Shared::work`), so a thread
+//! tends to run the same share of every stage and its data stays in that
+//! thread's cache. Whatever a job computes for block `i` must not depend on
 //! which thread runs it; the solver's jobs write disjoint data per block, so
 //! results are bit-identical for any thread count.
 //!
@@ -44,10 +47,14 @@
 //!    The job cell itself is written only by the leader while the epoch is
 //!    idle and `active == 0`, when no follower reads it.
 //! 2. **Disjoint mutable blocks of one slice** ([`Team::for_each_chunk_mut`]).
-//!    Block `i` is the sub-slice `[i·len, min((i+1)·len, n))`; the claim
-//!    counter hands each block index to exactly one thread exactly once per
-//!    job, so the `&mut` sub-slices never alias, and they do not outlive the
-//!    job (hence not the `&mut` borrow `for_each_chunk_mut` holds).
+//!    Block `i` is the sub-slice `[i·len, min((i+1)·len, n))`; a block is
+//!    run by the one thread whose swap of the job's epoch into the block's
+//!    claim flag returned another value (epochs never repeat within a team,
+//!    and the flags start at 0), blocks past the flags by the one thread
+//!    the claim counter hands them to, so each block index runs exactly
+//!    once per job: the `&mut` sub-slices never alias, and they do not
+//!    outlive the job (hence not the `&mut` borrow `for_each_chunk_mut`
+//!    holds).
 //! 3. **Body states written by several threads at once**
 //!    ([`Team::for_each_planned`]). A [`StatePlan`] lists, per item of a
 //!    group (a colour's chunk), the state indices it reads and the subset
@@ -89,15 +96,26 @@ struct Shared {
     /// The published job, lifetime erased (see the module's safety proof).
     job: UnsafeCell<Option<Job<'static>>>,
     blocks: AtomicUsize,
-    /// The claim counter, the finished count and the holders each on a
-    /// cache line of their own: claims do not slow the followers' polling.
+    /// The claim counter (blocks past the claim flags), the finished count
+    /// and the holders each on a cache line of their own: claims do not
+    /// slow the followers' polling.
     next: Line<AtomicUsize>,
     done: Line<AtomicUsize>,
     /// Followers currently holding the published job.
     active: Line<AtomicUsize>,
     /// Set when a block panicked on a follower.
     panicked: AtomicBool,
+    /// Per block (the first [`CLAIM_FLAGS`] of a job): the epoch of the
+    /// last job in which a thread claimed it.
+    claims: Box<[AtomicU64]>,
+    /// Threads of the team (the leader is thread 0).
+    threads: usize,
 }
+
+/// Blocks of a job claimed through per-block flags, each thread starting at
+/// its own share (see [`Shared::work`]); a job with more blocks claims the
+/// rest through the counter.
+const CLAIM_FLAGS: usize = 4096;
 
 /// A value alone on its cache line (128 bytes: two lines on x86, whose
 /// prefetcher pairs them).
@@ -118,8 +136,10 @@ unsafe impl Sync for Shared {}
 
 impl Shared {
     #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
-    fn new() -> Self {
+    fn new(threads: usize) -> Self {
         Shared {
+            claims: (0..CLAIM_FLAGS).map(|_| AtomicU64::new(0)).collect(),
+            threads: threads.max(1),
             epoch: AtomicU64::new(0),
             job: UnsafeCell::new(None),
             blocks: AtomicUsize::new(0),
@@ -130,8 +150,22 @@ impl Shared {
         }
     }
 
-    /// Claims and runs blocks of the published job until none is left.
-    fn work(&self, job: Job<'_>, blocks: usize) {
+    /// Claims and runs blocks of the published job (epoch `epoch`) until
+    /// none is left, as thread `thread` of the team.
+    ///
+    /// Thread `t` of `n` starts at block `t · blocks / n` and claims forward
+    /// (wrapping) while the blocks are free, then backward from its start;
+    /// a block is claimed by swapping the job's epoch into its flag (the
+    /// thread that sees another value there has it). So with the usual
+    /// timing each thread runs the same share of every job, stage after
+    /// stage, and the data of a share stays in its thread's cache: where
+    /// the cores do not share a cache, moving a stage's data between them
+    /// costs more than the stage. Every block is claimed: a free block's
+    /// nearest claimed block on its left was claimed by a forward run
+    /// (which would then have tried the free block next) or by a backward
+    /// run (which starts just left of a claimed block and moves left), so
+    /// none is left free once every thread has stopped.
+    fn work(&self, job: Job<'_>, blocks: usize, epoch: u64, thread: usize) {
         // The blocks this thread started, added to `done` once at the end,
         // even if a block panics, so the leader never waits for a block
         // that will not finish.
@@ -144,8 +178,29 @@ impl Shared {
             }
         }
         let mut done = Done(&self.done, 0);
+        let flagged = blocks.min(CLAIM_FLAGS);
+        if flagged > 0 && thread < flagged {
+            let claim = |i: usize| self.claims[i].swap(epoch, SeqCst) != epoch;
+            let start = thread * flagged / self.threads;
+            let mut i = start;
+            while claim(i) {
+                done.1 += 1;
+                job(i);
+                i = if i + 1 == flagged { 0 } else { i + 1 };
+            }
+            let mut i = start;
+            loop {
+                i = if i == 0 { flagged - 1 } else { i - 1 };
+                if !claim(i) {
+                    break;
+                }
+                done.1 += 1;
+                job(i);
+            }
+        }
+        // Blocks past the flags: the counter.
         loop {
-            let i = self.next.fetch_add(1, SeqCst);
+            let i = CLAIM_FLAGS + self.next.fetch_add(1, SeqCst);
             if i >= blocks {
                 return;
             }
@@ -240,7 +295,7 @@ impl Team<'_> {
             }
         }
         let retire = Retire(shared, epoch, blocks);
-        shared.work(job, blocks);
+        shared.work(job, blocks, epoch + 1, 0);
         drop(retire);
         if shared.panicked.load(SeqCst) {
             panic!("a block of a parallel stage panicked on a worker thread");
@@ -509,7 +564,7 @@ pub fn with_team<R: Send>(leader: impl FnOnce(&Team) -> R + Send) -> R {
 #[cfg(feature = "parallel")]
 fn broadcast_team<R: Send>(leader: impl FnOnce(&Team) -> R + Send) -> R {
     use std::sync::Mutex;
-    let shared = Shared::new();
+    let shared = Shared::new(rayon::current_num_threads());
     let leader = Mutex::new(Some(leader));
     let result = Mutex::new(None);
     rayon::broadcast(|ctx| {
@@ -534,7 +589,7 @@ fn broadcast_team<R: Send>(leader: impl FnOnce(&Team) -> R + Send) -> R {
             let r = f(&team);
             *result.lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
         } else {
-            follow(&shared);
+            follow(&shared, ctx.index());
         }
     });
     result
@@ -545,7 +600,7 @@ fn broadcast_team<R: Send>(leader: impl FnOnce(&Team) -> R + Send) -> R {
 
 /// A follower's loop: serve published jobs until the leader stops.
 #[cfg(feature = "parallel")]
-fn follow(shared: &Shared) {
+fn follow(shared: &Shared, thread: usize) {
     let mut seen = 0;
     let mut spins = 0;
     loop {
@@ -580,7 +635,7 @@ fn follow(shared: &Shared) {
             continue;
         };
         let blocks = shared.blocks.load(SeqCst);
-        shared.work(job, blocks);
+        shared.work(job, blocks, epoch, thread);
     }
 }
 
@@ -593,6 +648,39 @@ mod tests {
         let seen = std::sync::Mutex::new(Vec::new());
         Team::serial().run(5, &|i| seen.lock().unwrap().push(i));
         assert_eq!(*seen.lock().unwrap(), vec![0, 1, 2, 3, 4]);
+    }
+
+    /// Every block of a job runs exactly once, for any team size and any
+    /// block count (past the claim flags too), job after job.
+    #[cfg(feature = "parallel")]
+    #[test]
+    fn every_block_runs_once_on_any_team() {
+        for threads in [2, 3, 4] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                with_team(|team| {
+                    for blocks in [0, 1, 2, 3, 7, 64, 1000, CLAIM_FLAGS + 37] {
+                        let runs: Vec<AtomicUsize> =
+                            (0..blocks).map(|_| AtomicUsize::new(0)).collect();
+                        for _ in 0..3 {
+                            team.run(blocks, &|i| {
+                                runs[i].fetch_add(1, SeqCst);
+                            });
+                        }
+                        for (i, r) in runs.iter().enumerate() {
+                            assert_eq!(
+                                r.load(SeqCst),
+                                3,
+                                "block {i} of {blocks}, {threads} threads"
+                            );
+                        }
+                    }
+                });
+            });
+        }
     }
 
     #[test]

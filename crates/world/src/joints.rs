@@ -16,7 +16,7 @@
 
 use std::collections::HashMap;
 
-use janus2d_constraints::{JointForest, RevoluteJoint, RevoluteJointDef};
+use janus2d_constraints::{JointColours, JointForest, RevoluteJoint, RevoluteJointDef};
 use janus2d_core::body::BodyHandle;
 use janus2d_core::handle::{Handle, JointTag};
 use janus2d_core::math::Real;
@@ -101,6 +101,10 @@ pub struct JointSet {
     /// the tree solve an index out of range.
     #[cfg_attr(feature = "serde", serde(skip))]
     pub(crate) forest: JointForest,
+    /// The colours of the joints' Gauss–Seidel rows (derived like the
+    /// forest, and like it not in snapshot bytes).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub(crate) colours: JointColours,
 }
 
 impl JointSet {

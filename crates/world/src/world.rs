@@ -1494,6 +1494,7 @@ impl World {
         let mut revolute = janus2d_constraints::RevoluteBatch {
             joints: &mut self.joints.revolute,
             forest: &mut self.joints.forest,
+            colours: &mut self.joints.colours,
         };
         let mut contacts = janus2d_constraints::ContactBatch {
             solver: &mut self.contact_solver,
