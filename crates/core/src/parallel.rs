@@ -46,7 +46,8 @@
 //!    and it never touches the job. So no job is used after `run` returns.
 //!    The job cell itself is written only by the leader while the epoch is
 //!    idle and `active == 0`, when no follower reads it.
-//! 2. **Disjoint mutable blocks of one slice** ([`Team::for_each_chunk_mut`]).
+//! 2. **Disjoint mutable blocks of one slice** ([`Team::for_each_chunk_mut`],
+//!    and of two equally long slices at once, [`Team::for_each_chunk_pair_mut`]).
 //!    Block `i` is the sub-slice `[i·len, min((i+1)·len, n))`; a block is
 //!    run by the one thread whose swap of the job's epoch into the block's
 //!    claim flag returned another value (epochs never repeat within a team,
@@ -330,6 +331,51 @@ impl Team<'_> {
             // mutably borrowed until `run` returns.
             let chunk = unsafe { std::slice::from_raw_parts_mut(base.0.add(start), count) };
             f(i, chunk);
+        });
+    }
+}
+
+impl Team<'_> {
+    /// [`Team::for_each_chunk_mut`] over two slices of the same length at
+    /// once: `f(i, a_block, b_block)` gets the same item range of both
+    /// (the body sims and their states, say).
+    ///
+    /// # Panics
+    ///
+    /// When the slices' lengths differ (a bug of the caller, not input).
+    pub fn for_each_chunk_pair_mut<A: Send, B: Send>(
+        &self,
+        a: &mut [A],
+        b: &mut [B],
+        len: usize,
+        f: impl Fn(usize, &mut [A], &mut [B]) + Sync,
+    ) {
+        assert_eq!(a.len(), b.len(), "paired slices differ in length");
+        let len = len.max(1);
+        let n = a.len();
+        let blocks = n.div_ceil(len);
+        if self.shared.is_none() || blocks <= 1 {
+            for (i, (ca, cb)) in a.chunks_mut(len).zip(b.chunks_mut(len)).enumerate() {
+                f(i, ca, cb);
+            }
+            return;
+        }
+        let (base_a, base_b) = (Base(a.as_mut_ptr()), Base(b.as_mut_ptr()));
+        let (base_a, base_b) = (&base_a, &base_b);
+        self.run(blocks, &|i| {
+            let start = i * len;
+            let count = len.min(n - start);
+            // SAFETY: as in `for_each_chunk_mut` (module docs, point 2),
+            // for each slice: `start + count ≤ n` for both (equal lengths),
+            // block `i` is claimed once, blocks do not overlap, and both
+            // slices stay mutably borrowed until `run` returns.
+            let (ca, cb) = unsafe {
+                (
+                    std::slice::from_raw_parts_mut(base_a.0.add(start), count),
+                    std::slice::from_raw_parts_mut(base_b.0.add(start), count),
+                )
+            };
+            f(i, ca, cb);
         });
     }
 }

@@ -372,15 +372,21 @@ fn lap(t: &mut Instant) -> f64 {
     d
 }
 
-fn prepare_bodies(bodies: &mut BodySet) {
+/// The step's start for every body: the pose it began at, zero deltas, the
+/// solver flags. In blocks of bodies on the team.
+fn prepare_bodies(bodies: &mut BodySet, team: &Team) {
     let BodySet { sims, states, .. } = bodies;
-    for (sim, state) in sims.iter_mut().zip(states.iter_mut()).skip(1) {
-        sim.center0 = sim.center;
-        sim.rotation0 = sim.transform.q;
-        state.dp = Vec2::ZERO;
-        state.dq = crate::math::Rot::IDENTITY;
-        state.flags = sim.state_flags();
-    }
+    team.for_each_chunk_pair_mut(sims, states, BODY_BLOCK, |i, sims, states| {
+        // Slot 0 is the static identity (its sim is a placeholder).
+        let skip = usize::from(i == 0);
+        for (sim, state) in sims.iter_mut().zip(states.iter_mut()).skip(skip) {
+            sim.center0 = sim.center;
+            sim.rotation0 = sim.transform.q;
+            state.dp = Vec2::ZERO;
+            state.dq = crate::math::Rot::IDENTITY;
+            state.flags = sim.state_flags();
+        }
+    });
 }
 
 /// Integrates velocities of moving bodies over one substep `h`: gravity,
@@ -416,14 +422,14 @@ pub fn integrate_velocities(ctx: &StepContext, bodies: &mut BodySet) {
     }
 }
 
-/// The velocity integration of one dynamic body over a substep, with
-/// everything that is fixed for the step (forces, gravity, damping, limits)
-/// evaluated once: [`integrate_velocities`] on a compact array instead of
-/// the bodies' per-step data. Same arithmetic, same results.
-#[derive(Clone, Copy, Debug)]
+/// The velocity integration of one body over a substep, with everything
+/// that is fixed for the step (forces, gravity, damping, limits) evaluated
+/// once: [`integrate_velocities`] on a compact array instead of the
+/// bodies' per-step data. Same arithmetic, same results.
+#[derive(Clone, Copy, Debug, Default)]
 struct VelocityTerms {
-    /// Index of the body's state.
-    state: u32,
+    /// The body is dynamic (the others' velocities are not integrated).
+    dynamic: bool,
     /// `h (F/m + s g)`, m/s.
     dv: Vec2,
     /// `h τ / I`, rad/s.
@@ -438,49 +444,53 @@ struct VelocityTerms {
     max_w: Real,
 }
 
-/// The [`VelocityTerms`] of every dynamic body, in state order.
-fn velocity_terms(ctx: &StepContext, bodies: &BodySet) -> Vec<VelocityTerms> {
+/// The [`VelocityTerms`] of every body, by state index (state 0 and the
+/// bodies that are not dynamic are marked so), in blocks on the team.
+fn velocity_terms(ctx: &StepContext, bodies: &BodySet, team: &Team) -> Vec<VelocityTerms> {
     let h = ctx.h;
     let gravity = ctx.gravity;
     let has_gravity = gravity != Vec2::ZERO;
-    let mut terms = Vec::with_capacity(bodies.sims.len());
-    for (i, sim) in bodies.sims.iter().enumerate().skip(1) {
-        if sim.body_type != BodyType::Dynamic {
-            continue;
+    let sims = &bodies.sims[..];
+    let mut terms = vec![VelocityTerms::default(); sims.len()];
+    team.for_each_chunk_mut(&mut terms, BODY_BLOCK, |i, block| {
+        let start = i * BODY_BLOCK;
+        for (k, t) in block.iter_mut().enumerate() {
+            let sim = &sims[start + k];
+            if start + k == 0 || sim.body_type != BodyType::Dynamic {
+                continue;
+            }
+            let mut accel = sim.inv_mass * sim.force;
+            if has_gravity {
+                accel += sim.gravity_scale * gravity;
+            }
+            *t = VelocityTerms {
+                dynamic: true,
+                dv: h * accel,
+                dw: h * sim.inv_inertia * sim.torque,
+                linear_damping: 1.0 / (1.0 + h * sim.linear_damping),
+                angular_damping: 1.0 / (1.0 + h * sim.angular_damping),
+                max_v: sim.max_linear_speed,
+                max_w: sim.max_rotation * ctx.inv_h,
+            };
         }
-        let mut accel = sim.inv_mass * sim.force;
-        if has_gravity {
-            accel += sim.gravity_scale * gravity;
-        }
-        terms.push(VelocityTerms {
-            state: i as u32,
-            dv: h * accel,
-            dw: h * sim.inv_inertia * sim.torque,
-            linear_damping: 1.0 / (1.0 + h * sim.linear_damping),
-            angular_damping: 1.0 / (1.0 + h * sim.angular_damping),
-            max_v: sim.max_linear_speed,
-            max_w: sim.max_rotation * ctx.inv_h,
-        });
-    }
+    });
     terms
 }
 
-/// [`integrate_velocities`] from precomputed terms (one per state, in
-/// state order: block `i` of the states meets the terms of its own bodies).
+/// [`integrate_velocities`] from precomputed terms (one per state: block
+/// `i` of the states meets block `i` of the terms).
 fn integrate_velocity_terms(terms: &[VelocityTerms], states: &mut [BodyState], team: &Team) {
     team.for_each_chunk_mut(states, BODY_BLOCK, |i, block| {
         let start = i * BODY_BLOCK;
-        let end = start + block.len();
-        // Terms are sorted by state index: the ones of this block.
-        let from = terms.partition_point(|t| (t.state as usize) < start);
-        let to = terms.partition_point(|t| (t.state as usize) < end);
-        integrate_terms(&terms[from..to], block, start);
+        integrate_terms(&terms[start..start + block.len()], block);
     });
 }
 
-fn integrate_terms(terms: &[VelocityTerms], states: &mut [BodyState], offset: usize) {
-    for t in terms {
-        let state = &mut states[t.state as usize - offset];
+fn integrate_terms(terms: &[VelocityTerms], states: &mut [BodyState]) {
+    for (t, state) in terms.iter().zip(states.iter_mut()) {
+        if !t.dynamic {
+            continue;
+        }
         let mut v = t.linear_damping * (state.v + t.dv);
         let mut w = t.angular_damping * (state.w + t.dw);
         let v2 = v.length_squared();
@@ -517,26 +527,43 @@ fn integrate_positions_on(ctx: &StepContext, states: &mut [BodyState], team: &Te
     });
 }
 
-fn finalize_bodies(bodies: &mut BodySet, report: &mut SolveReport) {
-    let BodySet { sims, states, .. } = bodies;
-    for (sim, state) in sims.iter_mut().zip(states.iter_mut()).skip(1) {
-        let ok = vec_is_finite(state.v)
+/// The step's end for every body: the pose from the deltas, forces
+/// cleared. In blocks on the team; a body whose state is not finite is
+/// left for the serial pass after, which zeroes its motion and reports it
+/// (in body order).
+fn finalize_bodies(bodies: &mut BodySet, report: &mut SolveReport, team: &Team) {
+    let finite = |state: &BodyState| {
+        vec_is_finite(state.v)
             && state.w.is_finite()
             && vec_is_finite(state.dp)
-            && state.dq.is_finite();
-        if !ok {
-            report.non_finite.push(sim.handle);
-            state.v = Vec2::ZERO;
-            state.w = 0.0;
-            state.dp = Vec2::ZERO;
-            state.dq = crate::math::Rot::IDENTITY;
-            continue;
+            && state.dq.is_finite()
+    };
+    let any_bad = std::sync::atomic::AtomicBool::new(false);
+    let BodySet { sims, states, .. } = bodies;
+    team.for_each_chunk_pair_mut(sims, states, BODY_BLOCK, |i, sims, states| {
+        let skip = usize::from(i == 0);
+        for (sim, state) in sims.iter_mut().zip(states.iter()).skip(skip) {
+            if !finite(state) {
+                any_bad.store(true, std::sync::atomic::Ordering::Relaxed);
+                continue;
+            }
+            sim.center = sim.center0 + state.dp;
+            sim.transform.q = state.dq.mul(sim.rotation0).normalize();
+            sim.transform.p = sim.center - sim.transform.q.rotate(sim.local_center);
+            sim.force = Vec2::ZERO;
+            sim.torque = 0.0;
         }
-        sim.center = sim.center0 + state.dp;
-        sim.transform.q = state.dq.mul(sim.rotation0).normalize();
-        sim.transform.p = sim.center - sim.transform.q.rotate(sim.local_center);
-        sim.force = Vec2::ZERO;
-        sim.torque = 0.0;
+    });
+    if any_bad.into_inner() {
+        for (sim, state) in sims.iter_mut().zip(states.iter_mut()).skip(1) {
+            if !finite(state) {
+                report.non_finite.push(sim.handle);
+                state.v = Vec2::ZERO;
+                state.w = 0.0;
+                state.dp = Vec2::ZERO;
+                state.dq = crate::math::Rot::IDENTITY;
+            }
+        }
     }
     states[0] = BodyState::IDENTITY;
 }
@@ -570,8 +597,8 @@ fn solve_step_on(
 ) -> SolveReport {
     let mut report = SolveReport::default();
     let mut t = Instant::now();
-    prepare_bodies(bodies);
-    let terms = velocity_terms(ctx, bodies);
+    prepare_bodies(bodies, team);
+    let terms = velocity_terms(ctx, bodies, team);
     for b in batches.iter_mut() {
         b.prepare_on(ctx, bodies, team);
     }
@@ -628,7 +655,7 @@ fn solve_step_on(
     for &i in &active {
         batches[i].store_impulses();
     }
-    finalize_bodies(bodies, &mut report);
+    finalize_bodies(bodies, &mut report, team);
     report.profile.finalize += lap(&mut t);
     report
 }
