@@ -229,6 +229,10 @@ struct SolvedContact {
     cluster: [u32; 2],
     /// Its colour ([`OVERFLOW`]: solved scalar).
     colour: u8,
+    /// Its manifold's point count (two solver rows each).
+    point_count: u8,
+    /// Its restitution is positive.
+    bouncy: bool,
 }
 
 /// What the narrowphase reads besides the contacts it updates.
@@ -732,6 +736,8 @@ pub(crate) fn build_constraints(
             inv_mass: inv_masses,
             cluster: [NO_CLUSTER; 2],
             colour: OVERFLOW,
+            point_count: lane.point_count as u8,
+            bouncy: lane.restitution > 0.0,
         });
     }
     // Light clusters (`contact_group`): their contacts go to the overflow,
@@ -784,9 +790,8 @@ pub(crate) fn build_constraints(
     let colours = &mut narrowphase.colours;
     colours.clear();
     for s in solved.iter() {
-        let lane = &staged[s.index as usize].lane;
-        rows += 2 * lane.point_count;
-        bouncy += usize::from(lane.restitution > 0.0);
+        rows += 2 * usize::from(s.point_count);
+        bouncy += usize::from(s.bouncy);
         colours.push(s.colour);
     }
     let (solved, staged) = (&*solved, &*staged);
