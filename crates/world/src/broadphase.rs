@@ -5,7 +5,9 @@
 //! The broadphase is built on [`DynamicTree`] (see
 //! [`dynamic_tree`](crate::dynamic_tree)), an incremental bounding-volume
 //! hierarchy whose leaves are **fat** boxes: the shape's tight box grown by a
-//! margin (default [`DEFAULT_AABB_MARGIN`] = 0.1 m). As long as the tight box
+//! margin (at most [`DEFAULT_AABB_MARGIN`] = 0.1 m; the world gives a small
+//! shape a smaller one, sized by its extent: see
+//! [`proxy_margin`](crate::collision::proxy_margin)). As long as the tight box
 //! stays inside the fat one, moving the shape costs one containment test and
 //! the tree is not touched. Only when the tight box leaves the fat box is the
 //! leaf removed and re-inserted, and only then can new pairs appear, so only
@@ -78,6 +80,8 @@ struct ProxySlot {
     moved: bool,
     /// False once destroyed (the slot is on the free list).
     alive: bool,
+    /// The proxy's own fat-box margin, metres (at most its tree's).
+    margin: Real,
 }
 
 /// The broadphase: proxies in two [`DynamicTree`]s (static and movable) and
@@ -113,6 +117,9 @@ pub struct BroadPhase {
     /// static), whether its subtree holds a moved proxy.
     #[cfg_attr(feature = "serde", serde(skip))]
     moved_marks: [Vec<bool>; 2],
+    /// Every movable proxy takes the tree's whole margin, whatever margin
+    /// its creator asked for (see [`BroadPhase::use_uniform_margin`]).
+    uniform_margin: bool,
 }
 
 impl Default for BroadPhase {
@@ -138,6 +145,7 @@ impl BroadPhase {
             free_proxies: Vec::new(),
             move_buffer: Vec::new(),
             moved_marks: [Vec::new(), Vec::new()],
+            uniform_margin: false,
             pair_stack: Vec::new(),
             rebuild_items: Vec::new(),
         }
@@ -171,6 +179,27 @@ impl BroadPhase {
     /// returns its id. The new proxy counts as moved: its pairs are reported
     /// by the next [`update_pairs`](Self::update_pairs).
     pub fn create_proxy(&mut self, aabb: Aabb, payload: u32, is_static: bool) -> u32 {
+        self.create_proxy_with_margin(aabb, payload, is_static, Real::INFINITY)
+    }
+
+    /// [`create_proxy`](Self::create_proxy) whose fat boxes grow the tight
+    /// box by `margin` metres, or by the tree's margin if that is smaller
+    /// (static proxies: 0). Small shapes take small margins, so that the
+    /// fat boxes of a dense pile of them do not overlap far beyond their
+    /// neighbours (see [`proxy_margin`](crate::collision::proxy_margin)).
+    pub fn create_proxy_with_margin(
+        &mut self,
+        aabb: Aabb,
+        payload: u32,
+        is_static: bool,
+        margin: Real,
+    ) -> u32 {
+        let full = self.tree(is_static).margin();
+        let margin = if self.uniform_margin {
+            full
+        } else {
+            margin.min(full).max(0.0)
+        };
         let id = match self.free_proxies.pop() {
             Some(id) => id,
             None => {
@@ -182,6 +211,7 @@ impl BroadPhase {
                     is_static: false,
                     moved: false,
                     alive: false,
+                    margin: 0.0,
                 });
                 id
             }
@@ -191,7 +221,7 @@ impl BroadPhase {
         } else {
             &mut self.dynamic_tree
         };
-        let leaf = tree.create_proxy(aabb, id);
+        let leaf = tree.create_proxy_with_margin(aabb, id, margin);
         self.proxies[id as usize] = ProxySlot {
             fat: tree.fat_aabb(leaf),
             leaf,
@@ -199,6 +229,7 @@ impl BroadPhase {
             is_static,
             moved: true,
             alive: true,
+            margin,
         };
         self.move_buffer.push(id);
         id
@@ -227,7 +258,7 @@ impl BroadPhase {
             return false;
         }
         let tree = self.tree_mut(slot.is_static);
-        let reinserted = tree.move_proxy(slot.leaf, aabb);
+        let reinserted = tree.move_proxy_with_margin(slot.leaf, aabb, slot.margin);
         if reinserted {
             let fat = tree.fat_aabb(slot.leaf);
             self.proxies[proxy as usize].fat = fat;
@@ -248,7 +279,9 @@ impl BroadPhase {
         if slot.is_static {
             return self.move_proxy(proxy, aabb);
         }
-        let moved = self.dynamic_tree.enlarge_proxy(slot.leaf, aabb);
+        let moved = self
+            .dynamic_tree
+            .enlarge_proxy_with_margin(slot.leaf, aabb, slot.margin);
         if moved {
             self.proxies[proxy as usize].fat = self.dynamic_tree.fat_aabb(slot.leaf);
             self.mark_moved(proxy);
@@ -286,6 +319,45 @@ impl BroadPhase {
     /// The fat box of a proxy.
     pub fn fat_aabb(&self, proxy: u32) -> Aabb {
         self.slot(proxy).fat
+    }
+
+    /// The fat-box margin of a proxy, metres.
+    pub fn proxy_margin(&self, proxy: u32) -> Real {
+        self.slot(proxy).margin
+    }
+
+    /// True once [`BroadPhase::use_uniform_margin`] was called.
+    #[must_use]
+    pub fn uniform_margin(&self) -> bool {
+        self.uniform_margin
+    }
+
+    /// From now on every movable proxy has the tree's whole margin: those
+    /// with a smaller one are re-inserted at once with their tight box
+    /// `tight_of(payload)` fattened by it (in proxy order, each marked as
+    /// moved), and later proxies are created with it.
+    pub fn use_uniform_margin(&mut self, tight_of: impl Fn(u32) -> Aabb) {
+        if self.uniform_margin {
+            return;
+        }
+        self.uniform_margin = true;
+        let full = self.dynamic_tree.margin();
+        for proxy in 0..self.proxies.len() as u32 {
+            let slot = self.proxies[proxy as usize];
+            if !slot.alive || slot.is_static || slot.margin >= full {
+                continue;
+            }
+            let tight = tight_of(slot.payload);
+            self.dynamic_tree.destroy_proxy(slot.leaf);
+            let leaf = self
+                .dynamic_tree
+                .create_proxy_with_margin(tight, proxy, full);
+            let s = &mut self.proxies[proxy as usize];
+            s.leaf = leaf;
+            s.margin = full;
+            s.fat = self.dynamic_tree.fat_aabb(leaf);
+            self.mark_moved(proxy);
+        }
     }
 
     /// The payload of a proxy.

@@ -289,11 +289,17 @@ impl DynamicTree {
     /// Inserts a proxy for the tight box `aabb` (stored fattened by the
     /// margin) carrying `user_data`, and returns its id.
     pub fn create_proxy(&mut self, aabb: Aabb, user_data: u32) -> u32 {
+        self.create_proxy_with_margin(aabb, user_data, self.margin)
+    }
+
+    /// [`create_proxy`](Self::create_proxy) with a margin of the proxy's
+    /// own (metres, `≥ 0`) instead of the tree's.
+    pub fn create_proxy_with_margin(&mut self, aabb: Aabb, user_data: u32, margin: Real) -> u32 {
         debug_assert!(aabb.is_valid(), "invalid AABB {aabb:?}");
         let id = self.allocate_node();
         {
             let node = &mut self.nodes[id as usize];
-            node.aabb = aabb.fattened(self.margin);
+            node.aabb = aabb.fattened(margin);
             node.user_data = user_data;
             node.height = 0;
         }
@@ -315,13 +321,19 @@ impl DynamicTree {
     /// was re-inserted (the tight box left the fat box; the new fat box is the
     /// tight box grown by the margin), `false` when nothing changed.
     pub fn move_proxy(&mut self, id: u32, aabb: Aabb) -> bool {
+        self.move_proxy_with_margin(id, aabb, self.margin)
+    }
+
+    /// [`move_proxy`](Self::move_proxy) with the proxy's own margin (as
+    /// given to [`create_proxy_with_margin`](Self::create_proxy_with_margin)).
+    pub fn move_proxy_with_margin(&mut self, id: u32, aabb: Aabb, margin: Real) -> bool {
         self.check_proxy(id);
         debug_assert!(aabb.is_valid(), "invalid AABB {aabb:?}");
         if self.nodes[id as usize].aabb.contains(&aabb) {
             return false;
         }
         self.remove_leaf(id);
-        self.nodes[id as usize].aabb = aabb.fattened(self.margin);
+        self.nodes[id as usize].aabb = aabb.fattened(margin);
         self.insert_leaf(id);
         true
     }
@@ -335,12 +347,18 @@ impl DynamicTree {
     /// this way: many moves then cost one partial rebuild instead of a
     /// removal, an insertion and the rotations of each.
     pub fn enlarge_proxy(&mut self, id: u32, aabb: Aabb) -> bool {
+        self.enlarge_proxy_with_margin(id, aabb, self.margin)
+    }
+
+    /// [`enlarge_proxy`](Self::enlarge_proxy) with the proxy's own margin
+    /// (as given to [`create_proxy_with_margin`](Self::create_proxy_with_margin)).
+    pub fn enlarge_proxy_with_margin(&mut self, id: u32, aabb: Aabb, margin: Real) -> bool {
         self.check_proxy(id);
         debug_assert!(aabb.is_valid(), "invalid AABB {aabb:?}");
         if self.nodes[id as usize].aabb.contains(&aabb) {
             return false;
         }
-        let fat = aabb.fattened(self.margin);
+        let fat = aabb.fattened(margin);
         self.nodes[id as usize].aabb = fat;
         let mut index = self.nodes[id as usize].parent;
         // Grow the ancestors until one already covers the new box…

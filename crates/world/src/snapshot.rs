@@ -173,7 +173,7 @@ pub mod bytes {
     /// their recycling cache; 3: the contact set keeps each contact's
     /// island link; 4: body states carry flags instead of inverse masses,
     /// joints and portal constraints keep the masses they loaded).
-    pub const SNAPSHOT_VERSION: u16 = 4;
+    pub const SNAPSHOT_VERSION: u16 = 5;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.

@@ -858,6 +858,33 @@ impl Shape {
         Ok(())
     }
 
+    /// How far the shape reaches from its [`centroid`](Shape::centroid),
+    /// metres: the radius of the smallest disc about the centroid that
+    /// holds it (a polygon's farthest core vertex plus its rounding; half a
+    /// capsule's or segment's length plus its radius).
+    ///
+    /// ```
+    /// use janus2d_core::geometry::{Polygon, Shape};
+    /// let square = Shape::Polygon(Polygon::make_box(0.3, 0.4));
+    /// assert!((square.extent() - 0.5).abs() < 1e-6);
+    /// ```
+    #[must_use]
+    pub fn extent(&self) -> Real {
+        match self {
+            Shape::Circle(c) => c.radius,
+            Shape::Capsule(c) => 0.5 * (c.center2 - c.center1).length() + c.radius,
+            Shape::Polygon(p) => {
+                let far = p.vertices[..p.count]
+                    .iter()
+                    .map(|v| (*v - p.centroid).length())
+                    .fold(0.0, Real::max);
+                far + p.radius
+            }
+            Shape::Segment(s) => 0.5 * (s.point2 - s.point1).length(),
+            Shape::ChainSegment(c) => 0.5 * (c.segment.point2 - c.segment.point1).length(),
+        }
+    }
+
     /// The geometric centre used for one-sided tests and as the centre of
     /// mass: circle centre, capsule/segment midpoint, polygon core centroid.
     pub fn centroid(&self) -> Vec2 {

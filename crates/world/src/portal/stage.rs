@@ -641,6 +641,9 @@ impl World {
             eta,
             mass_model: def.mass_model,
         };
+        // Portals keep every shape's fat box at the full margin (see
+        // `Collision::use_uniform_margins`).
+        self.collision.use_uniform_margins();
         let (index, generation) = self.portals.pairs.insert(data);
         Ok(PortalPairHandle::new(
             index,
