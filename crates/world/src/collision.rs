@@ -128,6 +128,7 @@ impl Collision {
     /// and checked with one 0.1 m margin for all; with size-based margins
     /// the portal stream completed 123 of its 200 crossings at 4 substeps
     /// instead of 194 and blew up at 1 and 16 substeps.
+    #[cfg(feature = "portals")]
     pub(crate) fn use_uniform_margins(&mut self) {
         let shapes = &self.shapes;
         self.broadphase
@@ -555,7 +556,7 @@ fn should_pair(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{PortalDef, PortalPairDef, World, WorldDef};
+    use crate::{World, WorldDef};
     use janus2d_core::body::BodyDef;
     use janus2d_core::geometry::Polygon;
 
@@ -599,8 +600,10 @@ mod tests {
         assert!((fat.upper.x - (tight.upper.x + AABB_MARGIN)).abs() < 1e-5);
     }
 
+    #[cfg(feature = "portals")]
     #[test]
     fn portal_pair_gives_every_shape_the_full_margin() {
+        use crate::{PortalDef, PortalPairDef};
         let mut world = World::new(WorldDef::default()).unwrap();
         let small = body_with_box(&mut world, 0.0, 0.1);
         assert!(fat_of(&world, small).2 < AABB_MARGIN);
