@@ -1250,6 +1250,28 @@ impl BodySet {
         }
     }
 
+    /// [`BodySet::solver_body`] with a guess of the body's state index
+    /// (`hint`, as read in an earlier step): when the moving body at `hint`
+    /// is this body, its record is not looked up (a random read per body
+    /// saved where the narrowphase visits every contact); otherwise, or
+    /// for `hint == 0`, the record says where the body is. The same answer
+    /// either way.
+    #[inline]
+    pub fn solver_body_hinted(&self, handle: BodyHandle, hint: u32) -> SolverBody<'_> {
+        if hint != 0
+            && let Some(sim) = self.sims.get(hint as usize)
+            && sim.handle == handle
+        {
+            return SolverBody {
+                state_index: hint,
+                sim,
+                state: &self.states[hint as usize],
+                sleeping: false,
+            };
+        }
+        self.solver_body(handle)
+    }
+
     /// Handles of all live bodies in slot order (deterministic).
     pub fn handles(&self) -> impl Iterator<Item = BodyHandle> + '_ {
         self.records

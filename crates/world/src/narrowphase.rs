@@ -384,8 +384,10 @@ impl Narrowphase {
 /// new manifold (impulses carried over by feature id), the aperture
 /// clipping and the touching flag.
 fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpdate {
-    let body_a = input.bodies.solver_body(c.body_a);
-    let body_b = input.bodies.solver_body(c.body_b);
+    // The state indices read last step are the likely ones still.
+    let [(hint_a, _), (hint_b, _)] = c.solve_bodies;
+    let body_a = input.bodies.solver_body_hinted(c.body_a, hint_a);
+    let body_b = input.bodies.solver_body_hinted(c.body_b, hint_b);
     if body_a.state_index == 0 && body_b.state_index == 0 {
         // Both asleep (or asleep and static): nothing moves.
         c.still = [true, true];
