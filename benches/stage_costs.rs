@@ -7,6 +7,9 @@
 //!   step that despawns and respawns a column of ragdolls beside the mean
 //!   ordinary step (steps after the first 160). `DIRECT=0` turns the
 //!   joint-tree solve off.
+//! - Box2D's `large_pyramid` settled: the mean step once every body sleeps
+//!   (sleep on) beside the mean step of the same settled pyramid with sleep
+//!   off (the target: asleep costs at most 5% of awake).
 //!
 //! Timing lives here, never in tests; compare ratios within one run.
 use janus2d::base::geometry::Circle;
@@ -99,5 +102,36 @@ fn main() {
         despawn / nd.max(1) as f64 * 1e3,
         ordinary / no.max(1) as f64 * 1e3,
         (despawn / nd.max(1) as f64) / (ordinary / no.max(1) as f64)
+    );
+    settled_pyramid();
+}
+
+/// Mean ms/step of `large_pyramid` after `settle` steps, over `timed`
+/// steps, with sleep on or off; and the awake body count at the end.
+fn pyramid_after(sleep: bool, settle: usize, timed: usize) -> (f64, usize) {
+    use janus2d_testbed::engine::Engine;
+    use janus2d_testbed::janus::Janus;
+    let desc = janus2d_testbed::benchmarks::by_name("large_pyramid").expect("a built-in scene");
+    let mut wd = janus2d_testbed::janus::world_def(&desc.settings);
+    wd.sleep.enabled = sleep;
+    let mut e = Janus::with_def(&desc, wd).unwrap();
+    for _ in 0..settle {
+        e.step();
+    }
+    let t = Instant::now();
+    for _ in 0..timed {
+        e.step();
+    }
+    let ms = t.elapsed().as_secs_f64() * 1e3 / timed as f64;
+    (ms, e.awake_count())
+}
+
+fn settled_pyramid() {
+    let (settle, timed) = (600, 200);
+    let (awake_ms, awake_n) = pyramid_after(false, settle, timed);
+    let (asleep_ms, asleep_n) = pyramid_after(true, settle, timed);
+    println!(
+        "large_pyramid after {settle} steps: sleep off {awake_ms:.3} ms/step ({awake_n} awake), sleep on {asleep_ms:.4} ms/step ({asleep_n} awake): {:.1}% of awake",
+        100.0 * asleep_ms / awake_ms
     );
 }
