@@ -64,7 +64,7 @@ pub struct RunArgs {
     /// Substeps per step (the scene's own by default).
     #[arg(long)]
     pub substeps: Option<u32>,
-    /// Worker threads of the parallel narrowphase (above 1 needs the
+    /// Worker threads of the step (above 1 needs the
     /// `parallel` feature).
     #[arg(long, default_value_t = 1)]
     pub threads: usize,

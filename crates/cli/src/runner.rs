@@ -208,7 +208,7 @@ pub struct RunOptions {
     pub steps: Option<usize>,
     /// Substeps (the scene's own by default).
     pub substeps: Option<u32>,
-    /// Worker threads of the parallel narrowphase (a pool of exactly this many).
+    /// Worker threads of the step: collision and solver (a pool of exactly this many).
     pub threads: usize,
     /// Pictures.
     pub frames: Frames,
@@ -487,7 +487,7 @@ pub fn run<W: Write + Send>(
     }
     if options.threads > 1 && cfg!(not(feature = "parallel")) {
         return Err(CliError::Invalid(format!(
-            "--threads {} needs the parallel narrowphase: build with `--features parallel` (cargo run --release -p janus2d-cli --features parallel -- …)",
+            "--threads {} needs the parallel feature: build with `--features parallel` (cargo run --release -p janus2d-cli --features parallel -- …)",
             options.threads
         )));
     }
