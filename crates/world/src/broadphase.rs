@@ -70,6 +70,12 @@ struct ProxySlot {
     /// The fat box of the leaf, kept here too so that the narrowphase's
     /// overlap test per contact reads one slot instead of slot and node.
     fat: Aabb,
+    /// The fat box without the velocity sweep (the tight box grown by the
+    /// margin when last moved): two movable proxies pair, and keep their
+    /// pair, only while these overlap, and a proxy counts as moved when its
+    /// tight box leaves it. Equal to `fat` for a static proxy, for one that
+    /// was not swept, and in a world with uniform margins.
+    core: Aabb,
     /// Leaf id in the tree selected by `is_static`.
     leaf: u32,
     /// User payload (a shape key).
@@ -206,6 +212,7 @@ impl BroadPhase {
                 let id = u32::try_from(self.proxies.len()).expect("too many proxies");
                 self.proxies.push(ProxySlot {
                     fat: aabb,
+                    core: aabb,
                     leaf: NULL_NODE,
                     payload: 0,
                     is_static: false,
@@ -224,6 +231,7 @@ impl BroadPhase {
         let leaf = tree.create_proxy_with_margin(aabb, id, margin);
         self.proxies[id as usize] = ProxySlot {
             fat: tree.fat_aabb(leaf),
+            core: tree.fat_aabb(leaf),
             leaf,
             payload,
             is_static,
@@ -262,6 +270,7 @@ impl BroadPhase {
         if reinserted {
             let fat = tree.fat_aabb(slot.leaf);
             self.proxies[proxy as usize].fat = fat;
+            self.proxies[proxy as usize].core = fat;
             self.mark_moved(proxy);
         }
         reinserted
@@ -283,7 +292,58 @@ impl BroadPhase {
             .dynamic_tree
             .enlarge_proxy_with_margin(slot.leaf, aabb, slot.margin);
         if moved {
+            let fat = self.dynamic_tree.fat_aabb(slot.leaf);
+            self.proxies[proxy as usize].fat = fat;
+            self.proxies[proxy as usize].core = fat;
+            self.mark_moved(proxy);
+        }
+        moved
+    }
+
+    /// [`move_proxy_in_batch`](Self::move_proxy_in_batch) for a proxy whose
+    /// tree box covers its swept box `query` (the tight box `tight` and
+    /// where the velocity takes it) while its pairs with other movable
+    /// proxies follow `tight` alone. The tree box is enlarged when `query`
+    /// leaves it; the core box is `tight` grown by the margin, renewed (and
+    /// the proxy counted as moved) whenever `tight` leaves it. For a proxy
+    /// never swept the two boxes are one and this is
+    /// `move_proxy_in_batch(proxy, tight)`; for a proxy with the tree's
+    /// whole margin (a large shape, or any shape in a world with uniform
+    /// margins) it is `move_proxy_in_batch(proxy, query)`: the split is for
+    /// small shapes, which then pair with other movable shapes as in Box2D
+    /// (sized margin, no sweep) and with static ones through their swept box.
+    pub fn move_proxy_in_batch_swept(&mut self, proxy: u32, tight: Aabb, query: Aabb) -> bool {
+        let slot = self.slot(proxy);
+        // Static proxies do not move; a proxy with the tree's whole margin
+        // (a large shape, or any in a world with uniform margins) keeps one
+        // box, swept, for all its pairs.
+        if slot.is_static || self.uniform_margin || slot.margin >= self.dynamic_tree.margin() {
+            return self.move_proxy_in_batch(proxy, query);
+        }
+        let mut moved = false;
+        if !slot.fat.contains(&query)
+            && self
+                .dynamic_tree
+                .enlarge_proxy_with_margin(slot.leaf, query, slot.margin)
+        {
             self.proxies[proxy as usize].fat = self.dynamic_tree.fat_aabb(slot.leaf);
+            moved = true;
+        }
+        if !moved && !slot.core.contains(&tight) {
+            // A new core must lie inside the tree box, or a pair it makes
+            // would not be found: the tree box grows to the swept box with
+            // its margin unless it holds that already.
+            if self.dynamic_tree.enlarge_proxy_with_margin(
+                slot.leaf,
+                query.fattened(slot.margin),
+                0.0,
+            ) {
+                self.proxies[proxy as usize].fat = self.dynamic_tree.fat_aabb(slot.leaf);
+            }
+            moved = true;
+        }
+        if moved {
+            self.proxies[proxy as usize].core = tight.fattened(slot.margin);
             self.mark_moved(proxy);
         }
         moved
@@ -373,7 +433,7 @@ impl BroadPhase {
     /// True when the fat boxes of two proxies overlap (touching counts). A
     /// caller keeps a contact while this holds.
     pub fn test_overlap(&self, proxy_a: u32, proxy_b: u32) -> bool {
-        self.fat_aabb(proxy_a).overlaps(&self.fat_aabb(proxy_b))
+        pair_overlaps(&self.slot(proxy_a), &self.slot(proxy_b))
     }
 
     /// Calls `callback(proxy, payload)` for every proxy (static or not) whose
@@ -507,7 +567,7 @@ impl BroadPhase {
             // moved member.
             let mut visit = |x: u32, y: u32| {
                 let (sx, sy) = (&proxies[x as usize], &proxies[y as usize]);
-                if sx.moved || sy.moved {
+                if (sx.moved || sy.moved) && pair_overlaps(sx, sy) {
                     report(sx.payload, sy.payload);
                 }
             };
@@ -529,7 +589,7 @@ impl BroadPhase {
                 let mut visit = |other: u32| {
                     let o = &proxies[other as usize];
                     // When both moved, only the smaller id reports the pair.
-                    if other != m && !(o.moved && other < m) {
+                    if other != m && !(o.moved && other < m) && pair_overlaps(&slot, o) {
                         report(slot.payload, o.payload);
                     }
                     true
@@ -584,7 +644,7 @@ impl BroadPhase {
                             &mut stack,
                             |x, y| {
                                 let (sx, sy) = (&proxies[x as usize], &proxies[y as usize]);
-                                if sx.moved || sy.moved {
+                                if (sx.moved || sy.moved) && pair_overlaps(sx, sy) {
                                     keep_pair(filter, &mut pairs, sx.payload, sy.payload);
                                 }
                             },
@@ -603,7 +663,7 @@ impl BroadPhase {
                         let fat = slot.fat;
                         let mut visit = |other: u32| {
                             let o = &proxies[other as usize];
-                            if other != m && !(o.moved && other < m) {
+                            if other != m && !(o.moved && other < m) && pair_overlaps(&slot, o) {
                                 keep_pair(filter, &mut pairs, slot.payload, o.payload);
                             }
                             true
@@ -631,6 +691,10 @@ impl BroadPhase {
             let s = self.proxies[i];
             if s.alive {
                 self.proxies[i].fat = self.tree(s.is_static).fat_aabb(s.leaf);
+                self.proxies[i].core = Aabb {
+                    lower: s.core.lower - new_origin,
+                    upper: s.core.upper - new_origin,
+                };
             }
         }
     }
@@ -712,6 +776,20 @@ impl BroadPhase {
             s.moved = true;
             self.move_buffer.push(proxy);
         }
+    }
+}
+
+/// Whether two proxies' boxes overlap as a pair needs: the core boxes
+/// (without the velocity sweep) of two movable proxies, the tree boxes
+/// otherwise (a swept box against static geometry, so that a fast shape
+/// meets a wall or a one-sided chain before it arrives). The tree's
+/// overlap is implied by either (every box holds its core).
+#[inline]
+fn pair_overlaps(a: &ProxySlot, b: &ProxySlot) -> bool {
+    if a.is_static || b.is_static {
+        a.fat.overlaps(&b.fat)
+    } else {
+        a.core.overlaps(&b.core)
     }
 }
 

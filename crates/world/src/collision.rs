@@ -371,18 +371,20 @@ impl Collision {
             for k in 0..n {
                 let s = self.shapes.of_body(sim.handle)[k];
                 let shape = self.shapes.at_mut(s);
-                let mut aabb = shape.geometry.compute_aabb(&sim.transform);
-                shape.aabb = aabb;
+                let tight = shape.geometry.compute_aabb(&sim.transform);
+                shape.aabb = tight;
+                let mut aabb = tight;
                 if is_fast(sweep, self.broadphase.proxy_margin(shape.proxy)) {
                     aabb = Aabb::new(
                         aabb.lower + sweep.min(Vec2::ZERO),
                         aabb.upper + sweep.max(Vec2::ZERO),
                     );
                 }
-                if self
-                    .broadphase
-                    .move_proxy_in_batch(shape.proxy, bounded(aabb))
-                {
+                if self.broadphase.move_proxy_in_batch_swept(
+                    shape.proxy,
+                    bounded(tight),
+                    bounded(aabb),
+                ) {
                     moved += 1;
                 }
             }
@@ -427,10 +429,11 @@ impl Collision {
         for (s, tight, query) in blocks.into_iter().flatten() {
             let shape = self.shapes.at_mut(s);
             shape.aabb = tight;
-            if self
-                .broadphase
-                .move_proxy_in_batch(shape.proxy, bounded(query))
-            {
+            if self.broadphase.move_proxy_in_batch_swept(
+                shape.proxy,
+                bounded(tight),
+                bounded(query),
+            ) {
                 moved += 1;
             }
         }
