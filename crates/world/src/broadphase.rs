@@ -1114,4 +1114,41 @@ mod tests {
         assert!(forward.len() > 300);
         assert_eq!(forward, run(true));
     }
+
+    #[test]
+    fn small_swept_proxy_pairs_with_movable_ones_by_its_core_only() {
+        let mut bp = BroadPhase::new();
+        let m = 0.04;
+        let a = bp.create_proxy_with_margin(boxed(0.0, 0.0, 0.1, 0.1), 1, false, m);
+        let b = bp.create_proxy_with_margin(boxed(1.0, 0.0, 0.1, 0.1), 2, false, m);
+        let wall = bp.create_proxy(boxed(1.5, 0.0, 0.1, 2.0), 3, true);
+        let mut out = Vec::new();
+        bp.update_pairs(|_, _| true, &mut out);
+        assert!(out.is_empty(), "{out:?}");
+        // a moves 0.05 m and is swept 1.5 m to the right: its tree box now
+        // covers b and the wall, its core only its own neighbourhood.
+        let tight = boxed(0.05, 0.0, 0.1, 0.1);
+        let swept = Aabb::new(tight.lower, tight.upper + Vec2::new(1.5, 0.0));
+        assert!(bp.move_proxy_in_batch_swept(a, tight, swept));
+        bp.finish_moves();
+        assert!(bp.fat_aabb(a).overlaps(&bp.fat_aabb(b)));
+        bp.update_pairs(|_, _| true, &mut out);
+        assert_eq!(
+            out,
+            vec![(1, 3)],
+            "the wall pairs through the sweep, b does not"
+        );
+        assert!(!bp.test_overlap(a, b));
+        assert!(bp.test_overlap(a, wall));
+        // Still inside both boxes: no move. Out of its core: a move, and a
+        // pair with b once the cores meet.
+        assert!(!bp.move_proxy_in_batch_swept(a, tight, tight));
+        let near_b = boxed(0.75, 0.0, 0.1, 0.1);
+        assert!(bp.move_proxy_in_batch_swept(a, near_b, near_b));
+        bp.finish_moves();
+        bp.update_pairs(|_, _| true, &mut out);
+        assert_eq!(out, vec![(1, 2), (1, 3)]);
+        assert!(bp.test_overlap(a, b));
+        bp.validate();
+    }
 }
