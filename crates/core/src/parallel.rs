@@ -312,30 +312,12 @@ impl Team<'_> {
         len: usize,
         f: impl Fn(usize, &mut [T]) + Sync,
     ) {
-        let len = len.max(1);
-        let n = items.len();
-        let blocks = n.div_ceil(len);
-        if self.shared.is_none() || blocks <= 1 {
-            for (i, chunk) in items.chunks_mut(len).enumerate() {
-                f(i, chunk);
-            }
-            return;
-        }
-        let base = Base(items.as_mut_ptr());
-        let base = &base;
-        self.run(blocks, &|i| {
-            let start = i * len;
-            let count = len.min(n - start);
-            // SAFETY: `start + count ≤ n`, block `i` is claimed once, and
-            // blocks do not overlap (module docs, point 2); `items` stays
-            // mutably borrowed until `run` returns.
-            let chunk = unsafe { std::slice::from_raw_parts_mut(base.0.add(start), count) };
-            f(i, chunk);
-        });
+        // A slice of `()` as long as `items` costs no memory: the two-slice
+        // form carries the one proof of disjoint blocks.
+        let mut none = vec![(); items.len()];
+        self.for_each_chunk_pair_mut(items, &mut none, len, |i, chunk, _| f(i, chunk));
     }
-}
 
-impl Team<'_> {
     /// [`Team::for_each_chunk_mut`] over two slices of the same length at
     /// once: `f(i, a_block, b_block)` gets the same item range of both
     /// (the body sims and their states, say).
@@ -365,10 +347,10 @@ impl Team<'_> {
         self.run(blocks, &|i| {
             let start = i * len;
             let count = len.min(n - start);
-            // SAFETY: as in `for_each_chunk_mut` (module docs, point 2),
-            // for each slice: `start + count ≤ n` for both (equal lengths),
-            // block `i` is claimed once, blocks do not overlap, and both
-            // slices stay mutably borrowed until `run` returns.
+            // SAFETY: for each slice, `start + count ≤ n` (equal lengths),
+            // block `i` is claimed once, and blocks do not overlap (module
+            // docs, point 2); both slices stay mutably borrowed until `run`
+            // returns.
             let (ca, cb) = unsafe {
                 (
                     std::slice::from_raw_parts_mut(base_a.0.add(start), count),

@@ -300,20 +300,32 @@ impl BroadPhase {
         moved
     }
 
-    /// [`move_proxy_in_batch`](Self::move_proxy_in_batch) for a proxy whose
-    /// tree box covers its swept box `query` (the tight box `tight` and
-    /// where the velocity takes it) while its pairs with other movable
-    /// proxies follow `tight` alone. The tree box is enlarged when `query`
-    /// leaves it; the core box is `tight` grown by the margin, renewed (and
-    /// the proxy counted as moved) whenever `tight` leaves it. For a proxy
-    /// never swept the two boxes are one and this is
-    /// `move_proxy_in_batch(proxy, tight)`; for a proxy with the tree's
-    /// whole margin (a large shape, or any shape in a world with uniform
-    /// margins) it is `move_proxy_in_batch(proxy, query)`: the split is for
-    /// small shapes, which then pair with other movable shapes as in Box2D
-    /// (sized margin, no sweep) and with static ones through their swept box.
-    pub fn move_proxy_in_batch_swept(&mut self, proxy: u32, tight: Aabb, query: Aabb) -> bool {
+    /// [`move_proxy_in_batch`](Self::move_proxy_in_batch) for a shape with
+    /// tight box `tight` that moves by `sweep` in a step. When that is more
+    /// than half the proxy's margin, the tree box covers the swept box
+    /// `query` (the tight box and where the velocity takes it), so that
+    /// pairs exist before the shape arrives; otherwise `query` is `tight`.
+    /// Pairs with other movable proxies follow `tight` alone: the tree box
+    /// is enlarged when `query` leaves it, and the core box is `tight`
+    /// grown by the margin, renewed (and the proxy counted as moved)
+    /// whenever `tight` leaves it. For a proxy never swept the two boxes
+    /// are one and this is `move_proxy_in_batch(proxy, tight)`; for a proxy
+    /// with the tree's whole margin (a large shape, or any shape in a world
+    /// with uniform margins) it is `move_proxy_in_batch(proxy, query)`: the
+    /// split is for small shapes, which then pair with other movable shapes
+    /// as in Box2D (sized margin, no sweep) and with static ones through
+    /// their swept box.
+    pub fn move_proxy_in_batch_swept(&mut self, proxy: u32, tight: Aabb, sweep: Vec2) -> bool {
         let slot = self.slot(proxy);
+        let half = 0.5 * slot.margin;
+        let query = if sweep.length_squared() > half * half {
+            crate::collision::bounded(Aabb::new(
+                tight.lower + sweep.min(Vec2::ZERO),
+                tight.upper + sweep.max(Vec2::ZERO),
+            ))
+        } else {
+            tight
+        };
         // Static proxies do not move; a proxy with the tree's whole margin
         // (a large shape, or any in a world with uniform margins) keeps one
         // box, swept, for all its pairs.
@@ -386,12 +398,6 @@ impl BroadPhase {
         self.slot(proxy).margin
     }
 
-    /// True once [`BroadPhase::use_uniform_margin`] was called.
-    #[must_use]
-    pub fn uniform_margin(&self) -> bool {
-        self.uniform_margin
-    }
-
     /// From now on every movable proxy has the tree's whole margin: those
     /// with a smaller one are re-inserted at once with their tight box
     /// `tight_of(payload)` fattened by it (in proxy order, each marked as
@@ -416,6 +422,7 @@ impl BroadPhase {
             s.leaf = leaf;
             s.margin = full;
             s.fat = self.dynamic_tree.fat_aabb(leaf);
+            s.core = s.fat;
             self.mark_moved(proxy);
         }
     }
@@ -1128,8 +1135,7 @@ mod tests {
         // a moves 0.05 m and is swept 1.5 m to the right: its tree box now
         // covers b and the wall, its core only its own neighbourhood.
         let tight = boxed(0.05, 0.0, 0.1, 0.1);
-        let swept = Aabb::new(tight.lower, tight.upper + Vec2::new(1.5, 0.0));
-        assert!(bp.move_proxy_in_batch_swept(a, tight, swept));
+        assert!(bp.move_proxy_in_batch_swept(a, tight, Vec2::new(1.5, 0.0)));
         bp.finish_moves();
         assert!(bp.fat_aabb(a).overlaps(&bp.fat_aabb(b)));
         bp.update_pairs(|_, _| true, &mut out);
@@ -1142,9 +1148,9 @@ mod tests {
         assert!(bp.test_overlap(a, wall));
         // Still inside both boxes: no move. Out of its core: a move, and a
         // pair with b once the cores meet.
-        assert!(!bp.move_proxy_in_batch_swept(a, tight, tight));
+        assert!(!bp.move_proxy_in_batch_swept(a, tight, Vec2::ZERO));
         let near_b = boxed(0.75, 0.0, 0.1, 0.1);
-        assert!(bp.move_proxy_in_batch_swept(a, near_b, near_b));
+        assert!(bp.move_proxy_in_batch_swept(a, near_b, Vec2::ZERO));
         bp.finish_moves();
         bp.update_pairs(|_, _| true, &mut out);
         assert_eq!(out, vec![(1, 2), (1, 3)]);

@@ -363,9 +363,10 @@ impl Collision {
         }
         let mut moved = 0;
         for (sim, state) in bodies.sims.iter().zip(&bodies.states).skip(1) {
-            // Only a shape that travels more than half its fat margin in a
-            // step gets a swept box: slower ones stay inside their fat box
-            // as in Box2D, so they are not re-inserted more often.
+            // A shape that travels more than half its fat margin in a step
+            // gets a swept box (`BroadPhase::move_proxy_in_batch_swept`):
+            // slower ones stay inside their fat box as in Box2D, so they are
+            // not re-inserted more often.
             let sweep = dt * state.v;
             let n = self.shapes.of_body(sim.handle).len();
             for k in 0..n {
@@ -373,18 +374,10 @@ impl Collision {
                 let shape = self.shapes.at_mut(s);
                 let tight = shape.geometry.compute_aabb(&sim.transform);
                 shape.aabb = tight;
-                let mut aabb = tight;
-                if is_fast(sweep, self.broadphase.proxy_margin(shape.proxy)) {
-                    aabb = Aabb::new(
-                        aabb.lower + sweep.min(Vec2::ZERO),
-                        aabb.upper + sweep.max(Vec2::ZERO),
-                    );
-                }
-                if self.broadphase.move_proxy_in_batch_swept(
-                    shape.proxy,
-                    bounded(tight),
-                    bounded(aabb),
-                ) {
+                if self
+                    .broadphase
+                    .move_proxy_in_batch_swept(shape.proxy, bounded(tight), sweep)
+                {
                     moved += 1;
                 }
             }
@@ -400,8 +393,7 @@ impl Collision {
     fn update_proxies_parallel(&mut self, bodies: &BodySet, dt: Real) {
         use rayon::prelude::*;
         let shapes = &self.shapes;
-        let broadphase = &self.broadphase;
-        let blocks: Vec<Vec<(u32, Aabb, Aabb)>> = bodies.sims[1..]
+        let blocks: Vec<Vec<(u32, Aabb, Vec2)>> = bodies.sims[1..]
             .par_chunks(256)
             .zip(bodies.states[1..].par_chunks(256))
             .map(|(sims, states)| {
@@ -409,31 +401,21 @@ impl Collision {
                 for (sim, state) in sims.iter().zip(states) {
                     let sweep = dt * state.v;
                     for &s in shapes.of_body(sim.handle) {
-                        let shape = shapes.at(s);
-                        let tight = shape.geometry.compute_aabb(&sim.transform);
-                        let query = if is_fast(sweep, broadphase.proxy_margin(shape.proxy)) {
-                            Aabb::new(
-                                tight.lower + sweep.min(Vec2::ZERO),
-                                tight.upper + sweep.max(Vec2::ZERO),
-                            )
-                        } else {
-                            tight
-                        };
-                        out.push((s, tight, query));
+                        let tight = shapes.at(s).geometry.compute_aabb(&sim.transform);
+                        out.push((s, tight, sweep));
                     }
                 }
                 out
             })
             .collect();
         let mut moved = 0;
-        for (s, tight, query) in blocks.into_iter().flatten() {
+        for (s, tight, sweep) in blocks.into_iter().flatten() {
             let shape = self.shapes.at_mut(s);
             shape.aabb = tight;
-            if self.broadphase.move_proxy_in_batch_swept(
-                shape.proxy,
-                bounded(tight),
-                bounded(query),
-            ) {
+            if self
+                .broadphase
+                .move_proxy_in_batch_swept(shape.proxy, bounded(tight), sweep)
+            {
                 moved += 1;
             }
         }
@@ -493,13 +475,6 @@ pub const AABB_MARGIN_FRACTION: Real = 0.125;
 #[must_use]
 pub fn proxy_margin(geometry: &Shape, max: Real) -> Real {
     (SPECULATIVE_DISTANCE + AABB_MARGIN_FRACTION * geometry.extent()).min(max)
-}
-
-/// True when a shape moving by `sweep` in a step travels more than half its
-/// fat margin: its proxy box then covers where the velocity takes it.
-#[inline]
-fn is_fast(sweep: Vec2, margin: Real) -> bool {
-    sweep.length_squared() > (0.5 * margin) * (0.5 * margin)
 }
 
 /// Largest coordinate of a box handed to the broadphase, m: four times
