@@ -584,7 +584,21 @@ mod tests {
         use crate::{PortalDef, PortalPairDef};
         let mut world = World::new(WorldDef::default()).unwrap();
         let small = body_with_box(&mut world, 0.0, 0.1);
+        // A neighbour 0.15 m away: beyond two sized margins (2 × 0.038 m),
+        // within two full ones (2 × 0.1 m).
+        let neighbour = body_with_box(&mut world, 0.35, 0.1);
+        let proxy_of = |world: &World, body| {
+            let c = &world.collision;
+            c.shapes.at(c.shapes.of_body(body)[0]).proxy
+        };
+        let overlap = |world: &World| {
+            world
+                .collision
+                .broadphase
+                .test_overlap(proxy_of(world, small), proxy_of(world, neighbour))
+        };
         assert!(fat_of(&world, small).2 < AABB_MARGIN);
+        assert!(!overlap(&world));
         let floor = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
         let wall = world
             .create_body(&BodyDef::fixed(Vec2::new(10.0, 0.0)))
@@ -605,6 +619,8 @@ mod tests {
             assert_eq!(margin, AABB_MARGIN);
             assert!((fat.lower.y - (tight.lower.y - AABB_MARGIN)).abs() < 1e-5);
         }
+        // The pair test reads the full margins at once, before any move.
+        assert!(overlap(&world));
         assert!(world.validate().is_ok());
     }
 }
