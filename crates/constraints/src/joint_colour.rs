@@ -71,6 +71,7 @@ use janus2d_core::graph::{COLOURS, ColourGraph};
 use janus2d_core::parallel::{StatePlan, Team};
 use smallvec::SmallVec;
 
+use crate::joint_tree::is_moving;
 use crate::parts::{PairOf, WRITE_A, WRITE_B};
 use crate::revolute::RevoluteJoint;
 
@@ -422,7 +423,6 @@ fn key(j: &RevoluteJoint, states: &[BodyState]) -> [u32; 3] {
     if !j.enabled || (a == 0 && b == 0) {
         return [0, 0, 0];
     }
-    let moving = |s: u32| s != 0 && states.get(s as usize).is_some_and(BodyState::moves);
     let coloured = if j.in_tree && !j.has_angle_rows() {
         0
     } else {
@@ -430,8 +430,16 @@ fn key(j: &RevoluteJoint, states: &[BodyState]) -> [u32; 3] {
     };
     let flags = ACTIVE
         | coloured
-        | if moving(a) { u32::from(WRITE_A) } else { 0 }
-        | if moving(b) { u32::from(WRITE_B) } else { 0 };
+        | if is_moving(states, a) {
+            u32::from(WRITE_A)
+        } else {
+            0
+        }
+        | if is_moving(states, b) {
+            u32::from(WRITE_B)
+        } else {
+            0
+        };
     [a, b, flags]
 }
 

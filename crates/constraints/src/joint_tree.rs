@@ -491,11 +491,12 @@ pub struct JointForest {
     parent_joint: Vec<u32>,
 }
 
-/// A body that the tree moves: dynamic (some inverse mass or inertia,
-/// [`BodyState::MOVES`]).
+/// A body that the solve moves: a state of its own (not the static
+/// identity 0) whose body is dynamic ([`BodyState::MOVES`]); false for an
+/// index past the states.
 #[inline]
-fn is_moving(states: &[BodyState], s: u32) -> bool {
-    s != 0 && states[s as usize].moves()
+pub(crate) fn is_moving(states: &[BodyState], s: u32) -> bool {
+    s != 0 && states.get(s as usize).is_some_and(BodyState::moves)
 }
 
 /// A joint's two state indices, 0 for an end the tree does not move
