@@ -172,8 +172,9 @@ pub mod bytes {
     /// The format version this build writes and reads (2: contacts keep
     /// their recycling cache; 3: the contact set keeps each contact's
     /// island link; 4: body states carry flags instead of inverse masses,
-    /// joints and portal constraints keep the masses they loaded).
-    pub const SNAPSHOT_VERSION: u16 = 5;
+    /// joints and portal constraints keep the masses they loaded; 6: the
+    /// contact set keeps each contact's position in its bodies' lists).
+    pub const SNAPSHOT_VERSION: u16 = 6;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.
