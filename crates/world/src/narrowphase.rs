@@ -650,9 +650,22 @@ pub(crate) fn build_constraints(
     if staged.len() < n {
         staged.resize(n, StagedContact::default());
     }
-    // Whether any moving pair is light beside the other (then the light
-    // clusters are looked for, below).
+    // Whether any moving pair is light beside the other with neither body
+    // excluded from the light clusters (then they are looked for, below).
+    // A light pair with a body a motor turns or a portal object's body
+    // makes no cluster: every cluster it marks touches that body and is
+    // blocked (`Clusters::assign`), so without another one the clusters
+    // are all empty and are not looked for (spinner: its paddle).
     let mut any_light = false;
+    // A body a motor turns and a portal object's bodies take no part in a
+    // light cluster (`Clusters::assign`).
+    let excluded = &mut narrowphase.excluded;
+    excluded.clear();
+    for body in driven.chain(objects.iter().map(|o| o.body)) {
+        if let Some(i) = bodies.state_index(body).filter(|&i| i != 0) {
+            excluded.push(i);
+        }
+    }
     let candidates = narrowphase
         .touching
         .iter()
@@ -727,7 +740,9 @@ pub(crate) fn build_constraints(
         let (ia, moving_a) = state_of((lane.state_a, [m_a, i_a]));
         let (ib, moving_b) = state_of((lane.state_b, [m_b, i_b]));
         let inv_masses = [m_a, m_b];
-        any_light |= light_pair([moving_a, moving_b], inv_masses);
+        any_light |= light_pair([moving_a, moving_b], inv_masses)
+            && !excluded.contains(&ia)
+            && !excluded.contains(&ib);
         let copy = !objects.is_empty() && (is_copy(lane.body_a) || is_copy(lane.body_b));
         solved.push(SolvedContact {
             index: k as u32,
@@ -747,15 +762,6 @@ pub(crate) fn build_constraints(
     let cluster_of = &mut narrowphase.cluster_of;
     cluster_of.clear();
     if any_light {
-        // A body a motor turns and a portal object's bodies take no part
-        // (`Clusters::assign`).
-        let excluded = &mut narrowphase.excluded;
-        excluded.clear();
-        for body in driven.chain(objects.iter().map(|o| o.body)) {
-            if let Some(i) = bodies.state_index(body).filter(|&i| i != 0) {
-                excluded.push(i);
-            }
-        }
         narrowphase.clusters.assign(
             bodies.states.len(),
             solved.len(),
