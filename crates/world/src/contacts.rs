@@ -115,11 +115,9 @@ pub(crate) struct RecycleCache {
     pub q_b: Rot,
     /// Pose of b's centre of mass in a's centre frame then (`x_a⁻¹ x_b`).
     pub relative: Transform,
-    /// Separation of each point then, m.
+    /// Separation of each point then, m. (The anchors then are the
+    /// points' own: recycling keeps them.)
     pub separation: [Real; 2],
-    /// Anchors `[r_a, r_b]` of each point then (world frame, from the
-    /// centres of mass), m.
-    pub anchors: [[Vec2; 2]; 2],
 }
 
 impl Contact {

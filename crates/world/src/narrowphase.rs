@@ -479,10 +479,6 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
         q_b: sim_b.transform.q,
         relative: centre_frame(sim_a).inv_mul(&centre_frame(sim_b)),
         separation: [c.points[0].separation, c.points[1].separation],
-        anchors: [
-            [c.points[0].anchor_a, c.points[0].anchor_b],
-            [c.points[1].anchor_a, c.points[1].anchor_b],
-        ],
     };
     c.still = [body_a.state_index == 0, body_b.state_index == 0];
     c.solve_bodies = [solve_body(&body_a), solve_body(&body_b)];
@@ -567,9 +563,10 @@ fn recycle(
     let dc = sim_b.center - sim_a.center;
     let n = c.normal;
     for i in 0..c.point_count {
-        let [r_a0, r_b0] = cache.anchors[i];
-        let (r_a, r_b) = (dq_a.rotate(r_a0), dq_b.rotate(r_b0));
         let p = &mut c.points[i];
+        // The anchors stay as computed with the cache (recycling never
+        // changes them).
+        let (r_a, r_b) = (dq_a.rotate(p.anchor_a), dq_b.rotate(p.anchor_b));
         p.separation = cache.separation[i] + n.dot(dc + (r_b - r_a));
         p.point = sim_a.center + r_a;
     }

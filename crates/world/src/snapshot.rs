@@ -173,7 +173,8 @@ pub mod bytes {
     /// their recycling cache; 3: the contact set keeps each contact's
     /// island link; 4: body states carry flags instead of inverse masses,
     /// joints and portal constraints keep the masses they loaded; 6: the
-    /// contact set keeps each contact's position in its bodies' lists).
+    /// contact set keeps each contact's position in its bodies' lists, and
+    /// the recycling cache no longer repeats the anchors).
     pub const SNAPSHOT_VERSION: u16 = 6;
     const HEADER: usize = 24;
 
