@@ -3,7 +3,7 @@
 //! a quick check that a change meant to keep results bit-identical does.
 
 use janus2d_testbed::benchmarks::{BOX2D_TEN, by_name};
-use janus2d_testbed::engine::{Engine, scripted_step};
+use janus2d_testbed::engine::scripted_step;
 use janus2d_testbed::janus::Janus;
 
 fn main() {
