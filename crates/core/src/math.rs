@@ -91,62 +91,6 @@ pub fn wrap_angle(x: Real) -> Real {
     }
 }
 
-/// `atan2(y, x)` in `[-π, π]` for the solver's per-substep angles: with
-/// `f32` a polynomial (range reduced to `atan(t)`, `t ∈ [0, 1]`, odd
-/// polynomial of degree 17 fitted to the relative error), measured within
-/// 2.5 ulp of the exact angle over the whole circle (`libm`'s `atan2f`:
-/// 1.4 ulp on the same inputs) without a library call and the same on
-/// every platform (only `+ − × ÷`); with `f64` the library's `atan2`. `atan2(0, 0)` is 0;
-/// NaN in gives NaN out.
-///
-/// ```
-/// use janus2d_core::math::{atan2_fast, Real};
-/// let a: Real = 2.0;
-/// assert!((atan2_fast(a.sin(), a.cos()) - a).abs() < 1e-6);
-/// ```
-#[inline]
-#[must_use]
-pub fn atan2_fast(y: Real, x: Real) -> Real {
-    #[cfg(feature = "f64")]
-    {
-        y.atan2(x)
-    }
-    #[cfg(not(feature = "f64"))]
-    {
-        // atan(t) = t + t³ Q(t²) on [0, 1] (Q weighted least squares on
-        // the relative error: 1.7e-8 in exact arithmetic, 1.3 ulp in f32).
-        const Q: [f32; 8] = [
-            -0.333_331_53,
-            0.199_937_73,
-            -0.142_110_56,
-            0.106_660_046,
-            -0.075_522_13,
-            0.043_211_848,
-            -0.016_367_916,
-            0.002_920_688_6,
-        ];
-        let (ax, ay) = (x.abs(), y.abs());
-        let (lo, hi) = if ay > ax { (ax, ay) } else { (ay, ax) };
-        if hi == 0.0 {
-            return 0.0;
-        }
-        let t = lo / hi;
-        let t2 = t * t;
-        let mut q = Q[7];
-        for &c in Q[..7].iter().rev() {
-            q = q * t2 + c;
-        }
-        let mut r = t + t * (t2 * q);
-        if ay > ax {
-            r = PI / 2.0 - r;
-        }
-        if x < 0.0 {
-            r = PI - r;
-        }
-        if y < 0.0 { -r } else { r }
-    }
-}
-
 /// True when every component is finite.
 #[inline]
 pub fn vec_is_finite(v: Vec2) -> bool {
@@ -215,15 +159,6 @@ impl Rot {
             c: self.c * other.c + self.s * other.s,
             s: self.c * other.s - self.s * other.c,
         }
-    }
-
-    /// [`Rot::relative_angle`] through [`atan2_fast`] (the solver's
-    /// per-substep joint angles).
-    #[inline]
-    #[must_use]
-    pub fn relative_angle_fast(self, other: Rot) -> Real {
-        let q = self.inv_mul(other);
-        atan2_fast(q.s, q.c)
     }
 
     /// The relative angle from `self` to `other`, in `[-π, π]`.
@@ -482,32 +417,6 @@ mod tests {
             assert_eq!(wrap_angle(x).to_bits(), slow.to_bits(), "x = {x}");
         }
         assert!(wrap_angle(Real::NAN).is_nan());
-    }
-
-    #[test]
-    fn atan2_fast_is_within_its_bound_over_the_circle() {
-        // Error in units of the last place of the exact angle (as Real),
-        // beside the library's own atan2 on the same inputs.
-        let (mut worst, mut worst_lib): (f64, f64) = (0.0, 0.0);
-        for k in 0..200_000 {
-            let a = -std::f64::consts::PI + (k as f64 + 0.5) * std::f64::consts::TAU / 200_000.0;
-            for r in [1.0, 0.37, 2.9e3] {
-                let (y, x) = ((r * a.sin()) as Real, (r * a.cos()) as Real);
-                let exact = (y as f64).atan2(x as f64);
-                let ulp = {
-                    let e = exact as Real;
-                    (Real::from_bits(e.abs().to_bits() + 1) - e.abs()) as f64
-                };
-                worst = worst.max((atan2_fast(y, x) as f64 - exact).abs() / ulp);
-                worst_lib = worst_lib.max((y.atan2(x) as f64 - exact).abs() / ulp);
-            }
-        }
-        // Measured: 1.8 ulp (the library's atan2f: 1.4 ulp).
-        assert!(worst <= 2.5, "worst error {worst} ulp (library {worst_lib})");
-        assert_eq!(atan2_fast(0.0, 0.0), 0.0);
-        assert!(atan2_fast(Real::NAN, 1.0).is_nan());
-        assert!((atan2_fast(0.0, -1.0) - PI).abs() < 1e-6);
-        assert!((atan2_fast(-1.0, 0.0) + PI / 2.0).abs() < 1e-6);
     }
 
     #[test]
