@@ -68,7 +68,6 @@ pub use janus2d_core::graph::COLOURS;
 /// bound); above it the points are nearly redundant and Gauss–Seidel takes
 /// them one by one.
 pub const BLOCK_CONDITION: Real = 1000.0;
-use janus2d_core::graph::ColourGraph;
 
 /// A dynamic body that stands for a whole object (a copy crossing a
 /// portal): its contacts build their effective masses on the object's
@@ -235,11 +234,11 @@ pub struct ContactLane {
 /// A step's contact constraints in their colours and lanes: the contact
 /// batch's own data.
 ///
-/// The pipeline builds it in two passes over its contacts:
-/// [`ContactSolver::assign`] gives each its colour (or the overflow), then
-/// [`ContactSolver::push`] writes it into the open chunk of that colour.
-/// Both passes read the contacts in order, and the open chunks (one per
-/// colour) stay in cache, so neither pass jumps around memory.
+/// The pipeline gives each contact its colour from the persistent
+/// [`ConstraintGraph`](janus2d_core::graph::ConstraintGraph) (or the
+/// overflow), then [`ContactSolver::push`] (or `push_all`) writes it into
+/// the open chunk of that colour, reading the contacts in order while the
+/// open chunks (one per colour) stay in cache.
 #[derive(Clone, Debug, Default)]
 pub struct ContactSolver {
     /// Chunks per colour; the last chunk of a colour may have free lanes.
@@ -253,8 +252,6 @@ pub struct ContactSolver {
     clusters: Vec<[u32; 2]>,
     /// The coupled groups of the overflow's light clusters.
     groups: Groups,
-    /// The colouring of this step.
-    graph: ColourGraph,
     /// Number of contacts pushed since [`ContactSolver::begin`].
     len: usize,
     /// Scratch of [`ContactSolver::push_all`]: the contacts of each colour.
@@ -264,7 +261,7 @@ pub struct ContactSolver {
     plan: StatePlan<PLAN_SLOTS>,
 }
 
-/// The slot of the overflow in [`ContactSolver::assign`]'s answers.
+/// The colour slot of the overflow (solved scalar, one contact at a time).
 pub const OVERFLOW: u8 = COLOURS as u8;
 
 impl ContactSolver {
@@ -298,10 +295,9 @@ impl ContactSolver {
         self.len() == 0
     }
 
-    /// Drops every contact and starts a step's colouring for `state_count`
-    /// body states.
-    pub fn begin(&mut self, state_count: usize) {
-        self.graph.reset(state_count);
+    /// Drops every contact (the colours come from the caller's
+    /// [`ConstraintGraph`](janus2d_core::graph::ConstraintGraph)).
+    pub fn begin(&mut self) {
         self.colours.resize_with(COLOURS, Vec::new);
         for chunks in &mut self.colours {
             chunks.clear();
@@ -311,16 +307,7 @@ impl ContactSolver {
         self.len = 0;
     }
 
-    /// The colour of a contact whose bodies have the state indices `a` and
-    /// `b` (`None` for a body the solve does not move: static, kinematic
-    /// or asleep), marking both bodies in it; [`OVERFLOW`] when none is
-    /// free.
-    pub fn assign(&mut self, a: Option<u32>, b: Option<u32>) -> u8 {
-        self.graph.assign(a, b).map_or(OVERFLOW, |c| c as u8)
-    }
-
-    /// Adds a contact to the colour [`ContactSolver::assign`] gave it
-    /// ([`OVERFLOW`]: solved scalar).
+    /// Adds a contact to its colour ([`OVERFLOW`]: solved scalar).
     pub fn push(&mut self, colour: u8, lane: &ContactLane) -> LanePlace {
         self.len += 1;
         let count = lane.point_count.min(MAX_MANIFOLD_POINTS);

@@ -17,6 +17,11 @@
 //! Colouring is greedy in the order constraints are offered (the lowest
 //! free colour); a constraint whose bodies already use all [`COLOURS`]
 //! colours goes to the overflow set, solved one by one.
+//!
+//! Two forms: [`ColourGraph`] colours one step's constraints from scratch
+//! (the joints, recoloured when one changes); [`ConstraintGraph`] keeps
+//! each constraint's colour from step to step (the contacts: a contact
+//! keeps its colour while it touches).
 
 /// Number of colours.
 pub const COLOURS: usize = 24;
@@ -62,6 +67,235 @@ impl ColourGraph {
     }
 }
 
+/// The first colour a constraint with one moving body (against a static
+/// or kinematic body) looks in ([`ConstraintGraph`]); pairs of moving
+/// bodies look from colour 0.
+pub const STATIC_FIRST: usize = COLOURS / 2;
+
+/// No body: a side of a constraint that takes no colour.
+pub const NO_BODY: u32 = u32::MAX;
+
+/// A [`ConstraintGraph`] constraint's colour and the bodies it holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+struct GraphEntry {
+    /// Its colour; [`GraphEntry::OUT`] when not in the graph,
+    /// [`COLOURS`] when in the overflow.
+    colour: u8,
+    /// The step it was last kept in.
+    stamp: u32,
+    /// Body key of each side ([`NO_BODY`]: takes no colour).
+    keys: [u32; 2],
+}
+
+impl GraphEntry {
+    const OUT: u8 = u8::MAX;
+    const VACANT: GraphEntry = GraphEntry {
+        colour: Self::OUT,
+        stamp: 0,
+        keys: [NO_BODY; 2],
+    };
+}
+
+/// The persistent constraint graph: colours over the moving bodies that
+/// last from step to step, as Box2D v3 keeps them.
+///
+/// A constraint (by a stable id: a contact's id) enters the graph the first
+/// step it is solved and keeps its colour while its moving bodies stay the
+/// same; it leaves when a step does not solve it (it stopped touching, was
+/// destroyed, fell asleep, or a hook disabled it), or when its moving
+/// bodies change (a body slept, woke or changed type), and then takes a
+/// colour afresh. Bodies are keyed by something stable (a body's slot
+/// index), not by the step's state index.
+///
+/// ```text
+/// step n:    keep(c, keys) for every solved constraint, in a fixed order
+///              same keys as stored, in a colour: that colour
+///              otherwise: out (bits cleared), then the lowest free colour
+///              (a pair with one moving body: from STATIC_FIRST up)
+///            sweep(): every entry not kept this step leaves (bits cleared)
+/// ```
+///
+/// Pairs of two moving bodies fill the colours from the first, pairs with
+/// one moving body (against the ground, say) from [`STATIC_FIRST`] (then
+/// any free one), so that a forward sweep ends near the ground, which then
+/// has the last word, as the per-step colouring did by colouring those
+/// pairs after all the others. (From the last colour down, Box2D's order,
+/// also kept the hard cases' figures, but reversed a body's ground
+/// contacts against their contact order, and the rain ragdoll dropped
+/// alone bounced off its ground instead of coming to rest.) A
+/// constraint whose bodies already appear in every colour goes to the
+/// overflow ([`COLOURS`]), and tries again each step.
+#[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct ConstraintGraph {
+    /// By body key: bit `c` set, the body appears in colour `c`.
+    body_colours: Vec<u32>,
+    /// By constraint id.
+    entries: Vec<GraphEntry>,
+    /// Ids with an entry in the graph (or the overflow), in the order they
+    /// entered (the sweep's order).
+    members: Vec<u32>,
+    /// The current step's stamp.
+    stamp: u32,
+}
+
+impl ConstraintGraph {
+    /// An empty graph.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Starts a step: [`ConstraintGraph::keep`] then marks what stays.
+    pub fn begin_step(&mut self) {
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            // Wrapped: stamps of 0 mean "not kept"; the rest restart.
+            for e in &mut self.entries {
+                e.stamp = 0;
+            }
+            self.stamp = 1;
+        }
+    }
+
+    /// The colour of constraint `id` between the bodies with keys `keys`
+    /// ([`NO_BODY`] for a side that takes no colour) this step: the one it
+    /// had if its keys are unchanged, otherwise a new one. Returns
+    /// [`COLOURS`] for the overflow.
+    pub fn keep(&mut self, id: u32, keys: [u32; 2]) -> u8 {
+        let i = id as usize;
+        if self.entries.len() <= i {
+            self.entries.resize(i + 1, GraphEntry::VACANT);
+        }
+        let entry = self.entries[i];
+        if entry.colour != GraphEntry::OUT {
+            if entry.keys == keys && (entry.colour as usize) < COLOURS {
+                self.entries[i].stamp = self.stamp;
+                return entry.colour;
+            }
+            // Its bodies changed, or it waits in the overflow: again.
+            self.clear_bits(entry);
+        } else {
+            self.members.push(id);
+        }
+        let colour = self.find_colour(keys);
+        if (colour as usize) < COLOURS {
+            for k in keys {
+                if k != NO_BODY {
+                    self.body_colours[k as usize] |= 1 << colour;
+                }
+            }
+        }
+        self.entries[i] = GraphEntry {
+            colour,
+            stamp: self.stamp,
+            keys,
+        };
+        colour
+    }
+
+    /// Every constraint not kept since [`ConstraintGraph::begin_step`]
+    /// leaves the graph (its bodies' colour bits are cleared).
+    pub fn sweep(&mut self) {
+        let mut members = std::mem::take(&mut self.members);
+        members.retain(|&id| {
+            let entry = self.entries[id as usize];
+            if entry.stamp == self.stamp {
+                return true;
+            }
+            self.clear_bits(entry);
+            self.entries[id as usize] = GraphEntry::VACANT;
+            false
+        });
+        self.members = members;
+    }
+
+    /// Number of constraints in the graph (overflow included).
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.members.len()
+    }
+
+    /// True when no constraint is in the graph.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.members.is_empty()
+    }
+
+    /// Checks that every body's bits are exactly the colours of the
+    /// constraints that hold it, and that no colour holds a body twice
+    /// (for tests and snapshot validation).
+    pub fn check(&self) -> Result<(), String> {
+        let mut bits = vec![0u32; self.body_colours.len()];
+        for &id in &self.members {
+            let e = self
+                .entries
+                .get(id as usize)
+                .ok_or_else(|| format!("member {id} has no entry"))?;
+            if e.colour == GraphEntry::OUT {
+                return Err(format!("member {id} is out of the graph"));
+            }
+            if (e.colour as usize) < COLOURS {
+                for k in e.keys {
+                    if k == NO_BODY {
+                        continue;
+                    }
+                    let b = bits
+                        .get_mut(k as usize)
+                        .ok_or_else(|| format!("member {id}: body key {k} out of range"))?;
+                    if *b & (1 << e.colour) != 0 {
+                        return Err(format!("body {k} twice in colour {}", e.colour));
+                    }
+                    *b |= 1 << e.colour;
+                }
+            }
+        }
+        if bits != self.body_colours[..bits.len()] {
+            return Err("body colour bits differ from the members' colours".into());
+        }
+        Ok(())
+    }
+
+    fn clear_bits(&mut self, entry: GraphEntry) {
+        if (entry.colour as usize) < COLOURS {
+            for k in entry.keys {
+                if let Some(b) = self.body_colours.get_mut(k as usize) {
+                    *b &= !(1 << entry.colour);
+                }
+            }
+        }
+    }
+
+    /// The lowest colour (both sides move) or the highest (one side
+    /// moves) in which no keyed body appears; [`COLOURS`] when none.
+    fn find_colour(&mut self, keys: [u32; 2]) -> u8 {
+        let mut used = 0u32;
+        let mut moving = 0;
+        for k in keys {
+            if k != NO_BODY {
+                let k = k as usize;
+                if self.body_colours.len() <= k {
+                    self.body_colours.resize(k + 1, 0);
+                }
+                used |= self.body_colours[k];
+                moving += 1;
+            }
+        }
+        let free = !used & ((1u32 << COLOURS) - 1);
+        if free == 0 {
+            return COLOURS as u8;
+        }
+        // Pairs with one moving body look from STATIC_FIRST up first.
+        let late = free & !((1u32 << STATIC_FIRST) - 1);
+        if moving < 2 && late != 0 {
+            late.trailing_zeros() as u8
+        } else {
+            free.trailing_zeros() as u8
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -87,5 +321,58 @@ mod tests {
         }
         assert_eq!(g.assign(Some(0), Some(COLOURS as u32 + 1)), None);
         assert_eq!(g.assign(Some(99), None), None, "out of range");
+    }
+
+    #[test]
+    fn graph_keeps_colours_between_steps_and_frees_them_when_not_kept() {
+        let mut g = ConstraintGraph::new();
+        g.begin_step();
+        assert_eq!(g.keep(0, [1, 2]), 0);
+        assert_eq!(g.keep(1, [2, 3]), 1);
+        // One moving body: from STATIC_FIRST up.
+        assert_eq!(g.keep(2, [3, NO_BODY]), STATIC_FIRST as u8);
+        assert_eq!(g.keep(3, [NO_BODY, 3]), STATIC_FIRST as u8 + 1);
+        g.sweep();
+        g.check().unwrap();
+        // Next step, in another order: the same colours.
+        g.begin_step();
+        assert_eq!(g.keep(3, [NO_BODY, 3]), STATIC_FIRST as u8 + 1);
+        assert_eq!(g.keep(1, [2, 3]), 1);
+        assert_eq!(g.keep(0, [1, 2]), 0);
+        g.sweep();
+        g.check().unwrap();
+        assert_eq!(g.len(), 3, "constraint 2 was not kept: it left");
+        // Its colour is free again for body 3.
+        g.begin_step();
+        assert_eq!(g.keep(9, [3, NO_BODY]), STATIC_FIRST as u8);
+        // A constraint whose bodies changed is coloured afresh.
+        // (its old colour is freed first, so colour 0 serves again).
+        assert_eq!(g.keep(0, [1, 4]), 0);
+        assert_eq!(g.keep(5, [2, 4]), 2, "body 2 is in 1, body 4 in 0");
+        g.sweep();
+        g.check().unwrap();
+    }
+
+    #[test]
+    fn graph_overflows_when_a_body_is_in_every_colour_and_retries() {
+        let mut g = ConstraintGraph::new();
+        g.begin_step();
+        for k in 0..COLOURS as u32 {
+            assert_eq!(g.keep(k, [0, k + 1]), k as u8);
+        }
+        let extra = COLOURS as u32;
+        assert_eq!(g.keep(extra, [0, extra + 1]), COLOURS as u8);
+        g.sweep();
+        g.check().unwrap();
+        // Next step one of body 0's constraints is gone: the overflowed
+        // one takes its colour.
+        g.begin_step();
+        for k in 1..COLOURS as u32 {
+            g.keep(k, [0, k + 1]);
+        }
+        g.sweep();
+        g.begin_step();
+        assert_eq!(g.keep(extra, [0, extra + 1]), 0);
+        g.check().unwrap();
     }
 }

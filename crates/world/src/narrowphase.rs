@@ -27,6 +27,7 @@ use janus2d_constraints::contact_group::{Clusters, ContactBodies, NO_CLUSTER, li
 use janus2d_constraints::contact_solver::{ContactLane, ContactSolver, LanePlace, OVERFLOW};
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::geometry::{Aabb, Manifold, collide};
+use janus2d_core::graph::{ConstraintGraph, NO_BODY};
 use janus2d_core::math::{Real, Rot, Transform, Vec2};
 
 use crate::broadphase::BroadPhase;
@@ -115,6 +116,9 @@ pub(crate) struct Narrowphase {
     /// does not take), for storing the impulses back in contact order.
     #[cfg_attr(feature = "serde", serde(skip))]
     place_of: Vec<LanePlace>,
+    /// The persistent colours of the solved contacts (kept in snapshots:
+    /// the colours are part of the state a step continues from).
+    graph: ConstraintGraph,
     /// The light clusters of the solved contacts (scratch of the build).
     #[cfg_attr(feature = "serde", serde(skip))]
     clusters: Clusters,
@@ -142,6 +146,8 @@ const UNSOLVED: LanePlace = LanePlace {
 struct StagedContact {
     /// The solver's lane data (`contact_index` is set at push).
     lane: ContactLane,
+    /// The contact's id (its key in the constraint graph).
+    id: u32,
     /// [`Contact::still`] when staged.
     still: [bool; 2],
 }
@@ -150,6 +156,7 @@ impl Default for StagedContact {
     fn default() -> Self {
         Self {
             lane: empty_lane(),
+            id: u32::MAX,
             still: [true, true],
         }
     }
@@ -202,6 +209,7 @@ fn stage(c: &Contact) -> StagedContact {
             contact_index: 0,
             cluster: [NO_CLUSTER; 2],
         },
+        id: c.id,
         still: c.still,
     }
 }
@@ -216,8 +224,6 @@ struct SolvedContact {
     state: [u32; 2],
     /// Whether the solve moves each body.
     moving: [bool; 2],
-    /// Against a static (or sleeping) body: coloured after the moving pairs.
-    with_static: bool,
     /// A portal copy takes part: the object-mass hook, in the overflow.
     copy: bool,
     /// Inverse mass of each body, 1/kg (0 for one the solve does not move).
@@ -252,6 +258,12 @@ impl Narrowphase {
     #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
     pub(crate) fn places_by_contact(&self) -> &[LanePlace] {
         &self.place_of
+    }
+
+    /// Checks the persistent constraint graph (every body's colour bits
+    /// are its contacts' colours; no colour holds a body twice).
+    pub(crate) fn check_graph(&self) -> Result<(), String> {
+        self.graph.check().map_err(|e| format!("constraint graph: {e}"))
     }
 
     /// Whether a place holds a solved contact.
@@ -616,9 +628,11 @@ fn update_manifold(c: &mut Contact, m: &Manifold, offset: [Vec2; 2]) {
 /// Builds the contact constraints of touching solid awake contacts, in
 /// their colours.
 ///
-/// Contacts between two moving bodies take colours first and contacts with
-/// a static body after them, so the static ones gather in the later
-/// colours and each Gauss–Seidel sweep ends near the ground: the support a
+/// Colours come from the persistent [`ConstraintGraph`]: a contact keeps
+/// its colour while it is solved and its moving bodies stay the same.
+/// Contacts with one moving body (against the ground) take colours from
+/// [`janus2d_core::graph::STATIC_FIRST`] up, after the pairs of moving
+/// bodies, so each Gauss–Seidel sweep ends near the ground: the support a
 /// stack stands on has the last word (Box2D v3 likewise keeps static
 /// contacts out of its first graph colours).
 ///
@@ -701,7 +715,7 @@ pub(crate) fn build_constraints(
     // Pass 1: colours, moving pairs first, static pairs last. One read of
     // the contacts lists the solved ones; the two colour passes then run
     // over that short list.
-    solver.begin(bodies.states.len());
+    solver.begin();
     let awake = contacts.awake();
     solved.clear();
     for k in candidates {
@@ -745,7 +759,6 @@ pub(crate) fn build_constraints(
             index: k as u32,
             state: [ia, ib],
             moving: [moving_a, moving_b],
-            with_static: sa || sb,
             copy,
             inv_mass: inv_masses,
             cluster: [NO_CLUSTER; 2],
@@ -777,19 +790,28 @@ pub(crate) fn build_constraints(
             s.cluster = *ids;
         }
     }
-    for static_pass in [false, true] {
-        for s in solved.iter_mut() {
-            if s.with_static == static_pass {
-                s.colour = if s.copy || s.cluster != [NO_CLUSTER; 2] {
-                    OVERFLOW
-                } else {
-                    let [ia, ib] = s.state;
-                    let [ma, mb] = s.moving;
-                    solver.assign(ma.then_some(ia), mb.then_some(ib))
-                };
-            }
-        }
+    // Colours from the persistent graph, keyed by the bodies' slots: a
+    // contact keeps last step's colour while its moving bodies stay the
+    // same; the contacts not solved this step leave it.
+    let graph = &mut narrowphase.graph;
+    graph.begin_step();
+    for s in solved.iter_mut() {
+        let record = &staged[s.index as usize];
+        let key = |moving: bool, body: BodyHandle| if moving { body.index } else { NO_BODY };
+        let keys = [
+            key(s.moving[0], record.lane.body_a),
+            key(s.moving[1], record.lane.body_b),
+        ];
+        let colour = graph.keep(record.id, keys);
+        // A portal copy's contacts and a light cluster's are solved in the
+        // overflow this step (they keep their place in the graph).
+        s.colour = if s.copy || s.cluster != [NO_CLUSTER; 2] {
+            OVERFLOW
+        } else {
+            colour.min(OVERFLOW)
+        };
     }
+    graph.sweep();
     // Pass 2: each contact into its colour, in contact order.
     let (mut rows, mut bouncy) = (0, 0);
     let colours = &mut narrowphase.colours;

@@ -1486,7 +1486,7 @@ impl World {
             );
             sp.narrowphase += lap();
         } else {
-            self.contact_solver.begin(0);
+            self.contact_solver.begin();
         }
         // No restitution anywhere: no restitution pass.
         ctx.restitution = has_shapes && self.collision.counters.restitution_contacts > 0;
