@@ -220,6 +220,11 @@ fn stage(c: &Contact) -> StagedContact {
 struct SolvedContact {
     /// Index in the awake list.
     index: u32,
+    /// The contact's id (its key in the constraint graph).
+    id: u32,
+    /// The graph's body keys: each moving body's slot ([`NO_BODY`] for a
+    /// body the solve does not move).
+    keys: [u32; 2],
     /// State index of each body (0: static or asleep).
     state: [u32; 2],
     /// Whether the solve moves each body.
@@ -755,8 +760,11 @@ pub(crate) fn build_constraints(
             && !excluded.contains(&ia)
             && !excluded.contains(&ib);
         let copy = !objects.is_empty() && (is_copy(lane.body_a) || is_copy(lane.body_b));
+        let key = |moving: bool, body: BodyHandle| if moving { body.index } else { NO_BODY };
         solved.push(SolvedContact {
             index: k as u32,
+            id: record.id,
+            keys: [key(moving_a, lane.body_a), key(moving_b, lane.body_b)],
             state: [ia, ib],
             moving: [moving_a, moving_b],
             copy,
@@ -796,13 +804,7 @@ pub(crate) fn build_constraints(
     let graph = &mut narrowphase.graph;
     graph.begin_step();
     for s in solved.iter_mut() {
-        let record = &staged[s.index as usize];
-        let key = |moving: bool, body: BodyHandle| if moving { body.index } else { NO_BODY };
-        let keys = [
-            key(s.moving[0], record.lane.body_a),
-            key(s.moving[1], record.lane.body_b),
-        ];
-        let colour = graph.keep(record.id, keys);
+        let colour = graph.keep(s.id, s.keys);
         // A portal copy's contacts and a light cluster's are solved in the
         // overflow this step (they keep their place in the graph).
         s.colour = if s.copy || s.cluster != [NO_CLUSTER; 2] {
