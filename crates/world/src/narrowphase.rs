@@ -666,13 +666,10 @@ pub(crate) fn build_constraints(
     if staged.len() < n {
         staged.resize(n, StagedContact::default());
     }
-    // Whether any moving pair is light beside the other with neither body
-    // excluded from the light clusters (then they are looked for, below).
     // A light pair with a body a motor turns or a portal object's body
     // makes no cluster: every cluster it marks touches that body and is
-    // blocked (`Clusters::assign`), so without another one the clusters
-    // are all empty and are not looked for (spinner: its paddle).
-    let mut any_light = false;
+    // blocked (`Clusters::assign`), so without another light pair the
+    // clusters are all empty and are not looked for (spinner: its paddle).
     // A body a motor turns and a portal object's bodies take no part in a
     // light cluster (`Clusters::assign`).
     let excluded = &mut narrowphase.excluded;
@@ -717,64 +714,89 @@ pub(crate) fn build_constraints(
     };
     // A portal copy: its contacts take the object-mass hook, in the overflow.
     let is_copy = |body: BodyHandle| objects.iter().any(|o| o.body == body);
-    // Pass 1: colours, moving pairs first, static pairs last. One read of
-    // the contacts lists the solved ones; the two colour passes then run
-    // over that short list.
+    // Pass 1: the solved contacts, in contact order (colours below).
     solver.begin();
     let awake = contacts.awake();
     solved.clear();
-    for k in candidates {
-        let record = &staged[k];
-        let [sa, sb] = record.still;
-        if (sa && sb) || (k >= scanned && !awake[k].is_solid_touching()) {
-            continue;
-        }
-        if let Some(hook) = pre_solve.as_mut() {
-            let c = &awake[k];
-            let velocity = |b| bodies.state(b).map_or(Vec2::ZERO, |s| s.v);
-            let mut separations = [0.0; 2];
-            for (s, p) in separations.iter_mut().zip(&c.points[..c.point_count]) {
-                *s = p.separation;
-            }
-            let view = PreSolve {
-                shape_a: c.shapes[0],
-                shape_b: c.shapes[1],
-                body_a: c.body_a,
-                body_b: c.body_b,
-                normal: c.normal,
-                separations,
-                point_count: c.point_count,
-                velocity_a: velocity(c.body_a),
-                velocity_b: velocity(c.body_b),
-            };
-            if !hook(&view) {
-                continue;
-            }
-        }
+    let key = |moving: bool, body: BodyHandle| if moving { body.index } else { NO_BODY };
+    let entry = |k: usize, record: &StagedContact| {
         let lane = &record.lane;
         let [m_a, i_a, m_b, i_b] = lane.inv_masses;
         let (ia, moving_a) = state_of((lane.state_a, [m_a, i_a]));
         let (ib, moving_b) = state_of((lane.state_b, [m_b, i_b]));
-        let inv_masses = [m_a, m_b];
-        any_light |= light_pair([moving_a, moving_b], inv_masses)
-            && !excluded.contains(&ia)
-            && !excluded.contains(&ib);
         let copy = !objects.is_empty() && (is_copy(lane.body_a) || is_copy(lane.body_b));
-        let key = |moving: bool, body: BodyHandle| if moving { body.index } else { NO_BODY };
-        solved.push(SolvedContact {
+        SolvedContact {
             index: k as u32,
             id: record.id,
             keys: [key(moving_a, lane.body_a), key(moving_b, lane.body_b)],
             state: [ia, ib],
             moving: [moving_a, moving_b],
             copy,
-            inv_mass: inv_masses,
+            inv_mass: [m_a, m_b],
             cluster: [NO_CLUSTER; 2],
             colour: OVERFLOW,
             point_count: lane.point_count as u8,
             bouncy: lane.restitution > 0.0,
-        });
+        }
+    };
+    // With threads, no hook and nothing woken since the narrowphase, the
+    // entries are made on rayon (order kept): on two threads this pass was
+    // most of what the leader did alone between the narrowphase and the
+    // solve.
+    #[cfg(feature = "parallel")]
+    let parallel = pre_solve.is_none() && !woke && scanned == n && rayon::current_num_threads() > 1;
+    #[cfg(not(feature = "parallel"))]
+    let parallel = false;
+    if parallel {
+        #[cfg(feature = "parallel")]
+        {
+            use rayon::prelude::*;
+            let staged = &*staged;
+            solved.par_extend(narrowphase.touching.par_iter().filter_map(|&k| {
+                let record = &staged[k as usize];
+                let [sa, sb] = record.still;
+                (!(sa && sb)).then(|| entry(k as usize, record))
+            }));
+        }
+    } else {
+        for k in candidates {
+            let record = &staged[k];
+            let [sa, sb] = record.still;
+            if (sa && sb) || (k >= scanned && !awake[k].is_solid_touching()) {
+                continue;
+            }
+            if let Some(hook) = pre_solve.as_mut() {
+                let c = &awake[k];
+                let velocity = |b| bodies.state(b).map_or(Vec2::ZERO, |s| s.v);
+                let mut separations = [0.0; 2];
+                for (s, p) in separations.iter_mut().zip(&c.points[..c.point_count]) {
+                    *s = p.separation;
+                }
+                let view = PreSolve {
+                    shape_a: c.shapes[0],
+                    shape_b: c.shapes[1],
+                    body_a: c.body_a,
+                    body_b: c.body_b,
+                    normal: c.normal,
+                    separations,
+                    point_count: c.point_count,
+                    velocity_a: velocity(c.body_a),
+                    velocity_b: velocity(c.body_b),
+                };
+                if !hook(&view) {
+                    continue;
+                }
+            }
+            solved.push(entry(k, record));
+        }
     }
+    // Whether any moving pair is light beside the other with neither body
+    // excluded (then the light clusters are looked for).
+    let any_light = solved.iter().any(|s| {
+        light_pair(s.moving, s.inv_mass)
+            && !excluded.contains(&s.state[0])
+            && !excluded.contains(&s.state[1])
+    });
     // Light clusters (`contact_group`): their contacts go to the overflow,
     // where the solver takes each cluster's contacts as one block.
     let cluster_of = &mut narrowphase.cluster_of;
