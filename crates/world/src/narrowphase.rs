@@ -268,7 +268,9 @@ impl Narrowphase {
     /// Checks the persistent constraint graph (every body's colour bits
     /// are its contacts' colours; no colour holds a body twice).
     pub(crate) fn check_graph(&self) -> Result<(), String> {
-        self.graph.check().map_err(|e| format!("constraint graph: {e}"))
+        self.graph
+            .check()
+            .map_err(|e| format!("constraint graph: {e}"))
     }
 
     /// Whether a place holds a solved contact.
