@@ -792,15 +792,40 @@ pub(crate) fn build_constraints(
             solved.push(entry(k, record));
         }
     }
-    // Whether any moving pair is light beside the other with neither body
-    // excluded (then the light clusters are looked for).
-    let any_light = solved.iter().any(|s| {
-        light_pair(s.moving, s.inv_mass)
-            && !excluded.contains(&s.state[0])
-            && !excluded.contains(&s.state[1])
-    });
-    // Light clusters (`contact_group`): their contacts go to the overflow,
-    // where the solver takes each cluster's contacts as one block.
+    // One pass over the solved contacts: colours from the persistent
+    // graph, keyed by the bodies' slots (a contact keeps last step's colour
+    // while its moving bodies stay the same; the contacts not solved this
+    // step leave it), the counters, and whether any moving pair is light
+    // beside the other with neither body excluded (then the light clusters
+    // are looked for below). (Three passes over `solved` before: on
+    // many_pyramids at 2 threads they were most of the leader's serial
+    // build time.)
+    let graph = &mut narrowphase.graph;
+    graph.begin_step();
+    let colours = &mut narrowphase.colours;
+    colours.clear();
+    let (mut rows, mut bouncy, mut any_light) = (0, 0, false);
+    for s in solved.iter_mut() {
+        let colour = graph.keep(s.id, s.keys);
+        // A portal copy's contacts are solved in the overflow (they keep
+        // their place in the graph).
+        s.colour = if s.copy {
+            OVERFLOW
+        } else {
+            colour.min(OVERFLOW)
+        };
+        colours.push(s.colour);
+        rows += 2 * usize::from(s.point_count);
+        bouncy += usize::from(s.bouncy);
+        any_light = any_light
+            || (light_pair(s.moving, s.inv_mass)
+                && !excluded.contains(&s.state[0])
+                && !excluded.contains(&s.state[1]));
+    }
+    graph.sweep();
+    // Light clusters (`contact_group`): their contacts go to the overflow
+    // this step (keeping their place in the graph), where the solver takes
+    // each cluster's contacts as one block.
     let cluster_of = &mut narrowphase.cluster_of;
     cluster_of.clear();
     if any_light {
@@ -818,35 +843,19 @@ pub(crate) fn build_constraints(
             excluded,
             cluster_of,
         );
-        for (s, ids) in solved.iter_mut().zip(cluster_of.iter()) {
+        for ((s, ids), colour) in solved
+            .iter_mut()
+            .zip(cluster_of.iter())
+            .zip(colours.iter_mut())
+        {
             s.cluster = *ids;
+            if *ids != [NO_CLUSTER; 2] {
+                s.colour = OVERFLOW;
+                *colour = OVERFLOW;
+            }
         }
     }
-    // Colours from the persistent graph, keyed by the bodies' slots: a
-    // contact keeps last step's colour while its moving bodies stay the
-    // same; the contacts not solved this step leave it.
-    let graph = &mut narrowphase.graph;
-    graph.begin_step();
-    for s in solved.iter_mut() {
-        let colour = graph.keep(s.id, s.keys);
-        // A portal copy's contacts and a light cluster's are solved in the
-        // overflow this step (they keep their place in the graph).
-        s.colour = if s.copy || s.cluster != [NO_CLUSTER; 2] {
-            OVERFLOW
-        } else {
-            colour.min(OVERFLOW)
-        };
-    }
-    graph.sweep();
     // Pass 2: each contact into its colour, in contact order.
-    let (mut rows, mut bouncy) = (0, 0);
-    let colours = &mut narrowphase.colours;
-    colours.clear();
-    for s in solved.iter() {
-        rows += 2 * usize::from(s.point_count);
-        bouncy += usize::from(s.bouncy);
-        colours.push(s.colour);
-    }
     let (solved, staged) = (&*solved, &*staged);
     let places = &mut narrowphase.places;
     solver.push_all(
