@@ -360,9 +360,19 @@ pub struct SolveReport {
     /// Bodies whose state went non-finite; they were reset to their
     /// start-of-step pose at rest.
     pub non_finite: Vec<BodyHandle>,
+    /// Every moving body's pose after the step is finite and within
+    /// [`POSE_LIMIT`] (checked while the poses were written, so that the
+    /// caller's [`BodySet::reset_escaped`] pass can be skipped); false when
+    /// unknown.
+    pub poses_inside: bool,
     /// Stage timings.
     pub profile: SolverProfile,
 }
+
+/// The largest coordinate a pose may reach in a step, m: twice
+/// [`crate::limits::MAX_COORDINATE`]; beyond it (or at inf or NaN) the body
+/// is put back ([`BodySet::reset_escaped`]).
+pub const POSE_LIMIT: Real = 2.0 * crate::limits::MAX_COORDINATE;
 
 #[inline]
 fn lap(t: &mut Instant) -> f64 {
@@ -528,9 +538,10 @@ fn integrate_positions_on(ctx: &StepContext, states: &mut [BodyState], team: &Te
 }
 
 /// The step's end for every body: the pose from the deltas, forces
-/// cleared. In blocks on the team; a body whose state is not finite is
-/// left for the serial pass after, which zeroes its motion and reports it
-/// (in body order).
+/// cleared, and whether every pose is inside [`POSE_LIMIT`]
+/// ([`SolveReport::poses_inside`]). In blocks on the team; a body whose
+/// state is not finite is left for the serial pass after, which zeroes its
+/// motion and reports it (in body order).
 fn finalize_bodies(bodies: &mut BodySet, report: &mut SolveReport, team: &Team) {
     let finite = |state: &BodyState| {
         vec_is_finite(state.v)
@@ -538,22 +549,31 @@ fn finalize_bodies(bodies: &mut BodySet, report: &mut SolveReport, team: &Team) 
             && vec_is_finite(state.dp)
             && state.dq.is_finite()
     };
+    let inside = |p: Vec2| vec_is_finite(p) && p.x.abs() <= POSE_LIMIT && p.y.abs() <= POSE_LIMIT;
     let any_bad = std::sync::atomic::AtomicBool::new(false);
+    let any_outside = std::sync::atomic::AtomicBool::new(false);
     let BodySet { sims, states, .. } = bodies;
     team.for_each_chunk_pair_mut(sims, states, BODY_BLOCK, |i, sims, states| {
         let skip = usize::from(i == 0);
+        let mut outside = false;
         for (sim, state) in sims.iter_mut().zip(states.iter()).skip(skip) {
-            if !finite(state) {
+            if finite(state) {
+                sim.center = sim.center0 + state.dp;
+                sim.transform.q = state.dq.mul(sim.rotation0).normalize();
+                sim.transform.p = sim.center - sim.transform.q.rotate(sim.local_center);
+                sim.force = Vec2::ZERO;
+                sim.torque = 0.0;
+            } else {
                 any_bad.store(true, std::sync::atomic::Ordering::Relaxed);
-                continue;
             }
-            sim.center = sim.center0 + state.dp;
-            sim.transform.q = state.dq.mul(sim.rotation0).normalize();
-            sim.transform.p = sim.center - sim.transform.q.rotate(sim.local_center);
-            sim.force = Vec2::ZERO;
-            sim.torque = 0.0;
+            outside |=
+                !(inside(sim.transform.p) && inside(sim.center) && sim.transform.q.is_finite());
+        }
+        if outside {
+            any_outside.store(true, std::sync::atomic::Ordering::Relaxed);
         }
     });
+    report.poses_inside = !any_outside.into_inner();
     if any_bad.into_inner() {
         for (sim, state) in sims.iter_mut().zip(states.iter_mut()).skip(1) {
             if !finite(state) {

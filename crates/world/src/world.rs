@@ -1523,10 +1523,11 @@ impl World {
         // The solver checks velocities and deltas; a pose they carried out
         // of the world (or to inf) is put back here, before any box is
         // computed from it.
-        self.bodies.reset_escaped(
-            2.0 * janus2d_core::limits::MAX_COORDINATE,
-            &mut report.non_finite,
-        );
+        // (The solve's finalize checked the poses as it wrote them.)
+        if !report.poses_inside {
+            self.bodies
+                .reset_escaped(janus2d_core::solver::POSE_LIMIT, &mut report.non_finite);
+        }
         lap();
         if has_shapes {
             let c = &self.collision;
