@@ -25,7 +25,6 @@
 
 use janus2d_constraints::ContactSolver;
 use janus2d_constraints::contact::{mix_friction, mix_restitution};
-#[cfg(feature = "parallel")]
 use janus2d_constraints::contact_solver::LanePlace;
 use janus2d_constraints::contact_solver::PointImpulse;
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
@@ -301,9 +300,17 @@ impl Collision {
         }
     }
 
-    /// Copies solved impulses back into the contacts (for warm starting).
-    pub(crate) fn store_impulses(&mut self, solver: &ContactSolver) {
-        let contacts = &mut self.contacts;
+    /// Copies solved impulses back into the contacts (for warm starting);
+    /// `places` is where the solver holds each awake contact's impulses
+    /// ([`Narrowphase::places_by_contact`]). Touches only the contacts, so
+    /// it may run beside [`Collision::update_proxies`].
+    pub(crate) fn store_impulses(
+        contacts: &mut ContactSet,
+        places: &[LanePlace],
+        solver: &ContactSolver,
+    ) {
+        #[cfg(not(feature = "parallel"))]
+        let _ = places;
         // A non-finite impulse (a solve that blew up) is not kept for warm
         // starting: the contact starts cold next step instead of carrying
         // NaN into it.
@@ -316,7 +323,6 @@ impl Collision {
         };
         #[cfg(feature = "parallel")]
         {
-            let places = self.narrowphase.places_by_contact();
             if rayon::current_num_threads() > 1
                 && places.len() > 4096
                 && places.len() == contacts.awake().len()
@@ -354,12 +360,18 @@ impl Collision {
     /// proxies when they left their fat boxes.
     ///
     /// A fast body's proxy box covers the shape now and where its velocity
-    /// takes it within `dt`, so pairs exist before it arrives.
-    pub(crate) fn update_proxies(&mut self, bodies: &BodySet, dt: Real) {
+    /// takes it within `dt`, so pairs exist before it arrives. Returns the
+    /// number of proxies moved. Touches only the shapes and the
+    /// broadphase, so it may run beside [`Collision::store_impulses`].
+    pub(crate) fn update_proxies(
+        shapes: &mut ShapeStore,
+        broadphase: &mut BroadPhase,
+        bodies: &BodySet,
+        dt: Real,
+    ) -> usize {
         #[cfg(feature = "parallel")]
         if rayon::current_num_threads() > 1 && bodies.sims.len() > 1024 {
-            self.update_proxies_parallel(bodies, dt);
-            return;
+            return Self::update_proxies_parallel(shapes, broadphase, bodies, dt);
         }
         let mut moved = 0;
         for (sim, state) in bodies.sims.iter().zip(&bodies.states).skip(1) {
@@ -368,31 +380,33 @@ impl Collision {
             // slower ones stay inside their fat box as in Box2D, so they are
             // not re-inserted more often.
             let sweep = dt * state.v;
-            let n = self.shapes.of_body(sim.handle).len();
+            let n = shapes.of_body(sim.handle).len();
             for k in 0..n {
-                let s = self.shapes.of_body(sim.handle)[k];
-                let shape = self.shapes.at_mut(s);
+                let s = shapes.of_body(sim.handle)[k];
+                let shape = shapes.at_mut(s);
                 let tight = shape.geometry.compute_aabb(&sim.transform);
                 shape.aabb = tight;
-                if self
-                    .broadphase
-                    .move_proxy_in_batch_swept(shape.proxy, bounded(tight), sweep)
-                {
+                if broadphase.move_proxy_in_batch_swept(shape.proxy, bounded(tight), sweep) {
                     moved += 1;
                 }
             }
         }
-        self.broadphase.finish_moves();
-        self.counters.proxies_moved = moved;
+        broadphase.finish_moves();
+        moved
     }
 
     /// [`Collision::update_proxies`] with the boxes computed on rayon, in
     /// blocks of bodies; the proxies are then moved here, in body order, as
     /// the serial version does.
     #[cfg(feature = "parallel")]
-    fn update_proxies_parallel(&mut self, bodies: &BodySet, dt: Real) {
+    fn update_proxies_parallel(
+        shapes: &mut ShapeStore,
+        broadphase: &mut BroadPhase,
+        bodies: &BodySet,
+        dt: Real,
+    ) -> usize {
         use rayon::prelude::*;
-        let shapes = &self.shapes;
+        let read = &*shapes;
         let blocks: Vec<Vec<(u32, Aabb, Vec2)>> = bodies.sims[1..]
             .par_chunks(256)
             .zip(bodies.states[1..].par_chunks(256))
@@ -400,8 +414,8 @@ impl Collision {
                 let mut out = Vec::with_capacity(sims.len());
                 for (sim, state) in sims.iter().zip(states) {
                     let sweep = dt * state.v;
-                    for &s in shapes.of_body(sim.handle) {
-                        let tight = shapes.at(s).geometry.compute_aabb(&sim.transform);
+                    for &s in read.of_body(sim.handle) {
+                        let tight = read.at(s).geometry.compute_aabb(&sim.transform);
                         out.push((s, tight, sweep));
                     }
                 }
@@ -410,17 +424,14 @@ impl Collision {
             .collect();
         let mut moved = 0;
         for (s, tight, sweep) in blocks.into_iter().flatten() {
-            let shape = self.shapes.at_mut(s);
+            let shape = shapes.at_mut(s);
             shape.aabb = tight;
-            if self
-                .broadphase
-                .move_proxy_in_batch_swept(shape.proxy, bounded(tight), sweep)
-            {
+            if broadphase.move_proxy_in_batch_swept(shape.proxy, bounded(tight), sweep) {
                 moved += 1;
             }
         }
-        self.broadphase.finish_moves();
-        self.counters.proxies_moved = moved;
+        broadphase.finish_moves();
+        moved
     }
 
     /// Moves a body's shape proxies to the tree of its (new) type: each is

@@ -259,8 +259,8 @@ pub(crate) struct NarrowphaseInput<'a> {
 
 impl Narrowphase {
     /// Where the solver holds each awake contact's impulses this step, by
-    /// awake position (as the last constraint building left them).
-    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
+    /// awake position (as the last constraint building left them; empty on
+    /// one thread).
     pub(crate) fn places_by_contact(&self) -> &[LanePlace] {
         &self.place_of
     }

@@ -1530,24 +1530,52 @@ impl World {
         }
         lap();
         if has_shapes {
-            let c = &self.collision;
-            let input = crate::continuous::ContinuousInput {
-                shapes: &c.shapes,
-                broadphase: &c.broadphase,
-                no_collide: &self.joints.no_collide,
-                clipping: self.portals.clipping(),
+            // Two stages that share nothing run side by side (one after the
+            // other on one thread): the impulses go back into the contacts,
+            // while continuous collision moves fast bodies and the proxies
+            // follow the new poses.
+            let crate::collision::Collision {
+                shapes,
+                broadphase,
+                contacts,
+                narrowphase,
+                counters,
+                ..
+            } = &mut self.collision;
+            let (solver, places) = (&self.contact_solver, narrowphase.places_by_contact());
+            let mut store =
+                move || crate::collision::Collision::store_impulses(contacts, places, solver);
+            let (bodies, continuous) = (&mut self.bodies, &mut self.continuous);
+            let (no_collide, clipping) = (&self.joints.no_collide, self.portals.clipping());
+            let mut advance = move || {
+                let start = std::time::Instant::now();
+                let input = crate::continuous::ContinuousInput {
+                    shapes,
+                    broadphase,
+                    no_collide,
+                    clipping,
+                };
+                continuous.run(bodies, &input);
+                let continuous_time = start.elapsed().as_secs_f64();
+                counters.proxies_moved =
+                    crate::collision::Collision::update_proxies(shapes, broadphase, bodies, dt);
+                continuous_time
             };
-            self.continuous.run(&mut self.bodies, &input);
-            sp.continuous += lap();
-        }
-        if has_shapes {
-            self.collision.store_impulses(&self.contact_solver);
+            #[cfg(feature = "parallel")]
+            let ((), continuous_time) = if rayon::current_num_threads() > 1 {
+                rayon::join(store, advance)
+            } else {
+                (store(), advance())
+            };
+            #[cfg(not(feature = "parallel"))]
+            let ((), continuous_time) = (store(), advance());
             if self.collision.shapes.hit_event_shapes() > 0 {
                 self.collision
                     .collect_hits(&self.contact_solver, self.hit_event_threshold);
             }
-            self.collision.update_proxies(&self.bodies, dt);
-            sp.broadphase += lap();
+            let both = lap();
+            sp.continuous += continuous_time;
+            sp.broadphase += both - continuous_time;
         }
         if has_portals {
             self.portal_crossings();
