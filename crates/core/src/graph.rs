@@ -138,6 +138,11 @@ pub struct ConstraintGraph {
     members: Vec<u32>,
     /// The current step's stamp.
     stamp: u32,
+    /// Members kept (stamped) since [`ConstraintGraph::begin_step`]: when
+    /// that is every member, the sweep has nothing to remove and skips its
+    /// pass (a settled scene's usual step).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    kept: usize,
 }
 
 impl ConstraintGraph {
@@ -157,6 +162,7 @@ impl ConstraintGraph {
             }
             self.stamp = 1;
         }
+        self.kept = 0;
     }
 
     /// The colour of constraint `id` between the bodies with keys `keys`
@@ -170,6 +176,8 @@ impl ConstraintGraph {
         }
         let entry = self.entries[i];
         if entry.colour != GraphEntry::OUT {
+            // (A second keep of the same id in a step counts once.)
+            self.kept += usize::from(entry.stamp != self.stamp);
             if entry.keys == keys && (entry.colour as usize) < COLOURS {
                 self.entries[i].stamp = self.stamp;
                 return entry.colour;
@@ -178,6 +186,7 @@ impl ConstraintGraph {
             self.clear_bits(entry);
         } else {
             self.members.push(id);
+            self.kept += 1;
         }
         let colour = self.find_colour(keys);
         if (colour as usize) < COLOURS {
@@ -198,6 +207,9 @@ impl ConstraintGraph {
     /// Every constraint not kept since [`ConstraintGraph::begin_step`]
     /// leaves the graph (its bodies' colour bits are cleared).
     pub fn sweep(&mut self) {
+        if self.kept == self.members.len() {
+            return;
+        }
         let mut members = std::mem::take(&mut self.members);
         members.retain(|&id| {
             let entry = self.entries[id as usize];
@@ -373,6 +385,30 @@ mod tests {
         g.sweep();
         g.begin_step();
         assert_eq!(g.keep(extra, [0, extra + 1]), 0);
+        g.check().unwrap();
+    }
+
+    #[test]
+    fn sweep_skip_counts_a_constraint_kept_twice_in_a_step_once() {
+        let mut g = ConstraintGraph::new();
+        g.begin_step();
+        g.keep(0, [1, 2]);
+        g.keep(1, [3, 4]);
+        g.sweep();
+        assert_eq!(g.len(), 2);
+        // Constraint 0 kept twice, constraint 1 not at all: two keeps
+        // for two members, yet 1 must leave.
+        g.begin_step();
+        assert_eq!(g.keep(0, [1, 2]), 0);
+        assert_eq!(g.keep(0, [1, 2]), 0);
+        g.sweep();
+        g.check().unwrap();
+        assert_eq!(g.len(), 1, "constraint 1 was not kept: it left");
+        // Every member kept: the sweep keeps them all.
+        g.begin_step();
+        g.keep(0, [1, 2]);
+        g.sweep();
+        assert_eq!(g.len(), 1);
         g.check().unwrap();
     }
 }
