@@ -136,8 +136,40 @@ impl ContinuousStage {
         }
         self.counters.toi_bodies = self.fast.len() + self.bullets.len();
         let fast = std::mem::take(&mut self.fast);
-        for &i in &fast {
-            self.sweep_body(i as usize, bodies, input, false);
+        // Fast bodies that are not bullets sweep against static shapes
+        // only, so no one's sweep reads another's move: with threads their
+        // impacts are found at once and applied after, in the same order.
+        #[cfg(feature = "parallel")]
+        let parallel = rayon::current_num_threads() > 1 && fast.len() >= PARALLEL_FAST;
+        #[cfg(not(feature = "parallel"))]
+        let parallel = false;
+        if parallel {
+            #[cfg(feature = "parallel")]
+            {
+                use rayon::prelude::*;
+                let read = &*bodies;
+                let impacts: Vec<(Real, usize)> = fast
+                    .par_iter()
+                    .with_min_len(8)
+                    .map_init(Vec::new, |candidates, &i| {
+                        let mut calls = 0;
+                        let sweep = sweep_of(read, i as usize);
+                        let handle = read.sims[i as usize].handle;
+                        let fraction = first_impact(
+                            handle, &sweep, read, input, false, candidates, &mut calls,
+                        );
+                        (fraction, calls)
+                    })
+                    .collect();
+                for (&i, &(fraction, calls)) in fast.iter().zip(&impacts) {
+                    self.counters.toi_calls += calls;
+                    self.move_back(i as usize, bodies, fraction);
+                }
+            }
+        } else {
+            for &i in &fast {
+                self.sweep_body(i as usize, bodies, input, false);
+            }
         }
         self.fast = fast;
         let bullets = std::mem::take(&mut self.bullets);
@@ -155,180 +187,204 @@ impl ContinuousStage {
         input: &ContinuousInput<'_>,
         bullet: bool,
     ) {
-        let sim = &bodies.sims[i];
-        let sweep = Sweep::between(
-            sim.local_center,
-            sim.center0,
-            sim.rotation0,
-            sim.center,
-            sim.transform.q,
+        let sweep = sweep_of(bodies, i);
+        let handle = bodies.sims[i].handle;
+        let fraction = first_impact(
+            handle,
+            &sweep,
+            bodies,
+            input,
+            bullet,
+            &mut self.candidates,
+            &mut self.counters.toi_calls,
         );
-        let fraction = self.first_impact(sim.handle, &sweep, bodies, input, bullet);
+        self.move_back(i, bodies, fraction);
+    }
+
+    /// Moves body `i` back to `fraction` of its step's sweep (nothing at 1).
+    fn move_back(&mut self, i: usize, bodies: &mut BodySet, fraction: Real) {
         if fraction < 1.0 {
+            let sweep = sweep_of(bodies, i);
             let sim = &mut bodies.sims[i];
             sim.transform = sweep.transform_at(fraction);
             sim.center = sweep.center_at(fraction);
             self.counters.toi_hits += 1;
         }
     }
+}
 
-    /// The first fraction of the step at which the body's sweep meets what
-    /// it may not pass (1: nothing).
-    fn first_impact(
-        &mut self,
-        body: janus2d_core::body::BodyHandle,
-        sweep: &Sweep,
-        bodies: &BodySet,
-        input: &ContinuousInput<'_>,
-        bullet: bool,
-    ) -> Real {
-        let shapes = input.shapes;
-        let bp = input.broadphase;
-        let xf1 = sweep.transform_at(0.0);
-        let xf2 = sweep.transform_at(1.0);
-        let mut best: Real = 1.0;
-        for &s in shapes.of_body(body) {
-            let fast_shape = shapes.at(s);
-            if fast_shape.def.is_sensor {
-                continue;
-            }
-            let geometry = &fast_shape.geometry;
-            let proxy = ShapeProxy::from_shape(geometry);
-            let swept = geometry
-                .compute_aabb(&xf1)
-                .union(&geometry.compute_aabb(&xf2));
-            let centroid = geometry.centroid();
-            let (c1, c2) = (xf1.apply(centroid), xf2.apply(centroid));
-            let shape_min = shape_extent(geometry, centroid).min_extent;
-            let mut candidates = std::mem::take(&mut self.candidates);
-            candidates.clear();
-            bp.static_tree().query(&swept, |proxy| {
+/// Fast bodies from which the non-bullet sweeps run on threads.
+#[cfg(feature = "parallel")]
+const PARALLEL_FAST: usize = 32;
+
+/// Body `i`'s sweep over the step (start pose to the solve's end pose).
+fn sweep_of(bodies: &BodySet, i: usize) -> Sweep {
+    let sim = &bodies.sims[i];
+    Sweep::between(
+        sim.local_center,
+        sim.center0,
+        sim.rotation0,
+        sim.center,
+        sim.transform.q,
+    )
+}
+
+/// The first fraction of the step at which the body's sweep meets what it
+/// may not pass (1: nothing); `candidates` is scratch, `toi_calls` counts
+/// the time-of-impact searches.
+fn first_impact(
+    body: janus2d_core::body::BodyHandle,
+    sweep: &Sweep,
+    bodies: &BodySet,
+    input: &ContinuousInput<'_>,
+    bullet: bool,
+    candidates: &mut Vec<u32>,
+    toi_calls: &mut usize,
+) -> Real {
+    let shapes = input.shapes;
+    let bp = input.broadphase;
+    let xf1 = sweep.transform_at(0.0);
+    let xf2 = sweep.transform_at(1.0);
+    let mut best: Real = 1.0;
+    for &s in shapes.of_body(body) {
+        let fast_shape = shapes.at(s);
+        if fast_shape.def.is_sensor {
+            continue;
+        }
+        let geometry = &fast_shape.geometry;
+        let proxy = ShapeProxy::from_shape(geometry);
+        let swept = geometry
+            .compute_aabb(&xf1)
+            .union(&geometry.compute_aabb(&xf2));
+        let centroid = geometry.centroid();
+        let (c1, c2) = (xf1.apply(centroid), xf2.apply(centroid));
+        let shape_min = shape_extent(geometry, centroid).min_extent;
+        candidates.clear();
+        bp.static_tree().query(&swept, |proxy| {
+            candidates.push(bp.payload(proxy));
+            true
+        });
+        if bullet {
+            bp.dynamic_tree().query(&swept, |proxy| {
                 candidates.push(bp.payload(proxy));
                 true
             });
-            if bullet {
-                bp.dynamic_tree().query(&swept, |proxy| {
-                    candidates.push(bp.payload(proxy));
-                    true
-                });
-            }
-            // Tree order depends on history; the answer must not.
-            candidates.sort_unstable();
-            candidates.dedup();
-            for &other_slot in &candidates {
-                let other = shapes.at(other_slot);
-                if other.body == body
-                    || other.def.is_sensor
-                    || !fast_shape.def.filter.should_collide(&other.def.filter)
-                    || input.no_collide.contains(body, other.body)
-                    || input.clipping.ignores(body, other.body)
-                {
-                    continue;
-                }
-                let Some(other_sim) = bodies.sim(other.body) else {
-                    continue;
-                };
-                let other_sweep = if other_sim.body_type == BodyType::Static {
-                    Sweep::stationary(&other_sim.transform)
-                } else {
-                    if other_sim.bullet {
-                        continue; // bullets do not sweep against bullets
-                    }
-                    match bodies.location(other.body) {
-                        Some(BodyLocation::Moving(_)) => Sweep::between(
-                            other_sim.local_center,
-                            other_sim.center0,
-                            other_sim.rotation0,
-                            other_sim.center,
-                            other_sim.transform.q,
-                        ),
-                        _ => Sweep::stationary(&other_sim.transform),
-                    }
-                };
-                // One-sided chain segments: only a centroid that goes from
-                // the front to behind the segment's line is stopped, and it
-                // never crosses the segment itself (a shape pressed deep into
-                // the chain, where the time of impact sees an overlap, would
-                // escape once its centre is behind).
-                let mut chain_fraction: Real = 1.0;
-                if let Shape::ChainSegment(chain) = &other.geometry {
-                    let xf = other_sim.transform;
-                    let p1 = xf.apply(chain.segment.point1);
-                    let p2 = xf.apply(chain.segment.point2);
-                    let n = xf.q.rotate(chain.normal());
-                    let (o1, o2) = ((c1 - p1).dot(n), (c2 - p1).dot(n));
-                    if o2 > 0.0 || o1 == o2 || o1 < -HUG_FRACTION * shape_min {
-                        continue; // ends in front, or started well behind
-                    }
-                    let e = p2 - p1;
-                    let slack = LINEAR_SLOP / e.length();
-                    let within = |x: Vec2| {
-                        let along = (x - p1).dot(e) / e.length_squared();
-                        (-slack..=1.0 + slack).contains(&along)
-                    };
-                    // Where the centroid's path meets the line (its start
-                    // when it starts behind).
-                    let crossing = if o1 > 0.0 {
-                        c1 + (o1 / (o1 - o2)) * (c2 - c1)
-                    } else {
-                        c1
-                    };
-                    if within(crossing) || (o1 <= 0.0 && within(c2)) {
-                        chain_fraction = if o1 <= LINEAR_SLOP {
-                            // Hugging the chain (pressed into it, up to a
-                            // fraction of its extent behind): held where it
-                            // started rather than let out.
-                            0.0
-                        } else {
-                            (o1 - LINEAR_SLOP) / (o1 - o2)
-                        };
-                    }
-                }
-                let other_proxy = ShapeProxy::from_shape(&other.geometry);
-                self.counters.toi_calls += 1;
-                let out = time_of_impact(&other_proxy, &other_sweep, &proxy, sweep, best);
-                let usable = |state: ToiState| matches!(state, ToiState::Hit | ToiState::Failed);
-                let mut hit = None;
-                if out.fraction > 0.0 && out.fraction < best && usable(out.state) {
-                    hit = Some((out.fraction, proxy));
-                } else if out.fraction == 0.0 && out.state != ToiState::Separated {
-                    // Touching at the start: a small disc at the centroid
-                    // still must not pass (Box2D's fallback).
-                    let mut small = ShapeProxy::point(centroid);
-                    small.radius = 0.25 * shape_min;
-                    self.counters.toi_calls += 1;
-                    let out = time_of_impact(&other_proxy, &other_sweep, &small, sweep, best);
-                    if out.fraction > 0.0 && out.fraction < best && usable(out.state) {
-                        hit = Some((out.fraction, small));
-                    }
-                }
-                if chain_fraction < best && hit.is_none_or(|(f, _)| chain_fraction < f) {
-                    let mut centre = ShapeProxy::point(centroid);
-                    centre.radius = 0.0;
-                    hit = Some((chain_fraction, centre));
-                }
-                let Some((fraction, hit_proxy)) = hit else {
-                    continue;
-                };
-                if !input.clipping.clips.is_empty() {
-                    // A hit inside an aperture's hole is no hit: the body
-                    // goes through the portal instead.
-                    let d = shape_distance(
-                        &other_proxy,
-                        &other_sweep.transform_at(fraction),
-                        &hit_proxy,
-                        &sweep.transform_at(fraction),
-                    );
-                    if input.clipping.in_hole_for(other.body, body, d.point_a) {
-                        continue;
-                    }
-                }
-                best = fraction;
-            }
-            self.candidates = candidates;
         }
-        best.min(aperture_fraction(body, sweep, input.clipping))
+        // Tree order depends on history; the answer must not.
+        candidates.sort_unstable();
+        candidates.dedup();
+        for &other_slot in candidates.iter() {
+            let other = shapes.at(other_slot);
+            if other.body == body
+                || other.def.is_sensor
+                || !fast_shape.def.filter.should_collide(&other.def.filter)
+                || input.no_collide.contains(body, other.body)
+                || input.clipping.ignores(body, other.body)
+            {
+                continue;
+            }
+            let Some(other_sim) = bodies.sim(other.body) else {
+                continue;
+            };
+            let other_sweep = if other_sim.body_type == BodyType::Static {
+                Sweep::stationary(&other_sim.transform)
+            } else {
+                if other_sim.bullet {
+                    continue; // bullets do not sweep against bullets
+                }
+                match bodies.location(other.body) {
+                    Some(BodyLocation::Moving(_)) => Sweep::between(
+                        other_sim.local_center,
+                        other_sim.center0,
+                        other_sim.rotation0,
+                        other_sim.center,
+                        other_sim.transform.q,
+                    ),
+                    _ => Sweep::stationary(&other_sim.transform),
+                }
+            };
+            // One-sided chain segments: only a centroid that goes from
+            // the front to behind the segment's line is stopped, and it
+            // never crosses the segment itself (a shape pressed deep into
+            // the chain, where the time of impact sees an overlap, would
+            // escape once its centre is behind).
+            let mut chain_fraction: Real = 1.0;
+            if let Shape::ChainSegment(chain) = &other.geometry {
+                let xf = other_sim.transform;
+                let p1 = xf.apply(chain.segment.point1);
+                let p2 = xf.apply(chain.segment.point2);
+                let n = xf.q.rotate(chain.normal());
+                let (o1, o2) = ((c1 - p1).dot(n), (c2 - p1).dot(n));
+                if o2 > 0.0 || o1 == o2 || o1 < -HUG_FRACTION * shape_min {
+                    continue; // ends in front, or started well behind
+                }
+                let e = p2 - p1;
+                let slack = LINEAR_SLOP / e.length();
+                let within = |x: Vec2| {
+                    let along = (x - p1).dot(e) / e.length_squared();
+                    (-slack..=1.0 + slack).contains(&along)
+                };
+                // Where the centroid's path meets the line (its start
+                // when it starts behind).
+                let crossing = if o1 > 0.0 {
+                    c1 + (o1 / (o1 - o2)) * (c2 - c1)
+                } else {
+                    c1
+                };
+                if within(crossing) || (o1 <= 0.0 && within(c2)) {
+                    chain_fraction = if o1 <= LINEAR_SLOP {
+                        // Hugging the chain (pressed into it, up to a
+                        // fraction of its extent behind): held where it
+                        // started rather than let out.
+                        0.0
+                    } else {
+                        (o1 - LINEAR_SLOP) / (o1 - o2)
+                    };
+                }
+            }
+            let other_proxy = ShapeProxy::from_shape(&other.geometry);
+            *toi_calls += 1;
+            let out = time_of_impact(&other_proxy, &other_sweep, &proxy, sweep, best);
+            let usable = |state: ToiState| matches!(state, ToiState::Hit | ToiState::Failed);
+            let mut hit = None;
+            if out.fraction > 0.0 && out.fraction < best && usable(out.state) {
+                hit = Some((out.fraction, proxy));
+            } else if out.fraction == 0.0 && out.state != ToiState::Separated {
+                // Touching at the start: a small disc at the centroid
+                // still must not pass (Box2D's fallback).
+                let mut small = ShapeProxy::point(centroid);
+                small.radius = 0.25 * shape_min;
+                *toi_calls += 1;
+                let out = time_of_impact(&other_proxy, &other_sweep, &small, sweep, best);
+                if out.fraction > 0.0 && out.fraction < best && usable(out.state) {
+                    hit = Some((out.fraction, small));
+                }
+            }
+            if chain_fraction < best && hit.is_none_or(|(f, _)| chain_fraction < f) {
+                let mut centre = ShapeProxy::point(centroid);
+                centre.radius = 0.0;
+                hit = Some((chain_fraction, centre));
+            }
+            let Some((fraction, hit_proxy)) = hit else {
+                continue;
+            };
+            if !input.clipping.clips.is_empty() {
+                // A hit inside an aperture's hole is no hit: the body
+                // goes through the portal instead.
+                let d = shape_distance(
+                    &other_proxy,
+                    &other_sweep.transform_at(fraction),
+                    &hit_proxy,
+                    &sweep.transform_at(fraction),
+                );
+                if input.clipping.in_hole_for(other.body, body, d.point_a) {
+                    continue;
+                }
+            }
+            best = fraction;
+        }
     }
+    best.min(aperture_fraction(body, sweep, input.clipping))
 }
 
 /// The fraction at which the body's centre, crossing a portal aperture from
