@@ -368,7 +368,7 @@ impl ContactSolver {
         // in cache; the per-colour lists below read the contacts out of
         // order, which only pays when threads share the filling.
         #[cfg(feature = "parallel")]
-        let serial = rayon::current_num_threads() == 1;
+        let serial = rayon::current_num_threads() == 1 || colours.len() < PARALLEL_PUSH;
         #[cfg(not(feature = "parallel"))]
         let serial = true;
         if serial || self.colours.iter().any(|c| !c.is_empty()) {
@@ -667,6 +667,12 @@ const CHUNKS_PER_BLOCK: usize = 4;
 /// chunks: 0.96 ms of solver per step on 2 threads against 0.61 on one
 /// when every colour of more than 4 chunks went to the team).
 const SERIAL_CHUNKS: usize = 32;
+
+/// Contacts from which [`ContactSolver::push_all`] fills the chunks on
+/// threads (fewer are pushed in order on the caller: the lists and tasks
+/// cost more than the filling).
+#[cfg(feature = "parallel")]
+const PARALLEL_PUSH: usize = 4096;
 
 /// Chunks per block for `chunks` chunks on `team`: about four blocks per
 /// thread (each claim is an atomic increment on a shared line), at least

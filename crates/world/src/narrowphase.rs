@@ -131,6 +131,11 @@ pub(crate) struct Narrowphase {
     excluded: Vec<u32>,
 }
 
+/// Touching contacts from which constraint building's first pass runs on
+/// threads (below, the tasks cost more than the pass).
+#[cfg(feature = "parallel")]
+const PARALLEL_BUILD: usize = 4096;
+
 /// [`Narrowphase::place_of`] of a contact that is not solved this step.
 #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
 const UNSOLVED: LanePlace = LanePlace {
@@ -746,7 +751,11 @@ pub(crate) fn build_constraints(
     // most of what the leader did alone between the narrowphase and the
     // solve.
     #[cfg(feature = "parallel")]
-    let parallel = pre_solve.is_none() && !woke && scanned == n && rayon::current_num_threads() > 1;
+    let parallel = pre_solve.is_none()
+        && !woke
+        && scanned == n
+        && rayon::current_num_threads() > 1
+        && narrowphase.touching.len() >= PARALLEL_BUILD;
     #[cfg(not(feature = "parallel"))]
     let parallel = false;
     if parallel {
