@@ -515,6 +515,11 @@ impl BroadPhase {
         out: &mut Vec<(u32, u32)>,
     ) {
         out.clear();
+        if self.static_tree.is_unbalanced() {
+            // Static shapes added in an unlucky order (checked each step,
+            // O(1); rebuilt rarely: a rebuilt tree is balanced).
+            self.static_tree.rebuild_all(&mut self.rebuild_items);
+        }
         let mut moves = std::mem::take(&mut self.move_buffer);
         moves.sort_unstable();
         moves.dedup();

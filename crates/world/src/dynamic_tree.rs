@@ -71,6 +71,12 @@ use janus2d_core::math::{Real, Vec2};
 /// The "no node" index (`u32::MAX`), used for absent parents and children.
 pub const NULL_NODE: u32 = u32::MAX;
 
+/// Levels a tree may grow above a balanced one (`⌈log₂ n⌉`) before
+/// [`DynamicTree::is_unbalanced`] says so: the insertion heuristics keep
+/// random inserts within a few levels; a static ground inserted box by box
+/// along a row went 12 levels over (height 24 for 2,505 boxes, rain).
+pub const SLACK_LEVELS: u32 = 6;
+
 /// Default fat-box margin, in metres (0.1 m): how far a shape may move
 /// before its proxy is re-inserted into the tree.
 pub const DEFAULT_AABB_MARGIN: Real = 0.1;
@@ -409,6 +415,41 @@ impl DynamicTree {
         }
         self.root = self.build_top_down(items);
         self.nodes[self.root as usize].parent = NULL_NODE;
+    }
+
+    /// Rebuilds the whole tree top down as [`rebuild`](Self::rebuild) does
+    /// the enlarged part: every internal node is freed and the leaves are
+    /// joined again, each node split at the middle of its leaves' centres
+    /// along the longer axis. Proxy ids (the leaves) do not change. For a
+    /// tree grown one insertion at a time in an unlucky order (a static
+    /// ground of boxes inserted row by row grows tall and overlapping).
+    pub fn rebuild_all(&mut self, items: &mut Vec<u32>) {
+        items.clear();
+        if self.root == NULL_NODE {
+            return;
+        }
+        let mut stack = NodeStack::new(self.root);
+        while let Some(index) = stack.pop() {
+            let node = self.nodes[index as usize];
+            if node.is_leaf() {
+                items.push(index);
+            } else {
+                stack.push(node.child2);
+                stack.push(node.child1);
+                self.free_node(index);
+            }
+        }
+        self.root = self.build_top_down(items);
+        self.nodes[self.root as usize].parent = NULL_NODE;
+    }
+
+    /// Whether the tree is taller than a balanced one by more than
+    /// [`SLACK_LEVELS`] levels (see [`rebuild_all`](Self::rebuild_all)).
+    #[must_use]
+    pub fn is_unbalanced(&self) -> bool {
+        let n = self.proxy_count();
+        let balanced = usize::BITS - n.leading_zeros();
+        self.height() > balanced + SLACK_LEVELS
     }
 
     /// Joins `items` (roots of subtrees) under new internal nodes, top down
@@ -1436,6 +1477,56 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_ground_inserted_row_by_row_is_rebuilt_balanced_with_the_same_overlaps() {
+        // Rain's ground: 5 rows 45 m apart of 501 boxes of half-width
+        // 0.25 m, inserted box by box along each row.
+        let mut tree = DynamicTree::with_margin(0.0);
+        let mut id = 0;
+        for row in 0..5 {
+            for j in 0..=500 {
+                let (x, y) = (-125.0 + 0.5 * j as Real, 45.0 * row as Real);
+                tree.create_proxy(boxed(x, y, 0.25, 0.25), id);
+                id += 1;
+            }
+        }
+        assert!(tree.is_unbalanced(), "height {}", tree.height());
+        let (height, ratio) = (tree.height(), tree.area_ratio());
+        let probes: Vec<Aabb> = (0..50)
+            .map(|k| boxed(-130.0 + 5.3 * k as Real, 45.0 * (k % 5) as Real, 0.8, 0.6))
+            .collect();
+        let hits = |t: &DynamicTree| -> Vec<Vec<u32>> {
+            probes
+                .iter()
+                .map(|b| {
+                    let mut found = Vec::new();
+                    t.query(b, |u| {
+                        found.push(u);
+                        true
+                    });
+                    found.sort_unstable();
+                    found
+                })
+                .collect()
+        };
+        let before = hits(&tree);
+        tree.rebuild_all(&mut Vec::new());
+        tree.validate();
+        assert!(!tree.is_unbalanced());
+        // ⌈log₂ 2,505⌉ = 12.
+        assert!(tree.height() <= 13, "height {height} -> {}", tree.height());
+        assert!(
+            tree.area_ratio() < 0.5 * ratio,
+            "area ratio {ratio} -> {}",
+            tree.area_ratio()
+        );
+        assert_eq!(hits(&tree), before);
+        assert!(
+            before.iter().any(|h| h.len() > 4),
+            "the probes touch the ground"
+        );
     }
 
     #[test]
