@@ -6,8 +6,8 @@
 //!   ├─ portal clipping (portal stage; a no-op without portal pairs)
 //!   ├─ broadphase: new pairs ─ narrowphase ─ wake touched islands ─ contact constraints
 //!   ├─ solve_step (janus2d-core): prepare ─ substeps ─ restitution ─ store ─ finalize
-//!   ├─ continuous: fast bodies swept, moved back to their time of impact
-//!   ├─ store impulses ─ move proxies
+//!   ├─ store impulses  ∥  continuous (fast bodies swept, moved back to
+//!   │                     their time of impact) ─ move proxies
 //!   ├─ portal crossings (commands applied by the world)
 //!   ├─ islands: sleep timers, resting islands sleep
 //!   └─ counters, events (non-finite bodies, contacts, sensors)
