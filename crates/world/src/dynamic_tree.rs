@@ -402,19 +402,7 @@ impl DynamicTree {
             return;
         }
         // The items: leaves and untouched subtrees under enlarged nodes.
-        let mut stack = NodeStack::new(self.root);
-        while let Some(index) = stack.pop() {
-            let node = self.nodes[index as usize];
-            if node.is_leaf() || !node.enlarged {
-                items.push(index);
-            } else {
-                stack.push(node.child2);
-                stack.push(node.child1);
-                self.free_node(index);
-            }
-        }
-        self.root = self.build_top_down(items);
-        self.nodes[self.root as usize].parent = NULL_NODE;
+        self.rejoin(items, false);
     }
 
     /// Rebuilds the whole tree top down as [`rebuild`](Self::rebuild) does
@@ -428,10 +416,17 @@ impl DynamicTree {
         if self.root == NULL_NODE {
             return;
         }
+        self.rejoin(items, true);
+    }
+
+    /// Frees the internal nodes from the root down to the items (the
+    /// leaves, and with `whole` false the subtrees not enlarged), collects
+    /// the items and joins them again top down under a new root.
+    fn rejoin(&mut self, items: &mut Vec<u32>, whole: bool) {
         let mut stack = NodeStack::new(self.root);
         while let Some(index) = stack.pop() {
             let node = self.nodes[index as usize];
-            if node.is_leaf() {
+            if node.is_leaf() || !(whole || node.enlarged) {
                 items.push(index);
             } else {
                 stack.push(node.child2);
