@@ -300,15 +300,48 @@ impl Collision {
         }
     }
 
+    /// The step's end for the pipeline: the solved impulses go back into
+    /// the contacts while `advance` (continuous collision: it moves fast
+    /// bodies, reading the shapes and the broadphase) runs and the proxies
+    /// then follow the new poses. The two halves share no data: with
+    /// threads they run side by side (`rayon::join`), on one thread one
+    /// after the other; the result is the same. Returns what `advance`
+    /// returned.
+    pub(crate) fn end_step<R: Send>(
+        &mut self,
+        solver: &ContactSolver,
+        bodies: &mut BodySet,
+        dt: Real,
+        advance: impl FnOnce(&mut BodySet, &ShapeStore, &BroadPhase) -> R + Send,
+    ) -> R {
+        let Collision {
+            shapes,
+            broadphase,
+            contacts,
+            narrowphase,
+            counters,
+            ..
+        } = self;
+        let places = narrowphase.places_by_contact();
+        let mut store = move || Self::store_impulses(contacts, places, solver);
+        let rest = move || {
+            let out = advance(bodies, shapes, broadphase);
+            counters.proxies_moved = Self::update_proxies(shapes, broadphase, bodies, dt);
+            out
+        };
+        #[cfg(feature = "parallel")]
+        if rayon::current_num_threads() > 1 {
+            return rayon::join(store, rest).1;
+        }
+        store();
+        rest()
+    }
+
     /// Copies solved impulses back into the contacts (for warm starting);
     /// `places` is where the solver holds each awake contact's impulses
-    /// ([`Narrowphase::places_by_contact`]). Touches only the contacts, so
-    /// it may run beside [`Collision::update_proxies`].
-    pub(crate) fn store_impulses(
-        contacts: &mut ContactSet,
-        places: &[LanePlace],
-        solver: &ContactSolver,
-    ) {
+    /// ([`Narrowphase::places_by_contact`]). Touches only the contacts (see
+    /// [`Collision::end_step`]).
+    fn store_impulses(contacts: &mut ContactSet, places: &[LanePlace], solver: &ContactSolver) {
         #[cfg(not(feature = "parallel"))]
         let _ = places;
         // A non-finite impulse (a solve that blew up) is not kept for warm
@@ -362,8 +395,8 @@ impl Collision {
     /// A fast body's proxy box covers the shape now and where its velocity
     /// takes it within `dt`, so pairs exist before it arrives. Returns the
     /// number of proxies moved. Touches only the shapes and the
-    /// broadphase, so it may run beside [`Collision::store_impulses`].
-    pub(crate) fn update_proxies(
+    /// broadphase (see [`Collision::end_step`]).
+    fn update_proxies(
         shapes: &mut ShapeStore,
         broadphase: &mut BroadPhase,
         bodies: &BodySet,

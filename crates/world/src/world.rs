@@ -1530,45 +1530,26 @@ impl World {
         }
         lap();
         if has_shapes {
-            // Two stages that share nothing run side by side (one after the
-            // other on one thread): the impulses go back into the contacts,
-            // while continuous collision moves fast bodies and the proxies
-            // follow the new poses.
-            let crate::collision::Collision {
-                shapes,
-                broadphase,
-                contacts,
-                narrowphase,
-                counters,
-                ..
-            } = &mut self.collision;
-            let (solver, places) = (&self.contact_solver, narrowphase.places_by_contact());
-            let mut store =
-                move || crate::collision::Collision::store_impulses(contacts, places, solver);
-            let (bodies, continuous) = (&mut self.bodies, &mut self.continuous);
+            // The impulses go back into the contacts beside continuous
+            // collision and the proxy update (`Collision::end_step`).
+            let continuous = &mut self.continuous;
             let (no_collide, clipping) = (&self.joints.no_collide, self.portals.clipping());
-            let mut advance = move || {
-                let start = std::time::Instant::now();
-                let input = crate::continuous::ContinuousInput {
-                    shapes,
-                    broadphase,
-                    no_collide,
-                    clipping,
-                };
-                continuous.run(bodies, &input);
-                let continuous_time = start.elapsed().as_secs_f64();
-                counters.proxies_moved =
-                    crate::collision::Collision::update_proxies(shapes, broadphase, bodies, dt);
-                continuous_time
-            };
-            #[cfg(feature = "parallel")]
-            let ((), continuous_time) = if rayon::current_num_threads() > 1 {
-                rayon::join(store, advance)
-            } else {
-                (store(), advance())
-            };
-            #[cfg(not(feature = "parallel"))]
-            let ((), continuous_time) = (store(), advance());
+            let continuous_time = self.collision.end_step(
+                &self.contact_solver,
+                &mut self.bodies,
+                dt,
+                |bodies, shapes, broadphase| {
+                    let start = std::time::Instant::now();
+                    let input = crate::continuous::ContinuousInput {
+                        shapes,
+                        broadphase,
+                        no_collide,
+                        clipping,
+                    };
+                    continuous.run(bodies, &input);
+                    start.elapsed().as_secs_f64()
+                },
+            );
             if self.collision.shapes.hit_event_shapes() > 0 {
                 self.collision
                     .collect_hits(&self.contact_solver, self.hit_event_threshold);
