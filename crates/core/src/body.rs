@@ -419,6 +419,18 @@ pub struct BodySim {
 }
 
 impl BodySim {
+    /// Whether the pose (origin, centre of mass, rotation) is finite with
+    /// every coordinate within `max_coordinate`, m (the solver's finalize
+    /// and [`BodySet::reset_escaped`] ask it).
+    #[inline]
+    #[must_use]
+    pub fn pose_within(&self, max_coordinate: Real) -> bool {
+        let inside = |p: Vec2| {
+            vec_is_finite(p) && p.x.abs() <= max_coordinate && p.y.abs() <= max_coordinate
+        };
+        inside(self.transform.p) && inside(self.center) && self.transform.q.is_finite()
+    }
+
     /// The [`BodyState::flags`] of this body's state.
     #[inline]
     #[must_use]
@@ -931,13 +943,9 @@ impl BodySet {
     /// its handle to `out`. Run after a solve: the solver's own check sees
     /// velocities and deltas, this one the pose they produced.
     pub fn reset_escaped(&mut self, max_coordinate: Real, out: &mut Vec<BodyHandle>) {
-        let inside = |p: Vec2| {
-            vec_is_finite(p) && p.x.abs() <= max_coordinate && p.y.abs() <= max_coordinate
-        };
         let BodySet { sims, states, .. } = self;
         for (sim, state) in sims.iter_mut().zip(states.iter_mut()).skip(1) {
-            let ok = inside(sim.transform.p) && inside(sim.center) && sim.transform.q.is_finite();
-            if ok {
+            if sim.pose_within(max_coordinate) {
                 continue;
             }
             sim.center = sim.center0;

@@ -549,7 +549,6 @@ fn finalize_bodies(bodies: &mut BodySet, report: &mut SolveReport, team: &Team) 
             && vec_is_finite(state.dp)
             && state.dq.is_finite()
     };
-    let inside = |p: Vec2| vec_is_finite(p) && p.x.abs() <= POSE_LIMIT && p.y.abs() <= POSE_LIMIT;
     let any_bad = std::sync::atomic::AtomicBool::new(false);
     let any_outside = std::sync::atomic::AtomicBool::new(false);
     let BodySet { sims, states, .. } = bodies;
@@ -566,8 +565,7 @@ fn finalize_bodies(bodies: &mut BodySet, report: &mut SolveReport, team: &Team) 
             } else {
                 any_bad.store(true, std::sync::atomic::Ordering::Relaxed);
             }
-            outside |=
-                !(inside(sim.transform.p) && inside(sim.center) && sim.transform.q.is_finite());
+            outside |= !sim.pose_within(POSE_LIMIT);
         }
         if outside {
             any_outside.store(true, std::sync::atomic::Ordering::Relaxed);

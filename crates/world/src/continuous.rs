@@ -153,11 +153,8 @@ impl ContinuousStage {
                     .with_min_len(8)
                     .map_init(Vec::new, |candidates, &i| {
                         let mut calls = 0;
-                        let sweep = sweep_of(read, i as usize);
-                        let handle = read.sims[i as usize].handle;
-                        let fraction = first_impact(
-                            handle, &sweep, read, input, false, candidates, &mut calls,
-                        );
+                        let fraction =
+                            impact_of(read, i as usize, input, false, candidates, &mut calls);
                         (fraction, calls)
                     })
                     .collect();
@@ -187,12 +184,9 @@ impl ContinuousStage {
         input: &ContinuousInput<'_>,
         bullet: bool,
     ) {
-        let sweep = sweep_of(bodies, i);
-        let handle = bodies.sims[i].handle;
-        let fraction = first_impact(
-            handle,
-            &sweep,
+        let fraction = impact_of(
             bodies,
+            i,
             input,
             bullet,
             &mut self.candidates,
@@ -227,6 +221,20 @@ fn sweep_of(bodies: &BodySet, i: usize) -> Sweep {
         sim.center,
         sim.transform.q,
     )
+}
+
+/// [`first_impact`] of body `i`'s sweep over the step.
+fn impact_of(
+    bodies: &BodySet,
+    i: usize,
+    input: &ContinuousInput<'_>,
+    bullet: bool,
+    candidates: &mut Vec<u32>,
+    toi_calls: &mut usize,
+) -> Real {
+    let sweep = sweep_of(bodies, i);
+    let handle = bodies.sims[i].handle;
+    first_impact(handle, &sweep, bodies, input, bullet, candidates, toi_calls)
 }
 
 /// The first fraction of the step at which the body's sweep meets what it

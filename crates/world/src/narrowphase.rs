@@ -243,8 +243,6 @@ struct SolvedContact {
     /// overflow, solved with the cluster's other contacts as one block.
     #[cfg_attr(feature = "serde", serde(skip))]
     cluster: [u32; 2],
-    /// Its colour ([`OVERFLOW`]: solved scalar).
-    colour: u8,
     /// Its manifold's point count (two solver rows each).
     point_count: u8,
     /// Its restitution is positive.
@@ -741,7 +739,6 @@ pub(crate) fn build_constraints(
             copy,
             inv_mass: [m_a, m_b],
             cluster: [NO_CLUSTER; 2],
-            colour: OVERFLOW,
             point_count: lane.point_count as u8,
             bouncy: lane.restitution > 0.0,
         }
@@ -831,16 +828,15 @@ pub(crate) fn build_constraints(
     let colours = &mut narrowphase.colours;
     colours.clear();
     let (mut rows, mut bouncy, mut any_light) = (0, 0, false);
-    for s in solved.iter_mut() {
+    for s in solved.iter() {
         let colour = graph.keep(s.id, s.keys);
         // A portal copy's contacts are solved in the overflow (they keep
         // their place in the graph).
-        s.colour = if s.copy {
+        colours.push(if s.copy {
             OVERFLOW
         } else {
             colour.min(OVERFLOW)
-        };
-        colours.push(s.colour);
+        });
         rows += 2 * usize::from(s.point_count);
         bouncy += usize::from(s.bouncy);
         any_light = any_light
@@ -876,7 +872,6 @@ pub(crate) fn build_constraints(
         {
             s.cluster = *ids;
             if *ids != [NO_CLUSTER; 2] {
-                s.colour = OVERFLOW;
                 *colour = OVERFLOW;
             }
         }

@@ -174,8 +174,9 @@ pub mod bytes {
     /// island link; 4: body states carry flags instead of inverse masses,
     /// joints and portal constraints keep the masses they loaded; 6: the
     /// contact set keeps each contact's position in its bodies' lists, and
-    /// the recycling cache no longer repeats the anchors).
-    pub const SNAPSHOT_VERSION: u16 = 6;
+    /// the recycling cache no longer repeats the anchors; 7: a solved
+    /// contact's colour lives only in the narrowphase's colour list).
+    pub const SNAPSHOT_VERSION: u16 = 7;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.
