@@ -19,8 +19,8 @@
 //! through its joint. `JANUS2D_REPORT=1` prints the
 //! worst error as a fraction of its bound.
 
-use janus2d_constraints::JointForest;
 use janus2d_constraints::revolute::{RevoluteJoint, RevoluteJointDef};
+use janus2d_constraints::{Joint, JointForest};
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::constraint::{Constraint, StepContext};
 use janus2d_core::math::{Real, Vec2};
@@ -89,10 +89,15 @@ fn tree_case() -> impl Strategy<Value = TreeCase> {
         })
 }
 
+/// The revolute joint inside a [`Joint`] (every joint here is one).
+fn revolute(j: &Joint) -> &RevoluteJoint {
+    j.as_revolute().expect("a revolute joint")
+}
+
 struct Built {
     set: BodySet,
     bodies: Vec<BodyHandle>,
-    joints: Vec<RevoluteJoint>,
+    joints: Vec<Joint>,
     /// Per joint: true when body a is the static pin.
     pinned: Vec<bool>,
 }
@@ -110,12 +115,12 @@ fn build(case: &TreeCase, ctx: &StepContext) -> Built {
             bodies[link.parent - 1]
         };
         let def = RevoluteJointDef::new(parent, bodies[k], link.anchor_parent, link.anchor_child);
-        joints.push(RevoluteJoint::new(def));
+        joints.push(Joint::from(RevoluteJoint::new(def)));
         pinned.push(link.parent == 0);
     }
     for &(i, anchor) in &case.extra_pins {
         let def = RevoluteJointDef::new(pin, bodies[i], Vec2::ZERO, anchor);
-        joints.push(RevoluteJoint::new(def));
+        joints.push(Joint::from(RevoluteJoint::new(def)));
         pinned.push(true);
     }
     for j in joints.iter_mut() {
@@ -163,7 +168,7 @@ fn tree_solve_satisfies_every_soft_row() {
         let mut worst: f64 = 0.0;
         for (j, rows) in b.joints.iter().zip(&before) {
             let after = j.rows(&ctx, &b.set);
-            let lambda = j.linear_impulse();
+            let lambda = revolute(j).linear_impulse();
             let k = &rows.blocks[0].k;
             for i in 0..2 {
                 let c_dot = d(after.row_velocity(i, |h| velocity(&b.set, h)));
@@ -219,8 +224,8 @@ fn tree_solve_changes_momentum_only_through_the_pin() {
         // The pin is body a of its joints: it takes −λ, the bodies +λ.
         for (j, &pinned) in b.joints.iter().zip(&b.pinned) {
             if pinned {
-                p[0] -= d(j.linear_impulse().x);
-                p[1] -= d(j.linear_impulse().y);
+                p[0] -= d(revolute(j).linear_impulse().x);
+                p[1] -= d(revolute(j).linear_impulse().y);
             }
         }
         let err = p[0].hypot(p[1]);
@@ -264,7 +269,7 @@ fn joint_loops_stay_gauss_seidel() -> Result<(), TestCaseError> {
     assert_eq!(forest.tree_joint_count(), 4, "a second pin keeps a tree");
     // Close a loop: body 3 back to body 1.
     let extra = RevoluteJointDef::new(b.bodies[2], b.bodies[0], Vec2::ZERO, Vec2::ZERO);
-    let mut loop_joint = RevoluteJoint::new(extra);
+    let mut loop_joint = Joint::from(RevoluteJoint::new(extra));
     loop_joint.prepare(&ctx, &b.set);
     b.joints.push(loop_joint);
     forest.build(&mut b.joints, &b.set.states, true);

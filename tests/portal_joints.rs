@@ -70,7 +70,7 @@ fn rope_through(eta: Real) -> (Run, Real) {
     }
     for &j in &joints {
         assert!(
-            world.revolute_joint(j).unwrap().enabled,
+            world.revolute_joint(j).unwrap().is_enabled(),
             "a joint was disabled"
         );
     }
@@ -212,7 +212,7 @@ fn jointed_pair_backs_out_whole() {
     assert_eq!(r.disabled, 0);
     assert_eq!(world.crossing_count(), 0);
     let j = world.revolute_joint(joint).unwrap();
-    assert!(j.enabled);
+    assert!(j.is_enabled());
     assert_eq!((j.def.body_a, j.def.body_b), (a, b));
     // Both back above the floor portal, moving up.
     for body in [a, b] {
@@ -250,7 +250,7 @@ fn destroying_the_pair_under_a_crossing_rope_disables_only_what_cannot_follow() 
         .count();
     let disabled = joints
         .iter()
-        .filter(|&&j| !world.revolute_joint(j).unwrap().enabled)
+        .filter(|&&j| !world.revolute_joint(j).unwrap().is_enabled())
         .count();
     assert_eq!(world.crossing_count(), 0);
     assert!(disabled >= 1, "a joint across the portal stayed enabled");
@@ -377,7 +377,7 @@ fn jointed_pair_through_dynamic_portal_bodies_conserves_momentum() {
     }
     assert_eq!(completed, 2, "both boxes go through");
     assert_eq!(r.disabled, 0);
-    assert!(world.revolute_joint(joint).unwrap().enabled);
+    assert!(world.revolute_joint(joint).unwrap().is_enabled());
     assert!(
         r.worst_gap < 1e-3,
         "worst gap through the map {} m",

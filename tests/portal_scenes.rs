@@ -568,7 +568,7 @@ fn joint_on_a_body_that_goes_through_follows_it() {
     assert!(completed_body.is_some(), "the box never went through");
     assert!(!disabled, "a joint-disabled event");
     let j = world.revolute_joint(joint).unwrap();
-    assert!(j.enabled);
+    assert!(j.is_enabled());
     // The joint now joins the box (on the exit side) and the buddy's copy there.
     assert_eq!(j.def.body_a, scene.probe);
     assert_eq!(Some(j.def.body_b), world.clone_of(buddy));

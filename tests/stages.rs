@@ -132,9 +132,12 @@ fn joint_setters_reject_bad_values_and_leave_the_joint_unchanged() {
     assert!(d.enable_limit && d.enable_motor && d.max_motor_torque == 10.0);
     assert_eq!(world.revolute_joint(j).unwrap().row_count(), 2 + 2 + 1);
     world.set_joint_enabled(j, false).unwrap();
-    assert!(!world.revolute_joint(j).unwrap().enabled);
+    assert!(!world.revolute_joint(j).unwrap().is_enabled());
     world.set_joint_enabled(j, true).unwrap();
-    assert!(world.revolute_joint(j).unwrap().enabled, "enabled again");
+    assert!(
+        world.revolute_joint(j).unwrap().is_enabled(),
+        "enabled again"
+    );
 }
 
 #[test]

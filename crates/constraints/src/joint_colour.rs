@@ -66,14 +66,14 @@
 //! its only Gauss–Seidel part is the warm start.
 
 use janus2d_core::body::BodyState;
-use janus2d_core::constraint::{Constraint, StepContext};
+use janus2d_core::constraint::StepContext;
 use janus2d_core::graph::{COLOURS, ColourGraph};
 use janus2d_core::parallel::{StatePlan, Team};
 use smallvec::SmallVec;
 
+use crate::joint::Joint;
 use crate::joint_tree::is_moving;
 use crate::parts::{PairOf, WRITE_A, WRITE_B};
-use crate::revolute::RevoluteJoint;
 
 /// No position: a joint that is not solved (disabled or resting).
 const NONE: u32 = u32::MAX;
@@ -163,13 +163,13 @@ impl JointColours {
     /// Reads every joint's key (call after the joints' `prepare`) and
     /// colours the joints again if a key or the state count changed since
     /// the last colouring.
-    pub fn update(&mut self, joints: &[RevoluteJoint], states: &[BodyState]) {
+    pub fn update(&mut self, joints: &[Joint], states: &[BodyState]) {
         self.update_on(joints, states, &Team::serial());
     }
 
     /// [`JointColours::update`] with the keys read in blocks on the step's
     /// team (a colouring, when needed, runs on the caller).
-    pub fn update_on(&mut self, joints: &[RevoluteJoint], states: &[BodyState], team: &Team) {
+    pub fn update_on(&mut self, joints: &[Joint], states: &[BodyState], team: &Team) {
         const BLOCK: usize = 1024;
         self.keys.resize(joints.len(), [0; 3]);
         team.for_each_chunk_mut(&mut self.keys, BLOCK, |i, block| {
@@ -291,12 +291,7 @@ impl JointColours {
     /// team). The same arithmetic, in the same order per body, as the
     /// joints' warm starts one after the other in storage order; no
     /// colours needed (a body writes only itself).
-    pub(crate) fn warm_start(
-        &mut self,
-        joints: &[RevoluteJoint],
-        states: &mut [BodyState],
-        team: &Team,
-    ) {
+    pub(crate) fn warm_start(&mut self, joints: &[Joint], states: &mut [BodyState], team: &Team) {
         if self.position.len() != joints.len() || states.len() != self.built_states {
             self.update(joints, states);
         }
@@ -330,7 +325,7 @@ impl JointColours {
     pub(crate) fn solve(
         &mut self,
         ctx: &StepContext,
-        joints: &mut [RevoluteJoint],
+        joints: &mut [Joint],
         states: &mut [BodyState],
         use_bias: bool,
         reverse: bool,
@@ -351,7 +346,8 @@ impl JointColours {
                 let range = self.starts[s] as usize..self.starts[s + 1] as usize;
                 for p in range {
                     let j = &mut joints[self.order[p] as usize];
-                    let mut pair = PairOf::new(states, j.state_a, j.state_b, self.writes[p]);
+                    let mut pair =
+                        PairOf::new(states, j.base().state_a, j.base().state_b, self.writes[p]);
                     j.solve_pair(ctx, &mut pair, use_bias);
                 }
             }
@@ -366,8 +362,7 @@ impl JointColours {
             }
         }
         {
-            let mut parts: SmallVec<[&mut [Option<&mut RevoluteJoint>]; COLOURS + 1]> =
-                SmallVec::new();
+            let mut parts: SmallVec<[&mut [Option<&mut Joint>]; COLOURS + 1]> = SmallVec::new();
             let mut rest = &mut refs[..];
             for s in 0..segments {
                 let len = (self.starts[s + 1] - self.starts[s]) as usize;
@@ -383,7 +378,7 @@ impl JointColours {
                     let writes = &self.writes[self.starts[s] as usize..];
                     for (j, &w) in part.iter_mut().zip(writes) {
                         let Some(j) = j else { continue };
-                        let mut pair = PairOf::new(states, j.state_a, j.state_b, w);
+                        let mut pair = PairOf::new(states, j.base().state_a, j.base().state_b, w);
                         j.solve_pair(ctx, &mut pair, use_bias);
                     }
                     continue;
@@ -397,37 +392,18 @@ impl JointColours {
         }
         self.scratch.put(refs);
     }
-
-    /// The restitution stage: every solved joint colour by colour on the
-    /// leader (a revolute joint has no restitution rows).
-    pub(crate) fn apply_restitution(
-        &mut self,
-        ctx: &StepContext,
-        joints: &mut [RevoluteJoint],
-        states: &mut [BodyState],
-    ) {
-        if self.position.len() != joints.len() || states.len() != self.built_states {
-            self.update(joints, states);
-        }
-        for &i in &self.order {
-            joints[i as usize].apply_restitution(ctx, states);
-        }
-    }
 }
 
 /// A joint's colouring key: its state indices and which ends move (see
 /// [`JointColours::update`]).
 #[inline]
-fn key(j: &RevoluteJoint, states: &[BodyState]) -> [u32; 3] {
-    let (a, b) = (j.state_a, j.state_b);
-    if !j.enabled || (a == 0 && b == 0) {
+fn key(j: &Joint, states: &[BodyState]) -> [u32; 3] {
+    let base = j.base();
+    let (a, b) = (base.state_a, base.state_b);
+    if !base.enabled || (a == 0 && b == 0) {
         return [0, 0, 0];
     }
-    let coloured = if j.in_tree && !j.has_angle_rows() {
-        0
-    } else {
-        COLOURED
-    };
+    let coloured = if j.has_iterative_rows() { COLOURED } else { 0 };
     let flags = ACTIVE
         | coloured
         | if is_moving(states, a) {
@@ -446,11 +422,11 @@ fn key(j: &RevoluteJoint, states: &[BodyState]) -> [u32; 3] {
 /// The allocation of a stage's joint references, kept empty between
 /// stages (a reference cannot outlive its stage; the buffer can).
 #[derive(Default)]
-struct JointRefs(Vec<Option<&'static mut RevoluteJoint>>);
+struct JointRefs(Vec<Option<&'static mut Joint>>);
 
 impl JointRefs {
     /// The buffer, empty, for references of any lifetime.
-    fn take<'a>(&mut self) -> Vec<Option<&'a mut RevoluteJoint>> {
+    fn take<'a>(&mut self) -> Vec<Option<&'a mut Joint>> {
         let mut v = std::mem::take(&mut self.0);
         v.clear();
         // An empty vector converts in place (same element layout).
@@ -458,7 +434,7 @@ impl JointRefs {
     }
 
     /// Keeps the buffer of `v` for the next stage.
-    fn put(&mut self, mut v: Vec<Option<&mut RevoluteJoint>>) {
+    fn put(&mut self, mut v: Vec<Option<&mut Joint>>) {
         v.clear();
         self.0 = v.into_iter().map(|_| None).collect();
     }
@@ -479,10 +455,11 @@ impl std::fmt::Debug for JointRefs {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::joint_tree::{JointForest, RevoluteBatch};
-    use crate::revolute::RevoluteJointDef;
+    use crate::joint::JointBatch;
+    use crate::joint_tree::JointForest;
+    use crate::revolute::{RevoluteJoint, RevoluteJointDef};
     use janus2d_core::body::{BodyDef, BodyHandle, BodySet};
-    use janus2d_core::constraint::ConstraintBatch;
+    use janus2d_core::constraint::{Constraint, ConstraintBatch};
     use janus2d_core::math::{Real, Vec2};
     use janus2d_core::solver::SolverSettings;
 
@@ -490,7 +467,7 @@ mod tests {
     /// neighbour (a grid has loops: no joint is in a tree), the top row
     /// pinned to a static body; plus a hub with `spokes` motor joints and a
     /// plain two-link chain (a tree without angle rows).
-    fn grid(n: usize, spokes: usize) -> (BodySet, Vec<RevoluteJoint>, BodyHandle) {
+    fn grid(n: usize, spokes: usize) -> (BodySet, Vec<Joint>, BodyHandle) {
         let mut set = BodySet::new();
         let ground = set.create(&BodyDef::fixed(Vec2::ZERO)).unwrap();
         let v = |x: usize, y: usize| Vec2::new(x as Real, -(y as Real));
@@ -501,7 +478,7 @@ mod tests {
                 ids.push(set.create(&def).unwrap());
             }
         }
-        let mut joints = Vec::new();
+        let mut joints: Vec<Joint> = Vec::new();
         let join =
             |a, b, la: Vec2, lb: Vec2| RevoluteJoint::new(RevoluteJointDef::new(a, b, la, lb));
         let half = 0.5;
@@ -510,7 +487,7 @@ mod tests {
                 let id = ids[y * n + x];
                 if x + 1 < n {
                     let d = Vec2::new(half, 0.0);
-                    joints.push(join(id, ids[y * n + x + 1], d, -d));
+                    joints.push(Joint::from(join(id, ids[y * n + x + 1], d, -d)));
                 }
                 if y + 1 < n {
                     let d = Vec2::new(0.0, -half);
@@ -520,10 +497,10 @@ mod tests {
                         j.def.lower_angle = -0.2;
                         j.def.upper_angle = 0.2;
                     }
-                    joints.push(j);
+                    joints.push(Joint::from(j));
                 }
                 if y == 0 {
-                    joints.push(join(ground, id, v(x, 0), Vec2::ZERO));
+                    joints.push(Joint::from(join(ground, id, v(x, 0), Vec2::ZERO)));
                 }
             }
         }
@@ -536,24 +513,31 @@ mod tests {
             let mut j = join(hub, b, Vec2::ZERO, Vec2::new(0.0, -2.0));
             j.def.enable_motor = true;
             j.def.max_motor_torque = 1.0;
-            joints.push(j);
+            joints.push(Joint::from(j));
         }
         let c0 = set.create(&BodyDef::dynamic(Vec2::new(0.0, 60.0))).unwrap();
         let c1 = set.create(&BodyDef::dynamic(Vec2::new(1.0, 60.0))).unwrap();
-        joints.push(join(ground, c0, Vec2::new(0.0, 60.0), Vec2::ZERO));
-        joints.push(join(c0, c1, Vec2::new(0.5, 0.0), Vec2::new(-0.5, 0.0)));
+        joints.push(Joint::from(join(
+            ground,
+            c0,
+            Vec2::new(0.0, 60.0),
+            Vec2::ZERO,
+        )));
+        joints.push(Joint::from(join(
+            c0,
+            c1,
+            Vec2::new(0.5, 0.0),
+            Vec2::new(-0.5, 0.0),
+        )));
         (set, joints, hub)
     }
 
-    fn prepared(
-        n: usize,
-        spokes: usize,
-    ) -> (BodySet, Vec<RevoluteJoint>, JointColours, StepContext) {
+    fn prepared(n: usize, spokes: usize) -> (BodySet, Vec<Joint>, JointColours, StepContext) {
         let (set, mut joints, _) = grid(n, spokes);
         let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::new(0.0, -10.0));
         let mut forest = JointForest::default();
         let mut colours = JointColours::new();
-        let mut batch = RevoluteBatch {
+        let mut batch = JointBatch {
             joints: &mut joints,
             forest: &mut forest,
             colours: &mut colours,
@@ -571,7 +555,7 @@ mod tests {
             let mut bodies = std::collections::HashSet::new();
             for &i in colours.joints_in(c) {
                 let j = &joints[i as usize];
-                for s in [j.state_a, j.state_b] {
+                for s in [j.base().state_a, j.base().state_b] {
                     let st = &set.states[s as usize];
                     if s != 0 && st.moves() {
                         assert!(bodies.insert(s), "state {s} twice in colour {c}");
@@ -595,7 +579,7 @@ mod tests {
         let order = colours.order.clone();
         colours.update(&joints, &set.states);
         assert_eq!(colours.order, order, "same keys, same order");
-        joints[0].enabled = false;
+        joints[0].set_enabled(false);
         colours.update(&joints, &set.states);
         assert_eq!(
             colours.order.len() + 1,
@@ -610,7 +594,7 @@ mod tests {
     fn run_stages(team: &Team) -> Vec<u64> {
         let (mut set, mut joints, mut colours, ctx) = prepared(24, 30);
         for j in &mut joints {
-            j.point.impulse = Vec2::new(0.01, -0.02);
+            j.tree_point_mut().unwrap().impulse = Vec2::new(0.01, -0.02);
         }
         for flip in [false, true, false] {
             let states = &mut set.states;
@@ -648,8 +632,9 @@ mod tests {
         let (set, mut joints, mut colours, ctx) = prepared(9, 30);
         for (k, j) in joints.iter_mut().enumerate() {
             let x = k as Real;
-            j.point.impulse = Vec2::new(0.013 * x.sin(), -0.021 * x.cos());
-            j.point.frame_a = Vec2::new(0.5 + 0.01 * x.cos(), 0.02 * x.sin());
+            let point = j.tree_point_mut().unwrap();
+            point.impulse = Vec2::new(0.013 * x.sin(), -0.021 * x.cos());
+            point.frame_a = Vec2::new(0.5 + 0.01 * x.cos(), 0.02 * x.sin());
         }
         let mut expected = set.states.clone();
         for s in expected.iter_mut() {

@@ -121,16 +121,24 @@
 use glam::{DMat3 as Matrix3, DVec2, DVec3};
 use janus2d_core::body::BodySet;
 use janus2d_core::body::{BodyState, InvMass};
-use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
+use janus2d_core::constraint::{Constraint, StepContext};
 use janus2d_core::math::{Real, Vec2, cross, cross_sv, from_f64, to_f64};
 use janus2d_core::parallel::Team;
 use janus2d_core::union_find::{find, union};
 
-use crate::joint_colour::JointColours;
+use crate::joint::Joint;
 use crate::parts::{PairMass, PointPart, clamp_length};
-use crate::revolute::RevoluteJoint;
 
 const NONE: u32 = u32::MAX;
+
+/// The point part of a joint without one (never in a tree: the build
+/// leaves its component iterative).
+const NO_POINT: PointPart = PointPart {
+    frame_a: Vec2::ZERO,
+    frame_b: Vec2::ZERO,
+    delta_center: Vec2::ZERO,
+    impulse: Vec2::ZERO,
+};
 
 /// Largest ratio `K_g / Ĩ` of a body's geometric stiffness term to the
 /// inertia the tree solve gives it (see the module docs): the explicit part
@@ -504,16 +512,25 @@ pub(crate) fn is_moving(states: &[BodyState], s: u32) -> bool {
 /// `in_tree` flag, so that a joint created since the last build (flag
 /// unset) forces a rebuild even where the ends repeat.
 #[inline]
-fn moving_pair(j: &RevoluteJoint, states: &[BodyState]) -> [u32; 3] {
-    let flag = u32::from(j.in_tree);
-    if !j.enabled {
-        return [0, 0, flag];
+fn moving_pair(j: &Joint, states: &[BodyState]) -> [u32; 3] {
+    let base = j.base();
+    let flags = u32::from(base.in_tree)
+        | if j.tree_point().is_some() {
+            0
+        } else {
+            ITERATIVE
+        };
+    if !base.enabled {
+        return [0, 0, flags];
     }
     let end = |s: u32| if is_moving(states, s) { s } else { 0 };
-    [end(j.state_a), end(j.state_b), flag]
+    [end(base.state_a), end(base.state_b), flags]
 }
 
-/// Widens a vector to f64.
+/// Pair flag: the joint's kind has no rows the tree solve takes (no
+/// point part), so a component holding it stays wholly iterative.
+const ITERATIVE: u32 = 2;
+
 #[inline(always)]
 fn wide(v: Vec2) -> DVec2 {
     DVec2::new(to_f64(v.x), to_f64(v.y))
@@ -530,7 +547,7 @@ impl JointForest {
 
     /// Finds the joint forest among the enabled joints and marks its joints
     /// (`in_tree`). With `enabled` false every joint stays iterative.
-    pub fn build(&mut self, joints: &mut [RevoluteJoint], states: &[BodyState], enabled: bool) {
+    pub fn build(&mut self, joints: &mut [Joint], states: &[BodyState], enabled: bool) {
         self.build_on(joints, states, enabled, &Team::serial());
     }
 
@@ -538,7 +555,7 @@ impl JointForest {
     /// on the step's team (the forest itself is found on the caller).
     pub fn build_on(
         &mut self,
-        joints: &mut [RevoluteJoint],
+        joints: &mut [Joint],
         states: &[BodyState],
         enabled: bool,
         team: &Team,
@@ -557,10 +574,10 @@ impl JointForest {
 
     /// Prepares every enabled joint and finds the forest in the same pass
     /// over the joints (the batch's `prepare`).
-    pub fn prepare(&mut self, joints: &mut [RevoluteJoint], ctx: &StepContext, bodies: &BodySet) {
+    pub fn prepare(&mut self, joints: &mut [Joint], ctx: &StepContext, bodies: &BodySet) {
         self.pairs.clear();
         for j in joints.iter_mut() {
-            if j.enabled {
+            if j.is_enabled() {
                 j.prepare(ctx, bodies);
             }
             self.pairs.push(moving_pair(j, &bodies.states));
@@ -571,7 +588,7 @@ impl JointForest {
     /// Rebuilds the forest when the joints' moving ends changed since the
     /// last build (joints created, destroyed, enabled or disabled, bodies
     /// woken, put to sleep or re-indexed); otherwise keeps it.
-    fn update(&mut self, joints: &mut [RevoluteJoint], n: usize, enabled: bool) {
+    fn update(&mut self, joints: &mut [Joint], n: usize, enabled: bool) {
         if enabled == self.built_enabled && self.pairs == self.built_pairs {
             return;
         }
@@ -579,18 +596,18 @@ impl JointForest {
         self.built_enabled = enabled;
         self.built_pairs.clone_from(&self.pairs);
         for (pair, j) in self.built_pairs.iter_mut().zip(joints.iter()) {
-            pair[2] = u32::from(j.in_tree);
+            pair[2] = (pair[2] & ITERATIVE) | u32::from(j.in_tree());
         }
     }
 
-    fn rebuild(&mut self, joints: &mut [RevoluteJoint], n: usize, enabled: bool) {
+    fn rebuild(&mut self, joints: &mut [Joint], n: usize, enabled: bool) {
         self.trees.clear();
         self.bodies.clear();
         self.joints.clear();
         self.parent_joint.clear();
         self.tree_joints.clear();
         for j in joints.iter_mut() {
-            j.in_tree = false;
+            j.base_mut().in_tree = false;
         }
         if !enabled || joints.is_empty() {
             return;
@@ -602,7 +619,17 @@ impl JointForest {
         // Pass 1: components of moving bodies; mark those with a loop.
         self.cyclic.clear();
         self.cyclic.resize(n, false);
-        for &[a, b, _] in &self.pairs {
+        for &[a, b, flags] in &self.pairs {
+            if flags & ITERATIVE != 0 {
+                // A joint the tree cannot take: its component stays
+                // iterative, like one with a loop.
+                for s in [a, b] {
+                    if s != 0 {
+                        let root = find(&mut self.union, s);
+                        self.cyclic[root as usize] = true;
+                    }
+                }
+            }
             if a == 0 || b == 0 {
                 continue;
             }
@@ -625,7 +652,7 @@ impl JointForest {
             if self.cyclic[root as usize] {
                 continue;
             }
-            joints[i].in_tree = true;
+            joints[i].base_mut().in_tree = true;
             self.tree_joints.push(i as u32);
             for s in [a, b] {
                 if s != 0 {
@@ -716,7 +743,7 @@ impl JointForest {
     pub fn solve(
         &mut self,
         ctx: &StepContext,
-        joints: &mut [RevoluteJoint],
+        joints: &mut [Joint],
         states: &mut [BodyState],
         use_bias: bool,
     ) {
@@ -732,7 +759,7 @@ impl JointForest {
     pub fn solve_on(
         &mut self,
         ctx: &StepContext,
-        joints: &mut [RevoluteJoint],
+        joints: &mut [Joint],
         states: &mut [BodyState],
         use_bias: bool,
         team: &Team,
@@ -799,7 +826,9 @@ impl JointForest {
             st.w = sc.state.w;
         }
         for (tj, row) in self.joints.iter().zip(&self.joint_scratch) {
-            joints[tj.index as usize].point.impulse = row.impulse;
+            if let Some(point) = joints[tj.index as usize].tree_point_mut() {
+                point.impulse = row.impulse;
+            }
         }
     }
 }
@@ -848,12 +877,7 @@ fn other_end<'s>(
 /// ends from `states`. Each joint is seen from its parent body: `C` and `Ċ`
 /// are `side ((x_p + r_p) − (x_o + r_o))`, with `o` its other end (child or
 /// fixed) and `side` +1 where the parent is the joint's body b.
-fn solve_tree(
-    tree: &mut Tree<'_>,
-    joints: &[RevoluteJoint],
-    states: &[BodyState],
-    params: &TreeParams,
-) {
+fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], params: &TreeParams) {
     let TreeParams {
         softness,
         compliance,
@@ -879,19 +903,20 @@ fn solve_tree(
     // parent joint (which comes before the body's own joints).
     if let Some(first) = topology.first() {
         debug_assert_eq!(first.parent, 0, "a tree's first joint hangs from its root");
-        let m = joints[first.index as usize].masses;
+        let m = joints[first.index as usize].base().masses;
         bodies[0].set_mass(if first.side > 0.0 { m.b } else { m.a });
     }
     // Arms, separations, Jacobians and impulses of the joints, and the
     // geometric stiffness each body takes from its joints.
     for (tj, row) in topology.iter().zip(rows.iter_mut()) {
         let j = &joints[tj.index as usize];
+        let (base, point) = (j.base(), j.tree_point().unwrap_or(&NO_POINT));
         let side = tj.side;
-        row.masses = j.masses;
+        row.masses = base.masses;
         let (frame_parent, frame_other, fixed) = if side > 0.0 {
-            (j.point.frame_b, j.point.frame_a, j.state_a)
+            (point.frame_b, point.frame_a, base.state_a)
         } else {
-            (j.point.frame_a, j.point.frame_b, j.state_b)
+            (point.frame_a, point.frame_b, base.state_b)
         };
         row.fixed = fixed;
         let parent = &bodies[tj.parent as usize];
@@ -899,17 +924,21 @@ fn solve_tree(
         let r_parent = parent.state.dq.rotate(frame_parent);
         let r_other = other.dq.rotate(frame_other);
         row.c = from_f64(side) * ((parent.state.dp - other.dp) + (r_parent - r_other))
-            + j.point.delta_center;
+            + point.delta_center;
         (row.r_parent, row.r_other) = (r_parent, r_other);
         row.jac_parent = Jacobian::new(side, r_parent, parent);
-        row.impulse = j.point.impulse;
+        row.impulse = point.impulse;
         let lambda = wide(row.impulse);
         let parent = &mut bodies[tj.parent as usize];
         parent.leaf = false;
         parent.geometric += geometric_stiffness(h, lambda, r_parent, side);
         if tj.child != NONE {
             let child = &mut bodies[tj.child as usize];
-            child.set_mass(if side > 0.0 { j.masses.a } else { j.masses.b });
+            child.set_mass(if side > 0.0 {
+                base.masses.a
+            } else {
+                base.masses.b
+            });
             row.jac_child = Jacobian::new(-side, r_other, child);
             child.geometric_up = geometric_stiffness(h, lambda, r_other, -side);
         }
@@ -1030,91 +1059,4 @@ fn solve_tree(
 #[inline(always)]
 fn geometric_stiffness(h: f64, lambda: DVec2, r: Vec2, side: f64) -> f64 {
     (h * side * lambda.dot(wide(r))).max(0.0)
-}
-
-/// Joints per block of the joints' prepare on the team.
-const PREPARE_BLOCK: usize = 256;
-
-/// The revolute joints of a world, their forest and their colours, driven
-/// by the solver as one batch: the iterative rows in the sweep with the
-/// other constraints (before the contacts), on the step's team
-/// ([`crate::joint_colour`]); the direct tree solve in the late pass after
-/// every batch (so the tree's joints have the last word).
-pub struct RevoluteBatch<'a> {
-    /// The joints, in storage order.
-    pub joints: &'a mut Vec<RevoluteJoint>,
-    /// The forest found at `prepare`.
-    pub forest: &'a mut JointForest,
-    /// The colours of the iterative rows, updated at `prepare`.
-    pub colours: &'a mut JointColours,
-}
-
-impl ConstraintBatch for RevoluteBatch<'_> {
-    fn count(&self) -> usize {
-        self.joints.len()
-    }
-    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
-        self.prepare_on(ctx, bodies, &Team::serial());
-    }
-    fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
-        self.warm_start_on(ctx, states, &Team::serial());
-    }
-    fn solve(
-        &mut self,
-        ctx: &StepContext,
-        states: &mut [BodyState],
-        use_bias: bool,
-        reverse: bool,
-    ) {
-        self.solve_on(ctx, states, use_bias, reverse, &Team::serial());
-    }
-    fn solve_late(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        self.forest.solve(ctx, self.joints, states, use_bias);
-    }
-    fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
-        self.colours.apply_restitution(ctx, self.joints, states);
-    }
-    fn store_impulses(&mut self) {
-        self.joints.store_impulses();
-    }
-    fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
-        // Each joint's prepare reads the bodies and writes only itself:
-        // blocks of joints on the team, then the forest and the colours
-        // from the prepared joints (the same as `JointForest::prepare`).
-        team.for_each_chunk_mut(self.joints, PREPARE_BLOCK, |_, block| {
-            for j in block.iter_mut().filter(|j| j.enabled) {
-                j.prepare(ctx, bodies);
-            }
-        });
-        self.forest
-            .build_on(self.joints, &bodies.states, ctx.direct_joints, team);
-        self.colours.update_on(self.joints, &bodies.states, team);
-    }
-    fn warm_start_on(&mut self, _ctx: &StepContext, states: &mut [BodyState], team: &Team) {
-        self.colours.warm_start(self.joints, states, team);
-    }
-    fn solve_on(
-        &mut self,
-        ctx: &StepContext,
-        states: &mut [BodyState],
-        use_bias: bool,
-        reverse: bool,
-        team: &Team,
-    ) {
-        self.colours
-            .solve(ctx, self.joints, states, use_bias, reverse, team);
-    }
-    fn solve_late_on(
-        &mut self,
-        ctx: &StepContext,
-        states: &mut [BodyState],
-        use_bias: bool,
-        team: &Team,
-    ) {
-        self.forest
-            .solve_on(ctx, self.joints, states, use_bias, team);
-    }
-    fn apply_restitution_on(&mut self, ctx: &StepContext, states: &mut [BodyState], _team: &Team) {
-        self.colours.apply_restitution(ctx, self.joints, states);
-    }
 }

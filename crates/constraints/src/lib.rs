@@ -4,6 +4,7 @@
 //!
 //! | type                          | rows | bodies | built from              |
 //! |-------------------------------|------|--------|-------------------------|
+//! | [`joint::Joint`]              | per kind | 2  | one file per kind ([`joint`]) |
 //! | [`revolute::RevoluteJoint`]   | 2–6  | 2      | point + angle parts     |
 //! | [`portal::PortalConstraint`]  | 3    | 4      | portal part + portal map |
 //! | [`contact::ContactConstraint`]| 2–4  | 2      | compact rows (normal, friction) |
@@ -20,6 +21,7 @@
 pub mod contact;
 pub mod contact_group;
 pub mod contact_solver;
+pub mod joint;
 pub mod joint_colour;
 pub mod joint_tree;
 pub mod parts;
@@ -29,8 +31,9 @@ pub mod revolute;
 
 pub use contact::{ContactConstraint, ContactPointInput};
 pub use contact_solver::{ContactBatch, ContactSolver, ObjectMass, PointImpulse};
+pub use joint::{Joint, JointBase, JointBatch, JointDef, JointKind};
 pub use joint_colour::JointColours;
-pub use joint_tree::{JointForest, RevoluteBatch};
+pub use joint_tree::JointForest;
 pub use portal::{PortalBatch, PortalConstraint, PortalConstraintDef};
 pub use portal_map::{Portal, PortalError, PortalMap, PortalPair};
 pub use revolute::{RevoluteJoint, RevoluteJointDef};

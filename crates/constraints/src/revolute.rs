@@ -39,6 +39,7 @@ use janus2d_core::softness::Softness;
 use smallvec::smallvec;
 
 use crate::JointError;
+use crate::joint::JointBase;
 use crate::parts::{
     AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, load_pair, store_pair,
 };
@@ -163,17 +164,9 @@ impl RevoluteJointDef {
 pub struct RevoluteJoint {
     /// The definition it was made from (limits, motor and spring settings).
     pub def: RevoluteJointDef,
-    /// False when the joint is disabled (skipped by the solver).
-    pub enabled: bool,
-    pub(crate) state_a: u32,
-    pub(crate) state_b: u32,
-    /// The bodies' inverse masses, loaded at prepare (zero for a body on
-    /// the static identity state).
-    pub(crate) masses: PairMass,
+    /// State indices, masses and switches the solver reads.
+    pub(crate) base: JointBase,
     pub(crate) point: PointPart,
-    /// True while the point rows belong to the direct solve of a joint tree
-    /// (set every step by [`JointForest`](crate::joint_tree::JointForest)).
-    pub(crate) in_tree: bool,
     /// `θ_b − θ_a − θ_ref` at the start of the step, rad.
     delta_angle: Real,
     spring: AnglePart,
@@ -183,12 +176,6 @@ pub struct RevoluteJoint {
     spring_softness: Softness,
     /// Softness of the point rows for this step (mass-ratio aware).
     point_softness: Softness,
-    /// `1 / h` of the last step the joint was solved in, 1/s (turns the
-    /// per-substep impulses into forces).
-    inv_h: Real,
-    /// Neither body moves this step (both static or asleep): the joint is
-    /// not solved and keeps its last impulses, so its read-back holds.
-    resting: bool,
 }
 
 /// The softness of the Gauss–Seidel point rows: the joint softness scaled
@@ -221,12 +208,8 @@ impl RevoluteJoint {
     pub fn new(def: RevoluteJointDef) -> Self {
         RevoluteJoint {
             def,
-            enabled: true,
-            state_a: 0,
-            state_b: 0,
-            masses: PairMass::default(),
+            base: JointBase::default(),
             point: PointPart::default(),
-            in_tree: false,
             delta_angle: 0.0,
             spring: AnglePart::default(),
             motor: AnglePart::default(),
@@ -234,8 +217,6 @@ impl RevoluteJoint {
             upper: AnglePart::default(),
             spring_softness: Softness::RIGID,
             point_softness: Softness::RIGID,
-            inv_h: 0.0,
-            resting: false,
         }
     }
 
@@ -278,7 +259,13 @@ impl RevoluteJoint {
     /// True when the last step solved the point rows directly (the joint
     /// is part of a tree of joints, see [`crate::joint_tree`]).
     pub fn in_tree(&self) -> bool {
-        self.in_tree
+        self.base.in_tree
+    }
+
+    /// False when the joint is disabled (skipped by the solver).
+    #[must_use]
+    pub fn is_enabled(&self) -> bool {
+        self.base.enabled
     }
 
     /// Point impulse of one substep of the last solved step, N·s (each
@@ -298,7 +285,7 @@ impl RevoluteJoint {
     /// bob hanging from a pin under g = 10 m/s² reads 100 N upwards.
     #[must_use]
     pub fn constraint_force(&self) -> Vec2 {
-        self.point.impulse * self.inv_h
+        self.point.impulse * self.base.inv_h
     }
 
     /// Torque about the joint axis that the spring, motor and limits apply
@@ -307,7 +294,7 @@ impl RevoluteJoint {
     pub fn constraint_torque(&self) -> Real {
         let axial =
             self.spring.impulse + self.motor.impulse + self.lower.impulse - self.upper.impulse;
-        axial * self.inv_h
+        axial * self.base.inv_h
     }
 
     /// The warm start's share on one of its bodies (`side_b`: body b, else
@@ -325,13 +312,13 @@ impl RevoluteJoint {
         // AnglePart::apply, then PointPart::warm_start (apply_pair with no
         // angular impulse), one side of each.
         if side_b {
-            let m_b = &self.masses.b;
+            let m_b = &self.base.masses.b;
             st.w += m_b.inv_inertia * axial;
             let r_b = st.dq.rotate(self.point.frame_b);
             st.v += m_b.inv_mass * p;
             st.w += m_b.inv_inertia * (cross(r_b, p) + 0.0);
         } else {
-            let m_a = &self.masses.a;
+            let m_a = &self.base.masses.a;
             st.w -= m_a.inv_inertia * axial;
             let r_a = st.dq.rotate(self.point.frame_a);
             st.v -= m_a.inv_mass * p;
@@ -349,11 +336,11 @@ impl RevoluteJoint {
         pair: &mut P,
         use_bias: bool,
     ) {
-        if self.resting || (self.in_tree && !self.has_angle_rows()) {
+        if self.base.resting || (self.base.in_tree && !self.has_angle_rows()) {
             return;
         }
         let (mut sa, mut sb) = pair.load();
-        let m = &self.masses;
+        let m = &self.base.masses;
         // The angle depends on the rotations only, which the rows below do
         // not change: one atan2 for the spring and the limits.
         let angle = if self.def.enable_spring || self.def.enable_limit {
@@ -393,7 +380,7 @@ impl RevoluteJoint {
                 use_bias,
             );
         }
-        if !self.in_tree {
+        if !self.base.in_tree {
             self.point.solve(
                 &mut sa,
                 &mut sb,
@@ -420,15 +407,12 @@ impl RevoluteJoint {
 
 impl Constraint for RevoluteJoint {
     fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
-        let a = bodies.solver_body(self.def.body_a);
-        let b = bodies.solver_body(self.def.body_b);
-        self.state_a = a.state_index;
-        self.state_b = b.state_index;
-        self.resting = a.state_index == 0 && b.state_index == 0;
-        if self.resting {
+        let Some((a, b)) = self
+            .base
+            .load(ctx, bodies, self.def.body_a, self.def.body_b)
+        else {
             return;
-        }
-        self.inv_h = ctx.inv_h;
+        };
         let q_a = a.sim.transform.q;
         let q_b = b.sim.transform.q;
         self.point.frame_a = q_a.rotate(self.def.local_anchor_a - a.sim.local_center);
@@ -436,11 +420,7 @@ impl Constraint for RevoluteJoint {
         self.point.delta_center = b.sim.center - a.sim.center;
         self.delta_angle =
             janus2d_core::math::wrap_angle(q_a.relative_angle(q_b) - self.def.reference_angle);
-        self.masses = PairMass {
-            a: a.inv_masses(),
-            b: b.inv_masses(),
-        };
-        let m = &self.masses;
+        let m = &self.base.masses;
         for part in [
             &mut self.spring,
             &mut self.motor,
@@ -471,20 +451,21 @@ impl Constraint for RevoluteJoint {
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        if self.resting {
+        if self.base.resting {
             return;
         }
-        let (mut sa, mut sb) = load_pair(states, self.state_a, self.state_b);
-        let m = &self.masses;
+        let (a, b) = (self.base.state_a, self.base.state_b);
+        let (mut sa, mut sb) = load_pair(states, a, b);
+        let m = &self.base.masses;
         let axial =
             self.spring.impulse + self.motor.impulse + self.lower.impulse - self.upper.impulse;
         AnglePart::apply(&mut sa, &mut sb, m, axial);
         self.point.warm_start(&mut sa, &mut sb, m);
-        store_pair(states, self.state_a, self.state_b, &sa, &sb);
+        store_pair(states, a, b, &sa, &sb);
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        let mut pair = PairOf::new(states, self.state_a, self.state_b, BOTH);
+        let mut pair = PairOf::new(states, self.base.state_a, self.base.state_b, BOTH);
         self.solve_pair(ctx, &mut pair, use_bias);
     }
 
@@ -515,7 +496,7 @@ impl Constraint for RevoluteJoint {
             inv_inertia: ii,
         };
         // Tree joints' point rows are solved directly, at their own softness.
-        let point_softness = if self.in_tree {
+        let point_softness = if self.base.in_tree {
             ctx.direct_joint_softness
         } else {
             point_softness(ctx, &m)
@@ -598,7 +579,7 @@ impl Constraint for RevoluteJoint {
     }
 
     fn is_enabled(&self) -> bool {
-        self.enabled
+        self.base.enabled
     }
 }
 

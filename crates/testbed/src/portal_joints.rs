@@ -184,7 +184,7 @@ pub fn gap_through_map(world: &World, joint: JointHandle, pair: PortalPairHandle
     let Ok(j) = world.revolute_joint(joint) else {
         return Real::INFINITY;
     };
-    if !j.enabled {
+    if !j.is_enabled() {
         return Real::INFINITY;
     }
     let ends = [

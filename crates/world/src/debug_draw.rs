@@ -445,21 +445,20 @@ pub(crate) fn draw_world<D: DebugDraw + ?Sized>(
     }
     if o.joints {
         for &j in world.joint_handles() {
-            let Ok(joint) = world.revolute_joint(j) else {
+            let Ok(joint) = world.joint(j) else {
                 continue;
             };
-            let (Ok(xa), Ok(xb)) = (
-                world.transform(joint.def.body_a),
-                world.transform(joint.def.body_b),
-            ) else {
+            let (body_a, body_b) = joint.bodies();
+            let (Ok(xa), Ok(xb)) = (world.transform(body_a), world.transform(body_b)) else {
                 continue;
             };
-            let pa = xa.apply(joint.def.local_anchor_a);
-            let pb = xb.apply(joint.def.local_anchor_b);
+            let (anchor_a, anchor_b) = joint.local_anchors();
+            let pa = xa.apply(anchor_a);
+            let pb = xb.apply(anchor_b);
             if !visible(&Aabb::new(pa.min(pb), pa.max(pb))) {
                 continue;
             }
-            let c = if joint.enabled {
+            let c = if joint.is_enabled() {
                 o.palette.joint
             } else {
                 o.palette.joint_disabled

@@ -20,6 +20,9 @@ pub enum WorldError {
     StaleBody,
     /// A joint handle that is stale.
     StaleJoint,
+    /// A live joint handle used where another kind of joint is needed (a
+    /// typed accessor or a setter that the joint's kind does not have).
+    WrongJointKind,
     /// A shape handle that is stale.
     StaleShape,
     /// A portal pair handle that is stale.
@@ -71,6 +74,7 @@ impl std::fmt::Display for WorldError {
             WorldError::Geometry(e) => write!(f, "shape: {e}"),
             WorldError::StaleBody => write!(f, "stale body handle"),
             WorldError::StaleJoint => write!(f, "stale joint handle"),
+            WorldError::WrongJointKind => write!(f, "the joint is of another kind"),
             WorldError::StaleShape => write!(f, "stale shape handle"),
             WorldError::StalePortal => write!(f, "stale portal pair handle"),
             WorldError::ForeignHandle => write!(f, "handle issued by another world"),

@@ -541,14 +541,8 @@ impl Islands {
                 part.push(b);
                 let via_contacts = contacts.links_of(b);
                 let via_joints = joints.of_body(b).iter().filter_map(|&j| {
-                    let joint = joints.revolute(j).ok()?;
-                    joint.enabled.then(|| {
-                        if joint.def.body_a == b {
-                            joint.def.body_b
-                        } else {
-                            joint.def.body_a
-                        }
-                    })
+                    let joint = joints.get(j).ok()?;
+                    joint.is_enabled().then(|| joint.other_body(b)).flatten()
                 });
                 for other in via_contacts.chain(via_joints) {
                     let oi = other.index as usize;

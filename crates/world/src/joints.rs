@@ -3,20 +3,25 @@
 //!
 //! ```text
 //! JointSet
-//!   slots        Slots<JointSlot>     handle → (JointKind, index in its type's array)
-//!   revolute     Vec<RevoluteJoint>   solver form, dense (swap-remove)
-//!   handles      Vec<JointHandle>     parallel to revolute
+//!   slots        Slots<JointSlot>     handle → (JointKind, index in `joints`)
+//!   joints       Vec<Joint>           solver form of every kind, dense (swap-remove)
+//!   handles      Vec<JointHandle>     parallel to joints
 //!   body_joints  body slot → [JointHandle]   (destroy body, portals walk these)
 //!   no_collide   NoCollide            body pair → joints with collide_connected = false
 //! ```
 //!
 //! A joint's bodies and `collide_connected` are fixed at creation; limits,
 //! motor, spring and the enabled switch change through validated setters
-//! that leave the joint unchanged on error.
+//! that leave the joint unchanged on error. The set never names a joint
+//! kind but in the typed accessors ([`JointSet::revolute`]) and the
+//! setters whose meaning is the kind's (angle limits of a revolute joint).
 
 use std::collections::HashMap;
 
-use janus2d_constraints::{JointColours, JointForest, RevoluteJoint, RevoluteJointDef};
+pub use janus2d_constraints::JointKind;
+use janus2d_constraints::{
+    Joint, JointBatch, JointColours, JointDef, JointForest, RevoluteJoint, RevoluteJointDef,
+};
 use janus2d_core::body::BodyHandle;
 use janus2d_core::handle::{Handle, JointTag};
 use janus2d_core::math::Real;
@@ -27,14 +32,6 @@ use crate::error::WorldError;
 
 /// A generational handle to a joint.
 pub type JointHandle = Handle<JointTag>;
-
-/// The joint types.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub enum JointKind {
-    /// A pin: two anchors coincide; optional limit, motor and spring.
-    Revolute,
-}
 
 /// Where a joint lives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -90,7 +87,7 @@ impl NoCollide {
 pub struct JointSet {
     owner: u32,
     slots: Slots<JointSlot>,
-    pub(crate) revolute: Vec<RevoluteJoint>,
+    joints: Vec<Joint>,
     handles: Vec<JointHandle>,
     body_joints: Vec<SmallVec<[JointHandle; 2]>>,
     pub(crate) no_collide: NoCollide,
@@ -147,12 +144,12 @@ impl JointSet {
     /// ↔ slots ↔ storage, each joint's bodies live and listing it, every
     /// body list holding live joints of that body, no-collide counts.
     pub(crate) fn check(&self, bodies: &janus2d_core::body::BodySet) -> Result<(), String> {
-        if self.handles.len() != self.slots.len() || self.revolute.len() != self.slots.len() {
+        if self.handles.len() != self.slots.len() || self.joints.len() != self.slots.len() {
             return Err(format!(
                 "{} handles, {} slots, {} joints",
                 self.handles.len(),
                 self.slots.len(),
-                self.revolute.len()
+                self.joints.len()
             ));
         }
         let mut no_collide: HashMap<(u32, u32), u32> = HashMap::new();
@@ -161,8 +158,8 @@ impl JointSet {
             if slot.index as usize != k {
                 return Err(format!("joint {k}: its slot points at {}", slot.index));
             }
-            let j = &self.revolute[k];
-            let (a, b) = (j.def.body_a, j.def.body_b);
+            let j = &self.joints[k];
+            let (a, b) = j.bodies();
             for body in [a, b] {
                 if !bodies.contains(body) {
                     return Err(format!("joint {k}: body {body:?} is not live"));
@@ -171,7 +168,7 @@ impl JointSet {
                     return Err(format!("joint {k}: not listed under body {body:?}"));
                 }
             }
-            if !j.def.collide_connected {
+            if !j.collide_connected() {
                 *no_collide
                     .entry(crate::contacts::pair_key(a.index, b.index))
                     .or_insert(0) += 1;
@@ -216,18 +213,42 @@ impl JointSet {
         Ok(())
     }
 
-    /// A revolute joint.
-    pub fn revolute(&self, joint: JointHandle) -> Result<&RevoluteJoint, WorldError> {
+    /// A joint, of any kind.
+    pub fn get(&self, joint: JointHandle) -> Result<&Joint, WorldError> {
         let s = self.slot(joint)?;
-        match s.kind {
-            JointKind::Revolute => Ok(&self.revolute[s.index as usize]),
-        }
+        Ok(&self.joints[s.index as usize])
+    }
+
+    fn get_mut(&mut self, joint: JointHandle) -> Result<&mut Joint, WorldError> {
+        let s = self.slot(joint)?;
+        Ok(&mut self.joints[s.index as usize])
+    }
+
+    /// A revolute joint (`Err(WrongJointKind)` for a joint of another kind).
+    pub fn revolute(&self, joint: JointHandle) -> Result<&RevoluteJoint, WorldError> {
+        self.get(joint)?
+            .as_revolute()
+            .ok_or(WorldError::WrongJointKind)
     }
 
     fn revolute_mut(&mut self, joint: JointHandle) -> Result<&mut RevoluteJoint, WorldError> {
-        let s = self.slot(joint)?;
-        match s.kind {
-            JointKind::Revolute => Ok(&mut self.revolute[s.index as usize]),
+        self.get_mut(joint)?
+            .as_revolute_mut()
+            .ok_or(WorldError::WrongJointKind)
+    }
+
+    /// Every joint in storage order (parallel to [`JointSet::handles`]).
+    pub fn iter(&self) -> impl Iterator<Item = (JointHandle, &Joint)> + '_ {
+        self.handles.iter().copied().zip(&self.joints)
+    }
+
+    /// The solver's view of the joints: the joints, their forest and
+    /// colours.
+    pub(crate) fn batch(&mut self) -> JointBatch<'_> {
+        JointBatch {
+            joints: &mut self.joints,
+            forest: &mut self.forest,
+            colours: &mut self.colours,
         }
     }
 
@@ -238,30 +259,30 @@ impl JointSet {
 
     /// The two bodies of a joint.
     pub fn bodies_of(&self, joint: JointHandle) -> Result<(BodyHandle, BodyHandle), WorldError> {
-        let j = self.revolute(joint)?;
-        Ok((j.def.body_a, j.def.body_b))
+        Ok(self.get(joint)?.bodies())
     }
 
-    /// Adds a revolute joint (its definition validated and its bodies
-    /// checked by the caller).
-    pub(crate) fn insert_revolute(&mut self, def: &RevoluteJointDef) -> JointHandle {
+    /// Adds a joint (its definition validated and its bodies checked by
+    /// the caller).
+    pub(crate) fn insert(&mut self, def: &JointDef) -> JointHandle {
         let (index, generation) = self.slots.insert(JointSlot {
-            kind: JointKind::Revolute,
-            index: self.revolute.len() as u32,
+            kind: def.kind(),
+            index: self.joints.len() as u32,
             user_data: 0,
         });
         let handle = JointHandle::new(index, generation, self.owner);
-        self.revolute.push(RevoluteJoint::new(def.clone()));
+        self.joints.push(Joint::new(def.clone()));
         self.handles.push(handle);
-        for body in [def.body_a, def.body_b] {
-            let b = body.index as usize;
-            if self.body_joints.len() <= b {
-                self.body_joints.resize(b + 1, SmallVec::new());
+        let (a, b) = def.bodies();
+        for body in [a, b] {
+            let i = body.index as usize;
+            if self.body_joints.len() <= i {
+                self.body_joints.resize(i + 1, SmallVec::new());
             }
-            self.body_joints[b].push(handle);
+            self.body_joints[i].push(handle);
         }
-        if !def.collide_connected {
-            self.no_collide.add(def.body_a, def.body_b);
+        if !def.collide_connected() {
+            self.no_collide.add(a, b);
         }
         handle
     }
@@ -273,8 +294,8 @@ impl JointSet {
     ) -> Result<(BodyHandle, BodyHandle, bool), WorldError> {
         let s = self.slot(joint)?;
         let i = s.index as usize;
-        let def = &self.revolute[i].def;
-        let (a, b, collide) = (def.body_a, def.body_b, def.collide_connected);
+        let j = &self.joints[i];
+        let ((a, b), collide) = (j.bodies(), j.collide_connected());
         if !collide {
             self.no_collide.remove(a, b);
         }
@@ -285,9 +306,9 @@ impl JointSet {
                 list.remove(k);
             }
         }
-        self.revolute.swap_remove(i);
+        self.joints.swap_remove(i);
         self.handles.swap_remove(i);
-        if i < self.revolute.len() {
+        if i < self.joints.len() {
             let moved = self.handles[i];
             if let Some(slot) = self.slots.at_mut(moved.index) {
                 slot.index = i as u32;
@@ -312,19 +333,13 @@ impl JointSet {
         to: BodyHandle,
         anchor: janus2d_core::math::Vec2,
     ) -> Option<((BodyHandle, BodyHandle), (BodyHandle, BodyHandle))> {
-        let j = self.revolute_mut(joint).ok()?;
-        let old = (j.def.body_a, j.def.body_b);
-        if j.def.body_a == from {
-            j.def.body_a = to;
-            j.def.local_anchor_a = anchor;
-        } else if j.def.body_b == from {
-            j.def.body_b = to;
-            j.def.local_anchor_b = anchor;
-        } else {
+        let j = self.get_mut(joint).ok()?;
+        let old = j.bodies();
+        if !j.repoint(from, to, anchor) {
             return None;
         }
-        let new = (j.def.body_a, j.def.body_b);
-        let collide = j.def.collide_connected;
+        let new = j.bodies();
+        let collide = j.collide_connected();
         if let Some(list) = self.body_joints.get_mut(from.index as usize)
             && let Some(k) = list.iter().position(|h| *h == joint)
         {
@@ -344,15 +359,13 @@ impl JointSet {
 
     /// A joint, mutable (the portal stage carries its impulses through).
     #[cfg_attr(not(feature = "portals"), allow(dead_code))]
-    pub(crate) fn revolute_joint_mut(
-        &mut self,
-        joint: JointHandle,
-    ) -> Result<&mut RevoluteJoint, WorldError> {
-        self.revolute_mut(joint)
+    pub(crate) fn joint_mut(&mut self, joint: JointHandle) -> Result<&mut Joint, WorldError> {
+        self.get_mut(joint)
     }
 
-    /// Changes a joint's definition through `edit`, keeping the change only
-    /// when the result validates. Returns the joint's bodies (to wake).
+    /// Changes a revolute joint's definition through `edit`, keeping the
+    /// change only when the result validates. Returns the joint's bodies
+    /// (to wake).
     fn edit(
         &mut self,
         joint: JointHandle,
@@ -398,10 +411,13 @@ impl JointSet {
     /// of each such joint, in joint order. The light clusters leave them
     /// out (`janus2d_constraints::contact_group`).
     pub(crate) fn driven_bodies(&self) -> impl Iterator<Item = BodyHandle> + '_ {
-        self.revolute
+        self.joints
             .iter()
-            .filter(|j| j.enabled && j.def.enable_motor && j.def.max_motor_torque > 0.0)
-            .flat_map(|j| [j.def.body_a, j.def.body_b])
+            .filter(|j| j.is_enabled() && j.is_driven())
+            .flat_map(|j| {
+                let (a, b) = j.bodies();
+                [a, b]
+            })
     }
 
     /// Sets the motor speed, rad/s.
@@ -477,34 +493,42 @@ impl JointSet {
         joint: JointHandle,
         on: bool,
     ) -> Result<(BodyHandle, BodyHandle), WorldError> {
-        let j = self.revolute_mut(joint)?;
-        j.enabled = on;
-        Ok((j.def.body_a, j.def.body_b))
+        let j = self.get_mut(joint)?;
+        j.set_enabled(on);
+        Ok(j.bodies())
     }
 
     /// Rows every enabled joint adds to the solver.
     #[must_use]
     pub fn row_count(&self) -> usize {
-        self.revolute
+        self.joints
             .iter()
-            .filter(|j| j.enabled)
-            .map(RevoluteJoint::row_count)
+            .filter(|j| j.is_enabled())
+            .map(Joint::row_count)
+            .sum()
+    }
+
+    /// Rows the tree solve took in the last step.
+    #[must_use]
+    pub fn direct_row_count(&self) -> usize {
+        self.joints
+            .iter()
+            .filter(|j| j.in_tree())
+            .map(Joint::tree_row_count)
             .sum()
     }
 }
 
 /// The world's limits on a joint definition, beyond
-/// [`RevoluteJointDef::validate`]: local anchors within
+/// [`JointDef::validate`]: local anchors within
 /// [`MAX_EXTENT`](janus2d_core::limits::MAX_EXTENT), the motor speed
 /// within [`MAX_ANGULAR_SPEED`](janus2d_core::limits::MAX_ANGULAR_SPEED),
 /// the spring within [`MAX_SPRING_HERTZ`] and
 /// [`MAX_DAMPING_RATIO`](janus2d_core::limits::MAX_DAMPING_RATIO).
-pub(crate) fn check_joint_limits(def: &RevoluteJointDef) -> Result<(), WorldError> {
+pub(crate) fn check_joint_limits(def: &JointDef) -> Result<(), WorldError> {
     let max = janus2d_core::limits::MAX_EXTENT;
-    for (a, field) in [
-        (def.local_anchor_a, "local_anchor_a"),
-        (def.local_anchor_b, "local_anchor_b"),
-    ] {
+    let (anchor_a, anchor_b) = def.local_anchors();
+    for (a, field) in [(anchor_a, "local_anchor_a"), (anchor_b, "local_anchor_b")] {
         if a.x.abs() > max || a.y.abs() > max {
             return Err(WorldError::OutOfBounds {
                 field,
@@ -513,8 +537,12 @@ pub(crate) fn check_joint_limits(def: &RevoluteJointDef) -> Result<(), WorldErro
             });
         }
     }
-    check_motor_speed(def.motor_speed)?;
-    check_spring(def.hertz, def.damping_ratio)
+    match def {
+        JointDef::Revolute(def) => {
+            check_motor_speed(def.motor_speed)?;
+            check_spring(def.hertz, def.damping_ratio)
+        }
+    }
 }
 
 /// Largest joint spring stiffness, Hz (1e6: a stiffer spring's softness

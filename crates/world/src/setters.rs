@@ -230,7 +230,7 @@ impl World {
             };
             let other = if a == body { b } else { a };
             self.wake_body(other);
-            let enabled = self.joints.revolute(j).is_ok_and(|r| r.enabled);
+            let enabled = self.joints.get(j).is_ok_and(|r| r.is_enabled());
             if ty == BodyType::Dynamic && enabled {
                 self.islands.link(a, b, &self.bodies);
             } else {

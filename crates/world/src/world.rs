@@ -19,7 +19,9 @@
 //! a generational handle; every call that rejects its input leaves the world
 //! unchanged.
 
-use janus2d_constraints::{ContactSolver, ObjectMass, RevoluteJoint, RevoluteJointDef};
+use janus2d_constraints::{
+    ContactSolver, Joint, JointDef, ObjectMass, RevoluteJoint, RevoluteJointDef,
+};
 use janus2d_core::BodyMass;
 use janus2d_core::body::{BodyDef, BodyHandle, BodyLocation, BodySet, BodyType, validate_mass};
 use janus2d_core::constraint::{ConstraintBatch, StepContext};
@@ -589,26 +591,45 @@ impl World {
 
     // ----- joints -----------------------------------------------------------
 
-    /// Creates a revolute joint. Its bodies and `collide_connected` are
+    /// Creates a joint of any kind. Its bodies and `collide_connected` are
     /// fixed for its life; with `collide_connected = false` the contacts
-    /// between its bodies end (walking one body's contacts).
+    /// between its bodies end (walking one body's contacts). A bad
+    /// definition or a stale body gets a typed error and changes nothing.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_constraints::RevoluteJointDef;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    /// let bob = world.create_body(&BodyDef::dynamic(Vec2::new(1.0, 0.0))).unwrap();
+    /// let def = RevoluteJointDef::new(ground, bob, Vec2::ZERO, Vec2::new(-1.0, 0.0));
+    /// let pin = world.create_joint(&def.into()).unwrap();
+    /// assert!(world.revolute_joint(pin).is_ok());
+    /// ```
+    pub fn create_joint(&mut self, def: &JointDef) -> Result<JointHandle, WorldError> {
+        def.validate()?;
+        crate::joints::check_joint_limits(def)?;
+        let (a, b) = def.bodies();
+        self.check_body(a)?;
+        self.check_body(b)?;
+        self.wake_body(a);
+        self.wake_body(b);
+        let handle = self.joints.insert(def);
+        self.islands.link(a, b, &self.bodies);
+        if !def.collide_connected() {
+            self.collision.remove_contacts_between(a, b);
+        }
+        Ok(handle)
+    }
+
+    /// Creates a revolute joint ([`World::create_joint`] with
+    /// [`JointDef::Revolute`]).
     pub fn create_revolute_joint(
         &mut self,
         def: &RevoluteJointDef,
     ) -> Result<JointHandle, WorldError> {
-        def.validate()?;
-        crate::joints::check_joint_limits(def)?;
-        self.check_body(def.body_a)?;
-        self.check_body(def.body_b)?;
-        self.wake_body(def.body_a);
-        self.wake_body(def.body_b);
-        let handle = self.joints.insert_revolute(def);
-        self.islands.link(def.body_a, def.body_b, &self.bodies);
-        if !def.collide_connected {
-            self.collision
-                .remove_contacts_between(def.body_a, def.body_b);
-        }
-        Ok(handle)
+        self.create_joint(&JointDef::Revolute(def.clone()))
     }
 
     /// Removes a live joint, waking its bodies.
@@ -633,7 +654,12 @@ impl World {
         Ok(())
     }
 
-    /// A revolute joint.
+    /// A joint of any kind.
+    pub fn joint(&self, joint: JointHandle) -> Result<&Joint, WorldError> {
+        self.joints.get(joint)
+    }
+
+    /// A revolute joint (`Err(WrongJointKind)` for another kind).
     pub fn revolute_joint(&self, joint: JointHandle) -> Result<&RevoluteJoint, WorldError> {
         self.joints.revolute(joint)
     }
@@ -686,13 +712,13 @@ impl World {
     /// Force the joint applied to its body b over the last solved step, N
     /// (body a got the opposite); kept while its bodies sleep.
     pub fn joint_force(&self, joint: JointHandle) -> Result<Vec2, WorldError> {
-        Ok(self.joints.revolute(joint)?.constraint_force())
+        Ok(self.joints.get(joint)?.constraint_force())
     }
 
     /// Torque about the joint axis (springs, motors, limits) applied to
     /// body b over the last solved step, N·m; kept while its bodies sleep.
     pub fn joint_torque(&self, joint: JointHandle) -> Result<Real, WorldError> {
-        Ok(self.joints.revolute(joint)?.constraint_torque())
+        Ok(self.joints.get(joint)?.constraint_torque())
     }
 
     /// The joints (read access: handles, per-body lists, kinds).
@@ -797,7 +823,7 @@ impl World {
 
     /// Distance between a joint's two world anchors, m.
     pub fn joint_gap(&self, joint: JointHandle) -> Result<Real, WorldError> {
-        Ok(self.revolute_joint(joint)?.gap(&self.bodies))
+        Ok(self.joints.get(joint)?.gap(&self.bodies))
     }
 
     /// Handles of every joint, in storage order.
@@ -808,9 +834,8 @@ impl World {
     /// The largest joint gap in the world, m.
     pub fn max_joint_gap(&self) -> Real {
         self.joints
-            .revolute
             .iter()
-            .map(|j| j.gap(&self.bodies))
+            .map(|(_, j)| j.gap(&self.bodies))
             .fold(0.0, Real::max)
     }
 
@@ -1491,11 +1516,7 @@ impl World {
         // No restitution anywhere: no restitution pass.
         ctx.restitution = has_shapes && self.collision.counters.restitution_contacts > 0;
         let couple = has_portals && self.portals.copies_carry_joints(&self.joints);
-        let mut revolute = janus2d_constraints::RevoluteBatch {
-            joints: &mut self.joints.revolute,
-            forest: &mut self.joints.forest,
-            colours: &mut self.joints.colours,
-        };
+        let mut joints = self.joints.batch();
         let mut contacts = janus2d_constraints::ContactBatch {
             solver: &mut self.contact_solver,
             object_masses: &self.object_masses,
@@ -1510,14 +1531,14 @@ impl World {
         };
         let mut report = if passes > 0 {
             let mut coupled = crate::portal::coupling::CoupledBatches {
-                batches: [&mut revolute, &mut contacts, &mut portals],
+                batches: [&mut joints, &mut contacts, &mut portals],
                 passes,
             };
             let mut batches: [&mut dyn ConstraintBatch; 1] = [&mut coupled];
             solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches)
         } else {
             let mut batches: [&mut dyn ConstraintBatch; 3] =
-                [&mut revolute, &mut contacts, &mut portals];
+                [&mut joints, &mut contacts, &mut portals];
             solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches)
         };
         // The solver checks velocities and deltas; a pose they carried out
@@ -1587,7 +1608,7 @@ impl World {
             collision: self.collision.counters,
             contacts: self.contact_solver.len(),
             joint_rows: self.joints.row_count(),
-            direct_joint_rows: 2 * self.joints.forest.tree_joint_count(),
+            direct_joint_rows: self.joints.direct_row_count(),
             portal_stage_ran: has_portals,
             portals: self.portals.counters_for_step(has_portals),
             gravity: self.gravity != Vec2::ZERO,
@@ -1708,7 +1729,7 @@ impl World {
             .of_body(body)
             .iter()
             .copied()
-            .filter(|h| self.joints.revolute(*h).is_ok_and(|j| j.enabled))
+            .filter(|h| self.joints.get(*h).is_ok_and(Joint::is_enabled))
             .collect()
     }
 
@@ -1736,8 +1757,8 @@ impl World {
         };
         let (enabled, collide) = self
             .joints
-            .revolute(joint)
-            .map_or((false, true), |j| (j.enabled, j.def.collide_connected));
+            .get(joint)
+            .map_or((false, true), |j| (j.is_enabled(), j.collide_connected()));
         if !collide {
             self.collision.remove_contacts_between(new.0, new.1);
             let freed = !self.joints.no_collide.contains(old.0, old.1);

@@ -501,7 +501,7 @@ impl PortalStage {
                 joints
                     .of_body(b)
                     .iter()
-                    .any(|&h| joints.revolute(h).is_ok_and(|j| j.enabled))
+                    .any(|&h| joints.get(h).is_ok_and(|j| j.is_enabled()))
             })
         })
     }
@@ -1346,14 +1346,7 @@ impl World {
 
     /// A joint's local anchor on `body` (`None` when `body` is neither end).
     fn anchor_on(&self, joint: JointHandle, body: BodyHandle) -> Option<Vec2> {
-        let j = self.joints.revolute(joint).ok()?;
-        if j.def.body_a == body {
-            Some(j.def.local_anchor_a)
-        } else if j.def.body_b == body {
-            Some(j.def.local_anchor_b)
-        } else {
-            None
-        }
+        self.joints.get(joint).ok()?.local_anchor_on(body)
     }
 
     /// Carries joint `joint` through crossing `c`: its end on `from` moves
@@ -1393,7 +1386,7 @@ impl World {
                     let anchor = other_center + other_scale * (anchor - other_center);
                     self.repoint_joint(joint, other, other_twin, anchor);
                 }
-                if let Ok(j) = self.joints.revolute_joint_mut(joint) {
+                if let Ok(j) = self.joints.joint_mut(joint) {
                     j.carry_impulses(q, impulse_scale);
                 }
             }

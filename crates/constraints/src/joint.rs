@@ -1,0 +1,575 @@
+//! The joint family: one definition enum at the API boundary, one solver
+//! form the solver iterates, and the stages every kind shares.
+//!
+//! ```text
+//!  user                      world (JointSet)              solver
+//!  ─────────────────────     ───────────────────────       ───────────────────────────────────
+//!  JointDef::Revolute(d) ──▶ Joint::Revolute(j)  ──▶  prepare       each joint (kind's rows)
+//!  (validated, typed error)  one Vec<Joint>,           colours       JointColours (keys from JointBase)
+//!                            dense, swap-remove        warm start    Joint::warm_start_side, per body
+//!                                                      solve, relax  Joint::solve_pair, colour by colour
+//!                                                      late solve    JointForest (Joint::tree_point)
+//! ```
+//!
+//! | kind        | file            | rows                                          | rows the tree solves |
+//! |-------------|-----------------|-----------------------------------------------|----------------------|
+//! | `Revolute`  | `revolute.rs`   | point (2), spring, motor, lower, upper (1 each) | point (2)          |
+//!
+//! Everything the solver needs from a joint that is not its own rows is in
+//! [`JointBase`]: the state indices, the masses loaded at prepare, whether
+//! it is enabled, resting or part of a tree. The colouring, the tree solve
+//! and the world read joints only through [`Joint`]'s methods, so they
+//! never name a kind.
+//!
+//! **Adding a kind** is one file in this crate (its definition with
+//! `validate`, its solver form with `prepare`, `warm_start_side`,
+//! `solve_pair`, `rows` and read-backs, and a `base: JointBase` field) plus
+//! one variant in [`JointDef`], [`Joint`] and [`JointKind`] and the arms of
+//! the matches below. Nothing in the solver, the colouring or the tree
+//! changes; a kind without a point part simply returns `None` from
+//! [`Joint::tree_point`] and the tree solve leaves its component iterative.
+
+use janus2d_core::body::{BodyHandle, BodySet, BodyState, SolverBody};
+use janus2d_core::constraint::{Constraint, ConstraintBatch, ConstraintRows, StepContext};
+use janus2d_core::math::{Real, Rot, Vec2};
+use janus2d_core::parallel::Team;
+
+use crate::JointError;
+use crate::joint_colour::JointColours;
+use crate::joint_tree::JointForest;
+use crate::parts::{BOTH, PairMass, PairOf, PairStates, PointPart};
+use crate::revolute::{RevoluteJoint, RevoluteJointDef};
+
+/// The joint kinds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum JointKind {
+    /// A pin: two anchors coincide; optional limit, motor and spring.
+    Revolute,
+}
+
+/// Everything needed to create a joint of any kind (the API boundary's
+/// one type: `World::create_joint` takes it).
+///
+/// ```
+/// use janus2d_constraints::{JointDef, JointKind, RevoluteJointDef};
+/// use janus2d_core::{BodyDef, BodySet, Vec2};
+/// let mut bodies = BodySet::new();
+/// let a = bodies.create(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+/// let b = bodies.create(&BodyDef::dynamic(Vec2::X)).unwrap();
+/// let def: JointDef = RevoluteJointDef::new(a, b, Vec2::X, Vec2::ZERO).into();
+/// assert_eq!(def.kind(), JointKind::Revolute);
+/// assert_eq!(def.bodies(), (a, b));
+/// assert!(def.validate().is_ok());
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum JointDef {
+    /// A revolute joint.
+    Revolute(RevoluteJointDef),
+}
+
+impl From<RevoluteJointDef> for JointDef {
+    fn from(def: RevoluteJointDef) -> Self {
+        JointDef::Revolute(def)
+    }
+}
+
+impl JointDef {
+    /// The kind of joint this defines.
+    #[must_use]
+    pub fn kind(&self) -> JointKind {
+        match self {
+            JointDef::Revolute(_) => JointKind::Revolute,
+        }
+    }
+
+    /// The two bodies `(a, b)`.
+    #[must_use]
+    pub fn bodies(&self) -> (BodyHandle, BodyHandle) {
+        match self {
+            JointDef::Revolute(d) => (d.body_a, d.body_b),
+        }
+    }
+
+    /// Whether the two bodies collide with each other.
+    #[must_use]
+    pub fn collide_connected(&self) -> bool {
+        match self {
+            JointDef::Revolute(d) => d.collide_connected,
+        }
+    }
+
+    /// The local anchors on a and b (in each body's frame), m.
+    #[must_use]
+    pub fn local_anchors(&self) -> (Vec2, Vec2) {
+        match self {
+            JointDef::Revolute(d) => (d.local_anchor_a, d.local_anchor_b),
+        }
+    }
+
+    /// Checks the definition's own values (not the handles).
+    pub fn validate(&self) -> Result<(), JointError> {
+        match self {
+            JointDef::Revolute(d) => d.validate(),
+        }
+    }
+}
+
+/// What the solver keeps of every joint, whatever its kind: the state
+/// indices and masses loaded at prepare and the switches the colouring and
+/// the tree solve read.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct JointBase {
+    /// False when the joint is disabled (skipped by the solver).
+    pub(crate) enabled: bool,
+    /// Body a's state index (0: the static identity state).
+    pub(crate) state_a: u32,
+    /// Body b's state index.
+    pub(crate) state_b: u32,
+    /// The bodies' inverse masses, loaded at prepare (zero for a body on
+    /// the static identity state).
+    pub(crate) masses: PairMass,
+    /// True while the joint's point rows belong to the direct solve of a
+    /// joint tree (set every step by [`JointForest`]).
+    pub(crate) in_tree: bool,
+    /// Neither body moves this step (both static or asleep): the joint is
+    /// not solved and keeps its last impulses, so its read-back holds.
+    pub(crate) resting: bool,
+    /// `1 / h` of the last step the joint was solved in, 1/s (turns the
+    /// per-substep impulses into forces).
+    pub(crate) inv_h: Real,
+}
+
+impl Default for JointBase {
+    fn default() -> Self {
+        JointBase {
+            enabled: true,
+            state_a: 0,
+            state_b: 0,
+            masses: PairMass::ZERO,
+            in_tree: false,
+            resting: false,
+            inv_h: 0.0,
+        }
+    }
+}
+
+impl JointBase {
+    /// Loads the state indices and masses of the two bodies for a step;
+    /// returns the bodies, or `None` when neither moves (the joint rests
+    /// this step and keeps its impulses).
+    #[inline]
+    pub(crate) fn load<'b>(
+        &mut self,
+        ctx: &StepContext,
+        bodies: &'b BodySet,
+        body_a: BodyHandle,
+        body_b: BodyHandle,
+    ) -> Option<(SolverBody<'b>, SolverBody<'b>)> {
+        let a = bodies.solver_body(body_a);
+        let b = bodies.solver_body(body_b);
+        self.state_a = a.state_index;
+        self.state_b = b.state_index;
+        self.resting = a.state_index == 0 && b.state_index == 0;
+        if self.resting {
+            return None;
+        }
+        self.inv_h = ctx.inv_h;
+        self.masses = PairMass {
+            a: a.inv_masses(),
+            b: b.inv_masses(),
+        };
+        Some((a, b))
+    }
+}
+
+/// A joint in solver form: one variant per kind.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Joint {
+    /// A revolute joint.
+    Revolute(RevoluteJoint),
+}
+
+impl From<RevoluteJoint> for Joint {
+    fn from(j: RevoluteJoint) -> Self {
+        Joint::Revolute(j)
+    }
+}
+
+impl Joint {
+    /// A joint from a definition (validate it first).
+    #[must_use]
+    pub fn new(def: JointDef) -> Self {
+        match def {
+            JointDef::Revolute(d) => Joint::Revolute(RevoluteJoint::new(d)),
+        }
+    }
+
+    /// Its kind.
+    #[must_use]
+    pub fn kind(&self) -> JointKind {
+        match self {
+            Joint::Revolute(_) => JointKind::Revolute,
+        }
+    }
+
+    /// Its definition as it stands (limits, motor and spring as last set).
+    #[must_use]
+    pub fn def(&self) -> JointDef {
+        match self {
+            Joint::Revolute(j) => JointDef::Revolute(j.def.clone()),
+        }
+    }
+
+    /// The revolute joint, if it is one.
+    #[must_use]
+    pub fn as_revolute(&self) -> Option<&RevoluteJoint> {
+        match self {
+            Joint::Revolute(j) => Some(j),
+        }
+    }
+
+    /// The revolute joint, mutable, if it is one.
+    pub fn as_revolute_mut(&mut self) -> Option<&mut RevoluteJoint> {
+        match self {
+            Joint::Revolute(j) => Some(j),
+        }
+    }
+
+    /// The common solver data.
+    #[inline(always)]
+    #[must_use]
+    pub fn base(&self) -> &JointBase {
+        match self {
+            Joint::Revolute(j) => &j.base,
+        }
+    }
+
+    #[inline(always)]
+    pub(crate) fn base_mut(&mut self) -> &mut JointBase {
+        match self {
+            Joint::Revolute(j) => &mut j.base,
+        }
+    }
+
+    /// The two bodies `(a, b)`.
+    #[must_use]
+    pub fn bodies(&self) -> (BodyHandle, BodyHandle) {
+        match self {
+            Joint::Revolute(j) => (j.def.body_a, j.def.body_b),
+        }
+    }
+
+    /// Whether its bodies collide with each other.
+    #[must_use]
+    pub fn collide_connected(&self) -> bool {
+        match self {
+            Joint::Revolute(j) => j.def.collide_connected,
+        }
+    }
+
+    /// The local anchors on a and b (in each body's frame), m.
+    #[must_use]
+    pub fn local_anchors(&self) -> (Vec2, Vec2) {
+        match self {
+            Joint::Revolute(j) => (j.def.local_anchor_a, j.def.local_anchor_b),
+        }
+    }
+
+    /// The local anchor on `body` (`None` when `body` is neither end).
+    #[must_use]
+    pub fn local_anchor_on(&self, body: BodyHandle) -> Option<Vec2> {
+        let (a, b) = self.bodies();
+        let (anchor_a, anchor_b) = self.local_anchors();
+        if a == body {
+            Some(anchor_a)
+        } else if b == body {
+            Some(anchor_b)
+        } else {
+            None
+        }
+    }
+
+    /// The body at the other end from `body` (`None` when `body` is
+    /// neither end).
+    #[must_use]
+    pub fn other_body(&self, body: BodyHandle) -> Option<BodyHandle> {
+        let (a, b) = self.bodies();
+        if a == body {
+            Some(b)
+        } else if b == body {
+            Some(a)
+        } else {
+            None
+        }
+    }
+
+    /// False when the joint is disabled.
+    #[inline(always)]
+    #[must_use]
+    pub fn is_enabled(&self) -> bool {
+        self.base().enabled
+    }
+
+    /// Enables or disables the joint.
+    pub fn set_enabled(&mut self, on: bool) {
+        self.base_mut().enabled = on;
+    }
+
+    /// True when the last step solved its point rows directly (it is part
+    /// of a tree of joints, see [`crate::joint_tree`]).
+    #[must_use]
+    pub fn in_tree(&self) -> bool {
+        self.base().in_tree
+    }
+
+    /// A motor of nonzero torque drives the joint's bodies (the light
+    /// clusters leave such bodies out).
+    #[must_use]
+    pub fn is_driven(&self) -> bool {
+        match self {
+            Joint::Revolute(j) => j.def.enable_motor && j.def.max_motor_torque > 0.0,
+        }
+    }
+
+    /// Rows this joint adds to the solver when enabled.
+    #[must_use]
+    pub fn row_count(&self) -> usize {
+        match self {
+            Joint::Revolute(j) => j.row_count(),
+        }
+    }
+
+    /// Rows of this joint the tree solve takes when it is in a tree.
+    #[must_use]
+    pub fn tree_row_count(&self) -> usize {
+        if self.tree_point().is_some() { 2 } else { 0 }
+    }
+
+    /// Force the joint applied to body b over the last solved step, N.
+    #[must_use]
+    pub fn constraint_force(&self) -> Vec2 {
+        match self {
+            Joint::Revolute(j) => j.constraint_force(),
+        }
+    }
+
+    /// Torque the joint applied to body b over the last solved step, N·m.
+    #[must_use]
+    pub fn constraint_torque(&self) -> Real {
+        match self {
+            Joint::Revolute(j) => j.constraint_torque(),
+        }
+    }
+
+    /// The world anchors on a and b.
+    #[must_use]
+    pub fn world_anchors(&self, bodies: &BodySet) -> (Vec2, Vec2) {
+        match self {
+            Joint::Revolute(j) => j.world_anchors(bodies),
+        }
+    }
+
+    /// Distance between the two world anchors, m.
+    #[must_use]
+    pub fn gap(&self, bodies: &BodySet) -> Real {
+        let (pa, pb) = self.world_anchors(bodies);
+        (pb - pa).length()
+    }
+
+    /// Carries the accumulated impulses through a portal when both ends
+    /// move to the other side (see [`RevoluteJoint::carry_impulses`]).
+    pub fn carry_impulses(&mut self, rotation: Rot, scale: Real) {
+        match self {
+            Joint::Revolute(j) => j.carry_impulses(rotation, scale),
+        }
+    }
+
+    /// Moves the end on body `from` to body `to` with the local anchor
+    /// `anchor` in `to`'s frame; false when `from` is not one of its ends.
+    pub fn repoint(&mut self, from: BodyHandle, to: BodyHandle, anchor: Vec2) -> bool {
+        match self {
+            Joint::Revolute(j) => {
+                if j.def.body_a == from {
+                    j.def.body_a = to;
+                    j.def.local_anchor_a = anchor;
+                } else if j.def.body_b == from {
+                    j.def.body_b = to;
+                    j.def.local_anchor_b = anchor;
+                } else {
+                    return false;
+                }
+                true
+            }
+        }
+    }
+
+    /// The point part the tree solve takes over when the joint is in a
+    /// tree (`None`: the kind has no point rows, and a component holding
+    /// it is solved iteratively).
+    #[inline(always)]
+    pub(crate) fn tree_point(&self) -> Option<&PointPart> {
+        match self {
+            Joint::Revolute(j) => Some(&j.point),
+        }
+    }
+
+    #[inline(always)]
+    pub(crate) fn tree_point_mut(&mut self) -> Option<&mut PointPart> {
+        match self {
+            Joint::Revolute(j) => Some(&mut j.point),
+        }
+    }
+
+    /// True when the joint has rows for the Gauss–Seidel pass this step:
+    /// every row when it is outside a tree, its other rows (springs,
+    /// motors, limits) when it is in one.
+    #[inline(always)]
+    pub(crate) fn has_iterative_rows(&self) -> bool {
+        match self {
+            Joint::Revolute(j) => !j.base.in_tree || j.has_angle_rows(),
+        }
+    }
+
+    /// The warm start's share on one body (`side_b`: body b, else a).
+    #[inline(always)]
+    pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
+        match self {
+            Joint::Revolute(j) => j.warm_start_side(st, side_b),
+        }
+    }
+
+    /// One velocity iteration of the joint's Gauss–Seidel rows.
+    #[inline(always)]
+    pub(crate) fn solve_pair<P: PairStates>(
+        &mut self,
+        ctx: &StepContext,
+        pair: &mut P,
+        use_bias: bool,
+    ) {
+        match self {
+            Joint::Revolute(j) => j.solve_pair(ctx, pair, use_bias),
+        }
+    }
+}
+
+impl Constraint for Joint {
+    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
+        match self {
+            Joint::Revolute(j) => j.prepare(ctx, bodies),
+        }
+    }
+
+    fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+        match self {
+            Joint::Revolute(j) => j.warm_start(ctx, states),
+        }
+    }
+
+    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
+        let (a, b) = (self.base().state_a, self.base().state_b);
+        let mut pair = PairOf::new(states, a, b, BOTH);
+        self.solve_pair(ctx, &mut pair, use_bias);
+    }
+
+    fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
+        match self {
+            Joint::Revolute(j) => j.rows(ctx, bodies),
+        }
+    }
+
+    fn is_enabled(&self) -> bool {
+        self.base().enabled
+    }
+}
+
+/// Rows of the joint prepare's blocks on the team.
+const PREPARE_BLOCK: usize = 256;
+
+/// Every joint of a world as the solver sees it: the joints, their tree
+/// solve and their colours.
+pub struct JointBatch<'a> {
+    /// The joints, in storage order.
+    pub joints: &'a mut Vec<Joint>,
+    /// The direct solve of the trees among them.
+    pub forest: &'a mut JointForest,
+    /// The colours of their Gauss–Seidel rows.
+    pub colours: &'a mut JointColours,
+}
+
+impl ConstraintBatch for JointBatch<'_> {
+    fn count(&self) -> usize {
+        self.joints.len()
+    }
+    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
+        self.prepare_on(ctx, bodies, &Team::serial());
+    }
+    fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+        self.warm_start_on(ctx, states, &Team::serial());
+    }
+    fn solve(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+    ) {
+        self.solve_on(ctx, states, use_bias, reverse, &Team::serial());
+    }
+    fn solve_late(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
+        self.forest.solve(ctx, self.joints, states, use_bias);
+    }
+    fn apply_restitution(&mut self, _ctx: &StepContext, _states: &mut [BodyState]) {
+        // No joint kind has restitution rows.
+    }
+    fn store_impulses(&mut self) {
+        // Joints keep their impulses in place.
+    }
+    fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
+        // Each joint's prepare reads the bodies and writes only itself:
+        // blocks of joints on the team, then the forest and the colours
+        // from the prepared joints (the same as `JointForest::prepare`).
+        team.for_each_chunk_mut(self.joints, PREPARE_BLOCK, |_, block| {
+            for j in block.iter_mut().filter(|j| j.is_enabled()) {
+                j.prepare(ctx, bodies);
+            }
+        });
+        self.forest
+            .build_on(self.joints, &bodies.states, ctx.direct_joints, team);
+        self.colours.update_on(self.joints, &bodies.states, team);
+    }
+    fn warm_start_on(&mut self, _ctx: &StepContext, states: &mut [BodyState], team: &Team) {
+        self.colours.warm_start(self.joints, states, team);
+    }
+    fn solve_on(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+        team: &Team,
+    ) {
+        self.colours
+            .solve(ctx, self.joints, states, use_bias, reverse, team);
+    }
+    fn solve_late_on(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        team: &Team,
+    ) {
+        self.forest
+            .solve_on(ctx, self.joints, states, use_bias, team);
+    }
+    fn apply_restitution_on(
+        &mut self,
+        _ctx: &StepContext,
+        _states: &mut [BodyState],
+        _team: &Team,
+    ) {
+    }
+}
