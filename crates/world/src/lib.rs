@@ -5,7 +5,7 @@
 //!
 //! | module           | what                                                     |
 //! |------------------|----------------------------------------------------------|
-//! | [`world`]        | [`World`], [`WorldDef`], the public API and the step      |
+//! | [`world`]        | [`World`], [`WorldDef`]: the public API split by topic (bodies, shapes, joints, queries, events) and the step |
 //! | [`error`]        | [`WorldError`], the typed errors of the API               |
 //! | [`shapes`]       | the shape store: geometry, material, filter, body → shapes |
 //! | [`debug_draw`]   | the [`DebugDraw`] trait, draw flags and colours, the drawing walk |
@@ -19,7 +19,6 @@
 //! | [`islands`]      | sleep timers and islands; sleeping islands leave every per-step loop |
 //! | [`portal`]       | portal pairs, crossings, clones, aperture clipping        |
 //! | [`profile`]      | per-stage timings and work counters                      |
-//! | [`setters`]      | setters and getters of bodies, shapes and joints after creation |
 //! | [`query`]        | scene queries: rays, shape casts, overlaps, distances    |
 //! | [`hash`]         | the state hash of determinism checks                     |
 //! | [`snapshot`]     | [`Snapshot`]: `World::snapshot` and `World::restore`      |
@@ -41,7 +40,6 @@ pub mod narrowphase;
 pub mod portal;
 pub mod profile;
 pub mod query;
-pub mod setters;
 pub mod shapes;
 pub mod snapshot;
 pub mod validate;

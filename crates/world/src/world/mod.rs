@@ -1,0 +1,437 @@
+//! The world: the public API, split by topic, over the stages of the
+//! step.
+//!
+//! | file            | what                                                        |
+//! |-----------------|-------------------------------------------------------------|
+//! | `world/mod.rs`  | [`World`], [`WorldDef`], [`StepEvents`]; settings, sleep, continuous switch |
+//! | `bodies.rs`     | bodies: create, destroy, read, set, forces, kinematic targets |
+//! | `shapes.rs`     | shapes and their materials, contacts as read after the step  |
+//! | `joints.rs`     | joints of every kind: create, destroy, typed reads, setters   |
+//! | `queries.rs`    | scene queries (the logic is `crate::query`'s)               |
+//! | `events.rs`     | events and hooks: the pre-solve hook, user data              |
+//! | `step.rs`       | [`World::step`]: the pipeline that calls the stages in order |
+//! | `internal.rs`   | one-thing operations the portal stage applies                |
+//!
+//!
+//! ```text
+//! World::step(dt)
+//!   ├─ validate dt; bodies created asleep go to sleep (islands)
+//!   ├─ portal clipping (portal stage; a no-op without portal pairs)
+//!   ├─ broadphase: new pairs ─ narrowphase ─ wake touched islands ─ contact constraints
+//!   ├─ solve_step (janus2d-core): prepare ─ substeps ─ restitution ─ store ─ finalize
+//!   ├─ store impulses  ∥  continuous (fast bodies swept, moved back to
+//!   │                     their time of impact) ─ move proxies
+//!   ├─ portal crossings (commands applied by the world)
+//!   ├─ islands: sleep timers, resting islands sleep
+//!   └─ counters, events (non-finite bodies, contacts, sensors)
+//! ```
+//!
+//! The stage table with each stage's data is in `docs/architecture.md`.
+//!
+//! Everything is created from definition structs with defaults and returns
+//! a generational handle; every call that rejects its input leaves the world
+//! unchanged.
+
+use janus2d_constraints::{
+    ContactSolver, Joint, JointDef, ObjectMass, RevoluteJoint, RevoluteJointDef,
+};
+use janus2d_core::BodyMass;
+use janus2d_core::body::{BodyDef, BodyHandle, BodyLocation, BodySet, BodyType, validate_mass};
+use janus2d_core::constraint::{ConstraintBatch, StepContext};
+use janus2d_core::geometry::Shape;
+use janus2d_core::math::{Real, Rot, Transform, Vec2, cross, vec_is_finite};
+use janus2d_core::solver::{SolverProfile, SolverSettings, solve_step};
+
+use crate::collision::{Collision, CollisionCounters, CollisionEvents};
+use crate::contacts::Contact;
+use crate::error::WorldError;
+use crate::islands::{Islands, SleepInput, SleepSettings};
+use crate::joints::{JointHandle, JointSet};
+use crate::portal::PortalStage;
+use crate::shapes::{ShapeData, ShapeDef, ShapeHandle};
+
+/// Default gravity, m/s² (usual (0, −10)).
+pub const DEFAULT_GRAVITY: Vec2 = Vec2::new(0.0, -10.0);
+
+/// Everything needed to create a world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldDef {
+    /// Gravity, m/s² (usual (0, −10)).
+    pub gravity: Vec2,
+    /// Solver accuracy and softness settings.
+    pub solver: SolverSettings,
+    /// When bodies fall asleep (on by default, as in Box2D and Rapier).
+    pub sleep: SleepSettings,
+    /// Continuous collision of fast bodies against static shapes, and of
+    /// bullets against moving ones (on by default, as in Box2D; see
+    /// [`crate::continuous`]).
+    pub enable_continuous: bool,
+    /// Approach speed above which a contact of a shape with hit events on
+    /// reports a [`HitEvent`](crate::contacts::HitEvent), m/s (usual 1, as
+    /// Box2D's `hitEventThreshold`).
+    pub hit_event_threshold: Real,
+}
+
+impl Default for WorldDef {
+    fn default() -> Self {
+        WorldDef {
+            gravity: DEFAULT_GRAVITY,
+            solver: SolverSettings::default(),
+            sleep: SleepSettings::default(),
+            enable_continuous: true,
+            hit_event_threshold: 1.0,
+        }
+    }
+}
+
+/// Events of the last step, read after `step`.
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct StepEvents {
+    /// Bodies whose state went non-finite during the step. Each was put back
+    /// at its start-of-step pose, at rest, instead of spreading NaN.
+    pub non_finite_bodies: Vec<BodyHandle>,
+    /// Contact and sensor begin/end events.
+    pub collision: CollisionEvents,
+}
+
+/// The simulation world: it owns one value of each stage and calls them
+/// in order, passing each what it reads.
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct World {
+    gravity: Vec2,
+    #[cfg_attr(feature = "serde", serde(with = "crate::snapshot::SettingsDef"))]
+    settings: SolverSettings,
+    pub(crate) bodies: BodySet,
+    pub(crate) joints: JointSet,
+    pub(crate) collision: Collision,
+    /// The step's contact constraints in their colours and lanes (the
+    /// contact solve's own data; rebuilt at every step, so not serialized).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    contact_solver: ContactSolver,
+    /// The contact-modification hook's data for this step (portal copies;
+    /// rebuilt at every step, so not serialized).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    object_masses: Vec<ObjectMass>,
+    pub(crate) portals: PortalStage,
+    pub(crate) islands: Islands,
+    continuous: crate::continuous::ContinuousStage,
+    /// Approach speed above which hit events are reported, m/s.
+    hit_event_threshold: Real,
+    /// The user's pre-solve hook, if any (called per touching contact).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pre_solve: Option<crate::narrowphase::PreSolveFn>,
+    pub(crate) sleep_settings: SleepSettings,
+    wake_list: Vec<BodyHandle>,
+    events: StepEvents,
+    /// Timings of the last step (not state: not serialized).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    step_profile: crate::profile::StepProfile,
+    counters: crate::profile::StepCounters,
+    step_count: u64,
+}
+
+impl World {
+    /// A new empty world. Rejects non-finite gravity.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// let world = World::new(WorldDef::default()).unwrap();
+    /// assert_eq!(world.body_count(), 0);
+    /// ```
+    pub fn new(def: WorldDef) -> Result<World, WorldError> {
+        check_gravity(def.gravity)?;
+        check_settings(&def.solver)?;
+        def.sleep.validate()?;
+        if def.hit_event_threshold.is_nan() {
+            return Err(WorldError::NonFinite("hit_event_threshold"));
+        }
+        if def.hit_event_threshold < 0.0 {
+            return Err(WorldError::OutOfRange("hit_event_threshold"));
+        }
+        let bodies = BodySet::new();
+        Ok(World {
+            gravity: def.gravity,
+            settings: def.solver,
+            collision: Collision::new(bodies.owner()),
+            contact_solver: ContactSolver::new(),
+            object_masses: Vec::new(),
+            portals: PortalStage::default(),
+            islands: Islands::default(),
+            continuous: crate::continuous::ContinuousStage::new(def.enable_continuous),
+            hit_event_threshold: def.hit_event_threshold,
+            pre_solve: None,
+            sleep_settings: def.sleep,
+            wake_list: Vec::new(),
+            joints: JointSet::new(bodies.owner()),
+            bodies,
+            events: StepEvents::default(),
+            step_profile: crate::profile::StepProfile::default(),
+            counters: crate::profile::StepCounters::default(),
+            step_count: 0,
+        })
+    }
+
+    /// Gravity, m/s².
+    pub fn gravity(&self) -> Vec2 {
+        self.gravity
+    }
+
+    /// Sets gravity (rejects non-finite values and a length above
+    /// [`MAX_GRAVITY`](janus2d_core::limits::MAX_GRAVITY)).
+    pub fn set_gravity(&mut self, gravity: Vec2) -> Result<(), WorldError> {
+        check_gravity(gravity)?;
+        self.gravity = gravity;
+        Ok(())
+    }
+
+    /// The solver settings.
+    pub fn settings(&self) -> &SolverSettings {
+        &self.settings
+    }
+
+    /// Replaces the solver settings (validated: every real finite and not
+    /// negative, damping ratios at most
+    /// [`MAX_DAMPING_RATIO`](janus2d_core::limits::MAX_DAMPING_RATIO); the
+    /// contact and iterative joint stiffness are capped at a quarter of
+    /// the substep rate at each step, see [`World::step_context`]).
+    pub fn set_settings(&mut self, settings: SolverSettings) -> Result<(), WorldError> {
+        check_settings(&settings)?;
+        self.settings = settings;
+        Ok(())
+    }
+
+    /// The body storage (the solver's arrays; internal to the engine).
+    #[cfg_attr(not(feature = "portals"), allow(dead_code))]
+    pub(crate) fn bodies(&self) -> &BodySet {
+        &self.bodies
+    }
+
+    /// Every live body's handle, in slot order.
+    pub fn body_handles(&self) -> impl Iterator<Item = BodyHandle> + '_ {
+        self.bodies.handles()
+    }
+
+    /// The body's gravity scale (dimensionless).
+    pub fn gravity_scale(&self, body: BodyHandle) -> Result<Real, WorldError> {
+        self.bodies
+            .sim(body)
+            .map(|s| s.gravity_scale)
+            .ok_or_else(|| self.body_error(body))
+    }
+
+    /// Number of live bodies.
+    pub fn body_count(&self) -> usize {
+        self.bodies.len()
+    }
+
+    /// Number of live joints.
+    pub fn joint_count(&self) -> usize {
+        self.joints.len()
+    }
+
+    /// Steps taken so far.
+    pub fn step_count(&self) -> u64 {
+        self.step_count
+    }
+
+    // ----- sleep --------------------------------------------------------------
+
+    /// Wakes the island of `body` (no effect on awake or static bodies).
+    pub fn wake_body(&mut self, body: BodyHandle) {
+        self.islands
+            .wake(body, &mut self.bodies, &mut self.collision.contacts);
+    }
+
+    /// Wakes every island in the list.
+    pub(super) fn wake_all(&mut self, bodies: &[BodyHandle]) {
+        for b in bodies {
+            self.wake_body(*b);
+        }
+    }
+
+    /// True when the body sleeps.
+    pub fn is_sleeping(&self, body: BodyHandle) -> bool {
+        self.bodies.is_sleeping(body)
+    }
+
+    /// Number of sleeping bodies.
+    pub fn sleeping_body_count(&self) -> usize {
+        self.bodies.sleeping_count()
+    }
+
+    /// Number of awake dynamic and kinematic bodies.
+    pub fn awake_body_count(&self) -> usize {
+        self.bodies.moving_count()
+    }
+
+    /// The sleep settings.
+    pub fn sleep_settings(&self) -> SleepSettings {
+        self.sleep_settings
+    }
+
+    /// Changes the sleep settings (validated); turning sleep off wakes
+    /// every body.
+    pub fn set_sleep_settings(&mut self, settings: SleepSettings) -> Result<(), WorldError> {
+        settings.validate()?;
+        if !settings.enabled {
+            let sleeping: Vec<BodyHandle> =
+                self.bodies.sleeping_sims.iter().map(|s| s.handle).collect();
+            self.wake_all(&sleeping);
+        }
+        self.sleep_settings = settings;
+        Ok(())
+    }
+
+    // ----- continuous collision ---------------------------------------------
+
+    /// True when continuous collision is on ([`WorldDef::enable_continuous`]).
+    pub fn continuous_enabled(&self) -> bool {
+        self.continuous.enabled
+    }
+
+    /// Turns continuous collision on or off from the next step.
+    pub fn set_continuous_enabled(&mut self, on: bool) {
+        self.continuous.enabled = on;
+    }
+
+    /// Every field copied but the pre-solve hook (a snapshot's world).
+    pub(crate) fn copy_state(&self) -> World {
+        World {
+            gravity: self.gravity,
+            settings: self.settings.clone(),
+            bodies: self.bodies.clone(),
+            joints: self.joints.clone(),
+            collision: self.collision.clone(),
+            contact_solver: self.contact_solver.clone(),
+            object_masses: self.object_masses.clone(),
+            portals: self.portals.clone(),
+            islands: self.islands.clone(),
+            continuous: self.continuous.clone(),
+            hit_event_threshold: self.hit_event_threshold,
+            pre_solve: None,
+            sleep_settings: self.sleep_settings,
+            wake_list: self.wake_list.clone(),
+            events: self.events.clone(),
+            step_profile: self.step_profile.clone(),
+            counters: self.counters,
+            step_count: self.step_count,
+        }
+    }
+}
+
+mod bodies;
+mod events;
+mod internal;
+mod joints;
+mod queries;
+mod shapes;
+mod step;
+/// Gravity: finite, its length at most
+/// [`MAX_GRAVITY`](janus2d_core::limits::MAX_GRAVITY).
+pub(super) fn check_gravity(gravity: Vec2) -> Result<(), WorldError> {
+    if !vec_is_finite(gravity) {
+        return Err(WorldError::NonFinite("gravity"));
+    }
+    let max = janus2d_core::limits::MAX_GRAVITY;
+    if gravity.x.abs() > max || gravity.y.abs() > max || gravity.length() > max {
+        return Err(WorldError::OutOfBounds {
+            field: "gravity",
+            min: 0.0,
+            max,
+        });
+    }
+    Ok(())
+}
+
+/// Solver settings: [`SolverSettings::validate`], then every real finite
+/// (`inf` Hz or an infinite damping ratio give NaN softness) and the
+/// damping ratios at most
+/// [`MAX_DAMPING_RATIO`](janus2d_core::limits::MAX_DAMPING_RATIO).
+pub(crate) fn check_settings(s: &SolverSettings) -> Result<(), WorldError> {
+    s.validate()?;
+    let reals = [
+        (s.baumgarte, "baumgarte"),
+        (s.contact_hertz, "contact_hertz"),
+        (s.contact_damping_ratio, "contact_damping_ratio"),
+        (s.contact_push_max_velocity, "contact_push_max_velocity"),
+        (s.joint_hertz, "joint_hertz"),
+        (s.joint_damping_ratio, "joint_damping_ratio"),
+        (s.joint_max_correction_speed, "joint_max_correction_speed"),
+        (s.restitution_threshold, "restitution_threshold"),
+        (s.contact_mass_ratio_cap, "contact_mass_ratio_cap"),
+        (s.joint_mass_ratio_cap, "joint_mass_ratio_cap"),
+        (s.direct_joint_hertz, "direct_joint_hertz"),
+        (
+            s.direct_joint_max_correction_speed,
+            "direct_joint_max_correction_speed",
+        ),
+    ];
+    for (v, name) in reals {
+        if !v.is_finite() {
+            return Err(WorldError::NonFinite(name));
+        }
+    }
+    let max = janus2d_core::limits::MAX_DAMPING_RATIO;
+    for (v, name) in [
+        (s.contact_damping_ratio, "contact_damping_ratio"),
+        (s.joint_damping_ratio, "joint_damping_ratio"),
+    ] {
+        if v > max {
+            return Err(WorldError::OutOfBounds {
+                field: name,
+                min: 0.0,
+                max,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The mass a shape adds at `density` must be at most the largest body
+/// mass, [`MASS_RANGE`](janus2d_core::limits::MASS_RANGE)`.1` (a radius of
+/// 1e6 m at a density of 1e38 overflows); the error names `density` and
+/// the largest density this shape may have. Within the extent limit the
+/// inertia is then finite (at most about 1e29 kg·m²).
+pub(crate) fn check_shape_mass(geometry: &Shape, density: Real) -> Result<(), WorldError> {
+    let area = geometry.area();
+    if density <= 0.0 || area <= 0.0 {
+        return Ok(());
+    }
+    let md = geometry.compute_mass(density);
+    let (_, max_mass) = janus2d_core::limits::MASS_RANGE;
+    if !(md.mass.is_finite() && md.mass <= max_mass && md.rotational_inertia.is_finite()) {
+        return Err(WorldError::OutOfBounds {
+            field: "density",
+            min: 0.0,
+            max: max_mass / area,
+        });
+    }
+    Ok(())
+}
+
+/// A force or torque whose sum for the step would not be finite.
+pub(super) fn accumulated(field: &'static str) -> WorldError {
+    WorldError::OutOfBounds {
+        field,
+        min: -Real::MAX,
+        max: Real::MAX,
+    }
+}
+
+/// The velocity an impulse gives must stay within
+/// [`MAX_SPEED`](janus2d_core::limits::MAX_SPEED) and
+/// [`MAX_ANGULAR_SPEED`](janus2d_core::limits::MAX_ANGULAR_SPEED); the
+/// error names `impulse` and the speed limit.
+pub(super) fn check_resulting_velocity(v: Vec2, w: Real) -> Result<(), WorldError> {
+    let to_impulse = |e: janus2d_core::body::BodyError| match e {
+        janus2d_core::body::BodyError::OutOfBounds { min, max, .. } => WorldError::OutOfBounds {
+            field: "impulse",
+            min,
+            max,
+        },
+        _ => WorldError::NonFinite("impulse"),
+    };
+    janus2d_core::body::check_velocity(v, "impulse").map_err(to_impulse)?;
+    janus2d_core::body::check_angular_velocity(w, "impulse").map_err(to_impulse)
+}

@@ -1,0 +1,246 @@
+//! The step: the pipeline that calls the stages in order over the stores
+//! it passes them (see the diagram in the `world` module docs).
+
+use super::*;
+
+impl World {
+    // ----- stepping ---------------------------------------------------------
+
+    /// The step context the solver uses for a step of `dt`: the contact
+    /// and iterative joint stiffness are capped at a quarter of the
+    /// substep rate ([`MAX_HERTZ_FRACTION`](janus2d_core::limits::MAX_HERTZ_FRACTION),
+    /// as Box2D caps its contact hertz): a stiffer soft row cannot be
+    /// resolved by the substeps (and `1e30` Hz would give no softness).
+    pub fn step_context(&self, dt: Real) -> StepContext {
+        let substeps = match self.settings.mode {
+            janus2d_core::SolverMode::SoftStep => self.settings.substeps.max(1),
+            janus2d_core::SolverMode::PgsBaumgarte => 1,
+        };
+        let cap = janus2d_core::limits::MAX_HERTZ_FRACTION * substeps as Real / dt;
+        if self.settings.contact_hertz <= cap && self.settings.joint_hertz <= cap {
+            return self.settings.context(dt, self.gravity);
+        }
+        let capped = SolverSettings {
+            contact_hertz: self.settings.contact_hertz.min(cap),
+            joint_hertz: self.settings.joint_hertz.min(cap),
+            ..self.settings.clone()
+        };
+        capped.context(dt, self.gravity)
+    }
+
+    /// Advances the world by `dt` seconds (finite, > 0).
+    pub fn step(&mut self, dt: Real) -> Result<(), WorldError> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(WorldError::InvalidTimeStep);
+        }
+        let mut ctx = self.step_context(dt);
+        let start = std::time::Instant::now();
+        let mut t = start;
+        let mut lap = || {
+            let now = std::time::Instant::now();
+            let d = now.duration_since(t).as_secs_f64();
+            t = now;
+            d
+        };
+        let mut sp = crate::profile::StepProfile::default();
+        self.islands
+            .apply_pending(self.sleep_settings.enabled, &mut self.bodies);
+        let has_shapes = !self.collision.shapes.is_empty();
+        let has_portals = self.portals.is_active();
+        if has_portals {
+            self.portals
+                .build_clipping(&self.bodies, &self.collision.shapes);
+            sp.portals += lap();
+        }
+        if has_shapes {
+            self.collision
+                .update_pairs(&self.bodies, &self.joints.no_collide);
+            sp.broadphase += lap();
+            let mut wake = std::mem::take(&mut self.wake_list);
+            wake.clear();
+            let c = &mut self.collision;
+            let input = crate::narrowphase::NarrowphaseInput {
+                shapes: &c.shapes,
+                broadphase: &c.broadphase,
+                bodies: &self.bodies,
+                dt,
+                clipping: self.portals.clipping(),
+                unclipped: self.portals.clipping().is_empty(),
+            };
+            c.narrowphase.run(
+                &input,
+                &mut c.contacts,
+                &mut c.events,
+                &mut c.counters,
+                &mut wake,
+            );
+            self.wake_all(&wake);
+            let woke = !wake.is_empty();
+            self.wake_list = wake;
+            self.islands
+                .read_contact_changes(&mut self.collision.contacts, &self.bodies);
+            self.portals
+                .object_masses(&self.bodies, &mut self.object_masses);
+            crate::narrowphase::build_constraints(
+                &mut self.collision.narrowphase,
+                &mut self.collision.contacts,
+                &self.bodies,
+                woke,
+                &self.object_masses,
+                self.joints.driven_bodies(),
+                self.pre_solve.as_mut(),
+                &mut self.contact_solver,
+                &mut self.collision.counters,
+            );
+            sp.narrowphase += lap();
+        } else {
+            self.contact_solver.begin();
+        }
+        // No restitution anywhere: no restitution pass.
+        ctx.restitution = has_shapes && self.collision.counters.restitution_contacts > 0;
+        let couple = has_portals && self.portals.copies_carry_joints(&self.joints);
+        let mut joints = self.joints.batch();
+        let mut contacts = janus2d_constraints::ContactBatch {
+            solver: &mut self.contact_solver,
+            object_masses: &self.object_masses,
+        };
+        let mut portals = janus2d_constraints::PortalBatch {
+            constraints: self.portals.constraints_mut(),
+        };
+        let passes = if couple {
+            crate::portal::coupling::COUPLING_PASSES
+        } else {
+            0
+        };
+        let mut report = if passes > 0 {
+            let mut coupled = crate::portal::coupling::CoupledBatches {
+                batches: [&mut joints, &mut contacts, &mut portals],
+                passes,
+            };
+            let mut batches: [&mut dyn ConstraintBatch; 1] = [&mut coupled];
+            solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches)
+        } else {
+            let mut batches: [&mut dyn ConstraintBatch; 3] =
+                [&mut joints, &mut contacts, &mut portals];
+            solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches)
+        };
+        // The solver checks velocities and deltas; a pose they carried out
+        // of the world (or to inf) is put back here, before any box is
+        // computed from it.
+        // (The solve's finalize checked the poses as it wrote them.)
+        if !report.poses_inside {
+            self.bodies
+                .reset_escaped(janus2d_core::solver::POSE_LIMIT, &mut report.non_finite);
+        }
+        lap();
+        if has_shapes {
+            // The impulses go back into the contacts beside continuous
+            // collision and the proxy update (`Collision::end_step`).
+            let continuous = &mut self.continuous;
+            let (no_collide, clipping) = (&self.joints.no_collide, self.portals.clipping());
+            let continuous_time = self.collision.end_step(
+                &self.contact_solver,
+                &mut self.bodies,
+                dt,
+                |bodies, shapes, broadphase| {
+                    let start = std::time::Instant::now();
+                    let input = crate::continuous::ContinuousInput {
+                        shapes,
+                        broadphase,
+                        no_collide,
+                        clipping,
+                    };
+                    continuous.run(bodies, &input);
+                    start.elapsed().as_secs_f64()
+                },
+            );
+            if self.collision.shapes.hit_event_shapes() > 0 {
+                self.collision
+                    .collect_hits(&self.contact_solver, self.hit_event_threshold);
+            }
+            let both = lap();
+            sp.continuous += continuous_time;
+            sp.broadphase += both - continuous_time;
+        }
+        if has_portals {
+            self.portal_crossings();
+            sp.portals += lap();
+        } else {
+            self.portals.clear_events();
+        }
+        if self.sleep_settings.enabled {
+            let keep_awake = self.portals.keep_awake();
+            let input = SleepInput {
+                dt,
+                settings: self.sleep_settings,
+                shapes: &self.collision.shapes,
+                keep_awake: &keep_awake,
+            };
+            self.islands.update(
+                &input,
+                &mut self.bodies,
+                &mut self.collision.contacts,
+                &self.joints,
+            );
+            sp.sleep += lap();
+        }
+        sp.solver = report.profile;
+        sp.total = start.elapsed().as_secs_f64();
+        self.counters = crate::profile::StepCounters::gather(&crate::profile::CounterSources {
+            collision_ran: has_shapes,
+            collision: self.collision.counters,
+            contacts: self.contact_solver.len(),
+            joint_rows: self.joints.row_count(),
+            direct_joint_rows: self.joints.direct_row_count(),
+            portal_stage_ran: has_portals,
+            portals: self.portals.counters_for_step(has_portals),
+            gravity: self.gravity != Vec2::ZERO,
+            bodies: &self.bodies,
+            continuous: self.continuous.counters(),
+        });
+        self.step_profile = sp;
+        self.events = StepEvents {
+            non_finite_bodies: report.non_finite,
+            collision: std::mem::take(&mut self.collision.events),
+        };
+        self.step_count += 1;
+        Ok(())
+    }
+
+    /// Draws the world through `draw`: shapes, joints, contacts, boxes,
+    /// islands, portals… as `options` says (see [`crate::debug_draw`]).
+    /// Reads only; costs nothing when not called.
+    pub fn debug_draw(
+        &self,
+        draw: &mut (impl crate::debug_draw::DebugDraw + ?Sized),
+        options: &crate::debug_draw::DrawOptions,
+    ) {
+        let island_of = |body| self.islands.island_id(body);
+        crate::debug_draw::draw_world(self, &island_of, draw, options);
+    }
+
+    /// The world-level part of [`World::validate`]: gravity and settings
+    /// within their limits, the contact solver's colours adding up.
+    pub(crate) fn check_world_values(&self) -> Result<(), String> {
+        check_gravity(self.gravity).map_err(|e| e.to_string())?;
+        check_settings(&self.settings).map_err(|e| e.to_string())?;
+        self.sleep_settings.validate().map_err(|e| e.to_string())?;
+        let coloured: usize = (0..janus2d_core::graph::COLOURS as u8)
+            .map(|k| self.contact_solver.count_in(k))
+            .sum::<usize>()
+            + self.contact_solver.overflow().len();
+        if coloured != self.contact_solver.len() {
+            return Err(format!(
+                "{coloured} contacts in colours, {} in the solver",
+                self.contact_solver.len()
+            ));
+        }
+        Ok(())
+    }
+
+    /// A hash of every body's transform and velocity bits, in handle order:
+    /// equal hashes mean bit-identical states (see [`crate::hash`]).
+    pub fn state_hash(&self) -> u64 {
+        crate::hash::state_hash(&self.bodies)
+    }
+}
