@@ -9,6 +9,7 @@
 //!                            dense, swap-remove        warm start    Joint::warm_start_side, per body
 //!                                                      solve, relax  Joint::solve_pair, colour by colour
 //!                                                      late solve    JointForest (Joint::tree_point)
+//!                                                      (all driven by joint_solver::JointBatch)
 //! ```
 //!
 //! | kind        | file            | rows                                          | rows the tree solves |
@@ -29,15 +30,13 @@
 //! changes; a kind without a point part simply returns `None` from
 //! [`Joint::tree_point`] and the tree solve leaves its component iterative.
 
-use janus2d_core::body::{BodyHandle, BodySet, BodyState, SolverBody};
-use janus2d_core::constraint::{Constraint, ConstraintBatch, ConstraintRows, StepContext};
+use janus2d_core::body::{BodyHandle, BodySet, BodyState};
+use janus2d_core::constraint::{Constraint, ConstraintRows, StepContext};
 use janus2d_core::math::{Real, Rot, Vec2};
-use janus2d_core::parallel::Team;
 
 use crate::JointError;
-use crate::joint_colour::JointColours;
-use crate::joint_tree::JointForest;
-use crate::parts::{BOTH, PairMass, PairOf, PairStates, PointPart};
+use crate::joint_base::JointBase;
+use crate::parts::{BOTH, PairOf, PairStates, PointPart};
 use crate::revolute::{RevoluteJoint, RevoluteJointDef};
 
 /// The joint kinds.
@@ -113,75 +112,6 @@ impl JointDef {
         match self {
             JointDef::Revolute(d) => d.validate(),
         }
-    }
-}
-
-/// What the solver keeps of every joint, whatever its kind: the state
-/// indices and masses loaded at prepare and the switches the colouring and
-/// the tree solve read.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct JointBase {
-    /// False when the joint is disabled (skipped by the solver).
-    pub(crate) enabled: bool,
-    /// Body a's state index (0: the static identity state).
-    pub(crate) state_a: u32,
-    /// Body b's state index.
-    pub(crate) state_b: u32,
-    /// The bodies' inverse masses, loaded at prepare (zero for a body on
-    /// the static identity state).
-    pub(crate) masses: PairMass,
-    /// True while the joint's point rows belong to the direct solve of a
-    /// joint tree (set every step by [`JointForest`]).
-    pub(crate) in_tree: bool,
-    /// Neither body moves this step (both static or asleep): the joint is
-    /// not solved and keeps its last impulses, so its read-back holds.
-    pub(crate) resting: bool,
-    /// `1 / h` of the last step the joint was solved in, 1/s (turns the
-    /// per-substep impulses into forces).
-    pub(crate) inv_h: Real,
-}
-
-impl Default for JointBase {
-    fn default() -> Self {
-        JointBase {
-            enabled: true,
-            state_a: 0,
-            state_b: 0,
-            masses: PairMass::ZERO,
-            in_tree: false,
-            resting: false,
-            inv_h: 0.0,
-        }
-    }
-}
-
-impl JointBase {
-    /// Loads the state indices and masses of the two bodies for a step;
-    /// returns the bodies, or `None` when neither moves (the joint rests
-    /// this step and keeps its impulses).
-    #[inline]
-    pub(crate) fn load<'b>(
-        &mut self,
-        ctx: &StepContext,
-        bodies: &'b BodySet,
-        body_a: BodyHandle,
-        body_b: BodyHandle,
-    ) -> Option<(SolverBody<'b>, SolverBody<'b>)> {
-        let a = bodies.solver_body(body_a);
-        let b = bodies.solver_body(body_b);
-        self.state_a = a.state_index;
-        self.state_b = b.state_index;
-        self.resting = a.state_index == 0 && b.state_index == 0;
-        if self.resting {
-            return None;
-        }
-        self.inv_h = ctx.inv_h;
-        self.masses = PairMass {
-            a: a.inv_masses(),
-            b: b.inv_masses(),
-        };
-        Some((a, b))
     }
 }
 
@@ -483,93 +413,5 @@ impl Constraint for Joint {
 
     fn is_enabled(&self) -> bool {
         self.base().enabled
-    }
-}
-
-/// Rows of the joint prepare's blocks on the team.
-const PREPARE_BLOCK: usize = 256;
-
-/// Every joint of a world as the solver sees it: the joints, their tree
-/// solve and their colours.
-pub struct JointBatch<'a> {
-    /// The joints, in storage order.
-    pub joints: &'a mut Vec<Joint>,
-    /// The direct solve of the trees among them.
-    pub forest: &'a mut JointForest,
-    /// The colours of their Gauss–Seidel rows.
-    pub colours: &'a mut JointColours,
-}
-
-impl ConstraintBatch for JointBatch<'_> {
-    fn count(&self) -> usize {
-        self.joints.len()
-    }
-    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
-        self.prepare_on(ctx, bodies, &Team::serial());
-    }
-    fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
-        self.warm_start_on(ctx, states, &Team::serial());
-    }
-    fn solve(
-        &mut self,
-        ctx: &StepContext,
-        states: &mut [BodyState],
-        use_bias: bool,
-        reverse: bool,
-    ) {
-        self.solve_on(ctx, states, use_bias, reverse, &Team::serial());
-    }
-    fn solve_late(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        self.forest.solve(ctx, self.joints, states, use_bias);
-    }
-    fn apply_restitution(&mut self, _ctx: &StepContext, _states: &mut [BodyState]) {
-        // No joint kind has restitution rows.
-    }
-    fn store_impulses(&mut self) {
-        // Joints keep their impulses in place.
-    }
-    fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
-        // Each joint's prepare reads the bodies and writes only itself:
-        // blocks of joints on the team, then the forest and the colours
-        // from the prepared joints (the same as `JointForest::prepare`).
-        team.for_each_chunk_mut(self.joints, PREPARE_BLOCK, |_, block| {
-            for j in block.iter_mut().filter(|j| j.is_enabled()) {
-                j.prepare(ctx, bodies);
-            }
-        });
-        self.forest
-            .build_on(self.joints, &bodies.states, ctx.direct_joints, team);
-        self.colours.update_on(self.joints, &bodies.states, team);
-    }
-    fn warm_start_on(&mut self, _ctx: &StepContext, states: &mut [BodyState], team: &Team) {
-        self.colours.warm_start(self.joints, states, team);
-    }
-    fn solve_on(
-        &mut self,
-        ctx: &StepContext,
-        states: &mut [BodyState],
-        use_bias: bool,
-        reverse: bool,
-        team: &Team,
-    ) {
-        self.colours
-            .solve(ctx, self.joints, states, use_bias, reverse, team);
-    }
-    fn solve_late_on(
-        &mut self,
-        ctx: &StepContext,
-        states: &mut [BodyState],
-        use_bias: bool,
-        team: &Team,
-    ) {
-        self.forest
-            .solve_on(ctx, self.joints, states, use_bias, team);
-    }
-    fn apply_restitution_on(
-        &mut self,
-        _ctx: &StepContext,
-        _states: &mut [BodyState],
-        _team: &Team,
-    ) {
     }
 }

@@ -72,7 +72,7 @@ use janus2d_core::parallel::{StatePlan, Team};
 use smallvec::SmallVec;
 
 use crate::joint::Joint;
-use crate::joint_tree::is_moving;
+use crate::joint_base::is_moving;
 use crate::parts::{PairOf, WRITE_A, WRITE_B};
 
 /// No position: a joint that is not solved (disabled or resting).
@@ -455,7 +455,7 @@ impl std::fmt::Debug for JointRefs {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::joint::JointBatch;
+    use crate::joint_solver::JointBatch;
     use crate::joint_tree::JointForest;
     use crate::revolute::{RevoluteJoint, RevoluteJointDef};
     use janus2d_core::body::{BodyDef, BodyHandle, BodySet};

@@ -127,6 +127,7 @@ use janus2d_core::parallel::Team;
 use janus2d_core::union_find::{find, union};
 
 use crate::joint::Joint;
+use crate::joint_base::is_moving;
 use crate::parts::{PairMass, PointPart, clamp_length};
 
 const NONE: u32 = u32::MAX;
@@ -502,10 +503,6 @@ pub struct JointForest {
 /// A body that the solve moves: a state of its own (not the static
 /// identity 0) whose body is dynamic ([`BodyState::MOVES`]); false for an
 /// index past the states.
-#[inline]
-pub(crate) fn is_moving(states: &[BodyState], s: u32) -> bool {
-    s != 0 && states.get(s as usize).is_some_and(BodyState::moves)
-}
 
 /// A joint's two state indices, 0 for an end the tree does not move
 /// (static, kinematic, sleeping), `[0, 0]` for a disabled joint; and its

@@ -39,7 +39,7 @@ use janus2d_core::softness::Softness;
 use smallvec::smallvec;
 
 use crate::JointError;
-use crate::joint::JointBase;
+use crate::joint_base::JointBase;
 use crate::parts::{
     AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, load_pair, store_pair,
 };

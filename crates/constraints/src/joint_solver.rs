@@ -1,0 +1,106 @@
+//! The joints as one solver batch: prepare every joint, build the tree
+//! solve and the colours from the prepared joints, then run the stages.
+//!
+//! | stage          | what runs                                                   |
+//! |----------------|-------------------------------------------------------------|
+//! | prepare        | each enabled joint's rows (blocks on the team), then [`JointForest`] and [`JointColours`] |
+//! | warm start     | [`JointColours`]: per moving body, its joints' shares in storage order |
+//! | solve, relax   | [`JointColours`]: the Gauss–Seidel rows colour by colour     |
+//! | late solve     | [`JointForest`]: the point rows of joint trees, exactly      |
+//! | restitution, store | nothing: no joint kind has restitution, impulses stay in the joints |
+
+use janus2d_core::body::{BodySet, BodyState};
+use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
+use janus2d_core::parallel::Team;
+
+use crate::joint::Joint;
+use crate::joint_colour::JointColours;
+use crate::joint_tree::JointForest;
+
+/// Rows of the joint prepare's blocks on the team.
+const PREPARE_BLOCK: usize = 256;
+
+/// Every joint of a world as the solver sees it: the joints, their tree
+/// solve and their colours.
+pub struct JointBatch<'a> {
+    /// The joints, in storage order.
+    pub joints: &'a mut Vec<Joint>,
+    /// The direct solve of the trees among them.
+    pub forest: &'a mut JointForest,
+    /// The colours of their Gauss–Seidel rows.
+    pub colours: &'a mut JointColours,
+}
+
+impl ConstraintBatch for JointBatch<'_> {
+    fn count(&self) -> usize {
+        self.joints.len()
+    }
+    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
+        self.prepare_on(ctx, bodies, &Team::serial());
+    }
+    fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+        self.warm_start_on(ctx, states, &Team::serial());
+    }
+    fn solve(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+    ) {
+        self.solve_on(ctx, states, use_bias, reverse, &Team::serial());
+    }
+    fn solve_late(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
+        self.forest.solve(ctx, self.joints, states, use_bias);
+    }
+    fn apply_restitution(&mut self, _ctx: &StepContext, _states: &mut [BodyState]) {
+        // No joint kind has restitution rows.
+    }
+    fn store_impulses(&mut self) {
+        // Joints keep their impulses in place.
+    }
+    fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
+        // Each joint's prepare reads the bodies and writes only itself:
+        // blocks of joints on the team, then the forest and the colours
+        // from the prepared joints (the same as `JointForest::prepare`).
+        team.for_each_chunk_mut(self.joints, PREPARE_BLOCK, |_, block| {
+            for j in block.iter_mut().filter(|j| j.is_enabled()) {
+                j.prepare(ctx, bodies);
+            }
+        });
+        self.forest
+            .build_on(self.joints, &bodies.states, ctx.direct_joints, team);
+        self.colours.update_on(self.joints, &bodies.states, team);
+    }
+    fn warm_start_on(&mut self, _ctx: &StepContext, states: &mut [BodyState], team: &Team) {
+        self.colours.warm_start(self.joints, states, team);
+    }
+    fn solve_on(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+        team: &Team,
+    ) {
+        self.colours
+            .solve(ctx, self.joints, states, use_bias, reverse, team);
+    }
+    fn solve_late_on(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        team: &Team,
+    ) {
+        self.forest
+            .solve_on(ctx, self.joints, states, use_bias, team);
+    }
+    fn apply_restitution_on(
+        &mut self,
+        _ctx: &StepContext,
+        _states: &mut [BodyState],
+        _team: &Team,
+    ) {
+    }
+}
