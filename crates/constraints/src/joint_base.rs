@@ -84,8 +84,9 @@ impl JointBase {
     }
 }
 
-/// True when state `s` is a moving body's (not the static identity state
-/// 0, and awake and dynamic).
+/// A body that the solve moves: a state of its own (not the static
+/// identity 0) whose body is dynamic ([`BodyState::MOVES`]); false for an
+/// index past the states.
 #[inline]
 pub(crate) fn is_moving(states: &[BodyState], s: u32) -> bool {
     s != 0 && states.get(s as usize).is_some_and(BodyState::moves)

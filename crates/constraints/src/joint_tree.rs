@@ -500,10 +500,6 @@ pub struct JointForest {
     parent_joint: Vec<u32>,
 }
 
-/// A body that the solve moves: a state of its own (not the static
-/// identity 0) whose body is dynamic ([`BodyState::MOVES`]); false for an
-/// index past the states.
-
 /// A joint's two state indices, 0 for an end the tree does not move
 /// (static, kinematic, sleeping), `[0, 0]` for a disabled joint; and its
 /// `in_tree` flag, so that a joint created since the last build (flag

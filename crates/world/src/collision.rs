@@ -28,7 +28,7 @@ use janus2d_constraints::contact::{mix_friction, mix_restitution};
 use janus2d_constraints::contact_solver::LanePlace;
 use janus2d_constraints::contact_solver::PointImpulse;
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
-use janus2d_core::geometry::{Aabb, Shape};
+use janus2d_core::geometry::Shape;
 use janus2d_core::math::{Real, Transform, Vec2};
 
 use crate::broadphase::BroadPhase;
@@ -47,23 +47,9 @@ pub use janus2d_core::geometry::SPECULATIVE_DISTANCE;
 /// beside the tree.
 pub use crate::dynamic_tree::DEFAULT_AABB_MARGIN as AABB_MARGIN;
 
-/// Counters of the last collision pass.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct CollisionCounters {
-    /// Shape pairs whose manifolds were computed.
-    pub pairs_tested: usize,
-    /// New pairs found by the broadphase.
-    pub pairs_created: usize,
-    /// Touching solid contacts.
-    pub touching: usize,
-    /// Proxies re-inserted in the broadphase.
-    pub proxies_moved: usize,
-    /// Contact rows built (normal + friction per point).
-    pub contact_rows: usize,
-    /// Contact constraints built with restitution > 0.
-    pub restitution_contacts: usize,
-}
+pub use crate::broadphase::{AABB_MARGIN_FRACTION, MAX_BOX_COORDINATE, bounded, proxy_margin};
+
+pub use crate::profile::CollisionCounters;
 
 /// Shapes, broadphase and contacts of a world.
 #[derive(Clone, Debug)]
@@ -502,54 +488,6 @@ impl Collision {
     }
 }
 
-/// A movable shape's fat-box margin as a fraction of its
-/// [`extent`](janus2d_core::geometry::Shape::extent), on top of the
-/// speculative distance (Box2D v3.2 sizes its margins the same way).
-pub const AABB_MARGIN_FRACTION: Real = 0.125;
-
-/// The fat-box margin of a shape's proxy, metres: the speculative distance
-/// (so that pairs exist before the manifold can have points) plus
-/// [`AABB_MARGIN_FRACTION`] of the shape's extent, at most `max` (the
-/// broadphase's margin, [`AABB_MARGIN`] by default). A box of half-width
-/// 0.1 m gets 0.038 m, one of half-width 0.5 m (or anything larger) the
-/// whole 0.1 m. With one margin for all, a dense pile of small shapes
-/// kept a contact for every neighbour within 0.2 m (washer: 88,000
-/// contacts where 23,000 touch; Box2D, sizing margins by shape, kept
-/// 32,000).
-#[must_use]
-pub fn proxy_margin(geometry: &Shape, max: Real) -> Real {
-    (SPECULATIVE_DISTANCE + AABB_MARGIN_FRACTION * geometry.extent()).min(max)
-}
-
-/// Largest coordinate of a box handed to the broadphase, m: four times
-/// [`MAX_COORDINATE`](janus2d_core::limits::MAX_COORDINATE), beyond any
-/// shape on a body inside the world.
-pub const MAX_BOX_COORDINATE: Real = 4.0 * janus2d_core::limits::MAX_COORDINATE;
-
-/// The box handed to the broadphase: `aabb` itself when it is valid and
-/// inside [`MAX_BOX_COORDINATE`] (always, while the API's limits hold),
-/// otherwise clamped into it with NaN coordinates at 0, so that no
-/// invalid box ever reaches a tree.
-#[must_use]
-pub fn bounded(aabb: Aabb) -> Aabb {
-    let m = MAX_BOX_COORDINATE;
-    let inside = |v: Vec2| v.x.abs() <= m && v.y.abs() <= m;
-    if aabb.lower.x <= aabb.upper.x
-        && aabb.lower.y <= aabb.upper.y
-        && inside(aabb.lower)
-        && inside(aabb.upper)
-    {
-        return aabb;
-    }
-    let fix = |x: Real| if x.is_nan() { 0.0 } else { x.clamp(-m, m) };
-    let (lx, ux) = (fix(aabb.lower.x), fix(aabb.upper.x));
-    let (ly, uy) = (fix(aabb.lower.y), fix(aabb.upper.y));
-    Aabb::new(
-        Vec2::new(lx.min(ux), ly.min(uy)),
-        Vec2::new(lx.max(ux), ly.max(uy)),
-    )
-}
-
 /// Whether shapes `a` and `b` (slot indices) may have a contact: on
 /// different bodies, passing each other's filter, one of them dynamic,
 /// and their bodies not jointed with collision off.
@@ -580,7 +518,7 @@ mod tests {
     use super::*;
     use crate::{World, WorldDef};
     use janus2d_core::body::BodyDef;
-    use janus2d_core::geometry::Polygon;
+    use janus2d_core::geometry::{Aabb, Polygon};
 
     /// The fat box and margin of the only shape of `body`.
     fn fat_of(world: &World, body: BodyHandle) -> (Aabb, Aabb, Real) {

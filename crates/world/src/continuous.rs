@@ -33,9 +33,9 @@ use janus2d_core::geometry::{
 };
 use janus2d_core::math::{Real, Vec2, cross};
 
+use crate::aperture::ContactClipping;
 use crate::broadphase::BroadPhase;
 use crate::joints::NoCollide;
-use crate::portal::ContactClipping;
 use crate::shapes::ShapeStore;
 
 /// Fraction of a body's smallest extent it may travel in one step before it

@@ -381,15 +381,19 @@ fn draw_geometry<D: DebugDraw + ?Sized>(draw: &mut D, xf: &Transform, shape: &Sh
     }
 }
 
-/// The walk behind [`World::debug_draw`]: reads `world` through its public
-/// accessors; `island_of` gives a body's island id (the islands stage's,
-/// passed by the world).
-pub(crate) fn draw_world<D: DebugDraw + ?Sized>(
-    world: &World,
-    island_of: &dyn Fn(BodyHandle) -> Option<u32>,
-    draw: &mut D,
-    o: &DrawOptions,
-) {
+impl World {
+    /// Draws the world through `draw`: shapes, joints, contacts, boxes,
+    /// islands, portals… as `options` says (see [`crate::debug_draw`]).
+    /// Reads only, through the world's public accessors; costs nothing when
+    /// not called.
+    pub fn debug_draw(&self, draw: &mut (impl DebugDraw + ?Sized), options: &DrawOptions) {
+        draw_world(self, draw, options);
+    }
+}
+
+/// The walk behind [`World::debug_draw`].
+fn draw_world<D: DebugDraw + ?Sized>(world: &World, draw: &mut D, o: &DrawOptions) {
+    let island_of = |body| world.island_id(body);
     let visible = |b: &Aabb| o.bounds.is_none_or(|v| v.overlaps(b));
     let want_bodies = o.shapes || o.aabbs || o.islands || o.transforms;
     if want_bodies {

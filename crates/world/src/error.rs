@@ -62,7 +62,7 @@ pub enum WorldError {
         /// The input at fault.
         field: &'static str,
         /// What is wrong with it.
-        problem: crate::query::QueryProblem,
+        problem: QueryProblem,
     },
 }
 
@@ -133,5 +133,29 @@ impl From<JointError> for WorldError {
 impl From<GeometryError> for WorldError {
     fn from(e: GeometryError) -> Self {
         WorldError::Geometry(e)
+    }
+}
+
+/// What is wrong with a query input ([`WorldError::BadQuery`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum QueryProblem {
+    /// A coordinate is NaN or infinite.
+    NonFinite,
+    /// A translation of zero length (a ray or cast needs a direction).
+    ZeroLength,
+    /// A box whose lower corner is above its upper corner.
+    Inverted,
+    /// The query shape is invalid.
+    Shape(GeometryError),
+}
+
+impl std::fmt::Display for QueryProblem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            QueryProblem::NonFinite => write!(f, "is not finite"),
+            QueryProblem::ZeroLength => write!(f, "has zero length"),
+            QueryProblem::Inverted => write!(f, "has its lower corner above its upper corner"),
+            QueryProblem::Shape(e) => write!(f, "is an invalid shape: {e}"),
+        }
     }
 }

@@ -48,7 +48,7 @@ struct JointSlot {
 #[derive(Clone, Debug, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct NoCollide {
-    #[cfg_attr(feature = "serde", serde(with = "crate::snapshot::sorted_map"))]
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_maps::sorted_map"))]
     pairs: HashMap<(u32, u32), u32>,
 }
 

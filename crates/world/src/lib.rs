@@ -17,7 +17,8 @@
 //! | [`dynamic_tree`] | the dynamic AABB tree (insert, remove, rotate, query)     |
 //! | [`joints`]       | the joint set: slots, per-type storage, body → joints, no-collide pairs |
 //! | [`islands`]      | sleep timers and islands; sleeping islands leave every per-step loop |
-//! | [`portal`]       | portal pairs, crossings, clones, aperture clipping        |
+//! | [`portal`]       | portal pairs, crossings, clones                           |
+//! | [`aperture`]     | aperture clipping: the geometry the portal stage hands the narrowphase and continuous collision |
 //! | [`profile`]      | per-stage timings and work counters                      |
 //! | [`query`]        | scene queries: rays, shape casts, overlaps, distances    |
 //! | [`hash`]         | the state hash of determinism checks                     |
@@ -26,6 +27,7 @@
 //!
 //! See `docs/architecture.md` for the stage table.
 
+pub mod aperture;
 pub mod broadphase;
 pub mod collision;
 pub mod contacts;
@@ -40,6 +42,8 @@ pub mod narrowphase;
 pub mod portal;
 pub mod profile;
 pub mod query;
+#[cfg(feature = "serde")]
+mod serde_maps;
 pub mod shapes;
 pub mod snapshot;
 pub mod validate;

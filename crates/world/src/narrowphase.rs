@@ -30,11 +30,12 @@ use janus2d_core::geometry::{Aabb, Manifold, collide};
 use janus2d_core::graph::{ConstraintGraph, NO_BODY};
 use janus2d_core::math::{Real, Rot, Transform, Vec2};
 
+use crate::aperture::ContactClipping;
 use crate::broadphase::BroadPhase;
-use crate::collision::{CollisionCounters, SPECULATIVE_DISTANCE};
 use crate::contacts::{CollisionEvents, Contact, ContactPointData, ContactSet, RecycleCache};
-use crate::portal::ContactClipping;
+use crate::profile::CollisionCounters;
 use crate::shapes::ShapeStore;
+use janus2d_core::geometry::SPECULATIVE_DISTANCE;
 
 /// What a pre-solve hook sees of a touching contact before it is solved
 /// (see `World::set_pre_solve`).
@@ -474,13 +475,13 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
     if !input.unclipped {
         // Before the manifold is stored, so that points made at aperture
         // edges warm-start by their ids like any other.
-        let motion = crate::portal::PairMotion {
+        let motion = crate::aperture::PairMotion {
             center: [sim_a.center, sim_b.center],
             velocity: [body_a.state.v, body_b.state.v],
             angular_velocity: [body_a.state.w, body_b.state.w],
             dt: input.dt,
         };
-        let shapes = crate::portal::PairShapes {
+        let shapes = crate::aperture::PairShapes {
             shapes: [&sa.geometry, &sb.geometry],
             transforms: [sim_a.transform, sim_b.transform],
             speculative,

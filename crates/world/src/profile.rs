@@ -83,7 +83,7 @@ pub struct StepCounters {
 /// What the step's counters are gathered from.
 pub(crate) struct CounterSources<'a> {
     pub(crate) collision_ran: bool,
-    pub(crate) collision: crate::collision::CollisionCounters,
+    pub(crate) collision: CollisionCounters,
     pub(crate) contacts: usize,
     pub(crate) joint_rows: usize,
     pub(crate) direct_joint_rows: usize,
@@ -127,4 +127,22 @@ impl StepCounters {
             toi_hits: s.continuous.toi_hits,
         }
     }
+}
+
+/// Counters of the last collision pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct CollisionCounters {
+    /// Shape pairs whose manifolds were computed.
+    pub pairs_tested: usize,
+    /// New pairs found by the broadphase.
+    pub pairs_created: usize,
+    /// Touching solid contacts.
+    pub touching: usize,
+    /// Proxies re-inserted in the broadphase.
+    pub proxies_moved: usize,
+    /// Contact rows built (normal + friction per point).
+    pub contact_rows: usize,
+    /// Contact constraints built with restitution > 0.
+    pub restitution_contacts: usize,
 }

@@ -44,8 +44,8 @@
 use janus2d_constraints::portal_map::PortalMap;
 use janus2d_core::body::{BodyHandle, BodySet};
 use janus2d_core::geometry::{
-    Aabb, CastHit, DistanceOutput, GeometryError, LINEAR_SLOP, RayInput, Shape, ShapeProxy,
-    shape_cast, shapes_overlap,
+    Aabb, CastHit, DistanceOutput, LINEAR_SLOP, RayInput, Shape, ShapeProxy, shape_cast,
+    shapes_overlap,
 };
 use janus2d_core::handle::{Handle, PortalPairTag};
 use janus2d_core::math::{Real, Rot, Transform, Vec2, cross, vec_is_finite};
@@ -124,29 +124,7 @@ impl QueryFilter {
     }
 }
 
-/// What is wrong with a query input ([`WorldError::BadQuery`]).
-#[derive(Clone, Debug, PartialEq)]
-pub enum QueryProblem {
-    /// A coordinate is NaN or infinite.
-    NonFinite,
-    /// A translation of zero length (a ray or cast needs a direction).
-    ZeroLength,
-    /// A box whose lower corner is above its upper corner.
-    Inverted,
-    /// The query shape is invalid.
-    Shape(GeometryError),
-}
-
-impl std::fmt::Display for QueryProblem {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            QueryProblem::NonFinite => write!(f, "is not finite"),
-            QueryProblem::ZeroLength => write!(f, "has zero length"),
-            QueryProblem::Inverted => write!(f, "has its lower corner above its upper corner"),
-            QueryProblem::Shape(e) => write!(f, "is an invalid shape: {e}"),
-        }
-    }
-}
+pub use crate::error::QueryProblem;
 
 /// One portal aperture a ray went through.
 #[derive(Clone, Copy, Debug, PartialEq)]

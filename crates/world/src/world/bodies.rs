@@ -641,4 +641,13 @@ impl World {
             .reproxy_body(body, &xf, ty == BodyType::Static);
         Ok(())
     }
+
+    /// The id of the island a dynamic body belongs to (bodies linked by
+    /// touching contacts and joints sleep and wake together), or `None`
+    /// for a static or kinematic body, or one not yet in an island (it
+    /// joins one at its next step).
+    #[must_use]
+    pub fn island_id(&self, body: BodyHandle) -> Option<u32> {
+        self.islands.island_id(body)
+    }
 }

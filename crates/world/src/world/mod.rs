@@ -100,7 +100,7 @@ pub struct StepEvents {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct World {
     gravity: Vec2,
-    #[cfg_attr(feature = "serde", serde(with = "crate::snapshot::SettingsDef"))]
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_maps::SettingsDef"))]
     settings: SolverSettings,
     pub(crate) bodies: BodySet,
     pub(crate) joints: JointSet,

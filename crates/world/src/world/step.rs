@@ -207,18 +207,6 @@ impl World {
         Ok(())
     }
 
-    /// Draws the world through `draw`: shapes, joints, contacts, boxes,
-    /// islands, portals… as `options` says (see [`crate::debug_draw`]).
-    /// Reads only; costs nothing when not called.
-    pub fn debug_draw(
-        &self,
-        draw: &mut (impl crate::debug_draw::DebugDraw + ?Sized),
-        options: &crate::debug_draw::DrawOptions,
-    ) {
-        let island_of = |body| self.islands.island_id(body);
-        crate::debug_draw::draw_world(self, &island_of, draw, options);
-    }
-
     /// The world-level part of [`World::validate`]: gravity and settings
     /// within their limits, the contact solver's colours adding up.
     pub(crate) fn check_world_values(&self) -> Result<(), String> {

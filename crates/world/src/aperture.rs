@@ -267,7 +267,7 @@ impl ContactClipping {
             return;
         }
         let tangent = n.perp();
-        let margin = 0.1 * clip.half_width + crate::collision::SPECULATIVE_DISTANCE;
+        let margin = 0.1 * clip.half_width + janus2d_core::geometry::SPECULATIVE_DISTANCE;
         m.normal = if wall == 0 { n } else { -n };
         m.point_count = 0;
         for (side, id) in [(-1.0, LIP_ID_LOW), (1.0, LIP_ID_HIGH)] {
