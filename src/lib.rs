@@ -6,8 +6,13 @@
 //! | crate                 | contents                                                   |
 //! |-----------------------|------------------------------------------------------------|
 //! | [`base`] (janus2d-core) | bodies, integration, the solver, the constraint trait      |
-//! | [`constraints`]       | contact, revolute and portal constraints                   |
+//! | [`constraints`]       | contact, joint (every kind: [`JointDef`]) and portal constraints |
 //! | [`world`]             | the stepping loop, collision pipeline, portals            |
+//!
+//! What a program needs is also re-exported here, at the root: the world
+//! and its definitions, handles, joints, shapes, events, queries, errors
+//! (and, with the `portals` feature, the portal types). [`prelude`] holds
+//! the names most programs use.
 //!
 //! ```
 //! use janus2d::prelude::*;
@@ -30,9 +35,32 @@ pub use janus2d_constraints as constraints;
 pub use janus2d_core as base;
 pub use janus2d_world as world;
 
+#[doc(inline)]
+pub use janus2d_constraints::{
+    Joint, JointDef, JointError, JointKind, PortalError, RevoluteJoint, RevoluteJointDef,
+};
+#[doc(inline)]
+pub use janus2d_core::{
+    BodyDef, BodyHandle, BodyMass, BodyType, Real, Rot, SolverMode, SolverSettings, Transform, Vec2,
+};
+#[doc(inline)]
+pub use janus2d_world::{
+    CollisionCounters, CollisionEvents, Color, Contact, ContactPointData, DebugDraw, DrawOptions,
+    Filter, HitEvent, Invariant, InvariantError, JointHandle, JointSet, Palette, PortalHop,
+    PreSolve, PreSolveFn, QueryFilter, QueryProblem, RayHit, ShapeData, ShapeDef, ShapeHandle,
+    ShapeOverlap, ShapePairEvent, SleepSettings, Snapshot, StepCounters, StepEvents, StepProfile,
+    World, WorldDef, WorldError,
+};
+#[cfg(feature = "portals")]
+#[doc(inline)]
+pub use janus2d_world::{
+    CrossingRole, MassModel, PlaneSide, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle,
+    PortalSide,
+};
+
 /// The names most programs need.
 pub mod prelude {
-    pub use janus2d_constraints::{RevoluteJoint, RevoluteJointDef};
+    pub use janus2d_constraints::{Joint, JointDef, JointKind, RevoluteJoint, RevoluteJointDef};
     pub use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
     pub use janus2d_core::constraint::SolverMode;
     pub use janus2d_core::geometry::{

@@ -400,7 +400,7 @@ fn short_stack_stands_and_loses_energy() {
 #[test]
 fn portal_metrics_measure_a_passive_crossing() {
     use janus2d::world::{PortalDef, PortalPairDef};
-    use janus2d_testbed::metrics::{ExtraMetric, PortalError, PortalMomentumError};
+    use janus2d_testbed::metrics::{ExtraMetric, PortalMapError, PortalMomentumError};
     let mut world = zero_gravity();
     let wall = |world: &mut World, p: Vec2| {
         let b = world.create_body(&BodyDef::fixed(p)).unwrap();
@@ -431,7 +431,7 @@ fn portal_metrics_measure_a_passive_crossing() {
     world
         .create_shape(body, &ShapeDef::default(), Polygon::make_box(0.3, 0.3))
         .unwrap();
-    let (mut c, mut p) = (PortalError, PortalMomentumError::default());
+    let (mut c, mut p) = (PortalMapError, PortalMomentumError::default());
     let (mut worst_c, mut worst_p, mut seen) = (0.0f64, 0.0f64, 0);
     for _ in 0..90 {
         world.step(1.0 / 60.0).unwrap();

@@ -55,7 +55,7 @@ use boxdd::{
 use janus2d_testbed::desc::{
     Action, BodyDesc, BodyKind, FilterDesc, Geometry, RevoluteDesc, SceneDesc, Settings, ShapeDesc,
 };
-use janus2d_testbed::engine::{BodyState, Engine, EngineOptions, StageTimes};
+use janus2d_testbed::engine::{BodyReading, Engine, EngineOptions, StageTimes};
 
 /// A description vector as a Box2D local vector.
 fn local(x: f64, y: f64) -> Vec2 {
@@ -343,14 +343,14 @@ impl Box2d {
     }
 
     /// State of one body (None if it is gone).
-    fn state_of(world: &mut World, id: BodyId) -> Option<BodyState> {
+    fn state_of(world: &mut World, id: BodyId) -> Option<BodyReading> {
         let body = world.body(id).ok()?;
         let p = body.position().ok()?;
         let v = body.linear_velocity().ok()?;
-        let mut s = BodyState {
+        let mut s = BodyReading {
             angle: f64::from(body.rotation().ok()?.angle()),
             angular_velocity: f64::from(body.angular_velocity().ok()?),
-            ..BodyState::default()
+            ..BodyReading::default()
         };
         s.position.x = f64::from(p.x);
         s.position.y = f64::from(p.y);
@@ -401,12 +401,12 @@ impl Engine for Box2d {
         }
     }
 
-    fn state(&self, body: usize) -> Option<BodyState> {
+    fn state(&self, body: usize) -> Option<BodyReading> {
         let (id, _) = *self.bodies.get(body)?;
         Self::state_of(&mut self.world.borrow_mut(), id)
     }
 
-    fn dynamic_states(&self, out: &mut Vec<BodyState>) {
+    fn dynamic_states(&self, out: &mut Vec<BodyReading>) {
         out.clear();
         let mut world = self.world.borrow_mut();
         for &(id, kind) in self.all_bodies() {

@@ -74,7 +74,7 @@
 //!   `smash`'s block wakes at step 1 (and sleeps again after 0.5 s), and it
 //!   is then one touching island, which the projectile wakes whole. Box2D
 //!   makes no contacts between sleeping bodies.
-//! - **Velocities.** [`BodyState::linear_velocity`] is the centre of mass's
+//! - **Velocities.** [`BodyReading::linear_velocity`] is the centre of mass's
 //!   (Rapier's `linvel`), as Box2D's `b2Body_GetLinearVelocity` and the
 //!   janus2d adapter report it.
 //! - **Stage times.** Rapier's stage timers only run with its `profiler`
@@ -92,7 +92,7 @@ use std::time::Instant;
 use janus2d_testbed::desc::{
     Action, BodyDesc, BodyKind, FilterDesc, Geometry, RevoluteDesc, SceneDesc, ShapeDesc, v,
 };
-use janus2d_testbed::engine::{BodyState, Engine, EngineOptions, StageTimes};
+use janus2d_testbed::engine::{BodyReading, Engine, EngineOptions, StageTimes};
 use rapier2d::prelude::*;
 
 /// A Rapier vector from description components.
@@ -440,10 +440,10 @@ impl Rapier {
     }
 }
 
-fn state_of(rb: &RigidBody) -> BodyState {
+fn state_of(rb: &RigidBody) -> BodyReading {
     let p = rb.translation();
     let w = rb.linvel();
-    BodyState {
+    BodyReading {
         position: v(p.x as f64, p.y as f64),
         angle: rb.rotation().angle() as f64,
         linear_velocity: v(w.x as f64, w.y as f64),
@@ -554,11 +554,11 @@ impl Engine for Rapier {
         self.last_step_ms = start.elapsed().as_secs_f64() * 1e3;
     }
 
-    fn state(&self, body: usize) -> Option<BodyState> {
+    fn state(&self, body: usize) -> Option<BodyReading> {
         self.bodies.get(*self.initial.get(body)?).map(state_of)
     }
 
-    fn dynamic_states(&self, out: &mut Vec<BodyState>) {
+    fn dynamic_states(&self, out: &mut Vec<BodyReading>) {
         out.clear();
         out.extend(
             self.bodies

@@ -28,7 +28,7 @@
 //! one variant in [`JointDef`], [`Joint`] and [`JointKind`] and the arms of
 //! the matches below. Nothing in the solver, the colouring or the tree
 //! changes; a kind without a point part simply returns `None` from
-//! [`Joint::tree_point`] and the tree solve leaves its component iterative.
+//! `Joint::tree_point` and the tree solve leaves its component iterative.
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState};
 use janus2d_core::constraint::{Constraint, ConstraintRows, StepContext};

@@ -245,7 +245,7 @@ pub struct PortalMasses {
 /// at the start of the step, in world axes.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct PortalSide {
+pub struct PortalRowSide {
     /// Portal anchor relative to the portal body's centre, `p₀`, m.
     pub frame: Vec2,
     /// Portal normal `n₀` (unit).
@@ -254,12 +254,12 @@ pub struct PortalSide {
     pub delta_center: Vec2,
 }
 
-impl PortalSide {
+impl PortalRowSide {
     /// The start-of-step side for `body` passing through `portal` on
     /// `portal_body`.
-    pub fn new(body: &BodySim, portal_body: &BodySim, portal: &Portal) -> PortalSide {
+    pub fn new(body: &BodySim, portal_body: &BodySim, portal: &Portal) -> PortalRowSide {
         let frame = PortalFrame::new(&portal_body.transform, portal);
-        PortalSide {
+        PortalRowSide {
             frame: frame.point - portal_body.center,
             normal: frame.normal,
             delta_center: body.center - portal_body.center,
@@ -488,9 +488,9 @@ pub fn solve_block(k: &Mat3, b: [Real; 3]) -> [Real; 3] {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PortalPart {
     /// Side 1 at the start of the step.
-    pub side1: PortalSide,
+    pub side1: PortalRowSide,
     /// Side 2 at the start of the step.
-    pub side2: PortalSide,
+    pub side2: PortalRowSide,
     /// Scale `η`.
     pub eta: Real,
     /// The angle row's error `c2` at the start of the step, rad.
@@ -800,8 +800,8 @@ impl Constraint for PortalConstraint {
             a: a.state_index,
             b: b.state_index,
         };
-        self.part.side1 = PortalSide::new(b1.sim, a.sim, &d.portal_a);
-        self.part.side2 = PortalSide::new(b2.sim, b.sim, &d.portal_b);
+        self.part.side1 = PortalRowSide::new(b1.sim, a.sim, &d.portal_a);
+        self.part.side2 = PortalRowSide::new(b2.sim, b.sim, &d.portal_b);
         self.part.eta = d.eta;
         let alpha1 = self.part.side1.normal.y.atan2(self.part.side1.normal.x);
         let alpha2 = self.part.side2.normal.y.atan2(self.part.side2.normal.x);

@@ -292,11 +292,10 @@ pub struct BodyState {
     pub v: Vec2,
     /// Angular velocity, rad/s.
     pub w: Real,
-    /// What the body is, for the solver: a set of [`BodyState::MOVES`],
-    /// [`BodyState::KINEMATIC`], [`BodyState::BULLET`] and
-    /// [`BodyState::LOCKED_ROTATION`] ([`BodySim::state_flags`]). Set when
-    /// a body is made or changes type, mass or bullet, and at every step's
-    /// prepare; 0 in the static identity state.
+    /// What the body is, for the solver: [`BodyState::MOVES`] or 0
+    /// ([`BodySim::state_flags`]). Set when a body is made or changes type
+    /// or mass, and at every step's prepare; 0 in the static identity
+    /// state.
     pub flags: u32,
     /// Displacement of the centre of mass since the step began, m.
     pub dp: Vec2,
@@ -324,14 +323,6 @@ impl BodyState {
     /// Flag: constraint impulses move the body (a dynamic body: positive
     /// inverse mass or inverse inertia).
     pub const MOVES: u32 = 1;
-    /// Flag: a kinematic body (moves at its own velocity, infinite mass).
-    pub const KINEMATIC: u32 = 1 << 1;
-    /// Flag: a bullet ([`BodyDef::bullet`]: swept against moving bodies
-    /// too).
-    pub const BULLET: u32 = 1 << 2;
-    /// Flag: a dynamic body that does not turn (zero inverse inertia:
-    /// [`BodyDef::fixed_rotation`]).
-    pub const LOCKED_ROTATION: u32 = 1 << 3;
 
     /// True when constraint impulses move the body ([`BodyState::MOVES`]).
     #[inline(always)]
@@ -435,20 +426,10 @@ impl BodySim {
     #[inline]
     #[must_use]
     pub fn state_flags(&self) -> u32 {
-        let mut flags = match self.body_type {
-            BodyType::Static => return 0,
-            BodyType::Kinematic => BodyState::KINEMATIC,
-            BodyType::Dynamic if self.inv_inertia == 0.0 => BodyState::LOCKED_ROTATION,
-            BodyType::Dynamic => 0,
-        };
         // Only a dynamic body has a positive inverse mass or inertia.
-        if self.inv_mass > 0.0 || self.inv_inertia > 0.0 {
-            flags |= BodyState::MOVES;
-        }
-        if self.bullet {
-            flags |= BodyState::BULLET;
-        }
-        flags
+        let moves =
+            self.body_type == BodyType::Dynamic && (self.inv_mass > 0.0 || self.inv_inertia > 0.0);
+        if moves { BodyState::MOVES } else { 0 }
     }
 
     /// The inverse mass and inertia of this body.
@@ -1401,16 +1382,13 @@ mod tests {
         let k = set.create(&BodyDef::kinematic(Vec2::ONE)).unwrap();
         let s = set.create(&BodyDef::fixed(Vec2::ONE)).unwrap();
         assert_eq!(flags(&set, d), BodyState::MOVES);
-        assert_eq!(flags(&set, bullet), BodyState::MOVES | BodyState::BULLET);
-        assert_eq!(
-            flags(&set, locked),
-            BodyState::MOVES | BodyState::LOCKED_ROTATION
-        );
-        assert_eq!(flags(&set, k), BodyState::KINEMATIC);
+        assert_eq!(flags(&set, bullet), BodyState::MOVES);
+        assert_eq!(flags(&set, locked), BodyState::MOVES, "it still translates");
+        assert_eq!(flags(&set, k), 0, "impulses do not move a kinematic body");
         assert_eq!(flags(&set, s), 0, "a static body reads the identity state");
         assert_eq!(BodyState::IDENTITY.flags, 0);
         set.set_body_type(d, BodyType::Kinematic).unwrap();
-        assert_eq!(flags(&set, d), BodyState::KINEMATIC);
+        assert_eq!(flags(&set, d), 0);
         set.set_body_type(k, BodyType::Dynamic).unwrap();
         assert!(set.state(k).unwrap().moves());
         assert_eq!(set.solver_body(k).inv_masses().inv_mass, 1.0);

@@ -12,7 +12,7 @@ use crate::desc::{Action, SceneDesc};
 
 /// Position, angle and velocities of one body.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct BodyState {
+pub struct BodyReading {
     /// Origin, m.
     pub position: DVec2,
     /// Angle, rad.
@@ -150,10 +150,10 @@ pub trait Engine: Sized {
     fn step(&mut self);
 
     /// State of a body of the scene's initial `bodies` (None once gone).
-    fn state(&self, body: usize) -> Option<BodyState>;
+    fn state(&self, body: usize) -> Option<BodyReading>;
 
     /// State of every dynamic body now in the world (spawned ones too).
-    fn dynamic_states(&self, out: &mut Vec<BodyState>);
+    fn dynamic_states(&self, out: &mut Vec<BodyReading>);
 
     /// Bodies in the world (static ones included).
     fn body_count(&self) -> usize;

@@ -23,7 +23,7 @@ use glam::DVec2;
 
 use crate::benchmarks::{joint_grid, pyramid};
 use crate::desc::*;
-use crate::engine::{BodyState, Engine, EngineOptions, scripted_step};
+use crate::engine::{BodyReading, Engine, EngineOptions, scripted_step};
 use crate::measure::{ShapeIndex, max_joint_gap, outside_container, peak_speed};
 
 /// A figure a hard case bounds.
@@ -182,7 +182,8 @@ impl HardCase {
         let d = &self.desc;
         let index = ShapeIndex::new(d);
         let late_from = self.steps.saturating_sub(60);
-        let start: Vec<Option<BodyState>> = (0..d.bodies.len()).map(|i| engine.state(i)).collect();
+        let start: Vec<Option<BodyReading>> =
+            (0..d.bodies.len()).map(|i| engine.state(i)).collect();
         let probe0 = d.probe.and_then(|p| start[p]);
         let (mut pen, mut late_pen, mut sink, mut drift, mut late_probe_speed) =
             (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);

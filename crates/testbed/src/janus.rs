@@ -22,7 +22,7 @@ use janus2d_core::math::{Real, Vec2, from_f64, to_f64, wrap_angle};
 use janus2d_world::{Filter, JointHandle, ShapeDef, World, WorldDef, WorldError};
 
 use crate::desc::*;
-use crate::engine::{BodyState, Engine, EngineOptions, StageTimes};
+use crate::engine::{BodyReading, Engine, EngineOptions, StageTimes};
 
 /// A description vector in janus2d's scalar.
 #[must_use]
@@ -282,10 +282,10 @@ impl Janus {
     }
 }
 
-fn state_of(world: &World, h: BodyHandle) -> Option<BodyState> {
+fn state_of(world: &World, h: BodyHandle) -> Option<BodyReading> {
     let p = world.position(h).ok()?;
     let v = world.linear_velocity(h).ok()?;
-    Some(BodyState {
+    Some(BodyReading {
         position: DVec2::new(to_f64(p.x), to_f64(p.y)),
         angle: to_f64(world.angle(h).ok()?),
         linear_velocity: DVec2::new(to_f64(v.x), to_f64(v.y)),
@@ -308,11 +308,11 @@ impl Engine for Janus {
         self.world.step(self.dt).expect("step");
     }
 
-    fn state(&self, body: usize) -> Option<BodyState> {
+    fn state(&self, body: usize) -> Option<BodyReading> {
         state_of(&self.world, *self.bodies.get(body)?)
     }
 
-    fn dynamic_states(&self, out: &mut Vec<BodyState>) {
+    fn dynamic_states(&self, out: &mut Vec<BodyReading>) {
         out.clear();
         for h in self.world.body_handles() {
             if self.world.body_type(h) == Ok(BodyType::Dynamic) {

@@ -19,7 +19,7 @@ use janus2d_core::math::{Real, Transform, to_f64};
 use janus2d_world::Filter;
 
 use crate::desc::{BodyKind, SceneDesc};
-use crate::engine::BodyState;
+use crate::engine::BodyReading;
 use crate::janus::{filter, shapes_of, vec};
 
 struct IndexedShape {
@@ -65,7 +65,7 @@ impl ShapeIndex {
     /// Deepest overlap (≥ 0, m) of any two shapes that may collide, with
     /// body `i` at `states[i]` (a body without a state is skipped).
     #[must_use]
-    pub fn deepest_overlap(&self, states: &[Option<BodyState>]) -> f64 {
+    pub fn deepest_overlap(&self, states: &[Option<BodyReading>]) -> f64 {
         struct Placed {
             shape: usize,
             xf: Transform,
@@ -118,9 +118,9 @@ impl ShapeIndex {
 
 /// Largest distance between the world anchors of the scene's joints.
 #[must_use]
-pub fn max_joint_gap(desc: &SceneDesc, states: &[Option<BodyState>]) -> f64 {
+pub fn max_joint_gap(desc: &SceneDesc, states: &[Option<BodyReading>]) -> f64 {
     let world_point =
-        |st: &BodyState, local: DVec2| st.position + DVec2::from_angle(st.angle).rotate(local);
+        |st: &BodyReading, local: DVec2| st.position + DVec2::from_angle(st.angle).rotate(local);
     desc.joints
         .iter()
         .filter_map(|j| {
@@ -136,8 +136,8 @@ pub fn max_joint_gap(desc: &SceneDesc, states: &[Option<BodyState>]) -> f64 {
 #[must_use]
 pub fn outside_container(
     desc: &SceneDesc,
-    container_state: Option<BodyState>,
-    dynamic: &[BodyState],
+    container_state: Option<BodyReading>,
+    dynamic: &[BodyReading],
 ) -> usize {
     let Some(c) = &desc.container else {
         return 0;
@@ -147,7 +147,7 @@ pub fn outside_container(
             Some(s) => s,
             None => return 0,
         },
-        None => BodyState::default(),
+        None => BodyReading::default(),
     };
     let to_local = DVec2::from_angle(-frame.angle);
     dynamic
@@ -161,7 +161,7 @@ pub fn outside_container(
 
 /// Largest linear speed of the given bodies.
 #[must_use]
-pub fn peak_speed(dynamic: &[BodyState]) -> f64 {
+pub fn peak_speed(dynamic: &[BodyReading]) -> f64 {
     dynamic
         .iter()
         .map(|s| s.linear_velocity.length())

@@ -67,7 +67,7 @@
 //! sampled after every step and the tracker keeps its peak and last value,
 //! which [`Metrics::columns`] appends to the fixed columns, so the sweep
 //! writes it to its CSV without any change. The portal figures plug in this
-//! way: [`PortalError`] (`portal_c`, m: the largest `|x₂ − T(x₁)|` of any
+//! way: [`PortalMapError`] (`portal_c`, m: the largest `|x₂ − T(x₁)|` of any
 //! crossing) and [`PortalMomentumError`] (`portal_eta_momentum`, relative:
 //! `|p − p₀| / |p₀|` of the η-scaled momentum a crossing conserves);
 //! [`cases::Case::tracker`] adds both when the world has portals. A
@@ -149,10 +149,10 @@ pub trait ExtraMetric {
 /// Portal constraint error `max |x₂ − T(x₁)|` over the crossings in
 /// progress, m (`None` while nothing crosses).
 #[cfg(feature = "portals")]
-pub struct PortalError;
+pub struct PortalMapError;
 
 #[cfg(feature = "portals")]
-impl ExtraMetric for PortalError {
+impl ExtraMetric for PortalMapError {
     fn name(&self) -> &'static str {
         "portal_c"
     }
@@ -599,7 +599,7 @@ pub mod cases {
             #[cfg(feature = "portals")]
             if self.world.portal_pair_count() > 0 {
                 return tracker
-                    .with_extra(Box::new(super::PortalError))
+                    .with_extra(Box::new(super::PortalMapError))
                     .with_extra(Box::new(super::PortalMomentumError::default()));
             }
             tracker
@@ -691,7 +691,7 @@ pub mod cases {
     /// Portal stream ([`scenes::portal_stream`]): 200 mixed shapes pour
     /// through a floor portal and out of a wall portal; `steps` steps.
     /// Probe: the last shape (no collapse box). The tracker adds
-    /// [`PortalError`](super::PortalError).
+    /// [`PortalMapError`](super::PortalMapError).
     #[cfg(feature = "portals")]
     pub fn portal_stream(def: &WorldDef, steps: usize) -> Case {
         swinging(scenes::portal_stream(def, true), steps)

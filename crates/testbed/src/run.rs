@@ -12,7 +12,7 @@
 use std::time::Instant;
 
 use crate::desc::{ANGLE_TOLERANCE, COUNT_TOLERANCE, POSITION_TOLERANCE, Reference, SceneDesc};
-use crate::engine::{BodyState, Engine, EngineOptions, StageTimes, scripted_step};
+use crate::engine::{BodyReading, Engine, EngineOptions, StageTimes, scripted_step};
 use crate::measure::outside_container;
 
 /// What a run left behind: the figures compared with Box2D's.
@@ -25,7 +25,7 @@ pub struct Sanity {
     /// Touching shape pairs.
     pub touching: usize,
     /// The probe's state.
-    pub probe: Option<BodyState>,
+    pub probe: Option<BodyReading>,
     /// Dynamic bodies outside the container (None: the scene has none).
     pub outside: Option<usize>,
 }

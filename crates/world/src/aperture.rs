@@ -186,6 +186,7 @@ fn open_range(f0: Real, f1: Real, lo: Real, hi: Real) -> (Real, Real) {
 }
 
 /// Clipping that drops nothing (the narrowphase's input without portals).
+#[cfg_attr(feature = "portals", allow(dead_code))]
 pub static NO_CLIPPING: ContactClipping = ContactClipping {
     clips: Vec::new(),
     ignored_pairs: Vec::new(),
@@ -309,7 +310,7 @@ impl ContactClipping {
     /// use janus2d_core::body::BodyHandle;
     /// use janus2d_core::geometry::{Manifold, ManifoldPoint};
     /// use janus2d_core::math::{Real, Vec2};
-    /// use janus2d_world::portal::{ApertureClip, ContactClipping, PairMotion};
+    /// use janus2d_world::aperture::{ApertureClip, ContactClipping, PairMotion};
     ///
     /// // A floor at y = 0 with a 1 m aperture at the origin; a plank's
     /// // footprint from x = −0.3 (over the aperture) to x = 3.

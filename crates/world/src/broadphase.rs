@@ -181,6 +181,7 @@ impl BroadPhase {
         &self.static_tree
     }
 
+    #[cfg(test)]
     /// Adds a proxy for the tight box `aabb` with the given payload and
     /// returns its id. The new proxy counts as moved: its pairs are reported
     /// by the next [`update_pairs`](Self::update_pairs).
@@ -382,6 +383,7 @@ impl BroadPhase {
         self.mark_moved(proxy);
     }
 
+    #[cfg(test)]
     /// True when the proxy was created, re-inserted or touched since the last
     /// [`update_pairs`](Self::update_pairs).
     pub fn is_moved(&self, proxy: u32) -> bool {
@@ -394,6 +396,7 @@ impl BroadPhase {
     }
 
     /// The fat-box margin of a proxy, metres.
+    #[cfg(test)]
     pub fn proxy_margin(&self, proxy: u32) -> Real {
         self.slot(proxy).margin
     }
@@ -402,6 +405,7 @@ impl BroadPhase {
     /// with a smaller one are re-inserted at once with their tight box
     /// `tight_of(payload)` fattened by it (in proxy order, each marked as
     /// moved), and later proxies are created with it.
+    #[cfg_attr(not(feature = "portals"), allow(dead_code))]
     pub fn use_uniform_margin(&mut self, tight_of: impl Fn(u32) -> Aabb) {
         if self.uniform_margin {
             return;
@@ -694,23 +698,7 @@ impl BroadPhase {
         }
     }
 
-    /// Translates every box by `-new_origin` (see
-    /// [`DynamicTree::shift_origin`]).
-    pub fn shift_origin(&mut self, new_origin: Vec2) {
-        self.dynamic_tree.shift_origin(new_origin);
-        self.static_tree.shift_origin(new_origin);
-        for i in 0..self.proxies.len() {
-            let s = self.proxies[i];
-            if s.alive {
-                self.proxies[i].fat = self.tree(s.is_static).fat_aabb(s.leaf);
-                self.proxies[i].core = Aabb {
-                    lower: s.core.lower - new_origin,
-                    upper: s.core.upper - new_origin,
-                };
-            }
-        }
-    }
-
+    #[cfg(test)]
     /// Validates both trees and the proxy table; panics on inconsistency.
     pub fn validate(&self) {
         if let Err(e) = self.check() {

@@ -32,22 +32,18 @@ use janus2d_core::geometry::Shape;
 use janus2d_core::math::{Real, Transform, Vec2};
 
 use crate::broadphase::BroadPhase;
-pub use crate::contacts::{CollisionEvents, ShapePairEvent};
+pub use crate::contacts::CollisionEvents;
 use crate::contacts::{Contact, ContactPointData, ContactSet};
 use crate::joints::NoCollide;
 #[cfg(feature = "parallel")]
 use crate::narrowphase::Narrowphase;
 use crate::shapes::{ShapeData, ShapeDef, ShapeHandle, ShapeStore};
 
-/// Speculative distance, m (0.02 = 4 × linear slop): contact points exist
-/// this far before touching. One constant, defined beside the manifolds.
-pub use janus2d_core::geometry::SPECULATIVE_DISTANCE;
-
 /// Fattening margin of broadphase boxes, m (0.1). One constant, defined
 /// beside the tree.
 pub use crate::dynamic_tree::DEFAULT_AABB_MARGIN as AABB_MARGIN;
 
-pub use crate::broadphase::{AABB_MARGIN_FRACTION, MAX_BOX_COORDINATE, bounded, proxy_margin};
+use crate::broadphase::{bounded, proxy_margin};
 
 pub use crate::profile::CollisionCounters;
 
@@ -516,9 +512,10 @@ fn should_pair(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::broadphase::AABB_MARGIN_FRACTION;
     use crate::{World, WorldDef};
     use janus2d_core::body::BodyDef;
-    use janus2d_core::geometry::{Aabb, Polygon};
+    use janus2d_core::geometry::{Aabb, Polygon, SPECULATIVE_DISTANCE};
 
     /// The fat box and margin of the only shape of `body`.
     fn fat_of(world: &World, body: BodyHandle) -> (Aabb, Aabb, Real) {

@@ -285,12 +285,6 @@ impl ContactSet {
         self.awake.len() + self.sleeping.len()
     }
 
-    /// True when there is no contact.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
     /// The awake contacts, in list order.
     #[must_use]
     pub fn awake(&self) -> &[Contact] {

@@ -22,7 +22,7 @@
 //! | `aabbs`            | off     | each shape's tight world box as a [`DebugDraw::polygon`]          |
 //! | `transforms`       | off     | each body's frame ([`DebugDraw::transform`]) and centre of mass ([`DebugDraw::point`]) |
 //! | `portals`          | on      | per portal: its aperture ([`DebugDraw::segment`]), its outward normal, a label `a`/`b` with η ([`DebugDraw::text`]); a faint segment linking the pair |
-//! | `apertures`        | off     | the last step's contact clipping regions ([`crate::portal::ApertureClip`]): the hole in a wall (as deep as the aperture is wide) and the half-space behind a crossing copy, as [`DebugDraw::polygon`] |
+//! | `apertures`        | off     | the last step's contact clipping regions (the aperture clipping's regions): the hole in a wall (as deep as the aperture is wide) and the half-space behind a crossing copy, as [`DebugDraw::polygon`] |
 //! | `crossings`        | on      | per crossing: a segment from the original's centre of mass to its clone's, both as points |
 //!
 //! Without the `portals` feature the last three flags draw nothing.

@@ -1,5 +1,5 @@
 //! The dynamic AABB tree: an incremental bounding-volume hierarchy of fat
-//! boxes, the structure under the [broadphase](crate::broadphase).
+//! boxes, the structure under the broadphase.
 //!
 //! # Structure
 //!
@@ -51,7 +51,7 @@
 //! # Operations
 //!
 //! All on [`DynamicTree`]; the pair traversals are crate-internal, used by
-//! [`BroadPhase::update_pairs`](crate::broadphase::BroadPhase::update_pairs).
+//! `BroadPhase::update_pairs`.
 //!
 //! | operation                            | cost / rule                                              |
 //! |--------------------------------------|----------------------------------------------------------|

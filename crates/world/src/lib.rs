@@ -3,54 +3,57 @@
 //! The world: the stepping loop and the stages it calls, each owning its
 //! data.
 //!
+//! The public surface is [`World`] and the types re-exported at this
+//! crate's root; [`world`], [`query`], [`portal`], [`debug_draw`] and
+//! [`dynamic_tree`] and [`aperture`] are public modules, the stages are private to the crate:
+//!
 //! | module           | what                                                     |
 //! |------------------|----------------------------------------------------------|
 //! | [`world`]        | [`World`], [`WorldDef`]: the public API split by topic (bodies, shapes, joints, queries, events) and the step |
-//! | [`error`]        | [`WorldError`], the typed errors of the API               |
-//! | [`shapes`]       | the shape store: geometry, material, filter, body → shapes |
+//! | `error`          | [`WorldError`], the typed errors of the API               |
+//! | `shapes`         | the shape store: geometry, material, filter, body → shapes |
 //! | [`debug_draw`]   | the [`DebugDraw`] trait, draw flags and colours, the drawing walk |
-//! | [`continuous`]   | continuous collision: fast bodies swept to their time of impact |
-//! | [`contacts`]     | the contact life cycle; awake and sleeping contacts, body → contacts |
-//! | [`narrowphase`]  | manifolds of awake contacts; contact constraints          |
-//! | [`collision`]    | the collision stage: shapes + broadphase + contacts + events |
-//! | [`broadphase`]   | pair finding over two dynamic trees                      |
+//! | `continuous`     | continuous collision: fast bodies swept to their time of impact |
+//! | `contacts`       | the contact life cycle; awake and sleeping contacts, body → contacts |
+//! | `narrowphase`    | manifolds of awake contacts; contact constraints          |
+//! | `collision`      | the collision stage: shapes + broadphase + contacts + events |
+//! | `broadphase`     | pair finding over two dynamic trees                      |
 //! | [`dynamic_tree`] | the dynamic AABB tree (insert, remove, rotate, query)     |
-//! | [`joints`]       | the joint set: slots, per-type storage, body → joints, no-collide pairs |
-//! | [`islands`]      | sleep timers and islands; sleeping islands leave every per-step loop |
+//! | `joints`         | the joint set: slots, one storage for every kind, body → joints, no-collide pairs |
+//! | `islands`        | sleep timers and islands; sleeping islands leave every per-step loop |
 //! | [`portal`]       | portal pairs, crossings, clones                           |
 //! | [`aperture`]     | aperture clipping: the geometry the portal stage hands the narrowphase and continuous collision |
-//! | [`profile`]      | per-stage timings and work counters                      |
+//! | `profile`        | per-stage timings and work counters                      |
 //! | [`query`]        | scene queries: rays, shape casts, overlaps, distances    |
-//! | [`hash`]         | the state hash of determinism checks                     |
-//! | [`snapshot`]     | [`Snapshot`]: `World::snapshot` and `World::restore`      |
-//! | [`validate`]     | [`World::validate`]: every cross-structure invariant     |
+//! | `hash`           | the state hash of determinism checks                     |
+//! | `snapshot`       | [`Snapshot`]: `World::snapshot` and `World::restore`      |
+//! | `validate`       | [`World::validate`]: every cross-structure invariant     |
 //!
 //! See `docs/architecture.md` for the stage table.
 
 pub mod aperture;
-pub mod broadphase;
-pub mod collision;
-pub mod contacts;
-pub mod continuous;
+pub(crate) mod broadphase;
+pub(crate) mod collision;
+pub(crate) mod contacts;
+pub(crate) mod continuous;
 pub mod debug_draw;
 pub mod dynamic_tree;
-pub mod error;
-pub mod hash;
-pub mod islands;
-pub mod joints;
-pub mod narrowphase;
+pub(crate) mod error;
+pub(crate) mod hash;
+pub(crate) mod islands;
+pub(crate) mod joints;
+pub(crate) mod narrowphase;
 pub mod portal;
-pub mod profile;
+pub(crate) mod profile;
 pub mod query;
 #[cfg(feature = "serde")]
 mod serde_maps;
-pub mod shapes;
-pub mod snapshot;
-pub mod validate;
+pub(crate) mod shapes;
+pub(crate) mod snapshot;
+pub(crate) mod validate;
 pub mod world;
 
-pub use collision::CollisionCounters;
-pub use contacts::{CollisionEvents, Contact, ContactPointData, ShapePairEvent};
+pub use contacts::{CollisionEvents, Contact, ContactPointData, HitEvent, ShapePairEvent};
 pub use continuous::ContinuousCounters;
 pub use debug_draw::{Color, DebugDraw, DrawOptions, Palette};
 pub use error::WorldError;
@@ -62,7 +65,7 @@ pub use portal::{
     CrossingRole, MassModel, PlaneSide, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle,
     PortalSide,
 };
-pub use profile::{StepCounters, StepProfile};
+pub use profile::{CollisionCounters, StepCounters, StepProfile};
 pub use query::{PortalHop, QueryFilter, QueryProblem, RayHit, ShapeOverlap};
 pub use shapes::{Filter, ShapeData, ShapeDef, ShapeHandle};
 pub use snapshot::Snapshot;

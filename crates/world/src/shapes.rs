@@ -81,7 +81,7 @@ pub struct ShapeDef {
     pub is_sensor: bool,
     /// Report hit events for this shape's contacts (usual false): after a
     /// step, each contact that pushed with an approach speed above the
-    /// world's `hit_event_threshold` gives a [`HitEvent`](crate::contacts::HitEvent).
+    /// world's `hit_event_threshold` gives a [`HitEvent`](crate::HitEvent).
     pub enable_hit_events: bool,
     /// Opaque user value.
     pub user_data: u64,

@@ -17,7 +17,7 @@
 
 use crate::world::World;
 
-/// A copy of a world's whole simulation state (see [`crate::snapshot`]).
+/// A copy of a world's whole simulation state (see [`World::snapshot`]).
 pub struct Snapshot {
     pub(crate) world: Box<World>,
 }

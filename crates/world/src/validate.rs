@@ -66,7 +66,7 @@ fn tag(invariant: Invariant) -> impl FnOnce(String) -> InvariantError {
 
 impl World {
     /// Checks every cross-structure invariant of the world (see
-    /// [`crate::validate`]) and returns the first one broken. A world
+    /// [`Invariant`]) and returns the first one broken. A world
     /// reached through the public API always passes.
     ///
     /// ```

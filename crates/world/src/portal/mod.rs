@@ -6,14 +6,14 @@
 //! | `crossing.rs` | the crossing stage's decisions, read from bodies, shapes and the broadphase, returned as commands |
 //! | `noop.rs` | the stage's twin without the feature: no state, every step call does nothing |
 //! | `coupling.rs` | joints and portal rows solved together while a crossing copy carries a joint |
-//! | [`clipping`] | (re-export of [`crate::aperture`], collision-side) apertures as geometry: manifolds clipped to a wall's solid parts, copies' far sides, ignored pairs; the stage fills it, the narrowphase and continuous collision read it |
+//! | `clipping` | (re-export of the collision-side `crate::aperture`) apertures as geometry: manifolds clipped to a wall's solid parts, copies' far sides, ignored pairs; the stage fills it, the narrowphase and continuous collision read it |
 //!
 //! The world calls the stage in the same places with or without the
 //! feature; only which twin is compiled changes.
 
 /// Aperture clipping is collision-side geometry ([`crate::aperture`]):
 /// the portal stage builds its [`ContactClipping`] each step.
-pub use crate::aperture as clipping;
+pub(crate) use crate::aperture as clipping;
 pub(crate) mod coupling;
 #[cfg(feature = "portals")]
 mod crossing;
@@ -22,7 +22,6 @@ mod noop;
 #[cfg(feature = "portals")]
 mod stage;
 
-pub use crate::aperture::{ApertureClip, ContactClipping, NO_CLIPPING, PairMotion, PairShapes};
 #[cfg(not(feature = "portals"))]
 pub(crate) use noop::PortalStage;
 #[cfg(feature = "portals")]

@@ -528,10 +528,6 @@ impl World {
         self.check_body(body)?;
         if let Some(s) = self.bodies.sim_mut(body) {
             s.bullet = on;
-            let flags = s.state_flags();
-            if let Some(st) = self.bodies.state_mut(body) {
-                st.flags = flags;
-            }
         }
         Ok(())
     }

@@ -64,10 +64,10 @@ pub struct WorldDef {
     pub sleep: SleepSettings,
     /// Continuous collision of fast bodies against static shapes, and of
     /// bullets against moving ones (on by default, as in Box2D; see
-    /// [`crate::continuous`]).
+    /// the continuous stage).
     pub enable_continuous: bool,
     /// Approach speed above which a contact of a shape with hit events on
-    /// reports a [`HitEvent`](crate::contacts::HitEvent), m/s (usual 1, as
+    /// reports a [`HitEvent`](crate::HitEvent), m/s (usual 1, as
     /// Box2D's `hitEventThreshold`).
     pub hit_event_threshold: Real,
 }

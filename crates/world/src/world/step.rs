@@ -226,8 +226,8 @@ impl World {
         Ok(())
     }
 
-    /// A hash of every body's transform and velocity bits, in handle order:
-    /// equal hashes mean bit-identical states (see [`crate::hash`]).
+    /// A hash of every body's transform and velocity bits, in handle order
+    /// (FNV-1a, 64 bit): equal hashes mean bit-identical states.
     pub fn state_hash(&self) -> u64 {
         crate::hash::state_hash(&self.bodies)
     }
