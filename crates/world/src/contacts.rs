@@ -232,6 +232,17 @@ pub(crate) fn pair_key(a: u32, b: u32) -> (u32, u32) {
     if a < b { (a, b) } else { (b, a) }
 }
 
+/// Body pairs whose solid contact began or stopped touching during a
+/// step: what the contacts hand the islands (through the pipeline).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct TouchChanges {
+    /// Pairs that began touching (they link islands).
+    pub(crate) began: Vec<(BodyHandle, BodyHandle)>,
+    /// Pairs that stopped touching or whose touching contact was destroyed
+    /// (their islands may split).
+    pub(crate) ended: Vec<(BodyHandle, BodyHandle)>,
+}
+
 /// Every contact of a world, awake or asleep, with per-body adjacency.
 #[derive(Clone, Debug, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -246,10 +257,10 @@ pub struct ContactSet {
     body_contacts: Vec<SmallVec<[u32; 4]>>,
     /// Body pairs whose solid contact began touching since the islands
     /// last read them (they link islands).
-    pub(crate) began: Vec<(BodyHandle, BodyHandle)>,
+    began: Vec<(BodyHandle, BodyHandle)>,
     /// Body pairs whose solid contact stopped touching or was destroyed
     /// while touching (their islands may split).
-    pub(crate) ended: Vec<(BodyHandle, BodyHandle)>,
+    ended: Vec<(BodyHandle, BodyHandle)>,
     /// By contact id: its bodies and whether it touches solidly, kept as
     /// contacts come, go and begin or stop touching, so that an island
     /// split walks a body's links without reading the contacts themselves
@@ -279,6 +290,15 @@ struct ContactLink {
 }
 
 impl ContactSet {
+    /// The body pairs whose solid contact began or stopped touching since
+    /// the last call, handed to the islands by the pipeline.
+    pub(crate) fn take_touch_changes(&mut self) -> TouchChanges {
+        TouchChanges {
+            began: std::mem::take(&mut self.began),
+            ended: std::mem::take(&mut self.ended),
+        }
+    }
+
     /// Number of contacts, awake and asleep.
     #[must_use]
     pub fn len(&self) -> usize {

@@ -34,7 +34,7 @@
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::math::Real;
 
-use crate::contacts::ContactSet;
+use crate::contacts::{ContactSet, TouchChanges};
 use crate::error::WorldError;
 use crate::joints::JointSet;
 use crate::shapes::ShapeStore;
@@ -334,13 +334,13 @@ impl Islands {
         }
     }
 
-    /// Reads the contacts that began and stopped touching since the last
-    /// call: links and possible splits.
-    pub(crate) fn read_contact_changes(&mut self, contacts: &mut ContactSet, bodies: &BodySet) {
-        for (a, b) in std::mem::take(&mut contacts.began) {
+    /// Takes the contacts that began and stopped touching during the step
+    /// (handed over by the pipeline): links and possible splits.
+    pub(crate) fn apply_touch_changes(&mut self, changes: TouchChanges, bodies: &BodySet) {
+        for (a, b) in changes.began {
             self.link(a, b, bodies);
         }
-        for (a, _) in std::mem::take(&mut contacts.ended) {
+        for (a, _) in changes.ended {
             self.note_removed(a);
         }
     }

@@ -77,8 +77,8 @@ impl World {
             self.wake_all(&wake);
             let woke = !wake.is_empty();
             self.wake_list = wake;
-            self.islands
-                .read_contact_changes(&mut self.collision.contacts, &self.bodies);
+            let touches = self.collision.contacts.take_touch_changes();
+            self.islands.apply_touch_changes(touches, &self.bodies);
             self.portals
                 .object_masses(&self.bodies, &mut self.object_masses);
             crate::narrowphase::build_constraints(
