@@ -53,6 +53,74 @@ pub enum JointError {
     Negative,
     /// The lower limit exceeds the upper limit.
     InvalidLimits,
+    /// A value outside the range the engine accepts (see
+    /// [`janus2d_core::limits`]); the world reports it as its own
+    /// `OutOfBounds`.
+    OutOfBounds {
+        /// The field.
+        field: &'static str,
+        /// Smallest accepted value.
+        min: janus2d_core::math::Real,
+        /// Largest accepted value.
+        max: janus2d_core::math::Real,
+    },
+}
+
+/// Checks a local anchor against
+/// [`MAX_EXTENT`](janus2d_core::limits::MAX_EXTENT), m.
+pub fn check_anchor(
+    anchor: janus2d_core::math::Vec2,
+    field: &'static str,
+) -> Result<(), JointError> {
+    let max = janus2d_core::limits::MAX_EXTENT;
+    if anchor.x.abs() > max || anchor.y.abs() > max {
+        return Err(JointError::OutOfBounds {
+            field,
+            min: -max,
+            max,
+        });
+    }
+    Ok(())
+}
+
+/// Checks a motor speed against
+/// [`MAX_ANGULAR_SPEED`](janus2d_core::limits::MAX_ANGULAR_SPEED), rad/s.
+pub fn check_motor_speed(speed: janus2d_core::math::Real) -> Result<(), JointError> {
+    let max = janus2d_core::limits::MAX_ANGULAR_SPEED;
+    if speed.abs() > max {
+        return Err(JointError::OutOfBounds {
+            field: "motor_speed",
+            min: -max,
+            max,
+        });
+    }
+    Ok(())
+}
+
+/// Checks a spring against
+/// [`MAX_SPRING_HERTZ`](janus2d_core::limits::MAX_SPRING_HERTZ) and
+/// [`MAX_DAMPING_RATIO`](janus2d_core::limits::MAX_DAMPING_RATIO).
+pub fn check_spring(
+    hertz: janus2d_core::math::Real,
+    damping_ratio: janus2d_core::math::Real,
+) -> Result<(), JointError> {
+    let max_hertz = janus2d_core::limits::MAX_SPRING_HERTZ;
+    if hertz > max_hertz {
+        return Err(JointError::OutOfBounds {
+            field: "hertz",
+            min: 0.0,
+            max: max_hertz,
+        });
+    }
+    let max = janus2d_core::limits::MAX_DAMPING_RATIO;
+    if damping_ratio > max {
+        return Err(JointError::OutOfBounds {
+            field: "damping_ratio",
+            min: 0.0,
+            max,
+        });
+    }
+    Ok(())
 }
 
 impl std::fmt::Display for JointError {
@@ -65,6 +133,9 @@ impl std::fmt::Display for JointError {
                 "joint definition has a negative torque, hertz or damping"
             ),
             JointError::InvalidLimits => write!(f, "joint lower limit exceeds upper limit"),
+            JointError::OutOfBounds { field, min, max } => {
+                write!(f, "joint {field} outside [{min}, {max}]")
+            }
         }
     }
 }

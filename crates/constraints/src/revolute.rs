@@ -38,11 +38,11 @@ use janus2d_core::math::{Real, Vec2, cross, vec_is_finite};
 use janus2d_core::softness::Softness;
 use smallvec::smallvec;
 
-use crate::JointError;
 use crate::joint_base::JointBase;
 use crate::parts::{
     AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, load_pair, store_pair,
 };
+use crate::{JointError, check_anchor, check_motor_speed, check_spring};
 
 /// Everything needed to create a revolute joint.
 #[derive(Clone, Debug, PartialEq)]
@@ -154,7 +154,10 @@ impl RevoluteJointDef {
         if self.max_motor_torque < 0.0 || self.hertz < 0.0 || self.damping_ratio < 0.0 {
             return Err(JointError::Negative);
         }
-        Ok(())
+        check_anchor(self.local_anchor_a, "local_anchor_a")?;
+        check_anchor(self.local_anchor_b, "local_anchor_b")?;
+        check_motor_speed(self.motor_speed)?;
+        check_spring(self.hertz, self.damping_ratio)
     }
 }
 

@@ -55,6 +55,10 @@ pub const MAX_GRAVITY_SCALE: Real = 1e6;
 /// Largest contact or joint damping ratio (1e4).
 pub const MAX_DAMPING_RATIO: Real = 1e4;
 
+/// Largest joint spring stiffness, Hz (1e6: a stiffer spring's softness
+/// overflows).
+pub const MAX_SPRING_HERTZ: Real = 1e6;
+
 /// Largest friction coefficient of a shape (1e6: the friction impulse
 /// bound `μ λ_n` must stay finite).
 pub const MAX_FRICTION: Real = 1e6;

@@ -126,7 +126,13 @@ impl From<janus2d_core::solver::SettingsError> for WorldError {
 
 impl From<JointError> for WorldError {
     fn from(e: JointError) -> Self {
-        WorldError::Joint(e)
+        match e {
+            // One out-of-range error for every input, as the other setters.
+            JointError::OutOfBounds { field, min, max } => {
+                WorldError::OutOfBounds { field, min, max }
+            }
+            e => WorldError::Joint(e),
+        }
     }
 }
 

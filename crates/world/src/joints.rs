@@ -519,63 +519,10 @@ impl JointSet {
     }
 }
 
-/// The world's limits on a joint definition, beyond
-/// [`JointDef::validate`]: local anchors within
-/// [`MAX_EXTENT`](janus2d_core::limits::MAX_EXTENT), the motor speed
-/// within [`MAX_ANGULAR_SPEED`](janus2d_core::limits::MAX_ANGULAR_SPEED),
-/// the spring within [`MAX_SPRING_HERTZ`] and
-/// [`MAX_DAMPING_RATIO`](janus2d_core::limits::MAX_DAMPING_RATIO).
-pub(crate) fn check_joint_limits(def: &JointDef) -> Result<(), WorldError> {
-    let max = janus2d_core::limits::MAX_EXTENT;
-    let (anchor_a, anchor_b) = def.local_anchors();
-    for (a, field) in [(anchor_a, "local_anchor_a"), (anchor_b, "local_anchor_b")] {
-        if a.x.abs() > max || a.y.abs() > max {
-            return Err(WorldError::OutOfBounds {
-                field,
-                min: -max,
-                max,
-            });
-        }
-    }
-    match def {
-        JointDef::Revolute(def) => {
-            check_motor_speed(def.motor_speed)?;
-            check_spring(def.hertz, def.damping_ratio)
-        }
-    }
-}
-
-/// Largest joint spring stiffness, Hz (1e6: a stiffer spring's softness
-/// overflows).
-pub const MAX_SPRING_HERTZ: Real = 1e6;
-
 fn check_motor_speed(speed: Real) -> Result<(), WorldError> {
-    let max = janus2d_core::limits::MAX_ANGULAR_SPEED;
-    if speed.abs() > max {
-        return Err(WorldError::OutOfBounds {
-            field: "motor_speed",
-            min: -max,
-            max,
-        });
-    }
-    Ok(())
+    Ok(janus2d_constraints::check_motor_speed(speed)?)
 }
 
 fn check_spring(hertz: Real, damping_ratio: Real) -> Result<(), WorldError> {
-    if hertz > MAX_SPRING_HERTZ {
-        return Err(WorldError::OutOfBounds {
-            field: "hertz",
-            min: 0.0,
-            max: MAX_SPRING_HERTZ,
-        });
-    }
-    let max = janus2d_core::limits::MAX_DAMPING_RATIO;
-    if damping_ratio > max {
-        return Err(WorldError::OutOfBounds {
-            field: "damping_ratio",
-            min: 0.0,
-            max,
-        });
-    }
-    Ok(())
+    Ok(janus2d_constraints::check_spring(hertz, damping_ratio)?)
 }

@@ -29,7 +29,6 @@ impl World {
     /// ```
     pub fn create_joint(&mut self, def: &JointDef) -> Result<JointHandle, WorldError> {
         def.validate()?;
-        crate::joints::check_joint_limits(def)?;
         let (a, b) = def.bodies();
         self.check_body(a)?;
         self.check_body(b)?;
