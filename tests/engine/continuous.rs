@@ -8,7 +8,7 @@ use janus2d_testbed::benchmarks::spinner;
 use janus2d_testbed::janus::Janus;
 use janus2d_testbed::run::Sanity;
 
-#[path = "../examples/bullet.rs"]
+#[path = "../../examples/bullet.rs"]
 #[allow(dead_code)]
 mod bullet;
 

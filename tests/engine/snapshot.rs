@@ -199,7 +199,7 @@ mod bytes {
     /// child's state hash equals this process's continuation.
     #[test]
     fn snapshot_bytes_continue_bit_exactly_in_a_fresh_process() {
-        const NAME: &str = "bytes::snapshot_bytes_continue_bit_exactly_in_a_fresh_process";
+        const NAME: &str = "snapshot::bytes::snapshot_bytes_continue_bit_exactly_in_a_fresh_process";
         if let Ok(path) = std::env::var("JANUS_SNAPSHOT_CHILD") {
             let bytes = std::fs::read(&path).unwrap();
             let mut world = Snapshot::from_bytes(&bytes).unwrap().to_world();

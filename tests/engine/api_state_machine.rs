@@ -11,7 +11,6 @@
 //! ```text
 //! JANUS_STATE_MACHINE_CASES=5000 cargo test --release --test api_state_machine
 //! ```
-#![cfg(feature = "portals")]
 
 use janus2d::prelude::*;
 use janus2d::world::{PortalDef, PortalPairDef, PortalPairHandle, SleepSettings};

@@ -3,7 +3,7 @@
 //! one breaks both and the sign falls.
 
 #[allow(dead_code)]
-#[path = "../examples/breakable_joint.rs"]
+#[path = "../../examples/breakable_joint.rs"]
 mod breakable_joint;
 
 use breakable_joint::{BREAK_FORCE, run};

@@ -9,7 +9,6 @@
 //! 100 m/s, entry points across the feasible width) runs with
 //! `cargo test --release --test portal_grazing -- --ignored`.
 //! Set `JANUS2D_REPORT=1` to print the worst errors.
-#![cfg(feature = "portals")]
 
 use janus2d::prelude::*;
 use janus2d::world::{PortalDef, PortalEvent, PortalPairDef};
@@ -164,7 +163,7 @@ fn grazing_entries_full_grid() {
 }
 
 #[allow(dead_code)]
-#[path = "../examples/portal_grazing.rs"]
+#[path = "../../examples/portal_grazing.rs"]
 mod portal_grazing;
 
 /// The grazing example: through within a few steps, out within 1% of the
