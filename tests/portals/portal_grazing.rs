@@ -7,7 +7,7 @@
 //!
 //! The CI grid is small; the full grid (angles 10° to 80°, speeds 5 to
 //! 100 m/s, entry points across the feasible width) runs with
-//! `cargo test --release --test portal_grazing -- --ignored`.
+//! `cargo test --release --test portals -- --ignored portal_grazing::`.
 //! Set `JANUS2D_REPORT=1` to print the worst errors.
 
 use janus2d::prelude::*;
@@ -151,7 +151,7 @@ fn grazing_fast_entries_cross_at_their_speed_and_mapped_direction() {
 }
 
 /// The full grid. Run with
-/// `cargo test --release --test portal_grazing -- --ignored`.
+/// `cargo test --release --test portals -- --ignored portal_grazing::`.
 #[test]
 #[ignore]
 fn grazing_entries_full_grid() {
