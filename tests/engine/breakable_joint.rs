@@ -2,7 +2,8 @@
 //! sign's weight while it hangs, a light ball leaves them whole, a heavy
 //! one breaks both and the sign falls.
 
-#[allow(dead_code)]
+// The example keeps its name inside this module of the same name.
+#[allow(dead_code, clippy::module_inception)]
 #[path = "../../examples/breakable_joint.rs"]
 mod breakable_joint;
 

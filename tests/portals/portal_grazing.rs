@@ -162,7 +162,8 @@ fn grazing_entries_full_grid() {
     );
 }
 
-#[allow(dead_code)]
+// The example keeps its name inside this module of the same name.
+#[allow(dead_code, clippy::module_inception)]
 #[path = "../../examples/portal_grazing.rs"]
 mod portal_grazing;
 
