@@ -14,7 +14,7 @@ use janus2d_testbed::{hard, scenes};
 
 const DT: Real = 1.0 / 60.0;
 
-/// The three hinged chains of `tests/scenes/determinism.rs`.
+/// The three hinged chains of `tests/scene_runs/determinism.rs`.
 fn chains() -> World {
     janus2d_testbed::support::hinged_chains()
 }
