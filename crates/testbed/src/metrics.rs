@@ -565,8 +565,8 @@ pub fn free_fall_energy_loss(mass: f64, gravity: f64, h: f64, substeps: u64) -> 
 }
 
 /// The hard scenes of the scene definitions (`janus2d_testbed`) that the accuracy sweep
-/// runs, each built exactly as `tests/hard_cases.rs` and
-/// `tests/joint_scenes.rs` build them, with the probe and tracker settings
+/// runs, each built exactly as `tests/scene_runs/hard_cases.rs` and
+/// `tests/scene_runs/joint_scenes.rs` build them, with the probe and tracker settings
 /// that measure them.
 pub mod cases {
     use janus2d_core::body::BodyHandle;
@@ -661,7 +661,7 @@ pub mod cases {
     /// The vertical stack of `rows` 1 m boxes (0.1 m gaps, x alternating
     /// ±0.01, μ 0.3) on a ground box, run for `seconds`. Probe: the top box;
     /// collapse: its origin more than 0.5 m from (0, rest height) after a 2 s
-    /// grace, as in `tests/hard_cases.rs`.
+    /// grace, as in `tests/scene_runs/hard_cases.rs`.
     pub fn vertical_stack(def: &WorldDef, rows: usize, seconds: usize) -> Case {
         let scene = scenes::vertical_stack(def, rows);
         let steps = seconds * 60;

@@ -1,5 +1,5 @@
 //! Jointed bodies through portals: the rope and ragdoll scenes of
-//! `tests/portal_joints.rs` and `examples/portal_rope.rs`, and the joint
+//! `tests/portals/portal_joints.rs` and `examples/portal_rope.rs`, and the joint
 //! gap measured through the portal map.
 //!
 //! ```text

@@ -578,7 +578,7 @@ pub fn portal_def(
 
 /// The determinism scene: three chains of 12 hinged bodies from a static
 /// ground, one with joint limits, one with springs, one with motors
-/// (`tests/determinism.rs` pins its state hash after 500 steps; the
+/// (`tests/scene_runs/determinism.rs` pins its state hash after 500 steps; the
 /// snapshot tests continue it from a copy).
 #[must_use]
 pub fn hinged_chains() -> janus2d_world::World {

@@ -77,7 +77,7 @@ pub const F_MIN: Real = 0.1;
 /// to another body (dimensionless, 0.5; when both copies carry one, each
 /// keeps half). The joint's load reaches the other copy through the portal
 /// rows, and those move a light copy away from what it is jointed to: with
-/// [`F_MIN`] the rope of `tests/portal_joints.rs` opened 6.2 mm (η = 1) and
+/// [`F_MIN`] the rope of `tests/portals/portal_joints.rs` opened 6.2 mm (η = 1) and
 /// 24 mm (η = 2) across the portal, with this floor 1.4 and 13 mm (and
 /// with the coupled passes of the joint and portal solves 0.8 and 7.7 mm).
 pub const F_JOINTED: Real = 0.5;

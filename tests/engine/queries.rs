@@ -5,7 +5,7 @@ use janus2d::base::geometry::Aabb;
 use janus2d::prelude::*;
 use janus2d::world::query::QueryProblem;
 
-#[path = "../examples/picking.rs"]
+#[path = "../../examples/picking.rs"]
 #[allow(dead_code)]
 mod picking;
 

@@ -1,6 +1,5 @@
 //! The portal scenes of the scene definitions (`janus2d_testbed`), each with its bound.
 //! Set `JANUS2D_REPORT=1` to print the measured figures.
-#![cfg(feature = "portals")]
 
 use janus2d::prelude::*;
 use janus2d::world::{MassModel, PortalEvent, PortalPairDef};

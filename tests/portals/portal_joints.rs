@@ -4,7 +4,6 @@
 //! measured through the portal map
 //! (`janus2d_testbed::portal_joints::gap_through_map`). Set
 //! `JANUS2D_REPORT=1` to print the figures.
-#![cfg(feature = "portals")]
 
 use janus2d::prelude::*;
 use janus2d::world::{PortalEvent, PortalPairHandle};
@@ -263,7 +262,7 @@ fn destroying_the_pair_under_a_crossing_rope_disables_only_what_cannot_follow() 
 }
 
 #[allow(dead_code)]
-#[path = "../examples/portal_rope.rs"]
+#[path = "../../examples/portal_rope.rs"]
 mod portal_rope;
 
 /// The rope example: with η = 1 and η = 2 all 20 links go through, no

@@ -1,6 +1,5 @@
 //! Portal edge cases and the portal API: the accepted range of η, crossings
 //! that always end, the pair's current map and which side a body is on.
-#![cfg(feature = "portals")]
 
 use janus2d::constraints::PortalError;
 use janus2d::prelude::*;

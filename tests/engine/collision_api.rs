@@ -288,7 +288,7 @@ fn hit_events_report_the_approach_speed_of_a_hard_landing_only() {
 }
 
 #[allow(dead_code)]
-#[path = "../examples/one_way_platform.rs"]
+#[path = "../../examples/one_way_platform.rs"]
 mod one_way_platform;
 
 /// The one-way platform example: the box passes up through the platform

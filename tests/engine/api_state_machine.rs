@@ -9,9 +9,8 @@
 //! starting worlds (a ground box, the portal drop, a small pyramid). A longer run:
 //!
 //! ```text
-//! JANUS_STATE_MACHINE_CASES=5000 cargo test --release --test api_state_machine
+//! JANUS_STATE_MACHINE_CASES=5000 cargo test --release --test engine api_state_machine
 //! ```
-#![cfg(feature = "portals")]
 
 use janus2d::prelude::*;
 use janus2d::world::{PortalDef, PortalPairDef, PortalPairHandle, SleepSettings};

@@ -322,7 +322,7 @@ fn joint_grid_40_peak_gap() {
 /// case's bounded figures and whether it passes, and asserts that nothing
 /// goes non-finite. A report, not a bound (the bounds are for 4 substeps);
 /// minutes of work, so ignored: run it with
-/// `cargo test --test hard_cases -- --ignored --nocapture hard_cases_by_substeps`
+/// `cargo test --test scene_runs -- --ignored --nocapture hard_cases_by_substeps`
 /// (`JANUS2D_CASES=a,b` picks cases, `JANUS2D_SUBSTEPS=1,2` substep counts).
 #[test]
 #[ignore = "report: every hard case at 1, 2, 4, 8 substeps (minutes)"]
@@ -382,7 +382,7 @@ fn hard_cases_by_substeps() {
 
 /// The mass-ratio cases at ratios 10 to 1e5 (`RATIOS=a,b` picks): prints each
 /// figure and whether it passes (the bounds are for 1000:1, see the tests
-/// below). Ignored: `cargo test --test hard_cases -- --ignored --nocapture
+/// below). Ignored: `cargo test --test scene_runs -- --ignored --nocapture
 /// mass_ratio_sweep`.
 #[test]
 #[ignore = "report: mass-ratio cases over ratios 10 to 1e5"]

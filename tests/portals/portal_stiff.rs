@@ -1,7 +1,6 @@
 //! Stiff portal rows: the portal constraint holds |C| = |x₂ − T(x₁)| to
 //! 1 mm while contacts push either copy hard, and a blocked body does not
 //! creep sideways. Set `JANUS2D_REPORT=1` to print |C| under each load.
-#![cfg(feature = "portals")]
 
 use janus2d::prelude::*;
 use janus2d::world::PortalPairDef;

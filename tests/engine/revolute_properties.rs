@@ -126,7 +126,7 @@ const FD_STEP: Real = 1.0e-5;
 const FD_STEP: Real = 5.0e-3;
 
 /// `(8 eps / ε + 4 ε²) M`: rounding over the step plus truncation (see
-/// `portal_properties.rs`).
+/// `tests/portals/portal_properties.rs`).
 fn fd_tolerance(c_mag: f64) -> f64 {
     let step = d(FD_STEP);
     (8.0 * EPS / step + 4.0 * step * step) * c_mag

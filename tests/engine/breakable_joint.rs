@@ -2,8 +2,9 @@
 //! sign's weight while it hangs, a light ball leaves them whole, a heavy
 //! one breaks both and the sign falls.
 
-#[allow(dead_code)]
-#[path = "../examples/breakable_joint.rs"]
+// The example keeps its name inside this module of the same name.
+#[allow(dead_code, clippy::module_inception)]
+#[path = "../../examples/breakable_joint.rs"]
 mod breakable_joint;
 
 use breakable_joint::{BREAK_FORCE, run};

@@ -2,7 +2,6 @@
 //! solid parts. A plank across an aperture rests, a box on the strip
 //! between two close apertures rests, a box whose footprint is within the
 //! aperture enters. Set `JANUS2D_REPORT=1` to print the figures.
-#![cfg(feature = "portals")]
 
 use janus2d::base::geometry::LINEAR_SLOP;
 use janus2d::prelude::*;
@@ -279,7 +278,7 @@ fn body_at_two_portals_is_held_by_the_second_wall() {
 }
 
 #[allow(dead_code)]
-#[path = "../examples/portal_plank.rs"]
+#[path = "../../examples/portal_plank.rs"]
 mod portal_plank;
 
 /// The plank example: the plank rests within the slop, level, never

@@ -6,7 +6,7 @@
 //! check (1,000 steps after it, every hard case):
 //!
 //! ```text
-//! cargo test --release --test snapshot -- --ignored
+//! cargo test --release --test engine -- --ignored snapshot::
 //! ```
 
 use janus2d::prelude::*;
@@ -14,7 +14,7 @@ use janus2d_testbed::{hard, scenes};
 
 const DT: Real = 1.0 / 60.0;
 
-/// The three hinged chains of `tests/determinism.rs`.
+/// The three hinged chains of `tests/scene_runs/determinism.rs`.
 fn chains() -> World {
     janus2d_testbed::support::hinged_chains()
 }
@@ -98,7 +98,7 @@ fn restored_snapshot_continues_bit_exactly_on_the_small_hard_cases() {
 /// The full run: 1,000 steps after the snapshot on every determinism scene
 /// and every hard case (minutes in release).
 #[test]
-#[ignore = "long: cargo test --release --test snapshot -- --ignored"]
+#[ignore = "long: cargo test --release --test engine -- --ignored snapshot::"]
 fn restored_snapshot_continues_bit_exactly_for_1000_steps_everywhere() {
     let def = scenes::shared_settings();
     continues_bit_exactly("chains", chains(), 100, 1000);
@@ -199,7 +199,8 @@ mod bytes {
     /// child's state hash equals this process's continuation.
     #[test]
     fn snapshot_bytes_continue_bit_exactly_in_a_fresh_process() {
-        const NAME: &str = "bytes::snapshot_bytes_continue_bit_exactly_in_a_fresh_process";
+        const NAME: &str =
+            "snapshot::bytes::snapshot_bytes_continue_bit_exactly_in_a_fresh_process";
         if let Ok(path) = std::env::var("JANUS_SNAPSHOT_CHILD") {
             let bytes = std::fs::read(&path).unwrap();
             let mut world = Snapshot::from_bytes(&bytes).unwrap().to_world();

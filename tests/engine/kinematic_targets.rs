@@ -4,7 +4,7 @@
 
 use janus2d::prelude::*;
 
-#[path = "../examples/moving_platform.rs"]
+#[path = "../../examples/moving_platform.rs"]
 #[allow(dead_code)]
 mod moving_platform;
 

@@ -8,7 +8,7 @@ use janus2d_testbed::benchmarks::spinner;
 use janus2d_testbed::janus::Janus;
 use janus2d_testbed::run::Sanity;
 
-#[path = "../examples/bullet.rs"]
+#[path = "../../examples/bullet.rs"]
 #[allow(dead_code)]
 mod bullet;
 
@@ -262,7 +262,7 @@ fn spinner_loop_holds_flung_bodies_for_60_steps() {
 /// pressed through the loop's concave vertices; none since a chain segment
 /// that rejects a deep polygon's axis still holds it along its own face).
 /// About 10 s in the (optimised) test profile: CI runs it in the f32 run;
-/// with `f64` run it with `cargo test --features f64 --test continuous --
+/// with `f64` run it with `cargo test --features f64 --test engine continuous:: --
 /// --ignored`.
 #[test]
 #[cfg_attr(

@@ -1,0 +1,23 @@
+//! The engine and its API: bodies, shapes, joints, contacts, queries,
+//! continuous collision, snapshots and the step's stages, one module per
+//! former test file. One binary instead of one per file: each integration
+//! test binary links the engine and the testbed again.
+
+#[cfg(feature = "portals")]
+mod api_state_machine;
+mod bad_input;
+mod breakable_joint;
+mod collision_api;
+mod contact_data;
+mod contact_properties;
+mod continuous;
+mod effects;
+mod joint_tree_properties;
+mod kinematic_targets;
+mod pendulum;
+mod queries;
+mod reliability;
+mod revolute_properties;
+mod setters;
+mod snapshot;
+mod stages;

@@ -1,0 +1,19 @@
+//! Portals: the portal constraint and its map on their own (properties,
+//! the small simulator) and portals in the world (scenes, apertures,
+//! grazing entries, stiff loads, edge cases, joints through a portal).
+//! The world's portal tests need the `portals` feature.
+
+#[cfg(feature = "portals")]
+mod portal_apertures;
+#[cfg(feature = "portals")]
+mod portal_edges;
+#[cfg(feature = "portals")]
+mod portal_grazing;
+#[cfg(feature = "portals")]
+mod portal_joints;
+mod portal_properties;
+#[cfg(feature = "portals")]
+mod portal_scenes;
+mod portal_sim;
+#[cfg(feature = "portals")]
+mod portal_stiff;
