@@ -42,6 +42,7 @@ pub mod profile;
 pub mod query;
 pub mod shapes;
 pub mod snapshot;
+mod stores;
 pub mod validate;
 pub mod world;
 
