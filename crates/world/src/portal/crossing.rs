@@ -60,6 +60,9 @@ pub(crate) enum Decision {
 /// world (`Stores::apply`, in `world/internal.rs`), which applies it at
 /// once: the stage reads the stores again before its next command, so
 /// the order of operations is the stage's.
+// A command is applied as soon as it is made, never stored: the size of
+// the shape variant (large with `f64`) costs nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) enum PortalCommand {
     /// Wake the island of a body.
