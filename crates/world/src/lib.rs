@@ -50,6 +50,7 @@ pub mod query;
 mod serde_maps;
 pub(crate) mod shapes;
 pub(crate) mod snapshot;
+mod stores;
 pub(crate) mod validate;
 pub mod world;
 

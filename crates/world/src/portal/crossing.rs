@@ -1,6 +1,8 @@
 //! The crossing stage's decisions: what happens to each crossing in
 //! progress and which bodies begin one, read from the bodies, the shapes
-//! and the broadphase, and returned as commands the world applies.
+//! and the broadphase, and returned as [`Decision`]s the stage carries out
+//! (`PortalStage::cross`); and the [`PortalCommand`]s by which it asks
+//! the world for each change of structure on the way.
 //!
 //! ```text
 //! review (crossings in progress, in order)
@@ -15,22 +17,24 @@
 //! ```
 //!
 //! Neither pass changes anything: the poses they read do not change while
-//! the world applies the commands (only masses, velocities and which
-//! bodies exist do), so applying them in order gives the same result as
-//! deciding each one just before it is applied.
+//! the stage carries the decisions out (only masses, velocities and which
+//! bodies exist do), so carrying them out in order gives the same result
+//! as deciding each one just before it is carried out.
 
 use janus2d_constraints::portal_map::PortalFrame;
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
-use janus2d_core::geometry::Aabb;
-use janus2d_core::math::{Real, cross};
+use janus2d_core::geometry::{Aabb, Shape};
+use janus2d_core::math::{Real, Vec2, cross};
 
 use super::stage::{PairData, PortalStage};
 use crate::broadphase::BroadPhase;
-use crate::shapes::{ShapeHandle, ShapeStore};
+use crate::joints::JointHandle;
+use crate::shapes::{ShapeDef, ShapeHandle, ShapeStore};
 
-/// What the world does for the crossing stage, in order.
+/// What the crossing stage does with a crossing in progress or a body at
+/// an aperture (the stage carries each out, in order).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum PortalCommand {
+pub(crate) enum Decision {
     /// The original went through: its handle moves to the clone's body.
     Complete(BodyHandle),
     /// The body backed out: its clone is removed.
@@ -52,9 +56,52 @@ pub(crate) enum PortalCommand {
     },
 }
 
+/// A change to the world's structure that the portal stage asks of the
+/// world (`Stores::apply`, in `world/internal.rs`), which applies it at
+/// once: the stage reads the stores again before its next command, so
+/// the order of operations is the stage's.
+// A command is applied as soon as it is made, never stored: the size of
+// the shape variant (large with `f64`) costs nothing.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum PortalCommand {
+    /// Wake the island of a body.
+    Wake(BodyHandle),
+    /// Attach a shape known to be valid (a clone's scaled copy of the
+    /// original's); the body's mass is left as it is.
+    AddShape {
+        /// The body.
+        body: BodyHandle,
+        /// Material, filter and flags.
+        def: ShapeDef,
+        /// The geometry in the body's frame.
+        geometry: Shape,
+    },
+    /// Set a body's mass from its shapes.
+    MassFromShapes(BodyHandle),
+    /// Disable a live joint (the solver skips it; it stays until destroyed).
+    DisableJoint(JointHandle),
+    /// Move one end of a joint from `from` to `to`, with local anchor
+    /// `anchor` in `to`'s frame.
+    RepointJoint {
+        /// The joint.
+        joint: JointHandle,
+        /// The body its end leaves.
+        from: BodyHandle,
+        /// The body its end moves to.
+        to: BodyHandle,
+        /// The new local anchor on `to`.
+        anchor: Vec2,
+    },
+    /// Exchange two bodies' identities (handles, shapes, islands).
+    SwapIdentity(BodyHandle, BodyHandle),
+    /// Destroy a live body, its shapes and joints.
+    DestroyBody(BodyHandle),
+}
+
 impl PortalStage {
     /// Decides what happens to each crossing in progress.
-    pub(crate) fn review(&self, bodies: &BodySet, shapes: &ShapeStore) -> Vec<PortalCommand> {
+    pub(crate) fn review(&self, bodies: &BodySet, shapes: &ShapeStore) -> Vec<Decision> {
         let mut out = Vec::with_capacity(self.crossings.len());
         for c in &self.crossings {
             let d = self.pairs.at(c.pair).expect("live pair");
@@ -67,13 +114,13 @@ impl PortalStage {
             let changed = shape_handles(shapes, c.original, owner) != c.original_shapes
                 || shape_handles(shapes, c.clone, owner) != c.clone_shapes;
             out.push(if changed {
-                PortalCommand::Restart(c.original)
+                Decision::Restart(c.original)
             } else if behind(c.original, &f_entry) {
-                PortalCommand::Complete(c.original)
+                Decision::Complete(c.original)
             } else if behind(c.clone, &f_exit) {
-                PortalCommand::Cancel(c.original)
+                Decision::Cancel(c.original)
             } else {
-                PortalCommand::Weigh(c.original)
+                Decision::Weigh(c.original)
             });
         }
         out
@@ -87,7 +134,7 @@ impl PortalStage {
         shapes: &ShapeStore,
         broadphase: &BroadPhase,
         crossed: &[BodyHandle],
-    ) -> (Vec<PortalCommand>, usize) {
+    ) -> (Vec<Decision>, usize) {
         let mut out = Vec::new();
         let mut planned: Vec<BodyHandle> = Vec::new();
         let mut tested = 0;
@@ -119,7 +166,7 @@ impl PortalStage {
                     };
                     if straddles || swept {
                         planned.push(body);
-                        out.push(PortalCommand::Start {
+                        out.push(Decision::Start {
                             pair: index,
                             entry,
                             body,

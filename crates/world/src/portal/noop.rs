@@ -1,12 +1,13 @@
 //! The portal stage without the `portals` feature: it holds nothing and
 //! each of its step calls returns at once, so a world built without portals
-//! pays for none of them.
+//! pays for none of them. Its interface is the stage's: the same verbs
+//! over the same stores.
 
 use janus2d_constraints::{ObjectMass, PortalConstraint};
 use janus2d_core::body::{BodyHandle, BodySet};
 
 use super::clipping::{ContactClipping, NO_CLIPPING};
-use crate::world::World;
+use crate::stores::Stores;
 
 /// The no-op portal stage.
 #[derive(Clone, Debug, Default)]
@@ -58,12 +59,8 @@ impl PortalStage {
     ) -> Vec<crate::query::QueryAperture> {
         Vec::new()
     }
-}
-
-impl World {
     /// Nothing crosses without portals.
-    pub(crate) fn portal_crossings(&mut self) {}
-
+    pub(crate) fn cross(&mut self, _stores: &mut Stores<'_>) {}
     /// No crossing or pair to end.
-    pub(crate) fn portal_forget_body(&mut self, _body: BodyHandle) {}
+    pub(crate) fn forget_body(&mut self, _body: BodyHandle, _stores: &mut Stores<'_>) {}
 }

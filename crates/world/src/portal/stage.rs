@@ -52,20 +52,33 @@
 //! [`ETA_MAX`](janus2d_constraints::portal_map::ETA_MAX).
 //!
 //! The whole stage is skipped when the world has no portal pair.
+//!
+//! What is here: the stage's types and state; the logic of the public
+//! portal API (create, destroy and read pairs; the methods themselves are
+//! on `World`, in `world/portals.rs`, and pass the stores each needs); and
+//! the crossing stage, [`PortalStage::cross`], which the step calls over
+//! the `Stores` (and [`PortalStage::forget_body`], which destroying a body
+//! calls). The crossing stage carries out the decisions of `crossing.rs`
+//! in order: it writes masses, velocities (with the momentum exchanged
+//! with a dynamic portal body) and joint impulses in place, and asks for
+//! each change of structure by a `PortalCommand` that the world applies
+//! at once (`Stores::apply`), so that every step reads the stores as the
+//! one before it left them.
 
 use janus2d_constraints::portal_map::{BodyMotion, PortalBodyMotion, PortalFrame, PortalMap};
 use janus2d_constraints::{ObjectMass, Portal, PortalConstraint, PortalConstraintDef};
 use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
-use janus2d_core::math::{Real, Rot, Vec2};
+use janus2d_core::math::{Real, Rot, Vec2, cross};
 use janus2d_core::slots::Slots;
 
 use super::clipping::{ApertureClip, ContactClipping};
-use super::crossing::{PortalCommand, extents_in, front_fraction, shape_handles};
+use super::crossing::{Decision, PortalCommand, extents_in, front_fraction, shape_handles};
+use crate::collision::Collision;
 use crate::error::WorldError;
-use crate::joints::JointHandle;
-use crate::shapes::ShapeHandle;
-use crate::world::World;
-use janus2d_core::body::BodySet;
+use crate::joints::{JointHandle, JointSet};
+use crate::shapes::{ShapeHandle, ShapeStore};
+use crate::stores::Stores;
+use janus2d_core::body::{BodyLocation, BodySet};
 use janus2d_core::handle::{Handle, PortalPairTag};
 
 /// Smallest mass fraction a straddling copy keeps (dimensionless, usual
@@ -175,7 +188,7 @@ impl PortalPairDef {
     }
 
     /// The same pair with scale `eta` from a to b (instead of `w_b / w_a`);
-    /// checked by [`World::create_portal_pair`] (finite, within
+    /// checked by [`World::create_portal_pair`](crate::World::create_portal_pair) (finite, within
     /// [`ETA_MIN`](janus2d_constraints::portal_map::ETA_MIN) to
     /// [`ETA_MAX`](janus2d_constraints::portal_map::ETA_MAX)).
     #[must_use]
@@ -222,7 +235,7 @@ pub enum CrossingRole {
     },
 }
 
-/// Where a body is against a portal pair (see [`World::portal_side`]).
+/// Where a body is against a portal pair (see [`World::portal_side`](crate::World::portal_side)).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PortalSide {
     /// Against portal a's plane.
@@ -580,12 +593,8 @@ fn frame_in(bodies: &BodySet, def: &PortalDef, local: &Portal) -> PortalFrame {
     PortalFrame::new(&bodies.solver_body(def.body).sim.transform, local)
 }
 
-fn frame_of(world: &World, def: &PortalDef, local: &Portal) -> PortalFrame {
-    frame_in(world.bodies(), def, local)
-}
-
-fn motion_of(world: &World, body: BodyHandle) -> PortalBodyMotion {
-    let b = world.bodies().solver_body(body);
+fn motion_in(bodies: &BodySet, body: BodyHandle) -> PortalBodyMotion {
+    let b = bodies.solver_body(body);
     PortalBodyMotion {
         center: b.sim.center,
         linear_velocity: b.state.v,
@@ -593,21 +602,66 @@ fn motion_of(world: &World, body: BodyHandle) -> PortalBodyMotion {
     }
 }
 
-impl World {
-    /// Creates a linked pair of portals.
-    ///
-    /// Rejects stale body handles, non-finite values, a zero direction, a
-    /// non-positive half-width, `η ≤ 0` and an `η` outside
-    /// [`ETA_RANGE`](janus2d_core::limits::ETA_RANGE); a body that is
-    /// crossing a portal ([`WorldError::PortalBody`]).
-    pub fn create_portal_pair(
+/// The enabled joints attached to a body, in the body's list order.
+fn joints_attached_to(joints: &JointSet, body: BodyHandle) -> Vec<JointHandle> {
+    joints
+        .of_body(body)
+        .iter()
+        .copied()
+        .filter(|h| joints.get(*h).is_ok_and(|j| j.is_enabled()))
+        .collect()
+}
+
+/// Sets a dynamic body's mass properties without touching its velocity.
+fn apply_mass_keep_velocity(bodies: &mut BodySet, body: BodyHandle, mass: BodyMass) {
+    let fixed = bodies
+        .record(body)
+        .map(|r| r.fixed_rotation)
+        .unwrap_or(false);
+    bodies.apply_mass(body, mass, fixed);
+}
+
+/// Wakes a body and sets its velocity (no checks).
+fn set_velocity(stores: &mut Stores<'_>, body: BodyHandle, v: Vec2, w: Real) {
+    stores.apply(PortalCommand::Wake(body));
+    if let Some(s) = stores.bodies.state_mut(body) {
+        s.v = v;
+        s.w = w;
+    }
+}
+
+/// Wakes a body and adds an impulse at a world point to it when it is
+/// dynamic (no checks).
+fn push_body(stores: &mut Stores<'_>, body: BodyHandle, impulse: Vec2, point: Vec2, angular: Real) {
+    stores.apply(PortalCommand::Wake(body));
+    if let Some(BodyLocation::Moving(i)) = stores.bodies.location(body) {
+        let sim = &stores.bodies.sims[i as usize];
+        if sim.body_type == BodyType::Dynamic {
+            let (im, ii, c) = (sim.inv_mass, sim.inv_inertia, sim.center);
+            let st = &mut stores.bodies.states[i as usize];
+            st.v += im * impulse;
+            st.w += ii * cross(point - c, impulse);
+            st.w += ii * angular;
+        }
+    }
+}
+
+/// The pair API's logic: the world's portal methods (`world/portals.rs`)
+/// pass what each reads and changes.
+impl PortalStage {
+    /// Creates a linked pair of portals on live bodies of `bodies`; see
+    /// `World::create_portal_pair` for what is rejected. Turns the
+    /// collision stage's uniform margins on.
+    pub(crate) fn create_pair(
         &mut self,
         def: &PortalPairDef,
+        bodies: &BodySet,
+        collision: &mut Collision,
     ) -> Result<PortalPairHandle, WorldError> {
         let mut local = Vec::with_capacity(2);
         for p in [def.portal_a, def.portal_b] {
-            if !self.bodies().contains(p.body) {
-                return Err(if p.body.owner == self.bodies().owner() {
+            if !bodies.contains(p.body) {
+                return Err(if p.body.owner == bodies.owner() {
                     WorldError::StaleBody
                 } else {
                     WorldError::ForeignHandle
@@ -615,7 +669,7 @@ impl World {
             }
             // A copy in a crossing may be destroyed by the stage at any
             // step: it cannot carry a portal.
-            if self.portals.crossing_of(p.body).is_some() {
+            if self.crossing_of(p.body).is_some() {
                 return Err(WorldError::PortalBody);
             }
             local.push(
@@ -643,107 +697,82 @@ impl World {
         };
         // Portals keep every shape's fat box at the full margin (see
         // `Collision::use_uniform_margins`).
-        self.collision.use_uniform_margins();
-        let (index, generation) = self.portals.pairs.insert(data);
-        Ok(PortalPairHandle::new(
-            index,
-            generation,
-            self.bodies().owner(),
-        ))
+        collision.use_uniform_margins();
+        let (index, generation) = self.pairs.insert(data);
+        Ok(PortalPairHandle::new(index, generation, bodies.owner()))
     }
 
-    fn pair_slot(&self, pair: PortalPairHandle) -> Result<u32, WorldError> {
-        self.portals
-            .pairs
-            .resolve(pair, self.bodies().owner())
+    /// The slot of a live pair of the world `owner` (`StalePortal` or
+    /// `ForeignHandle` otherwise).
+    pub(crate) fn pair_slot(&self, pair: PortalPairHandle, owner: u32) -> Result<u32, WorldError> {
+        self.pairs
+            .resolve(pair, owner)
             .map(|_| pair.index)
             .map_err(|e| WorldError::of_handle(e, WorldError::StalePortal))
     }
 
-    fn pair_handle(&self, index: u32) -> PortalPairHandle {
-        self.portals.pairs.handle(index, self.bodies().owner())
+    fn pair_handle(&self, index: u32, owner: u32) -> PortalPairHandle {
+        self.pairs.handle(index, owner)
     }
 
-    /// Destroys a portal pair, cancelling every crossing in progress through it.
-    pub fn destroy_portal_pair(&mut self, pair: PortalPairHandle) -> Result<(), WorldError> {
-        let index = self.pair_slot(pair)?;
-        self.remove_pair(index);
+    /// Destroys a portal pair, cancelling every crossing in progress
+    /// through it.
+    pub(crate) fn destroy_pair(
+        &mut self,
+        pair: PortalPairHandle,
+        stores: &mut Stores<'_>,
+    ) -> Result<(), WorldError> {
+        let index = self.pair_slot(pair, stores.bodies.owner())?;
+        self.remove_pair(index, stores);
         Ok(())
     }
 
     /// Removes live pair `index`, cancelling its crossings.
-    fn remove_pair(&mut self, index: u32) {
-        while let Some(k) = self.portals.crossings.iter().position(|c| c.pair == index) {
-            self.cancel_crossing(k);
+    fn remove_pair(&mut self, index: u32, stores: &mut Stores<'_>) {
+        while let Some(k) = self.crossings.iter().position(|c| c.pair == index) {
+            self.cancel_crossing(k, stores);
         }
-        let generation = self.portals.pairs.generation(index);
-        self.portals.pairs.remove(index, generation);
-    }
-
-    /// Number of live portal pairs.
-    pub fn portal_pair_count(&self) -> usize {
-        self.portals.pairs.len()
-    }
-
-    /// Number of crossings in progress (each has one clone and one constraint).
-    pub fn crossing_count(&self) -> usize {
-        self.portals.crossings.len()
-    }
-
-    /// Portal events of the last step.
-    pub fn portal_events(&self) -> &[PortalEvent] {
-        &self.portals.events
-    }
-
-    /// Portal counters of the last step.
-    pub fn portal_counters(&self) -> PortalCounters {
-        self.portals.counters
-    }
-
-    /// The portal constraints of the crossings in progress.
-    pub fn portal_constraints(&self) -> &[PortalConstraint] {
-        &self.portals.constraints
+        let generation = self.pairs.generation(index);
+        self.pairs.remove(index, generation);
     }
 
     /// The pair's map from portal a to portal b at the portal bodies'
-    /// present poses: `T(x) = P_b + η Q (x − P_a)` ([`PortalMap::map_point`]),
-    /// `Q` ([`PortalMap::rotation`]) and `η`. Its
-    /// [`inverse`](PortalMap::inverse) maps b to a.
-    pub fn portal_map(&self, pair: PortalPairHandle) -> Result<PortalMap, WorldError> {
-        let index = self.pair_slot(pair)?;
-        let d = self.portals.pairs.at(index).expect("live pair");
+    /// present poses.
+    pub(crate) fn map(
+        &self,
+        pair: PortalPairHandle,
+        bodies: &BodySet,
+    ) -> Result<PortalMap, WorldError> {
+        let index = self.pair_slot(pair, bodies.owner())?;
+        let d = self.pairs.at(index).expect("live pair");
         Ok(PortalMap {
-            frame1: frame_of(self, &d.portals[0], &d.local[0]),
-            frame2: frame_of(self, &d.portals[1], &d.local[1]),
+            frame1: frame_in(bodies, &d.portals[0], &d.local[0]),
+            frame2: frame_in(bodies, &d.portals[1], &d.local[1]),
             eta: d.eta,
         })
     }
 
-    /// Where `body` is against the two portals of `pair` (from its shapes'
-    /// extents; a body without shapes reads as at its centre of mass) and
-    /// its part in a crossing through the pair.
-    ///
-    /// Errors: a stale or foreign body or pair handle.
-    pub fn portal_side(
+    /// Where live `body` is against the two portals of `pair` and its part
+    /// in a crossing through the pair (see `World::portal_side`).
+    pub(crate) fn side(
         &self,
         body: BodyHandle,
         pair: PortalPairHandle,
+        bodies: &BodySet,
+        shapes: &ShapeStore,
     ) -> Result<PortalSide, WorldError> {
-        self.check_body(body)?;
-        let index = self.pair_slot(pair)?;
-        let d = self.portals.pairs.at(index).expect("live pair");
-        let shapes = &self.collision_ref().shapes;
-        let center = self.bodies().sim(body).map_or(Vec2::ZERO, |s| s.center);
+        let index = self.pair_slot(pair, bodies.owner())?;
+        let d = self.pairs.at(index).expect("live pair");
+        let center = bodies.sim(body).map_or(Vec2::ZERO, |s| s.center);
         let mut sides = [PlaneSide::Front; 2];
         let mut within = [false; 2];
         for k in 0..2 {
-            let f = frame_of(self, &d.portals[k], &d.local[k]);
-            let (n0, n1, t0, t1) =
-                extents_in(self.bodies(), shapes, body, &f).unwrap_or_else(|| {
-                    let s = (center - f.point).dot(f.normal);
-                    let t = (center - f.point).dot(f.tangent);
-                    (s, s, t, t)
-                });
+            let f = frame_in(bodies, &d.portals[k], &d.local[k]);
+            let (n0, n1, t0, t1) = extents_in(bodies, shapes, body, &f).unwrap_or_else(|| {
+                let s = (center - f.point).dot(f.normal);
+                let t = (center - f.point).dot(f.tangent);
+                (s, s, t, t)
+            });
             sides[k] = if n0 >= 0.0 {
                 PlaneSide::Front
             } else if n1 <= 0.0 {
@@ -755,7 +784,6 @@ impl World {
             within[k] = t0 >= -w && t1 <= w;
         }
         let crossing = self
-            .portals
             .crossings
             .iter()
             .find(|c| c.pair == index && (c.original == body || c.clone == body))
@@ -774,17 +802,13 @@ impl World {
         })
     }
 
-    /// The current map (T, Q, η) of a crossing's portal constraint, at the
-    /// portal bodies' present poses.
-    pub fn portal_constraint_map(&self, constraint: &PortalConstraint) -> PortalMap {
-        constraint.map(self.bodies())
-    }
-
-    /// Every live portal pair with its definition as the world holds it:
-    /// directions normalised, `eta` set to the pair's scale (read-only,
-    /// for drawing and tools).
-    pub fn portal_pairs(&self) -> impl Iterator<Item = (PortalPairHandle, PortalPairDef)> + '_ {
-        self.portals.pairs.iter().map(|(index, d)| {
+    /// Every live pair with its definition as the stage holds it
+    /// (directions normalised, `eta` set to the pair's scale).
+    pub(crate) fn pair_defs(
+        &self,
+        owner: u32,
+    ) -> impl Iterator<Item = (PortalPairHandle, PortalPairDef)> + '_ {
+        self.pairs.iter().map(move |(index, d)| {
             let def = |k: usize| PortalDef {
                 direction: d.local[k].direction,
                 half_width: d.local[k].half_width,
@@ -796,213 +820,220 @@ impl World {
                 eta: Some(d.eta),
                 mass_model: d.mass_model,
             };
-            (self.pair_handle(index), pair)
+            (self.pair_handle(index, owner), pair)
         })
     }
 
-    /// The aperture clipping the last step's narrowphase applied: the hole
-    /// of each portal and the half-space behind each crossing copy
-    /// (read-only, for drawing).
-    pub fn portal_clipping(&self) -> &ContactClipping {
-        self.portals.clipping()
-    }
-
     /// The clone of `body` while it crosses, if any.
-    pub fn clone_of(&self, body: BodyHandle) -> Option<BodyHandle> {
-        self.portals
-            .crossings
+    pub(crate) fn clone_of(&self, body: BodyHandle) -> Option<BodyHandle> {
+        self.crossings
             .iter()
             .find(|c| c.original == body)
             .map(|c| c.clone)
     }
 
     /// Largest portal constraint error `|x₂ − T(x₁)|` over crossings, m.
-    pub fn max_portal_error(&self) -> Real {
-        self.portals
-            .constraints
+    pub(crate) fn max_error(&self, bodies: &BodySet) -> Real {
+        self.constraints
             .iter()
-            .map(|c| c.position_error(self.bodies()))
+            .map(|c| c.position_error(bodies))
             .fold(0.0, Real::max)
     }
 
     /// Called when a body is about to be destroyed: ends the crossings it
     /// takes part in and destroys the portal pairs it carries.
-    pub(crate) fn portal_forget_body(&mut self, body: BodyHandle) {
+    pub(crate) fn forget_body(&mut self, body: BodyHandle, stores: &mut Stores<'_>) {
         let carried: Vec<u32> = self
-            .portals
             .pairs
             .iter()
             .filter(|(_, d)| d.portals.iter().any(|p| p.body == body))
             .map(|(i, _)| i)
             .collect();
         for index in carried {
-            self.remove_pair(index);
+            self.remove_pair(index, stores);
         }
-        while let Some(k) = self.portals.crossing_of(body) {
-            self.cancel_crossing(k);
+        while let Some(k) = self.crossing_of(body) {
+            self.cancel_crossing(k, stores);
         }
     }
+}
 
-    /// The crossing stage: the stage reviews the crossings in progress and
-    /// finds new entries (reading bodies, shapes and the broadphase); the
-    /// world applies the commands it returns, here and only here.
-    pub(crate) fn portal_crossings(&mut self) {
-        self.portals.events.clear();
+/// The crossing stage: the verb the step calls over the stores, and what
+/// it carries out. Masses, velocities and joint impulses are written in
+/// place; every change of structure is a [`PortalCommand`] the world
+/// applies at once (`Stores::apply`), in the order the stage emits them.
+impl PortalStage {
+    /// The crossing stage: reviews the crossings in progress and finds new
+    /// entries (reading bodies, shapes and the broadphase), then carries
+    /// out each decision in order.
+    pub(crate) fn cross(&mut self, stores: &mut Stores<'_>) {
+        self.events.clear();
         let mut counters = PortalCounters::default();
         let mut crossed: Vec<BodyHandle> = Vec::new();
         // 0. A joint between the two copies of one object would hold it
         // against its own map: disabled, so that the crossing can end.
-        self.unjoin_copies();
+        self.unjoin_copies(stores);
         // 1. Crossings in progress: hand over, cancel, or re-weight.
-        let review = self
-            .portals
-            .review(self.bodies(), &self.collision_ref().shapes);
-        for command in review {
-            self.apply_portal_command(command, &mut counters, &mut crossed);
+        let review = self.review(stores.bodies, &stores.collision.shapes);
+        for decision in review {
+            self.carry_out(decision, stores, &mut counters, &mut crossed);
         }
         // 2. New crossings.
-        let (entries, tested) = {
-            let c = self.collision_ref();
-            self.portals
-                .entries(self.bodies(), &c.shapes, &c.broadphase, &crossed)
-        };
+        let (entries, tested) = self.entries(
+            stores.bodies,
+            &stores.collision.shapes,
+            &stores.collision.broadphase,
+            &crossed,
+        );
         counters.bodies_tested = tested;
-        for command in entries {
-            self.apply_portal_command(command, &mut counters, &mut crossed);
+        for decision in entries {
+            self.carry_out(decision, stores, &mut counters, &mut crossed);
         }
-        counters.active_crossings = self.portals.crossings.len();
-        self.portals.counters = counters;
+        counters.active_crossings = self.crossings.len();
+        self.counters = counters;
     }
 
     /// Disables every enabled joint between a crossing's two copies and
     /// reports it ([`PortalEvent::JointDisabled`]).
-    fn unjoin_copies(&mut self) {
-        for k in 0..self.portals.crossings.len() {
+    fn unjoin_copies(&mut self, stores: &mut Stores<'_>) {
+        for k in 0..self.crossings.len() {
             let (original, clone, index) = {
-                let c = &self.portals.crossings[k];
+                let c = &self.crossings[k];
                 (c.original, c.clone, c.pair)
             };
-            let between: Vec<JointHandle> = self
-                .joints_attached_to(original)
+            let between: Vec<JointHandle> = joints_attached_to(stores.joints, original)
                 .into_iter()
                 .filter(|j| {
-                    self.joints.bodies_of(*j).is_ok_and(|(a, b)| {
+                    stores.joints.bodies_of(*j).is_ok_and(|(a, b)| {
                         (a == original && b == clone) || (a == clone && b == original)
                     })
                 })
                 .collect();
-            let pair = self.pair_handle(index);
+            let pair = self.pair_handle(index, stores.bodies.owner());
             for joint in between {
-                self.disable_joint(joint);
-                self.portals
-                    .events
-                    .push(PortalEvent::JointDisabled { joint, pair });
+                stores.apply(PortalCommand::DisableJoint(joint));
+                self.events.push(PortalEvent::JointDisabled { joint, pair });
             }
         }
     }
 
-    /// Applies one command of the crossing stage.
-    fn apply_portal_command(
+    /// The world frames of crossing `k`'s entry and exit portals.
+    fn crossing_frames(&self, k: usize, bodies: &BodySet) -> (PortalFrame, PortalFrame) {
+        let c = &self.crossings[k];
+        let d = self.pairs.at(c.pair).expect("live pair");
+        (
+            frame_in(bodies, &d.portals[c.entry], &d.local[c.entry]),
+            frame_in(bodies, &d.portals[1 - c.entry], &d.local[1 - c.entry]),
+        )
+    }
+
+    /// Carries out one decision of the crossing stage.
+    fn carry_out(
         &mut self,
-        command: PortalCommand,
+        decision: Decision,
+        stores: &mut Stores<'_>,
         counters: &mut PortalCounters,
         crossed: &mut Vec<BodyHandle>,
     ) {
-        let frames = |w: &World, k: usize| {
-            let c = &w.portals.crossings[k];
-            let d = w.portals.pairs.at(c.pair).expect("live pair");
-            (
-                frame_of(w, &d.portals[c.entry], &d.local[c.entry]),
-                frame_of(w, &d.portals[1 - c.entry], &d.local[1 - c.entry]),
-            )
-        };
-        match command {
-            PortalCommand::Complete(original) => {
-                if let Some(k) = self.portals.crossing_of(original) {
-                    if self.joints_can_follow(k, true) || !self.within_span(k, true) {
-                        self.complete_crossing(k);
+        match decision {
+            Decision::Complete(original) => {
+                if let Some(k) = self.crossing_of(original) {
+                    if self.joints_can_follow(k, true, stores.joints)
+                        || !self.within_span(k, true, stores)
+                    {
+                        self.complete_crossing(k, stores);
                         counters.completed += 1;
                         crossed.push(original);
                     } else {
                         // A joint on the original has no copy of its other
                         // body on the exit side yet: the crossing goes on
                         // (the joint acts through the portal rows).
-                        let (f_entry, f_exit) = frames(self, k);
-                        self.weigh_crossing(k, &f_entry, &f_exit);
+                        let (f_entry, f_exit) = self.crossing_frames(k, stores.bodies);
+                        self.weigh_crossing(k, &f_entry, &f_exit, stores);
                     }
                 }
             }
-            PortalCommand::Cancel(original) => {
-                if let Some(k) = self.portals.crossing_of(original) {
-                    if self.joints_can_follow(k, false) || !self.within_span(k, false) {
-                        self.cancel_crossing(k);
+            Decision::Cancel(original) => {
+                if let Some(k) = self.crossing_of(original) {
+                    if self.joints_can_follow(k, false, stores.joints)
+                        || !self.within_span(k, false, stores)
+                    {
+                        self.cancel_crossing(k, stores);
                         counters.cancelled += 1;
                         crossed.push(original);
                     } else {
-                        let (f_entry, f_exit) = frames(self, k);
-                        self.weigh_crossing(k, &f_entry, &f_exit);
+                        let (f_entry, f_exit) = self.crossing_frames(k, stores.bodies);
+                        self.weigh_crossing(k, &f_entry, &f_exit, stores);
                     }
                 }
             }
-            PortalCommand::Restart(original) => {
-                if let Some(k) = self.portals.crossing_of(original) {
-                    self.cancel_crossing(k);
+            Decision::Restart(original) => {
+                if let Some(k) = self.crossing_of(original) {
+                    self.cancel_crossing(k, stores);
                     counters.cancelled += 1;
                     // The mass it had at the start is stale: its shapes
                     // give it now (unless the user set one).
-                    let follows = self
-                        .bodies()
+                    let follows = stores
+                        .bodies
                         .record(original)
                         .is_some_and(|r| !r.mass_override);
-                    if follows && self.bodies().body_type(original) == Some(BodyType::Dynamic) {
-                        self.update_mass_from_shapes(original);
+                    if follows && stores.bodies.body_type(original) == Some(BodyType::Dynamic) {
+                        stores.apply(PortalCommand::MassFromShapes(original));
                     }
                 }
             }
-            PortalCommand::Weigh(original) => {
-                if let Some(k) = self.portals.crossing_of(original) {
-                    let (f_entry, f_exit) = frames(self, k);
-                    self.weigh_crossing(k, &f_entry, &f_exit);
+            Decision::Weigh(original) => {
+                if let Some(k) = self.crossing_of(original) {
+                    let (f_entry, f_exit) = self.crossing_frames(k, stores.bodies);
+                    self.weigh_crossing(k, &f_entry, &f_exit, stores);
                 }
             }
-            PortalCommand::Start { pair, entry, body } => {
-                if self.start_crossing(pair, entry, body).is_none() {
+            Decision::Start { pair, entry, body } => {
+                if self.start_crossing(pair, entry, body, stores).is_none() {
                     return;
                 }
                 counters.started += 1;
                 crossed.push(body);
                 // A fast body may already be entirely through.
-                let k = self.portals.crossings.len() - 1;
-                let (f_entry, f_exit) = frames(self, k);
-                let through =
-                    extents_in(self.bodies(), &self.collision_ref().shapes, body, &f_entry)
-                        .is_some_and(|e| e.1 < 0.0);
-                if through && (self.joints_can_follow(k, true) || !self.within_span(k, true)) {
-                    self.complete_crossing(k);
+                let k = self.crossings.len() - 1;
+                let (f_entry, f_exit) = self.crossing_frames(k, stores.bodies);
+                let through = extents_in(stores.bodies, &stores.collision.shapes, body, &f_entry)
+                    .is_some_and(|e| e.1 < 0.0);
+                if through
+                    && (self.joints_can_follow(k, true, stores.joints)
+                        || !self.within_span(k, true, stores))
+                {
+                    self.complete_crossing(k, stores);
                     counters.completed += 1;
                 } else {
-                    self.weigh_crossing(k, &f_entry, &f_exit);
+                    self.weigh_crossing(k, &f_entry, &f_exit, stores);
                 }
             }
         }
     }
 
     /// Creates the clone of `body` entering portal `entry` of pair `index`.
-    fn start_crossing(&mut self, index: u32, entry: usize, body: BodyHandle) -> Option<()> {
-        let d = self.portals.pairs.at(index).cloned()?;
+    fn start_crossing(
+        &mut self,
+        index: u32,
+        entry: usize,
+        body: BodyHandle,
+        stores: &mut Stores<'_>,
+    ) -> Option<()> {
+        let d = self.pairs.at(index).cloned()?;
         // A crossing wakes the portal bodies (their constraint rows act now).
-        self.wake_body(d.portals[0].body);
-        self.wake_body(d.portals[1].body);
+        stores.apply(PortalCommand::Wake(d.portals[0].body));
+        stores.apply(PortalCommand::Wake(d.portals[1].body));
         let exit = 1 - entry;
         let eta = if entry == 0 { d.eta } else { 1.0 / d.eta };
-        let f1 = frame_of(self, &d.portals[entry], &d.local[entry]);
-        let f2 = frame_of(self, &d.portals[exit], &d.local[exit]);
+        let f1 = frame_in(stores.bodies, &d.portals[entry], &d.local[entry]);
+        let f2 = frame_in(stores.bodies, &d.portals[exit], &d.local[exit]);
         let map = PortalMap::new(f1, f2, eta).ok()?;
         let (sim, state) = {
-            let b = self.bodies().solver_body(body);
+            let b = stores.bodies.solver_body(body);
             (*b.sim, *b.state)
         };
-        let record = self.bodies().record(body)?.clone();
+        let record = stores.bodies.record(body)?.clone();
         let motion = BodyMotion {
             center: sim.center,
             angle: sim.transform.q.angle(),
@@ -1011,8 +1042,8 @@ impl World {
         };
         let clone_motion = map.clone_state(
             &motion,
-            &motion_of(self, d.portals[entry].body),
-            &motion_of(self, d.portals[exit].body),
+            &motion_in(stores.bodies, d.portals[entry].body),
+            &motion_in(stores.bodies, d.portals[exit].body),
         );
         let full = BodyMass {
             mass: sim.mass,
@@ -1039,29 +1070,36 @@ impl World {
             user_data: record.user_data,
             ..BodyDef::default()
         };
-        let clone = self.insert_body(&clone_def).ok()?;
-        let shapes: Vec<u32> = self.collision_ref().shapes.of_body(body).to_vec();
+        // The new handle is needed at once: a store-level call, not a
+        // command.
+        let clone = stores.insert_body(&clone_def).ok()?;
+        let shapes: Vec<u32> = stores.collision.shapes.of_body(body).to_vec();
         for s in shapes {
-            let data = self.collision_ref().shapes.at(s);
+            let data = stores.collision.shapes.at(s);
             let geometry = data.geometry.scaled(eta, sim.local_center);
             let mut def = data.def.clone();
             if d.mass_model == MassModel::EnergyPreserving {
                 def.density /= eta.powi(4);
             }
-            self.add_shape_unchecked(clone, def, geometry);
+            stores.apply(PortalCommand::AddShape {
+                body: clone,
+                def,
+                geometry,
+            });
         }
-        let owner = self.bodies().owner();
-        let original_shapes = shape_handles(&self.collision_ref().shapes, body, owner);
-        let clone_shapes = shape_handles(&self.collision_ref().shapes, clone, owner);
-        self.apply_mass_keep_velocity(clone, mass_clone);
-        self.set_velocity_unchecked(
+        let owner = stores.bodies.owner();
+        let original_shapes = shape_handles(&stores.collision.shapes, body, owner);
+        let clone_shapes = shape_handles(&stores.collision.shapes, clone, owner);
+        apply_mass_keep_velocity(stores.bodies, clone, mass_clone);
+        set_velocity(
+            stores,
             clone,
             clone_motion.linear_velocity,
             clone_motion.angular_velocity,
         );
         // The clone's momentum comes out of the exit portal's body.
         let clone_full = (mass_clone.mass, mass_clone.rotational_inertia);
-        self.exchange_with_portal(clone, (0.0, 0.0), clone_full, d.portals[exit].body);
+        exchange_with_portal(stores, clone, (0.0, 0.0), clone_full, d.portals[exit].body);
         let constraint = PortalConstraint::new(PortalConstraintDef {
             body,
             clone,
@@ -1072,7 +1110,7 @@ impl World {
             eta,
         })
         .ok()?;
-        self.portals.crossings.push(Crossing {
+        self.crossings.push(Crossing {
             pair: index,
             entry,
             original: body,
@@ -1082,28 +1120,34 @@ impl World {
             original_shapes,
             clone_shapes,
         });
-        self.portals.constraints.push(constraint);
-        let pair = self.pair_handle(index);
-        self.portals
-            .events
+        self.constraints.push(constraint);
+        let pair = self.pair_handle(index, owner);
+        self.events
             .push(PortalEvent::CrossingStarted { body, clone, pair });
         Some(())
     }
 
     /// Weighs the two copies of crossing `k` by their area fractions.
-    fn weigh_crossing(&mut self, k: usize, f_entry: &PortalFrame, f_exit: &PortalFrame) {
-        let c = self.portals.crossings[k].clone();
-        let shapes = &self.collision_ref().shapes;
-        let a = front_fraction(self.bodies(), shapes, c.original, f_entry);
-        let b = front_fraction(self.bodies(), shapes, c.clone, f_exit);
+    fn weigh_crossing(
+        &mut self,
+        k: usize,
+        f_entry: &PortalFrame,
+        f_exit: &PortalFrame,
+        stores: &mut Stores<'_>,
+    ) {
+        let c = self.crossings[k].clone();
+        let shapes = &stores.collision.shapes;
+        let a = front_fraction(stores.bodies, shapes, c.original, f_entry);
+        let b = front_fraction(stores.bodies, shapes, c.clone, f_exit);
         let f = if a + b > 0.0 { a / (a + b) } else { 0.5 };
         let mut f = f.clamp(F_MIN, 1.0 - F_MIN);
         // A copy that carries a joint keeps at least F_JOINTED of the
         // object: the joint's load passes through the portal rows, which
         // move a light copy away from what it is jointed to.
+        let joints: &JointSet = stores.joints;
         let jointed = |copy: BodyHandle, twin: BodyHandle| {
-            self.joints_attached_to(copy).iter().any(|&j| {
-                self.joints
+            joints_attached_to(joints, copy).iter().any(|&j| {
+                joints
                     .bodies_of(j)
                     .is_ok_and(|(a, b)| a != twin && b != twin)
             })
@@ -1119,103 +1163,68 @@ impl World {
             rotational_inertia: f * m.rotational_inertia,
             center: m.center,
         };
-        let (entry_body, exit_body) = self.portals.portal_bodies(&c);
-        self.set_copy_mass(c.original, scale(c.mass_original, f), entry_body);
-        self.set_copy_mass(c.clone, scale(c.mass_clone, 1.0 - f), exit_body);
-    }
-
-    /// Sets a crossing copy's (weighted) mass, velocity unchanged. The mass
-    /// that leaves (or enters) through the portal carries its momentum to
-    /// (or from) the portal body, so with a dynamic portal body the total
-    /// linear and angular momentum is unchanged:
-    ///
-    /// ```text
-    /// Δm = m_old − m_new,  ΔI = I_old − I_new
-    /// portal body:  linear impulse Δm v at the copy's centre x,
-    ///               angular impulse ΔI ω
-    /// ```
-    ///
-    /// Static and kinematic portal bodies absorb it (infinite mass).
-    fn set_copy_mass(&mut self, body: BodyHandle, new: BodyMass, portal_body: BodyHandle) {
-        let Some(b) = self.bodies().sim(body).copied() else {
-            return;
-        };
-        if self.bodies().body_type(portal_body) == Some(BodyType::Dynamic) {
-            let st = *self.bodies().state(body).expect("live");
-            let dm = b.mass - new.mass;
-            let di = b.inertia - new.rotational_inertia;
-            self.push_body(portal_body, dm * st.v, b.center, di * st.w);
-        }
-        if new.mass > 0.0 {
-            self.apply_mass_keep_velocity(body, new);
-        }
-    }
-
-    /// The momentum of `body` as if its mass went from `from` to `to`
-    /// (velocity fixed) is exchanged with the portal body: the portal body
-    /// receives `(m_from − m_to) v` at the copy's centre and
-    /// `(I_from − I_to) ω`. Used when a copy appears (`from` = 0) or
-    /// disappears (`to` = 0) as a whole.
-    fn exchange_with_portal(
-        &mut self,
-        body: BodyHandle,
-        from: (Real, Real),
-        to: (Real, Real),
-        portal_body: BodyHandle,
-    ) {
-        if self.bodies().body_type(portal_body) != Some(BodyType::Dynamic) {
-            return;
-        }
-        let Some(b) = self.bodies().sim(body).copied() else {
-            return;
-        };
-        let st = *self.bodies().state(body).expect("live");
-        self.push_body(
-            portal_body,
-            (from.0 - to.0) * st.v,
-            b.center,
-            (from.1 - to.1) * st.w,
-        );
+        let (entry_body, exit_body) = self.portal_bodies(&c);
+        set_copy_mass(stores, c.original, scale(c.mass_original, f), entry_body);
+        set_copy_mass(stores, c.clone, scale(c.mass_clone, 1.0 - f), exit_body);
     }
 
     /// Removes crossing `k` and its constraint, returning it.
     fn take_crossing(&mut self, k: usize) -> Crossing {
-        self.portals.constraints.remove(k);
-        self.portals.crossings.remove(k)
+        self.constraints.remove(k);
+        self.crossings.remove(k)
     }
 
     /// The original went through: the handle follows the object to the
     /// exit side; the original's old body is removed.
-    fn complete_crossing(&mut self, k: usize) {
+    fn complete_crossing(&mut self, k: usize, stores: &mut Stores<'_>) {
         let c = self.take_crossing(k);
-        let (entry_body, exit_body) = self.portals.portal_bodies(&c);
-        self.set_copy_mass(c.clone, c.mass_clone, exit_body);
+        let (entry_body, exit_body) = self.portal_bodies(&c);
+        set_copy_mass(stores, c.clone, c.mass_clone, exit_body);
         // What is left of the original goes into the entry portal's body.
-        if let Some(b) = self.bodies().sim(c.original).copied() {
-            self.exchange_with_portal(c.original, (b.mass, b.inertia), (0.0, 0.0), entry_body);
+        if let Some(b) = stores.bodies.sim(c.original).copied() {
+            exchange_with_portal(
+                stores,
+                c.original,
+                (b.mass, b.inertia),
+                (0.0, 0.0),
+                entry_body,
+            );
         }
-        let pair = self.pair_handle(c.pair);
+        let pair = self.pair_handle(c.pair, stores.bodies.owner());
         // Joints on the original move to the exit side with it: their
         // other bodies to their copies there (checked by
         // `joints_can_follow`; one that has none is disabled).
-        let on_original = self.joints_attached_to(c.original);
-        let on_clone = self.joints_attached_to(c.clone);
-        let q = self.crossing_rotation(&c);
+        let on_original = joints_attached_to(stores.joints, c.original);
+        let on_clone = joints_attached_to(stores.joints, c.clone);
+        let q = self.crossing_rotation(&c, stores.bodies);
         let eta = self.crossing_eta(&c);
-        self.swap_body_identity(c.original, c.clone);
+        stores.apply(PortalCommand::SwapIdentity(c.original, c.clone));
         // The handle `original` is now the exit copy (the clone's frame:
         // the original's scaled by η about the centre of mass).
         for joint in on_original {
-            self.carry_joint(joint, &c, c.original, c.original, eta, q, 1.0 / eta);
+            self.carry_joint(
+                joint,
+                &c,
+                (c.original, c.original),
+                eta,
+                q,
+                1.0 / eta,
+                stores,
+            );
         }
         // Joints on the clone follow its body, which `original` now names.
         for joint in on_clone {
-            if let Some(anchor) = self.anchor_on(joint, c.clone) {
-                self.repoint_joint(joint, c.clone, c.original, anchor);
+            if let Some(anchor) = anchor_on(stores.joints, joint, c.clone) {
+                stores.apply(PortalCommand::RepointJoint {
+                    joint,
+                    from: c.clone,
+                    to: c.original,
+                    anchor,
+                });
             }
         }
-        self.destroy_body_unchecked(c.clone);
-        self.portals.events.push(PortalEvent::CrossingCompleted {
+        stores.apply(PortalCommand::DestroyBody(c.clone));
+        self.events.push(PortalEvent::CrossingCompleted {
             body: c.original,
             pair,
         });
@@ -1223,33 +1232,32 @@ impl World {
 
     /// The body backed out (or the crossing is ended): remove the clone and
     /// restore the original's full mass.
-    fn cancel_crossing(&mut self, k: usize) {
-        let (entry_body, exit_body) = {
-            let c = &self.portals.crossings[k];
-            self.portals.portal_bodies(c)
-        };
+    fn cancel_crossing(&mut self, k: usize, stores: &mut Stores<'_>) {
+        let (entry_body, exit_body) = self.portal_bodies(&self.crossings[k]);
         let c = self.take_crossing(k);
-        if self.bodies().contains(c.original) {
-            self.set_copy_mass(c.original, c.mass_original, entry_body);
+        if stores.bodies.contains(c.original) {
+            set_copy_mass(stores, c.original, c.mass_original, entry_body);
         }
-        if self.bodies().contains(c.original) && self.bodies().contains(c.clone) {
+        if stores.bodies.contains(c.original) && stores.bodies.contains(c.clone) {
             // Joints on the clone move back to the original, their other
             // bodies to their copies on the entry side.
             // Qᵀ: back from the exit side to the entry side.
-            let q = self.crossing_rotation(&c).inv_mul(Rot::IDENTITY);
+            let q = self
+                .crossing_rotation(&c, stores.bodies)
+                .inv_mul(Rot::IDENTITY);
             let eta = self.crossing_eta(&c);
-            for joint in self.joints_attached_to(c.clone) {
-                self.carry_joint(joint, &c, c.clone, c.original, 1.0 / eta, q, eta);
+            for joint in joints_attached_to(stores.joints, c.clone) {
+                self.carry_joint(joint, &c, (c.clone, c.original), 1.0 / eta, q, eta, stores);
             }
         }
-        if self.bodies().contains(c.clone) {
-            if let Some(b) = self.bodies().sim(c.clone).copied() {
-                self.exchange_with_portal(c.clone, (b.mass, b.inertia), (0.0, 0.0), exit_body);
+        if stores.bodies.contains(c.clone) {
+            if let Some(b) = stores.bodies.sim(c.clone).copied() {
+                exchange_with_portal(stores, c.clone, (b.mass, b.inertia), (0.0, 0.0), exit_body);
             }
-            self.destroy_body_unchecked(c.clone);
+            stores.apply(PortalCommand::DestroyBody(c.clone));
         }
-        let pair = self.pair_handle(c.pair);
-        self.portals.events.push(PortalEvent::CrossingCancelled {
+        let pair = self.pair_handle(c.pair, stores.bodies.owner());
+        self.events.push(PortalEvent::CrossingCancelled {
             body: c.original,
             pair,
         });
@@ -1260,20 +1268,22 @@ impl World {
     /// it backs out) can follow the object: its other body has a copy on
     /// the side that stays. A joint between the two copies does not count
     /// (it is disabled at the start of the stage).
-    fn joints_can_follow(&self, k: usize, complete: bool) -> bool {
-        let c = &self.portals.crossings[k];
+    fn joints_can_follow(&self, k: usize, complete: bool, joints: &JointSet) -> bool {
+        let c = &self.crossings[k];
         let (leaving, staying) = if complete {
             (c.original, c.clone)
         } else {
             (c.clone, c.original)
         };
         let leaving_side = if complete { c.entry } else { 1 - c.entry };
-        self.joints_attached_to(leaving).into_iter().all(|joint| {
-            self.joints.bodies_of(joint).is_ok_and(|(a, b)| {
-                let other = if a == leaving { b } else { a };
-                other == staying || self.twin_across(other, c.pair, leaving_side).is_some()
+        joints_attached_to(joints, leaving)
+            .into_iter()
+            .all(|joint| {
+                joints.bodies_of(joint).is_ok_and(|(a, b)| {
+                    let other = if a == leaving { b } else { a };
+                    other == staying || self.twin_across(other, c.pair, leaving_side).is_some()
+                })
             })
-        })
     }
 
     /// True when the copy that crossing `k` would remove (the original when
@@ -1282,17 +1292,17 @@ impl World {
     /// is held for its joints. One that has slid beside the aperture,
     /// behind the wall, ends its crossing and its joints that cannot follow
     /// are disabled.
-    fn within_span(&self, k: usize, complete: bool) -> bool {
-        let c = &self.portals.crossings[k];
-        let d = self.portals.pairs.at(c.pair).expect("live pair");
+    fn within_span(&self, k: usize, complete: bool, stores: &Stores<'_>) -> bool {
+        let c = &self.crossings[k];
+        let d = self.pairs.at(c.pair).expect("live pair");
         let (body, side) = if complete {
             (c.original, c.entry)
         } else {
             (c.clone, 1 - c.entry)
         };
-        let f = frame_of(self, &d.portals[side], &d.local[side]);
+        let f = frame_in(stores.bodies, &d.portals[side], &d.local[side]);
         let w = d.local[side].half_width;
-        extents_in(self.bodies(), &self.collision_ref().shapes, body, &f)
+        extents_in(stores.bodies, &stores.collision.shapes, body, &f)
             .is_some_and(|(_, _, t0, t1)| t0 >= -w && t1 <= w)
     }
 
@@ -1306,10 +1316,9 @@ impl World {
         pair: u32,
         side: usize,
     ) -> Option<(BodyHandle, Vec2, Real)> {
-        self.portals
-            .crossings
+        self.crossings
             .iter()
-            .zip(&self.portals.constraints)
+            .zip(&self.constraints)
             .find_map(|(m, pc)| {
                 if m.pair != pair {
                     return None;
@@ -1327,15 +1336,15 @@ impl World {
 
     /// The scale `η` of crossing `c` (entry to exit).
     fn crossing_eta(&self, c: &Crossing) -> Real {
-        let d = self.portals.pairs.at(c.pair).expect("live pair");
+        let d = self.pairs.at(c.pair).expect("live pair");
         if c.entry == 0 { d.eta } else { 1.0 / d.eta }
     }
 
     /// The rotation `Q` of crossing `c`'s map (entry to exit), now.
-    fn crossing_rotation(&self, c: &Crossing) -> Rot {
-        let d = self.portals.pairs.at(c.pair).expect("live pair");
-        let f1 = frame_of(self, &d.portals[c.entry], &d.local[c.entry]);
-        let f2 = frame_of(self, &d.portals[1 - c.entry], &d.local[1 - c.entry]);
+    fn crossing_rotation(&self, c: &Crossing, bodies: &BodySet) -> Rot {
+        let d = self.pairs.at(c.pair).expect("live pair");
+        let f1 = frame_in(bodies, &d.portals[c.entry], &d.local[c.entry]);
+        let f2 = frame_in(bodies, &d.portals[1 - c.entry], &d.local[1 - c.entry]);
         PortalMap {
             frame1: f1,
             frame2: f2,
@@ -1344,29 +1353,24 @@ impl World {
         .rotation()
     }
 
-    /// A joint's local anchor on `body` (`None` when `body` is neither end).
-    fn anchor_on(&self, joint: JointHandle, body: BodyHandle) -> Option<Vec2> {
-        self.joints.get(joint).ok()?.local_anchor_on(body)
-    }
-
     /// Carries joint `joint` through crossing `c`: its end on `from` moves
-    /// to `to` (anchor scaled by `scale` about the object's local centre of
-    /// mass), its other end to that body's copy on the same side (scaled
-    /// the same way), and its impulses turn by `q` and scale by
-    /// `impulse_scale`. Its other body having no copy there (a forced end
-    /// of the crossing), the joint is disabled and reported.
+    /// to `to` (`(from, to)`; anchor scaled by `scale` about the object's
+    /// local centre of mass), its other end to that body's copy on the
+    /// same side (scaled the same way), and its impulses turn by `q` and
+    /// scale by `impulse_scale`. Its other body having no copy there (a
+    /// forced end of the crossing), the joint is disabled and reported.
     #[allow(clippy::too_many_arguments)]
     fn carry_joint(
         &mut self,
         joint: JointHandle,
         c: &Crossing,
-        from: BodyHandle,
-        to: BodyHandle,
+        (from, to): (BodyHandle, BodyHandle),
         scale: Real,
         q: Rot,
         impulse_scale: Real,
+        stores: &mut Stores<'_>,
     ) {
-        let Ok((a, b)) = self.joints.bodies_of(joint) else {
+        let Ok((a, b)) = stores.joints.bodies_of(joint) else {
             return;
         };
         let other = if a == from { b } else { a };
@@ -1377,26 +1381,99 @@ impl World {
         };
         let twin = self.twin_across(other, c.pair, leaving_side);
         let center = c.mass_original.center;
-        if let Some(anchor) = self.anchor_on(joint, from) {
-            self.repoint_joint(joint, from, to, center + scale * (anchor - center));
+        if let Some(anchor) = anchor_on(stores.joints, joint, from) {
+            stores.apply(PortalCommand::RepointJoint {
+                joint,
+                from,
+                to,
+                anchor: center + scale * (anchor - center),
+            });
         }
         match twin {
             Some((other_twin, other_center, other_scale)) => {
-                if let Some(anchor) = self.anchor_on(joint, other) {
+                if let Some(anchor) = anchor_on(stores.joints, joint, other) {
                     let anchor = other_center + other_scale * (anchor - other_center);
-                    self.repoint_joint(joint, other, other_twin, anchor);
+                    stores.apply(PortalCommand::RepointJoint {
+                        joint,
+                        from: other,
+                        to: other_twin,
+                        anchor,
+                    });
                 }
-                if let Ok(j) = self.joints.joint_mut(joint) {
+                if let Ok(j) = stores.joints.joint_mut(joint) {
                     j.carry_impulses(q, impulse_scale);
                 }
             }
             None => {
-                self.disable_joint(joint);
-                let pair = self.pair_handle(c.pair);
-                self.portals
-                    .events
-                    .push(PortalEvent::JointDisabled { joint, pair });
+                stores.apply(PortalCommand::DisableJoint(joint));
+                let pair = self.pair_handle(c.pair, stores.bodies.owner());
+                self.events.push(PortalEvent::JointDisabled { joint, pair });
             }
         }
     }
+}
+
+/// A joint's local anchor on `body` (`None` when `body` is neither end).
+fn anchor_on(joints: &JointSet, joint: JointHandle, body: BodyHandle) -> Option<Vec2> {
+    joints.get(joint).ok()?.local_anchor_on(body)
+}
+
+/// Sets a crossing copy's (weighted) mass, velocity unchanged. The mass
+/// that leaves (or enters) through the portal carries its momentum to
+/// (or from) the portal body, so with a dynamic portal body the total
+/// linear and angular momentum is unchanged:
+///
+/// ```text
+/// Δm = m_old − m_new,  ΔI = I_old − I_new
+/// portal body:  linear impulse Δm v at the copy's centre x,
+///               angular impulse ΔI ω
+/// ```
+///
+/// Static and kinematic portal bodies absorb it (infinite mass).
+fn set_copy_mass(
+    stores: &mut Stores<'_>,
+    body: BodyHandle,
+    new: BodyMass,
+    portal_body: BodyHandle,
+) {
+    let Some(b) = stores.bodies.sim(body).copied() else {
+        return;
+    };
+    if stores.bodies.body_type(portal_body) == Some(BodyType::Dynamic) {
+        let st = *stores.bodies.state(body).expect("live");
+        let dm = b.mass - new.mass;
+        let di = b.inertia - new.rotational_inertia;
+        push_body(stores, portal_body, dm * st.v, b.center, di * st.w);
+    }
+    if new.mass > 0.0 {
+        apply_mass_keep_velocity(stores.bodies, body, new);
+    }
+}
+
+/// The momentum of `body` as if its mass went from `from` to `to`
+/// (velocity fixed) is exchanged with the portal body: the portal body
+/// receives `(m_from − m_to) v` at the copy's centre and
+/// `(I_from − I_to) ω`. Used when a copy appears (`from` = 0) or
+/// disappears (`to` = 0) as a whole.
+fn exchange_with_portal(
+    stores: &mut Stores<'_>,
+    body: BodyHandle,
+    from: (Real, Real),
+    to: (Real, Real),
+    portal_body: BodyHandle,
+) {
+    if stores.bodies.body_type(portal_body) != Some(BodyType::Dynamic) {
+        return;
+    }
+    let Some(b) = stores.bodies.sim(body).copied() else {
+        return;
+    };
+    let st = *stores.bodies.state(body).expect("live");
+    push_body(
+        stores,
+        portal_body,
+        (from.0 - to.0) * st.v,
+        b.center,
+        (from.1 - to.1) * st.w,
+    );
 }

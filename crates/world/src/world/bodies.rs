@@ -41,7 +41,8 @@ impl World {
     /// clone; the original stays).
     pub fn destroy_body(&mut self, body: BodyHandle) -> Result<(), WorldError> {
         self.check_body(body)?;
-        self.portal_forget_body(body);
+        let (portals, mut stores) = self.portals_and_stores();
+        portals.forget_body(body, &mut stores);
         // A clone is already gone with its cancelled crossing.
         if self.bodies.contains(body) {
             self.destroy_body_unchecked(body);
@@ -51,40 +52,13 @@ impl World {
 
     /// Wakes every body that has a contact with `body` (its own list).
     pub(crate) fn wake_touching(&mut self, body: BodyHandle) {
-        let touching: smallvec::SmallVec<[BodyHandle; 8]> = self
-            .collision
-            .contacts
-            .of_body(body)
-            .iter()
-            .filter_map(|&id| self.collision.contacts.get(id))
-            .map(|c| c.other(body))
-            .collect();
-        self.wake_all(&touching);
+        self.stores().wake_touching(body);
     }
 
     /// Destroys a live body (checked by the caller, crossings already
-    /// ended).
+    /// ended; see `Stores::destroy_body`).
     pub(crate) fn destroy_body_unchecked(&mut self, body: BodyHandle) {
-        self.wake_touching(body);
-        self.wake_body(body);
-        let attached: smallvec::SmallVec<[JointHandle; 4]> =
-            self.joints.of_body(body).iter().copied().collect();
-        for h in attached {
-            self.remove_joint(h);
-        }
-        let shapes: smallvec::SmallVec<[u32; 4]> = self
-            .collision
-            .shapes
-            .of_body(body)
-            .iter()
-            .copied()
-            .collect();
-        for s in shapes {
-            self.collision.remove_shape(s);
-        }
-        self.islands.remove_body(body);
-        let destroyed = self.bodies.destroy(body);
-        debug_assert!(destroyed.is_ok(), "checked by the caller");
+        self.stores().destroy_body(body);
     }
 
     /// `StaleBody`, or `ForeignHandle` for another world's handle.

@@ -53,17 +53,7 @@ impl World {
 
     /// Removes a live joint, waking its bodies.
     pub(super) fn remove_joint(&mut self, joint: JointHandle) {
-        if let Ok((a, b, freed)) = self.joints.remove(joint) {
-            if freed {
-                // Their proxies may not move again for a long time: the
-                // broadphase looks for their pairs at the next step.
-                self.collision.refind_pairs_of(a);
-                self.collision.refind_pairs_of(b);
-            }
-            self.wake_body(a);
-            self.wake_body(b);
-            self.islands.note_removed(a);
-        }
+        self.stores().remove_joint(joint);
     }
 
     /// Destroys a joint.
@@ -179,20 +169,14 @@ impl World {
         Ok(())
     }
 
-    /// Enables or disables a joint and tells the islands (linked when on,
-    /// a removed link when off); wakes nothing.
+    /// Enables or disables a joint and tells the islands (see
+    /// `Stores::switch_joint`); wakes nothing.
     pub(super) fn switch_joint(
         &mut self,
         joint: JointHandle,
         on: bool,
     ) -> Result<(BodyHandle, BodyHandle), WorldError> {
-        let (a, b) = self.joints.set_enabled(joint, on)?;
-        if on {
-            self.islands.link(a, b, &self.bodies);
-        } else {
-            self.islands.note_removed(a);
-        }
-        Ok((a, b))
+        self.stores().switch_joint(joint, on)
     }
 
     /// Distance between a joint's two world anchors, m.

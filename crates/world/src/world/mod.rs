@@ -10,7 +10,8 @@
 //! | `queries.rs`    | scene queries (the logic is `crate::query`'s)               |
 //! | `events.rs`     | events and hooks: the pre-solve hook, user data              |
 //! | `step.rs`       | [`World::step`]: the pipeline that calls the stages in order |
-//! | `internal.rs`   | one-thing operations the portal stage applies                |
+//! | `portals.rs`    | portal pairs: create, destroy, read (the logic is the portal stage's; with the `portals` feature) |
+//! | `internal.rs`   | store-level operations over the borrowed stores, and where the portal stage's commands are applied |
 //!
 //!
 //! ```text
@@ -21,7 +22,7 @@
 //!   ├─ solve_step (janus2d-core): prepare ─ substeps ─ restitution ─ store ─ finalize
 //!   ├─ store impulses  ∥  continuous (fast bodies swept, moved back to
 //!   │                     their time of impact) ─ move proxies
-//!   ├─ portal crossings (commands applied by the world)
+//!   ├─ portal crossings (the stage over the stores; its commands applied by `internal.rs`)
 //!   ├─ islands: sleep timers, resting islands sleep
 //!   └─ counters, events (non-finite bodies, contacts, sensors)
 //! ```
@@ -36,7 +37,7 @@ use janus2d_constraints::{
     ContactSolver, Joint, JointDef, ObjectMass, RevoluteJoint, RevoluteJointDef,
 };
 use janus2d_core::BodyMass;
-use janus2d_core::body::{BodyDef, BodyHandle, BodyLocation, BodySet, BodyType, validate_mass};
+use janus2d_core::body::{BodyDef, BodyHandle, BodySet, BodyType, validate_mass};
 use janus2d_core::constraint::{ConstraintBatch, StepContext};
 use janus2d_core::geometry::Shape;
 use janus2d_core::math::{Real, Rot, Transform, Vec2, cross, vec_is_finite};
@@ -239,8 +240,7 @@ impl World {
 
     /// Wakes the island of `body` (no effect on awake or static bodies).
     pub fn wake_body(&mut self, body: BodyHandle) {
-        self.islands
-            .wake(body, &mut self.bodies, &mut self.collision.contacts);
+        self.stores().wake_body(body);
     }
 
     /// Wakes every island in the list.
@@ -324,6 +324,8 @@ mod bodies;
 mod events;
 mod internal;
 mod joints;
+#[cfg(feature = "portals")]
+mod portals;
 mod queries;
 mod shapes;
 mod step;

@@ -98,42 +98,9 @@ impl World {
             .collect())
     }
 
+    /// Sets a body's mass from its shapes (see `Stores::mass_from_shapes`).
     pub(crate) fn update_mass_from_shapes(&mut self, body: BodyHandle) {
-        let md = self.collision.shapes.mass_of(body);
-        let fixed = self
-            .bodies
-            .record(body)
-            .map(|r| r.fixed_rotation)
-            .unwrap_or(false);
-        let mass = if md.mass > 0.0 {
-            BodyMass {
-                mass: md.mass,
-                rotational_inertia: md.rotational_inertia,
-                center: md.center,
-            }
-        } else {
-            BodyMass::new(1.0, 1.0)
-        };
-        let inertia_ok = fixed || mass.rotational_inertia > 0.0;
-        let mass = if inertia_ok {
-            mass
-        } else {
-            BodyMass {
-                rotational_inertia: mass.mass * 1e-3,
-                ..mass
-            }
-        };
-        // Mass from shapes is clamped into the stated ranges (a tiny
-        // density must not give an infinite inverse mass).
-        let mass = BodyMass {
-            mass: janus2d_core::limits::clamp_to(mass.mass, janus2d_core::limits::MASS_RANGE),
-            rotational_inertia: janus2d_core::limits::clamp_to(
-                mass.rotational_inertia,
-                janus2d_core::limits::INERTIA_RANGE,
-            ),
-            center: mass.center,
-        };
-        self.bodies.apply_mass(body, mass, fixed);
+        self.stores().mass_from_shapes(body);
     }
 
     /// Number of live shapes.

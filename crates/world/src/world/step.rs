@@ -163,7 +163,8 @@ impl World {
             sp.broadphase += both - continuous_time;
         }
         if has_portals {
-            self.portal_crossings();
+            let (portals, mut stores) = self.portals_and_stores();
+            portals.cross(&mut stores);
             sp.portals += lap();
         } else {
             self.portals.clear_events();
