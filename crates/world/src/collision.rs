@@ -25,9 +25,9 @@
 
 use janus2d_constraints::ContactSolver;
 use janus2d_constraints::contact::{mix_friction, mix_restitution};
-use janus2d_constraints::contact_solver::LanePlace;
-use janus2d_constraints::contact_solver::PointImpulse;
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
+#[cfg(feature = "parallel")]
+use janus2d_core::geometry::Aabb;
 use janus2d_core::geometry::Shape;
 use janus2d_core::math::{Real, Transform, Vec2};
 
@@ -35,8 +35,6 @@ use crate::broadphase::BroadPhase;
 pub use crate::contacts::CollisionEvents;
 use crate::contacts::{Contact, ContactPointData, ContactSet};
 use crate::joints::NoCollide;
-#[cfg(feature = "parallel")]
-use crate::narrowphase::Narrowphase;
 use crate::shapes::{ShapeData, ShapeDef, ShapeHandle, ShapeStore};
 
 /// Fattening margin of broadphase boxes, m (0.1). One constant, defined
@@ -291,21 +289,19 @@ impl Collision {
     /// returned.
     pub(crate) fn end_step<R: Send>(
         &mut self,
-        solver: &ContactSolver,
         bodies: &mut BodySet,
         dt: Real,
+        store: impl FnOnce(&mut ContactSet) + Send,
         advance: impl FnOnce(&mut BodySet, &ShapeStore, &BroadPhase) -> R + Send,
     ) -> R {
         let Collision {
             shapes,
             broadphase,
             contacts,
-            narrowphase,
             counters,
             ..
         } = self;
-        let places = narrowphase.places_by_contact();
-        let mut store = move || Self::store_impulses(contacts, places, solver);
+        let store = move || store(contacts);
         let rest = move || {
             let out = advance(bodies, shapes, broadphase);
             counters.proxies_moved = Self::update_proxies(shapes, broadphase, bodies, dt);
@@ -317,58 +313,6 @@ impl Collision {
         }
         store();
         rest()
-    }
-
-    /// Copies solved impulses back into the contacts (for warm starting);
-    /// `places` is where the solver holds each awake contact's impulses
-    /// ([`Narrowphase::places_by_contact`]). Touches only the contacts (see
-    /// [`Collision::end_step`]).
-    fn store_impulses(contacts: &mut ContactSet, places: &[LanePlace], solver: &ContactSolver) {
-        #[cfg(not(feature = "parallel"))]
-        let _ = places;
-        // A non-finite impulse (a solve that blew up) is not kept for warm
-        // starting: the contact starts cold next step instead of carrying
-        // NaN into it.
-        let finite = |x: Real| if x.is_finite() { x } else { 0.0 };
-        let keep = |p: &mut crate::contacts::ContactPointData, impulse: PointImpulse| {
-            p.normal_impulse = finite(impulse.normal);
-            p.tangent_impulse = finite(impulse.tangent);
-            p.total_normal_impulse = finite(impulse.total_normal);
-            p.total_tangent_impulse = finite(impulse.total_tangent);
-        };
-        #[cfg(feature = "parallel")]
-        {
-            if rayon::current_num_threads() > 1
-                && places.len() > 4096
-                && places.len() == contacts.awake().len()
-            {
-                // On the threads, in contact order: each contact written
-                // once, in place, reading its lanes from the chunks. (On one
-                // thread the scatter below measured faster: 6.8% of
-                // many_pyramids' samples against 10.2% for this gather.)
-                use rayon::prelude::*;
-                let store = |(c, place): (&mut Contact, &LanePlace)| {
-                    if Narrowphase::is_solved(place) {
-                        for i in 0..c.point_count {
-                            keep(&mut c.points[i], solver.point_impulse_at(*place, i));
-                        }
-                    }
-                };
-                contacts
-                    .awake_slice_mut()
-                    .par_iter_mut()
-                    .zip(places.par_iter())
-                    .with_min_len(1024)
-                    .for_each(store);
-                return;
-            }
-        }
-        solver.for_each_impulse(|index, point, impulse| {
-            keep(
-                &mut contacts.awake_mut(index as usize).points[point],
-                impulse,
-            );
-        });
     }
 
     /// Recomputes the boxes of the shapes of moving bodies and moves their

@@ -15,7 +15,8 @@
 //! | [`debug_draw`]   | the [`DebugDraw`] trait, draw flags and colours, the drawing walk |
 //! | `continuous`     | continuous collision: fast bodies swept to their time of impact |
 //! | `contacts`       | the contact life cycle; awake and sleeping contacts, body → contacts |
-//! | `narrowphase`    | manifolds of awake contacts; contact constraints          |
+//! | `narrowphase`    | manifolds of awake contacts, staged for the solve         |
+//! | `contact_build`  | contact constraints from the narrowphase's hand-off (colours, clusters, lanes) |
 //! | `collision`      | the collision stage: shapes + broadphase + contacts + events |
 //! | `broadphase`     | pair finding over two dynamic trees                      |
 //! | [`dynamic_tree`] | the dynamic AABB tree (insert, remove, rotate, query)     |
@@ -34,6 +35,7 @@
 pub mod aperture;
 pub(crate) mod broadphase;
 pub(crate) mod collision;
+pub(crate) mod contact_build;
 pub(crate) mod contacts;
 pub(crate) mod continuous;
 pub mod debug_draw;

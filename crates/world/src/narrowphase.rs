@@ -1,5 +1,5 @@
-//! The narrowphase: new manifolds for the awake contacts, and the contact
-//! constraints built from them.
+//! The narrowphase: new manifolds for the awake contacts, staged for the
+//! solve while each is in cache.
 //!
 //! ```text
 //! phase 1 (parallel with `parallel`)   each awake contact alone, in place:
@@ -14,20 +14,19 @@
 //! phase 2 (contact order)    destroy separated, move asleep ones to the
 //!                            sleeping list, begin/end events, list
 //!                            bodies to wake
-//! build                      one ContactConstraint per touching solid
-//!                            contact: moving pairs first, static ones last
+//! hand-off                   the touching contacts and their staged
+//!                            lanes ([`Handoff`]) go to constraint building
+//!                            (`crate::contact_build`, the solver side)
 //! ```
 //!
 //! Phase 1 results do not depend on the thread count, since each contact
 //! is computed alone; phase 2 runs in list order.
 
 use janus2d_constraints::ContactPointInput;
-use janus2d_constraints::ObjectMass;
-use janus2d_constraints::contact_group::{Clusters, ContactBodies, NO_CLUSTER, light_pair};
-use janus2d_constraints::contact_solver::{ContactLane, ContactSolver, LanePlace, OVERFLOW};
+use janus2d_constraints::contact_group::NO_CLUSTER;
+use janus2d_constraints::contact_solver::ContactLane;
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::geometry::{Aabb, Manifold, collide};
-use janus2d_core::graph::{ConstraintGraph, NO_BODY};
 use janus2d_core::math::{Real, Rot, Transform, Vec2};
 
 use crate::aperture::ContactClipping;
@@ -100,62 +99,36 @@ pub(crate) struct Narrowphase {
     /// Number of awake contacts when the last run ended; contacts woken
     /// after it are appended beyond.
     scanned: usize,
-    /// The contacts solved this step, in contact order.
-    solved: Vec<SolvedContact>,
-    /// Their colours, in the same order (the solver's `push_all` input).
-    colours: Vec<u8>,
     /// What the solve takes of each awake contact, by awake position,
     /// written by phase 1 while the contact is in cache (valid where the
     /// contact touches solidly). Constraint building reads these compact
     /// records instead of the contacts themselves (about half their size).
     #[cfg_attr(feature = "serde", serde(skip))]
     staged: Vec<StagedContact>,
-    /// Where the solver put each solved contact, in `solved` order.
-    #[cfg_attr(feature = "serde", serde(skip))]
-    places: Vec<LanePlace>,
-    /// The same by awake position ([`UNSOLVED`] for a contact the solve
-    /// does not take), for storing the impulses back in contact order.
-    #[cfg_attr(feature = "serde", serde(skip))]
-    place_of: Vec<LanePlace>,
-    /// The persistent colours of the solved contacts (kept in snapshots:
-    /// the colours are part of the state a step continues from).
-    graph: ConstraintGraph,
-    /// The light clusters of the solved contacts (scratch of the build).
-    #[cfg_attr(feature = "serde", serde(skip))]
-    clusters: Clusters,
-    /// Their clusters, per solved contact (scratch of the build).
-    #[cfg_attr(feature = "serde", serde(skip))]
-    cluster_of: Vec<[u32; 2]>,
-    /// State indices of the bodies no cluster may hold (scratch of the
-    /// build).
-    #[cfg_attr(feature = "serde", serde(skip))]
-    excluded: Vec<u32>,
 }
 
-/// Touching contacts from which constraint building's first pass runs on
-/// threads (below, the tasks cost more than the pass).
-#[cfg(feature = "parallel")]
-const PARALLEL_BUILD: usize = 4096;
-
-/// [`Narrowphase::place_of`] of a contact that is not solved this step.
-#[cfg_attr(not(feature = "parallel"), allow(dead_code))]
-const UNSOLVED: LanePlace = LanePlace {
-    colour: u8::MAX,
-    lane: 0,
-    chunk: 0,
-};
+/// What the narrowphase hands constraint building: the contacts it found
+/// touching and their staged records.
+pub(crate) struct Handoff<'a> {
+    /// Awake positions of the contacts that touch solidly, contact order.
+    pub(crate) touching: &'a [u32],
+    /// Awake contacts when the narrowphase ended (later ones were woken).
+    pub(crate) scanned: usize,
+    /// The staged record of each awake contact, by awake position.
+    pub(crate) staged: &'a mut Vec<StagedContact>,
+}
 
 /// What constraint building needs of one awake contact: its lane (the
 /// solver's input, state indices and inverse masses included) and whether
 /// each body read as still.
 #[derive(Clone, Copy, Debug)]
-struct StagedContact {
+pub(crate) struct StagedContact {
     /// The solver's lane data (`contact_index` is set at push).
-    lane: ContactLane,
+    pub(crate) lane: ContactLane,
     /// The contact's id (its key in the constraint graph).
-    id: u32,
+    pub(crate) id: u32,
     /// [`Contact::still`] when staged.
-    still: [bool; 2],
+    pub(crate) still: [bool; 2],
 }
 
 impl Default for StagedContact {
@@ -188,7 +161,7 @@ fn empty_lane() -> ContactLane {
 
 /// Stages a contact: its lane and stillness as the solve takes them.
 #[inline]
-fn stage(c: &Contact) -> StagedContact {
+pub(crate) fn stage(c: &Contact) -> StagedContact {
     let mut points = [ContactPointInput::default(); 2];
     for (input, p) in points.iter_mut().zip(&c.points[..c.point_count]) {
         *input = ContactPointInput {
@@ -220,36 +193,6 @@ fn stage(c: &Contact) -> StagedContact {
     }
 }
 
-/// A contact the solve takes this step, as the build's first pass found it.
-#[derive(Clone, Copy, Debug)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-struct SolvedContact {
-    /// Index in the awake list.
-    index: u32,
-    /// The contact's id (its key in the constraint graph).
-    id: u32,
-    /// The graph's body keys: each moving body's slot ([`NO_BODY`] for a
-    /// body the solve does not move).
-    keys: [u32; 2],
-    /// State index of each body (0: static or asleep).
-    state: [u32; 2],
-    /// Whether the solve moves each body.
-    moving: [bool; 2],
-    /// A portal copy takes part: the object-mass hook, in the overflow.
-    copy: bool,
-    /// Inverse mass of each body, 1/kg (0 for one the solve does not move).
-    #[cfg_attr(feature = "serde", serde(skip))]
-    inv_mass: [Real; 2],
-    /// The light cluster of each side (`contact_group`): with one, in the
-    /// overflow, solved with the cluster's other contacts as one block.
-    #[cfg_attr(feature = "serde", serde(skip))]
-    cluster: [u32; 2],
-    /// Its manifold's point count (two solver rows each).
-    point_count: u8,
-    /// Its restitution is positive.
-    bouncy: bool,
-}
-
 /// What the narrowphase reads besides the contacts it updates.
 pub(crate) struct NarrowphaseInput<'a> {
     pub(crate) shapes: &'a ShapeStore,
@@ -262,25 +205,13 @@ pub(crate) struct NarrowphaseInput<'a> {
 }
 
 impl Narrowphase {
-    /// Where the solver holds each awake contact's impulses this step, by
-    /// awake position (as the last constraint building left them; empty on
-    /// one thread).
-    pub(crate) fn places_by_contact(&self) -> &[LanePlace] {
-        &self.place_of
-    }
-
-    /// Checks the persistent constraint graph (every body's colour bits
-    /// are its contacts' colours; no colour holds a body twice).
-    pub(crate) fn check_graph(&self) -> Result<(), String> {
-        self.graph
-            .check()
-            .map_err(|e| format!("constraint graph: {e}"))
-    }
-
-    /// Whether a place holds a solved contact.
-    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
-    pub(crate) fn is_solved(place: &LanePlace) -> bool {
-        *place != UNSOLVED
+    /// The hand-off to constraint building (after [`Narrowphase::run`]).
+    pub(crate) fn handoff(&mut self) -> Handoff<'_> {
+        Handoff {
+            touching: &self.touching,
+            scanned: self.scanned,
+            staged: &mut self.staged,
+        }
     }
 
     /// Updates every awake contact's manifold; destroys contacts whose fat
@@ -599,7 +530,7 @@ fn recycle(
 /// A body's state index and inverse masses as the solve takes them (zero
 /// masses for the static identity state 0).
 #[inline]
-fn solve_body(b: &janus2d_core::body::SolverBody<'_>) -> (u32, [Real; 2]) {
+pub(crate) fn solve_body(b: &janus2d_core::body::SolverBody<'_>) -> (u32, [Real; 2]) {
     if b.state_index == 0 {
         (0, [0.0; 2])
     } else {
@@ -634,275 +565,4 @@ fn update_manifold(c: &mut Contact, m: &Manifold, offset: [Vec2; 2]) {
         }
         c.points[i] = p;
     }
-}
-
-/// Builds the contact constraints of touching solid awake contacts, in
-/// their colours.
-///
-/// Colours come from the persistent [`ConstraintGraph`]: a contact keeps
-/// its colour while it is solved and its moving bodies stay the same.
-/// Contacts with one moving body (against the ground) take colours from
-/// [`janus2d_core::graph::STATIC_FIRST`] up, after the pairs of moving
-/// bodies, so each Gauss–Seidel sweep ends near the ground: the support a
-/// stack stands on has the last word (Box2D v3 likewise keeps static
-/// contacts out of its first graph colours).
-///
-/// Whether a body reads as static was noted by the narrowphase
-/// ([`Contact::still`]); a contact whose two bodies are still is skipped.
-/// When islands were woken after the narrowphase (`woke`), contacts that
-/// read still are checked again.
-pub(crate) fn build_constraints(
-    narrowphase: &mut Narrowphase,
-    contacts: &mut ContactSet,
-    bodies: &BodySet,
-    woke: bool,
-    objects: &[ObjectMass],
-    driven: impl Iterator<Item = BodyHandle>,
-    mut pre_solve: Option<&mut PreSolveFn>,
-    solver: &mut ContactSolver,
-    counters: &mut CollisionCounters,
-) {
-    let solved = &mut narrowphase.solved;
-    let staged = &mut narrowphase.staged;
-    // The contacts to look at: those the narrowphase found touching, then
-    // any woken (appended) since.
-    let n = contacts.awake().len();
-    let scanned = narrowphase.scanned.min(n);
-    let woken = scanned..n;
-    if staged.len() < n {
-        staged.resize(n, StagedContact::default());
-    }
-    // A light pair with a body a motor turns or a portal object's body
-    // makes no cluster: every cluster it marks touches that body and is
-    // blocked (`Clusters::assign`), so without another light pair the
-    // clusters are all empty and are not looked for (spinner: its paddle).
-    // A body a motor turns and a portal object's bodies take no part in a
-    // light cluster (`Clusters::assign`).
-    let excluded = &mut narrowphase.excluded;
-    excluded.clear();
-    for body in driven.chain(objects.iter().map(|o| o.body)) {
-        if let Some(i) = bodies.state_index(body).filter(|&i| i != 0) {
-            excluded.push(i);
-        }
-    }
-    let candidates = narrowphase
-        .touching
-        .iter()
-        .map(|&k| k as usize)
-        .chain(woken);
-    if woke {
-        // Woken bodies have new state indices, and woken contacts were not
-        // read by this step's narrowphase: read their bodies again.
-        for k in candidates.clone() {
-            let c = contacts.awake_mut(k);
-            if c.still == [true, true] {
-                c.still = [
-                    bodies.state_index(c.body_a) == Some(0),
-                    bodies.state_index(c.body_b) == Some(0),
-                ];
-            }
-            c.solve_bodies = [
-                solve_body(&bodies.solver_body(c.body_a)),
-                solve_body(&bodies.solver_body(c.body_b)),
-            ];
-            staged[k] = stage(c);
-        }
-    } else {
-        // Contacts woken after the narrowphase were not staged by it.
-        for k in scanned..n {
-            staged[k] = stage(&contacts.awake()[k]);
-        }
-    }
-    // The state index of a body (0: static or asleep) and whether the
-    // solve moves it (dynamic and awake), as the narrowphase read them.
-    let state_of = |(i, [m, inertia]): (u32, [Real; 2])| -> (u32, bool) {
-        (i, i != 0 && (m > 0.0 || inertia > 0.0))
-    };
-    // A portal copy: its contacts take the object-mass hook, in the overflow.
-    let is_copy = |body: BodyHandle| objects.iter().any(|o| o.body == body);
-    // Pass 1: the solved contacts, in contact order (colours below).
-    solver.begin();
-    let awake = contacts.awake();
-    solved.clear();
-    let key = |moving: bool, body: BodyHandle| if moving { body.index } else { NO_BODY };
-    let entry = |k: usize, record: &StagedContact| {
-        let lane = &record.lane;
-        let [m_a, i_a, m_b, i_b] = lane.inv_masses;
-        let (ia, moving_a) = state_of((lane.state_a, [m_a, i_a]));
-        let (ib, moving_b) = state_of((lane.state_b, [m_b, i_b]));
-        let copy = !objects.is_empty() && (is_copy(lane.body_a) || is_copy(lane.body_b));
-        SolvedContact {
-            index: k as u32,
-            id: record.id,
-            keys: [key(moving_a, lane.body_a), key(moving_b, lane.body_b)],
-            state: [ia, ib],
-            moving: [moving_a, moving_b],
-            copy,
-            inv_mass: [m_a, m_b],
-            cluster: [NO_CLUSTER; 2],
-            point_count: lane.point_count as u8,
-            bouncy: lane.restitution > 0.0,
-        }
-    };
-    // With threads, no hook and nothing woken since the narrowphase, the
-    // entries are made on rayon (order kept): on two threads this pass was
-    // most of what the leader did alone between the narrowphase and the
-    // solve.
-    #[cfg(feature = "parallel")]
-    let parallel = pre_solve.is_none()
-        && !woke
-        && scanned == n
-        && rayon::current_num_threads() > 1
-        && narrowphase.touching.len() >= PARALLEL_BUILD;
-    #[cfg(not(feature = "parallel"))]
-    let parallel = false;
-    if parallel {
-        #[cfg(feature = "parallel")]
-        {
-            use rayon::prelude::*;
-            let staged = &*staged;
-            // Written in place (an indexed collect): a filtering
-            // `par_extend` gathers per-thread pieces and copies them all
-            // into `solved` on one thread (0.9% of many_pyramids' samples
-            // at 2 threads). A contact whose bodies are both still is
-            // marked and dropped after (phase 1 leaves none in
-            // `touching`, so the drop is a check).
-            const STILL: u32 = u32::MAX;
-            narrowphase
-                .touching
-                .par_iter()
-                .map(|&k| {
-                    let record = &staged[k as usize];
-                    let mut s = entry(k as usize, record);
-                    if record.still == [true, true] {
-                        s.index = STILL;
-                    }
-                    s
-                })
-                .collect_into_vec(solved);
-            if solved.par_iter().any(|s| s.index == STILL) {
-                solved.retain(|s| s.index != STILL);
-            }
-        }
-    } else {
-        for k in candidates {
-            let record = &staged[k];
-            let [sa, sb] = record.still;
-            if (sa && sb) || (k >= scanned && !awake[k].is_solid_touching()) {
-                continue;
-            }
-            if let Some(hook) = pre_solve.as_mut() {
-                let c = &awake[k];
-                let velocity = |b| bodies.state(b).map_or(Vec2::ZERO, |s| s.v);
-                let mut separations = [0.0; 2];
-                for (s, p) in separations.iter_mut().zip(&c.points[..c.point_count]) {
-                    *s = p.separation;
-                }
-                let view = PreSolve {
-                    shape_a: c.shapes[0],
-                    shape_b: c.shapes[1],
-                    body_a: c.body_a,
-                    body_b: c.body_b,
-                    normal: c.normal,
-                    separations,
-                    point_count: c.point_count,
-                    velocity_a: velocity(c.body_a),
-                    velocity_b: velocity(c.body_b),
-                };
-                if !hook(&view) {
-                    continue;
-                }
-            }
-            solved.push(entry(k, record));
-        }
-    }
-    // One pass over the solved contacts: colours from the persistent
-    // graph, keyed by the bodies' slots (a contact keeps last step's colour
-    // while its moving bodies stay the same; the contacts not solved this
-    // step leave it), the counters, and whether any moving pair is light
-    // beside the other with neither body excluded (then the light clusters
-    // are looked for below). (Three passes over `solved` before: on
-    // many_pyramids at 2 threads they were most of the leader's serial
-    // build time.)
-    let graph = &mut narrowphase.graph;
-    graph.begin_step();
-    let colours = &mut narrowphase.colours;
-    colours.clear();
-    let (mut rows, mut bouncy, mut any_light) = (0, 0, false);
-    for s in solved.iter() {
-        let colour = graph.keep(s.id, s.keys);
-        // A portal copy's contacts are solved in the overflow (they keep
-        // their place in the graph).
-        colours.push(if s.copy {
-            OVERFLOW
-        } else {
-            colour.min(OVERFLOW)
-        });
-        rows += 2 * usize::from(s.point_count);
-        bouncy += usize::from(s.bouncy);
-        any_light = any_light
-            || (light_pair(s.moving, s.inv_mass)
-                && !excluded.contains(&s.state[0])
-                && !excluded.contains(&s.state[1]));
-    }
-    graph.sweep();
-    // Light clusters (`contact_group`): their contacts go to the overflow
-    // this step (keeping their place in the graph), where the solver takes
-    // each cluster's contacts as one block.
-    let cluster_of = &mut narrowphase.cluster_of;
-    cluster_of.clear();
-    if any_light {
-        narrowphase.clusters.assign(
-            bodies.states.len(),
-            solved.len(),
-            |k| {
-                let s = &solved[k];
-                ContactBodies {
-                    state: s.state,
-                    moving: s.moving,
-                    inv_mass: s.inv_mass,
-                }
-            },
-            excluded,
-            cluster_of,
-        );
-        for ((s, ids), colour) in solved
-            .iter_mut()
-            .zip(cluster_of.iter())
-            .zip(colours.iter_mut())
-        {
-            s.cluster = *ids;
-            if *ids != [NO_CLUSTER; 2] {
-                *colour = OVERFLOW;
-            }
-        }
-    }
-    // Pass 2: each contact into its colour, in contact order.
-    let (solved, staged) = (&*solved, &*staged);
-    let places = &mut narrowphase.places;
-    solver.push_all(
-        colours,
-        |i| {
-            let s = &solved[i];
-            ContactLane {
-                contact_index: s.index,
-                cluster: s.cluster,
-                ..staged[s.index as usize].lane
-            }
-        },
-        places,
-    );
-    // By contact, for storing the impulses on the threads (one thread
-    // stores by the solver's order and needs none of it).
-    let place_of = &mut narrowphase.place_of;
-    place_of.clear();
-    #[cfg(feature = "parallel")]
-    if rayon::current_num_threads() > 1 {
-        place_of.resize(n, UNSOLVED);
-        for (s, &place) in solved.iter().zip(places.iter()) {
-            place_of[s.index as usize] = place;
-        }
-    }
-    counters.contact_rows = rows;
-    counters.restitution_contacts = bouncy;
 }

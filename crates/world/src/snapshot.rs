@@ -117,8 +117,11 @@ pub mod bytes {
     /// joints and portal constraints keep the masses they loaded; 6: the
     /// contact set keeps each contact's position in its bodies' lists, and
     /// the recycling cache no longer repeats the anchors; 7: a solved
-    /// contact's colour lives only in the narrowphase's colour list).
-    pub const SNAPSHOT_VERSION: u16 = 7;
+    /// contact's colour lives only in the narrowphase's colour list; 8:
+    /// joints are stored as `Joint` (one variant per kind) with their
+    /// common solver data in `JointBase`, and the constraint graph and
+    /// solved list belong to constraint building, not the narrowphase).
+    pub const SNAPSHOT_VERSION: u16 = 8;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.

@@ -89,7 +89,9 @@ impl World {
         c.contacts
             .check(bodies, &c.shapes)
             .map_err(tag(I::Contacts))?;
-        c.narrowphase.check_graph().map_err(tag(I::Contacts))?;
+        self.contact_builder
+            .check_graph()
+            .map_err(tag(I::Contacts))?;
         self.joints.check(bodies).map_err(tag(I::Joints))?;
         self.islands.check(bodies).map_err(tag(I::Islands))?;
         self.portals.check(bodies).map_err(tag(I::Portals))?;

@@ -106,6 +106,9 @@ pub struct World {
     pub(crate) bodies: BodySet,
     pub(crate) joints: JointSet,
     pub(crate) collision: Collision,
+    /// Contact constraint building: the persistent constraint graph (kept
+    /// in snapshots) and the lanes' places.
+    pub(crate) contact_builder: crate::contact_build::ContactBuilder,
     /// The step's contact constraints in their colours and lanes (the
     /// contact solve's own data; rebuilt at every step, so not serialized).
     #[cfg_attr(feature = "serde", serde(skip))]
@@ -155,6 +158,7 @@ impl World {
             gravity: def.gravity,
             settings: def.solver,
             collision: Collision::new(bodies.owner()),
+            contact_builder: Default::default(),
             contact_solver: ContactSolver::new(),
             object_masses: Vec::new(),
             portals: PortalStage::default(),
@@ -303,6 +307,7 @@ impl World {
             bodies: self.bodies.clone(),
             joints: self.joints.clone(),
             collision: self.collision.clone(),
+            contact_builder: self.contact_builder.clone(),
             contact_solver: self.contact_solver.clone(),
             object_masses: self.object_masses.clone(),
             portals: self.portals.clone(),

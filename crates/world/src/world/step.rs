@@ -81,8 +81,8 @@ impl World {
             self.islands.apply_touch_changes(touches, &self.bodies);
             self.portals
                 .object_masses(&self.bodies, &mut self.object_masses);
-            crate::narrowphase::build_constraints(
-                &mut self.collision.narrowphase,
+            self.contact_builder.build(
+                self.collision.narrowphase.handoff(),
                 &mut self.collision.contacts,
                 &self.bodies,
                 woke,
@@ -138,10 +138,11 @@ impl World {
             // collision and the proxy update (`Collision::end_step`).
             let continuous = &mut self.continuous;
             let (no_collide, clipping) = (&self.joints.no_collide, self.portals.clipping());
+            let (builder, solver) = (&self.contact_builder, &self.contact_solver);
             let continuous_time = self.collision.end_step(
-                &self.contact_solver,
                 &mut self.bodies,
                 dt,
+                |contacts| builder.store_impulses(contacts, solver),
                 |bodies, shapes, broadphase| {
                     let start = std::time::Instant::now();
                     let input = crate::continuous::ContinuousInput {

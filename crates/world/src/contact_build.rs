@@ -1,0 +1,444 @@
+//! Contact constraint building: the solver side of the hand-off from the
+//! narrowphase.
+//!
+//! ```text
+//! narrowphase ──Handoff { touching, scanned, staged lanes }──▶ build
+//!   pass 1   the contacts the solve takes (pre-solve hook, still bodies,
+//!            portal copies), their graph keys and light-pair flags
+//!   colours  each keeps its colour in the persistent ConstraintGraph
+//!   clusters light bodies under heavy ones (contact_group)
+//!   push     lanes into the ContactSolver's colour chunks, the rest to
+//!            its overflow; places kept for storing the impulses back
+//! ```
+//!
+//! The builder owns what lives from step to step on the solver side: the
+//! graph (kept in snapshots: a step continues from its colours), the
+//! solved list and the lanes' places.
+
+use janus2d_constraints::ObjectMass;
+use janus2d_constraints::contact_group::{Clusters, ContactBodies, NO_CLUSTER, light_pair};
+use janus2d_constraints::contact_solver::{
+    ContactLane, ContactSolver, LanePlace, OVERFLOW, PointImpulse,
+};
+use janus2d_core::body::{BodyHandle, BodySet};
+use janus2d_core::graph::{ConstraintGraph, NO_BODY};
+use janus2d_core::math::{Real, Vec2};
+
+#[cfg(feature = "parallel")]
+use crate::contacts::Contact;
+use crate::contacts::ContactSet;
+use crate::narrowphase::{Handoff, PreSolve, PreSolveFn, StagedContact, solve_body, stage};
+use crate::profile::CollisionCounters;
+
+/// Touching contacts from which constraint building's first pass runs on
+/// threads (below, the tasks cost more than the pass).
+#[cfg(feature = "parallel")]
+const PARALLEL_BUILD: usize = 4096;
+
+/// [`Narrowphase::place_of`] of a contact that is not solved this step.
+#[cfg_attr(not(feature = "parallel"), allow(dead_code))]
+const UNSOLVED: LanePlace = LanePlace {
+    colour: u8::MAX,
+    lane: 0,
+    chunk: 0,
+};
+
+/// A contact the solve takes this step, as the build's first pass found it.
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+struct SolvedContact {
+    /// Index in the awake list.
+    index: u32,
+    /// The contact's id (its key in the constraint graph).
+    id: u32,
+    /// The graph's body keys: each moving body's slot ([`NO_BODY`] for a
+    /// body the solve does not move).
+    keys: [u32; 2],
+    /// State index of each body (0: static or asleep).
+    state: [u32; 2],
+    /// Whether the solve moves each body.
+    moving: [bool; 2],
+    /// A portal copy takes part: the object-mass hook, in the overflow.
+    copy: bool,
+    /// Inverse mass of each body, 1/kg (0 for one the solve does not move).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    inv_mass: [Real; 2],
+    /// The light cluster of each side (`contact_group`): with one, in the
+    /// overflow, solved with the cluster's other contacts as one block.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    cluster: [u32; 2],
+    /// Its manifold's point count (two solver rows each).
+    point_count: u8,
+    /// Its restitution is positive.
+    bouncy: bool,
+}
+
+/// Constraint building's state: the persistent constraint graph and the
+/// buffers it reuses from step to step.
+#[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub(crate) struct ContactBuilder {
+    /// The contacts solved this step, in contact order.
+    solved: Vec<SolvedContact>,
+    /// Their colours, in the same order (the solver's `push_all` input).
+    colours: Vec<u8>,
+    /// Where the solver put each solved contact, in `solved` order.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    places: Vec<LanePlace>,
+    /// The same by awake position ([`UNSOLVED`] for a contact the solve
+    /// does not take), for storing the impulses back in contact order.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    place_of: Vec<LanePlace>,
+    /// The persistent colours of the solved contacts (kept in snapshots:
+    /// the colours are part of the state a step continues from).
+    graph: ConstraintGraph,
+    /// The light clusters of the solved contacts (scratch of the build).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    clusters: Clusters,
+    /// Their clusters, per solved contact (scratch of the build).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    cluster_of: Vec<[u32; 2]>,
+    /// State indices of the bodies no cluster may hold (scratch of the
+    /// build).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    excluded: Vec<u32>,
+}
+
+impl ContactBuilder {
+    /// Checks the persistent constraint graph (every body's colour bits
+    /// are its contacts' colours; no colour holds a body twice).
+    pub(crate) fn check_graph(&self) -> Result<(), String> {
+        self.graph
+            .check()
+            .map_err(|e| format!("constraint graph: {e}"))
+    }
+
+    /// Whether a place holds a solved contact.
+    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
+    pub(crate) fn is_solved(place: &LanePlace) -> bool {
+        *place != UNSOLVED
+    }
+}
+
+impl ContactBuilder {
+    /// Builds the contact constraints of touching solid awake contacts, in
+    /// their colours.
+    ///
+    /// Colours come from the persistent [`ConstraintGraph`]: a contact keeps
+    /// its colour while it is solved and its moving bodies stay the same.
+    /// Contacts with one moving body (against the ground) take colours from
+    /// [`janus2d_core::graph::STATIC_FIRST`] up, after the pairs of moving
+    /// bodies, so each Gauss–Seidel sweep ends near the ground: the support a
+    /// stack stands on has the last word (Box2D v3 likewise keeps static
+    /// contacts out of its first graph colours).
+    ///
+    /// Whether a body reads as static was noted by the narrowphase
+    /// ([`Contact::still`]); a contact whose two bodies are still is skipped.
+    /// When islands were woken after the narrowphase (`woke`), contacts that
+    /// read still are checked again.
+    pub(crate) fn build(
+        &mut self,
+        handoff: Handoff<'_>,
+        contacts: &mut ContactSet,
+        bodies: &BodySet,
+        woke: bool,
+        objects: &[ObjectMass],
+        driven: impl Iterator<Item = BodyHandle>,
+        mut pre_solve: Option<&mut PreSolveFn>,
+        solver: &mut ContactSolver,
+        counters: &mut CollisionCounters,
+    ) {
+        let solved = &mut self.solved;
+        let staged = handoff.staged;
+        // The contacts to look at: those the narrowphase found touching, then
+        // any woken (appended) since.
+        let n = contacts.awake().len();
+        let scanned = handoff.scanned.min(n);
+        let woken = scanned..n;
+        if staged.len() < n {
+            staged.resize(n, StagedContact::default());
+        }
+        // A light pair with a body a motor turns or a portal object's body
+        // makes no cluster: every cluster it marks touches that body and is
+        // blocked (`Clusters::assign`), so without another light pair the
+        // clusters are all empty and are not looked for (spinner: its paddle).
+        // A body a motor turns and a portal object's bodies take no part in a
+        // light cluster (`Clusters::assign`).
+        let excluded = &mut self.excluded;
+        excluded.clear();
+        for body in driven.chain(objects.iter().map(|o| o.body)) {
+            if let Some(i) = bodies.state_index(body).filter(|&i| i != 0) {
+                excluded.push(i);
+            }
+        }
+        let candidates = handoff.touching.iter().map(|&k| k as usize).chain(woken);
+        if woke {
+            // Woken bodies have new state indices, and woken contacts were not
+            // read by this step's narrowphase: read their bodies again.
+            for k in candidates.clone() {
+                let c = contacts.awake_mut(k);
+                if c.still == [true, true] {
+                    c.still = [
+                        bodies.state_index(c.body_a) == Some(0),
+                        bodies.state_index(c.body_b) == Some(0),
+                    ];
+                }
+                c.solve_bodies = [
+                    solve_body(&bodies.solver_body(c.body_a)),
+                    solve_body(&bodies.solver_body(c.body_b)),
+                ];
+                staged[k] = stage(c);
+            }
+        } else {
+            // Contacts woken after the narrowphase were not staged by it.
+            for k in scanned..n {
+                staged[k] = stage(&contacts.awake()[k]);
+            }
+        }
+        // The state index of a body (0: static or asleep) and whether the
+        // solve moves it (dynamic and awake), as the narrowphase read them.
+        let state_of = |(i, [m, inertia]): (u32, [Real; 2])| -> (u32, bool) {
+            (i, i != 0 && (m > 0.0 || inertia > 0.0))
+        };
+        // A portal copy: its contacts take the object-mass hook, in the overflow.
+        let is_copy = |body: BodyHandle| objects.iter().any(|o| o.body == body);
+        // Pass 1: the solved contacts, in contact order (colours below).
+        solver.begin();
+        let awake = contacts.awake();
+        solved.clear();
+        let key = |moving: bool, body: BodyHandle| if moving { body.index } else { NO_BODY };
+        let entry = |k: usize, record: &StagedContact| {
+            let lane = &record.lane;
+            let [m_a, i_a, m_b, i_b] = lane.inv_masses;
+            let (ia, moving_a) = state_of((lane.state_a, [m_a, i_a]));
+            let (ib, moving_b) = state_of((lane.state_b, [m_b, i_b]));
+            let copy = !objects.is_empty() && (is_copy(lane.body_a) || is_copy(lane.body_b));
+            SolvedContact {
+                index: k as u32,
+                id: record.id,
+                keys: [key(moving_a, lane.body_a), key(moving_b, lane.body_b)],
+                state: [ia, ib],
+                moving: [moving_a, moving_b],
+                copy,
+                inv_mass: [m_a, m_b],
+                cluster: [NO_CLUSTER; 2],
+                point_count: lane.point_count as u8,
+                bouncy: lane.restitution > 0.0,
+            }
+        };
+        // With threads, no hook and nothing woken since the narrowphase, the
+        // entries are made on rayon (order kept): on two threads this pass was
+        // most of what the leader did alone between the narrowphase and the
+        // solve.
+        #[cfg(feature = "parallel")]
+        let parallel = pre_solve.is_none()
+            && !woke
+            && scanned == n
+            && rayon::current_num_threads() > 1
+            && handoff.touching.len() >= PARALLEL_BUILD;
+        #[cfg(not(feature = "parallel"))]
+        let parallel = false;
+        if parallel {
+            #[cfg(feature = "parallel")]
+            {
+                use rayon::prelude::*;
+                let staged = &*staged;
+                // Written in place (an indexed collect): a filtering
+                // `par_extend` gathers per-thread pieces and copies them all
+                // into `solved` on one thread (0.9% of many_pyramids' samples
+                // at 2 threads). A contact whose bodies are both still is
+                // marked and dropped after (phase 1 leaves none in
+                // `touching`, so the drop is a check).
+                const STILL: u32 = u32::MAX;
+                handoff
+                    .touching
+                    .par_iter()
+                    .map(|&k| {
+                        let record = &staged[k as usize];
+                        let mut s = entry(k as usize, record);
+                        if record.still == [true, true] {
+                            s.index = STILL;
+                        }
+                        s
+                    })
+                    .collect_into_vec(solved);
+                if solved.par_iter().any(|s| s.index == STILL) {
+                    solved.retain(|s| s.index != STILL);
+                }
+            }
+        } else {
+            for k in candidates {
+                let record = &staged[k];
+                let [sa, sb] = record.still;
+                if (sa && sb) || (k >= scanned && !awake[k].is_solid_touching()) {
+                    continue;
+                }
+                if let Some(hook) = pre_solve.as_mut() {
+                    let c = &awake[k];
+                    let velocity = |b| bodies.state(b).map_or(Vec2::ZERO, |s| s.v);
+                    let mut separations = [0.0; 2];
+                    for (s, p) in separations.iter_mut().zip(&c.points[..c.point_count]) {
+                        *s = p.separation;
+                    }
+                    let view = PreSolve {
+                        shape_a: c.shapes[0],
+                        shape_b: c.shapes[1],
+                        body_a: c.body_a,
+                        body_b: c.body_b,
+                        normal: c.normal,
+                        separations,
+                        point_count: c.point_count,
+                        velocity_a: velocity(c.body_a),
+                        velocity_b: velocity(c.body_b),
+                    };
+                    if !hook(&view) {
+                        continue;
+                    }
+                }
+                solved.push(entry(k, record));
+            }
+        }
+        // One pass over the solved contacts: colours from the persistent
+        // graph, keyed by the bodies' slots (a contact keeps last step's colour
+        // while its moving bodies stay the same; the contacts not solved this
+        // step leave it), the counters, and whether any moving pair is light
+        // beside the other with neither body excluded (then the light clusters
+        // are looked for below). (Three passes over `solved` before: on
+        // many_pyramids at 2 threads they were most of the leader's serial
+        // build time.)
+        let graph = &mut self.graph;
+        graph.begin_step();
+        let colours = &mut self.colours;
+        colours.clear();
+        let (mut rows, mut bouncy, mut any_light) = (0, 0, false);
+        for s in solved.iter() {
+            let colour = graph.keep(s.id, s.keys);
+            // A portal copy's contacts are solved in the overflow (they keep
+            // their place in the graph).
+            colours.push(if s.copy {
+                OVERFLOW
+            } else {
+                colour.min(OVERFLOW)
+            });
+            rows += 2 * usize::from(s.point_count);
+            bouncy += usize::from(s.bouncy);
+            any_light = any_light
+                || (light_pair(s.moving, s.inv_mass)
+                    && !excluded.contains(&s.state[0])
+                    && !excluded.contains(&s.state[1]));
+        }
+        graph.sweep();
+        // Light clusters (`contact_group`): their contacts go to the overflow
+        // this step (keeping their place in the graph), where the solver takes
+        // each cluster's contacts as one block.
+        let cluster_of = &mut self.cluster_of;
+        cluster_of.clear();
+        if any_light {
+            self.clusters.assign(
+                bodies.states.len(),
+                solved.len(),
+                |k| {
+                    let s = &solved[k];
+                    ContactBodies {
+                        state: s.state,
+                        moving: s.moving,
+                        inv_mass: s.inv_mass,
+                    }
+                },
+                excluded,
+                cluster_of,
+            );
+            for ((s, ids), colour) in solved
+                .iter_mut()
+                .zip(cluster_of.iter())
+                .zip(colours.iter_mut())
+            {
+                s.cluster = *ids;
+                if *ids != [NO_CLUSTER; 2] {
+                    *colour = OVERFLOW;
+                }
+            }
+        }
+        // Pass 2: each contact into its colour, in contact order.
+        let (solved, staged) = (&*solved, &*staged);
+        let places = &mut self.places;
+        solver.push_all(
+            colours,
+            |i| {
+                let s = &solved[i];
+                ContactLane {
+                    contact_index: s.index,
+                    cluster: s.cluster,
+                    ..staged[s.index as usize].lane
+                }
+            },
+            places,
+        );
+        // By contact, for storing the impulses on the threads (one thread
+        // stores by the solver's order and needs none of it).
+        let place_of = &mut self.place_of;
+        place_of.clear();
+        #[cfg(feature = "parallel")]
+        if rayon::current_num_threads() > 1 {
+            place_of.resize(n, UNSOLVED);
+            for (s, &place) in solved.iter().zip(places.iter()) {
+                place_of[s.index as usize] = place;
+            }
+        }
+        counters.contact_rows = rows;
+        counters.restitution_contacts = bouncy;
+    }
+
+    /// Copies solved impulses back into the contacts (for warm starting);
+    /// `places` is where the solver holds each awake contact's impulses
+    /// (`place_of`). Touches only the contacts: it runs beside continuous
+    /// collision and the proxy update (`Collision::end_step`).
+    pub(crate) fn store_impulses(&self, contacts: &mut ContactSet, solver: &ContactSolver) {
+        let places = &self.place_of[..];
+        #[cfg(not(feature = "parallel"))]
+        let _ = places;
+        // A non-finite impulse (a solve that blew up) is not kept for warm
+        // starting: the contact starts cold next step instead of carrying
+        // NaN into it.
+        let finite = |x: Real| if x.is_finite() { x } else { 0.0 };
+        let keep = |p: &mut crate::contacts::ContactPointData, impulse: PointImpulse| {
+            p.normal_impulse = finite(impulse.normal);
+            p.tangent_impulse = finite(impulse.tangent);
+            p.total_normal_impulse = finite(impulse.total_normal);
+            p.total_tangent_impulse = finite(impulse.total_tangent);
+        };
+        #[cfg(feature = "parallel")]
+        {
+            if rayon::current_num_threads() > 1
+                && places.len() > 4096
+                && places.len() == contacts.awake().len()
+            {
+                // On the threads, in contact order: each contact written
+                // once, in place, reading its lanes from the chunks. (On one
+                // thread the scatter below measured faster: 6.8% of
+                // many_pyramids' samples against 10.2% for this gather.)
+                use rayon::prelude::*;
+                let store = |(c, place): (&mut Contact, &LanePlace)| {
+                    if Self::is_solved(place) {
+                        for i in 0..c.point_count {
+                            keep(&mut c.points[i], solver.point_impulse_at(*place, i));
+                        }
+                    }
+                };
+                contacts
+                    .awake_slice_mut()
+                    .par_iter_mut()
+                    .zip(places.par_iter())
+                    .with_min_len(1024)
+                    .for_each(store);
+                return;
+            }
+        }
+        solver.for_each_impulse(|index, point, impulse| {
+            keep(
+                &mut contacts.awake_mut(index as usize).points[point],
+                impulse,
+            );
+        });
+    }
+}
