@@ -136,10 +136,12 @@ impl ContactConstraint {
     /// Applies the impulses kept from the last step, `Δv = M⁻¹ Jᵀ λ`.
     pub(crate) fn apply_warm_start(&mut self, states: &mut [BodyState]) {
         let (ia, ib) = (self.state_a as usize, self.state_b as usize);
+        let push = self.rows.warm_start();
         let mut a = Velocity::of(&states[ia]);
-        let mut b = Velocity::of(&states[ib]);
-        self.rows.warm_start(&mut a, &mut b);
+        self.rows.push_a(&push, &mut a);
         a.store(&mut states[ia]);
+        let mut b = Velocity::of(&states[ib]);
+        self.rows.push_b(&push, &mut b);
         b.store(&mut states[ib]);
     }
 

@@ -241,6 +241,17 @@ pub(crate) struct ContactRows<L: Lane> {
     pub(crate) step_base: [L; ROWS],
 }
 
+/// Impulses summed over a contact's rows, as they act on its bodies:
+/// `p = (λ₀ + λ₁) n + (λ₂ + λ₃) t` (N·s) and the angular impulses
+/// `l_a = Σ λ_k (r_a × ·)_k`, `l_b` likewise (N·m·s).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Push<L> {
+    p_x: L,
+    p_y: L,
+    l_a: L,
+    l_b: L,
+}
+
 /// `Σ x_k y_k` over the rows, as `(x₀y₀ + x₁y₁) + (x₂y₂ + x₃y₃)`.
 #[inline(always)]
 fn dot_rows<L: Lane>(x: &[L; ROWS], y: &[L; ROWS]) -> L {
@@ -396,10 +407,12 @@ impl<L: Lane> ContactRows<L> {
         self.step_base = self.impulse.map(|l| -l);
     }
 
-    /// Applies the kept impulses, `Δv = M⁻¹ Jᵀ λ`, and adds them to the
-    /// step totals.
+    /// The warm start: adds the kept impulses to the step totals and
+    /// returns them as one push, `Δv = M⁻¹ Jᵀ λ`, for
+    /// [`ContactRows::push_a`] and [`ContactRows::push_b`] (one side at a
+    /// time: the wide lanes then hold one side's velocities at once).
     #[inline(always)]
-    pub(crate) fn warm_start(&mut self, a: &mut Velocity<L>, b: &mut Velocity<L>) {
+    pub(crate) fn warm_start(&mut self) -> Push<L> {
         let (n_x, n_y) = (self.n_x, self.n_y);
         let lambda = &self.impulse;
         for (base, &l) in self.step_base.iter_mut().zip(lambda) {
@@ -407,16 +420,28 @@ impl<L: Lane> ContactRows<L> {
         }
         let (pn, pt) = (lambda[0] + lambda[1], lambda[2] + lambda[3]);
         // p = pn n + pt t with t = (n_y, −n_x).
-        let p_x = pn * n_x + pt * n_y;
-        let p_y = pn * n_y - pt * n_x;
-        let l_a = dot_rows(lambda, &self.ja);
-        let l_b = dot_rows(lambda, &self.jb);
-        a.v_x = a.v_x - self.inv_mass_a * p_x;
-        a.v_y = a.v_y - self.inv_mass_a * p_y;
-        a.w = a.w - self.inv_inertia_a * l_a;
-        b.v_x = b.v_x + self.inv_mass_b * p_x;
-        b.v_y = b.v_y + self.inv_mass_b * p_y;
-        b.w = b.w + self.inv_inertia_b * l_b;
+        Push {
+            p_x: pn * n_x + pt * n_y,
+            p_y: pn * n_y - pt * n_x,
+            l_a: dot_rows(lambda, &self.ja),
+            l_b: dot_rows(lambda, &self.jb),
+        }
+    }
+
+    /// Body a's share of a push: `v_a −= m_a⁻¹ p`, `ω_a −= i_a⁻¹ l_a`.
+    #[inline(always)]
+    pub(crate) fn push_a(&self, push: &Push<L>, a: &mut Velocity<L>) {
+        a.v_x -= self.inv_mass_a * push.p_x;
+        a.v_y -= self.inv_mass_a * push.p_y;
+        a.w -= self.inv_inertia_a * push.l_a;
+    }
+
+    /// Body b's share of a push: `v_b += m_b⁻¹ p`, `ω_b += i_b⁻¹ l_b`.
+    #[inline(always)]
+    pub(crate) fn push_b(&self, push: &Push<L>, b: &mut Velocity<L>) {
+        b.v_x += self.inv_mass_b * push.p_x;
+        b.v_y += self.inv_mass_b * push.p_y;
+        b.w += self.inv_inertia_b * push.l_b;
     }
 
     /// One velocity iteration (module docs, Evaluation): `Ċ` of every row
@@ -498,12 +523,12 @@ impl<L: Lane> ContactRows<L> {
         let p_y = pn * n_y - pt * n_x;
         let l_a = dot_rows(&d, &ja);
         let l_b = dot_rows(&d, &jb);
-        a.v_x = a.v_x - self.inv_mass_a * p_x;
-        a.v_y = a.v_y - self.inv_mass_a * p_y;
-        a.w = a.w - i_a * l_a;
-        b.v_x = b.v_x + self.inv_mass_b * p_x;
-        b.v_y = b.v_y + self.inv_mass_b * p_y;
-        b.w = b.w + i_b * l_b;
+        a.v_x -= self.inv_mass_a * p_x;
+        a.v_y -= self.inv_mass_a * p_y;
+        a.w -= i_a * l_a;
+        b.v_x += self.inv_mass_b * p_x;
+        b.v_y += self.inv_mass_b * p_y;
+        b.w += i_b * l_b;
     }
 
     /// The terms of point `i`'s normal row: the bias `b` (m/s), the mass

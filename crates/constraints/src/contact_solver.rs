@@ -883,13 +883,15 @@ impl WideContact {
         store(states, B, &b);
     }
 
-    /// [`ContactRows::warm_start`] on the lanes.
+    /// [`ContactRows::warm_start`] on the lanes, side a then side b.
     #[inline(always)]
     fn warm_start<S: LaneStates>(&mut self, states: &mut S) {
+        let push = self.rows.warm_start();
         let mut a = load_velocity(states, A);
-        let mut b = load_velocity(states, B);
-        self.rows.warm_start(&mut a, &mut b);
+        self.rows.push_a(&push, &mut a);
         store(states, A, &a);
+        let mut b = load_velocity(states, B);
+        self.rows.push_b(&push, &mut b);
         store(states, B, &b);
     }
 
