@@ -72,7 +72,7 @@
 //! K' λ' = K λ − (Ċ + b),   K' = K + diag(k_rr (1 / s_m,r − 1))
 //! ```
 //!
-//! the manifold block of `contact.rs` over several manifolds (`b`: `s / h`
+//! the manifold block of [`crate::contact_row`] over several manifolds (`b`: `s / h`
 //! speculative, `max(β s, −v_push)` soft, `max(s / h, 0)` relaxing, `s_m
 //! = 1` where rigid). It is solved by Cholesky in `f64` (`K` mixes the light
 //! body's and the heavy body's inverse masses, a condition number of about
@@ -107,6 +107,7 @@ use janus2d_core::math::{Real, from_f64, to_f64};
 use janus2d_core::union_find::{find, union};
 
 use crate::contact::ContactConstraint;
+use crate::contact_row::Delta;
 
 /// How much heavier a moving neighbour makes a body light (dimensionless):
 /// its contacts are solved as one coupled group.
@@ -323,7 +324,7 @@ impl Groups {
         let mut full = false;
         for (k, c) in overflow.iter().enumerate() {
             let pair = ids(k);
-            let [m_a, i_a, m_b, i_b] = c.applied_masses;
+            let [m_a, i_a, m_b, i_b] = c.applied_masses();
             for s in 0..2 {
                 let id = pair[s];
                 if id == NO_CLUSTER || (s == 1 && pair[0] == id) {
@@ -370,7 +371,7 @@ impl Groups {
                 self.grouped[k as usize] = true;
                 let pair = ids(k as usize);
                 let c = &mut overflow[k as usize];
-                let masses = c.applied_masses;
+                let masses = c.applied_masses();
                 c.stiffen_for_group(ctx, pair.map(|id| id == g.cluster), masses, g.heavy);
             }
         }
@@ -378,7 +379,9 @@ impl Groups {
 }
 
 /// One group's friction rows one by one, then its normal rows as one
-/// block (module docs). Returns false where the block is singular: the
+/// block (module docs). The friction rows and each normal row's bias and
+/// mass scale are the contact rows' own (`ContactRows::friction_row`,
+/// `ContactRows::normal_terms`); only the block is the group's. Returns false where the block is singular: the
 /// caller then solves the members one by one (their friction rows again).
 pub(crate) fn solve_group<const USE_BIAS: bool>(
     group: &ContactGroup,
@@ -406,18 +409,25 @@ pub(crate) fn solve_group<const USE_BIAS: bool>(
     // Each row's two sides: (state, σ n, a, m⁻¹, i⁻¹), in f64.
     let side = |k: usize, i: usize| {
         let c = &overflow[k];
-        let [m_a, i_a, m_b, i_b] = c.applied_masses;
-        let (nx, ny) = (to_f64(c.normal.x), to_f64(c.normal.y));
+        let [m_a, i_a, m_b, i_b] = c.applied_masses();
+        let (nx, ny) = (to_f64(c.rows.n_x), to_f64(c.rows.n_y));
         [
             (
                 c.state_a,
                 -nx,
                 -ny,
-                -to_f64(c.ja[i]),
+                -to_f64(c.rows.ja[i]),
                 to_f64(m_a),
                 to_f64(i_a),
             ),
-            (c.state_b, nx, ny, to_f64(c.jb[i]), to_f64(m_b), to_f64(i_b)),
+            (
+                c.state_b,
+                nx,
+                ny,
+                to_f64(c.rows.jb[i]),
+                to_f64(m_b),
+                to_f64(i_b),
+            ),
         ]
     };
     let mut sides = [[(0u32, 0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64); 2]; GROUP_ROWS];
@@ -449,11 +459,12 @@ pub(crate) fn solve_group<const USE_BIAS: bool>(
         let (k, i) = rows[r];
         let c = &overflow[k];
         let (sa, sb) = (&states[c.state_a as usize], &states[c.state_b as usize]);
-        let nrm = c.normal;
-        let c_dot = (sb.v - sa.v).dot(nrm) + (sb.w * c.jb[i] - sa.w * c.ja[i]);
+        let (nrm, rows) = (c.normal(), &c.rows);
+        let c_dot = (sb.v - sa.v).dot(nrm) + (sb.w * rows.jb[i] - sa.w * rows.ja[i]);
         let dpn = (sb.dp - sa.dp).dot(nrm);
-        let (bias, ms, _) = c.normal_terms::<USE_BIAS>(i, dpn, sa.dq, sb.dq, inv_h, push_max);
-        old[r] = to_f64(c.impulse[i]);
+        let (da, db) = (Delta::of(sa), Delta::of(sb));
+        let (bias, ms, _) = rows.normal_terms::<USE_BIAS>(i, dpn, &da, &db, inv_h, push_max);
+        old[r] = to_f64(rows.impulse[i]);
         rhs[r] = -(to_f64(c_dot) + to_f64(bias));
         diag[r] = k_mat[r][r] / to_f64(ms);
     }
@@ -517,11 +528,12 @@ pub(crate) fn solve_group<const USE_BIAS: bool>(
         } else {
             0.0
         };
-        let d = to_f64(new) - to_f64(c.impulse[i]);
-        let d_real = new - c.impulse[i];
-        c.impulse[i] = new;
-        if d_real > c.max_normal_impulse[i] {
-            c.max_normal_impulse[i] = d_real;
+        let rows = &mut c.rows;
+        let d = to_f64(new) - to_f64(rows.impulse[i]);
+        let d_real = new - rows.impulse[i];
+        rows.impulse[i] = new;
+        if d_real > rows.max_normal_impulse[i] {
+            rows.max_normal_impulse[i] = d_real;
         }
         for (state, x, y, ang, m, inv_i) in sides[r] {
             if state == 0 {
@@ -685,9 +697,10 @@ mod tests {
         for c in &overflow {
             let (sa, sb) = (&states[c.state_a as usize], &states[c.state_b as usize]);
             for i in 0..2 {
-                let c_dot = (sb.v - sa.v).dot(c.normal) + (sb.w * c.jb[i] - sa.w * c.ja[i]);
+                let r = &c.rows;
+                let c_dot = (sb.v - sa.v).dot(c.normal()) + (sb.w * r.jb[i] - sa.w * r.ja[i]);
                 assert!(c_dot.abs() < 1e-4, "point {i} still closes at {c_dot} m/s");
-                assert!(c.impulse[i] > 0.0);
+                assert!(r.impulse[i] > 0.0);
             }
         }
         assert!((momentum(&states) - p0).length() < 1e-2, "momentum");

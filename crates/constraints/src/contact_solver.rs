@@ -1,5 +1,6 @@
-//! The contact solve in colours and lanes: the stages of
-//! [`ContactConstraint`] run [`LANES`] contacts at a time.
+//! The contact solve in colours and lanes: the contact rows of
+//! [`crate::contact_row`] run [`LANES`] contacts at a time, the overflow
+//! one [`ContactConstraint`] at a time.
 //!
 //! ```text
 //! build      (the collision pipeline, two passes over its contacts)
@@ -23,9 +24,9 @@
 //! warm start, solve (bias), relax (no bias), restitution
 //!            colour by colour (solve and relax reversed on alternate
 //!            sweeps), chunk by chunk: gather the lanes' body states, the
-//!            row arithmetic of ContactConstraint on lanes, scatter the
-//!            velocities; then the overflow, scalar, and each light
-//!            cluster's group as one block
+//!            row code (ContactRows, the same as the overflow's) on
+//!            lanes, scatter the velocities; then the overflow, scalar,
+//!            and each light cluster's group as one block
 //! store      the impulses of every lane and overflow constraint go back to
 //!            the pipeline's contacts, by contact index
 //! ```
@@ -37,37 +38,25 @@
 //! was; so does a lane on a static or kinematic body (its inverse masses are
 //! zero, the velocity it writes back is the one it read).
 //!
-//! The lane type is `wide::f32x8` (8 lanes) with `f32` and `wide::f64x4`
-//! (4 lanes) with the `f64` feature: SIMD without `unsafe`.
+//! The lane type ([`crate::lane::Wide`]) is `wide::f32x8` (8 lanes) with
+//! `f32` and `wide::f64x4` (4 lanes) with the `f64` feature: SIMD without
+//! `unsafe`. A chunk (`WideContact`) is a data holder: the lanes' state
+//! and contact indices and their rows in structure-of-arrays form.
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState};
 use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
-use janus2d_core::math::{Real, Vec2, cross};
+use janus2d_core::math::{Real, Vec2};
 use janus2d_core::parallel::{PlannedStates, StatePlan, Team};
-use wide::{CmpEq, CmpGe, CmpGt, CmpLt, CmpNe};
 
-use crate::contact::{ContactConstraint, ContactPointInput, MAX_MANIFOLD_POINTS, ROWS};
+use crate::contact::{ContactConstraint, ContactPointInput, MAX_MANIFOLD_POINTS};
 use crate::contact_group::{Groups, solve_group};
+use crate::contact_row::{ContactRows, Delta, Velocity};
+use crate::lane::{Lane, Wide as W};
 
-/// Lanes of the SIMD type.
-#[cfg(not(feature = "f64"))]
-pub const LANES: usize = 8;
-/// Lanes of the SIMD type.
-#[cfg(feature = "f64")]
-pub const LANES: usize = 4;
-
-#[cfg(not(feature = "f64"))]
-type W = wide::f32x8;
-#[cfg(feature = "f64")]
-type W = wide::f64x4;
+pub use crate::contact_row::BLOCK_CONDITION;
+pub use crate::lane::LANES;
 
 pub use janus2d_core::graph::COLOURS;
-
-/// Largest condition number `k₀₀² / det K` at which a manifold's two normal
-/// rows are solved as one block (Box2D v2.4's block solver uses the same
-/// bound); above it the points are nearly redundant and Gauss–Seidel takes
-/// them one by one.
-pub const BLOCK_CONDITION: Real = 1000.0;
 
 /// A dynamic body that stands for a whole object (a copy crossing a
 /// portal): its contacts build their effective masses on the object's
@@ -84,21 +73,10 @@ pub struct ObjectMass {
     pub inv_inertia: Real,
 }
 
-/// The lanes' body states, gathered from the AoS states.
-struct WideBody {
-    v_x: W,
-    v_y: W,
-    w: W,
-    dp_x: W,
-    dp_y: W,
-    q_c: W,
-    q_s: W,
-}
-
-/// [`LANES`] contacts in structure-of-arrays form: what the warm start and
-/// the velocity iterations read and write. Names follow
-/// [`ContactConstraint`]: rows 0, 1 are the normal rows, 2, 3 the friction
-/// rows.
+/// [`LANES`] contacts in structure-of-arrays form: their rows
+/// ([`ContactRows`] on the wide lane type, what the warm start, the
+/// velocity iterations and restitution read and write) and which bodies
+/// and contacts the lanes hold.
 #[derive(Clone, Debug)]
 struct WideContact {
     /// State index of body a per lane (0: static identity or padding).
@@ -111,49 +89,12 @@ struct WideContact {
     len: usize,
     /// 1 where the lane's manifold has a second point, else 0.
     second: W,
-    /// Restitution coefficient.
-    restitution: W,
-    /// Normal velocity of each point before the solve (restitution), m/s.
-    relative_velocity: [W; MAX_MANIFOLD_POINTS],
-    /// Inverse masses the impulses act with, 1/kg.
-    inv_mass_a: W,
-    inv_mass_b: W,
-    /// Inverse inertias the impulses act with, 1/(kg·m²).
-    inv_inertia_a: W,
-    inv_inertia_b: W,
-    /// Unit normal from a to b.
-    n_x: W,
-    n_y: W,
-    /// Angular Jacobian parts `r_a × n`, `r_a × t` per row, m.
-    ja: [W; ROWS],
-    /// Angular Jacobian parts `r_b × n`, `r_b × t` per row, m.
-    jb: [W; ROWS],
-    /// Rigid effective mass per row, kg.
-    mass: [W; ROWS],
-    /// Soft impulse scale per normal row.
-    impulse_scale: [W; MAX_MANIFOLD_POINTS],
-    /// Diagonal `[k₀₀, k₁₁]` of the two normal rows' `K`, 1/kg.
-    block_k: [W; 2],
-    /// Mask: the lane's two normal rows are solved as one block (two
-    /// points and a well-conditioned `K`).
-    block: W,
-    /// Separation at zero deltas, m.
-    base_separation: [W; MAX_MANIFOLD_POINTS],
-    /// Friction coefficient.
-    friction: W,
-    /// Soft bias rate, 1/s.
-    bias_rate: W,
-    /// Accumulated impulse per row, N·s.
-    impulse: [W; ROWS],
-    /// Largest normal impulse increment (restitution gate), N·s.
-    max_normal_impulse: [W; MAX_MANIFOLD_POINTS],
-    /// Step totals less the current impulse: `Σ_warm starts λ − λ_prepare`
-    /// per row, N·s (see [`PointImpulse`]).
-    step_base: [W; ROWS],
     /// Bit `k`: lane `k`'s body a is moved by the solve (dynamic and
     /// awake); bit `LANES + k`: its body b. The parallel stages write only
     /// these.
     moving: u32,
+    /// The rows of the lanes' contacts.
+    rows: ContactRows<W>,
 }
 
 /// The impulses of one manifold point after a step, N·s.
@@ -435,13 +376,13 @@ impl ContactSolver {
         }
         let chunk = &self.colours[place.colour as usize][place.chunk as usize];
         let k = place.lane as usize;
-        let lane = |w: &W| w.as_array_ref()[k];
-        let (n, t) = (lane(&chunk.impulse[point]), lane(&chunk.impulse[point + 2]));
+        let rows = &chunk.rows;
+        let (n, t) = (rows.impulse[point].lane(k), rows.impulse[point + 2].lane(k));
         PointImpulse {
             normal: n,
             tangent: t,
-            total_normal: lane(&chunk.step_base[point]) + n,
-            total_tangent: lane(&chunk.step_base[point + 2]) + t,
+            total_normal: rows.step_base[point].lane(k) + n,
+            total_tangent: rows.step_base[point + 2].lane(k) + t,
         }
     }
 
@@ -450,8 +391,8 @@ impl ContactSolver {
     /// and the step's totals.
     pub fn for_each_impulse(&self, mut store: impl FnMut(u32, usize, PointImpulse)) {
         for chunk in self.colours.iter().flatten() {
-            let impulse = chunk.impulse.map(W::to_array);
-            let base = chunk.step_base.map(W::to_array);
+            let impulse = chunk.rows.impulse.map(W::to_array);
+            let base = chunk.rows.step_base.map(W::to_array);
             let second = chunk.second.to_array();
             for k in 0..chunk.len {
                 let points = if second[k] > 0.0 { 2 } else { 1 };
@@ -482,8 +423,8 @@ impl ContactSolver {
     /// pushed (a positive normal impulse increment).
     pub fn for_each_approach(&self, threshold: Real, mut hit: impl FnMut(u32, usize, Real)) {
         for chunk in self.colours.iter().flatten() {
-            let approach = chunk.relative_velocity.map(W::to_array);
-            let pushed = chunk.max_normal_impulse.map(W::to_array);
+            let approach = chunk.rows.relative_velocity.map(W::to_array);
+            let pushed = chunk.rows.max_normal_impulse.map(W::to_array);
             let second = chunk.second.to_array();
             for k in 0..chunk.len {
                 let points = if second[k] > 0.0 { 2 } else { 1 };
@@ -497,8 +438,8 @@ impl ContactSolver {
         }
         for c in &self.overflow {
             for i in 0..c.point_count() {
-                let speed = -c.relative_velocity[i];
-                if speed > threshold && c.max_normal_impulse[i] > 0.0 {
+                let speed = -c.rows.relative_velocity[i];
+                if speed > threshold && c.rows.max_normal_impulse[i] > 0.0 {
                     hit(c.contact_index, i, speed);
                 }
             }
@@ -554,14 +495,14 @@ impl ContactSolver {
             let (oa, ob) = (find(c.body_a), find(c.body_b));
             self.hooked.push(oa.is_some() || ob.is_some());
             if oa.is_some() || ob.is_some() {
-                let [m_a, i_a, m_b, i_b] = c.applied_masses;
+                let [m_a, i_a, m_b, i_b] = c.applied_masses();
                 let (m_a, i_a) = oa.map_or((m_a, i_a), |o| (o.inv_mass, o.inv_inertia));
                 let (m_b, i_b) = ob.map_or((m_b, i_b), |o| (o.inv_mass, o.inv_inertia));
                 c.prepare_rows(ctx, bodies, [m_a, i_a, m_b, i_b]);
                 // The object masses stand for the copy and its twin joined
                 // by the portal rows, not for the copy alone: the two points
                 // are solved one by one, not as one block.
-                c.block = false;
+                c.rows.block = false;
             }
         }
         self.groups.build(
@@ -645,7 +586,7 @@ impl ContactSolver {
     }
 
     fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState], team: &Team) {
-        let threshold = splat(ctx.restitution_threshold);
+        let threshold = W::splat(ctx.restitution_threshold);
         let stage = Stage::Restitution { threshold };
         for (colour, chunks) in self.colours.iter_mut().enumerate() {
             colour_stage(team, &self.plan, colour, chunks, states, stage);
@@ -746,17 +687,6 @@ fn colour_stage(
     });
 }
 
-#[inline(always)]
-fn splat(x: Real) -> W {
-    W::splat(x)
-}
-
-/// `x` clamped to `[lo, hi]` lane by lane.
-#[inline(always)]
-fn clamp_w(x: W, lo: W, hi: W) -> W {
-    x.fast_max(lo).fast_min(hi)
-}
-
 /// Side a of a lane (its first body).
 const A: usize = 0;
 /// Side b of a lane.
@@ -807,8 +737,9 @@ impl LaneStates for PlannedStates<'_, PLAN_SLOTS> {
     }
 }
 
+/// The lanes' velocities and position deltas on side `side`.
 #[inline(always)]
-fn load<S: LaneStates>(states: &S, side: usize) -> WideBody {
+fn load<S: LaneStates>(states: &S, side: usize) -> (Velocity<W>, Delta<W>) {
     let mut v_x = [0.0; LANES];
     let mut v_y = [0.0; LANES];
     let mut w = [0.0; LANES];
@@ -826,20 +757,24 @@ fn load<S: LaneStates>(states: &S, side: usize) -> WideBody {
         q_c[k] = s.dq.c;
         q_s[k] = s.dq.s;
     }
-    WideBody {
-        v_x: W::from(v_x),
-        v_y: W::from(v_y),
-        w: W::from(w),
-        dp_x: W::from(dp_x),
-        dp_y: W::from(dp_y),
-        q_c: W::from(q_c),
-        q_s: W::from(q_s),
-    }
+    (
+        Velocity {
+            v_x: W::from(v_x),
+            v_y: W::from(v_y),
+            w: W::from(w),
+        },
+        Delta {
+            dp_x: W::from(dp_x),
+            dp_y: W::from(dp_y),
+            q_c: W::from(q_c),
+            q_s: W::from(q_s),
+        },
+    )
 }
 
 /// The lanes' velocities only (the warm start needs no position deltas).
 #[inline(always)]
-fn load_velocity<S: LaneStates>(states: &S, side: usize) -> (W, W, W) {
+fn load_velocity<S: LaneStates>(states: &S, side: usize) -> Velocity<W> {
     let mut v_x = [0.0; LANES];
     let mut v_y = [0.0; LANES];
     let mut w = [0.0; LANES];
@@ -849,13 +784,17 @@ fn load_velocity<S: LaneStates>(states: &S, side: usize) -> (W, W, W) {
         v_y[k] = s.v.y;
         w[k] = s.w;
     }
-    (W::from(v_x), W::from(v_y), W::from(w))
+    Velocity {
+        v_x: W::from(v_x),
+        v_y: W::from(v_y),
+        w: W::from(w),
+    }
 }
 
 /// Writes the lanes' velocities back.
 #[inline(always)]
-fn store<S: LaneStates>(states: &mut S, side: usize, v_x: W, v_y: W, w: W) {
-    let (v_x, v_y, w) = (v_x.to_array(), v_y.to_array(), w.to_array());
+fn store<S: LaneStates>(states: &mut S, side: usize, v: &Velocity<W>) {
+    let (v_x, v_y, w) = (v.v_x.to_array(), v.v_y.to_array(), v.w.to_array());
     for k in 0..LANES {
         states.store(side, k, Vec2::new(v_x[k], v_y[k]), w[k]);
     }
@@ -863,7 +802,7 @@ fn store<S: LaneStates>(states: &mut S, side: usize, v_x: W, v_y: W, w: W) {
 
 /// The lanes' velocities from the state slice (prepare).
 #[inline(always)]
-fn gather_velocity(states: &[BodyState], index: &[u32; LANES]) -> (W, W, W) {
+fn gather_velocity(states: &[BodyState], index: &[u32; LANES]) -> Velocity<W> {
     let mut v_x = [0.0; LANES];
     let mut v_y = [0.0; LANES];
     let mut w = [0.0; LANES];
@@ -873,46 +812,29 @@ fn gather_velocity(states: &[BodyState], index: &[u32; LANES]) -> (W, W, W) {
         v_y[k] = s.v.y;
         w[k] = s.w;
     }
-    (W::from(v_x), W::from(v_y), W::from(w))
+    Velocity {
+        v_x: W::from(v_x),
+        v_y: W::from(v_y),
+        w: W::from(w),
+    }
 }
 
 impl WideContact {
     /// The zero chunk: every lane a padding lane.
     fn empty() -> Self {
-        let z = W::splat(0.0);
         WideContact {
             state_a: [0; LANES],
             state_b: [0; LANES],
             contact: [u32::MAX; LANES],
             len: 0,
-            second: z,
-            restitution: z,
-            relative_velocity: [z; MAX_MANIFOLD_POINTS],
-            inv_mass_a: z,
-            inv_mass_b: z,
-            inv_inertia_a: z,
-            inv_inertia_b: z,
-            n_x: z,
-            n_y: z,
-            ja: [z; ROWS],
-            jb: [z; ROWS],
-            mass: [z; ROWS],
-            impulse_scale: [z; MAX_MANIFOLD_POINTS],
-            block_k: [z; 2],
-            block: z,
-            base_separation: [z; MAX_MANIFOLD_POINTS],
-            friction: z,
-            bias_rate: z,
-            impulse: [z; ROWS],
-            max_normal_impulse: [z; MAX_MANIFOLD_POINTS],
-            step_base: [z; ROWS],
+            second: W::splat(0.0),
             moving: 0,
+            rows: ContactRows::empty(),
         }
     }
 
-    /// Writes a contact into the next free lane: the Jacobian's angular
-    /// parts from the anchors (as `ContactConstraint::new`), the kept
-    /// impulses, the masses.
+    /// Writes a contact into the next free lane
+    /// ([`ContactRows::set_lane`]).
     fn push(&mut self, lane: &ContactLane, count: usize) {
         let k = self.len;
         self.len += 1;
@@ -926,170 +848,54 @@ impl WideContact {
             self.moving |= 1 << (LANES + k);
         }
         self.contact[k] = lane.contact_index;
-        let [m_a, i_a, m_b, i_b] = lane.inv_masses;
-        self.inv_mass_a.as_array_mut()[k] = m_a;
-        self.inv_inertia_a.as_array_mut()[k] = i_a;
-        self.inv_mass_b.as_array_mut()[k] = m_b;
-        self.inv_inertia_b.as_array_mut()[k] = i_b;
-        let n = lane.normal;
-        let t = Vec2::new(n.y, -n.x);
-        self.n_x.as_array_mut()[k] = n.x;
-        self.n_y.as_array_mut()[k] = n.y;
-        self.friction.as_array_mut()[k] = lane.friction;
-        self.restitution.as_array_mut()[k] = lane.restitution;
-        self.second.as_array_mut()[k] = if count > 1 { 1.0 } else { 0.0 };
-        for (i, p) in lane.points[..count].iter().enumerate() {
-            let (r_a, r_b) = (p.anchor_a, p.anchor_b);
-            let (rt_a, rt_b) = (cross(r_a, t), cross(r_b, t));
-            self.ja[i].as_array_mut()[k] = cross(r_a, n);
-            self.jb[i].as_array_mut()[k] = cross(r_b, n);
-            self.ja[i + 2].as_array_mut()[k] = rt_a;
-            self.jb[i + 2].as_array_mut()[k] = rt_b;
-            // r · n = −(r × t).
-            self.base_separation[i].as_array_mut()[k] = p.separation + (rt_b - rt_a);
-            self.impulse[i].as_array_mut()[k] = p.normal_impulse;
-            self.impulse[i + 2].as_array_mut()[k] = p.tangent_impulse;
-        }
+        self.second.set_lane(k, if count > 1 { 1.0 } else { 0.0 });
+        self.rows.set_lane(
+            k,
+            lane.normal,
+            &lane.points[..count],
+            lane.friction,
+            lane.restitution,
+            lane.inv_masses,
+        );
     }
 
-    /// Effective masses, the mass-ratio softness of each normal row and the
-    /// approach speeds, lane-wise (the arithmetic of
-    /// `ContactConstraint::prepare`).
+    /// [`ContactRows::prepare`] on the lanes, with the masses the impulses
+    /// act with.
     fn prepare(&mut self, ctx: &StepContext, states: &[BodyState]) {
-        let zero = W::splat(0.0);
-        let one = W::splat(1.0);
-        let (m_a, i_a) = (self.inv_mass_a, self.inv_inertia_a);
-        let (m_b, i_b) = (self.inv_mass_b, self.inv_inertia_b);
-        // A pair with a static (or kinematic, or sleeping) body.
-        let static_pair = m_a.cmp_eq(zero) | m_b.cmp_eq(zero);
-        let (sc, ss) = (ctx.contact_softness, ctx.static_softness);
-        self.bias_rate = static_pair.blend(splat(ss.bias_rate), splat(sc.bias_rate));
-        let rho_max = ctx.contact_mass_ratio_cap;
-        let stiffen = rho_max > 1.0 && sc.impulse_scale > 0.0;
-        let a2 = if sc.impulse_scale > 0.0 {
-            sc.mass_scale / sc.impulse_scale
-        } else {
-            0.0
-        };
-        let (v_xa, v_ya, w_a) = gather_velocity(states, &self.state_a);
-        let (v_xb, v_yb, w_b) = gather_velocity(states, &self.state_b);
-        let dvn = (v_xb - v_xa) * self.n_x + (v_yb - v_ya) * self.n_y;
-        let keep = [one, self.second];
-        for i in 0..MAX_MANIFOLD_POINTS {
-            let (rn_a, rn_b) = (self.ja[i], self.jb[i]);
-            let (rt_a, rt_b) = (self.ja[i + 2], self.jb[i + 2]);
-            let k_a = m_a + i_a * rn_a * rn_a;
-            let k_b = m_b + i_b * rn_b * rn_b;
-            let k = k_a + k_b;
-            let normal_mass = k.cmp_gt(zero).blend(one / k, zero) * keep[i];
-            // Softness::with_mass_ratio on lanes: ρ = min(k / min(k_a, k_b), ρ_max).
-            // Only the impulse scale is kept: the mass scale is 1 − s_i.
-            let mut impulse_scale = splat(sc.impulse_scale);
-            if stiffen {
-                let k_heavy = k_a.fast_min(k_b);
-                let rho = (k / k_heavy).fast_min(splat(rho_max));
-                let stiffer = k_heavy.cmp_gt(zero) & rho.cmp_gt(one);
-                let scaled = one / (one + rho * splat(a2));
-                impulse_scale = stiffer.blend(scaled, impulse_scale);
-            }
-            let impulse_scale = static_pair.blend(splat(ss.impulse_scale), impulse_scale);
-            self.mass[i] = normal_mass;
-            self.impulse_scale[i] = impulse_scale;
-            let k_t = m_a + m_b + i_a * rt_a * rt_a + i_b * rt_b * rt_b;
-            self.mass[i + 2] = k_t.cmp_gt(zero).blend(one / k_t, zero) * keep[i];
-            self.relative_velocity[i] = dvn + (w_b * rn_b - w_a * rn_a);
-            self.max_normal_impulse[i] = zero;
-        }
-        // The block of the two normal rows: K = [[k00, k01], [k01, k11]].
-        let (ja, jb) = (self.ja, self.jb);
-        let k00 = m_a + m_b + i_a * ja[0] * ja[0] + i_b * jb[0] * jb[0];
-        let k11 = m_a + m_b + i_a * ja[1] * ja[1] + i_b * jb[1] * jb[1];
-        let k01 = m_a + m_b + i_a * ja[0] * ja[1] + i_b * jb[0] * jb[1];
-        let det = k00 * k11 - k01 * k01;
-        let well_conditioned = (k00 * k00).cmp_lt(splat(BLOCK_CONDITION) * det) & det.cmp_gt(zero);
-        self.block = well_conditioned & self.second.cmp_gt(zero);
-        self.block_k = [k00, k11];
-        if !ctx.warm_starting {
-            self.impulse = [zero; ROWS];
-        }
-        self.step_base = self.impulse.map(|l| zero - l);
+        let a = gather_velocity(states, &self.state_a);
+        let b = gather_velocity(states, &self.state_b);
+        let r = &self.rows;
+        let k_masses = [r.inv_mass_a, r.inv_inertia_a, r.inv_mass_b, r.inv_inertia_b];
+        let keep = [W::splat(1.0), self.second];
+        self.rows.prepare(ctx, k_masses, keep, &a, &b);
     }
 
-    /// Restitution lane-wise, point 0 then point 1: where a point approached
-    /// faster than the threshold and pushed, drive `Ċ` to `−e · Ċ_before`.
-    /// Returns false (and leaves the outputs as they were) when no lane
-    /// has restitution.
+    /// [`ContactRows::restitution`] on the lanes (nothing where no lane
+    /// has restitution).
     fn apply_restitution<S: LaneStates>(&mut self, states: &mut S, threshold: W) {
-        let zero = W::splat(0.0);
-        if self.restitution.cmp_gt(zero).none() {
+        if !self.rows.has_restitution() {
             return;
         }
-        let (mut v_xa, mut v_ya, mut w_a) = load_velocity(states, A);
-        let (mut v_xb, mut v_yb, mut w_b) = load_velocity(states, B);
-        let (n_x, n_y) = (self.n_x, self.n_y);
-        let e = self.restitution;
-        for i in 0..MAX_MANIFOLD_POINTS {
-            let rv = self.relative_velocity[i];
-            let active = self.restitution.cmp_gt(zero)
-                & rv.cmp_lt(zero - threshold)
-                & self.max_normal_impulse[i].cmp_ne(zero);
-            if active.none() {
-                continue;
-            }
-            let (rn_a, rn_b) = (self.ja[i], self.jb[i]);
-            let c_dot = (v_xb - v_xa) * n_x + (v_yb - v_ya) * n_y + (w_b * rn_b - w_a * rn_a);
-            let lambda = zero - self.mass[i] * (c_dot + e * rv);
-            let old = self.impulse[i];
-            let new_impulse = (old + lambda).fast_max(zero);
-            let applied = active.blend(new_impulse - old, zero);
-            self.impulse[i] = old + applied;
-            self.max_normal_impulse[i] = self.max_normal_impulse[i].fast_max(applied);
-            let (p_x, p_y) = (applied * n_x, applied * n_y);
-            v_xa -= self.inv_mass_a * p_x;
-            v_ya -= self.inv_mass_a * p_y;
-            w_a -= self.inv_inertia_a * applied * rn_a;
-            v_xb += self.inv_mass_b * p_x;
-            v_yb += self.inv_mass_b * p_y;
-            w_b += self.inv_inertia_b * applied * rn_b;
-        }
-        store(states, A, v_xa, v_ya, w_a);
-        store(states, B, v_xb, v_yb, w_b);
+        let mut a = load_velocity(states, A);
+        let mut b = load_velocity(states, B);
+        self.rows.restitution(&mut a, &mut b, threshold);
+        store(states, A, &a);
+        store(states, B, &b);
     }
 
-    /// Applies the kept impulses: `Δv = M⁻¹ Jᵀ λ`.
+    /// [`ContactRows::warm_start`] on the lanes, side a then side b.
     #[inline(always)]
     fn warm_start<S: LaneStates>(&mut self, states: &mut S) {
-        let (n_x, n_y) = (self.n_x, self.n_y);
-        let lambda = &self.impulse;
-        for (base, &l) in self.step_base.iter_mut().zip(lambda) {
-            *base += l;
-        }
-        let (pn, pt) = (lambda[0] + lambda[1], lambda[2] + lambda[3]);
-        // p = pn n + pt t with t = (n_y, −n_x).
-        let p_x = pn * n_x + pt * n_y;
-        let p_y = pn * n_y - pt * n_x;
-        let l_a = dot_rows(lambda, &self.ja);
-        let l_b = dot_rows(lambda, &self.jb);
-        let (v_x, v_y, w) = load_velocity(states, A);
-        store(
-            states,
-            A,
-            v_x - self.inv_mass_a * p_x,
-            v_y - self.inv_mass_a * p_y,
-            w - self.inv_inertia_a * l_a,
-        );
-        let (v_x, v_y, w) = load_velocity(states, B);
-        store(
-            states,
-            B,
-            v_x + self.inv_mass_b * p_x,
-            v_y + self.inv_mass_b * p_y,
-            w + self.inv_inertia_b * l_b,
-        );
+        let push = self.rows.warm_start();
+        let mut a = load_velocity(states, A);
+        self.rows.push_a(&push, &mut a);
+        store(states, A, &a);
+        let mut b = load_velocity(states, B);
+        self.rows.push_b(&push, &mut b);
+        store(states, B, &b);
     }
 
-    /// One velocity iteration on every lane: the arithmetic of
-    /// `ContactConstraint::solve_rows`, lane by lane.
+    /// One velocity iteration on every lane ([`ContactRows::solve`]).
     #[inline(always)]
     fn solve<S: LaneStates, const USE_BIAS: bool>(
         &mut self,
@@ -1097,145 +903,14 @@ impl WideContact {
         inv_h: Real,
         push_max: Real,
     ) {
-        let a = load(states, A);
-        let b = load(states, B);
-        let (n_x, n_y) = (self.n_x, self.n_y);
-        let (ja, jb) = (self.ja, self.jb);
-        let dpn = (b.dp_x - a.dp_x) * n_x + (b.dp_y - a.dp_y) * n_y;
-
-        // Ċ of every row at the loaded velocities (t = (n_y, −n_x)).
-        let dv_x = b.v_x - a.v_x;
-        let dv_y = b.v_y - a.v_y;
-        let dvn = dv_x * n_x + dv_y * n_y;
-        let dvt = dv_x * n_y - dv_y * n_x;
-        let c0 = dvn + (b.w * jb[0] - a.w * ja[0]);
-        let c1 = dvn + (b.w * jb[1] - a.w * ja[1]);
-        let c2 = dvt + (b.w * jb[2] - a.w * ja[2]);
-        let c3 = dvt + (b.w * jb[3] - a.w * ja[3]);
-
-        // K_ij = J_j M⁻¹ J_iᵀ for i < j (n · t = 0).
-        let (i_a, i_b) = (self.inv_inertia_a, self.inv_inertia_b);
-        let m_sum = self.inv_mass_a + self.inv_mass_b;
-        let (ka0, ka1, ka2) = (i_a * ja[0], i_a * ja[1], i_a * ja[2]);
-        let (kb0, kb1, kb2) = (i_b * jb[0], i_b * jb[1], i_b * jb[2]);
-        let k01 = m_sum + (ka0 * ja[1] + kb0 * jb[1]);
-        let k02 = ka0 * ja[2] + kb0 * jb[2];
-        let k03 = ka0 * ja[3] + kb0 * jb[3];
-        let k12 = ka1 * ja[2] + kb1 * jb[2];
-        let k13 = ka1 * ja[3] + kb1 * jb[3];
-        let k23 = m_sum + (ka2 * ja[3] + kb2 * jb[3]);
-
-        let (inv_h, push_max) = (splat(inv_h), splat(push_max));
-        let zero = W::splat(0.0);
-        let (b0, ms0, is0) = self.normal_terms::<USE_BIAS>(0, dpn, &a, &b, inv_h, push_max);
-        let (b1, ms1, is1) = self.normal_terms::<USE_BIAS>(1, dpn, &a, &b, inv_h, push_max);
-        let (old0, old1) = (self.impulse[0], self.impulse[1]);
-        // Gauss–Seidel: point 0, then point 1.
-        let g0 = (zero - self.mass[0] * ms0 * (c0 + b0) - is0 * old0).fast_max(zero - old0);
-        let g1 =
-            (zero - self.mass[1] * ms1 * ((c1 + k01 * g0) + b1) - is1 * old1).fast_max(zero - old1);
-        // Both points at once, each its own soft spring: with s_m + s_i = 1
-        // the per-point step is (k_ii / s_m) λ' = k_ii λ − (Ċ + b), so the
-        // pair solves K' λ' = K λ − (Ċ + b), K' = K + diag(k_ii (1/s_m − 1)).
-        let [k00, k11] = self.block_k;
-        let q0 = (c0 + b0) - (k00 * old0 + k01 * old1);
-        let q1 = (c1 + b1) - (k01 * old0 + k11 * old1);
-        let (kp00, kp11) = (k00 / ms0, k11 / ms1);
-        let inv_det = W::splat(1.0) / (kp00 * kp11 - k01 * k01);
-        let x0 = (k01 * q1 - kp11 * q0) * inv_det - old0;
-        let x1 = (k01 * q0 - kp00 * q1) * inv_det - old1;
-        let block = self.block & (old0 + x0).cmp_ge(zero) & (old1 + x1).cmp_ge(zero);
-        let d0 = block.blend(x0, g0);
-        let d1 = block.blend(x1, g1);
-        self.impulse[0] = old0 + d0;
-        self.impulse[1] = old1 + d1;
-        self.max_normal_impulse[0] = d0.fast_max(self.max_normal_impulse[0]);
-        self.max_normal_impulse[1] = d1.fast_max(self.max_normal_impulse[1]);
-        let c2 = (c2 + k02 * d0) + k12 * d1;
-        let d2 = self.friction_row(2, c2);
-        let c3 = ((c3 + k03 * d0) + k13 * d1) + k23 * d2;
-        let d3 = self.friction_row(3, c3);
-
-        let d = [d0, d1, d2, d3];
-        let (pn, pt) = (d0 + d1, d2 + d3);
-        let p_x = pn * n_x + pt * n_y;
-        let p_y = pn * n_y - pt * n_x;
-        let l_a = dot_rows(&d, &ja);
-        let l_b = dot_rows(&d, &jb);
-        store(
-            states,
-            A,
-            a.v_x - self.inv_mass_a * p_x,
-            a.v_y - self.inv_mass_a * p_y,
-            a.w - i_a * l_a,
-        );
-        store(
-            states,
-            B,
-            b.v_x + self.inv_mass_b * p_x,
-            b.v_y + self.inv_mass_b * p_y,
-            b.w + i_b * l_b,
-        );
+        let (mut a, da) = load(states, A);
+        let (mut b, db) = load(states, B);
+        let (inv_h, push_max) = (W::splat(inv_h), W::splat(push_max));
+        self.rows
+            .solve::<USE_BIAS>(&mut a, &da, &mut b, &db, inv_h, push_max);
+        store(states, A, &a);
+        store(states, B, &b);
     }
-
-    /// The terms of point `i`'s normal row on every lane: the bias `b`
-    /// (m/s), the mass scale `s_m` and the impulse scale `s_i` of
-    /// `Δλ = −m s_m (Ċ + b) − s_i λ`: speculative (`s > 0`) rigid with
-    /// `b = s / h`, soft push-out with `b = max(β s, −v_push)`, relax rigid
-    /// with `b = max(s / h, 0)`.
-    #[inline(always)]
-    fn normal_terms<const USE_BIAS: bool>(
-        &self,
-        i: usize,
-        dpn: W,
-        a: &WideBody,
-        b: &WideBody,
-        inv_h: W,
-        push_max: W,
-    ) -> (W, W, W) {
-        let (ja, jb) = (&self.ja, &self.jb);
-        // n · (dq r) = (r × n) sin − (r × t) cos.
-        let s = self.base_separation[i]
-            + dpn
-            + (b.q_s * jb[i] - b.q_c * jb[i + 2])
-            + (a.q_c * ja[i + 2] - a.q_s * ja[i]);
-        let zero = W::splat(0.0);
-        let one = W::splat(1.0);
-        if USE_BIAS {
-            let speculative = s.cmp_gt(zero);
-            let soft_bias = (self.bias_rate * s).fast_max(zero - push_max);
-            (
-                speculative.blend(s * inv_h, soft_bias),
-                // s_m + s_i = 1 (Softness).
-                speculative.blend(one, one - self.impulse_scale[i]),
-                speculative.blend(zero, self.impulse_scale[i]),
-            )
-        } else {
-            ((s * inv_h).fast_max(zero), one, zero)
-        }
-    }
-
-    /// Friction row `i` (2 or 3) on every lane; returns the increment.
-    #[inline(always)]
-    fn friction_row(&mut self, i: usize, c_dot: W) -> W {
-        let zero = W::splat(0.0);
-        let old = self.impulse[i];
-        let max_friction = self.friction * self.impulse[i - MAX_MANIFOLD_POINTS];
-        let min_friction = zero - max_friction;
-        let d = clamp_w(
-            zero - self.mass[i] * c_dot,
-            min_friction - old,
-            max_friction - old,
-        );
-        self.impulse[i] = clamp_w(old + d, min_friction, max_friction);
-        d
-    }
-}
-
-/// `Σ x_k y_k` over the rows, as `(x₀y₀ + x₁y₁) + (x₂y₂ + x₃y₃)`.
-#[inline(always)]
-fn dot_rows(x: &[W; ROWS], y: &[W; ROWS]) -> W {
-    (x[0] * y[0] + x[1] * y[1]) + (x[2] * y[2] + x[3] * y[3])
 }
 
 /// The contact constraints of a step, in their colours, as one batch for

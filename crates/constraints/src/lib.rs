@@ -7,7 +7,7 @@
 //! | [`joint::Joint`]              | per kind | 2  | one file per kind ([`joint`]) |
 //! | [`revolute::RevoluteJoint`]   | 2–6  | 2      | point + angle parts     |
 //! | [`portal::PortalConstraint`]  | 3    | 4      | portal part + portal map |
-//! | [`contact::ContactConstraint`]| 2–4  | 2      | compact rows (normal, friction) |
+//! | [`contact::ContactConstraint`]| 2–4  | 2      | contact rows (normal, friction) |
 //!
 //! The point rows of joints that form a tree are solved exactly, the
 //! whole tree at once ([`joint_tree`]); the joints' Gauss–Seidel rows are
@@ -16,16 +16,22 @@
 //! heavier or more ([`contact_group`]); the rest is Gauss–Seidel.
 //!
 //! Every type follows the same stages (prepare, warm start, solve with or
-//! without bias) and reports its rows through `Constraint::rows`.
+//! without bias) and reports its rows through `Constraint::rows`. The
+//! contact rows are written once ([`contact_row`]), generic over the lane
+//! type ([`lane::Lane`]): one contact at a time in the scalar overflow,
+//! [`lane::LANES`] at a time in the colours' SIMD chunks; every soft row
+//! takes the same soft update ([`parts::soft_impulse`]).
 
 pub mod contact;
 pub mod contact_group;
+pub mod contact_row;
 pub mod contact_solver;
 pub mod joint;
 pub mod joint_base;
 pub mod joint_colour;
 pub mod joint_solver;
 pub mod joint_tree;
+pub mod lane;
 pub mod parts;
 pub mod portal;
 pub mod portal_map;

@@ -1,14 +1,21 @@
-//! Reusable constraint parts: point, axis and angle.
+//! Reusable constraint parts: point and angle, and the soft update every
+//! soft row shares.
 //!
-//! Joints and contacts are assembled from these parts, in the spirit of
-//! Jolt's constraint parts. Each part owns its accumulated impulse and
-//! implements the same stages (warm start, solve with or without bias).
+//! Joints are assembled from these parts, in the spirit of Jolt's
+//! constraint parts. Each part owns its accumulated impulse and implements
+//! the same stages (warm start, solve with or without bias).
 //!
 //! | part          | rows | C                                         | J (body a │ body b)                          |
 //! |---------------|------|-------------------------------------------|----------------------------------------------|
 //! | [`PointPart`] | 2    | `(x_b + r_b) − (x_a + r_a)`               | `−I, −perp(r_a) │ I, perp(r_b)`                |
-//! | [`AxisPart`]  | 1    | `n · ((x_b + r_b) − (x_a + r_a))`         | `−n, −r_a × n │ n, r_b × n`                    |
 //! | [`AnglePart`] | 1    | `θ_b − θ_a − θ_ref`                       | `0, −1 │ 0, 1`                                |
+//!
+//! **The soft update.** Every soft row (these parts, the portal rows, the
+//! contact rows of [`crate::contact_row`]) takes the step of
+//! [`Softness`]: `Δλ = −s_m K⁻¹ (Ċ + b) − s_i λ`, written once in
+//! [`soft_impulse`]. The caller forms the product `s_m K⁻¹ (Ċ + b)` as its
+//! row needs it (a 2×2 or 3×3 solve scaled by `s_m`, or a scalar effective
+//! mass times `s_m` times the velocity error).
 //!
 //! Positions during a step are tracked as deltas: `r = dq · r₀`, and the
 //! centre offset is `Δc + dp_b − dp_a`, so `C` is refreshed every substep
@@ -23,6 +30,8 @@ use janus2d_core::body::{BodyState, InvMass};
 use janus2d_core::math::{Real, Vec2, cross, cross_sv, solve22};
 use janus2d_core::parallel::PlannedStates;
 use janus2d_core::softness::Softness;
+
+use crate::lane::Lane;
 
 /// The inverse masses of a constraint's two bodies (a, b), loaded at
 /// prepare ([`SolverBody::inv_masses`](janus2d_core::body::SolverBody::inv_masses)):
@@ -43,6 +52,18 @@ impl PairMass {
         a: InvMass::ZERO,
         b: InvMass::ZERO,
     };
+}
+
+/// The soft update of one row, `Δλ = −(scale · x) − s_i λ`, with
+/// `scale · x = s_m K⁻¹ (Ċ + b)` split as the row forms it: `scale = s_m`,
+/// `x = K⁻¹ (Ċ + b)` after a block solve, or `scale = s_m m`,
+/// `x = Ċ + b` for a row of effective mass `m = K⁻¹` (module docs).
+/// `impulse_scale` is `s_i`, `accumulated` the accumulated impulse `λ`.
+/// Lane-generic: one row on [`Real`], or [`LANES`](crate::lane::LANES)
+/// rows at once.
+#[inline(always)]
+pub fn soft_impulse<L: Lane>(scale: L, x: L, impulse_scale: L, accumulated: L) -> L {
+    -(scale * x) - impulse_scale * accumulated
 }
 
 /// Reads the velocity part of two states.
@@ -231,56 +252,12 @@ impl PointPart {
         };
         let (k11, k12, k22) = Self::effective_mass(m, r_a, r_b);
         let b = solve22(k11, k12, k22, c_dot + bias);
-        let impulse = -mass_scale * b - impulse_scale * self.impulse;
+        let impulse = Vec2::new(
+            soft_impulse(mass_scale, b.x, impulse_scale, self.impulse.x),
+            soft_impulse(mass_scale, b.y, impulse_scale, self.impulse.y),
+        );
         self.impulse += impulse;
         apply_pair(sa, sb, m, r_a, r_b, impulse, 0.0);
-    }
-}
-
-/// One row along a direction `n` between two anchors (contact normals,
-/// friction, prismatic axes). The caller keeps the arms and direction.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct AxisPart {
-    /// Effective mass `1 / (J M⁻¹ Jᵀ)`, kg.
-    pub mass: Real,
-    /// Accumulated impulse, N·s.
-    pub impulse: Real,
-}
-
-impl AxisPart {
-    /// `J M⁻¹ Jᵀ` of the row along `n` with arms `r_a`, `r_b`.
-    #[inline(always)]
-    pub fn k(m: &PairMass, r_a: Vec2, r_b: Vec2, n: Vec2) -> Real {
-        let rn_a = cross(r_a, n);
-        let rn_b = cross(r_b, n);
-        m.a.inv_mass + m.b.inv_mass + m.a.inv_inertia * rn_a * rn_a + m.b.inv_inertia * rn_b * rn_b
-    }
-
-    /// Sets the effective mass from `K` (zero when `K` is zero).
-    #[inline(always)]
-    pub fn set_mass(&mut self, k: Real) {
-        self.mass = if k > 0.0 { 1.0 / k } else { 0.0 };
-    }
-
-    /// Relative velocity along `n` at the arms.
-    #[inline(always)]
-    pub fn c_dot(sa: &BodyState, sb: &BodyState, r_a: Vec2, r_b: Vec2, n: Vec2) -> Real {
-        let dv = (sb.v + cross_sv(sb.w, r_b)) - (sa.v + cross_sv(sa.w, r_a));
-        dv.dot(n)
-    }
-
-    /// Applies an impulse `lambda` along `n`.
-    #[inline(always)]
-    pub fn apply(
-        sa: &mut BodyState,
-        sb: &mut BodyState,
-        m: &PairMass,
-        r_a: Vec2,
-        r_b: Vec2,
-        n: Vec2,
-        lambda: Real,
-    ) {
-        apply_pair(sa, sb, m, r_a, r_b, lambda * n, 0.0);
     }
 }
 
@@ -327,8 +304,12 @@ impl AnglePart {
     ) {
         let c_dot = Self::c_dot(sa, sb);
         let bias = softness.bias_rate * c;
-        let lambda = -softness.mass_scale * self.mass * (c_dot + bias)
-            - softness.impulse_scale * self.impulse;
+        let lambda = soft_impulse(
+            softness.mass_scale * self.mass,
+            c_dot + bias,
+            softness.impulse_scale,
+            self.impulse,
+        );
         self.impulse += lambda;
         Self::apply(sa, sb, m, lambda);
     }
@@ -377,7 +358,12 @@ impl AnglePart {
             (0.0, 1.0, 0.0)
         };
         let c_dot = sign * Self::c_dot(sa, sb);
-        let lambda = -self.mass * mass_scale * (c_dot + bias) - impulse_scale * self.impulse;
+        let lambda = soft_impulse(
+            self.mass * mass_scale,
+            c_dot + bias,
+            impulse_scale,
+            self.impulse,
+        );
         let old = self.impulse;
         self.impulse = (old + lambda).max(0.0);
         Self::apply(sa, sb, m, sign * (self.impulse - old));

@@ -149,7 +149,7 @@ use janus2d_core::math::{Mat3, PI, Real, Vec2, cross, cross_sv, wrap_angle};
 use janus2d_core::softness::Softness;
 use smallvec::SmallVec;
 
-use crate::parts::clamp_length;
+use crate::parts::{clamp_length, soft_impulse};
 use crate::portal_map::{Portal, PortalError, PortalFrame, PortalMap, validate_eta};
 
 /// Everything needed to create a portal constraint.
@@ -571,7 +571,7 @@ impl PortalPart {
         };
         let mut lambda = [0.0; 3];
         for i in 0..3 {
-            lambda[i] = -mass_scale * x[i] - impulse_scale * self.impulse[i];
+            lambda[i] = soft_impulse(mass_scale, x[i], impulse_scale, self.impulse[i]);
             self.impulse[i] += lambda[i];
         }
         g.apply(states, ix, m, lambda);

@@ -1,0 +1,232 @@
+//! Lane types: the numbers the contact rows are written over.
+//!
+//! The contact rows ([`crate::contact_row`]) are written once, generic over
+//! a [`Lane`]: one contact at a time on [`Real`] (the scalar overflow and the
+//! light clusters' groups), [`LANES`] contacts at a time on [`Wide`]
+//! (`wide::f32x8`, or `wide::f64x4` with the `f64` feature: SIMD without
+//! `unsafe`) in the colours' chunks. The trait has exactly the operations
+//! the rows use; each is one instruction on either type, with the same
+//! result lane by lane:
+//!
+//! | operation              | `Real`                       | `Wide`                    |
+//! |------------------------|------------------------------|---------------------------|
+//! | `+ − × ÷`, `+= −=`     | the float's                  | lane-wise                 |
+//! | `−x`                   | sign flip                    | `0 − x` (as `wide` does)  |
+//! | [`Lane::at_least`]     | `if x > lo { x } else { lo }`| `max` instruction         |
+//! | [`Lane::at_most`]      | `if x < hi { x } else { hi }`| `min` instruction         |
+//! | comparisons            | `bool`                       | all-ones lane masks       |
+//! | [`Lane::select`]       | `if`                         | blend                     |
+//!
+//! `at_least` and `at_most` return their argument where `x` is NaN (the
+//! `max` and `min` instructions of SSE do); `−x` differs between the two
+//! only in the sign of a zero (`−(+0) = −0` on `Real`, `0 − (+0) = +0` on
+//! `Wide`).
+
+use std::fmt::Debug;
+use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Sub, SubAssign};
+
+use janus2d_core::math::Real;
+use wide::{CmpEq, CmpGe, CmpGt, CmpLt, CmpNe};
+
+/// Lanes of [`Wide`].
+#[cfg(not(feature = "f64"))]
+pub const LANES: usize = 8;
+/// Lanes of [`Wide`].
+#[cfg(feature = "f64")]
+pub const LANES: usize = 4;
+
+/// The SIMD lane type: [`LANES`] values of [`Real`].
+#[cfg(not(feature = "f64"))]
+pub type Wide = wide::f32x8;
+/// The SIMD lane type: [`LANES`] values of [`Real`].
+#[cfg(feature = "f64")]
+pub type Wide = wide::f64x4;
+
+/// A number the contact rows are computed on: one [`Real`] or [`LANES`] of
+/// them ([`Wide`]). See the module docs for what each operation is.
+pub trait Lane:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+    + Debug
+    + PartialEq
+{
+    /// The result of a comparison: `bool`, or a lane mask.
+    type Mask: Copy + BitAnd<Output = Self::Mask> + BitOr<Output = Self::Mask> + Debug + PartialEq;
+
+    /// `x` in every lane.
+    fn splat(x: Real) -> Self;
+    /// `self` where it is greater than `lo`, else `lo` (also for a NaN
+    /// `self`).
+    fn at_least(self, lo: Self) -> Self;
+    /// `self` where it is less than `hi`, else `hi` (also for a NaN
+    /// `self`).
+    fn at_most(self, hi: Self) -> Self;
+    /// `self > other`.
+    fn gt(self, other: Self) -> Self::Mask;
+    /// `self < other`.
+    fn lt(self, other: Self) -> Self::Mask;
+    /// `self ≥ other`.
+    fn ge(self, other: Self) -> Self::Mask;
+    /// `self = other`.
+    fn eq(self, other: Self) -> Self::Mask;
+    /// `self ≠ other` (true where either is NaN).
+    fn ne(self, other: Self) -> Self::Mask;
+    /// `on_true` where `mask` holds, else `on_false`.
+    fn select(mask: Self::Mask, on_true: Self, on_false: Self) -> Self;
+    /// Whether `mask` holds in some lane.
+    fn any(mask: Self::Mask) -> bool;
+    /// Lane `k`'s value (`k = 0` for [`Real`]).
+    fn lane(&self, k: usize) -> Real;
+    /// Sets lane `k` to `x` (`k = 0` for [`Real`]).
+    fn set_lane(&mut self, k: usize, x: Real);
+
+    /// `self` clamped to `[lo, hi]`: `self.at_least(lo).at_most(hi)`.
+    #[inline(always)]
+    fn clamp_to(self, lo: Self, hi: Self) -> Self {
+        self.at_least(lo).at_most(hi)
+    }
+}
+
+impl Lane for Real {
+    type Mask = bool;
+
+    #[inline(always)]
+    fn splat(x: Real) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn at_least(self, lo: Self) -> Self {
+        if self > lo { self } else { lo }
+    }
+    #[inline(always)]
+    fn at_most(self, hi: Self) -> Self {
+        if self < hi { self } else { hi }
+    }
+    #[inline(always)]
+    fn gt(self, other: Self) -> bool {
+        self > other
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> bool {
+        self < other
+    }
+    #[inline(always)]
+    fn ge(self, other: Self) -> bool {
+        self >= other
+    }
+    #[inline(always)]
+    fn eq(self, other: Self) -> bool {
+        self == other
+    }
+    #[inline(always)]
+    fn ne(self, other: Self) -> bool {
+        self != other
+    }
+    #[inline(always)]
+    fn select(mask: bool, on_true: Self, on_false: Self) -> Self {
+        if mask { on_true } else { on_false }
+    }
+    #[inline(always)]
+    fn any(mask: bool) -> bool {
+        mask
+    }
+    #[inline(always)]
+    fn lane(&self, k: usize) -> Real {
+        debug_assert_eq!(k, 0);
+        *self
+    }
+    #[inline(always)]
+    fn set_lane(&mut self, k: usize, x: Real) {
+        debug_assert_eq!(k, 0);
+        *self = x;
+    }
+}
+
+impl Lane for Wide {
+    type Mask = Wide;
+
+    #[inline(always)]
+    fn splat(x: Real) -> Self {
+        Wide::splat(x)
+    }
+    #[inline(always)]
+    fn at_least(self, lo: Self) -> Self {
+        self.fast_max(lo)
+    }
+    #[inline(always)]
+    fn at_most(self, hi: Self) -> Self {
+        self.fast_min(hi)
+    }
+    #[inline(always)]
+    fn gt(self, other: Self) -> Wide {
+        self.cmp_gt(other)
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> Wide {
+        self.cmp_lt(other)
+    }
+    #[inline(always)]
+    fn ge(self, other: Self) -> Wide {
+        self.cmp_ge(other)
+    }
+    #[inline(always)]
+    fn eq(self, other: Self) -> Wide {
+        self.cmp_eq(other)
+    }
+    #[inline(always)]
+    fn ne(self, other: Self) -> Wide {
+        self.cmp_ne(other)
+    }
+    #[inline(always)]
+    fn select(mask: Wide, on_true: Self, on_false: Self) -> Self {
+        mask.blend(on_true, on_false)
+    }
+    #[inline(always)]
+    fn any(mask: Wide) -> bool {
+        mask.any()
+    }
+    #[inline(always)]
+    fn lane(&self, k: usize) -> Real {
+        self.as_array_ref()[k]
+    }
+    #[inline(always)]
+    fn set_lane(&mut self, k: usize, x: Real) {
+        self.as_array_mut()[k] = x;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each operation gives the same value on `Real` as lane by lane on
+    /// `Wide`, NaN included.
+    #[test]
+    fn real_and_wide_agree_lane_by_lane() {
+        let xs: [Real; 8] = [-2.0, -0.5, 0.0, 0.5, 1.0, 3.0, Real::NAN, Real::INFINITY];
+        let (lo, hi) = (-0.5, 1.0);
+        for x in xs {
+            let w = Wide::splat(x);
+            let lane0 = |v: Wide| v.to_array()[0];
+            let same = |a: Real, b: Real| a.to_bits() == b.to_bits();
+            assert!(same(x.at_least(lo), lane0(w.at_least(Wide::splat(lo)))));
+            assert!(same(x.at_most(hi), lane0(w.at_most(Wide::splat(hi)))));
+            assert!(same(
+                x.clamp_to(lo, hi),
+                lane0(w.clamp_to(Wide::splat(lo), Wide::splat(hi)))
+            ));
+            let mask = <Wide as Lane>::gt(w, Wide::splat(0.0));
+            assert_eq!(Lane::gt(x, 0.0), <Wide as Lane>::any(mask));
+            assert!(same(
+                Real::select(Lane::gt(x, 0.0), 1.0, 2.0),
+                lane0(Wide::select(mask, Wide::splat(1.0), Wide::splat(2.0)))
+            ));
+        }
+    }
+}
