@@ -17,23 +17,7 @@ use smallvec::smallvec;
 
 use crate::contact_row::{ContactRows, Delta, Velocity, normal_softness};
 
-/// Maximum points per manifold.
-pub const MAX_MANIFOLD_POINTS: usize = 2;
-
-/// One point of a contact, as the collision pipeline hands it over.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct ContactPointInput {
-    /// Anchor on a relative to a's centre of mass (world frame), m.
-    pub anchor_a: Vec2,
-    /// Anchor on b relative to b's centre of mass (world frame), m.
-    pub anchor_b: Vec2,
-    /// Separation along the normal when the manifold was computed, m.
-    pub separation: Real,
-    /// Normal impulse kept from the last step (warm start), N·s.
-    pub normal_impulse: Real,
-    /// Tangent impulse kept from the last step (warm start), N·s.
-    pub tangent_impulse: Real,
-}
+pub use crate::contact_row::{ContactPointInput, MAX_MANIFOLD_POINTS};
 
 /// A contact constraint between two bodies (one manifold, 1–2 points).
 ///
@@ -158,10 +142,10 @@ impl ContactConstraint {
 
     /// The kept and step-total impulses of point `i`.
     #[must_use]
-    pub fn point_impulse(&self, i: usize) -> crate::contact_solver::PointImpulse {
+    pub fn point_impulse(&self, i: usize) -> crate::contact_row::PointImpulse {
         let (n, t) = self.impulses(i);
         let base = &self.rows.step_base;
-        crate::contact_solver::PointImpulse {
+        crate::contact_row::PointImpulse {
             normal: n,
             tangent: t,
             total_normal: base[i] + n,

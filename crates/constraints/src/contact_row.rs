@@ -109,9 +109,53 @@ use janus2d_core::constraint::StepContext;
 use janus2d_core::math::{Real, Vec2, cross};
 use janus2d_core::softness::Softness;
 
-use crate::contact::{ContactPointInput, MAX_MANIFOLD_POINTS};
 use crate::lane::Lane;
 use crate::parts::soft_impulse;
+
+/// Maximum points per manifold.
+pub const MAX_MANIFOLD_POINTS: usize = 2;
+
+/// One point of a contact, as the collision pipeline hands it over.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactPointInput {
+    /// Anchor on a relative to a's centre of mass (world frame), m.
+    pub anchor_a: Vec2,
+    /// Anchor on b relative to b's centre of mass (world frame), m.
+    pub anchor_b: Vec2,
+    /// Separation along the normal when the manifold was computed, m.
+    pub separation: Real,
+    /// Normal impulse kept from the last step (warm start), N·s.
+    pub normal_impulse: Real,
+    /// Tangent impulse kept from the last step (warm start), N·s.
+    pub tangent_impulse: Real,
+}
+
+/// The impulses of one manifold point after a step, N·s.
+///
+/// `normal` and `tangent` are the accumulated impulses kept for the next
+/// step's warm start (what one substep applies). The totals are what the
+/// whole step applied: every warm start re-applies the kept impulse, and
+/// every solve, relax and restitution increment adds to it, so
+///
+/// ```text
+/// total = Σ_substeps λ_warm start + (λ_end − λ_prepare)
+/// ```
+///
+/// which a lane keeps as `step_base = Σ λ_warm start − λ_prepare` (added to
+/// at warm start only, never in the solve loop) plus the final `λ`. A box
+/// of mass `m` resting on the ground reads a total normal impulse of
+/// `m g dt` for any substep count.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PointImpulse {
+    /// Accumulated normal impulse (warm start), N·s.
+    pub normal: Real,
+    /// Accumulated tangent impulse (warm start), N·s.
+    pub tangent: Real,
+    /// Normal impulse applied over the whole step, N·s.
+    pub total_normal: Real,
+    /// Tangent impulse applied over the whole step, N·s.
+    pub total_tangent: Real,
+}
 
 /// Rows of a contact: the normal rows of points 0 and 1, then their
 /// friction rows. A one-point manifold leaves rows 1 and 3 at zero (zero

@@ -97,32 +97,7 @@ struct WideContact {
     rows: ContactRows<W>,
 }
 
-/// The impulses of one manifold point after a step, N·s.
-///
-/// `normal` and `tangent` are the accumulated impulses kept for the next
-/// step's warm start (what one substep applies). The totals are what the
-/// whole step applied: every warm start re-applies the kept impulse, and
-/// every solve, relax and restitution increment adds to it, so
-///
-/// ```text
-/// total = Σ_substeps λ_warm start + (λ_end − λ_prepare)
-/// ```
-///
-/// which a lane keeps as `step_base = Σ λ_warm start − λ_prepare` (added to
-/// at warm start only, never in the solve loop) plus the final `λ`. A box
-/// of mass `m` resting on the ground reads a total normal impulse of
-/// `m g dt` for any substep count.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PointImpulse {
-    /// Accumulated normal impulse (warm start), N·s.
-    pub normal: Real,
-    /// Accumulated tangent impulse (warm start), N·s.
-    pub tangent: Real,
-    /// Normal impulse applied over the whole step, N·s.
-    pub total_normal: Real,
-    /// Tangent impulse applied over the whole step, N·s.
-    pub total_tangent: Real,
-}
+pub use crate::contact_row::PointImpulse;
 
 /// Where a pushed contact lives in the solver: a lane of a colour's chunk,
 /// or a place in the overflow. [`ContactSolver::push_all`] reports one per
