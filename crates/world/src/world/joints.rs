@@ -101,6 +101,8 @@ impl World {
     }
 
     /// Sets a joint's angle limits, rad (`lower ≤ upper`); wakes its bodies.
+    /// A revolute joint's; a joint of another kind gets
+    /// `Err(WrongJointKind)` and is left unchanged.
     pub fn set_joint_limits(
         &mut self,
         joint: JointHandle,
@@ -112,12 +114,16 @@ impl World {
     }
 
     /// Turns a joint's limit on or off.
+    /// A revolute joint's; a joint of another kind gets
+    /// `Err(WrongJointKind)` and is left unchanged.
     pub fn enable_joint_limit(&mut self, joint: JointHandle, on: bool) -> Result<(), WorldError> {
         let r = self.joints.enable_limit(joint, on);
         self.wake_pair(r)
     }
 
     /// Sets a joint's motor speed, rad/s.
+    /// A revolute joint's; a joint of another kind gets
+    /// `Err(WrongJointKind)` and is left unchanged.
     pub fn set_joint_motor_speed(
         &mut self,
         joint: JointHandle,
@@ -128,6 +134,8 @@ impl World {
     }
 
     /// Sets a joint's largest motor torque, N·m (≥ 0).
+    /// A revolute joint's; a joint of another kind gets
+    /// `Err(WrongJointKind)` and is left unchanged.
     pub fn set_joint_max_motor_torque(
         &mut self,
         joint: JointHandle,
@@ -138,12 +146,16 @@ impl World {
     }
 
     /// Turns a joint's motor on or off.
+    /// A revolute joint's; a joint of another kind gets
+    /// `Err(WrongJointKind)` and is left unchanged.
     pub fn enable_joint_motor(&mut self, joint: JointHandle, on: bool) -> Result<(), WorldError> {
         let r = self.joints.enable_motor(joint, on);
         self.wake_pair(r)
     }
 
     /// Sets a joint's spring: stiffness, Hz, and damping ratio (both ≥ 0).
+    /// A revolute joint's; a joint of another kind gets
+    /// `Err(WrongJointKind)` and is left unchanged.
     pub fn set_joint_spring(
         &mut self,
         joint: JointHandle,
@@ -155,6 +167,8 @@ impl World {
     }
 
     /// Turns a joint's spring on or off.
+    /// A revolute joint's; a joint of another kind gets
+    /// `Err(WrongJointKind)` and is left unchanged.
     pub fn enable_joint_spring(&mut self, joint: JointHandle, on: bool) -> Result<(), WorldError> {
         let r = self.joints.enable_spring(joint, on);
         self.wake_pair(r)
