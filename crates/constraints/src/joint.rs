@@ -31,7 +31,7 @@
 //! changes; a kind whose rows the tree cannot take (no point part, or
 //! soft) returns `None` from `Joint::tree_rows` and the tree solve leaves
 //! its component iterative. A kind the tree takes describes its equality
-//! rows there ([`TreeRows`]: the point part, and the angle row when it
+//! rows there (`TreeRows`: the point part, and the angle row when it
 //! holds the relative angle too) and takes back the tree's impulses in
 //! `Joint::set_tree_impulses`.
 

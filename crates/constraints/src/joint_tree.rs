@@ -1,23 +1,32 @@
-//! Direct solve of the joints' point rows where the joints form a tree.
+//! Direct solve of the joints' equality rows where the joints form a tree:
+//! a revolute joint's point rows (2), a rigid weld's point and angle rows
+//! (3).
 //!
 //! Gauss–Seidel moves information one joint per iteration and builds a soft
 //! joint's spring on the *light* body's effective mass, so a heavy load on a
 //! chain of light links (the "ball and chain", 670:1) stretches every joint
 //! by about `F K / ω²`. Where the joints form a tree, the point rows of the
-//! whole tree can instead be solved exactly in time linear in its size
+//! whole tree (and the angle rows of its rigid welds) can instead be
+//! solved exactly in time linear in its size
 //! (the idea of Baraff, *Linear-time dynamics using Lagrange multipliers*,
 //! 1996), and an exact solve stays stable at any stiffness.
 //!
 //! # Derivation
 //!
 //! Unknowns: the velocity change `Δv_i = (Δv_x, Δv_y, Δω)` of every moving
-//! body in the tree and the impulse change `Δλ_j` (2 rows) of every joint.
-//! With `J_ji` the 2×3 block of joint `j` on body `i`
+//! body in the tree and the impulse change `Δλ_j` (`n_j` rows: 2 or 3) of
+//! every joint. With `J_ji` the `n_j`×3 block of joint `j` on body `i`
 //!
 //! ```text
 //! J_jb = [ 1 0 −r_b.y ]      J_ja = −[ 1 0 −r_a.y ]      (Ċ = v_b + ω_b × r_b − v_a − ω_a × r_a)
 //!        [ 0 1  r_b.x ]              [ 0 1  r_a.x ]
+//!        [ 0 0  1     ]              [ 0 0  1     ]      (3rd row: C_θ = θ_b − θ_a − θ_ref, Ċ_θ = ω_b − ω_a)
 //! ```
+//!
+//! (the third row only for a 3-row joint, a rigid weld; its bias is
+//! `β C_θ`, uncapped, its `K = J M⁻¹ Jᵀ` the full 3×3 block with the
+//! coupling `K₀₂ = −i_a r_a.y − i_b r_b.y`, `K₁₂ = i_a r_a.x + i_b r_b.x`,
+//! `K₂₂ = i_a + i_b`, `i = I⁻¹`; see [`crate::weld`]).
 //!
 //! the soft rows of [`Softness`](janus2d_core::softness::Softness) solved
 //! to convergence are
@@ -84,8 +93,23 @@
 //!                               (L_k = J_kpᵀ D_k⁻¹,  L_c = J_kc D_c⁻¹)
 //! ```
 //!
-//! Body pivots (3×3) stay positive definite and joint pivots (2×2)
+//! Body pivots (3×3) stay positive definite and joint pivots (`n_k`×`n_k`)
 //! negative definite, so both are inverted by cofactors without pivoting.
+//!
+//! **Joints of 2 and 3 rows.** The branch is per joint, on its row count.
+//! A 2-row joint takes the specialised path below (`Mat2` pivots, `J`
+//! written out term by term), unchanged from when the tree took only point
+//! joints, so a tree of revolute joints gives the same bits as before. A
+//! 3-row joint takes general 3×3 blocks (`eliminate_three`,
+//! `substitute_three`): `D_k = −Γ_k − J_kc D_c⁻¹ J_kcᵀ`, `T = D_k⁻¹`,
+//! `D_p −= J_kpᵀ T J_kp`, `b_p −= J_kpᵀ T b_k`; back substitution
+//! `x_k = T b_k − T J_kp x_p`, `x_c = D_c⁻¹ b_c − D_c⁻¹ J_kcᵀ x_k`. Both
+//! paths meet in the body pivots (3×3 whatever the joint), so a tree may
+//! mix revolute joints and welds. Its angle impulse acts as a torque
+//! through the solve's inertia `Ĩ`, is re-weighted at the bias pass like
+//! the point impulse's torque, and is written back into the joint (warm
+//! start, `constraint_torque`). The geometric stiffness stays on the point
+//! rows (the angle row's Jacobian does not turn with the body).
 //! `J_ji = ±[I | perp(r)]` has a third of its entries zero and the others
 //! ±1 but two, so its products with a pivot are written out term by term:
 //! the same sums in the same order as general 3×3 blocks (a joint's padded
@@ -101,7 +125,9 @@
 //! translate (or rotate) gets the placeholder mass 1 on that axis and a zero
 //! Jacobian column, so its `Δv` there is exactly zero.
 //!
-//! Only joint components without a loop are solved directly (found by
+//! Only joint components without a loop, and without a joint the tree
+//! cannot take (a soft weld: `Joint::tree_rows` is `None`), are solved
+//! directly (found by
 //! union–find over the moving bodies; a static, kinematic or sleeping body
 //! is a fixed end, so a bridge pinned at both ends is still a tree). A
 //! component with a loop (a joint grid, a cloth) stays wholly iterative:
