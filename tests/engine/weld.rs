@@ -216,6 +216,57 @@ fn bad_weld_input_is_a_typed_error_and_changes_nothing() {
     assert_eq!(counts(&world), before);
 }
 
+/// A tree mixing both row counts: a rigid arm of three welded boxes
+/// swinging on a revolute pin from the horizontal. Every joint is solved
+/// by the tree (2-row and 3-row joints meet in the body pivots) and the
+/// arm stays rigid through the swing.
+#[test]
+fn welded_arm_on_a_revolute_pin_is_one_tree() {
+    let mut def = WorldDef::default();
+    def.solver.substeps = 4;
+    def.sleep.enabled = false;
+    let mut world = World::new(def).unwrap();
+    let pin = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    let inertia = 2.0 * LENGTH * LENGTH / 12.0;
+    let half = Vec2::new(0.5 * LENGTH, 0.0);
+    let mut boxes = Vec::new();
+    for k in 0..3 {
+        let at = Vec2::new((k as Real + 0.5) * LENGTH, 0.0);
+        boxes.push(
+            world
+                .create_body(&BodyDef::dynamic(at).with_mass(1.0, inertia))
+                .unwrap(),
+        );
+    }
+    let hinge = world
+        .create_revolute_joint(&RevoluteJointDef::new(pin, boxes[0], Vec2::ZERO, -half))
+        .unwrap();
+    let welds: Vec<JointHandle> = (1..3)
+        .map(|k| {
+            world
+                .create_weld_joint(&WeldJointDef::new(boxes[k - 1], boxes[k], half, -half))
+                .unwrap()
+        })
+        .collect();
+    let (mut gap, mut angle): (Real, Real) = (0.0, 0.0);
+    for _ in 0..120 {
+        world.step(1.0 / 60.0).unwrap();
+        gap = gap.max(world.max_joint_gap());
+        for k in 1..3 {
+            let rel = world.angle(boxes[k]).unwrap() - world.angle(boxes[k - 1]).unwrap();
+            angle = angle.max(janus2d_core::math::wrap_angle(rel).abs());
+        }
+        assert!(world.joint(hinge).unwrap().in_tree());
+        assert!(welds.iter().all(|&w| world.joint(w).unwrap().in_tree()));
+    }
+    let swing = world.angle(boxes[0]).unwrap();
+    println!("welded arm: max gap {gap:e} m, max weld angle {angle:e} rad, arm angle {swing}");
+    // It swings (the hinge turns freely) while the welds hold.
+    assert!(swing.abs() > 0.1, "arm angle {swing}");
+    assert!(gap < 1e-3, "gap {gap}");
+    assert!(angle < 1e-3, "weld angle {angle}");
+}
+
 // ----- the 3-row tree solve on random weld trees --------------------------
 
 /// A random weld tree: 2–10 dynamic bodies (masses and inertias in

@@ -27,7 +27,11 @@
 //! `validate`, its solver form with `prepare`, `warm_start_side`,
 //! `solve_pair`, `rows` and read-backs, and a `base: JointBase` field) plus
 //! one variant in [`JointDef`], [`Joint`] and [`JointKind`] and the arms of
-//! the matches below. Nothing in the solver, the colouring or the tree
+//! the matches below. The weld joint touched, besides `weld.rs`: this file,
+//! `lib.rs` (module, re-export, kind table), the world's `joints.rs`
+//! (`JointSet::weld`), `world/joints.rs` (`World::weld_joint`,
+//! `create_weld_joint`) and `world/mod.rs` (its import), and the facade's
+//! `src/lib.rs` (re-export, prelude). Nothing in the solver, the colouring or the tree
 //! changes; a kind whose rows the tree cannot take (no point part, or
 //! soft) returns `None` from `Joint::tree_rows` and the tree solve leaves
 //! its component iterative. A kind the tree takes describes its equality
