@@ -38,6 +38,7 @@ pub use janus2d_world as world;
 #[doc(inline)]
 pub use janus2d_constraints::{
     Joint, JointDef, JointError, JointKind, PortalError, RevoluteJoint, RevoluteJointDef,
+    WeldJoint, WeldJointDef,
 };
 #[doc(inline)]
 pub use janus2d_core::{
@@ -60,7 +61,9 @@ pub use janus2d_world::{
 
 /// The names most programs need.
 pub mod prelude {
-    pub use janus2d_constraints::{Joint, JointDef, JointKind, RevoluteJoint, RevoluteJointDef};
+    pub use janus2d_constraints::{
+        Joint, JointDef, JointKind, RevoluteJoint, RevoluteJointDef, WeldJoint, WeldJointDef,
+    };
     pub use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
     pub use janus2d_core::constraint::SolverMode;
     pub use janus2d_core::geometry::{

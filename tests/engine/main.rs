@@ -21,3 +21,4 @@ mod revolute_properties;
 mod setters;
 mod snapshot;
 mod stages;
+mod weld;

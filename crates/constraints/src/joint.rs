@@ -8,13 +8,14 @@
 //!  (validated, typed error)  one Vec<Joint>,           colours       JointColours (keys from JointBase)
 //!                            dense, swap-remove        warm start    Joint::warm_start_side, per body
 //!                                                      solve, relax  Joint::solve_pair, colour by colour
-//!                                                      late solve    JointForest (Joint::tree_point)
+//!                                                      late solve    JointForest (Joint::tree_rows)
 //!                                                      (all driven by joint_solver::JointBatch)
 //! ```
 //!
 //! | kind        | file            | rows                                          | rows the tree solves |
 //! |-------------|-----------------|-----------------------------------------------|----------------------|
 //! | `Revolute`  | `revolute.rs`   | point (2), spring, motor, lower, upper (1 each) | point (2)          |
+//! | `Weld`      | `weld.rs`       | point (2), angle (1)                          | point + angle (3) when rigid, else none |
 //!
 //! Everything the solver needs from a joint that is not its own rows is in
 //! [`JointBase`]: the state indices, the masses loaded at prepare, whether
@@ -26,9 +27,17 @@
 //! `validate`, its solver form with `prepare`, `warm_start_side`,
 //! `solve_pair`, `rows` and read-backs, and a `base: JointBase` field) plus
 //! one variant in [`JointDef`], [`Joint`] and [`JointKind`] and the arms of
-//! the matches below. Nothing in the solver, the colouring or the tree
-//! changes; a kind without a point part simply returns `None` from
-//! `Joint::tree_point` and the tree solve leaves its component iterative.
+//! the matches below. The weld joint touched, besides `weld.rs`: this file,
+//! `lib.rs` (module, re-export, kind table), the world's `joints.rs`
+//! (`JointSet::weld`), `world/joints.rs` (`World::weld_joint`,
+//! `create_weld_joint`) and `world/mod.rs` (its import), and the facade's
+//! `src/lib.rs` (re-export, prelude). Nothing in the solver, the colouring or the tree
+//! changes; a kind whose rows the tree cannot take (no point part, or
+//! soft) returns `None` from `Joint::tree_rows` and the tree solve leaves
+//! its component iterative. A kind the tree takes describes its equality
+//! rows there (`TreeRows`: the point part, and the angle row when it
+//! holds the relative angle too) and takes back the tree's impulses in
+//! `Joint::set_tree_impulses`.
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState};
 use janus2d_core::constraint::{Constraint, ConstraintRows, StepContext};
@@ -38,6 +47,7 @@ use crate::JointError;
 use crate::joint_base::JointBase;
 use crate::parts::{BOTH, PairOf, PairStates, PointPart};
 use crate::revolute::{RevoluteJoint, RevoluteJointDef};
+use crate::weld::{WeldJoint, WeldJointDef};
 
 /// The joint kinds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -45,6 +55,9 @@ use crate::revolute::{RevoluteJoint, RevoluteJointDef};
 pub enum JointKind {
     /// A pin: two anchors coincide; optional limit, motor and spring.
     Revolute,
+    /// A weld: two anchors coincide and the relative angle is held,
+    /// rigidly or through springs.
+    Weld,
 }
 
 /// Everything needed to create a joint of any kind (the API boundary's
@@ -66,11 +79,19 @@ pub enum JointKind {
 pub enum JointDef {
     /// A revolute joint.
     Revolute(RevoluteJointDef),
+    /// A weld joint.
+    Weld(WeldJointDef),
 }
 
 impl From<RevoluteJointDef> for JointDef {
     fn from(def: RevoluteJointDef) -> Self {
         JointDef::Revolute(def)
+    }
+}
+
+impl From<WeldJointDef> for JointDef {
+    fn from(def: WeldJointDef) -> Self {
+        JointDef::Weld(def)
     }
 }
 
@@ -80,6 +101,7 @@ impl JointDef {
     pub fn kind(&self) -> JointKind {
         match self {
             JointDef::Revolute(_) => JointKind::Revolute,
+            JointDef::Weld(_) => JointKind::Weld,
         }
     }
 
@@ -88,6 +110,7 @@ impl JointDef {
     pub fn bodies(&self) -> (BodyHandle, BodyHandle) {
         match self {
             JointDef::Revolute(d) => (d.body_a, d.body_b),
+            JointDef::Weld(d) => (d.body_a, d.body_b),
         }
     }
 
@@ -96,6 +119,7 @@ impl JointDef {
     pub fn collide_connected(&self) -> bool {
         match self {
             JointDef::Revolute(d) => d.collide_connected,
+            JointDef::Weld(d) => d.collide_connected,
         }
     }
 
@@ -104,6 +128,7 @@ impl JointDef {
     pub fn local_anchors(&self) -> (Vec2, Vec2) {
         match self {
             JointDef::Revolute(d) => (d.local_anchor_a, d.local_anchor_b),
+            JointDef::Weld(d) => (d.local_anchor_a, d.local_anchor_b),
         }
     }
 
@@ -111,6 +136,7 @@ impl JointDef {
     pub fn validate(&self) -> Result<(), JointError> {
         match self {
             JointDef::Revolute(d) => d.validate(),
+            JointDef::Weld(d) => d.validate(),
         }
     }
 }
@@ -121,11 +147,19 @@ impl JointDef {
 pub enum Joint {
     /// A revolute joint.
     Revolute(RevoluteJoint),
+    /// A weld joint.
+    Weld(WeldJoint),
 }
 
 impl From<RevoluteJoint> for Joint {
     fn from(j: RevoluteJoint) -> Self {
         Joint::Revolute(j)
+    }
+}
+
+impl From<WeldJoint> for Joint {
+    fn from(j: WeldJoint) -> Self {
+        Joint::Weld(j)
     }
 }
 
@@ -135,6 +169,7 @@ impl Joint {
     pub fn new(def: JointDef) -> Self {
         match def {
             JointDef::Revolute(d) => Joint::Revolute(RevoluteJoint::new(d)),
+            JointDef::Weld(d) => Joint::Weld(WeldJoint::new(d)),
         }
     }
 
@@ -143,6 +178,7 @@ impl Joint {
     pub fn kind(&self) -> JointKind {
         match self {
             Joint::Revolute(_) => JointKind::Revolute,
+            Joint::Weld(_) => JointKind::Weld,
         }
     }
 
@@ -151,6 +187,7 @@ impl Joint {
     pub fn def(&self) -> JointDef {
         match self {
             Joint::Revolute(j) => JointDef::Revolute(j.def.clone()),
+            Joint::Weld(j) => JointDef::Weld(j.def.clone()),
         }
     }
 
@@ -159,6 +196,7 @@ impl Joint {
     pub fn as_revolute(&self) -> Option<&RevoluteJoint> {
         match self {
             Joint::Revolute(j) => Some(j),
+            _ => None,
         }
     }
 
@@ -166,6 +204,16 @@ impl Joint {
     pub fn as_revolute_mut(&mut self) -> Option<&mut RevoluteJoint> {
         match self {
             Joint::Revolute(j) => Some(j),
+            _ => None,
+        }
+    }
+
+    /// The weld joint, if it is one.
+    #[must_use]
+    pub fn as_weld(&self) -> Option<&WeldJoint> {
+        match self {
+            Joint::Weld(j) => Some(j),
+            _ => None,
         }
     }
 
@@ -175,6 +223,7 @@ impl Joint {
     pub fn base(&self) -> &JointBase {
         match self {
             Joint::Revolute(j) => &j.base,
+            Joint::Weld(j) => &j.base,
         }
     }
 
@@ -182,6 +231,7 @@ impl Joint {
     pub(crate) fn base_mut(&mut self) -> &mut JointBase {
         match self {
             Joint::Revolute(j) => &mut j.base,
+            Joint::Weld(j) => &mut j.base,
         }
     }
 
@@ -190,6 +240,7 @@ impl Joint {
     pub fn bodies(&self) -> (BodyHandle, BodyHandle) {
         match self {
             Joint::Revolute(j) => (j.def.body_a, j.def.body_b),
+            Joint::Weld(j) => (j.def.body_a, j.def.body_b),
         }
     }
 
@@ -198,6 +249,7 @@ impl Joint {
     pub fn collide_connected(&self) -> bool {
         match self {
             Joint::Revolute(j) => j.def.collide_connected,
+            Joint::Weld(j) => j.def.collide_connected,
         }
     }
 
@@ -206,6 +258,7 @@ impl Joint {
     pub fn local_anchors(&self) -> (Vec2, Vec2) {
         match self {
             Joint::Revolute(j) => (j.def.local_anchor_a, j.def.local_anchor_b),
+            Joint::Weld(j) => (j.def.local_anchor_a, j.def.local_anchor_b),
         }
     }
 
@@ -249,8 +302,8 @@ impl Joint {
         self.base_mut().enabled = on;
     }
 
-    /// True when the last step solved its point rows directly (it is part
-    /// of a tree of joints, see [`crate::joint_tree`]).
+    /// True when the last step solved its equality rows directly (it is
+    /// part of a tree of joints, see [`crate::joint_tree`]).
     #[must_use]
     pub fn in_tree(&self) -> bool {
         self.base().in_tree
@@ -262,6 +315,7 @@ impl Joint {
     pub fn is_driven(&self) -> bool {
         match self {
             Joint::Revolute(j) => j.def.enable_motor && j.def.max_motor_torque > 0.0,
+            Joint::Weld(_) => false,
         }
     }
 
@@ -270,13 +324,14 @@ impl Joint {
     pub fn row_count(&self) -> usize {
         match self {
             Joint::Revolute(j) => j.row_count(),
+            Joint::Weld(j) => j.row_count(),
         }
     }
 
     /// Rows of this joint the tree solve takes when it is in a tree.
     #[must_use]
     pub fn tree_row_count(&self) -> usize {
-        if self.tree_point().is_some() { 2 } else { 0 }
+        self.tree_rows().map_or(0, |r| r.count())
     }
 
     /// Force the joint applied to body b over the last solved step, N.
@@ -284,6 +339,7 @@ impl Joint {
     pub fn constraint_force(&self) -> Vec2 {
         match self {
             Joint::Revolute(j) => j.constraint_force(),
+            Joint::Weld(j) => j.constraint_force(),
         }
     }
 
@@ -292,6 +348,7 @@ impl Joint {
     pub fn constraint_torque(&self) -> Real {
         match self {
             Joint::Revolute(j) => j.constraint_torque(),
+            Joint::Weld(j) => j.constraint_torque(),
         }
     }
 
@@ -300,6 +357,7 @@ impl Joint {
     pub fn world_anchors(&self, bodies: &BodySet) -> (Vec2, Vec2) {
         match self {
             Joint::Revolute(j) => j.world_anchors(bodies),
+            Joint::Weld(j) => j.world_anchors(bodies),
         }
     }
 
@@ -315,42 +373,80 @@ impl Joint {
     pub fn carry_impulses(&mut self, rotation: Rot, scale: Real) {
         match self {
             Joint::Revolute(j) => j.carry_impulses(rotation, scale),
+            Joint::Weld(j) => j.carry_impulses(rotation, scale),
         }
     }
 
     /// Moves the end on body `from` to body `to` with the local anchor
     /// `anchor` in `to`'s frame; false when `from` is not one of its ends.
     pub fn repoint(&mut self, from: BodyHandle, to: BodyHandle, anchor: Vec2) -> bool {
+        let (body_a, anchor_a, body_b, anchor_b) = match self {
+            Joint::Revolute(j) => (
+                &mut j.def.body_a,
+                &mut j.def.local_anchor_a,
+                &mut j.def.body_b,
+                &mut j.def.local_anchor_b,
+            ),
+            Joint::Weld(j) => (
+                &mut j.def.body_a,
+                &mut j.def.local_anchor_a,
+                &mut j.def.body_b,
+                &mut j.def.local_anchor_b,
+            ),
+        };
+        if *body_a == from {
+            *body_a = to;
+            *anchor_a = anchor;
+        } else if *body_b == from {
+            *body_b = to;
+            *anchor_b = anchor;
+        } else {
+            return false;
+        }
+        true
+    }
+
+    /// The equality rows the tree solve takes over when the joint is in a
+    /// tree (`None`: the tree cannot take the joint, and a component
+    /// holding it is solved iteratively).
+    #[inline(always)]
+    pub(crate) fn tree_rows(&self) -> Option<TreeRows<'_>> {
         match self {
-            Joint::Revolute(j) => {
-                if j.def.body_a == from {
-                    j.def.body_a = to;
-                    j.def.local_anchor_a = anchor;
-                } else if j.def.body_b == from {
-                    j.def.body_b = to;
-                    j.def.local_anchor_b = anchor;
-                } else {
-                    return false;
-                }
-                true
-            }
+            Joint::Revolute(j) => Some(TreeRows {
+                point: &j.point,
+                angle: None,
+            }),
+            Joint::Weld(j) => j.def.is_rigid().then_some(TreeRows {
+                point: &j.point,
+                angle: Some(TreeAngle {
+                    delta_angle: j.delta_angle,
+                    impulse: j.angle.impulse,
+                }),
+            }),
         }
     }
 
-    /// The point part the tree solve takes over when the joint is in a
-    /// tree (`None`: the kind has no point rows, and a component holding
-    /// it is solved iteratively).
-    #[inline(always)]
-    pub(crate) fn tree_point(&self) -> Option<&PointPart> {
-        match self {
-            Joint::Revolute(j) => Some(&j.point),
-        }
-    }
-
-    #[inline(always)]
+    /// The point part, mutable (the unit tests set impulses and arms
+    /// through it).
+    #[cfg(test)]
     pub(crate) fn tree_point_mut(&mut self) -> Option<&mut PointPart> {
         match self {
             Joint::Revolute(j) => Some(&mut j.point),
+            Joint::Weld(j) => Some(&mut j.point),
+        }
+    }
+
+    /// Takes back the impulses of the tree's solve of its rows: the point
+    /// impulse, and the angle impulse when [`Joint::tree_rows`] has an
+    /// angle row (ignored otherwise).
+    #[inline(always)]
+    pub(crate) fn set_tree_impulses(&mut self, point: Vec2, angle: Real) {
+        match self {
+            Joint::Revolute(j) => j.point.impulse = point,
+            Joint::Weld(j) => {
+                j.point.impulse = point;
+                j.angle.impulse = angle;
+            }
         }
     }
 
@@ -361,6 +457,7 @@ impl Joint {
     pub(crate) fn has_iterative_rows(&self) -> bool {
         match self {
             Joint::Revolute(j) => !j.base.in_tree || j.has_angle_rows(),
+            Joint::Weld(j) => !j.base.in_tree,
         }
     }
 
@@ -369,6 +466,7 @@ impl Joint {
     pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
         match self {
             Joint::Revolute(j) => j.warm_start_side(st, side_b),
+            Joint::Weld(j) => j.warm_start_side(st, side_b),
         }
     }
 
@@ -382,6 +480,7 @@ impl Joint {
     ) {
         match self {
             Joint::Revolute(j) => j.solve_pair(ctx, pair, use_bias),
+            Joint::Weld(j) => j.solve_pair(ctx, pair, use_bias),
         }
     }
 }
@@ -390,12 +489,14 @@ impl Constraint for Joint {
     fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
         match self {
             Joint::Revolute(j) => j.prepare(ctx, bodies),
+            Joint::Weld(j) => j.prepare(ctx, bodies),
         }
     }
 
     fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
         match self {
             Joint::Revolute(j) => j.warm_start(ctx, states),
+            Joint::Weld(j) => j.warm_start(ctx, states),
         }
     }
 
@@ -408,10 +509,39 @@ impl Constraint for Joint {
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
         match self {
             Joint::Revolute(j) => j.rows(ctx, bodies),
+            Joint::Weld(j) => j.rows(ctx, bodies),
         }
     }
 
     fn is_enabled(&self) -> bool {
         self.base().enabled
     }
+}
+
+/// A joint's equality rows as the tree solve takes them: the point rows,
+/// and for a joint that also holds the relative angle, the angle row
+/// (`C_θ = θ_b − θ_a − θ_ref`, `J_θ = [0 0 −1 │ 0 0 1]`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TreeRows<'a> {
+    /// The point part (arms, centre offset, impulse).
+    pub(crate) point: &'a PointPart,
+    /// The angle row, for a 3-row joint.
+    pub(crate) angle: Option<TreeAngle>,
+}
+
+impl TreeRows<'_> {
+    /// Number of rows: 2 (point) or 3 (point and angle).
+    #[inline(always)]
+    pub(crate) fn count(&self) -> usize {
+        2 + usize::from(self.angle.is_some())
+    }
+}
+
+/// The angle row of a joint's tree rows.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TreeAngle {
+    /// `C_θ` at the start of the step, rad.
+    pub(crate) delta_angle: Real,
+    /// Accumulated impulse, N·m·s.
+    pub(crate) impulse: Real,
 }

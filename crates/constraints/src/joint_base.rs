@@ -6,7 +6,7 @@
 //! | `masses`           | prepare (`load`)  | the kind's rows, tree solve               |
 //! | `enabled`          | the world         | every stage (a disabled joint is skipped) |
 //! | `resting`          | prepare (`load`)  | every stage (neither body moves)          |
-//! | `in_tree`          | the tree build    | the kind's rows (point rows skipped), colouring |
+//! | `in_tree`          | the tree build    | the kind's rows (tree rows skipped), colouring |
 //! | `inv_h`            | prepare (`load`)  | force and torque read-back                |
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState, SolverBody};
@@ -30,7 +30,7 @@ pub struct JointBase {
     /// The bodies' inverse masses, loaded at prepare (zero for a body on
     /// the static identity state).
     pub(crate) masses: PairMass,
-    /// True while the joint's point rows belong to the direct solve of a
+    /// True while the joint's equality rows belong to the direct solve of a
     /// joint tree (set every step by [`JointForest`](crate::joint_tree::JointForest)).
     pub(crate) in_tree: bool,
     /// Neither body moves this step (both static or asleep): the joint is

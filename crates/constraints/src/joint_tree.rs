@@ -1,23 +1,32 @@
-//! Direct solve of the joints' point rows where the joints form a tree.
+//! Direct solve of the joints' equality rows where the joints form a tree:
+//! a revolute joint's point rows (2), a rigid weld's point and angle rows
+//! (3).
 //!
 //! Gauss–Seidel moves information one joint per iteration and builds a soft
 //! joint's spring on the *light* body's effective mass, so a heavy load on a
 //! chain of light links (the "ball and chain", 670:1) stretches every joint
 //! by about `F K / ω²`. Where the joints form a tree, the point rows of the
-//! whole tree can instead be solved exactly in time linear in its size
+//! whole tree (and the angle rows of its rigid welds) can instead be
+//! solved exactly in time linear in its size
 //! (the idea of Baraff, *Linear-time dynamics using Lagrange multipliers*,
 //! 1996), and an exact solve stays stable at any stiffness.
 //!
 //! # Derivation
 //!
 //! Unknowns: the velocity change `Δv_i = (Δv_x, Δv_y, Δω)` of every moving
-//! body in the tree and the impulse change `Δλ_j` (2 rows) of every joint.
-//! With `J_ji` the 2×3 block of joint `j` on body `i`
+//! body in the tree and the impulse change `Δλ_j` (`n_j` rows: 2 or 3) of
+//! every joint. With `J_ji` the `n_j`×3 block of joint `j` on body `i`
 //!
 //! ```text
 //! J_jb = [ 1 0 −r_b.y ]      J_ja = −[ 1 0 −r_a.y ]      (Ċ = v_b + ω_b × r_b − v_a − ω_a × r_a)
 //!        [ 0 1  r_b.x ]              [ 0 1  r_a.x ]
+//!        [ 0 0  1     ]              [ 0 0  1     ]      (3rd row: C_θ = θ_b − θ_a − θ_ref, Ċ_θ = ω_b − ω_a)
 //! ```
+//!
+//! (the third row only for a 3-row joint, a rigid weld; its bias is
+//! `β C_θ`, uncapped, its `K = J M⁻¹ Jᵀ` the full 3×3 block with the
+//! coupling `K₀₂ = −i_a r_a.y − i_b r_b.y`, `K₁₂ = i_a r_a.x + i_b r_b.x`,
+//! `K₂₂ = i_a + i_b`, `i = I⁻¹`; see [`crate::weld`]).
 //!
 //! the soft rows of [`Softness`](janus2d_core::softness::Softness) solved
 //! to convergence are
@@ -84,8 +93,23 @@
 //!                               (L_k = J_kpᵀ D_k⁻¹,  L_c = J_kc D_c⁻¹)
 //! ```
 //!
-//! Body pivots (3×3) stay positive definite and joint pivots (2×2)
+//! Body pivots (3×3) stay positive definite and joint pivots (`n_k`×`n_k`)
 //! negative definite, so both are inverted by cofactors without pivoting.
+//!
+//! **Joints of 2 and 3 rows.** The branch is per joint, on its row count.
+//! A 2-row joint takes the specialised path below (`Mat2` pivots, `J`
+//! written out term by term), unchanged from when the tree took only point
+//! joints, so a tree of revolute joints gives the same bits as before. A
+//! 3-row joint takes general 3×3 blocks (`eliminate_three`,
+//! `substitute_three`): `D_k = −Γ_k − J_kc D_c⁻¹ J_kcᵀ`, `T = D_k⁻¹`,
+//! `D_p −= J_kpᵀ T J_kp`, `b_p −= J_kpᵀ T b_k`; back substitution
+//! `x_k = T b_k − T J_kp x_p`, `x_c = D_c⁻¹ b_c − D_c⁻¹ J_kcᵀ x_k`. Both
+//! paths meet in the body pivots (3×3 whatever the joint), so a tree may
+//! mix revolute joints and welds. Its angle impulse acts as a torque
+//! through the solve's inertia `Ĩ`, is re-weighted at the bias pass like
+//! the point impulse's torque, and is written back into the joint (warm
+//! start, `constraint_torque`). The geometric stiffness stays on the point
+//! rows (the angle row's Jacobian does not turn with the body).
 //! `J_ji = ±[I | perp(r)]` has a third of its entries zero and the others
 //! ±1 but two, so its products with a pivot are written out term by term:
 //! the same sums in the same order as general 3×3 blocks (a joint's padded
@@ -101,7 +125,9 @@
 //! translate (or rotate) gets the placeholder mass 1 on that axis and a zero
 //! Jacobian column, so its `Δv` there is exactly zero.
 //!
-//! Only joint components without a loop are solved directly (found by
+//! Only joint components without a loop, and without a joint the tree
+//! cannot take (a soft weld: `Joint::tree_rows` is `None`), are solved
+//! directly (found by
 //! union–find over the moving bodies; a static, kinematic or sleeping body
 //! is a fixed end, so a bridge pinned at both ends is still a tree). A
 //! component with a loop (a joint grid, a cloth) stays wholly iterative:
@@ -129,6 +155,7 @@ use janus2d_core::union_find::{find, union};
 use crate::joint::Joint;
 use crate::joint_base::is_moving;
 use crate::parts::{PairMass, PointPart, clamp_length};
+use janus2d_core::math::wrap_angle;
 
 const NONE: u32 = u32::MAX;
 
@@ -232,6 +259,8 @@ struct Jacobian {
     lin: f64,
     px: f64,
     py: f64,
+    /// `side a`: the angle row's entry (read by 3-row joints only).
+    ang: f64,
 }
 
 impl Jacobian {
@@ -239,6 +268,7 @@ impl Jacobian {
         lin: 0.0,
         px: 0.0,
         py: 0.0,
+        ang: 0.0,
     };
 
     #[inline(always)]
@@ -248,7 +278,19 @@ impl Jacobian {
             lin: side * body.lin,
             px: -s_a * to_f64(r.y),
             py: s_a * to_f64(r.x),
+            ang: s_a,
         }
+    }
+
+    /// The 3×3 block of a 3-row joint (point rows and angle row):
+    /// `[s_l 0 p_x; 0 s_l p_y; 0 0 s_a]`, `s_a = side a`.
+    #[inline(always)]
+    fn full(&self) -> Matrix3 {
+        Matrix3::from_cols(
+            DVec3::new(self.lin, 0.0, 0.0),
+            DVec3::new(0.0, self.lin, 0.0),
+            DVec3::new(self.px, self.py, self.ang),
+        )
     }
 
     /// Row `i` (0 or 1) of `L = J S` for a body's `S = D⁻¹`, at column `j`.
@@ -402,6 +444,21 @@ impl BodyScratch {
         self.state.w += (from_f64(side) * self.inertia_change) * cross(r, p);
     }
 
+    /// Re-weights an angular impulse `l` on `side` applied through `I` to
+    /// `Ĩ` (a 3-row joint's angle row).
+    #[inline(always)]
+    fn reweight_angle(&mut self, side: f64, l: Real) {
+        self.state.w += (from_f64(side) * self.inertia_change) * l;
+    }
+
+    /// Applies the angular impulse `l` on `side` (+1: body b takes `+l`;
+    /// −1: body a, `−l`) through `Ĩ` (a 3-row joint's angle row).
+    #[inline(always)]
+    fn apply_angle(&mut self, side: f64, l: Real) {
+        let inv_i = self.mass.inv_inertia + self.inertia_change;
+        self.state.w += (from_f64(side) * inv_i) * l;
+    }
+
     /// Applies the impulse `p` at arm `r` on `side` (+1: the joint's body
     /// b, which takes `+p`; −1: body a, `−p`), turning through `Ĩ`.
     #[inline(always)]
@@ -438,10 +495,21 @@ struct JointScratch {
     fixed: u32,
     /// The joint's inverse masses (its bodies a and b).
     masses: PairMass,
-    /// The pivot `D_k` while eliminating, then `D_k⁻¹`.
+    /// The pivot `D_k` while eliminating, then `D_k⁻¹` (2-row joints).
     d: Mat2,
-    /// The right-hand side, then the solution `μ`.
+    /// The right-hand side, then the solution `μ` (2-row joints).
     b: DVec2,
+    /// True for a 3-row joint (point and angle rows): the fields below
+    /// are its angle row and its 3×3 pivot, and `d`, `b` are unused.
+    three: bool,
+    /// The angle error `C_θ = θ_b − θ_a − θ_ref`, rad.
+    c_angle: Real,
+    /// A copy of its accumulated angle impulse, N·m·s.
+    angle_impulse: Real,
+    /// The pivot `D_k` while eliminating, then `D_k⁻¹` (3-row joints).
+    d3: Matrix3,
+    /// The right-hand side, then the solution `μ` (3-row joints).
+    b3: DVec3,
 }
 
 impl JointScratch {
@@ -456,6 +524,11 @@ impl JointScratch {
         masses: PairMass::ZERO,
         d: Mat2::ZERO,
         b: DVec2::ZERO,
+        three: false,
+        c_angle: 0.0,
+        angle_impulse: 0.0,
+        d3: Matrix3::ZERO,
+        b3: DVec3::ZERO,
     };
 }
 
@@ -508,7 +581,7 @@ pub struct JointForest {
 fn moving_pair(j: &Joint, states: &[BodyState]) -> [u32; 3] {
     let base = j.base();
     let flags = u32::from(base.in_tree)
-        | if j.tree_point().is_some() {
+        | if j.tree_rows().is_some() {
             0
         } else {
             ITERATIVE
@@ -520,8 +593,9 @@ fn moving_pair(j: &Joint, states: &[BodyState]) -> [u32; 3] {
     [end(base.state_a), end(base.state_b), flags]
 }
 
-/// Pair flag: the joint's kind has no rows the tree solve takes (no
-/// point part), so a component holding it stays wholly iterative.
+/// Pair flag: the tree solve cannot take the joint's rows (its kind has
+/// no point part, or it is soft), so a component holding it stays wholly
+/// iterative.
 const ITERATIVE: u32 = 2;
 
 #[inline(always)]
@@ -819,9 +893,7 @@ impl JointForest {
             st.w = sc.state.w;
         }
         for (tj, row) in self.joints.iter().zip(&self.joint_scratch) {
-            if let Some(point) = joints[tj.index as usize].tree_point_mut() {
-                point.impulse = row.impulse;
-            }
+            joints[tj.index as usize].set_tree_impulses(row.impulse, row.angle_impulse);
         }
     }
 }
@@ -903,7 +975,9 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
     // geometric stiffness each body takes from its joints.
     for (tj, row) in topology.iter().zip(rows.iter_mut()) {
         let j = &joints[tj.index as usize];
-        let (base, point) = (j.base(), j.tree_point().unwrap_or(&NO_POINT));
+        let tree_rows = j.tree_rows();
+        let base = j.base();
+        let point = tree_rows.map_or(&NO_POINT, |r| r.point);
         let side = tj.side;
         row.masses = base.masses;
         let (frame_parent, frame_other, fixed) = if side > 0.0 {
@@ -921,6 +995,20 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
         (row.r_parent, row.r_other) = (r_parent, r_other);
         row.jac_parent = Jacobian::new(side, r_parent, parent);
         row.impulse = point.impulse;
+        row.three = false;
+        row.angle_impulse = 0.0;
+        if let Some(angle) = tree_rows.and_then(|r| r.angle) {
+            // C_θ = θ_b − θ_a − θ_ref from the start-of-step value and the
+            // rotation deltas since, in the joint's own order (a, b).
+            let (q_a, q_b) = if side > 0.0 {
+                (other.dq, parent.state.dq)
+            } else {
+                (parent.state.dq, other.dq)
+            };
+            row.three = true;
+            row.c_angle = wrap_angle(angle.delta_angle + q_a.relative_angle(q_b));
+            row.angle_impulse = angle.impulse;
+        }
         let lambda = wide(row.impulse);
         let parent = &mut bodies[tj.parent as usize];
         parent.leaf = false;
@@ -963,12 +1051,22 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
             if tj.child != NONE {
                 bodies[tj.child as usize].reweight(-tj.side, row.r_other, row.impulse);
             }
+            if row.three {
+                bodies[tj.parent as usize].reweight_angle(tj.side, row.angle_impulse);
+                if tj.child != NONE {
+                    bodies[tj.child as usize].reweight_angle(-tj.side, row.angle_impulse);
+                }
+            }
         }
     }
     // Leaves first: each joint's row and pivot, its child body's subtree
     // folded in (that body's pivot is complete: its other joints come
     // later), then the joint folded into its parent body.
     for (tj, row) in topology.iter().zip(rows.iter_mut()).rev() {
+        if row.three {
+            eliminate_three(tj, row, bodies, states, params);
+            continue;
+        }
         let side = tj.side;
         let (r_parent, r_other) = (row.r_parent, row.r_other);
         let parent = &bodies[tj.parent as usize].state;
@@ -1027,6 +1125,10 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
     root.d = pivot_inverse(&root.d);
     root.b = root.d * root.b;
     for (tj, row) in topology.iter().zip(rows.iter_mut()) {
+        if row.three {
+            substitute_three(tj, row, bodies);
+            continue;
+        }
         let side = tj.side;
         let parent = &mut bodies[tj.parent as usize];
         let x = row.jac_parent.joint_solution(&row.d, row.b, parent.b);
@@ -1052,4 +1154,115 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
 #[inline(always)]
 fn geometric_stiffness(h: f64, lambda: DVec2, r: Vec2, side: f64) -> f64 {
     (h * side * lambda.dot(wide(r))).max(0.0)
+}
+
+/// The 3×3 effective mass `K = J M⁻¹ Jᵀ` of a 3-row joint (point rows
+/// and angle row) in the joint's own order (a, b), in f64 (see the
+/// weld joint's derivation, [`crate::weld`]).
+#[inline(always)]
+fn three_row_k(m: &PairMass, r_a: Vec2, r_b: Vec2) -> Matrix3 {
+    let (k00, k01, k11) = PointPart::effective_mass(m, r_a, r_b);
+    let (i_a, i_b) = (to_f64(m.a.inv_inertia), to_f64(m.b.inv_inertia));
+    let (r_a, r_b) = (wide(r_a), wide(r_b));
+    let k02 = -i_a * r_a.y - i_b * r_b.y;
+    let k12 = i_a * r_a.x + i_b * r_b.x;
+    let k22 = i_a + i_b;
+    let (k00, k01, k11) = (to_f64(k00), to_f64(k01), to_f64(k11));
+    Matrix3::from_cols(
+        DVec3::new(k00, k01, k02),
+        DVec3::new(k01, k11, k12),
+        DVec3::new(k02, k12, k22),
+    )
+}
+
+/// Elimination of a 3-row joint `k` (point rows and angle row), general
+/// 3×3 blocks: its row and pivot `D_k = −Γ_k − J_kc D_c⁻¹ J_kcᵀ`,
+/// `b_k = r_k − J_kc D_c⁻¹ b_c`, `T = D_k⁻¹`, then folded into its parent
+/// body, `D_p −= J_kpᵀ T J_kp`, `b_p −= J_kpᵀ T b_k`.
+fn eliminate_three(
+    tj: &TreeJoint,
+    row: &mut JointScratch,
+    bodies: &mut [BodyScratch],
+    states: &[BodyState],
+    params: &TreeParams,
+) {
+    let side = tj.side;
+    let (r_parent, r_other) = (row.r_parent, row.r_other);
+    let parent = &bodies[tj.parent as usize].state;
+    let other = other_end(tj, row.fixed, bodies, states);
+    let c_dot = from_f64(side)
+        * ((parent.v + cross_sv(parent.w, r_parent)) - (other.v + cross_sv(other.w, r_other)));
+    let c_dot_angle = from_f64(side) * (parent.w - other.w);
+    let k = if side > 0.0 {
+        three_row_k(&row.masses, r_other, r_parent)
+    } else {
+        three_row_k(&row.masses, r_parent, r_other)
+    };
+    let compliance = params.compliance;
+    let rhs = if params.use_bias {
+        let softness = params.softness;
+        let bias = clamp_length(softness.bias_rate * row.c, params.max_correction_speed);
+        let bias_angle = softness.bias_rate * row.c_angle;
+        let lambda = DVec3::new(
+            to_f64(row.impulse.x),
+            to_f64(row.impulse.y),
+            to_f64(row.angle_impulse),
+        );
+        let held = (k * lambda) * compliance;
+        let v = wide(c_dot + bias);
+        -(DVec3::new(v.x, v.y, to_f64(c_dot_angle + bias_angle)) + held)
+    } else {
+        let v = wide(c_dot);
+        -DVec3::new(v.x, v.y, to_f64(c_dot_angle))
+    };
+    // D_k = −Γ, Γ = K / a2.
+    let mut d = k * -compliance;
+    let mut b = rhs;
+    if tj.child != NONE {
+        // D_k −= J D_c⁻¹ Jᵀ,  b_k −= J D_c⁻¹ b_c  (a leaf's b_c is zero).
+        let child = &mut bodies[tj.child as usize];
+        child.d = pivot_inverse(&child.d);
+        let j = row.jac_child.full();
+        let l = j * child.d;
+        d -= l * j.transpose();
+        if !child.leaf {
+            b -= l * child.b;
+        }
+    }
+    let t = pivot_inverse(&d);
+    row.d3 = t;
+    row.b3 = b;
+    // D_p −= Jᵀ D_k⁻¹ J,  b_p −= Jᵀ D_k⁻¹ b_k.
+    let parent = &mut bodies[tj.parent as usize];
+    let j = row.jac_parent.full();
+    let l = j.transpose() * t;
+    parent.d -= l * j;
+    parent.b -= l * b;
+}
+
+/// Back substitution of a 3-row joint `k` from its parent's solution:
+/// `x_k = T b_k − T J_kp x_p`, its impulse `Δλ = −x_k` applied (point
+/// impulse at the arms, angle impulse as a torque), then its child's
+/// `x_c = D_c⁻¹ b_c − D_c⁻¹ J_kcᵀ x_k`.
+fn substitute_three(tj: &TreeJoint, row: &mut JointScratch, bodies: &mut [BodyScratch]) {
+    let side = tj.side;
+    let parent = &mut bodies[tj.parent as usize];
+    let t = row.d3;
+    let x = t * row.b3 - t * (row.jac_parent.full() * parent.b);
+    row.b3 = x;
+    let impulse = -Vec2::new(from_f64(x.x), from_f64(x.y));
+    let angular = -from_f64(x.z);
+    row.impulse += impulse;
+    row.angle_impulse += angular;
+    parent.apply(side, row.r_parent, impulse);
+    parent.apply_angle(side, angular);
+    if tj.child != NONE {
+        let child = &mut bodies[tj.child as usize];
+        if !child.leaf {
+            let s = child.d;
+            child.b = s * child.b - s * (row.jac_child.full().transpose() * x);
+        }
+        child.apply(-side, row.r_other, impulse);
+        child.apply_angle(-side, angular);
+    }
 }

@@ -6,11 +6,13 @@
 //! |-------------------------------|------|--------|-------------------------|
 //! | [`joint::Joint`]              | per kind | 2  | one file per kind ([`joint`]) |
 //! | [`revolute::RevoluteJoint`]   | 2–6  | 2      | point + angle parts     |
+//! | [`weld::WeldJoint`]           | 3    | 2      | point + angle parts     |
 //! | [`portal::PortalConstraint`]  | 3    | 4      | portal part + portal map |
 //! | [`contact::ContactConstraint`]| 2–4  | 2      | contact rows (normal, friction) |
 //!
-//! The point rows of joints that form a tree are solved exactly, the
-//! whole tree at once ([`joint_tree`]); the joints' Gauss–Seidel rows are
+//! The equality rows of joints that form a tree (a revolute joint's
+//! point, a rigid weld's point and angle) are solved exactly, the whole
+//! tree at once ([`joint_tree`]); the joints' Gauss–Seidel rows are
 //! solved colour by colour on the step's team ([`joint_colour`]); so are the normal rows of the
 //! contacts of a light cluster, bodies under (or between) bodies ten times
 //! heavier or more ([`contact_group`]); the rest is Gauss–Seidel.
@@ -36,6 +38,7 @@ pub mod parts;
 pub mod portal;
 pub mod portal_map;
 pub mod revolute;
+pub mod weld;
 
 pub use contact::{ContactConstraint, ContactPointInput};
 pub use contact_solver::{ContactBatch, ContactSolver, ObjectMass, PointImpulse};
@@ -47,6 +50,7 @@ pub use joint_tree::JointForest;
 pub use portal::{PortalBatch, PortalConstraint, PortalConstraintDef};
 pub use portal_map::{Portal, PortalError, PortalMap, PortalPair};
 pub use revolute::{RevoluteJoint, RevoluteJointDef};
+pub use weld::{WeldJoint, WeldJointDef};
 
 /// Invalid joint input at the API boundary.
 #[derive(Clone, Debug, PartialEq)]

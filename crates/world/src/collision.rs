@@ -364,6 +364,7 @@ impl Collision {
         bodies: &BodySet,
         dt: Real,
     ) -> usize {
+        use janus2d_core::geometry::Aabb;
         use rayon::prelude::*;
         let read = &*shapes;
         let blocks: Vec<Vec<(u32, Aabb, Vec2)>> = bodies.sims[1..]

@@ -15,7 +15,7 @@
 //! | `shapes`           | on      | circles ([`DebugDraw::solid_circle`], with a radius line showing the turn), capsules ([`DebugDraw::solid_capsule`]), polygons ([`DebugDraw::solid_polygon`], rounded by their radius), segments and chain segments ([`DebugDraw::segment`]); coloured by body type |
 //! | `sleep`            | on      | shapes of sleeping bodies in [`Palette::sleeping`]                |
 //! | `islands`          | off     | shapes coloured by island; one outline box ([`DebugDraw::polygon`]) per island around its members' boxes, with its id as [`DebugDraw::text`] |
-//! | `joints`           | on      | per revolute joint: body origin → anchor a → anchor b ← body origin ([`DebugDraw::segment`]), both anchors as [`DebugDraw::point`]; disabled joints in [`Palette::joint_disabled`] |
+//! | `joints`           | on      | per joint (every kind): body origin → anchor a → anchor b ← body origin ([`DebugDraw::segment`]), both anchors as [`DebugDraw::point`]; disabled joints in [`Palette::joint_disabled`] |
 //! | `contacts`         | off     | one [`DebugDraw::point`] per manifold point of a solid contact: touching in [`Palette::contact_touching`], speculative (separation > 0) in [`Palette::contact_speculative`] |
 //! | `contact_normals`  | off     | a segment of `normal_length` along the contact normal at each point |
 //! | `contact_impulses` | off     | a segment of `impulse_scale × normal impulse` along the normal at each point |
@@ -208,7 +208,7 @@ pub struct DrawOptions {
     pub sleep: bool,
     /// Shapes coloured by island, and one box per island.
     pub islands: bool,
-    /// Revolute joints.
+    /// Joints (every kind).
     pub joints: bool,
     /// Contact points.
     pub contacts: bool,

@@ -13,7 +13,8 @@
 //! A joint's bodies and `collide_connected` are fixed at creation; limits,
 //! motor, spring and the enabled switch change through validated setters
 //! that leave the joint unchanged on error. The set never names a joint
-//! kind but in the typed accessors ([`JointSet::revolute`]) and the
+//! kind but in the typed accessors ([`JointSet::revolute`],
+//! [`JointSet::weld`]) and the
 //! setters whose meaning is the kind's (angle limits of a revolute joint).
 
 use std::collections::HashMap;
@@ -21,6 +22,7 @@ use std::collections::HashMap;
 pub use janus2d_constraints::JointKind;
 use janus2d_constraints::{
     Joint, JointBatch, JointColours, JointDef, JointForest, RevoluteJoint, RevoluteJointDef,
+    WeldJoint,
 };
 use janus2d_core::body::BodyHandle;
 use janus2d_core::handle::{Handle, JointTag};
@@ -229,6 +231,11 @@ impl JointSet {
         self.get(joint)?
             .as_revolute()
             .ok_or(WorldError::WrongJointKind)
+    }
+
+    /// A weld joint (`Err(WrongJointKind)` for a joint of another kind).
+    pub fn weld(&self, joint: JointHandle) -> Result<&WeldJoint, WorldError> {
+        self.get(joint)?.as_weld().ok_or(WorldError::WrongJointKind)
     }
 
     fn revolute_mut(&mut self, joint: JointHandle) -> Result<&mut RevoluteJoint, WorldError> {

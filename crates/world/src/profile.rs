@@ -51,7 +51,7 @@ pub struct StepCounters {
     pub contacts: usize,
     /// Contact rows (normal + friction per point).
     pub contact_rows: usize,
-    /// Joint rows (revolute: 2 point rows plus limit, motor, spring rows).
+    /// Joint rows (revolute: 2 point rows plus limit, motor, spring rows; weld: 3).
     pub joint_rows: usize,
     /// Joint point rows solved directly, as joint trees (0: the tree solve
     /// did nothing this step).

@@ -51,6 +51,25 @@ impl World {
         self.create_joint(&JointDef::Revolute(def.clone()))
     }
 
+    /// Creates a weld joint ([`World::create_joint`] with
+    /// [`JointDef::Weld`]).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_constraints::WeldJointDef;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    /// let beam = world.create_body(&BodyDef::dynamic(Vec2::new(0.5, 0.0))).unwrap();
+    /// let def = WeldJointDef::new(ground, beam, Vec2::ZERO, Vec2::new(-0.5, 0.0));
+    /// let weld = world.create_weld_joint(&def).unwrap();
+    /// assert!(world.weld_joint(weld).is_ok());
+    /// assert!(world.revolute_joint(weld).is_err());
+    /// ```
+    pub fn create_weld_joint(&mut self, def: &WeldJointDef) -> Result<JointHandle, WorldError> {
+        self.create_joint(&JointDef::Weld(def.clone()))
+    }
+
     /// Removes a live joint, waking its bodies.
     pub(super) fn remove_joint(&mut self, joint: JointHandle) {
         self.stores().remove_joint(joint);
@@ -71,6 +90,11 @@ impl World {
     /// A revolute joint (`Err(WrongJointKind)` for another kind).
     pub fn revolute_joint(&self, joint: JointHandle) -> Result<&RevoluteJoint, WorldError> {
         self.joints.revolute(joint)
+    }
+
+    /// A weld joint (`Err(WrongJointKind)` for another kind).
+    pub fn weld_joint(&self, joint: JointHandle) -> Result<&WeldJoint, WorldError> {
+        self.joints.weld(joint)
     }
 
     /// Force the joint applied to its body b over the last solved step, N

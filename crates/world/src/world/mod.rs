@@ -34,7 +34,8 @@
 //! unchanged.
 
 use janus2d_constraints::{
-    ContactSolver, Joint, JointDef, ObjectMass, RevoluteJoint, RevoluteJointDef,
+    ContactSolver, Joint, JointDef, ObjectMass, RevoluteJoint, RevoluteJointDef, WeldJoint,
+    WeldJointDef,
 };
 use janus2d_core::BodyMass;
 use janus2d_core::body::{BodyDef, BodyHandle, BodySet, BodyType, validate_mass};

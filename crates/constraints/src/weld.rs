@@ -1,0 +1,569 @@
+//! The weld joint: two bodies held at a shared point and a fixed relative
+//! angle, rigidly or through a linear and an angular spring.
+//!
+//! # Derivation
+//!
+//! Bodies `a` and `b` with centres `x_a`, `x_b`, angles `θ_a`, `θ_b`, and
+//! anchors `r_a = R(θ_a)(l_a − c_a)`, `r_b = R(θ_b)(l_b − c_b)` measured from
+//! the centres of mass.
+//!
+//! **Point (2 rows)**, as the revolute joint's:
+//! `C_p = (x_b + r_b) − (x_a + r_a)`, `J_p = [ −I  −perp(r_a)   I  perp(r_b) ]`.
+//!
+//! **Angle (1 row).** `C_θ = θ_b − θ_a − θ_ref`, `J_θ = [ 0 0 −1 │ 0 0 1 ]`,
+//! `K_θ = i_a⁻¹ + i_b⁻¹`.
+//!
+//! The three rows together (`J = [J_p; J_θ]`) have the 3×3 effective mass
+//!
+//! ```text
+//! K = J M⁻¹ Jᵀ = [ m + i_a r_a.y² + i_b r_b.y²      −i_a r_a.x r_a.y − i_b r_b.x r_b.y    −i_a r_a.y − i_b r_b.y ]
+//!                [ ·                                 m + i_a r_a.x² + i_b r_b.x²          i_a r_a.x + i_b r_b.x  ]
+//!                [ ·                                 ·                                    i_a + i_b              ]
+//! ```
+//!
+//! with `m = m_a⁻¹ + m_b⁻¹`, `i = I⁻¹`. The Gauss–Seidel pass solves the
+//! angle row, then the point rows as a 2×2 block (the coupling `K₀₂`, `K₁₂`
+//! is left to the iterations); the tree solve of a rigid weld takes all
+//! three rows at once with the full `K` ([`crate::joint_tree`]).
+//!
+//! **Softness.** A zero `linear_hertz` (`angular_hertz`) makes the point
+//! (angle) rows rigid: the world's joint softness, built on the heavier
+//! body's mass (inertia) like the revolute joint's point rows,
+//! `ρ = min((w_a + w_b) / min(w_a, w_b), ρ_max)` with `w` the inverse mass
+//! (inertia), `ρ_max` against a body that does not move (turn). A nonzero
+//! one makes a spring `Softness::new(hertz, damping_ratio, h)`, applied in
+//! the relax pass too (a spring is a force, not a position correction), its
+//! bias not capped. Only a weld rigid on both is solved by the tree.
+
+use janus2d_core::body::{BodyHandle, BodySet, BodyState};
+use janus2d_core::constraint::{Block, BodyJacobian, Constraint, ConstraintRows, Row, StepContext};
+use janus2d_core::math::{Real, Vec2, cross};
+use janus2d_core::softness::Softness;
+use smallvec::smallvec;
+
+use crate::joint_base::JointBase;
+use crate::parts::{
+    AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, load_pair, store_pair,
+};
+use crate::{JointError, check_anchor, check_spring};
+
+/// Everything needed to create a weld joint.
+///
+/// ```
+/// use janus2d_constraints::WeldJointDef;
+/// use janus2d_core::{BodyDef, BodySet, Vec2};
+/// let mut bodies = BodySet::new();
+/// let a = bodies.create(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+/// let b = bodies.create(&BodyDef::dynamic(Vec2::X)).unwrap();
+/// let def = WeldJointDef::new(a, b, Vec2::new(0.5, 0.0), Vec2::new(-0.5, 0.0));
+/// assert!(def.is_rigid());
+/// assert!(def.validate().is_ok());
+/// assert!(!def.with_stiffness(0.0, 0.0, 2.0, 0.1).is_rigid());
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct WeldJointDef {
+    /// First body.
+    pub body_a: BodyHandle,
+    /// Second body.
+    pub body_b: BodyHandle,
+    /// Anchor in body a's frame (relative to its origin), m.
+    pub local_anchor_a: Vec2,
+    /// Anchor in body b's frame (relative to its origin), m.
+    pub local_anchor_b: Vec2,
+    /// `θ_b − θ_a` the joint holds, rad.
+    pub reference_angle: Real,
+    /// Stiffness of the point rows, Hz (0: rigid).
+    pub linear_hertz: Real,
+    /// Damping ratio of the point rows (dimensionless; unused when rigid).
+    pub linear_damping_ratio: Real,
+    /// Stiffness of the angle row, Hz (0: rigid).
+    pub angular_hertz: Real,
+    /// Damping ratio of the angle row (dimensionless; unused when rigid).
+    pub angular_damping_ratio: Real,
+    /// Whether the two bodies collide with each other (usual false).
+    pub collide_connected: bool,
+}
+
+impl WeldJointDef {
+    /// A rigid weld between two bodies at the given local anchors, holding
+    /// the relative angle they have at zero (`reference_angle` 0).
+    pub fn new(
+        body_a: BodyHandle,
+        body_b: BodyHandle,
+        local_anchor_a: Vec2,
+        local_anchor_b: Vec2,
+    ) -> Self {
+        WeldJointDef {
+            body_a,
+            body_b,
+            local_anchor_a,
+            local_anchor_b,
+            reference_angle: 0.0,
+            linear_hertz: 0.0,
+            linear_damping_ratio: 0.0,
+            angular_hertz: 0.0,
+            angular_damping_ratio: 0.0,
+            collide_connected: false,
+        }
+    }
+
+    /// Sets the springs (builder style): stiffness in Hz (0: rigid) and
+    /// damping ratio of the point rows, then of the angle row.
+    pub fn with_stiffness(
+        mut self,
+        linear_hertz: Real,
+        linear_damping_ratio: Real,
+        angular_hertz: Real,
+        angular_damping_ratio: Real,
+    ) -> Self {
+        self.linear_hertz = linear_hertz;
+        self.linear_damping_ratio = linear_damping_ratio;
+        self.angular_hertz = angular_hertz;
+        self.angular_damping_ratio = angular_damping_ratio;
+        self
+    }
+
+    /// Sets the reference angle `θ_b − θ_a`, rad (builder style).
+    pub fn with_reference_angle(mut self, angle: Real) -> Self {
+        self.reference_angle = angle;
+        self
+    }
+
+    /// True when both the point rows and the angle row are rigid (zero
+    /// hertz): the joint tree can solve it directly.
+    #[must_use]
+    pub fn is_rigid(&self) -> bool {
+        self.linear_hertz == 0.0 && self.angular_hertz == 0.0
+    }
+
+    /// Checks the definition's own values (not the handles).
+    pub fn validate(&self) -> Result<(), JointError> {
+        if self.body_a == self.body_b {
+            return Err(JointError::SameBody);
+        }
+        let finite = self.local_anchor_a.x.is_finite()
+            && self.local_anchor_a.y.is_finite()
+            && self.local_anchor_b.x.is_finite()
+            && self.local_anchor_b.y.is_finite()
+            && self.reference_angle.is_finite()
+            && self.linear_hertz.is_finite()
+            && self.linear_damping_ratio.is_finite()
+            && self.angular_hertz.is_finite()
+            && self.angular_damping_ratio.is_finite();
+        if !finite {
+            return Err(JointError::NonFinite);
+        }
+        if self.linear_hertz < 0.0
+            || self.linear_damping_ratio < 0.0
+            || self.angular_hertz < 0.0
+            || self.angular_damping_ratio < 0.0
+        {
+            return Err(JointError::Negative);
+        }
+        check_anchor(self.local_anchor_a, "local_anchor_a")?;
+        check_anchor(self.local_anchor_b, "local_anchor_b")?;
+        check_spring(self.linear_hertz, self.linear_damping_ratio)?;
+        check_spring(self.angular_hertz, self.angular_damping_ratio)
+    }
+}
+
+/// A weld joint in solver form.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct WeldJoint {
+    /// The definition it was made from.
+    pub def: WeldJointDef,
+    /// State indices, masses and switches the solver reads.
+    pub(crate) base: JointBase,
+    /// The point rows.
+    pub(crate) point: PointPart,
+    /// The angle row.
+    pub(crate) angle: AnglePart,
+    /// `C_θ = θ_b − θ_a − θ_ref` at the start of the step, rad.
+    pub(crate) delta_angle: Real,
+    /// Softness of the point rows for this step.
+    linear_softness: Softness,
+    /// Softness of the angle row for this step.
+    angular_softness: Softness,
+}
+
+/// The world's joint softness built on the heavier end: `w_a`, `w_b` the
+/// two inverse masses (or inertias), `ρ = min((w_a + w_b) / min(w_a, w_b),
+/// ρ_max)`, `ρ_max` when one end does not move.
+fn rigid_softness(ctx: &StepContext, w_a: Real, w_b: Real) -> Softness {
+    let w_heavy = w_a.min(w_b);
+    let rho = if w_heavy > 0.0 {
+        ((w_a + w_b) / w_heavy).min(ctx.joint_mass_ratio_cap)
+    } else {
+        ctx.joint_mass_ratio_cap
+    };
+    ctx.joint_softness.with_mass_ratio(rho)
+}
+
+/// The softness of the weld's point rows and angle row for a step (see
+/// the module docs), used by the solve and reported by `rows()`.
+fn softnesses(def: &WeldJointDef, ctx: &StepContext, m: &PairMass) -> (Softness, Softness) {
+    let linear = if def.linear_hertz == 0.0 {
+        rigid_softness(ctx, m.a.inv_mass, m.b.inv_mass)
+    } else {
+        Softness::new(def.linear_hertz, def.linear_damping_ratio, ctx.h)
+    };
+    let angular = if def.angular_hertz == 0.0 {
+        rigid_softness(ctx, m.a.inv_inertia, m.b.inv_inertia)
+    } else {
+        Softness::new(def.angular_hertz, def.angular_damping_ratio, ctx.h)
+    };
+    (linear, angular)
+}
+
+impl WeldJoint {
+    /// A joint from a definition (validate it first).
+    pub fn new(def: WeldJointDef) -> Self {
+        WeldJoint {
+            def,
+            base: JointBase::default(),
+            point: PointPart::default(),
+            angle: AnglePart::default(),
+            delta_angle: 0.0,
+            linear_softness: Softness::RIGID,
+            angular_softness: Softness::RIGID,
+        }
+    }
+
+    /// Rows this joint adds to the solver when enabled: two point rows and
+    /// one angle row.
+    #[must_use]
+    pub fn row_count(&self) -> usize {
+        3
+    }
+
+    /// Carries the accumulated impulses through a portal when both ends
+    /// move to the other side (as [`crate::RevoluteJoint::carry_impulses`]:
+    /// the point impulse turns and scales, the angle impulse is kept).
+    pub fn carry_impulses(&mut self, rotation: janus2d_core::math::Rot, scale: Real) {
+        self.point.impulse = scale * rotation.rotate(self.point.impulse);
+    }
+
+    /// The world anchors on a and b (their distance is the joint gap).
+    pub fn world_anchors(&self, bodies: &BodySet) -> (Vec2, Vec2) {
+        let a = bodies.solver_body(self.def.body_a).sim;
+        let b = bodies.solver_body(self.def.body_b).sim;
+        (
+            a.transform.apply(self.def.local_anchor_a),
+            b.transform.apply(self.def.local_anchor_b),
+        )
+    }
+
+    /// Distance between the two world anchors, m.
+    pub fn gap(&self, bodies: &BodySet) -> Real {
+        let (pa, pb) = self.world_anchors(bodies);
+        (pb - pa).length()
+    }
+
+    /// The angle error `θ_b − θ_a − θ_ref`, rad (wrapped to `[−π, π]`).
+    pub fn angle(&self, bodies: &BodySet) -> Real {
+        let a = bodies.solver_body(self.def.body_a).sim;
+        let b = bodies.solver_body(self.def.body_b).sim;
+        janus2d_core::math::wrap_angle(
+            a.transform.q.relative_angle(b.transform.q) - self.def.reference_angle,
+        )
+    }
+
+    /// True when the last step solved its rows directly (the joint is part
+    /// of a tree of joints, see [`crate::joint_tree`]).
+    pub fn in_tree(&self) -> bool {
+        self.base.in_tree
+    }
+
+    /// False when the joint is disabled (skipped by the solver).
+    #[must_use]
+    pub fn is_enabled(&self) -> bool {
+        self.base.enabled
+    }
+
+    /// Point impulse of one substep of the last solved step, N·s.
+    pub fn linear_impulse(&self) -> Vec2 {
+        self.point.impulse
+    }
+
+    /// Angle impulse of one substep of the last solved step, N·m·s.
+    pub fn angular_impulse(&self) -> Real {
+        self.angle.impulse
+    }
+
+    /// Force the joint applies to body b over the last solved step, N
+    /// (body a gets the opposite).
+    #[must_use]
+    pub fn constraint_force(&self) -> Vec2 {
+        self.point.impulse * self.base.inv_h
+    }
+
+    /// Torque the angle row applies to body b over the last solved step,
+    /// N·m (body a gets the opposite).
+    #[must_use]
+    pub fn constraint_torque(&self) -> Real {
+        self.angle.impulse * self.base.inv_h
+    }
+
+    /// The warm start's share on one of its bodies (`side_b`: body b, else
+    /// body a): the kept angle impulse, then the kept point impulse at the
+    /// body's current arm (the arithmetic of [`Constraint::warm_start`] on
+    /// that body).
+    #[inline(always)]
+    pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
+        let axial = self.angle.impulse;
+        let p = self.point.impulse;
+        if side_b {
+            let m_b = &self.base.masses.b;
+            st.w += m_b.inv_inertia * axial;
+            let r_b = st.dq.rotate(self.point.frame_b);
+            st.v += m_b.inv_mass * p;
+            st.w += m_b.inv_inertia * (cross(r_b, p) + 0.0);
+        } else {
+            let m_a = &self.base.masses.a;
+            st.w -= m_a.inv_inertia * axial;
+            let r_a = st.dq.rotate(self.point.frame_a);
+            st.v -= m_a.inv_mass * p;
+            st.w -= m_a.inv_inertia * (cross(r_a, p) + 0.0);
+        }
+    }
+
+    /// One velocity iteration on the joint's two states: the angle row,
+    /// then the point rows. A tree joint has nothing to do here (all its
+    /// rows are the tree's).
+    #[inline(always)]
+    pub(crate) fn solve_pair<P: PairStates>(
+        &mut self,
+        ctx: &StepContext,
+        pair: &mut P,
+        use_bias: bool,
+    ) {
+        if self.base.resting || self.base.in_tree {
+            return;
+        }
+        let (mut sa, mut sb) = pair.load();
+        let m = &self.base.masses;
+        let angular_spring = self.def.angular_hertz > 0.0;
+        if m.a.inv_inertia + m.b.inv_inertia > 0.0 {
+            let c = self.current_angle(&sa, &sb);
+            let (bias, mass_scale, impulse_scale) = if use_bias || angular_spring {
+                let s = self.angular_softness;
+                (s.bias_rate * c, s.mass_scale, s.impulse_scale)
+            } else {
+                (0.0, 1.0, 0.0)
+            };
+            let c_dot = AnglePart::c_dot(&sa, &sb);
+            let lambda =
+                -mass_scale * self.angle.mass * (c_dot + bias) - impulse_scale * self.angle.impulse;
+            self.angle.impulse += lambda;
+            AnglePart::apply(&mut sa, &mut sb, m, lambda);
+        }
+        if self.def.linear_hertz > 0.0 {
+            // A spring: always on, its bias not capped.
+            self.point
+                .solve(&mut sa, &mut sb, m, self.linear_softness, Real::MAX, true);
+        } else {
+            self.point.solve(
+                &mut sa,
+                &mut sb,
+                m,
+                self.linear_softness,
+                ctx.joint_max_correction_speed,
+                use_bias,
+            );
+        }
+        pair.store(&sa, &sb);
+    }
+
+    /// `C_θ` from the states' rotation deltas.
+    fn current_angle(&self, sa: &BodyState, sb: &BodyState) -> Real {
+        janus2d_core::math::wrap_angle(self.delta_angle + sa.dq.relative_angle(sb.dq))
+    }
+}
+
+impl Constraint for WeldJoint {
+    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
+        let Some((a, b)) = self
+            .base
+            .load(ctx, bodies, self.def.body_a, self.def.body_b)
+        else {
+            return;
+        };
+        let q_a = a.sim.transform.q;
+        let q_b = b.sim.transform.q;
+        self.point.frame_a = q_a.rotate(self.def.local_anchor_a - a.sim.local_center);
+        self.point.frame_b = q_b.rotate(self.def.local_anchor_b - b.sim.local_center);
+        self.point.delta_center = b.sim.center - a.sim.center;
+        self.delta_angle =
+            janus2d_core::math::wrap_angle(q_a.relative_angle(q_b) - self.def.reference_angle);
+        let m = self.base.masses;
+        self.angle.prepare(&m);
+        (self.linear_softness, self.angular_softness) = softnesses(&self.def, ctx, &m);
+        if !ctx.warm_starting {
+            self.point.impulse = Vec2::ZERO;
+            self.angle.impulse = 0.0;
+        }
+    }
+
+    fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
+        if self.base.resting {
+            return;
+        }
+        let (a, b) = (self.base.state_a, self.base.state_b);
+        let (mut sa, mut sb) = load_pair(states, a, b);
+        let m = &self.base.masses;
+        AnglePart::apply(&mut sa, &mut sb, m, self.angle.impulse);
+        self.point.warm_start(&mut sa, &mut sb, m);
+        store_pair(states, a, b, &sa, &sb);
+    }
+
+    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
+        let mut pair = PairOf::new(states, self.base.state_a, self.base.state_b, BOTH);
+        self.solve_pair(ctx, &mut pair, use_bias);
+    }
+
+    fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
+        let a = bodies.solver_body(self.def.body_a);
+        let b = bodies.solver_body(self.def.body_b);
+        let r_a = a
+            .sim
+            .transform
+            .q
+            .rotate(self.def.local_anchor_a - a.sim.local_center);
+        let r_b = b
+            .sim
+            .transform
+            .q
+            .rotate(self.def.local_anchor_b - b.sim.local_center);
+        let c = (b.sim.center + r_b) - (a.sim.center + r_a);
+        let m = PairMass {
+            a: a.inv_masses(),
+            b: b.inv_masses(),
+        };
+        let (ima, iia, imb, iib) = (m.a.inv_mass, m.a.inv_inertia, m.b.inv_mass, m.b.inv_inertia);
+        let entry = |body, linear: Vec2, angular, im, ii| BodyJacobian {
+            body,
+            linear,
+            angular,
+            inv_mass: im,
+            inv_inertia: ii,
+        };
+        // A tree joint's three rows are solved directly, at its softness.
+        let (linear_softness, angular_softness) = if self.base.in_tree {
+            (ctx.direct_joint_softness, ctx.direct_joint_softness)
+        } else {
+            softnesses(&self.def, ctx, &m)
+        };
+        let point_row = |axis: Vec2, c: Real, impulse: Real| Row {
+            jacobian: smallvec![
+                entry(self.def.body_a, -axis, -cross(r_a, axis), ima, iia),
+                entry(self.def.body_b, axis, cross(r_b, axis), imb, iib),
+            ],
+            c,
+            softness: linear_softness,
+            lower: Real::NEG_INFINITY,
+            upper: Real::INFINITY,
+            impulse,
+        };
+        let mut out = ConstraintRows::default();
+        out.rows.push(point_row(Vec2::X, c.x, self.point.impulse.x));
+        out.rows.push(point_row(Vec2::Y, c.y, self.point.impulse.y));
+        out.rows.push(Row {
+            jacobian: smallvec![
+                entry(self.def.body_a, Vec2::ZERO, -1.0, ima, iia),
+                entry(self.def.body_b, Vec2::ZERO, 1.0, imb, iib),
+            ],
+            c: self.angle(bodies),
+            softness: angular_softness,
+            lower: Real::NEG_INFINITY,
+            upper: Real::INFINITY,
+            impulse: self.angle.impulse,
+        });
+        let (k11, k12, k22) = PointPart::effective_mass(&m, r_a, r_b);
+        let k33 = iia + iib;
+        if self.base.in_tree {
+            // One 3×3 block: the tree solves the rows together.
+            let k13 = -iia * r_a.y - iib * r_b.y;
+            let k23 = iia * r_a.x + iib * r_b.x;
+            out.blocks.push(Block {
+                first_row: 0,
+                len: 3,
+                k: [[k11, k12, k13], [k12, k22, k23], [k13, k23, k33]],
+            });
+        } else {
+            // The Gauss–Seidel pass solves the point block and the angle
+            // row one after the other.
+            out.blocks.push(Block {
+                first_row: 0,
+                len: 2,
+                k: [[k11, k12, 0.0], [k12, k22, 0.0], [0.0; 3]],
+            });
+            out.blocks.push(Block {
+                first_row: 2,
+                len: 1,
+                k: [[k33, 0.0, 0.0], [0.0; 3], [0.0; 3]],
+            });
+        }
+        out
+    }
+
+    fn is_enabled(&self) -> bool {
+        self.base.enabled
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use janus2d_core::body::BodyDef;
+    use janus2d_core::solver::SolverSettings;
+
+    fn pair() -> (BodySet, BodyHandle, BodyHandle) {
+        let mut set = BodySet::new();
+        let a = set.create(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+        let b = set.create(&BodyDef::dynamic(Vec2::new(1.0, 0.0))).unwrap();
+        (set, a, b)
+    }
+
+    #[test]
+    fn validate_rejects_bad_values() {
+        let (_, a, b) = pair();
+        let def = WeldJointDef::new(a, b, Vec2::ZERO, Vec2::ZERO);
+        assert_eq!(def.validate(), Ok(()));
+        let mut nan = def.clone();
+        nan.local_anchor_b.x = Real::NAN;
+        assert_eq!(nan.validate(), Err(JointError::NonFinite));
+        let negative = def.clone().with_stiffness(-1.0, 0.0, 0.0, 0.0);
+        assert_eq!(negative.validate(), Err(JointError::Negative));
+        let same = WeldJointDef::new(a, a, Vec2::ZERO, Vec2::ZERO);
+        assert_eq!(same.validate(), Err(JointError::SameBody));
+        let far = WeldJointDef::new(a, b, Vec2::new(1e12, 0.0), Vec2::ZERO);
+        assert!(matches!(
+            far.validate(),
+            Err(JointError::OutOfBounds { .. })
+        ));
+    }
+
+    #[test]
+    fn rows_report_three_rows_and_the_solve_softness() {
+        let (set, a, b) = pair();
+        let settings = SolverSettings::default();
+        let ctx = settings.context(1.0 / 60.0, Vec2::ZERO);
+        let mut joint = WeldJoint::new(WeldJointDef::new(
+            a,
+            b,
+            Vec2::new(0.5, 0.0),
+            Vec2::new(-0.5, 0.0),
+        ));
+        joint.prepare(&ctx, &set);
+        let rows = joint.rows(&ctx, &set);
+        assert_eq!(rows.rows.len(), joint.row_count());
+        for row in &rows.rows[..2] {
+            assert_eq!(row.softness, joint.linear_softness);
+        }
+        assert_eq!(rows.rows[2].softness, joint.angular_softness);
+        let lens: Vec<usize> = rows.blocks.iter().map(|b| b.len).collect();
+        assert_eq!(lens, vec![2, 1]);
+    }
+}
