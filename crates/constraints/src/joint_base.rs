@@ -11,7 +11,7 @@
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState, SolverBody};
 use janus2d_core::constraint::StepContext;
-use janus2d_core::math::Real;
+use janus2d_core::math::{Real, Vec2, wrap_angle};
 
 use crate::parts::PairMass;
 
@@ -90,4 +90,31 @@ impl JointBase {
 #[inline]
 pub(crate) fn is_moving(states: &[BodyState], s: u32) -> bool {
     s != 0 && states.get(s as usize).is_some_and(BodyState::moves)
+}
+
+/// The world points of two local anchors: `anchor_a` on `body_a`, `anchor_b`
+/// on `body_b` (each in its body's frame, from the body's origin), m. Every
+/// kind's `world_anchors` and gap read.
+#[must_use]
+pub fn world_anchors(
+    bodies: &BodySet,
+    (body_a, anchor_a): (BodyHandle, Vec2),
+    (body_b, anchor_b): (BodyHandle, Vec2),
+) -> (Vec2, Vec2) {
+    let a = bodies.solver_body(body_a).sim;
+    let b = bodies.solver_body(body_b).sim;
+    (a.transform.apply(anchor_a), b.transform.apply(anchor_b))
+}
+
+/// The relative angle `θ_b − θ_a − reference`, rad, wrapped to `[−π, π]`.
+#[must_use]
+pub fn relative_angle(
+    bodies: &BodySet,
+    body_a: BodyHandle,
+    body_b: BodyHandle,
+    reference: Real,
+) -> Real {
+    let a = bodies.solver_body(body_a).sim;
+    let b = bodies.solver_body(body_b).sim;
+    wrap_angle(a.transform.q.relative_angle(b.transform.q) - reference)
 }

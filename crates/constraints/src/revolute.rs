@@ -236,11 +236,10 @@ impl RevoluteJoint {
 
     /// The world anchors on a and b (their distance is the joint gap).
     pub fn world_anchors(&self, bodies: &BodySet) -> (Vec2, Vec2) {
-        let a = bodies.solver_body(self.def.body_a).sim;
-        let b = bodies.solver_body(self.def.body_b).sim;
-        (
-            a.transform.apply(self.def.local_anchor_a),
-            b.transform.apply(self.def.local_anchor_b),
+        crate::joint_base::world_anchors(
+            bodies,
+            (self.def.body_a, self.def.local_anchor_a),
+            (self.def.body_b, self.def.local_anchor_b),
         )
     }
 
@@ -252,10 +251,11 @@ impl RevoluteJoint {
 
     /// The joint angle `θ_b − θ_a − θ_ref`, rad.
     pub fn angle(&self, bodies: &BodySet) -> Real {
-        let a = bodies.solver_body(self.def.body_a).sim;
-        let b = bodies.solver_body(self.def.body_b).sim;
-        janus2d_core::math::wrap_angle(
-            a.transform.q.relative_angle(b.transform.q) - self.def.reference_angle,
+        crate::joint_base::relative_angle(
+            bodies,
+            self.def.body_a,
+            self.def.body_b,
+            self.def.reference_angle,
         )
     }
 
