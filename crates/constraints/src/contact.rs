@@ -355,17 +355,7 @@ impl Constraint for ContactConstraint {
     }
 }
 
-/// Mixes two friction coefficients: `√(μ_a μ_b)`.
-#[inline]
-pub fn mix_friction(a: Real, b: Real) -> Real {
-    (a * b).sqrt()
-}
-
-/// Mixes two restitution coefficients: `max(e_a, e_b)`.
-#[inline]
-pub fn mix_restitution(a: Real, b: Real) -> Real {
-    a.max(b)
-}
+pub use janus2d_core::material::{mix_friction, mix_restitution};
 
 #[cfg(test)]
 mod tests {

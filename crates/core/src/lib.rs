@@ -25,6 +25,7 @@ pub mod geometry;
 pub mod graph;
 pub mod handle;
 pub mod limits;
+pub mod material;
 pub mod math;
 pub mod parallel;
 pub mod slots;

@@ -23,12 +23,11 @@
 //! Contacts are iterated in list order and found through indices used only
 //! for lookups: the order of every loop is the same for the same inputs.
 
-use janus2d_constraints::ContactSolver;
-use janus2d_constraints::contact::{mix_friction, mix_restitution};
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 #[cfg(feature = "parallel")]
 use janus2d_core::geometry::Aabb;
 use janus2d_core::geometry::Shape;
+use janus2d_core::material::{mix_friction, mix_restitution};
 use janus2d_core::math::{Real, Transform, Vec2};
 
 use crate::broadphase::BroadPhase;
@@ -247,13 +246,17 @@ impl Collision {
         self.candidates = candidates;
     }
 
-    /// Hit events of the step: for each contact with hit events on, its
-    /// point that approached fastest, when faster than `threshold` (m/s)
-    /// and it pushed.
-    pub(crate) fn collect_hits(&mut self, solver: &ContactSolver, threshold: Real) {
+    /// Hit events of the step: `approaches` reports the solved points that
+    /// approached faster than the world's threshold and pushed (contact
+    /// index, point, approach speed in m/s; the solver side's read-back);
+    /// each contact with hit events on gets one event, at its fastest.
+    pub(crate) fn collect_hits(
+        &mut self,
+        approaches: impl FnOnce(&mut dyn FnMut(u32, usize, Real)),
+    ) {
         let mut best: Vec<(u32, usize, Real)> = Vec::new();
         let contacts = &self.contacts;
-        solver.for_each_approach(threshold, |index, point, speed| {
+        approaches(&mut |index, point, speed| {
             if !contacts.awake()[index as usize].hit_events {
                 return;
             }

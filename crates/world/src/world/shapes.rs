@@ -4,8 +4,8 @@
 use super::*;
 use crate::error::WorldError;
 use crate::shapes::{Filter, ShapeHandle};
-use janus2d_constraints::contact::{mix_friction, mix_restitution};
 use janus2d_core::body::{BodyHandle, BodyType};
+use janus2d_core::material::{mix_friction, mix_restitution};
 use janus2d_core::math::Real;
 
 impl World {

@@ -156,8 +156,9 @@ impl World {
                 },
             );
             if self.collision.shapes.hit_event_shapes() > 0 {
+                let (solver, threshold) = (&self.contact_solver, self.hit_event_threshold);
                 self.collision
-                    .collect_hits(&self.contact_solver, self.hit_event_threshold);
+                    .collect_hits(|hit| solver.for_each_approach(threshold, hit));
             }
             let both = lap();
             sp.continuous += continuous_time;
