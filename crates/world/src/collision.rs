@@ -24,8 +24,6 @@
 //! for lookups: the order of every loop is the same for the same inputs.
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
-#[cfg(feature = "parallel")]
-use janus2d_core::geometry::Aabb;
 use janus2d_core::geometry::Shape;
 use janus2d_core::material::{mix_friction, mix_restitution};
 use janus2d_core::math::{Real, Transform, Vec2};
