@@ -134,7 +134,7 @@ fn build(case: &TreeCase, ctx: &StepContext) -> Built {
     }
 }
 
-fn velocity(set: &BodySet, h: BodyHandle) -> (Vec2, Real) {
+pub(super) fn velocity(set: &BodySet, h: BodyHandle) -> (Vec2, Real) {
     let s = set.solver_body(h).state;
     (s.v, s.w)
 }
@@ -212,27 +212,50 @@ fn tree_solve_changes_momentum_only_through_the_pin() {
         let mut forest = JointForest::default();
         forest.build(&mut b.joints, &b.set.states, true);
         forest.solve(&ctx, &mut b.joints, &mut b.set.states, case.use_bias);
-        let (mut p, mut scale) = ([0.0f64; 2], 1e-12f64);
-        for (h, (v, _)) in b.bodies.iter().zip(&v0) {
-            let m = d(case.bodies[b.bodies.iter().position(|x| x == h).unwrap()].mass);
-            let dv = velocity(&b.set, *h).0 - *v;
-            p[0] += m * d(dv.x);
-            p[1] += m * d(dv.y);
-            // Rounding of v + Δv: relative to the velocity, not the change.
-            scale = scale.max(m * (d(v.length()) + d(dv.length())));
-        }
         // The pin is body a of its joints: it takes −λ, the bodies +λ.
-        for (j, &pinned) in b.joints.iter().zip(&b.pinned) {
-            if pinned {
-                p[0] -= d(revolute(j).linear_impulse().x);
-                p[1] -= d(revolute(j).linear_impulse().y);
-            }
-        }
-        let err = p[0].hypot(p[1]);
+        let pin = b
+            .joints
+            .iter()
+            .zip(&b.pinned)
+            .filter(|(_, pinned)| **pinned);
+        let (err, scale) = pin_momentum_error(
+            &b.set,
+            &b.bodies,
+            &v0,
+            |k| d(case.bodies[k].mass),
+            pin.map(|(j, _)| revolute(j).linear_impulse()),
+        );
         let bound = 64.0 * EPS * scale * (b.joints.len() as f64);
         prop_assert!(err <= bound, "momentum error {err:e} > {bound:e}");
         Ok(err / bound)
     });
+}
+
+/// The change of the bodies' total linear momentum since `v0` (their
+/// velocities before), less the impulses `pin_impulses` the static pin
+/// took (−λ on the pin, +λ on the bodies), and the scale its rounding
+/// grows with (a body's momentum relative to its velocity, not its
+/// change). `mass_of(k)`: the mass of body `k` of `bodies`.
+pub(super) fn pin_momentum_error(
+    set: &BodySet,
+    bodies: &[BodyHandle],
+    v0: &[(Vec2, Real)],
+    mass_of: impl Fn(usize) -> f64,
+    pin_impulses: impl Iterator<Item = Vec2>,
+) -> (f64, f64) {
+    let (mut p, mut scale) = ([0.0f64; 2], 1e-12f64);
+    for (k, (h, (v, _))) in bodies.iter().zip(v0).enumerate() {
+        let m = mass_of(k);
+        let dv = velocity(set, *h).0 - *v;
+        p[0] += m * d(dv.x);
+        p[1] += m * d(dv.y);
+        scale = scale.max(m * (d(v.length()) + d(dv.length())));
+    }
+    for impulse in pin_impulses {
+        p[0] -= d(impulse.x);
+        p[1] -= d(impulse.y);
+    }
+    (p[0].hypot(p[1]), scale)
 }
 
 /// A joint that closes a loop between moving bodies leaves the whole

@@ -123,15 +123,6 @@ impl JointDef {
         }
     }
 
-    /// The local anchors on a and b (in each body's frame), m.
-    #[must_use]
-    pub fn local_anchors(&self) -> (Vec2, Vec2) {
-        match self {
-            JointDef::Revolute(d) => (d.local_anchor_a, d.local_anchor_b),
-            JointDef::Weld(d) => (d.local_anchor_a, d.local_anchor_b),
-        }
-    }
-
     /// Checks the definition's own values (not the handles).
     pub fn validate(&self) -> Result<(), JointError> {
         match self {

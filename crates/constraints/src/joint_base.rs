@@ -10,8 +10,10 @@
 //! | `inv_h`            | prepare (`load`)  | force and torque read-back                |
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState, SolverBody};
-use janus2d_core::constraint::StepContext;
-use janus2d_core::math::{Real, Vec2, wrap_angle};
+use janus2d_core::constraint::{BodyJacobian, Row, StepContext};
+use janus2d_core::math::{Real, Vec2, cross, wrap_angle};
+use janus2d_core::softness::Softness;
+use smallvec::smallvec;
 
 use crate::parts::PairMass;
 
@@ -117,4 +119,123 @@ pub fn relative_angle(
     let a = bodies.solver_body(body_a).sim;
     let b = bodies.solver_body(body_b).sim;
     wrap_angle(a.transform.q.relative_angle(b.transform.q) - reference)
+}
+
+/// The world's joint softness built on the heavier end, for a joint's
+/// rigid rows: with `w_a`, `w_b` the two ends' inverse masses (point rows)
+/// or inverse inertias (angle rows), `ρ = min((w_a + w_b) / min(w_a, w_b),
+/// ρ_max)`, and `ρ_max` when one end does not move
+/// ([`Softness::with_mass_ratio`]).
+#[must_use]
+pub(crate) fn mass_ratio_softness(ctx: &StepContext, w_a: Real, w_b: Real) -> Softness {
+    let w_heavy = w_a.min(w_b);
+    let rho = if w_heavy > 0.0 {
+        ((w_a + w_b) / w_heavy).min(ctx.joint_mass_ratio_cap)
+    } else {
+        ctx.joint_mass_ratio_cap
+    };
+    ctx.joint_softness.with_mass_ratio(rho)
+}
+
+/// A two-body joint's geometry at the bodies' current poses, from which
+/// each kind's `rows()` report builds its rows: the arms from the centres
+/// of mass, the point error `C = (x_b + r_b) − (x_a + r_a)` and the masses.
+pub(crate) struct RowsAt {
+    body_a: BodyHandle,
+    body_b: BodyHandle,
+    /// Arm of the anchor on a, m.
+    pub(crate) r_a: Vec2,
+    /// Arm of the anchor on b, m.
+    pub(crate) r_b: Vec2,
+    /// The point error, m.
+    pub(crate) c: Vec2,
+    /// The two bodies' inverse masses as the solve loads them.
+    pub(crate) m: PairMass,
+}
+
+impl RowsAt {
+    /// The geometry of anchors `anchor_a` on `body_a` and `anchor_b` on
+    /// `body_b` (each in its body's frame, from its origin).
+    pub(crate) fn new(
+        bodies: &BodySet,
+        (body_a, anchor_a): (BodyHandle, Vec2),
+        (body_b, anchor_b): (BodyHandle, Vec2),
+    ) -> RowsAt {
+        let a = bodies.solver_body(body_a);
+        let b = bodies.solver_body(body_b);
+        let r_a = a.sim.transform.q.rotate(anchor_a - a.sim.local_center);
+        let r_b = b.sim.transform.q.rotate(anchor_b - b.sim.local_center);
+        RowsAt {
+            body_a,
+            body_b,
+            r_a,
+            r_b,
+            c: (b.sim.center + r_b) - (a.sim.center + r_a),
+            m: PairMass {
+                a: a.inv_masses(),
+                b: b.inv_masses(),
+            },
+        }
+    }
+
+    /// A row with Jacobian `[linear[0], angular[0] │ linear[1], angular[1]]`.
+    fn row(&self, linear: [Vec2; 2], angular: [Real; 2], c: Real, softness: Softness) -> Row {
+        let m = &self.m;
+        let entry = |body, linear, angular, inv_mass, inv_inertia| BodyJacobian {
+            body,
+            linear,
+            angular,
+            inv_mass,
+            inv_inertia,
+        };
+        Row {
+            jacobian: smallvec![
+                entry(
+                    self.body_a,
+                    linear[0],
+                    angular[0],
+                    m.a.inv_mass,
+                    m.a.inv_inertia
+                ),
+                entry(
+                    self.body_b,
+                    linear[1],
+                    angular[1],
+                    m.b.inv_mass,
+                    m.b.inv_inertia
+                ),
+            ],
+            c,
+            softness,
+            lower: Real::NEG_INFINITY,
+            upper: Real::INFINITY,
+            impulse: 0.0,
+        }
+    }
+
+    /// The point row along `axis`: `J = [−axis, −r_a × axis │ axis, r_b × axis]`.
+    pub(crate) fn point_row(&self, axis: Vec2, c: Real, softness: Softness, impulse: Real) -> Row {
+        let angular = [-cross(self.r_a, axis), cross(self.r_b, axis)];
+        Row {
+            impulse,
+            ..self.row([-axis, axis], angular, c, softness)
+        }
+    }
+
+    /// An angle row `J = [0, −sign │ 0, sign]` with impulse bounds.
+    pub(crate) fn angle_row(
+        &self,
+        sign: Real,
+        c: Real,
+        softness: Softness,
+        (lower, upper): (Real, Real),
+        impulse: Real,
+    ) -> Row {
+        Row {
+            lower,
+            upper,
+            impulse,
+            ..self.row([Vec2::ZERO; 2], [-sign, sign], c, softness)
+        }
+    }
 }

@@ -217,6 +217,30 @@ impl PointPart {
         apply_pair(sa, sb, m, r_a, r_b, self.impulse, 0.0);
     }
 
+    /// One body's share of a joint's warm start (`side_b`: body b, else
+    /// body a): the kept angle impulse `axial` (positive on b), then the
+    /// kept point impulse at the body's current arm. The arithmetic of
+    /// `AnglePart::apply` then [`PointPart::warm_start`] on that body, so a
+    /// body that takes the shares of its joints in storage order ends
+    /// exactly as after the joints' warm starts in storage order.
+    #[inline(always)]
+    pub fn warm_start_side(&self, st: &mut BodyState, m: &PairMass, axial: Real, side_b: bool) {
+        let p = self.impulse;
+        if side_b {
+            let m_b = &m.b;
+            st.w += m_b.inv_inertia * axial;
+            let r_b = st.dq.rotate(self.frame_b);
+            st.v += m_b.inv_mass * p;
+            st.w += m_b.inv_inertia * (cross(r_b, p) + 0.0);
+        } else {
+            let m_a = &m.a;
+            st.w -= m_a.inv_inertia * axial;
+            let r_a = st.dq.rotate(self.frame_a);
+            st.v -= m_a.inv_mass * p;
+            st.w -= m_a.inv_inertia * (cross(r_a, p) + 0.0);
+        }
+    }
+
     /// The 2×2 effective mass `K = J M⁻¹ Jᵀ` as `(k11, k12, k22)`.
     #[inline(always)]
     pub fn effective_mass(m: &PairMass, r_a: Vec2, r_b: Vec2) -> (Real, Real, Real) {

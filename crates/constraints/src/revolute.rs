@@ -33,12 +33,11 @@
 //! `C − lower ≥ 0` and `upper − C ≥ 0`, speculative while apart.
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState};
-use janus2d_core::constraint::{Block, BodyJacobian, Constraint, ConstraintRows, Row, StepContext};
-use janus2d_core::math::{Real, Vec2, cross, vec_is_finite};
+use janus2d_core::constraint::{Block, Constraint, ConstraintRows, StepContext};
+use janus2d_core::math::{Real, Vec2, vec_is_finite};
 use janus2d_core::softness::Softness;
-use smallvec::smallvec;
 
-use crate::joint_base::JointBase;
+use crate::joint_base::{JointBase, RowsAt, mass_ratio_softness};
 use crate::parts::{
     AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, load_pair, store_pair,
 };
@@ -186,14 +185,7 @@ pub struct RevoluteJoint {
 /// (`ρ_max` when one body is static). Used by the solve and reported by
 /// `rows()`, so both see the same rows.
 fn point_softness(ctx: &StepContext, m: &PairMass) -> Softness {
-    let inv_mass_sum = m.a.inv_mass + m.b.inv_mass;
-    let inv_mass_heavy = m.a.inv_mass.min(m.b.inv_mass);
-    let rho = if inv_mass_heavy > 0.0 {
-        (inv_mass_sum / inv_mass_heavy).min(ctx.joint_mass_ratio_cap)
-    } else {
-        ctx.joint_mass_ratio_cap
-    };
-    ctx.joint_softness.with_mass_ratio(rho)
+    mass_ratio_softness(ctx, m.a.inv_mass, m.b.inv_mass)
 }
 
 impl RevoluteJoint {
@@ -311,22 +303,8 @@ impl RevoluteJoint {
     pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
         let axial =
             self.spring.impulse + self.motor.impulse + self.lower.impulse - self.upper.impulse;
-        let p = self.point.impulse;
-        // AnglePart::apply, then PointPart::warm_start (apply_pair with no
-        // angular impulse), one side of each.
-        if side_b {
-            let m_b = &self.base.masses.b;
-            st.w += m_b.inv_inertia * axial;
-            let r_b = st.dq.rotate(self.point.frame_b);
-            st.v += m_b.inv_mass * p;
-            st.w += m_b.inv_inertia * (cross(r_b, p) + 0.0);
-        } else {
-            let m_a = &self.base.masses.a;
-            st.w -= m_a.inv_inertia * axial;
-            let r_a = st.dq.rotate(self.point.frame_a);
-            st.v -= m_a.inv_mass * p;
-            st.w -= m_a.inv_inertia * (cross(r_a, p) + 0.0);
-        }
+        self.point
+            .warm_start_side(st, &self.base.masses, axial, side_b);
     }
 
     /// One velocity iteration on the joint's two states as `pair` holds
@@ -473,51 +451,23 @@ impl Constraint for RevoluteJoint {
     }
 
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
-        let a = bodies.solver_body(self.def.body_a);
-        let b = bodies.solver_body(self.def.body_b);
-        let r_a = a
-            .sim
-            .transform
-            .q
-            .rotate(self.def.local_anchor_a - a.sim.local_center);
-        let r_b = b
-            .sim
-            .transform
-            .q
-            .rotate(self.def.local_anchor_b - b.sim.local_center);
-        let c = (b.sim.center + r_b) - (a.sim.center + r_a);
-        let m = PairMass {
-            a: a.inv_masses(),
-            b: b.inv_masses(),
-        };
-        let (ima, iia, imb, iib) = (m.a.inv_mass, m.a.inv_inertia, m.b.inv_mass, m.b.inv_inertia);
-        let entry = |body, linear: Vec2, angular, im, ii| BodyJacobian {
-            body,
-            linear,
-            angular,
-            inv_mass: im,
-            inv_inertia: ii,
-        };
+        let at = RowsAt::new(
+            bodies,
+            (self.def.body_a, self.def.local_anchor_a),
+            (self.def.body_b, self.def.local_anchor_b),
+        );
+        let (m, r_a, r_b, c) = (at.m, at.r_a, at.r_b, at.c);
         // Tree joints' point rows are solved directly, at their own softness.
         let point_softness = if self.base.in_tree {
             ctx.direct_joint_softness
         } else {
             point_softness(ctx, &m)
         };
-        let point_row = |axis: Vec2, c: Real, impulse: Real| Row {
-            jacobian: smallvec![
-                entry(self.def.body_a, -axis, -cross(r_a, axis), ima, iia),
-                entry(self.def.body_b, axis, cross(r_b, axis), imb, iib),
-            ],
-            c,
-            softness: point_softness,
-            lower: Real::NEG_INFINITY,
-            upper: Real::INFINITY,
-            impulse,
-        };
         let mut out = ConstraintRows::default();
-        out.rows.push(point_row(Vec2::X, c.x, self.point.impulse.x));
-        out.rows.push(point_row(Vec2::Y, c.y, self.point.impulse.y));
+        out.rows
+            .push(at.point_row(Vec2::X, c.x, point_softness, self.point.impulse.x));
+        out.rows
+            .push(at.point_row(Vec2::Y, c.y, point_softness, self.point.impulse.y));
         let (k11, k12, k22) = PointPart::effective_mass(&m, r_a, r_b);
         out.blocks.push(Block {
             first_row: 0,
@@ -529,17 +479,8 @@ impl Constraint for RevoluteJoint {
         let mut angle_row =
             |sign: Real, c: Real, softness: Softness, lower: Real, upper: Real, impulse: Real| {
                 let first_row = out.rows.len();
-                out.rows.push(Row {
-                    jacobian: smallvec![
-                        entry(self.def.body_a, Vec2::ZERO, -sign, ima, iia),
-                        entry(self.def.body_b, Vec2::ZERO, sign, imb, iib),
-                    ],
-                    c,
-                    softness,
-                    lower,
-                    upper,
-                    impulse,
-                });
+                out.rows
+                    .push(at.angle_row(sign, c, softness, (lower, upper), impulse));
                 out.blocks.push(Block {
                     first_row,
                     len: 1,

@@ -36,12 +36,11 @@
 //! bias not capped. Only a weld rigid on both is solved by the tree.
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState};
-use janus2d_core::constraint::{Block, BodyJacobian, Constraint, ConstraintRows, Row, StepContext};
-use janus2d_core::math::{Real, Vec2, cross};
+use janus2d_core::constraint::{Block, Constraint, ConstraintRows, StepContext};
+use janus2d_core::math::{Real, Vec2};
 use janus2d_core::softness::Softness;
-use smallvec::smallvec;
 
-use crate::joint_base::JointBase;
+use crate::joint_base::{JointBase, RowsAt, mass_ratio_softness};
 use crate::parts::{
     AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, load_pair, store_pair,
 };
@@ -188,29 +187,16 @@ pub struct WeldJoint {
     angular_softness: Softness,
 }
 
-/// The world's joint softness built on the heavier end: `w_a`, `w_b` the
-/// two inverse masses (or inertias), `ρ = min((w_a + w_b) / min(w_a, w_b),
-/// ρ_max)`, `ρ_max` when one end does not move.
-fn rigid_softness(ctx: &StepContext, w_a: Real, w_b: Real) -> Softness {
-    let w_heavy = w_a.min(w_b);
-    let rho = if w_heavy > 0.0 {
-        ((w_a + w_b) / w_heavy).min(ctx.joint_mass_ratio_cap)
-    } else {
-        ctx.joint_mass_ratio_cap
-    };
-    ctx.joint_softness.with_mass_ratio(rho)
-}
-
 /// The softness of the weld's point rows and angle row for a step (see
 /// the module docs), used by the solve and reported by `rows()`.
 fn softnesses(def: &WeldJointDef, ctx: &StepContext, m: &PairMass) -> (Softness, Softness) {
     let linear = if def.linear_hertz == 0.0 {
-        rigid_softness(ctx, m.a.inv_mass, m.b.inv_mass)
+        mass_ratio_softness(ctx, m.a.inv_mass, m.b.inv_mass)
     } else {
         Softness::new(def.linear_hertz, def.linear_damping_ratio, ctx.h)
     };
     let angular = if def.angular_hertz == 0.0 {
-        rigid_softness(ctx, m.a.inv_inertia, m.b.inv_inertia)
+        mass_ratio_softness(ctx, m.a.inv_inertia, m.b.inv_inertia)
     } else {
         Softness::new(def.angular_hertz, def.angular_damping_ratio, ctx.h)
     };
@@ -312,21 +298,8 @@ impl WeldJoint {
     /// that body).
     #[inline(always)]
     pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        let axial = self.angle.impulse;
-        let p = self.point.impulse;
-        if side_b {
-            let m_b = &self.base.masses.b;
-            st.w += m_b.inv_inertia * axial;
-            let r_b = st.dq.rotate(self.point.frame_b);
-            st.v += m_b.inv_mass * p;
-            st.w += m_b.inv_inertia * (cross(r_b, p) + 0.0);
-        } else {
-            let m_a = &self.base.masses.a;
-            st.w -= m_a.inv_inertia * axial;
-            let r_a = st.dq.rotate(self.point.frame_a);
-            st.v -= m_a.inv_mass * p;
-            st.w -= m_a.inv_inertia * (cross(r_a, p) + 0.0);
-        }
+        self.point
+            .warm_start_side(st, &self.base.masses, self.angle.impulse, side_b);
     }
 
     /// One velocity iteration on the joint's two states: the angle row,
@@ -347,17 +320,14 @@ impl WeldJoint {
         let angular_spring = self.def.angular_hertz > 0.0;
         if m.a.inv_inertia + m.b.inv_inertia > 0.0 {
             let c = self.current_angle(&sa, &sb);
-            let (bias, mass_scale, impulse_scale) = if use_bias || angular_spring {
-                let s = self.angular_softness;
-                (s.bias_rate * c, s.mass_scale, s.impulse_scale)
+            // A spring acts in the relax pass too; a rigid row relaxes
+            // without position feedback.
+            let softness = if use_bias || angular_spring {
+                self.angular_softness
             } else {
-                (0.0, 1.0, 0.0)
+                Softness::RIGID
             };
-            let c_dot = AnglePart::c_dot(&sa, &sb);
-            let lambda =
-                -mass_scale * self.angle.mass * (c_dot + bias) - impulse_scale * self.angle.impulse;
-            self.angle.impulse += lambda;
-            AnglePart::apply(&mut sa, &mut sb, m, lambda);
+            self.angle.solve_soft(&mut sa, &mut sb, m, c, softness);
         }
         if self.def.linear_hertz > 0.0 {
             // A spring: always on, its bias not capped.
@@ -424,62 +394,31 @@ impl Constraint for WeldJoint {
     }
 
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
-        let a = bodies.solver_body(self.def.body_a);
-        let b = bodies.solver_body(self.def.body_b);
-        let r_a = a
-            .sim
-            .transform
-            .q
-            .rotate(self.def.local_anchor_a - a.sim.local_center);
-        let r_b = b
-            .sim
-            .transform
-            .q
-            .rotate(self.def.local_anchor_b - b.sim.local_center);
-        let c = (b.sim.center + r_b) - (a.sim.center + r_a);
-        let m = PairMass {
-            a: a.inv_masses(),
-            b: b.inv_masses(),
-        };
-        let (ima, iia, imb, iib) = (m.a.inv_mass, m.a.inv_inertia, m.b.inv_mass, m.b.inv_inertia);
-        let entry = |body, linear: Vec2, angular, im, ii| BodyJacobian {
-            body,
-            linear,
-            angular,
-            inv_mass: im,
-            inv_inertia: ii,
-        };
+        let at = RowsAt::new(
+            bodies,
+            (self.def.body_a, self.def.local_anchor_a),
+            (self.def.body_b, self.def.local_anchor_b),
+        );
+        let (m, r_a, r_b, c) = (at.m, at.r_a, at.r_b, at.c);
+        let (iia, iib) = (m.a.inv_inertia, m.b.inv_inertia);
         // A tree joint's three rows are solved directly, at its softness.
         let (linear_softness, angular_softness) = if self.base.in_tree {
             (ctx.direct_joint_softness, ctx.direct_joint_softness)
         } else {
             softnesses(&self.def, ctx, &m)
         };
-        let point_row = |axis: Vec2, c: Real, impulse: Real| Row {
-            jacobian: smallvec![
-                entry(self.def.body_a, -axis, -cross(r_a, axis), ima, iia),
-                entry(self.def.body_b, axis, cross(r_b, axis), imb, iib),
-            ],
-            c,
-            softness: linear_softness,
-            lower: Real::NEG_INFINITY,
-            upper: Real::INFINITY,
-            impulse,
-        };
         let mut out = ConstraintRows::default();
-        out.rows.push(point_row(Vec2::X, c.x, self.point.impulse.x));
-        out.rows.push(point_row(Vec2::Y, c.y, self.point.impulse.y));
-        out.rows.push(Row {
-            jacobian: smallvec![
-                entry(self.def.body_a, Vec2::ZERO, -1.0, ima, iia),
-                entry(self.def.body_b, Vec2::ZERO, 1.0, imb, iib),
-            ],
-            c: self.angle(bodies),
-            softness: angular_softness,
-            lower: Real::NEG_INFINITY,
-            upper: Real::INFINITY,
-            impulse: self.angle.impulse,
-        });
+        out.rows
+            .push(at.point_row(Vec2::X, c.x, linear_softness, self.point.impulse.x));
+        out.rows
+            .push(at.point_row(Vec2::Y, c.y, linear_softness, self.point.impulse.y));
+        out.rows.push(at.angle_row(
+            1.0,
+            self.angle(bodies),
+            angular_softness,
+            (Real::NEG_INFINITY, Real::INFINITY),
+            self.angle.impulse,
+        ));
         let (k11, k12, k22) = PointPart::effective_mass(&m, r_a, r_b);
         let k33 = iia + iib;
         if self.base.in_tree {
