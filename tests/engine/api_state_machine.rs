@@ -301,7 +301,7 @@ fn apply(
         } => {
             let mut def =
                 RevoluteJointDef::new(body(*a, issued), body(*b, issued), *anchor, -*anchor);
-            def.collide_connected = *collide;
+            def.base.collide_connected = *collide;
             if let Some((lo, hi)) = limits {
                 def = def.with_limits(*lo, *hi);
             }

@@ -157,7 +157,7 @@ fn collide_connected_false_suppresses_contacts() {
         let a = boxed(&mut w, Vec2::new(0.0, 0.5), &ShapeDef::default());
         let b = boxed(&mut w, Vec2::new(0.0, 1.2), &ShapeDef::default()); // overlaps a
         let mut def = RevoluteJointDef::new(a, b, Vec2::new(0.0, 0.35), Vec2::new(0.0, -0.35));
-        def.collide_connected = collide;
+        def.base.collide_connected = collide;
         w.create_revolute_joint(&def).unwrap();
         w.step(DT).unwrap();
         let touching = w.contacts().any(|c| {

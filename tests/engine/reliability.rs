@@ -618,7 +618,7 @@ fn a_joint_anchor_beyond_the_shape_extent_is_refused() {
         ))
         .map(|_| ())
     });
-    assert!(out_of_bounds("local_anchor_a")(&e), "{e:?}");
+    assert!(out_of_bounds("local_frame_a.anchor")(&e), "{e:?}");
     let j = world
         .create_revolute_joint(&RevoluteJointDef::new(ground, b, Vec2::ZERO, Vec2::ZERO))
         .unwrap();

@@ -49,11 +49,8 @@ impl JointCase {
         let def = RevoluteJointDef::new(a, b, self.anchor_a, self.anchor_b)
             .with_limits(self.lower, self.upper)
             .with_motor(0.5, 10.0)
-            .with_spring(5.0, 0.7);
-        let def = RevoluteJointDef {
-            reference_angle: self.reference,
-            ..def
-        };
+            .with_spring(5.0, 0.7)
+            .with_reference_angle(self.reference);
         def.validate().expect("valid joint");
         BuiltJoint {
             set,

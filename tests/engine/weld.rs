@@ -181,7 +181,7 @@ fn bad_weld_input_is_a_typed_error_and_changes_nothing() {
     let counts = |w: &World| (w.body_count(), w.joint_count());
     let before = counts(&world);
     let mut nan = good.clone();
-    nan.local_anchor_a.x = Real::NAN;
+    nan.base.local_frame_a.anchor.x = Real::NAN;
     assert_eq!(
         world.create_weld_joint(&nan),
         Err(WorldError::Joint(JointError::NonFinite))

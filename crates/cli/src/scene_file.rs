@@ -786,8 +786,8 @@ impl SceneFile {
                 }
             };
             let mut def = RevoluteJointDef::new(bodies[a], bodies[b], la, lb);
-            def.reference_angle = from_f64(jf.reference_angle);
-            def.collide_connected = jf.collide_connected;
+            def = def.with_reference_angle(from_f64(jf.reference_angle));
+            def.base.collide_connected = jf.collide_connected;
             if let Some([lo, hi]) = jf.limit {
                 def = def.with_limits(from_f64(lo), from_f64(hi));
             }

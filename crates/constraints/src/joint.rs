@@ -45,212 +45,392 @@ use janus2d_core::math::{Real, Rot, Vec2};
 
 use crate::JointError;
 use crate::joint_base::JointBase;
+use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::parts::{BOTH, PairOf, PairStates, PointPart};
 use crate::revolute::{RevoluteJoint, RevoluteJointDef};
 use crate::weld::{WeldJoint, WeldJointDef};
 
-/// The joint kinds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub enum JointKind {
+/// What a joint kind's solver form supplies: its rows' stages, read-backs
+/// and what the tree solve may take. Dispatched by [`Joint`]'s match
+/// (static, no `dyn`); every method but the stages has a default that
+/// fits a kind without tree rows.
+pub(crate) trait KindRows: Constraint {
+    /// The shared solver data.
+    fn base(&self) -> &JointBase;
+    /// The shared solver data, mutable.
+    fn base_mut(&mut self) -> &mut JointBase;
+    /// Rows the kind adds to the solver when enabled.
+    fn row_count(&self) -> usize;
+    /// A motor of nonzero strength drives the bodies.
+    fn is_driven(&self) -> bool {
+        false
+    }
+    /// Force on body b over the last solved step, N.
+    fn constraint_force(&self) -> Vec2;
+    /// Torque on body b over the last solved step, N·m.
+    fn constraint_torque(&self) -> Real;
+    /// Turns and scales the kept impulses when both ends cross a portal
+    /// (`rotation = Q`, `scale = 1/η`: linear impulses turn and scale,
+    /// angular ones are kept).
+    fn carry_impulses(&mut self, rotation: Rot, scale: Real);
+    /// The warm start's share on one body (`side_b`: body b, else a).
+    fn warm_start_side(&self, st: &mut BodyState, side_b: bool);
+    /// One velocity iteration of the Gauss–Seidel rows.
+    fn solve_pair<P: PairStates>(&mut self, ctx: &StepContext, pair: &mut P, use_bias: bool);
+    /// The equality rows the tree solve may take (`None`: none).
+    fn tree_rows(&self) -> Option<TreeRows<'_>> {
+        None
+    }
+    /// Takes back the tree's impulses (point, angle).
+    fn set_tree_impulses(&mut self, _point: Vec2, _angle: Real) {}
+    /// Rows left for the Gauss–Seidel pass this step.
+    fn has_iterative_rows(&self) -> bool {
+        !self.base().in_tree && self.row_count() > 0
+    }
+    /// The point part, for the unit tests of the tree.
+    #[cfg(test)]
+    fn tree_point_mut(&mut self) -> Option<&mut PointPart> {
+        None
+    }
+}
+
+/// A kind's solver form as the world's typed accessors reach it
+/// (`World::joint_of::<PrismaticJoint>(h)`): implemented for every kind.
+pub trait JointOfKind: Sized {
+    /// The kind.
+    const KIND: JointKind;
+    /// The kind's definition type.
+    type Def: KindDef;
+    /// The joint, if it is of this kind.
+    fn from_joint(joint: &Joint) -> Option<&Self>;
+    /// The joint, mutable, if it is of this kind.
+    fn from_joint_mut(joint: &mut Joint) -> Option<&mut Self>;
+    /// Its definition as it stands.
+    fn def(&self) -> &Self::Def;
+}
+
+/// The kind list, written once: each line is `Variant(SolverForm,
+/// Definition)`. It makes [`JointKind`], [`JointDef`] and [`Joint`], their
+/// conversions, [`JointOfKind`], and the match of every dispatching method.
+/// A new kind is its file and one line here.
+macro_rules! joint_kinds {
+    ($( $(#[$doc:meta])* $kind:ident($joint:ident, $def:ident), )*) => {
+        /// The joint kinds.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+        pub enum JointKind { $( $(#[$doc])* $kind, )* }
+
+        /// Everything needed to create a joint of any kind (the API
+        /// boundary's one type: `World::create_joint` takes it).
+        ///
+        /// ```
+        /// use janus2d_constraints::{JointDef, JointKind, RevoluteJointDef};
+        /// use janus2d_core::{BodyDef, BodySet, Vec2};
+        /// let mut bodies = BodySet::new();
+        /// let a = bodies.create(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+        /// let b = bodies.create(&BodyDef::dynamic(Vec2::X)).unwrap();
+        /// let def: JointDef = RevoluteJointDef::new(a, b, Vec2::X, Vec2::ZERO).into();
+        /// assert_eq!(def.kind(), JointKind::Revolute);
+        /// assert_eq!(def.bodies(), (a, b));
+        /// assert!(def.validate().is_ok());
+        /// ```
+        #[derive(Clone, Debug, PartialEq)]
+        #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+        pub enum JointDef { $( $(#[$doc])* $kind($def), )* }
+
+        /// A joint in solver form: one variant per kind.
+        #[derive(Clone, Debug, PartialEq)]
+        #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+        pub enum Joint { $( $(#[$doc])* $kind($joint), )* }
+
+        $(
+            impl From<$def> for JointDef {
+                fn from(def: $def) -> Self {
+                    JointDef::$kind(def)
+                }
+            }
+            impl From<$joint> for Joint {
+                fn from(j: $joint) -> Self {
+                    Joint::$kind(j)
+                }
+            }
+            impl JointOfKind for $joint {
+                const KIND: JointKind = JointKind::$kind;
+                type Def = $def;
+                fn from_joint(joint: &Joint) -> Option<&Self> {
+                    match joint {
+                        Joint::$kind(j) => Some(j),
+                        #[allow(unreachable_patterns)]
+                        _ => None,
+                    }
+                }
+                fn from_joint_mut(joint: &mut Joint) -> Option<&mut Self> {
+                    match joint {
+                        Joint::$kind(j) => Some(j),
+                        #[allow(unreachable_patterns)]
+                        _ => None,
+                    }
+                }
+                fn def(&self) -> &$def {
+                    &self.def
+                }
+            }
+        )*
+
+        impl JointDef {
+            /// The kind of joint this defines.
+            #[must_use]
+            pub fn kind(&self) -> JointKind {
+                match self { $( JointDef::$kind(_) => JointKind::$kind, )* }
+            }
+
+            /// The shared part of the definition.
+            #[must_use]
+            pub fn base(&self) -> &JointDefBase {
+                match self { $( JointDef::$kind(d) => KindDef::base(d), )* }
+            }
+
+            /// The shared part of the definition, mutable.
+            pub fn base_mut(&mut self) -> &mut JointDefBase {
+                match self { $( JointDef::$kind(d) => KindDef::base_mut(d), )* }
+            }
+
+            /// Checks the definition's own values (not the handles).
+            pub fn validate(&self) -> Result<(), JointError> {
+                match self { $( JointDef::$kind(d) => KindDef::validate(d), )* }
+            }
+
+            /// The limits, when the kind has them.
+            pub fn limits_mut(&mut self) -> Option<LimitsMut<'_>> {
+                match self { $( JointDef::$kind(d) => d.limits_mut(), )* }
+            }
+
+            /// The motor, when the kind has one.
+            pub fn motor_mut(&mut self) -> Option<MotorMut<'_>> {
+                match self { $( JointDef::$kind(d) => d.motor_mut(), )* }
+            }
+
+            /// The spring, when the kind has one.
+            pub fn spring_mut(&mut self) -> Option<SpringMut<'_>> {
+                match self { $( JointDef::$kind(d) => d.spring_mut(), )* }
+            }
+        }
+
+        impl Joint {
+            /// A joint from a definition (validate it first).
+            #[must_use]
+            pub fn new(def: JointDef) -> Self {
+                match def { $( JointDef::$kind(d) => Joint::$kind($joint::new(d)), )* }
+            }
+
+            /// Its kind.
+            #[must_use]
+            pub fn kind(&self) -> JointKind {
+                match self { $( Joint::$kind(_) => JointKind::$kind, )* }
+            }
+
+            /// Its definition as it stands (limits, motor and spring as last set).
+            #[must_use]
+            pub fn def(&self) -> JointDef {
+                match self { $( Joint::$kind(j) => JointDef::$kind(j.def.clone()), )* }
+            }
+
+            /// The shared part of its definition.
+            #[must_use]
+            pub fn def_base(&self) -> &JointDefBase {
+                match self { $( Joint::$kind(j) => &j.def.base, )* }
+            }
+
+            fn def_base_mut(&mut self) -> &mut JointDefBase {
+                match self { $( Joint::$kind(j) => &mut j.def.base, )* }
+            }
+
+            /// Replaces its definition by `def` of the same kind and the
+            /// same bodies (validated), keeping its impulses; an error
+            /// leaves it unchanged.
+            pub fn set_def(&mut self, def: JointDef) -> Result<(), JointError> {
+                def.validate()?;
+                if def.kind() != self.kind() {
+                    return Err(JointError::WrongKind);
+                }
+                let (a, b) = (def.base().body_a, def.base().body_b);
+                if (a, b) != self.bodies() || def.base().collide_connected != self.collide_connected() {
+                    return Err(JointError::FixedField);
+                }
+                match (self, def) {
+                    $( (Joint::$kind(j), JointDef::$kind(d)) => j.def = d, )*
+                    #[allow(unreachable_patterns)]
+                    _ => return Err(JointError::WrongKind),
+                }
+                Ok(())
+            }
+
+            /// The common solver data.
+            #[inline(always)]
+            #[must_use]
+            pub fn base(&self) -> &JointBase {
+                match self { $( Joint::$kind(j) => KindRows::base(j), )* }
+            }
+
+            #[inline(always)]
+            pub(crate) fn base_mut(&mut self) -> &mut JointBase {
+                match self { $( Joint::$kind(j) => KindRows::base_mut(j), )* }
+            }
+
+            /// A motor of nonzero strength drives the joint's bodies (the
+            /// light clusters leave such bodies out).
+            #[must_use]
+            pub fn is_driven(&self) -> bool {
+                match self { $( Joint::$kind(j) => KindRows::is_driven(j), )* }
+            }
+
+            /// Rows this joint adds to the solver when enabled.
+            #[must_use]
+            pub fn row_count(&self) -> usize {
+                match self { $( Joint::$kind(j) => KindRows::row_count(j), )* }
+            }
+
+            /// Force the joint applied to body b over the last solved step, N.
+            #[must_use]
+            pub fn constraint_force(&self) -> Vec2 {
+                match self { $( Joint::$kind(j) => KindRows::constraint_force(j), )* }
+            }
+
+            /// Torque the joint applied to body b over the last solved step, N·m.
+            #[must_use]
+            pub fn constraint_torque(&self) -> Real {
+                match self { $( Joint::$kind(j) => KindRows::constraint_torque(j), )* }
+            }
+
+            /// Carries the accumulated impulses through a portal when both
+            /// ends move to the other side (`rotation = Q`, `scale = 1/η`;
+            /// see [`RevoluteJoint::carry_impulses`]).
+            pub fn carry_impulses(&mut self, rotation: Rot, scale: Real) {
+                match self { $( Joint::$kind(j) => KindRows::carry_impulses(j, rotation, scale), )* }
+            }
+
+            #[inline(always)]
+            pub(crate) fn tree_rows(&self) -> Option<TreeRows<'_>> {
+                match self { $( Joint::$kind(j) => KindRows::tree_rows(j), )* }
+            }
+
+            #[cfg(test)]
+            pub(crate) fn tree_point_mut(&mut self) -> Option<&mut PointPart> {
+                match self { $( Joint::$kind(j) => KindRows::tree_point_mut(j), )* }
+            }
+
+            #[inline(always)]
+            pub(crate) fn set_tree_impulses(&mut self, point: Vec2, angle: Real) {
+                match self { $( Joint::$kind(j) => KindRows::set_tree_impulses(j, point, angle), )* }
+            }
+
+            #[inline(always)]
+            pub(crate) fn has_iterative_rows(&self) -> bool {
+                match self { $( Joint::$kind(j) => KindRows::has_iterative_rows(j), )* }
+            }
+
+            #[inline(always)]
+            pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
+                match self { $( Joint::$kind(j) => KindRows::warm_start_side(j, st, side_b), )* }
+            }
+
+            #[inline(always)]
+            pub(crate) fn solve_pair<P: PairStates>(
+                &mut self,
+                ctx: &StepContext,
+                pair: &mut P,
+                use_bias: bool,
+            ) {
+                match self { $( Joint::$kind(j) => KindRows::solve_pair(j, ctx, pair, use_bias), )* }
+            }
+        }
+
+        impl Constraint for Joint {
+            fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
+                match self { $( Joint::$kind(j) => Constraint::prepare(j, ctx, bodies), )* }
+            }
+
+            fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+                match self { $( Joint::$kind(j) => Constraint::warm_start(j, ctx, states), )* }
+            }
+
+            fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
+                let (a, b) = (self.base().state_a, self.base().state_b);
+                let mut pair = PairOf::new(states, a, b, BOTH);
+                self.solve_pair(ctx, &mut pair, use_bias);
+            }
+
+            fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
+                match self { $( Joint::$kind(j) => Constraint::rows(j, ctx, bodies), )* }
+            }
+
+            fn is_enabled(&self) -> bool {
+                self.base().enabled
+            }
+        }
+    };
+}
+
+joint_kinds! {
     /// A pin: two anchors coincide; optional limit, motor and spring.
-    Revolute,
+    Revolute(RevoluteJoint, RevoluteJointDef),
     /// A weld: two anchors coincide and the relative angle is held,
     /// rigidly or through springs.
-    Weld,
-}
-
-/// Everything needed to create a joint of any kind (the API boundary's
-/// one type: `World::create_joint` takes it).
-///
-/// ```
-/// use janus2d_constraints::{JointDef, JointKind, RevoluteJointDef};
-/// use janus2d_core::{BodyDef, BodySet, Vec2};
-/// let mut bodies = BodySet::new();
-/// let a = bodies.create(&BodyDef::fixed(Vec2::ZERO)).unwrap();
-/// let b = bodies.create(&BodyDef::dynamic(Vec2::X)).unwrap();
-/// let def: JointDef = RevoluteJointDef::new(a, b, Vec2::X, Vec2::ZERO).into();
-/// assert_eq!(def.kind(), JointKind::Revolute);
-/// assert_eq!(def.bodies(), (a, b));
-/// assert!(def.validate().is_ok());
-/// ```
-#[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub enum JointDef {
-    /// A revolute joint.
-    Revolute(RevoluteJointDef),
-    /// A weld joint.
-    Weld(WeldJointDef),
-}
-
-impl From<RevoluteJointDef> for JointDef {
-    fn from(def: RevoluteJointDef) -> Self {
-        JointDef::Revolute(def)
-    }
-}
-
-impl From<WeldJointDef> for JointDef {
-    fn from(def: WeldJointDef) -> Self {
-        JointDef::Weld(def)
-    }
+    Weld(WeldJoint, WeldJointDef),
 }
 
 impl JointDef {
-    /// The kind of joint this defines.
-    #[must_use]
-    pub fn kind(&self) -> JointKind {
-        match self {
-            JointDef::Revolute(_) => JointKind::Revolute,
-            JointDef::Weld(_) => JointKind::Weld,
-        }
-    }
-
     /// The two bodies `(a, b)`.
     #[must_use]
     pub fn bodies(&self) -> (BodyHandle, BodyHandle) {
-        match self {
-            JointDef::Revolute(d) => (d.body_a, d.body_b),
-            JointDef::Weld(d) => (d.body_a, d.body_b),
-        }
+        let base = self.base();
+        (base.body_a, base.body_b)
     }
 
     /// Whether the two bodies collide with each other.
     #[must_use]
     pub fn collide_connected(&self) -> bool {
-        match self {
-            JointDef::Revolute(d) => d.collide_connected,
-            JointDef::Weld(d) => d.collide_connected,
-        }
-    }
-
-    /// Checks the definition's own values (not the handles).
-    pub fn validate(&self) -> Result<(), JointError> {
-        match self {
-            JointDef::Revolute(d) => d.validate(),
-            JointDef::Weld(d) => d.validate(),
-        }
-    }
-}
-
-/// A joint in solver form: one variant per kind.
-#[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub enum Joint {
-    /// A revolute joint.
-    Revolute(RevoluteJoint),
-    /// A weld joint.
-    Weld(WeldJoint),
-}
-
-impl From<RevoluteJoint> for Joint {
-    fn from(j: RevoluteJoint) -> Self {
-        Joint::Revolute(j)
-    }
-}
-
-impl From<WeldJoint> for Joint {
-    fn from(j: WeldJoint) -> Self {
-        Joint::Weld(j)
+        self.base().collide_connected
     }
 }
 
 impl Joint {
-    /// A joint from a definition (validate it first).
+    /// The joint of kind `K`, if it is one (`joint.of::<RevoluteJoint>()`).
     #[must_use]
-    pub fn new(def: JointDef) -> Self {
-        match def {
-            JointDef::Revolute(d) => Joint::Revolute(RevoluteJoint::new(d)),
-            JointDef::Weld(d) => Joint::Weld(WeldJoint::new(d)),
-        }
-    }
-
-    /// Its kind.
-    #[must_use]
-    pub fn kind(&self) -> JointKind {
-        match self {
-            Joint::Revolute(_) => JointKind::Revolute,
-            Joint::Weld(_) => JointKind::Weld,
-        }
-    }
-
-    /// Its definition as it stands (limits, motor and spring as last set).
-    #[must_use]
-    pub fn def(&self) -> JointDef {
-        match self {
-            Joint::Revolute(j) => JointDef::Revolute(j.def.clone()),
-            Joint::Weld(j) => JointDef::Weld(j.def.clone()),
-        }
+    pub fn of<K: JointOfKind>(&self) -> Option<&K> {
+        K::from_joint(self)
     }
 
     /// The revolute joint, if it is one.
     #[must_use]
     pub fn as_revolute(&self) -> Option<&RevoluteJoint> {
-        match self {
-            Joint::Revolute(j) => Some(j),
-            _ => None,
-        }
-    }
-
-    /// The revolute joint, mutable, if it is one.
-    pub fn as_revolute_mut(&mut self) -> Option<&mut RevoluteJoint> {
-        match self {
-            Joint::Revolute(j) => Some(j),
-            _ => None,
-        }
+        self.of()
     }
 
     /// The weld joint, if it is one.
     #[must_use]
     pub fn as_weld(&self) -> Option<&WeldJoint> {
-        match self {
-            Joint::Weld(j) => Some(j),
-            _ => None,
-        }
-    }
-
-    /// The common solver data.
-    #[inline(always)]
-    #[must_use]
-    pub fn base(&self) -> &JointBase {
-        match self {
-            Joint::Revolute(j) => &j.base,
-            Joint::Weld(j) => &j.base,
-        }
-    }
-
-    #[inline(always)]
-    pub(crate) fn base_mut(&mut self) -> &mut JointBase {
-        match self {
-            Joint::Revolute(j) => &mut j.base,
-            Joint::Weld(j) => &mut j.base,
-        }
+        self.of()
     }
 
     /// The two bodies `(a, b)`.
     #[must_use]
     pub fn bodies(&self) -> (BodyHandle, BodyHandle) {
-        match self {
-            Joint::Revolute(j) => (j.def.body_a, j.def.body_b),
-            Joint::Weld(j) => (j.def.body_a, j.def.body_b),
-        }
+        let base = self.def_base();
+        (base.body_a, base.body_b)
     }
 
     /// Whether its bodies collide with each other.
     #[must_use]
     pub fn collide_connected(&self) -> bool {
-        match self {
-            Joint::Revolute(j) => j.def.collide_connected,
-            Joint::Weld(j) => j.def.collide_connected,
-        }
+        self.def_base().collide_connected
     }
 
     /// The local anchors on a and b (in each body's frame), m.
     #[must_use]
     pub fn local_anchors(&self) -> (Vec2, Vec2) {
-        match self {
-            Joint::Revolute(j) => (j.def.local_anchor_a, j.def.local_anchor_b),
-            Joint::Weld(j) => (j.def.local_anchor_a, j.def.local_anchor_b),
-        }
+        let base = self.def_base();
+        (base.local_frame_a.anchor, base.local_frame_b.anchor)
     }
 
     /// The local anchor on `body` (`None` when `body` is neither end).
@@ -300,56 +480,16 @@ impl Joint {
         self.base().in_tree
     }
 
-    /// A motor of nonzero torque drives the joint's bodies (the light
-    /// clusters leave such bodies out).
-    #[must_use]
-    pub fn is_driven(&self) -> bool {
-        match self {
-            Joint::Revolute(j) => j.def.enable_motor && j.def.max_motor_torque > 0.0,
-            Joint::Weld(_) => false,
-        }
-    }
-
-    /// Rows this joint adds to the solver when enabled.
-    #[must_use]
-    pub fn row_count(&self) -> usize {
-        match self {
-            Joint::Revolute(j) => j.row_count(),
-            Joint::Weld(j) => j.row_count(),
-        }
-    }
-
     /// Rows of this joint the tree solve takes when it is in a tree.
     #[must_use]
     pub fn tree_row_count(&self) -> usize {
         self.tree_rows().map_or(0, |r| r.count())
     }
 
-    /// Force the joint applied to body b over the last solved step, N.
-    #[must_use]
-    pub fn constraint_force(&self) -> Vec2 {
-        match self {
-            Joint::Revolute(j) => j.constraint_force(),
-            Joint::Weld(j) => j.constraint_force(),
-        }
-    }
-
-    /// Torque the joint applied to body b over the last solved step, N·m.
-    #[must_use]
-    pub fn constraint_torque(&self) -> Real {
-        match self {
-            Joint::Revolute(j) => j.constraint_torque(),
-            Joint::Weld(j) => j.constraint_torque(),
-        }
-    }
-
     /// The world anchors on a and b.
     #[must_use]
     pub fn world_anchors(&self, bodies: &BodySet) -> (Vec2, Vec2) {
-        match self {
-            Joint::Revolute(j) => j.world_anchors(bodies),
-            Joint::Weld(j) => j.world_anchors(bodies),
-        }
+        self.def_base().world_anchors(bodies)
     }
 
     /// Distance between the two world anchors, m.
@@ -359,153 +499,41 @@ impl Joint {
         (pb - pa).length()
     }
 
-    /// Carries the accumulated impulses through a portal when both ends
-    /// move to the other side (see [`RevoluteJoint::carry_impulses`]).
-    pub fn carry_impulses(&mut self, rotation: Rot, scale: Real) {
-        match self {
-            Joint::Revolute(j) => j.carry_impulses(rotation, scale),
-            Joint::Weld(j) => j.carry_impulses(rotation, scale),
-        }
-    }
-
     /// Moves the end on body `from` to body `to` with the local anchor
-    /// `anchor` in `to`'s frame; false when `from` is not one of its ends.
+    /// `anchor` in `to`'s frame (the frame's angle is kept: a clone is
+    /// its original turned as a whole); false when `from` is not one of
+    /// its ends.
     pub fn repoint(&mut self, from: BodyHandle, to: BodyHandle, anchor: Vec2) -> bool {
-        let (body_a, anchor_a, body_b, anchor_b) = match self {
-            Joint::Revolute(j) => (
-                &mut j.def.body_a,
-                &mut j.def.local_anchor_a,
-                &mut j.def.body_b,
-                &mut j.def.local_anchor_b,
-            ),
-            Joint::Weld(j) => (
-                &mut j.def.body_a,
-                &mut j.def.local_anchor_a,
-                &mut j.def.body_b,
-                &mut j.def.local_anchor_b,
-            ),
-        };
-        if *body_a == from {
-            *body_a = to;
-            *anchor_a = anchor;
-        } else if *body_b == from {
-            *body_b = to;
-            *anchor_b = anchor;
-        } else {
+        let base = self.def_base_mut();
+        let Some(frame) = base.frame_on_mut(from) else {
             return false;
+        };
+        frame.anchor = anchor;
+        if base.body_a == from {
+            base.body_a = to;
+        } else {
+            base.body_b = to;
         }
         true
     }
 
-    /// The equality rows the tree solve takes over when the joint is in a
-    /// tree (`None`: the tree cannot take the joint, and a component
-    /// holding it is solved iteratively).
-    #[inline(always)]
-    pub(crate) fn tree_rows(&self) -> Option<TreeRows<'_>> {
-        match self {
-            Joint::Revolute(j) => Some(TreeRows {
-                point: &j.point,
-                angle: None,
-            }),
-            Joint::Weld(j) => j.def.is_rigid().then_some(TreeRows {
-                point: &j.point,
-                angle: Some(TreeAngle {
-                    delta_angle: j.delta_angle,
-                    impulse: j.angle.impulse,
-                }),
-            }),
+    /// Crosses the force and torque thresholds: true when the last
+    /// solved step's force or torque is above its threshold and the step
+    /// before was not (one event per crossing; falling back below re-arms
+    /// it).
+    pub fn check_thresholds(&mut self) -> bool {
+        let base = self.def_base();
+        let (force_threshold, torque_threshold) = (base.force_threshold, base.torque_threshold);
+        if force_threshold == Real::INFINITY && torque_threshold == Real::INFINITY {
+            return false;
         }
-    }
-
-    /// The point part, mutable (the unit tests set impulses and arms
-    /// through it).
-    #[cfg(test)]
-    pub(crate) fn tree_point_mut(&mut self) -> Option<&mut PointPart> {
-        match self {
-            Joint::Revolute(j) => Some(&mut j.point),
-            Joint::Weld(j) => Some(&mut j.point),
-        }
-    }
-
-    /// Takes back the impulses of the tree's solve of its rows: the point
-    /// impulse, and the angle impulse when [`Joint::tree_rows`] has an
-    /// angle row (ignored otherwise).
-    #[inline(always)]
-    pub(crate) fn set_tree_impulses(&mut self, point: Vec2, angle: Real) {
-        match self {
-            Joint::Revolute(j) => j.point.impulse = point,
-            Joint::Weld(j) => {
-                j.point.impulse = point;
-                j.angle.impulse = angle;
-            }
-        }
-    }
-
-    /// True when the joint has rows for the Gauss–Seidel pass this step:
-    /// every row when it is outside a tree, its other rows (springs,
-    /// motors, limits) when it is in one.
-    #[inline(always)]
-    pub(crate) fn has_iterative_rows(&self) -> bool {
-        match self {
-            Joint::Revolute(j) => !j.base.in_tree || j.has_angle_rows(),
-            Joint::Weld(j) => !j.base.in_tree,
-        }
-    }
-
-    /// The warm start's share on one body (`side_b`: body b, else a).
-    #[inline(always)]
-    pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        match self {
-            Joint::Revolute(j) => j.warm_start_side(st, side_b),
-            Joint::Weld(j) => j.warm_start_side(st, side_b),
-        }
-    }
-
-    /// One velocity iteration of the joint's Gauss–Seidel rows.
-    #[inline(always)]
-    pub(crate) fn solve_pair<P: PairStates>(
-        &mut self,
-        ctx: &StepContext,
-        pair: &mut P,
-        use_bias: bool,
-    ) {
-        match self {
-            Joint::Revolute(j) => j.solve_pair(ctx, pair, use_bias),
-            Joint::Weld(j) => j.solve_pair(ctx, pair, use_bias),
-        }
-    }
-}
-
-impl Constraint for Joint {
-    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
-        match self {
-            Joint::Revolute(j) => j.prepare(ctx, bodies),
-            Joint::Weld(j) => j.prepare(ctx, bodies),
-        }
-    }
-
-    fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
-        match self {
-            Joint::Revolute(j) => j.warm_start(ctx, states),
-            Joint::Weld(j) => j.warm_start(ctx, states),
-        }
-    }
-
-    fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        let (a, b) = (self.base().state_a, self.base().state_b);
-        let mut pair = PairOf::new(states, a, b, BOTH);
-        self.solve_pair(ctx, &mut pair, use_bias);
-    }
-
-    fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
-        match self {
-            Joint::Revolute(j) => j.rows(ctx, bodies),
-            Joint::Weld(j) => j.rows(ctx, bodies),
-        }
-    }
-
-    fn is_enabled(&self) -> bool {
-        self.base().enabled
+        let over = self.is_enabled()
+            && (self.constraint_force().length() > force_threshold
+                || self.constraint_torque().abs() > torque_threshold);
+        let b = self.base_mut();
+        let crossed = over && !b.over_threshold;
+        b.over_threshold = over;
+        crossed
     }
 }
 

@@ -8,6 +8,7 @@
 //! | `resting`          | prepare (`load`)  | every stage (neither body moves)          |
 //! | `in_tree`          | the tree build    | the kind's rows (tree rows skipped), colouring |
 //! | `inv_h`            | prepare (`load`)  | force and torque read-back                |
+//! | `over_threshold`   | the joint events  | the joint events (one per crossing)       |
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState, SolverBody};
 use janus2d_core::constraint::{BodyJacobian, Row, StepContext};
@@ -41,6 +42,9 @@ pub struct JointBase {
     /// `1 / h` of the last step the joint was solved in, 1/s (turns the
     /// per-substep impulses into forces).
     pub(crate) inv_h: Real,
+    /// The last solved step's force or torque was above its threshold
+    /// (the joint events report the crossing once).
+    pub(crate) over_threshold: bool,
 }
 
 impl Default for JointBase {
@@ -53,6 +57,7 @@ impl Default for JointBase {
             in_tree: false,
             resting: false,
             inv_h: 0.0,
+            over_threshold: false,
         }
     }
 }
@@ -154,13 +159,11 @@ pub(crate) struct RowsAt {
 }
 
 impl RowsAt {
-    /// The geometry of anchors `anchor_a` on `body_a` and `anchor_b` on
-    /// `body_b` (each in its body's frame, from its origin).
-    pub(crate) fn new(
-        bodies: &BodySet,
-        (body_a, anchor_a): (BodyHandle, Vec2),
-        (body_b, anchor_b): (BodyHandle, Vec2),
-    ) -> RowsAt {
+    /// The geometry of a joint's two frames' anchors (each in its body's
+    /// frame, from its origin).
+    pub(crate) fn new(bodies: &BodySet, def: &crate::joint_def::JointDefBase) -> RowsAt {
+        let (body_a, anchor_a) = (def.body_a, def.local_frame_a.anchor);
+        let (body_b, anchor_b) = (def.body_b, def.local_frame_b.anchor);
         let a = bodies.solver_body(body_a);
         let b = bodies.solver_body(body_b);
         let r_a = a.sim.transform.q.rotate(anchor_a - a.sim.local_center);

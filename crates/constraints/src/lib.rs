@@ -31,6 +31,7 @@ pub mod contact_solver;
 pub mod joint;
 pub mod joint_base;
 pub mod joint_colour;
+pub mod joint_def;
 pub mod joint_solver;
 pub mod joint_tree;
 pub mod lane;
@@ -42,9 +43,10 @@ pub mod weld;
 
 pub use contact::{ContactConstraint, ContactPointInput};
 pub use contact_solver::{ContactBatch, ContactSolver, ObjectMass, PointImpulse};
-pub use joint::{Joint, JointDef, JointKind};
+pub use joint::{Joint, JointDef, JointKind, JointOfKind};
 pub use joint_base::JointBase;
 pub use joint_colour::JointColours;
+pub use joint_def::{JointDefBase, JointFrame, KindDef, LimitsMut, MotorMut, SpringMut};
 pub use joint_solver::JointBatch;
 pub use joint_tree::JointForest;
 pub use portal::{PortalBatch, PortalConstraint, PortalConstraintDef};
@@ -63,6 +65,16 @@ pub enum JointError {
     Negative,
     /// The lower limit exceeds the upper limit.
     InvalidLimits,
+    /// A body the definition names is not in the body set.
+    UnknownBody,
+    /// A definition of another kind than the joint's.
+    WrongKind,
+    /// A change to what is fixed for a joint's life (its bodies,
+    /// `collide_connected`).
+    FixedField,
+    /// A length that must be positive is not (a rope's maximum, a
+    /// distance joint's rest length).
+    ZeroLength,
     /// A value outside the range the engine accepts (see
     /// [`janus2d_core::limits`]); the world reports it as its own
     /// `OutOfBounds`.
@@ -143,6 +155,13 @@ impl std::fmt::Display for JointError {
                 "joint definition has a negative torque, hertz or damping"
             ),
             JointError::InvalidLimits => write!(f, "joint lower limit exceeds upper limit"),
+            JointError::UnknownBody => write!(f, "joint definition names a body not in the set"),
+            JointError::WrongKind => write!(f, "joint definition of another kind than the joint"),
+            JointError::FixedField => write!(
+                f,
+                "a joint's bodies and collide_connected are fixed for its life"
+            ),
+            JointError::ZeroLength => write!(f, "joint length must be positive"),
             JointError::OutOfBounds { field, min, max } => {
                 write!(f, "joint {field} outside [{min}, {max}]")
             }

@@ -9,6 +9,7 @@
 //! |---------------|------|-------------------------------------------|----------------------------------------------|
 //! | [`PointPart`] | 2    | `(x_b + r_b) − (x_a + r_a)`               | `−I, −perp(r_a) │ I, perp(r_b)`                |
 //! | [`AnglePart`] | 1    | `θ_b − θ_a − θ_ref`                       | `0, −1 │ 0, 1`                                |
+//! | [`AxisPart`]  | 1    | the kind's (`n · d`, `‖d‖ − L`, …)        | `−n, −s_a │ n, s_b` ([`AxisRow`], built by the kind) |
 //!
 //! **The soft update.** Every soft row (these parts, the portal rows, the
 //! contact rows of [`crate::contact_row`]) takes the step of
@@ -391,5 +392,175 @@ impl AnglePart {
         let old = self.impulse;
         self.impulse = (old + lambda).max(0.0);
         Self::apply(sa, sb, m, sign * (self.impulse - old));
+    }
+}
+
+/// One row along a direction `n` between two bodies, at the current
+/// substep: `J = [−n, −s_a │ n, s_b]` (`s_a`, `s_b` the angular entries
+/// the kind derives: `(r_a + d) × n` and `r_b × n` for an axis fixed in
+/// body a, `r_a × n` and `r_b × n` for a direction along the anchors'
+/// line), with its effective mass `1 / K`, `K = J M⁻¹ Jᵀ`. Built by the
+/// kind every iteration from the states' deltas; used by [`AxisPart`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AxisRow {
+    /// The row's direction (unit), world frame.
+    pub n: Vec2,
+    /// Angular entry on body a (the row pushes a by `−n` and turns it by `−s_a`).
+    pub s_a: Real,
+    /// Angular entry on body b.
+    pub s_b: Real,
+    /// Effective mass `1 / K` (0 when neither body moves along the row), kg.
+    pub mass: Real,
+}
+
+impl AxisRow {
+    /// The row `J = [−n, −s_a │ n, s_b]` with its effective mass.
+    #[inline(always)]
+    #[must_use]
+    pub fn new(m: &PairMass, n: Vec2, s_a: Real, s_b: Real) -> AxisRow {
+        let k =
+            m.a.inv_mass + m.b.inv_mass + m.a.inv_inertia * s_a * s_a + m.b.inv_inertia * s_b * s_b;
+        AxisRow {
+            n,
+            s_a,
+            s_b,
+            mass: if k > 0.0 { 1.0 / k } else { 0.0 },
+        }
+    }
+
+    /// The row's `K = J M⁻¹ Jᵀ` (`1 / mass`, or 0).
+    #[inline(always)]
+    #[must_use]
+    pub fn k(&self) -> Real {
+        if self.mass > 0.0 {
+            1.0 / self.mass
+        } else {
+            0.0
+        }
+    }
+
+    /// `Ċ = J v`.
+    #[inline(always)]
+    #[must_use]
+    pub fn c_dot(&self, sa: &BodyState, sb: &BodyState) -> Real {
+        self.n.dot(sb.v - sa.v) + self.s_b * sb.w - self.s_a * sa.w
+    }
+
+    /// Applies the impulse `λ Jᵀ`.
+    #[inline(always)]
+    pub fn apply(&self, sa: &mut BodyState, sb: &mut BodyState, m: &PairMass, lambda: Real) {
+        let p = lambda * self.n;
+        sa.v -= m.a.inv_mass * p;
+        sa.w -= m.a.inv_inertia * lambda * self.s_a;
+        sb.v += m.b.inv_mass * p;
+        sb.w += m.b.inv_inertia * lambda * self.s_b;
+    }
+
+    /// One body's share of `λ Jᵀ` (`side_b`: body b, else body a): the
+    /// arithmetic of [`AxisRow::apply`] on that body alone.
+    #[inline(always)]
+    pub fn apply_side(&self, st: &mut BodyState, m: &PairMass, lambda: Real, side_b: bool) {
+        let p = lambda * self.n;
+        if side_b {
+            st.v += m.b.inv_mass * p;
+            st.w += m.b.inv_inertia * lambda * self.s_b;
+        } else {
+            st.v -= m.a.inv_mass * p;
+            st.w -= m.a.inv_inertia * lambda * self.s_a;
+        }
+    }
+}
+
+/// The accumulated impulse of one [`AxisRow`] and its solves: a soft
+/// equality, a motor, a one-sided limit, each as [`AnglePart`]'s but along
+/// a row the kind builds each iteration.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct AxisPart {
+    /// Accumulated impulse, N·s.
+    pub impulse: Real,
+}
+
+impl AxisPart {
+    /// A soft equality row driving `c` (m) to zero, the impulse clamped to
+    /// `[lower, upper]` (N·s; `±∞` for none).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve_soft(
+        &mut self,
+        sa: &mut BodyState,
+        sb: &mut BodyState,
+        m: &PairMass,
+        row: &AxisRow,
+        c: Real,
+        softness: Softness,
+        (lower, upper): (Real, Real),
+    ) {
+        let c_dot = row.c_dot(sa, sb);
+        let lambda = soft_impulse(
+            softness.mass_scale * row.mass,
+            c_dot + softness.bias_rate * c,
+            softness.impulse_scale,
+            self.impulse,
+        );
+        let old = self.impulse;
+        self.impulse = (old + lambda).clamp(lower, upper);
+        row.apply(sa, sb, m, self.impulse - old);
+    }
+
+    /// A velocity row driving `Ċ` to `target` (m/s), the accumulated
+    /// impulse clamped to `±max_impulse` (N·s).
+    #[inline(always)]
+    pub fn solve_motor(
+        &mut self,
+        sa: &mut BodyState,
+        sb: &mut BodyState,
+        m: &PairMass,
+        row: &AxisRow,
+        target: Real,
+        max_impulse: Real,
+    ) {
+        let lambda = -row.mass * (row.c_dot(sa, sb) - target);
+        let old = self.impulse;
+        self.impulse = (old + lambda).clamp(-max_impulse, max_impulse);
+        row.apply(sa, sb, m, self.impulse - old);
+    }
+
+    /// A one-sided row `c ≥ 0` along `row` (a limit; the caller negates
+    /// the row for an upper limit): speculative when apart, soft when
+    /// violated (only with `use_bias`).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve_limit(
+        &mut self,
+        sa: &mut BodyState,
+        sb: &mut BodyState,
+        m: &PairMass,
+        row: &AxisRow,
+        c: Real,
+        softness: Softness,
+        inv_h: Real,
+        use_bias: bool,
+    ) {
+        let (bias, mass_scale, impulse_scale) = if c > 0.0 {
+            (c * inv_h, 1.0, 0.0)
+        } else if use_bias {
+            (
+                softness.bias_rate * c,
+                softness.mass_scale,
+                softness.impulse_scale,
+            )
+        } else {
+            (0.0, 1.0, 0.0)
+        };
+        let lambda = soft_impulse(
+            row.mass * mass_scale,
+            row.c_dot(sa, sb) + bias,
+            impulse_scale,
+            self.impulse,
+        );
+        let old = self.impulse;
+        self.impulse = (old + lambda).max(0.0);
+        row.apply(sa, sb, m, self.impulse - old);
     }
 }

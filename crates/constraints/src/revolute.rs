@@ -34,29 +34,37 @@
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState};
 use janus2d_core::constraint::{Block, Constraint, ConstraintRows, StepContext};
-use janus2d_core::math::{Real, Vec2, vec_is_finite};
+use janus2d_core::math::{Real, Vec2};
 use janus2d_core::softness::Softness;
 
-use crate::joint_base::{JointBase, RowsAt, mass_ratio_softness};
+use crate::joint::{KindRows, TreeRows};
+use crate::joint_base::{JointBase, RowsAt};
+use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::parts::{
     AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, load_pair, store_pair,
 };
-use crate::{JointError, check_anchor, check_motor_speed, check_spring};
+use crate::{JointError, check_motor_speed, check_spring};
 
 /// Everything needed to create a revolute joint.
+///
+/// ```
+/// use janus2d_constraints::{RevoluteJointDef, JointError};
+/// use janus2d_core::{BodyDef, BodySet, Vec2};
+/// let mut bodies = BodySet::new();
+/// let a = bodies.create(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+/// let b = bodies.create(&BodyDef::dynamic(Vec2::X)).unwrap();
+/// let def = RevoluteJointDef::new(a, b, Vec2::X, Vec2::ZERO)
+///     .with_limits(-0.5, 0.5)
+///     .with_motor(1.0, 10.0);
+/// assert!(def.validate().is_ok());
+/// assert_eq!(def.clone().with_limits(1.0, -1.0).validate(), Err(JointError::InvalidLimits));
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct RevoluteJointDef {
-    /// First body.
-    pub body_a: BodyHandle,
-    /// Second body.
-    pub body_b: BodyHandle,
-    /// Anchor in body a's frame (relative to its origin), m.
-    pub local_anchor_a: Vec2,
-    /// Anchor in body b's frame (relative to its origin), m.
-    pub local_anchor_b: Vec2,
-    /// `θ_b − θ_a` at which the joint angle is zero, rad.
-    pub reference_angle: Real,
+    /// Bodies, frames (the anchors; the reference angle is `φ_a − φ_b`)
+    /// and shared settings.
+    pub base: JointDefBase,
     /// Enables the angle limits.
     pub enable_limit: bool,
     /// Lower angle limit, rad.
@@ -75,8 +83,8 @@ pub struct RevoluteJointDef {
     pub hertz: Real,
     /// Spring damping ratio (dimensionless).
     pub damping_ratio: Real,
-    /// Whether the two bodies collide with each other (usual false).
-    pub collide_connected: bool,
+    /// The joint angle the spring drives toward, rad.
+    pub target_angle: Real,
 }
 
 impl RevoluteJointDef {
@@ -87,12 +95,18 @@ impl RevoluteJointDef {
         local_anchor_a: Vec2,
         local_anchor_b: Vec2,
     ) -> Self {
-        RevoluteJointDef {
+        Self::from_base(JointDefBase::with_anchors(
             body_a,
             body_b,
             local_anchor_a,
             local_anchor_b,
-            reference_angle: 0.0,
+        ))
+    }
+
+    /// A plain hinge on a shared base (frames, thresholds, softness).
+    pub fn from_base(base: JointDefBase) -> Self {
+        RevoluteJointDef {
+            base,
             enable_limit: false,
             lower_angle: 0.0,
             upper_angle: 0.0,
@@ -102,8 +116,22 @@ impl RevoluteJointDef {
             enable_spring: false,
             hertz: 0.0,
             damping_ratio: 0.0,
-            collide_connected: false,
+            target_angle: 0.0,
         }
+    }
+
+    /// Sets the reference angle `θ_b − θ_a` at which the joint angle is
+    /// zero, rad (builder style): frame a's angle, frame b's set to 0.
+    pub fn with_reference_angle(mut self, angle: Real) -> Self {
+        self.base.local_frame_a.angle = angle;
+        self.base.local_frame_b.angle = 0.0;
+        self
+    }
+
+    /// Lets the two bodies collide (builder style).
+    pub fn with_collide_connected(mut self, on: bool) -> Self {
+        self.base.collide_connected = on;
+        self
     }
 
     /// Enables limits (builder style).
@@ -130,20 +158,22 @@ impl RevoluteJointDef {
         self
     }
 
+    /// Sets the joint angle the spring drives toward, rad (builder style).
+    pub fn with_target_angle(mut self, angle: Real) -> Self {
+        self.target_angle = angle;
+        self
+    }
+
     /// Checks the definition's own values (not the handles).
     pub fn validate(&self) -> Result<(), JointError> {
-        if self.body_a == self.body_b {
-            return Err(JointError::SameBody);
-        }
-        let finite = vec_is_finite(self.local_anchor_a)
-            && vec_is_finite(self.local_anchor_b)
-            && self.reference_angle.is_finite()
-            && self.lower_angle.is_finite()
+        self.base.validate()?;
+        let finite = self.lower_angle.is_finite()
             && self.upper_angle.is_finite()
             && self.motor_speed.is_finite()
             && !self.max_motor_torque.is_nan()
             && self.hertz.is_finite()
-            && self.damping_ratio.is_finite();
+            && self.damping_ratio.is_finite()
+            && self.target_angle.is_finite();
         if !finite {
             return Err(JointError::NonFinite);
         }
@@ -153,10 +183,42 @@ impl RevoluteJointDef {
         if self.max_motor_torque < 0.0 || self.hertz < 0.0 || self.damping_ratio < 0.0 {
             return Err(JointError::Negative);
         }
-        check_anchor(self.local_anchor_a, "local_anchor_a")?;
-        check_anchor(self.local_anchor_b, "local_anchor_b")?;
         check_motor_speed(self.motor_speed)?;
         check_spring(self.hertz, self.damping_ratio)
+    }
+}
+
+impl KindDef for RevoluteJointDef {
+    fn base(&self) -> &JointDefBase {
+        &self.base
+    }
+    fn base_mut(&mut self) -> &mut JointDefBase {
+        &mut self.base
+    }
+    fn validate(&self) -> Result<(), JointError> {
+        RevoluteJointDef::validate(self)
+    }
+    fn limits_mut(&mut self) -> Option<LimitsMut<'_>> {
+        Some(LimitsMut {
+            enable: &mut self.enable_limit,
+            lower: &mut self.lower_angle,
+            upper: &mut self.upper_angle,
+        })
+    }
+    fn motor_mut(&mut self) -> Option<MotorMut<'_>> {
+        Some(MotorMut {
+            enable: &mut self.enable_motor,
+            speed: &mut self.motor_speed,
+            max: &mut self.max_motor_torque,
+            linear: false,
+        })
+    }
+    fn spring_mut(&mut self) -> Option<SpringMut<'_>> {
+        Some(SpringMut {
+            enable: &mut self.enable_spring,
+            hertz: &mut self.hertz,
+            damping_ratio: &mut self.damping_ratio,
+        })
     }
 }
 
@@ -184,8 +246,8 @@ pub struct RevoluteJoint {
 /// by the mass ratio `ρ = min((m_a⁻¹ + m_b⁻¹) / min(m_a⁻¹, m_b⁻¹), ρ_max)`
 /// (`ρ_max` when one body is static). Used by the solve and reported by
 /// `rows()`, so both see the same rows.
-fn point_softness(ctx: &StepContext, m: &PairMass) -> Softness {
-    mass_ratio_softness(ctx, m.a.inv_mass, m.b.inv_mass)
+fn point_softness(def: &RevoluteJointDef, ctx: &StepContext, m: &PairMass) -> Softness {
+    def.base.rigid_softness(ctx, m.a.inv_mass, m.b.inv_mass)
 }
 
 impl RevoluteJoint {
@@ -228,11 +290,7 @@ impl RevoluteJoint {
 
     /// The world anchors on a and b (their distance is the joint gap).
     pub fn world_anchors(&self, bodies: &BodySet) -> (Vec2, Vec2) {
-        crate::joint_base::world_anchors(
-            bodies,
-            (self.def.body_a, self.def.local_anchor_a),
-            (self.def.body_b, self.def.local_anchor_b),
-        )
+        self.def.base.world_anchors(bodies)
     }
 
     /// Distance between the two world anchors, m.
@@ -245,9 +303,9 @@ impl RevoluteJoint {
     pub fn angle(&self, bodies: &BodySet) -> Real {
         crate::joint_base::relative_angle(
             bodies,
-            self.def.body_a,
-            self.def.body_b,
-            self.def.reference_angle,
+            self.def.base.body_a,
+            self.def.base.body_b,
+            self.def.base.reference_angle(),
         )
     }
 
@@ -330,8 +388,13 @@ impl RevoluteJoint {
             0.0
         };
         if self.def.enable_spring && m.a.inv_inertia + m.b.inv_inertia > 0.0 {
-            self.spring
-                .solve_soft(&mut sa, &mut sb, m, angle, self.spring_softness);
+            self.spring.solve_soft(
+                &mut sa,
+                &mut sb,
+                m,
+                angle - self.def.target_angle,
+                self.spring_softness,
+            );
         }
         if self.def.enable_motor {
             let max_impulse = ctx.h * self.def.max_motor_torque;
@@ -386,21 +449,73 @@ impl RevoluteJoint {
     }
 }
 
+impl KindRows for RevoluteJoint {
+    fn base(&self) -> &JointBase {
+        &self.base
+    }
+    fn base_mut(&mut self) -> &mut JointBase {
+        &mut self.base
+    }
+    fn row_count(&self) -> usize {
+        RevoluteJoint::row_count(self)
+    }
+    fn is_driven(&self) -> bool {
+        self.def.enable_motor && self.def.max_motor_torque > 0.0
+    }
+    fn constraint_force(&self) -> Vec2 {
+        RevoluteJoint::constraint_force(self)
+    }
+    fn constraint_torque(&self) -> Real {
+        RevoluteJoint::constraint_torque(self)
+    }
+    fn carry_impulses(&mut self, rotation: janus2d_core::math::Rot, scale: Real) {
+        RevoluteJoint::carry_impulses(self, rotation, scale);
+    }
+    #[inline(always)]
+    fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
+        RevoluteJoint::warm_start_side(self, st, side_b);
+    }
+    #[inline(always)]
+    fn solve_pair<P: PairStates>(&mut self, ctx: &StepContext, pair: &mut P, use_bias: bool) {
+        RevoluteJoint::solve_pair(self, ctx, pair, use_bias);
+    }
+    #[inline(always)]
+    fn tree_rows(&self) -> Option<TreeRows<'_>> {
+        Some(TreeRows {
+            point: &self.point,
+            angle: None,
+        })
+    }
+    #[inline(always)]
+    fn set_tree_impulses(&mut self, point: Vec2, _angle: Real) {
+        self.point.impulse = point;
+    }
+    #[inline(always)]
+    fn has_iterative_rows(&self) -> bool {
+        !self.base.in_tree || self.has_angle_rows()
+    }
+    #[cfg(test)]
+    fn tree_point_mut(&mut self) -> Option<&mut PointPart> {
+        Some(&mut self.point)
+    }
+}
+
 impl Constraint for RevoluteJoint {
     fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
         let Some((a, b)) = self
             .base
-            .load(ctx, bodies, self.def.body_a, self.def.body_b)
+            .load(ctx, bodies, self.def.base.body_a, self.def.base.body_b)
         else {
             return;
         };
         let q_a = a.sim.transform.q;
         let q_b = b.sim.transform.q;
-        self.point.frame_a = q_a.rotate(self.def.local_anchor_a - a.sim.local_center);
-        self.point.frame_b = q_b.rotate(self.def.local_anchor_b - b.sim.local_center);
+        self.point.frame_a = q_a.rotate(self.def.base.local_frame_a.anchor - a.sim.local_center);
+        self.point.frame_b = q_b.rotate(self.def.base.local_frame_b.anchor - b.sim.local_center);
         self.point.delta_center = b.sim.center - a.sim.center;
-        self.delta_angle =
-            janus2d_core::math::wrap_angle(q_a.relative_angle(q_b) - self.def.reference_angle);
+        self.delta_angle = janus2d_core::math::wrap_angle(
+            q_a.relative_angle(q_b) - self.def.base.reference_angle(),
+        );
         let m = &self.base.masses;
         for part in [
             &mut self.spring,
@@ -411,7 +526,7 @@ impl Constraint for RevoluteJoint {
             part.prepare(m);
         }
         self.spring_softness = Softness::new(self.def.hertz, self.def.damping_ratio, ctx.h);
-        self.point_softness = point_softness(ctx, m);
+        self.point_softness = point_softness(&self.def, ctx, m);
         if !ctx.warm_starting {
             self.point.impulse = Vec2::ZERO;
             self.spring.impulse = 0.0;
@@ -451,17 +566,13 @@ impl Constraint for RevoluteJoint {
     }
 
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
-        let at = RowsAt::new(
-            bodies,
-            (self.def.body_a, self.def.local_anchor_a),
-            (self.def.body_b, self.def.local_anchor_b),
-        );
+        let at = RowsAt::new(bodies, &self.def.base);
         let (m, r_a, r_b, c) = (at.m, at.r_a, at.r_b, at.c);
         // Tree joints' point rows are solved directly, at their own softness.
         let point_softness = if self.base.in_tree {
             ctx.direct_joint_softness
         } else {
-            point_softness(ctx, &m)
+            point_softness(&self.def, ctx, &m)
         };
         let mut out = ConstraintRows::default();
         out.rows
@@ -490,7 +601,7 @@ impl Constraint for RevoluteJoint {
         if self.def.enable_spring {
             angle_row(
                 1.0,
-                angle,
+                angle - self.def.target_angle,
                 Softness::new(self.def.hertz, self.def.damping_ratio, ctx.h),
                 Real::NEG_INFINITY,
                 Real::INFINITY,

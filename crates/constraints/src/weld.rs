@@ -40,11 +40,13 @@ use janus2d_core::constraint::{Block, Constraint, ConstraintRows, StepContext};
 use janus2d_core::math::{Real, Vec2};
 use janus2d_core::softness::Softness;
 
-use crate::joint_base::{JointBase, RowsAt, mass_ratio_softness};
+use crate::joint::{KindRows, TreeAngle, TreeRows};
+use crate::joint_base::{JointBase, RowsAt};
+use crate::joint_def::{JointDefBase, KindDef};
 use crate::parts::{
     AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, load_pair, store_pair,
 };
-use crate::{JointError, check_anchor, check_spring};
+use crate::{JointError, check_spring};
 
 /// Everything needed to create a weld joint.
 ///
@@ -62,16 +64,9 @@ use crate::{JointError, check_anchor, check_spring};
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct WeldJointDef {
-    /// First body.
-    pub body_a: BodyHandle,
-    /// Second body.
-    pub body_b: BodyHandle,
-    /// Anchor in body a's frame (relative to its origin), m.
-    pub local_anchor_a: Vec2,
-    /// Anchor in body b's frame (relative to its origin), m.
-    pub local_anchor_b: Vec2,
-    /// `θ_b − θ_a` the joint holds, rad.
-    pub reference_angle: Real,
+    /// Bodies, frames (the anchors; the held angle `θ_b − θ_a` is
+    /// `φ_a − φ_b`) and shared settings.
+    pub base: JointDefBase,
     /// Stiffness of the point rows, Hz (0: rigid).
     pub linear_hertz: Real,
     /// Damping ratio of the point rows (dimensionless; unused when rigid).
@@ -80,8 +75,6 @@ pub struct WeldJointDef {
     pub angular_hertz: Real,
     /// Damping ratio of the angle row (dimensionless; unused when rigid).
     pub angular_damping_ratio: Real,
-    /// Whether the two bodies collide with each other (usual false).
-    pub collide_connected: bool,
 }
 
 impl WeldJointDef {
@@ -93,17 +86,22 @@ impl WeldJointDef {
         local_anchor_a: Vec2,
         local_anchor_b: Vec2,
     ) -> Self {
-        WeldJointDef {
+        Self::from_base(JointDefBase::with_anchors(
             body_a,
             body_b,
             local_anchor_a,
             local_anchor_b,
-            reference_angle: 0.0,
+        ))
+    }
+
+    /// A rigid weld on a shared base (frames, thresholds, softness).
+    pub fn from_base(base: JointDefBase) -> Self {
+        WeldJointDef {
+            base,
             linear_hertz: 0.0,
             linear_damping_ratio: 0.0,
             angular_hertz: 0.0,
             angular_damping_ratio: 0.0,
-            collide_connected: false,
         }
     }
 
@@ -123,9 +121,11 @@ impl WeldJointDef {
         self
     }
 
-    /// Sets the reference angle `θ_b − θ_a`, rad (builder style).
+    /// Sets the held angle `θ_b − θ_a`, rad (builder style): frame a's
+    /// angle, frame b's set to 0.
     pub fn with_reference_angle(mut self, angle: Real) -> Self {
-        self.reference_angle = angle;
+        self.base.local_frame_a.angle = angle;
+        self.base.local_frame_b.angle = 0.0;
         self
     }
 
@@ -138,15 +138,8 @@ impl WeldJointDef {
 
     /// Checks the definition's own values (not the handles).
     pub fn validate(&self) -> Result<(), JointError> {
-        if self.body_a == self.body_b {
-            return Err(JointError::SameBody);
-        }
-        let finite = self.local_anchor_a.x.is_finite()
-            && self.local_anchor_a.y.is_finite()
-            && self.local_anchor_b.x.is_finite()
-            && self.local_anchor_b.y.is_finite()
-            && self.reference_angle.is_finite()
-            && self.linear_hertz.is_finite()
+        self.base.validate()?;
+        let finite = self.linear_hertz.is_finite()
             && self.linear_damping_ratio.is_finite()
             && self.angular_hertz.is_finite()
             && self.angular_damping_ratio.is_finite();
@@ -160,10 +153,20 @@ impl WeldJointDef {
         {
             return Err(JointError::Negative);
         }
-        check_anchor(self.local_anchor_a, "local_anchor_a")?;
-        check_anchor(self.local_anchor_b, "local_anchor_b")?;
         check_spring(self.linear_hertz, self.linear_damping_ratio)?;
         check_spring(self.angular_hertz, self.angular_damping_ratio)
+    }
+}
+
+impl KindDef for WeldJointDef {
+    fn base(&self) -> &JointDefBase {
+        &self.base
+    }
+    fn base_mut(&mut self) -> &mut JointDefBase {
+        &mut self.base
+    }
+    fn validate(&self) -> Result<(), JointError> {
+        WeldJointDef::validate(self)
     }
 }
 
@@ -191,12 +194,13 @@ pub struct WeldJoint {
 /// the module docs), used by the solve and reported by `rows()`.
 fn softnesses(def: &WeldJointDef, ctx: &StepContext, m: &PairMass) -> (Softness, Softness) {
     let linear = if def.linear_hertz == 0.0 {
-        mass_ratio_softness(ctx, m.a.inv_mass, m.b.inv_mass)
+        def.base.rigid_softness(ctx, m.a.inv_mass, m.b.inv_mass)
     } else {
         Softness::new(def.linear_hertz, def.linear_damping_ratio, ctx.h)
     };
     let angular = if def.angular_hertz == 0.0 {
-        mass_ratio_softness(ctx, m.a.inv_inertia, m.b.inv_inertia)
+        def.base
+            .rigid_softness(ctx, m.a.inv_inertia, m.b.inv_inertia)
     } else {
         Softness::new(def.angular_hertz, def.angular_damping_ratio, ctx.h)
     };
@@ -233,11 +237,7 @@ impl WeldJoint {
 
     /// The world anchors on a and b (their distance is the joint gap).
     pub fn world_anchors(&self, bodies: &BodySet) -> (Vec2, Vec2) {
-        crate::joint_base::world_anchors(
-            bodies,
-            (self.def.body_a, self.def.local_anchor_a),
-            (self.def.body_b, self.def.local_anchor_b),
-        )
+        self.def.base.world_anchors(bodies)
     }
 
     /// Distance between the two world anchors, m.
@@ -250,9 +250,9 @@ impl WeldJoint {
     pub fn angle(&self, bodies: &BodySet) -> Real {
         crate::joint_base::relative_angle(
             bodies,
-            self.def.body_a,
-            self.def.body_b,
-            self.def.reference_angle,
+            self.def.base.body_a,
+            self.def.base.body_b,
+            self.def.base.reference_angle(),
         )
     }
 
@@ -352,21 +352,70 @@ impl WeldJoint {
     }
 }
 
+impl KindRows for WeldJoint {
+    fn base(&self) -> &JointBase {
+        &self.base
+    }
+    fn base_mut(&mut self) -> &mut JointBase {
+        &mut self.base
+    }
+    fn row_count(&self) -> usize {
+        WeldJoint::row_count(self)
+    }
+    fn constraint_force(&self) -> Vec2 {
+        WeldJoint::constraint_force(self)
+    }
+    fn constraint_torque(&self) -> Real {
+        WeldJoint::constraint_torque(self)
+    }
+    fn carry_impulses(&mut self, rotation: janus2d_core::math::Rot, scale: Real) {
+        WeldJoint::carry_impulses(self, rotation, scale);
+    }
+    #[inline(always)]
+    fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
+        WeldJoint::warm_start_side(self, st, side_b);
+    }
+    #[inline(always)]
+    fn solve_pair<P: PairStates>(&mut self, ctx: &StepContext, pair: &mut P, use_bias: bool) {
+        WeldJoint::solve_pair(self, ctx, pair, use_bias);
+    }
+    #[inline(always)]
+    fn tree_rows(&self) -> Option<TreeRows<'_>> {
+        self.def.is_rigid().then_some(TreeRows {
+            point: &self.point,
+            angle: Some(TreeAngle {
+                delta_angle: self.delta_angle,
+                impulse: self.angle.impulse,
+            }),
+        })
+    }
+    #[inline(always)]
+    fn set_tree_impulses(&mut self, point: Vec2, angle: Real) {
+        self.point.impulse = point;
+        self.angle.impulse = angle;
+    }
+    #[cfg(test)]
+    fn tree_point_mut(&mut self) -> Option<&mut PointPart> {
+        Some(&mut self.point)
+    }
+}
+
 impl Constraint for WeldJoint {
     fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
         let Some((a, b)) = self
             .base
-            .load(ctx, bodies, self.def.body_a, self.def.body_b)
+            .load(ctx, bodies, self.def.base.body_a, self.def.base.body_b)
         else {
             return;
         };
         let q_a = a.sim.transform.q;
         let q_b = b.sim.transform.q;
-        self.point.frame_a = q_a.rotate(self.def.local_anchor_a - a.sim.local_center);
-        self.point.frame_b = q_b.rotate(self.def.local_anchor_b - b.sim.local_center);
+        self.point.frame_a = q_a.rotate(self.def.base.local_frame_a.anchor - a.sim.local_center);
+        self.point.frame_b = q_b.rotate(self.def.base.local_frame_b.anchor - b.sim.local_center);
         self.point.delta_center = b.sim.center - a.sim.center;
-        self.delta_angle =
-            janus2d_core::math::wrap_angle(q_a.relative_angle(q_b) - self.def.reference_angle);
+        self.delta_angle = janus2d_core::math::wrap_angle(
+            q_a.relative_angle(q_b) - self.def.base.reference_angle(),
+        );
         let m = self.base.masses;
         self.angle.prepare(&m);
         (self.linear_softness, self.angular_softness) = softnesses(&self.def, ctx, &m);
@@ -394,11 +443,7 @@ impl Constraint for WeldJoint {
     }
 
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
-        let at = RowsAt::new(
-            bodies,
-            (self.def.body_a, self.def.local_anchor_a),
-            (self.def.body_b, self.def.local_anchor_b),
-        );
+        let at = RowsAt::new(bodies, &self.def.base);
         let (m, r_a, r_b, c) = (at.m, at.r_a, at.r_b, at.c);
         let (iia, iib) = (m.a.inv_inertia, m.b.inv_inertia);
         // A tree joint's three rows are solved directly, at its softness.
@@ -471,7 +516,7 @@ mod tests {
         let def = WeldJointDef::new(a, b, Vec2::ZERO, Vec2::ZERO);
         assert_eq!(def.validate(), Ok(()));
         let mut nan = def.clone();
-        nan.local_anchor_b.x = Real::NAN;
+        nan.base.local_frame_b.anchor.x = Real::NAN;
         assert_eq!(nan.validate(), Err(JointError::NonFinite));
         let negative = def.clone().with_stiffness(-1.0, 0.0, 0.0, 0.0);
         assert_eq!(negative.validate(), Err(JointError::Negative));

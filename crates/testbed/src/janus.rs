@@ -162,8 +162,9 @@ pub fn create_joint(
         vec(j.local_a),
         vec(j.local_b),
     );
-    def.reference_angle = j.reference_angle as Real;
-    def.collide_connected = j.collide_connected;
+    def = def
+        .with_reference_angle(j.reference_angle as Real)
+        .with_collide_connected(j.collide_connected);
     if let Some((lo, hi)) = j.limit {
         def = def.with_limits(lo as Real, hi as Real);
     }

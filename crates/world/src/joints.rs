@@ -10,19 +10,19 @@
 //!   no_collide   NoCollide            body pair → joints with collide_connected = false
 //! ```
 //!
-//! A joint's bodies and `collide_connected` are fixed at creation; limits,
-//! motor, spring and the enabled switch change through validated setters
-//! that leave the joint unchanged on error. The set never names a joint
-//! kind but in the typed accessors ([`JointSet::revolute`],
-//! [`JointSet::weld`]) and the
-//! setters whose meaning is the kind's (angle limits of a revolute joint).
+//! A joint's bodies and `collide_connected` are fixed at creation; the
+//! rest of its definition, limits, motor, spring and the enabled switch
+//! change through validated setters that leave the joint unchanged on
+//! error. The set never names a joint kind: typed reads go through
+//! [`JointSet::of`] (`JointOfKind`), and the limit, motor and spring
+//! setters through the definition's `limits_mut`, `motor_mut` and
+//! `spring_mut` (`Err(WrongJointKind)` for a kind without one).
 
 use std::collections::HashMap;
 
 pub use janus2d_constraints::JointKind;
 use janus2d_constraints::{
-    Joint, JointBatch, JointColours, JointDef, JointForest, RevoluteJoint, RevoluteJointDef,
-    WeldJoint,
+    Joint, JointBatch, JointColours, JointDef, JointForest, JointOfKind, RevoluteJoint, WeldJoint,
 };
 use janus2d_core::body::BodyHandle;
 use janus2d_core::handle::{Handle, JointTag};
@@ -42,6 +42,22 @@ struct JointSlot {
     kind: JointKind,
     index: u32,
     user_data: u64,
+}
+
+/// A joint whose force or torque passed its threshold in the last step
+/// (`JointDefBase::force_threshold`, `torque_threshold`): reported once per
+/// crossing; the joint reports again only after falling back below both.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct JointEvent {
+    /// The joint.
+    pub joint: JointHandle,
+    /// Its user value.
+    pub user_data: u64,
+    /// The force it applied to body b over the step, N.
+    pub force: janus2d_core::math::Vec2,
+    /// The torque it applied to body b over the step, N·m.
+    pub torque: Real,
 }
 
 /// Body pairs (slot indices, ordered) that a joint with
@@ -226,22 +242,20 @@ impl JointSet {
         Ok(&mut self.joints[s.index as usize])
     }
 
+    /// A joint of kind `K` (`Err(WrongJointKind)` for a joint of another
+    /// kind).
+    pub fn of<K: JointOfKind>(&self, joint: JointHandle) -> Result<&K, WorldError> {
+        self.get(joint)?.of::<K>().ok_or(WorldError::WrongJointKind)
+    }
+
     /// A revolute joint (`Err(WrongJointKind)` for a joint of another kind).
     pub fn revolute(&self, joint: JointHandle) -> Result<&RevoluteJoint, WorldError> {
-        self.get(joint)?
-            .as_revolute()
-            .ok_or(WorldError::WrongJointKind)
+        self.of(joint)
     }
 
     /// A weld joint (`Err(WrongJointKind)` for a joint of another kind).
     pub fn weld(&self, joint: JointHandle) -> Result<&WeldJoint, WorldError> {
-        self.get(joint)?.as_weld().ok_or(WorldError::WrongJointKind)
-    }
-
-    fn revolute_mut(&mut self, joint: JointHandle) -> Result<&mut RevoluteJoint, WorldError> {
-        self.get_mut(joint)?
-            .as_revolute_mut()
-            .ok_or(WorldError::WrongJointKind)
+        self.of(joint)
     }
 
     /// Every joint in storage order (parallel to [`JointSet::handles`]).
@@ -275,7 +289,7 @@ impl JointSet {
         let (index, generation) = self.slots.insert(JointSlot {
             kind: def.kind(),
             index: self.joints.len() as u32,
-            user_data: 0,
+            user_data: def.base().user_data,
         });
         let handle = JointHandle::new(index, generation, self.owner);
         self.joints.push(Joint::new(def.clone()));
@@ -370,23 +384,38 @@ impl JointSet {
         self.get_mut(joint)
     }
 
-    /// Changes a revolute joint's definition through `edit`, keeping the
-    /// change only when the result validates. Returns the joint's bodies
-    /// (to wake).
+    /// Changes a joint's definition through `edit`, keeping the change
+    /// only when the result validates. Returns the joint's bodies (to
+    /// wake).
     fn edit(
         &mut self,
         joint: JointHandle,
-        edit: impl FnOnce(&mut RevoluteJointDef),
+        edit: impl FnOnce(&mut JointDef) -> Result<(), WorldError>,
     ) -> Result<(BodyHandle, BodyHandle), WorldError> {
-        let j = self.revolute_mut(joint)?;
-        let mut def = j.def.clone();
-        edit(&mut def);
-        def.validate()?;
-        j.def = def;
-        Ok((j.def.body_a, j.def.body_b))
+        let j = self.get_mut(joint)?;
+        let mut def = j.def();
+        edit(&mut def)?;
+        j.set_def(def)?;
+        Ok(j.bodies())
     }
 
-    /// Sets the angle limits, rad (`lower ≤ upper`, both finite).
+    /// Replaces a joint's definition by one of the same kind and bodies.
+    pub(crate) fn set_def(
+        &mut self,
+        joint: JointHandle,
+        def: JointDef,
+    ) -> Result<(BodyHandle, BodyHandle), WorldError> {
+        if self.kind(joint)? != def.kind() {
+            return Err(WorldError::WrongJointKind);
+        }
+        self.edit(joint, |d| {
+            *d = def;
+            Ok(())
+        })
+    }
+
+    /// Sets the limits (rad for an angle, m for a translation or length;
+    /// `lower ≤ upper`, both finite).
     pub(crate) fn set_limits(
         &mut self,
         joint: JointHandle,
@@ -400,8 +429,10 @@ impl JointSet {
             return Err(WorldError::OutOfRange("limits"));
         }
         self.edit(joint, |d| {
-            d.lower_angle = lower;
-            d.upper_angle = upper;
+            let l = d.limits_mut().ok_or(WorldError::WrongJointKind)?;
+            *l.lower = lower;
+            *l.upper = upper;
+            Ok(())
         })
     }
 
@@ -411,7 +442,10 @@ impl JointSet {
         joint: JointHandle,
         on: bool,
     ) -> Result<(BodyHandle, BodyHandle), WorldError> {
-        self.edit(joint, |d| d.enable_limit = on)
+        self.edit(joint, |d| {
+            *d.limits_mut().ok_or(WorldError::WrongJointKind)?.enable = on;
+            Ok(())
+        })
     }
 
     /// The bodies an enabled motor (of nonzero torque) turns: both bodies
@@ -427,7 +461,8 @@ impl JointSet {
             })
     }
 
-    /// Sets the motor speed, rad/s.
+    /// Sets the motor speed (rad/s for an angular motor, m/s for a
+    /// linear one; the kind's validation bounds it).
     pub(crate) fn set_motor_speed(
         &mut self,
         joint: JointHandle,
@@ -436,23 +471,40 @@ impl JointSet {
         if !speed.is_finite() {
             return Err(WorldError::NonFinite("motor_speed"));
         }
-        check_motor_speed(speed)?;
-        self.edit(joint, |d| d.motor_speed = speed)
+        self.edit(joint, |d| {
+            *d.motor_mut().ok_or(WorldError::WrongJointKind)?.speed = speed;
+            Ok(())
+        })
     }
 
-    /// Sets the largest motor torque, N·m (≥ 0).
-    pub(crate) fn set_max_motor_torque(
+    /// Sets the motor's largest torque (N·m, `linear` false) or force (N,
+    /// `linear` true), ≥ 0; a motor of the other sort is
+    /// `Err(WrongJointKind)`.
+    pub(crate) fn set_max_motor(
         &mut self,
         joint: JointHandle,
-        torque: Real,
+        max: Real,
+        linear: bool,
     ) -> Result<(BodyHandle, BodyHandle), WorldError> {
-        if torque.is_nan() {
-            return Err(WorldError::NonFinite("max_motor_torque"));
+        let field = if linear {
+            "max_motor_force"
+        } else {
+            "max_motor_torque"
+        };
+        if max.is_nan() {
+            return Err(WorldError::NonFinite(field));
         }
-        if torque < 0.0 {
-            return Err(WorldError::OutOfRange("max_motor_torque"));
+        if max < 0.0 {
+            return Err(WorldError::OutOfRange(field));
         }
-        self.edit(joint, |d| d.max_motor_torque = torque)
+        self.edit(joint, |d| {
+            let m = d.motor_mut().ok_or(WorldError::WrongJointKind)?;
+            if m.linear != linear {
+                return Err(WorldError::WrongJointKind);
+            }
+            *m.max = max;
+            Ok(())
+        })
     }
 
     /// Turns the motor on or off.
@@ -461,7 +513,10 @@ impl JointSet {
         joint: JointHandle,
         on: bool,
     ) -> Result<(BodyHandle, BodyHandle), WorldError> {
-        self.edit(joint, |d| d.enable_motor = on)
+        self.edit(joint, |d| {
+            *d.motor_mut().ok_or(WorldError::WrongJointKind)?.enable = on;
+            Ok(())
+        })
     }
 
     /// Sets the spring's stiffness, Hz, and damping ratio (both ≥ 0).
@@ -477,10 +532,11 @@ impl JointSet {
         if hertz < 0.0 || damping_ratio < 0.0 {
             return Err(WorldError::OutOfRange("spring"));
         }
-        check_spring(hertz, damping_ratio)?;
         self.edit(joint, |d| {
-            d.hertz = hertz;
-            d.damping_ratio = damping_ratio;
+            let sp = d.spring_mut().ok_or(WorldError::WrongJointKind)?;
+            *sp.hertz = hertz;
+            *sp.damping_ratio = damping_ratio;
+            Ok(())
         })
     }
 
@@ -490,7 +546,10 @@ impl JointSet {
         joint: JointHandle,
         on: bool,
     ) -> Result<(BodyHandle, BodyHandle), WorldError> {
-        self.edit(joint, |d| d.enable_spring = on)
+        self.edit(joint, |d| {
+            *d.spring_mut().ok_or(WorldError::WrongJointKind)?.enable = on;
+            Ok(())
+        })
     }
 
     /// Enables or disables a joint (a disabled joint stays until destroyed
@@ -503,6 +562,24 @@ impl JointSet {
         let j = self.get_mut(joint)?;
         j.set_enabled(on);
         Ok(j.bodies())
+    }
+
+    /// The joint events of the step just solved (see [`JointEvent`]), in
+    /// storage order.
+    pub(crate) fn threshold_events(&mut self) -> Vec<JointEvent> {
+        let mut out = Vec::new();
+        for (k, j) in self.joints.iter_mut().enumerate() {
+            if j.check_thresholds() {
+                let joint = self.handles[k];
+                out.push(JointEvent {
+                    joint,
+                    user_data: self.slots.live(joint.index).user_data,
+                    force: j.constraint_force(),
+                    torque: j.constraint_torque(),
+                });
+            }
+        }
+        out
     }
 
     /// Rows every enabled joint adds to the solver.
@@ -524,12 +601,4 @@ impl JointSet {
             .map(Joint::tree_row_count)
             .sum()
     }
-}
-
-fn check_motor_speed(speed: Real) -> Result<(), WorldError> {
-    Ok(janus2d_constraints::check_motor_speed(speed)?)
-}
-
-fn check_spring(hertz: Real, damping_ratio: Real) -> Result<(), WorldError> {
-    Ok(janus2d_constraints::check_spring(hertz, damping_ratio)?)
 }

@@ -5,6 +5,7 @@
 use super::*;
 use crate::error::WorldError;
 use crate::joints::JointHandle;
+use janus2d_constraints::JointOfKind;
 use janus2d_core::body::BodyHandle;
 use janus2d_core::math::Real;
 
@@ -87,6 +88,12 @@ impl World {
         self.joints.get(joint)
     }
 
+    /// A joint of kind `K` (`Err(WrongJointKind)` for another kind):
+    /// `world.joint_of::<PrismaticJoint>(h)`.
+    pub fn joint_of<K: JointOfKind>(&self, joint: JointHandle) -> Result<&K, WorldError> {
+        self.joints.of(joint)
+    }
+
     /// A revolute joint (`Err(WrongJointKind)` for another kind).
     pub fn revolute_joint(&self, joint: JointHandle) -> Result<&RevoluteJoint, WorldError> {
         self.joints.revolute(joint)
@@ -124,8 +131,9 @@ impl World {
         Ok(())
     }
 
-    /// Sets a joint's angle limits, rad (`lower ≤ upper`); wakes its bodies.
-    /// A revolute joint's; a joint of another kind gets
+    /// Sets a joint's limits (`lower ≤ upper`); wakes its bodies. Angles
+    /// (rad) of a revolute joint, translations (m) of a prismatic or wheel
+    /// joint, lengths (m) of a distance joint; a kind without limits gets
     /// `Err(WrongJointKind)` and is left unchanged.
     pub fn set_joint_limits(
         &mut self,
@@ -137,17 +145,17 @@ impl World {
         self.wake_pair(r)
     }
 
-    /// Turns a joint's limit on or off.
-    /// A revolute joint's; a joint of another kind gets
-    /// `Err(WrongJointKind)` and is left unchanged.
+    /// Turns a joint's limits on or off (a kind without limits gets
+    /// `Err(WrongJointKind)` and is left unchanged).
     pub fn enable_joint_limit(&mut self, joint: JointHandle, on: bool) -> Result<(), WorldError> {
         let r = self.joints.enable_limit(joint, on);
         self.wake_pair(r)
     }
 
-    /// Sets a joint's motor speed, rad/s.
-    /// A revolute joint's; a joint of another kind gets
-    /// `Err(WrongJointKind)` and is left unchanged.
+    /// Sets a joint's motor speed: rad/s for an angular motor (revolute,
+    /// wheel), m/s for a linear one (prismatic, distance); the kind's
+    /// bounds apply. A kind without a motor gets `Err(WrongJointKind)` and
+    /// is left unchanged.
     pub fn set_joint_motor_speed(
         &mut self,
         joint: JointHandle,
@@ -157,15 +165,53 @@ impl World {
         self.wake_pair(r)
     }
 
-    /// Sets a joint's largest motor torque, N·m (≥ 0).
-    /// A revolute joint's; a joint of another kind gets
+    /// Sets the largest torque of a joint's angular motor, N·m (≥ 0):
+    /// revolute, wheel. A joint without an angular motor gets
     /// `Err(WrongJointKind)` and is left unchanged.
     pub fn set_joint_max_motor_torque(
         &mut self,
         joint: JointHandle,
         torque: Real,
     ) -> Result<(), WorldError> {
-        let r = self.joints.set_max_motor_torque(joint, torque);
+        let r = self.joints.set_max_motor(joint, torque, false);
+        self.wake_pair(r)
+    }
+
+    /// Sets the largest force of a joint's linear motor, N (≥ 0):
+    /// prismatic, distance. A joint without a linear motor gets
+    /// `Err(WrongJointKind)` and is left unchanged.
+    pub fn set_joint_max_motor_force(
+        &mut self,
+        joint: JointHandle,
+        force: Real,
+    ) -> Result<(), WorldError> {
+        let r = self.joints.set_max_motor(joint, force, true);
+        self.wake_pair(r)
+    }
+
+    /// Replaces a joint's definition by `def` (any field but its bodies
+    /// and `collide_connected`, which are fixed for its life), keeping its
+    /// impulses; wakes its bodies. A definition of another kind, a change
+    /// of bodies or an invalid value gets a typed error and changes
+    /// nothing.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_constraints::{RevoluteJoint, RevoluteJointDef};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    /// let bob = world.create_body(&BodyDef::dynamic(Vec2::new(1.0, 0.0))).unwrap();
+    /// let pin = world
+    ///     .create_joint(&RevoluteJointDef::new(ground, bob, Vec2::ZERO, Vec2::new(-1.0, 0.0)).into())
+    ///     .unwrap();
+    /// let mut def = world.joint_of::<RevoluteJoint>(pin).unwrap().def.clone();
+    /// def.base.force_threshold = 400.0;
+    /// world.set_joint_def(pin, def.into()).unwrap();
+    /// assert_eq!(world.joint(pin).unwrap().def_base().force_threshold, 400.0);
+    /// ```
+    pub fn set_joint_def(&mut self, joint: JointHandle, def: JointDef) -> Result<(), WorldError> {
+        let r = self.joints.set_def(joint, def);
         self.wake_pair(r)
     }
 
@@ -178,8 +224,8 @@ impl World {
     }
 
     /// Sets a joint's spring: stiffness, Hz, and damping ratio (both ≥ 0).
-    /// A revolute joint's; a joint of another kind gets
-    /// `Err(WrongJointKind)` and is left unchanged.
+    /// A kind without a spring gets `Err(WrongJointKind)` and is left
+    /// unchanged.
     pub fn set_joint_spring(
         &mut self,
         joint: JointHandle,
@@ -190,9 +236,8 @@ impl World {
         self.wake_pair(r)
     }
 
-    /// Turns a joint's spring on or off.
-    /// A revolute joint's; a joint of another kind gets
-    /// `Err(WrongJointKind)` and is left unchanged.
+    /// Turns a joint's spring on or off (a kind without a spring gets
+    /// `Err(WrongJointKind)` and is left unchanged).
     pub fn enable_joint_spring(&mut self, joint: JointHandle, on: bool) -> Result<(), WorldError> {
         let r = self.joints.enable_spring(joint, on);
         self.wake_pair(r)

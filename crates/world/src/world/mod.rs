@@ -95,6 +95,8 @@ pub struct StepEvents {
     pub non_finite_bodies: Vec<BodyHandle>,
     /// Contact and sensor begin/end events.
     pub collision: CollisionEvents,
+    /// Joints whose force or torque passed their thresholds.
+    pub joints: Vec<crate::joints::JointEvent>,
 }
 
 /// The simulation world: it owns one value of each stage and calls them

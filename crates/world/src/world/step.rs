@@ -205,6 +205,7 @@ impl World {
         self.events = StepEvents {
             non_finite_bodies: report.non_finite,
             collision: std::mem::take(&mut self.collision.events),
+            joints: self.joints.threshold_events(),
         };
         self.step_count += 1;
         Ok(())
