@@ -81,8 +81,15 @@ pub(crate) trait KindRows: Constraint {
     fn tree_rows(&self) -> Option<TreeRows<'_>> {
         None
     }
-    /// Takes back the tree's impulses (point, angle).
-    fn set_tree_impulses(&mut self, _point: Vec2, _angle: Real) {}
+    /// The `General` tree rows at the states `sa`, `sb` (bodies a and b,
+    /// positions as deltas since the step's start); only called for a
+    /// kind whose `tree_rows` is `TreeRows::General`.
+    fn tree_general_rows(&self, _sa: &BodyState, _sb: &BodyState) -> GeneralRows {
+        GeneralRows::default()
+    }
+    /// Takes back the tree's impulses: `[point x, point y, angle]` for
+    /// `Point` rows, the rows' impulses in order for `General` rows.
+    fn set_tree_impulses(&mut self, _impulses: [Real; 3]) {}
     /// Rows left for the Gauss–Seidel pass this step.
     fn has_iterative_rows(&self) -> bool {
         !self.base().in_tree && self.row_count() > 0
@@ -320,8 +327,13 @@ macro_rules! joint_kinds {
             }
 
             #[inline(always)]
-            pub(crate) fn set_tree_impulses(&mut self, point: Vec2, angle: Real) {
-                match self { $( Joint::$kind(j) => KindRows::set_tree_impulses(j, point, angle), )* }
+            pub(crate) fn set_tree_impulses(&mut self, impulses: [Real; 3]) {
+                match self { $( Joint::$kind(j) => KindRows::set_tree_impulses(j, impulses), )* }
+            }
+
+            #[inline(always)]
+            pub(crate) fn tree_general_rows(&self, sa: &BodyState, sb: &BodyState) -> GeneralRows {
+                match self { $( Joint::$kind(j) => KindRows::tree_general_rows(j, sa, sb), )* }
             }
 
             #[inline(always)]
@@ -537,30 +549,67 @@ impl Joint {
     }
 }
 
-/// A joint's equality rows as the tree solve takes them: the point rows,
-/// and for a joint that also holds the relative angle, the angle row
-/// (`C_θ = θ_b − θ_a − θ_ref`, `J_θ = [0 0 −1 │ 0 0 1]`).
+/// A joint's equality rows as the tree solve takes them.
+///
+/// - `Point`: the point rows, and for a joint that also holds the relative
+///   angle the angle row (`C_θ = θ_b − θ_a − θ_ref`,
+///   `J_θ = [0 0 −1 │ 0 0 1]`): the specialised paths of the tree.
+/// - `General`: up to three rows of any Jacobian, which the kind builds at
+///   the tree's current states ([`KindRows::tree_general_rows`]): the
+///   general 3×3 path.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct TreeRows<'a> {
-    /// The point part (arms, centre offset, impulse).
-    pub(crate) point: &'a PointPart,
-    /// The angle row, for a 3-row joint.
-    pub(crate) angle: Option<TreeAngle>,
+pub(crate) enum TreeRows<'a> {
+    /// Point rows (and an angle row).
+    Point {
+        /// The point part (arms, centre offset, impulse).
+        point: &'a PointPart,
+        /// The angle row, for a 3-row joint.
+        angle: Option<TreeAngle>,
+    },
+    /// `count` rows the kind builds at the tree's states.
+    General {
+        /// Number of rows, 1 to 3.
+        count: usize,
+    },
 }
 
 impl TreeRows<'_> {
-    /// Number of rows: 2 (point) or 3 (point and angle).
+    /// Number of rows.
     #[inline(always)]
     pub(crate) fn count(&self) -> usize {
-        2 + usize::from(self.angle.is_some())
+        match self {
+            TreeRows::Point { angle, .. } => 2 + usize::from(angle.is_some()),
+            TreeRows::General { count } => *count,
+        }
     }
 }
 
-/// The angle row of a joint's tree rows.
+/// The angle row of a joint's point tree rows.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct TreeAngle {
     /// `C_θ` at the start of the step, rad.
     pub(crate) delta_angle: Real,
     /// Accumulated impulse, N·m·s.
     pub(crate) impulse: Real,
+}
+
+/// Up to three equality rows of a kind at given states, for the tree's
+/// general path: row `i` is `J_i = [j_a[i] │ j_b[i]]` with each entry
+/// `(linear x, linear y, angular)` on that body, its error `c[i]` and kept
+/// impulse; `linear[i]` caps the row's correction speed (a length row;
+/// an angle row is not capped). Rows past `count` are unused.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct GeneralRows {
+    /// Number of rows, 1 to 3.
+    pub(crate) count: usize,
+    /// The rows' entries on body a.
+    pub(crate) j_a: [[Real; 3]; 3],
+    /// The rows' entries on body b.
+    pub(crate) j_b: [[Real; 3]; 3],
+    /// The rows' errors (m or rad).
+    pub(crate) c: [Real; 3],
+    /// Whether each row's correction speed is capped.
+    pub(crate) linear: [bool; 3],
+    /// The rows' accumulated impulses.
+    pub(crate) impulse: [Real; 3],
 }

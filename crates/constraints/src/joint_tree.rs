@@ -152,7 +152,7 @@ use janus2d_core::math::{Real, Vec2, cross, cross_sv, from_f64, to_f64};
 use janus2d_core::parallel::Team;
 use janus2d_core::union_find::{find, union};
 
-use crate::joint::Joint;
+use crate::joint::{GeneralRows, Joint, TreeRows};
 use crate::joint_base::is_moving;
 use crate::parts::{PairMass, PointPart, clamp_length};
 use janus2d_core::math::wrap_angle;
@@ -461,6 +461,16 @@ impl BodyScratch {
 
     /// Applies the impulse `p` at arm `r` on `side` (+1: the joint's body
     /// b, which takes `+p`; −1: body a, `−p`), turning through `Ĩ`.
+    /// Applies `Jᵀ Δλ` of a block of rows (rows × (x, y, ω)) through the
+    /// solve's masses.
+    #[inline(always)]
+    fn apply_rows(&mut self, j: &Matrix3, delta: DVec3) {
+        let f = j.transpose() * delta;
+        let inv_i = self.mass.inv_inertia + self.inertia_change;
+        self.state.v += self.mass.inv_mass * Vec2::new(from_f64(f.x), from_f64(f.y));
+        self.state.w += inv_i * from_f64(f.z);
+    }
+
     #[inline(always)]
     fn apply(&mut self, side: f64, r: Vec2, p: Vec2) {
         let st = &mut self.state;
@@ -510,6 +520,25 @@ struct JointScratch {
     d3: Matrix3,
     /// The right-hand side, then the solution `μ` (3-row joints).
     b3: DVec3,
+    /// A `General` joint: its rows below, solved by the general 3×3 path
+    /// (with `d3`, `b3`).
+    general: bool,
+    /// Its rows on the parent body (rows past its count are zero), masked
+    /// like the point Jacobians.
+    g_parent: Matrix3,
+    /// Its rows on the child body (masked), or on the fixed end (unmasked,
+    /// for `Ċ` only).
+    g_child: Matrix3,
+    /// Its `K = J M⁻¹ Jᵀ` from the joint's own masses.
+    g_k: Matrix3,
+    /// Its errors.
+    g_c: DVec3,
+    /// A copy of its accumulated impulses.
+    g_impulse: [Real; 3],
+    /// Which of its rows have their correction speed capped.
+    g_linear: [bool; 3],
+    /// Its number of rows.
+    g_count: usize,
 }
 
 impl JointScratch {
@@ -529,6 +558,14 @@ impl JointScratch {
         angle_impulse: 0.0,
         d3: Matrix3::ZERO,
         b3: DVec3::ZERO,
+        general: false,
+        g_parent: Matrix3::ZERO,
+        g_child: Matrix3::ZERO,
+        g_k: Matrix3::ZERO,
+        g_c: DVec3::ZERO,
+        g_impulse: [0.0; 3],
+        g_linear: [false; 3],
+        g_count: 0,
     };
 }
 
@@ -893,7 +930,12 @@ impl JointForest {
             st.w = sc.state.w;
         }
         for (tj, row) in self.joints.iter().zip(&self.joint_scratch) {
-            joints[tj.index as usize].set_tree_impulses(row.impulse, row.angle_impulse);
+            let impulses = if row.general {
+                row.g_impulse
+            } else {
+                [row.impulse.x, row.impulse.y, row.angle_impulse]
+            };
+            joints[tj.index as usize].set_tree_impulses(impulses);
         }
     }
 }
@@ -977,9 +1019,17 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
         let j = &joints[tj.index as usize];
         let tree_rows = j.tree_rows();
         let base = j.base();
-        let point = tree_rows.map_or(&NO_POINT, |r| r.point);
         let side = tj.side;
         row.masses = base.masses;
+        row.general = matches!(tree_rows, Some(TreeRows::General { .. }));
+        if row.general {
+            general_rows(tj, row, j, bodies, states);
+            continue;
+        }
+        let (point, tree_angle) = match tree_rows {
+            Some(TreeRows::Point { point, angle }) => (point, angle),
+            _ => (&NO_POINT, None),
+        };
         let (frame_parent, frame_other, fixed) = if side > 0.0 {
             (point.frame_b, point.frame_a, base.state_a)
         } else {
@@ -997,7 +1047,7 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
         row.impulse = point.impulse;
         row.three = false;
         row.angle_impulse = 0.0;
-        if let Some(angle) = tree_rows.and_then(|r| r.angle) {
+        if let Some(angle) = tree_angle {
             // C_θ = θ_b − θ_a − θ_ref from the start-of-step value and the
             // rotation deltas since, in the joint's own order (a, b).
             let (q_a, q_b) = if side > 0.0 {
@@ -1047,6 +1097,15 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
         // The warm start applied the kept impulses through the bodies' own
         // inertia; re-weight their torque to the solve's inertia.
         for (tj, row) in topology.iter().zip(rows.iter()) {
+            if row.general {
+                let lambda = wide_rows(row.g_impulse);
+                let torque = |j: &Matrix3| from_f64(j.col(2).dot(lambda));
+                bodies[tj.parent as usize].reweight_angle(1.0, torque(&row.g_parent));
+                if tj.child != NONE {
+                    bodies[tj.child as usize].reweight_angle(1.0, torque(&row.g_child));
+                }
+                continue;
+            }
             bodies[tj.parent as usize].reweight(tj.side, row.r_parent, row.impulse);
             if tj.child != NONE {
                 bodies[tj.child as usize].reweight(-tj.side, row.r_other, row.impulse);
@@ -1065,6 +1124,10 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
     for (tj, row) in topology.iter().zip(rows.iter_mut()).rev() {
         if row.three {
             eliminate_three(tj, row, bodies, states, params);
+            continue;
+        }
+        if row.general {
+            eliminate_general(tj, row, bodies, states, params);
             continue;
         }
         let side = tj.side;
@@ -1127,6 +1190,10 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
     for (tj, row) in topology.iter().zip(rows.iter_mut()) {
         if row.three {
             substitute_three(tj, row, bodies);
+            continue;
+        }
+        if row.general {
+            substitute_general(tj, row, bodies);
             continue;
         }
         let side = tj.side;
@@ -1264,5 +1331,170 @@ fn substitute_three(tj: &TreeJoint, row: &mut JointScratch, bodies: &mut [BodySc
         }
         child.apply(-side, row.r_other, impulse);
         child.apply_angle(-side, angular);
+    }
+}
+
+/// Three `Real`s as an f64 vector.
+#[inline(always)]
+fn wide_rows(v: [Real; 3]) -> DVec3 {
+    DVec3::new(to_f64(v[0]), to_f64(v[1]), to_f64(v[2]))
+}
+
+/// A block of rows on one body as a matrix (rows × (x, y, ω)), each
+/// column masked by the body's `lin`/`ang` (a body with the placeholder
+/// mass on an axis gets a zero column there); rows past `count` zero.
+fn row_block(jr: &[[Real; 3]; 3], count: usize, lin: f64, ang: f64) -> Matrix3 {
+    let r = |i: usize| {
+        if i < count {
+            DVec3::new(
+                lin * to_f64(jr[i][0]),
+                lin * to_f64(jr[i][1]),
+                ang * to_f64(jr[i][2]),
+            )
+        } else {
+            DVec3::ZERO
+        }
+    };
+    Matrix3::from_cols(r(0), r(1), r(2)).transpose()
+}
+
+/// `J M⁻¹ Jᵀ` of a block of rows on one body of inverse masses `mass`.
+fn block_k(jr: &[[Real; 3]; 3], count: usize, mass: &InvMass) -> Matrix3 {
+    let (inv_m, inv_i) = (to_f64(mass.inv_mass), to_f64(mass.inv_inertia));
+    let mut k = Matrix3::ZERO;
+    for a in 0..count {
+        for b in 0..count {
+            let linear = to_f64(jr[a][0]) * to_f64(jr[b][0]) + to_f64(jr[a][1]) * to_f64(jr[b][1]);
+            let angular = to_f64(jr[a][2]) * to_f64(jr[b][2]);
+            k.col_mut(b)[a] += inv_m * linear + inv_i * angular;
+        }
+    }
+    k
+}
+
+/// A `General` joint's rows at the tree's current states: the kind builds
+/// them in its own order (a, b); the tree keeps them as the parent's and
+/// the child's blocks, with `K` from the joint's own masses, and sets the
+/// child's mass.
+fn general_rows(
+    tj: &TreeJoint,
+    row: &mut JointScratch,
+    j: &Joint,
+    bodies: &mut [BodyScratch],
+    states: &[BodyState],
+) {
+    let base = j.base();
+    let side = tj.side;
+    row.fixed = if side > 0.0 { base.state_a } else { base.state_b };
+    let parent = bodies[tj.parent as usize].state;
+    let other = *other_end(tj, row.fixed, bodies, states);
+    let rows: GeneralRows = if side > 0.0 {
+        j.tree_general_rows(&other, &parent)
+    } else {
+        j.tree_general_rows(&parent, &other)
+    };
+    let count = rows.count.min(3);
+    let m = row.masses;
+    let (j_parent, j_other, m_parent, m_other) = if side > 0.0 {
+        (&rows.j_b, &rows.j_a, m.b, m.a)
+    } else {
+        (&rows.j_a, &rows.j_b, m.a, m.b)
+    };
+    row.g_k = block_k(j_parent, count, &m_parent) + block_k(j_other, count, &m_other);
+    row.g_c = wide_rows(rows.c);
+    row.g_impulse = rows.impulse;
+    row.g_linear = rows.linear;
+    row.g_count = count;
+    row.three = false;
+    let parent = &mut bodies[tj.parent as usize];
+    parent.leaf = false;
+    row.g_parent = row_block(j_parent, count, parent.lin, parent.ang);
+    row.g_child = if tj.child != NONE {
+        let child = &mut bodies[tj.child as usize];
+        child.set_mass(m_other);
+        row_block(j_other, count, child.lin, child.ang)
+    } else {
+        // A fixed end: only its velocity enters (through `Ċ`).
+        row_block(j_other, count, 1.0, 1.0)
+    };
+}
+
+/// `J v` of a block of rows on one body's velocity.
+#[inline(always)]
+fn rows_times(j: &Matrix3, st: &BodyState) -> DVec3 {
+    *j * DVec3::new(to_f64(st.v.x), to_f64(st.v.y), to_f64(st.w))
+}
+
+/// Elimination of a `General` joint `k` (the general 3×3 blocks of
+/// `eliminate_three`, with the kind's rows; unused rows padded with a
+/// `−1` pivot and a zero right-hand side, so their solution is zero).
+fn eliminate_general(
+    tj: &TreeJoint,
+    row: &mut JointScratch,
+    bodies: &mut [BodyScratch],
+    states: &[BodyState],
+    params: &TreeParams,
+) {
+    let parent = &bodies[tj.parent as usize].state;
+    let other = other_end(tj, row.fixed, bodies, states);
+    let c_dot = rows_times(&row.g_parent, parent) + rows_times(&row.g_child, other);
+    let compliance = params.compliance;
+    let mut rhs = if params.use_bias {
+        let max = to_f64(params.max_correction_speed);
+        let mut bias = row.g_c * to_f64(params.softness.bias_rate);
+        for (i, linear) in row.g_linear.iter().enumerate() {
+            if *linear {
+                bias[i] = bias[i].clamp(-max, max);
+            }
+        }
+        let held = (row.g_k * wide_rows(row.g_impulse)) * compliance;
+        -(c_dot + bias + held)
+    } else {
+        -c_dot
+    };
+    let mut d = row.g_k * -compliance;
+    for i in row.g_count..3 {
+        rhs[i] = 0.0;
+        d.col_mut(i)[i] = -1.0;
+    }
+    let mut b = rhs;
+    if tj.child != NONE {
+        let child = &mut bodies[tj.child as usize];
+        child.d = pivot_inverse(&child.d);
+        let l = row.g_child * child.d;
+        d -= l * row.g_child.transpose();
+        if !child.leaf {
+            b -= l * child.b;
+        }
+    }
+    let t = pivot_inverse(&d);
+    row.d3 = t;
+    row.b3 = b;
+    let parent = &mut bodies[tj.parent as usize];
+    let l = row.g_parent.transpose() * t;
+    parent.d -= l * row.g_parent;
+    parent.b -= l * b;
+}
+
+/// Back substitution of a `General` joint: `x_k = T b_k − T J_kp x_p`,
+/// `Δλ = −x_k` applied through each body's block, then the child's
+/// `x_c = D_c⁻¹ b_c − D_c⁻¹ J_kcᵀ x_k`.
+fn substitute_general(tj: &TreeJoint, row: &mut JointScratch, bodies: &mut [BodyScratch]) {
+    let parent = &mut bodies[tj.parent as usize];
+    let t = row.d3;
+    let x = t * row.b3 - t * (row.g_parent * parent.b);
+    row.b3 = x;
+    let delta = -x;
+    for (i, impulse) in row.g_impulse.iter_mut().enumerate().take(row.g_count) {
+        *impulse += from_f64(delta[i]);
+    }
+    parent.apply_rows(&row.g_parent, delta);
+    if tj.child != NONE {
+        let child = &mut bodies[tj.child as usize];
+        if !child.leaf {
+            let s = child.d;
+            child.b = s * child.b - s * (row.g_child.transpose() * x);
+        }
+        child.apply_rows(&row.g_child, delta);
     }
 }

@@ -481,14 +481,14 @@ impl KindRows for RevoluteJoint {
     }
     #[inline(always)]
     fn tree_rows(&self) -> Option<TreeRows<'_>> {
-        Some(TreeRows {
+        Some(TreeRows::Point {
             point: &self.point,
             angle: None,
         })
     }
     #[inline(always)]
-    fn set_tree_impulses(&mut self, point: Vec2, _angle: Real) {
-        self.point.impulse = point;
+    fn set_tree_impulses(&mut self, impulses: [Real; 3]) {
+        self.point.impulse = Vec2::new(impulses[0], impulses[1]);
     }
     #[inline(always)]
     fn has_iterative_rows(&self) -> bool {

@@ -381,7 +381,7 @@ impl KindRows for WeldJoint {
     }
     #[inline(always)]
     fn tree_rows(&self) -> Option<TreeRows<'_>> {
-        self.def.is_rigid().then_some(TreeRows {
+        self.def.is_rigid().then_some(TreeRows::Point {
             point: &self.point,
             angle: Some(TreeAngle {
                 delta_angle: self.delta_angle,
@@ -390,9 +390,9 @@ impl KindRows for WeldJoint {
         })
     }
     #[inline(always)]
-    fn set_tree_impulses(&mut self, point: Vec2, angle: Real) {
-        self.point.impulse = point;
-        self.angle.impulse = angle;
+    fn set_tree_impulses(&mut self, impulses: [Real; 3]) {
+        self.point.impulse = Vec2::new(impulses[0], impulses[1]);
+        self.angle.impulse = impulses[2];
     }
     #[cfg(test)]
     fn tree_point_mut(&mut self) -> Option<&mut PointPart> {

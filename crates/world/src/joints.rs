@@ -159,7 +159,8 @@ impl JointSet {
     }
 
     /// Checks the set against the bodies (for `World::validate`): handles
-    /// ↔ slots ↔ storage, each joint's bodies live and listing it, every
+    /// ↔ slots ↔ storage, each joint's definition valid and of its slot's
+    /// kind, each joint's bodies live and listing it, every
     /// body list holding live joints of that body, no-collide counts.
     pub(crate) fn check(&self, bodies: &janus2d_core::body::BodySet) -> Result<(), String> {
         if self.handles.len() != self.slots.len() || self.joints.len() != self.slots.len() {
@@ -177,6 +178,12 @@ impl JointSet {
                 return Err(format!("joint {k}: its slot points at {}", slot.index));
             }
             let j = &self.joints[k];
+            j.def()
+                .validate()
+                .map_err(|e| format!("joint {k}: its definition does not validate: {e}"))?;
+            if self.slots.live(h.index).kind != j.kind() {
+                return Err(format!("joint {k}: its slot names another kind"));
+            }
             let (a, b) = j.bodies();
             for body in [a, b] {
                 if !bodies.contains(body) {

@@ -11,7 +11,7 @@
 //! | `Shapes`         | `ShapeStore::check`        | shapes ↔ bodies ↔ body lists, valid geometry, finite boxes        |
 //! | `Proxies`        | `Collision::check_proxies` | shapes ↔ broadphase proxies, tree by type, fat box ⊇ shape box    |
 //! | `Contacts`       | `ContactSet::check`        | contacts ↔ pair index ↔ per-body lists, sleep lists, finite data  |
-//! | `Joints`         | `JointSet::check`          | joint handles ↔ slots ↔ bodies ↔ body lists, no-collide pairs     |
+//! | `Joints`         | `JointSet::check`          | joint handles ↔ slots ↔ bodies ↔ body lists, definitions valid, no-collide pairs |
 //! | `Islands`        | `Islands::check`           | islands ↔ dynamic bodies, positions, sleeping islands asleep      |
 //! | `Portals`        | `PortalStage::check`       | pairs ↔ crossings ↔ clones ↔ portal constraints                   |
 //! | `World`          | here                       | gravity and settings finite and within their limits               |
