@@ -37,8 +37,8 @@ pub use janus2d_world as world;
 
 #[doc(inline)]
 pub use janus2d_constraints::{
-    Joint, JointDef, JointError, JointKind, PortalError, RevoluteJoint, RevoluteJointDef,
-    WeldJoint, WeldJointDef,
+    Joint, JointDef, JointDefBase, JointError, JointFrame, JointKind, JointOfKind, PortalError,
+    RevoluteJoint, RevoluteJointDef, WeldJoint, WeldJointDef,
 };
 #[doc(inline)]
 pub use janus2d_core::{
@@ -47,10 +47,10 @@ pub use janus2d_core::{
 #[doc(inline)]
 pub use janus2d_world::{
     CollisionCounters, CollisionEvents, Color, Contact, ContactPointData, DebugDraw, DrawOptions,
-    Filter, HitEvent, Invariant, InvariantError, JointHandle, JointSet, Palette, PortalHop,
-    PreSolve, PreSolveFn, QueryFilter, QueryProblem, RayHit, ShapeData, ShapeDef, ShapeHandle,
-    ShapeOverlap, ShapePairEvent, SleepSettings, Snapshot, StepCounters, StepEvents, StepProfile,
-    World, WorldDef, WorldError,
+    Filter, HitEvent, Invariant, InvariantError, JointEvent, JointHandle, JointSet, Palette,
+    PortalHop, PreSolve, PreSolveFn, QueryFilter, QueryProblem, RayHit, ShapeData, ShapeDef,
+    ShapeHandle, ShapeOverlap, ShapePairEvent, SleepSettings, Snapshot, StepCounters, StepEvents,
+    StepProfile, World, WorldDef, WorldError,
 };
 #[cfg(feature = "portals")]
 #[doc(inline)]
@@ -62,7 +62,8 @@ pub use janus2d_world::{
 /// The names most programs need.
 pub mod prelude {
     pub use janus2d_constraints::{
-        Joint, JointDef, JointKind, RevoluteJoint, RevoluteJointDef, WeldJoint, WeldJointDef,
+        Joint, JointDef, JointDefBase, JointFrame, JointKind, JointOfKind, RevoluteJoint,
+        RevoluteJointDef, WeldJoint, WeldJointDef,
     };
     pub use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
     pub use janus2d_core::constraint::SolverMode;
@@ -72,8 +73,8 @@ pub mod prelude {
     pub use janus2d_core::math::{Real, Rot, Transform, Vec2};
     pub use janus2d_core::solver::SolverSettings;
     pub use janus2d_world::{
-        Filter, JointHandle, QueryFilter, RayHit, ShapeDef, ShapeHandle, ShapeOverlap, StepEvents,
-        World, WorldDef, WorldError,
+        Filter, JointEvent, JointHandle, QueryFilter, RayHit, ShapeDef, ShapeHandle, ShapeOverlap,
+        StepEvents, World, WorldDef, WorldError,
     };
 }
 

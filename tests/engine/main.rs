@@ -12,6 +12,7 @@ mod contact_data;
 mod contact_properties;
 mod continuous;
 mod effects;
+mod joint_api;
 mod joint_tree_properties;
 mod kinematic_targets;
 mod pendulum;

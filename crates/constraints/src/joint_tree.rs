@@ -1385,7 +1385,11 @@ fn general_rows(
 ) {
     let base = j.base();
     let side = tj.side;
-    row.fixed = if side > 0.0 { base.state_a } else { base.state_b };
+    row.fixed = if side > 0.0 {
+        base.state_a
+    } else {
+        base.state_b
+    };
     let parent = bodies[tj.parent as usize].state;
     let other = *other_end(tj, row.fixed, bodies, states);
     let rows: GeneralRows = if side > 0.0 {

@@ -481,7 +481,9 @@ impl KindRows for RevoluteJoint {
     }
     #[inline(always)]
     fn tree_rows(&self) -> Option<TreeRows<'_>> {
-        Some(TreeRows::Point {
+        // A joint with its own constraint softness is solved at it, by
+        // the Gauss–Seidel pass.
+        (self.def.base.constraint_hertz == 0.0).then_some(TreeRows::Point {
             point: &self.point,
             angle: None,
         })

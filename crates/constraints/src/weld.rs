@@ -130,10 +130,11 @@ impl WeldJointDef {
     }
 
     /// True when both the point rows and the angle row are rigid (zero
-    /// hertz): the joint tree can solve it directly.
+    /// hertz, and no constraint softness of its own): the joint tree can
+    /// solve it directly.
     #[must_use]
     pub fn is_rigid(&self) -> bool {
-        self.linear_hertz == 0.0 && self.angular_hertz == 0.0
+        self.linear_hertz == 0.0 && self.angular_hertz == 0.0 && self.base.constraint_hertz == 0.0
     }
 
     /// Checks the definition's own values (not the handles).

@@ -61,7 +61,7 @@ pub use continuous::ContinuousCounters;
 pub use debug_draw::{Color, DebugDraw, DrawOptions, Palette};
 pub use error::WorldError;
 pub use islands::SleepSettings;
-pub use joints::{JointHandle, JointKind, JointSet};
+pub use joints::{JointEvent, JointHandle, JointKind, JointSet};
 pub use narrowphase::{PreSolve, PreSolveFn};
 #[cfg(feature = "portals")]
 pub use portal::{

@@ -5,7 +5,7 @@
 use super::*;
 use crate::error::WorldError;
 use crate::joints::JointHandle;
-use janus2d_constraints::JointOfKind;
+use janus2d_constraints::{JointDefBase, JointOfKind};
 use janus2d_core::body::BodyHandle;
 use janus2d_core::math::Real;
 
@@ -260,6 +260,56 @@ impl World {
         on: bool,
     ) -> Result<(BodyHandle, BodyHandle), WorldError> {
         self.stores().switch_joint(joint, on)
+    }
+
+    /// The base of a joint definition whose frames sit at the world point
+    /// `point` (m) on both bodies, aligned with the world's axes at their
+    /// current poses (the reference angle is their current relative
+    /// angle): `RevoluteJointDef::from_base(world.joint_base_at(a, b, p)?)`.
+    pub fn joint_base_at(
+        &self,
+        body_a: BodyHandle,
+        body_b: BodyHandle,
+        point: Vec2,
+    ) -> Result<JointDefBase, WorldError> {
+        self.joint_base_along(body_a, body_b, point, 0.0)
+    }
+
+    /// [`World::joint_base_at`] with the frames' x axes along the world
+    /// angle `axis_angle` (rad): the axis of a prismatic or wheel joint.
+    pub fn joint_base_along(
+        &self,
+        body_a: BodyHandle,
+        body_b: BodyHandle,
+        point: Vec2,
+        axis_angle: Real,
+    ) -> Result<JointDefBase, WorldError> {
+        self.check_body(body_a)?;
+        self.check_body(body_b)?;
+        Ok(JointDefBase::at_world_frame(
+            &self.bodies,
+            body_a,
+            body_b,
+            point,
+            axis_angle,
+        )?)
+    }
+
+    /// A joint's two world anchors (frame a's and frame b's origins), m.
+    pub fn joint_anchors(&self, joint: JointHandle) -> Result<(Vec2, Vec2), WorldError> {
+        Ok(self.joints.get(joint)?.world_anchors(&self.bodies))
+    }
+
+    /// A joint's angle `θ_b − θ_a − reference` (rad, wrapped to `[−π, π]`;
+    /// the reference is its frames' `φ_a − φ_b`), for any kind.
+    pub fn joint_angle(&self, joint: JointHandle) -> Result<Real, WorldError> {
+        let base = self.joints.get(joint)?.def_base();
+        Ok(janus2d_constraints::joint_base::relative_angle(
+            &self.bodies,
+            base.body_a,
+            base.body_b,
+            base.reference_angle(),
+        ))
     }
 
     /// Distance between a joint's two world anchors, m.
