@@ -41,6 +41,8 @@ pub use janus2d_constraints::{
     RevoluteJoint, RevoluteJointDef, WeldJoint, WeldJointDef,
 };
 #[doc(inline)]
+pub use janus2d_constraints::{FilterJoint, FilterJointDef, MotorJoint, MotorJointDef};
+#[doc(inline)]
 pub use janus2d_core::{
     BodyDef, BodyHandle, BodyMass, BodyType, Real, Rot, SolverMode, SolverSettings, Transform, Vec2,
 };
@@ -65,6 +67,7 @@ pub mod prelude {
         Joint, JointDef, JointDefBase, JointFrame, JointKind, JointOfKind, RevoluteJoint,
         RevoluteJointDef, WeldJoint, WeldJointDef,
     };
+    pub use janus2d_constraints::{FilterJoint, FilterJointDef, MotorJoint, MotorJointDef};
     pub use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
     pub use janus2d_core::constraint::SolverMode;
     pub use janus2d_core::geometry::{

@@ -16,6 +16,8 @@
 //! |-------------|-----------------|-----------------------------------------------|----------------------|
 //! | `Revolute`  | `revolute.rs`   | point (2), spring, motor, lower, upper (1 each) | point (2)          |
 //! | `Weld`      | `weld.rs`       | point (2), angle (1)                          | point + angle (3) when rigid, else none |
+//! | `Motor`     | `motor.rs`      | linear (2, force-bounded), angular (1, torque-bounded) | none            |
+//! | `Filter`    | `filter.rs`     | none (only `collide_connected = false`)       | none                 |
 //!
 //! Everything the solver needs from a joint that is not its own rows is in
 //! [`JointBase`]: the state indices, the masses loaded at prepare, whether
@@ -49,6 +51,8 @@ use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::parts::{BOTH, PairOf, PairStates, PointPart};
 use crate::revolute::{RevoluteJoint, RevoluteJointDef};
 use crate::weld::{WeldJoint, WeldJointDef};
+use crate::motor::{MotorJoint, MotorJointDef};
+use crate::filter::{FilterJoint, FilterJointDef};
 
 /// What a joint kind's solver form supplies: its rows' stages, read-backs
 /// and what the tree solve may take. Dispatched by [`Joint`]'s match
@@ -389,6 +393,11 @@ joint_kinds! {
     /// A weld: two anchors coincide and the relative angle is held,
     /// rigidly or through springs.
     Weld(WeldJoint, WeldJointDef),
+    /// A motor: drives b's pose relative to a toward a target offset and
+    /// angle, with a largest force and torque.
+    Motor(MotorJoint, MotorJointDef),
+    /// A filter: no rows; its two bodies do not collide.
+    Filter(FilterJoint, FilterJointDef),
 }
 
 impl JointDef {

@@ -162,8 +162,22 @@ impl RowsAt {
     /// The geometry of a joint's two frames' anchors (each in its body's
     /// frame, from its origin).
     pub(crate) fn new(bodies: &BodySet, def: &crate::joint_def::JointDefBase) -> RowsAt {
-        let (body_a, anchor_a) = (def.body_a, def.local_frame_a.anchor);
-        let (body_b, anchor_b) = (def.body_b, def.local_frame_b.anchor);
+        Self::at_points(
+            bodies,
+            (def.body_a, def.local_frame_a.anchor),
+            (def.body_b, def.local_frame_b.anchor),
+        )
+    }
+
+    /// The geometry of any two local points (`anchor_a` on `body_a`,
+    /// `anchor_b` on `body_b`, each in its body's frame, from its origin):
+    /// for a kind whose point rows hold other points than the frames'
+    /// origins (the motor joint's target point).
+    pub(crate) fn at_points(
+        bodies: &BodySet,
+        (body_a, anchor_a): (BodyHandle, Vec2),
+        (body_b, anchor_b): (BodyHandle, Vec2),
+    ) -> RowsAt {
         let a = bodies.solver_body(body_a);
         let b = bodies.solver_body(body_b);
         let r_a = a.sim.transform.q.rotate(anchor_a - a.sim.local_center);

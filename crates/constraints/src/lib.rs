@@ -7,6 +7,8 @@
 //! | [`joint::Joint`]              | per kind | 2  | one file per kind ([`joint`]) |
 //! | [`revolute::RevoluteJoint`]   | 2–6  | 2      | point + angle parts     |
 //! | [`weld::WeldJoint`]           | 3    | 2      | point + angle parts     |
+//! | [`motor::MotorJoint`]         | 3    | 2      | point + angle parts, force- and torque-bounded |
+//! | [`filter::FilterJoint`]       | 0    | 2      | nothing (only stops the pair colliding) |
 //! | [`portal::PortalConstraint`]  | 3    | 4      | portal part + portal map |
 //! | [`contact::ContactConstraint`]| 2–4  | 2      | contact rows (normal, friction) |
 //!
@@ -28,6 +30,7 @@ pub mod contact;
 pub mod contact_group;
 pub mod contact_row;
 pub mod contact_solver;
+pub mod filter;
 pub mod joint;
 pub mod joint_base;
 pub mod joint_colour;
@@ -35,6 +38,7 @@ pub mod joint_def;
 pub mod joint_solver;
 pub mod joint_tree;
 pub mod lane;
+pub mod motor;
 pub mod parts;
 pub mod portal;
 pub mod portal_map;
@@ -43,12 +47,14 @@ pub mod weld;
 
 pub use contact::{ContactConstraint, ContactPointInput};
 pub use contact_solver::{ContactBatch, ContactSolver, ObjectMass, PointImpulse};
+pub use filter::{FilterJoint, FilterJointDef};
 pub use joint::{Joint, JointDef, JointKind, JointOfKind};
 pub use joint_base::JointBase;
 pub use joint_colour::JointColours;
 pub use joint_def::{JointDefBase, JointFrame, KindDef, LimitsMut, MotorMut, SpringMut};
 pub use joint_solver::JointBatch;
 pub use joint_tree::JointForest;
+pub use motor::{MotorJoint, MotorJointDef};
 pub use portal::{PortalBatch, PortalConstraint, PortalConstraintDef};
 pub use portal_map::{Portal, PortalError, PortalMap, PortalPair};
 pub use revolute::{RevoluteJoint, RevoluteJointDef};
