@@ -24,3 +24,4 @@ mod snapshot;
 mod stages;
 mod weld;
 mod motor;
+mod filter;
