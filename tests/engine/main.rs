@@ -25,3 +25,4 @@ mod stages;
 mod weld;
 mod motor;
 mod filter;
+mod joint_events;
