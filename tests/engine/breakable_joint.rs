@@ -1,4 +1,5 @@
-//! The breakable-joint example (issue 13, item 7): the joints read the
+//! The breakable-joint example (issue 13, item 7; the joints break on their
+//! joint events, issue 30): the joints read the
 //! sign's weight while it hangs, a light ball leaves them whole, a heavy
 //! one breaks both and the sign falls.
 

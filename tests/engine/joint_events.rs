@@ -142,7 +142,7 @@ fn torque_threshold_reports_one_event_when_a_load_lands() {
     let heavy = events(&mut world, 120);
     let resting_torque = world.joint_torque(joint).unwrap();
     println!(
-        "shelf: {} events at 10 N·m ({light_torque:.2}); 1,287 N box: {} event(s) {:?}, \
+        "shelf: {} events under its own weight ({light_torque:.2} N·m); 1,287 N box: {} event(s) {:?}, \
          resting torque {resting_torque:.0} N·m",
         light.len(),
         heavy.len(),

@@ -8,9 +8,13 @@ mod portal_apertures;
 #[cfg(feature = "portals")]
 mod portal_edges;
 #[cfg(feature = "portals")]
+mod portal_filter;
+#[cfg(feature = "portals")]
 mod portal_grazing;
 #[cfg(feature = "portals")]
 mod portal_joints;
+#[cfg(feature = "portals")]
+mod portal_motor;
 mod portal_properties;
 #[cfg(feature = "portals")]
 mod portal_scenes;
