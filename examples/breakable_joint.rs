@@ -47,8 +47,12 @@ pub fn run(ball_density: Real) -> Result<Report, WorldError> {
     let mut joints = Vec::new();
     for x in [-0.9, 0.9] {
         let anchor = Vec2::new(x, 8.9);
-        let mut def =
-            RevoluteJointDef::new(ceiling, sign, anchor - Vec2::new(0.0, 10.0), anchor - sign_at);
+        let mut def = RevoluteJointDef::new(
+            ceiling,
+            sign,
+            anchor - Vec2::new(0.0, 10.0),
+            anchor - sign_at,
+        );
         def.base.force_threshold = BREAK_FORCE;
         joints.push(world.create_revolute_joint(&def)?);
     }
@@ -71,7 +75,12 @@ pub fn run(ball_density: Real) -> Result<Report, WorldError> {
     let (mut peak_force, mut broke_at): (Real, [Option<usize>; 2]) = (0.0, [None, None]);
     for step in 0..180 {
         world.step(dt)?;
-        let crossed: Vec<_> = world.events().joints.iter().map(|e| (e.joint, e.force)).collect();
+        let crossed: Vec<_> = world
+            .events()
+            .joints
+            .iter()
+            .map(|e| (e.joint, e.force))
+            .collect();
         for (j, force) in crossed {
             let Some(k) = joints.iter().position(|&h| h == j) else {
                 continue;

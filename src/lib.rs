@@ -36,12 +36,12 @@ pub use janus2d_core as base;
 pub use janus2d_world as world;
 
 #[doc(inline)]
+pub use janus2d_constraints::{FilterJoint, FilterJointDef, MotorJoint, MotorJointDef};
+#[doc(inline)]
 pub use janus2d_constraints::{
     Joint, JointDef, JointDefBase, JointError, JointFrame, JointKind, JointOfKind, PortalError,
     RevoluteJoint, RevoluteJointDef, WeldJoint, WeldJointDef,
 };
-#[doc(inline)]
-pub use janus2d_constraints::{FilterJoint, FilterJointDef, MotorJoint, MotorJointDef};
 #[doc(inline)]
 pub use janus2d_core::{
     BodyDef, BodyHandle, BodyMass, BodyType, Real, Rot, SolverMode, SolverSettings, Transform, Vec2,
@@ -63,11 +63,11 @@ pub use janus2d_world::{
 
 /// The names most programs need.
 pub mod prelude {
+    pub use janus2d_constraints::{FilterJoint, FilterJointDef, MotorJoint, MotorJointDef};
     pub use janus2d_constraints::{
         Joint, JointDef, JointDefBase, JointFrame, JointKind, JointOfKind, RevoluteJoint,
         RevoluteJointDef, WeldJoint, WeldJointDef,
     };
-    pub use janus2d_constraints::{FilterJoint, FilterJointDef, MotorJoint, MotorJointDef};
     pub use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
     pub use janus2d_core::constraint::SolverMode;
     pub use janus2d_core::geometry::{

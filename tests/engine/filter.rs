@@ -41,7 +41,9 @@ fn scene() -> (World, BodyHandle, BodyHandle) {
 fn contacts_between(world: &World, a: BodyHandle, b: BodyHandle) -> usize {
     world
         .contacts()
-        .filter(|c| c.touching && ((c.body_a, c.body_b) == (a, b) || (c.body_a, c.body_b) == (b, a)))
+        .filter(|c| {
+            c.touching && ((c.body_a, c.body_b) == (a, b) || (c.body_a, c.body_b) == (b, a))
+        })
         .count()
 }
 

@@ -55,7 +55,9 @@ fn events(world: &mut World, steps: usize) -> Vec<Seen> {
 #[test]
 fn force_threshold_reports_one_event_per_crossing() {
     let mut world = world();
-    let hook = world.create_body(&BodyDef::fixed(Vec2::new(0.0, 5.0))).unwrap();
+    let hook = world
+        .create_body(&BodyDef::fixed(Vec2::new(0.0, 5.0)))
+        .unwrap();
     let load = world
         .create_body(&BodyDef::dynamic(Vec2::new(0.0, 4.0)).with_mass(2.0, 0.5))
         .unwrap();
@@ -118,7 +120,10 @@ fn torque_threshold_reports_one_event_when_a_load_lands() {
         .create_shape(shelf, &ShapeDef::default(), Polygon::make_box(0.5, 0.05))
         .unwrap();
     world
-        .set_mass(shelf, BodyMass::new(SHELF_MASS, SHELF_MASS * (1.0 + 0.01) / 12.0))
+        .set_mass(
+            shelf,
+            BodyMass::new(SHELF_MASS, SHELF_MASS * (1.0 + 0.01) / 12.0),
+        )
         .unwrap();
     let mut def = WeldJointDef::new(wall, shelf, Vec2::ZERO, Vec2::new(-0.5, 0.0));
     def.base.torque_threshold = 400.0;
@@ -126,9 +131,15 @@ fn torque_threshold_reports_one_event_when_a_load_lands() {
 
     let light = events(&mut world, 120);
     let light_torque = world.joint_torque(joint).unwrap();
-    assert!(light.is_empty(), "events under the shelf's weight: {light:?}");
+    assert!(
+        light.is_empty(),
+        "events under the shelf's weight: {light:?}"
+    );
     let own = SHELF_MASS * 10.0 * 0.5;
-    assert!((light_torque - own).abs() < 0.01 * own, "torque {light_torque}");
+    assert!(
+        (light_torque - own).abs() < 0.01 * own,
+        "torque {light_torque}"
+    );
 
     let load = world
         .create_body(&BodyDef::dynamic(Vec2::new(0.8, 0.05 + 0.1 + DROP)))
@@ -154,6 +165,9 @@ fn torque_threshold_reports_one_event_when_a_load_lands() {
     assert!(e.torque.abs() > 400.0, "{}", e.torque);
     // 1,287 N × 0.8 m + 10 N·m, the box resting on the shelf.
     let resting = 1287.0 * 0.8 + own;
-    assert!((resting_torque - resting).abs() < 0.02 * resting, "{resting_torque}");
+    assert!(
+        (resting_torque - resting).abs() < 0.02 * resting,
+        "{resting_torque}"
+    );
     assert!((world.position(load).unwrap().x - 0.8).abs() < 0.01);
 }

@@ -335,7 +335,11 @@ fn motor_impulses_keep_total_momentum() {
             let w2 = momentum_change(before, after, c, [p.x, p.y], applied, "solve: (px, py, L)")?;
             // The solve's impulses stay within the drive's bounds.
             let (f, t) = (ctx.h * 1e3, ctx.h * 1e3);
-            prop_assert!(p.length() <= f * (1.0 + 4.0 * Real::EPSILON), "|P| {}", p.length());
+            prop_assert!(
+                p.length() <= f * (1.0 + 4.0 * Real::EPSILON),
+                "|P| {}",
+                p.length()
+            );
             prop_assert!(built.joint.angular_impulse().abs() <= t);
             Ok(w1.max(w2))
         },
@@ -377,9 +381,7 @@ fn motor_joint_keeps_its_offset_on_a_moving_platform() {
     let mut def = WorldDef::default();
     def.solver.substeps = 4;
     let mut world = World::new(def).unwrap();
-    let platform = world
-        .create_body(&BodyDef::kinematic(Vec2::ZERO))
-        .unwrap();
+    let platform = world.create_body(&BodyDef::kinematic(Vec2::ZERO)).unwrap();
     world
         .create_shape(platform, &ShapeDef::default(), Polygon::make_box(2.0, 0.1))
         .unwrap();
@@ -450,8 +452,10 @@ fn motor_joint_keeps_its_offset_on_a_moving_platform() {
 /// 3 m/s after 1 s, at rest after 2.5 s, 6.25 m from where it started.
 #[test]
 fn motor_joint_to_the_ground_is_a_friction_drag() {
-    let mut def = WorldDef::default();
-    def.gravity = Vec2::ZERO;
+    let def = WorldDef {
+        gravity: Vec2::ZERO,
+        ..WorldDef::default()
+    };
     let mut world = World::new(def).unwrap();
     let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
     let car = world

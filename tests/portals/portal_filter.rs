@@ -111,8 +111,7 @@ fn filter_joined_pair_never_collides_after_a_portal() {
     let w = &mut r.world;
     let xa = w.transform(r.a).unwrap();
     let offset = Vec2::new(ETA * 0.2, 0.0);
-    w.set_transform(r.b, xa.p + offset, xa.q.angle())
-        .unwrap();
+    w.set_transform(r.b, xa.p + offset, xa.q.angle()).unwrap();
     let (v, omega) = (
         w.linear_velocity(r.a).unwrap(),
         w.angular_velocity(r.a).unwrap(),
@@ -134,7 +133,10 @@ fn filter_joined_pair_never_collides_after_a_portal() {
         );
     }
     assert_eq!(most, 0);
-    assert!((apart - start).abs() < 1e-3, "centres {start} → {apart} m apart");
+    assert!(
+        (apart - start).abs() < 1e-3,
+        "centres {start} → {apart} m apart"
+    );
 }
 
 /// While the overlapping pair crosses, no copy of one touches a copy of

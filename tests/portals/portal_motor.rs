@@ -69,7 +69,10 @@ fn error_through_map(world: &World, joint: JointHandle, pair: PortalPairHandle) 
         let (body, local) = ends[k];
         if let Some((twin, map, scale)) = twin(world, body, pair) {
             let c = local_center(world, body);
-            let on_twin = world.transform(twin).unwrap().apply(c + scale * (local - c));
+            let on_twin = world
+                .transform(twin)
+                .unwrap()
+                .apply(c + scale * (local - c));
             error = error.max((map.map_point(at(ends[1 - k])) - on_twin).length());
         }
     }
@@ -154,7 +157,10 @@ fn motor_joined_pair_keeps_its_offset_through_a_portal() {
     assert_eq!((j.def.base.body_a, j.def.base.body_b), (a, b));
     // The offset scaled with the pair: η × 0.6 m.
     assert!((offset - ETA * OFFSET).length() < 1e-5, "offset {offset}");
-    assert!(crossing_error <= 0.01, "error while crossing {crossing_error} m");
+    assert!(
+        crossing_error <= 0.01,
+        "error while crossing {crossing_error} m"
+    );
     assert!(after_error <= 0.01, "error after {after_error} m");
     assert!(worst_angle <= 0.01, "angle error {worst_angle} rad");
 }

@@ -143,8 +143,7 @@ impl KindRows for FilterJoint {
     #[inline(always)]
     fn warm_start_side(&self, _st: &mut BodyState, _side_b: bool) {}
     #[inline(always)]
-    fn solve_pair<P: PairStates>(&mut self, _ctx: &StepContext, _pair: &mut P, _use_bias: bool) {
-    }
+    fn solve_pair<P: PairStates>(&mut self, _ctx: &StepContext, _pair: &mut P, _use_bias: bool) {}
 }
 
 impl Constraint for FilterJoint {

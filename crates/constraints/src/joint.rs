@@ -46,13 +46,13 @@ use janus2d_core::constraint::{Constraint, ConstraintRows, StepContext};
 use janus2d_core::math::{Real, Rot, Vec2};
 
 use crate::JointError;
+use crate::filter::{FilterJoint, FilterJointDef};
 use crate::joint_base::JointBase;
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
+use crate::motor::{MotorJoint, MotorJointDef};
 use crate::parts::{BOTH, PairOf, PairStates, PointPart};
 use crate::revolute::{RevoluteJoint, RevoluteJointDef};
 use crate::weld::{WeldJoint, WeldJointDef};
-use crate::motor::{MotorJoint, MotorJointDef};
-use crate::filter::{FilterJoint, FilterJointDef};
 
 /// What a joint kind's solver form supplies: its rows' stages, read-backs
 /// and what the tree solve may take. Dispatched by [`Joint`]'s match

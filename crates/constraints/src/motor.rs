@@ -56,8 +56,7 @@ use crate::joint::KindRows;
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef};
 use crate::parts::{
-    AnglePart, BOTH, PairOf, PairStates, PointPart, apply_pair, clamp_length, load_pair,
-    store_pair,
+    AnglePart, BOTH, PairOf, PairStates, PointPart, apply_pair, clamp_length, load_pair, store_pair,
 };
 use crate::{JointError, check_anchor};
 
@@ -279,7 +278,7 @@ impl MotorJoint {
     pub fn carry_impulses(&mut self, rotation: Rot, scale: Real) {
         self.point.impulse = scale * rotation.rotate(self.point.impulse);
         if scale > 0.0 && scale.is_finite() {
-            self.def.linear_offset = self.def.linear_offset / scale;
+            self.def.linear_offset /= scale;
         }
     }
 
