@@ -3,9 +3,9 @@
 //! and limit/motor/spring setters with typed errors that leave the world
 //! unchanged, and the validator's check of joint definitions.
 
+use janus2d::SleepSettings;
 use janus2d::prelude::*;
 use janus2d_constraints::JointError;
-use janus2d::SleepSettings;
 
 /// A 1 kg box hanging 1 m below a static pin, 4 substeps, sleep off.
 fn pendulum(def_edit: impl FnOnce(&mut RevoluteJointDef)) -> (World, BodyHandle, JointHandle) {
