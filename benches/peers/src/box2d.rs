@@ -340,18 +340,21 @@ impl Box2d {
                 world.create_weld_joint(&def)
             }
             JointDesc::Prismatic(p) => {
-                let mut def = PrismaticJointDef::new(Self::joint_base(world, &p.base, ids, tuning)?)
-                    .enable_limit(p.limit.is_some())
-                    .enable_motor(p.motor.is_some())
-                    .enable_spring(p.spring.is_some())
-                    .translation(p.target_translation as f32);
+                let mut def =
+                    PrismaticJointDef::new(Self::joint_base(world, &p.base, ids, tuning)?)
+                        .enable_limit(p.limit.is_some())
+                        .enable_motor(p.motor.is_some())
+                        .enable_spring(p.spring.is_some())
+                        .translation(p.target_translation as f32);
                 if let Some((lower, upper)) = p.limit {
                     def = def
                         .lower_translation(lower as f32)
                         .upper_translation(upper as f32);
                 }
                 if let Some((speed, force)) = p.motor {
-                    def = def.motor_speed(speed as f32).max_motor_force(clamped(force));
+                    def = def
+                        .motor_speed(speed as f32)
+                        .max_motor_force(clamped(force));
                 }
                 if let Some((hertz, zeta)) = p.spring {
                     def = def.hertz(hertz as f32).damping_ratio(zeta as f32);
@@ -369,7 +372,9 @@ impl Box2d {
                         .upper_translation(upper as f32);
                 }
                 if let Some((speed, torque)) = w.motor {
-                    def = def.motor_speed(speed as f32).max_motor_torque(clamped(torque));
+                    def = def
+                        .motor_speed(speed as f32)
+                        .max_motor_torque(clamped(torque));
                 }
                 if let Some((hertz, zeta)) = w.spring {
                     def = def.hertz(hertz as f32).damping_ratio(zeta as f32);
@@ -388,7 +393,9 @@ impl Box2d {
                     def = def.min_length(min as f32).max_length(max as f32);
                 }
                 if let Some((speed, force)) = d.motor {
-                    def = def.motor_speed(speed as f32).max_motor_force(clamped(force));
+                    def = def
+                        .motor_speed(speed as f32)
+                        .max_motor_force(clamped(force));
                 }
                 if let Some((hertz, zeta)) = d.spring {
                     def = def.hertz(hertz as f32).damping_ratio(zeta as f32);

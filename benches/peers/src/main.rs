@@ -101,10 +101,12 @@ fn parse_args() -> Args {
             "--svg" => args.svg = it.next().map(PathBuf::from),
             "--md" => args.md = it.next().map(PathBuf::from),
             "--out" => args.out = it.next().map(PathBuf::from).expect("--out DIR"),
-            cmd if first && matches!(
+            cmd if first
+                && matches!(
                     cmd,
                     "all" | "profile" | "hard" | "sweep" | "chart" | "joints"
-                ) => {
+                ) =>
+            {
                 args.command = cmd.into()
             }
             name if !name.starts_with('-') => args.names.push(name.into()),
@@ -892,14 +894,12 @@ fn joints_summary(scenes: &[JointScene], table: &[(String, Vec<JointRow>)]) -> S
     fn get<'a>(rows: &'a [JointRow], e: &str) -> Option<&'a JointRow> {
         rows.iter().find(|r| r.engine == e)
     }
-    let ratio = |rows: &[JointRow], peer: &str| {
-        match (
-            get(rows, "janus2d").and_then(|r| r.ms_per_step),
-            get(rows, peer).and_then(|r| r.ms_per_step),
-        ) {
-            (Some(a), Some(b)) => format!("{:.2}", a / b),
-            _ => "n/a".into(),
-        }
+    let ratio = |rows: &[JointRow], peer: &str| match (
+        get(rows, "janus2d").and_then(|r| r.ms_per_step),
+        get(rows, peer).and_then(|r| r.ms_per_step),
+    ) {
+        (Some(a), Some(b)) => format!("{:.2}", a / b),
+        _ => "n/a".into(),
     };
     let mut md = String::from(
         "| scene | janus2d ÷ Box2D | janus2d ÷ Rapier | figure | janus2d | Box2D | Rapier |\n|---|---|---|---|---|---|---|\n",

@@ -300,7 +300,12 @@ fn spring_motor(
     let omega = 2.0 * std::f64::consts::PI * hertz;
     builder
         .motor_model(axis, MotorModel::AccelerationBased)
-        .motor_position(axis, real(target), real(omega * omega), real(2.0 * zeta * omega))
+        .motor_position(
+            axis,
+            real(target),
+            real(omega * omega),
+            real(2.0 * zeta * omega),
+        )
         .motor_max_force(axis, real(max_force))
 }
 
