@@ -27,6 +27,12 @@
 //! | `RevoluteDesc::local_a/b`     | `b2JointDef::localFrameA.p` / `localFrameB.p`                     |
 //! | `reference_angle`             | `localFrameA.q = rot(reference)` (3.2 has no `referenceAngle`)    |
 //! | `limit`, `motor`, `spring`    | `enableLimit`/`lowerAngle`/`upperAngle`, `enableMotor`/`motorSpeed`/`maxMotorTorque` (clamped to `f32::MAX`), `enableSpring`/`hertz`/`dampingRatio` |
+//! | `JointDesc` frames            | `b2JointDef::localFrameA/B` (anchor and angle as given), `collideConnected`, the scene's constraint tuning |
+//! | `JointDesc::Revolute`         | as `joints` above                                                 |
+//! | `JointDesc::Weld`             | `b2WeldJointDef`: `linearHertz`, `linearDampingRatio`, `angularHertz`, `angularDampingRatio` (0 Hz: rigid) |
+//! | `JointDesc::Prismatic`        | `b2PrismaticJointDef`: `enableLimit`/`lowerTranslation`/`upperTranslation`, `enableMotor`/`motorSpeed`/`maxMotorForce`, `enableSpring`/`hertz`/`dampingRatio`/`targetTranslation` |
+//! | `JointDesc::Wheel`            | `b2WheelJointDef`: `enableSpring`/`hertz`/`dampingRatio` (no spring: `enableSpring = false`, Box2D's default is on), `enableLimit`/…, `enableMotor`/`motorSpeed`/`maxMotorTorque` |
+//! | `JointDesc::Distance`         | `b2DistanceJointDef`: `length`, `enableSpring`/`hertz`/`dampingRatio`/`lowerSpringForce`/`upperSpringForce`, `enableLimit`/`minLength`/`maxLength`, `enableMotor`/`motorSpeed`/`maxMotorForce` (forces clamped to ±`f32::MAX`) |
 //! | `Action::Spawn` / `Despawn`   | create the group's bodies then joints / `b2DestroyBody` each body |
 //! | `Action::Target`              | `b2Body_SetTargetTransform(target, dt, wake = true)`              |
 //! | [`Engine::body_count`]        | `b2World_GetCounters().bodyCount`                                 |
@@ -49,11 +55,13 @@ use std::collections::BTreeMap;
 
 use boxdd::shapes::{self, SurfaceMaterial};
 use boxdd::{
-    BodyId, BodyType, ChainDef, ConstraintTuning, Filter, Foundation, MassData, Polygon, Position,
-    RevoluteJointDef, ShapeDef, Transform, Vec2, WorkerCount, World, WorldScalar, WorldTransform,
+    BodyId, BodyType, ChainDef, ConstraintTuning, DistanceJointDef, Filter, Foundation, JointBase,
+    MassData, Polygon, Position, PrismaticJointDef, RevoluteJointDef, ShapeDef, Transform, Vec2,
+    WeldJointDef, WheelJointDef, WorkerCount, World, WorldScalar, WorldTransform,
 };
 use janus2d_testbed::desc::{
-    Action, BodyDesc, BodyKind, FilterDesc, Geometry, RevoluteDesc, SceneDesc, Settings, ShapeDesc,
+    Action, BodyDesc, BodyKind, FilterDesc, FrameDesc, Geometry, JointBaseDesc, JointDesc,
+    RevoluteDesc, SceneDesc, Settings, ShapeDesc,
 };
 use janus2d_testbed::engine::{BodyReading, Engine, EngineOptions, StageTimes};
 
@@ -65,6 +73,17 @@ fn local(x: f64, y: f64) -> Vec2 {
 /// A description point as a Box2D world position.
 fn position(x: f64, y: f64) -> Position {
     Position::new(x as WorldScalar, y as WorldScalar)
+}
+
+/// A description value in `f32`, `±f64::MAX`-like values clamped to
+/// `±f32::MAX`.
+fn clamped(x: f64) -> f32 {
+    x.clamp(-f64::from(f32::MAX), f64::from(f32::MAX)) as f32
+}
+
+/// A description frame as a Box2D local transform.
+fn frame(f: &FrameDesc) -> boxdd::Result<Transform> {
+    Transform::from_pos_angle(local(f.anchor.x, f.anchor.y), f.angle as f32)
 }
 
 /// A boxdd error as the adapter's error text.
@@ -283,6 +302,111 @@ impl Box2d {
             .map_err(|e| text("revolute joint", e))
     }
 
+    /// Box2D's joint base of a description's: bodies from `ids`, frames as
+    /// given, the scene's constraint tuning.
+    fn joint_base(
+        world: &World,
+        b: &JointBaseDesc,
+        ids: &[(BodyId, BodyKind)],
+        tuning: ConstraintTuning,
+    ) -> Result<JointBase, String> {
+        let (a, bb) = (ids[b.body_a].0, ids[b.body_b].0);
+        world
+            .joint_base(a, bb)
+            .and_then(|base| {
+                Ok(base
+                    .with_local_frames(frame(&b.frame_a)?, frame(&b.frame_b)?)
+                    .with_collide_connected(b.collide_connected)
+                    .with_constraint_tuning(tuning))
+            })
+            .map_err(|e| text("joint base", e))
+    }
+
+    /// Creates one joint of any kind between bodies of `ids`.
+    fn create_any_joint(
+        world: &mut World,
+        j: &JointDesc,
+        ids: &[(BodyId, BodyKind)],
+        tuning: ConstraintTuning,
+    ) -> Result<(), String> {
+        let made = match j {
+            JointDesc::Revolute(r) => return Self::create_joint(world, r, ids, tuning),
+            JointDesc::Weld(w) => {
+                let def = WeldJointDef::new(Self::joint_base(world, &w.base, ids, tuning)?)
+                    .linear_hertz(w.linear_hertz as f32)
+                    .linear_damping_ratio(w.linear_damping_ratio as f32)
+                    .angular_hertz(w.angular_hertz as f32)
+                    .angular_damping_ratio(w.angular_damping_ratio as f32);
+                world.create_weld_joint(&def)
+            }
+            JointDesc::Prismatic(p) => {
+                let mut def =
+                    PrismaticJointDef::new(Self::joint_base(world, &p.base, ids, tuning)?)
+                        .enable_limit(p.limit.is_some())
+                        .enable_motor(p.motor.is_some())
+                        .enable_spring(p.spring.is_some())
+                        .translation(p.target_translation as f32);
+                if let Some((lower, upper)) = p.limit {
+                    def = def
+                        .lower_translation(lower as f32)
+                        .upper_translation(upper as f32);
+                }
+                if let Some((speed, force)) = p.motor {
+                    def = def
+                        .motor_speed(speed as f32)
+                        .max_motor_force(clamped(force));
+                }
+                if let Some((hertz, zeta)) = p.spring {
+                    def = def.hertz(hertz as f32).damping_ratio(zeta as f32);
+                }
+                world.create_prismatic_joint(&def)
+            }
+            JointDesc::Wheel(w) => {
+                let mut def = WheelJointDef::new(Self::joint_base(world, &w.base, ids, tuning)?)
+                    .enable_limit(w.limit.is_some())
+                    .enable_motor(w.motor.is_some())
+                    .enable_spring(w.spring.is_some());
+                if let Some((lower, upper)) = w.limit {
+                    def = def
+                        .lower_translation(lower as f32)
+                        .upper_translation(upper as f32);
+                }
+                if let Some((speed, torque)) = w.motor {
+                    def = def
+                        .motor_speed(speed as f32)
+                        .max_motor_torque(clamped(torque));
+                }
+                if let Some((hertz, zeta)) = w.spring {
+                    def = def.hertz(hertz as f32).damping_ratio(zeta as f32);
+                }
+                world.create_wheel_joint(&def)
+            }
+            JointDesc::Distance(d) => {
+                let mut def = DistanceJointDef::new(Self::joint_base(world, &d.base, ids, tuning)?)
+                    .length(d.length as f32)
+                    .enable_limit(d.limit.is_some())
+                    .enable_motor(d.motor.is_some())
+                    .enable_spring(d.spring.is_some())
+                    .lower_spring_force(clamped(d.spring_force.0))
+                    .upper_spring_force(clamped(d.spring_force.1));
+                if let Some((min, max)) = d.limit {
+                    def = def.min_length(min as f32).max_length(max as f32);
+                }
+                if let Some((speed, force)) = d.motor {
+                    def = def
+                        .motor_speed(speed as f32)
+                        .max_motor_force(clamped(force));
+                }
+                if let Some((hertz, zeta)) = d.spring {
+                    def = def.hertz(hertz as f32).damping_ratio(zeta as f32);
+                }
+                world.create_distance_joint(&def)
+            }
+        };
+        made.map(drop)
+            .map_err(|e| text(&format!("{} joint", j.kind_name()), e))
+    }
+
     /// Creates bodies, then the joints between them (indices into `bodies`).
     fn create_group(
         world: &mut World,
@@ -377,6 +501,9 @@ impl Engine for Box2d {
             ConstraintTuning::new(s.joint_hertz as f32, s.joint_damping_ratio as f32)
                 .map_err(|e| text("joint tuning", e))?;
         let bodies = Self::create_group(&mut world, &desc.bodies, &desc.joints, joint_tuning)?;
+        for j in &desc.extra_joints {
+            Self::create_any_joint(&mut world, j, &bodies, joint_tuning)?;
+        }
         Ok(Box2d {
             world: RefCell::new(world),
             bodies,

@@ -7,6 +7,7 @@
 //! cargo run --release --manifest-path benches/peers/Cargo.toml -- profile large_pyramid tumbler
 //! cargo run --release --manifest-path benches/peers/Cargo.toml -- hard           # hard cases, pass/fail per engine
 //! cargo run --release --manifest-path benches/peers/Cargo.toml -- sweep          # substeps 1, 2, 4, 8 per engine
+//! cargo run --release --manifest-path benches/peers/Cargo.toml -- joints         # joint scenes: time ratios and accuracy
 //! ```
 //!
 //! | command   | prints                                                                 |
@@ -16,6 +17,7 @@
 //! | `hard`    | every hard case on every engine, measured by the shared metric code (`--substeps N`: at N substeps instead of 4) |
 //! | `sweep`   | error against ms/step at 1, 2, 4, 8 substeps, per engine (CSV + SVG)   |
 //! | `chart`   | `chart RUN.csv CHART.svg`: the ratio chart redrawn from an `all --csv` file |
+//! | `joints`  | the joint scenes (weld cantilever, car, elevator, spring bridge): ms/step and ratios, each engine's accuracy figures side by side; an engine without the scene's joint kind shows `n/a` (`--substeps N`, `--md FILE`) |
 //!
 //! Options: `--threads 1,2`, `--repeats N` (default 2), `--steps N`,
 //! `--scenes a,b`, `--engines janus2d,box2d,rapier`, `--csv FILE`,
@@ -33,6 +35,7 @@ use janus2d_testbed::benchmarks::{self, BOX2D_TEN};
 use janus2d_testbed::engine::{EngineOptions, StageTimes};
 use janus2d_testbed::hard::{self, Bound, Figure, HardCase};
 use janus2d_testbed::janus::Janus;
+use janus2d_testbed::joint_bench::{self, JointFigures, JointScene};
 use janus2d_testbed::run::{Timing, time_scene};
 use plotters::prelude::*;
 
@@ -98,7 +101,12 @@ fn parse_args() -> Args {
             "--svg" => args.svg = it.next().map(PathBuf::from),
             "--md" => args.md = it.next().map(PathBuf::from),
             "--out" => args.out = it.next().map(PathBuf::from).expect("--out DIR"),
-            cmd if first && matches!(cmd, "all" | "profile" | "hard" | "sweep" | "chart") => {
+            cmd if first
+                && matches!(
+                    cmd,
+                    "all" | "profile" | "hard" | "sweep" | "chart" | "joints"
+                ) =>
+            {
                 args.command = cmd.into()
             }
             name if !name.starts_with('-') => args.names.push(name.into()),
@@ -788,6 +796,139 @@ fn sweep_chart(
     Ok(())
 }
 
+fn measure_joint_scene(engine: &str, scene: &JointScene) -> Result<JointFigures, String> {
+    match engine {
+        "janus2d" => scene.measure::<Janus>(),
+        "Box2D" => scene.measure::<Box2d>(),
+        _ => scene.measure::<Rapier>(),
+    }
+}
+
+/// One joint scene on one engine: the timing and the figures (either may
+/// be missing: the engine has no such joint).
+struct JointRow {
+    engine: String,
+    ms_per_step: Option<f64>,
+    figures: Result<JointFigures, String>,
+}
+
+/// `joints`: every joint scene on every engine, timed as `all` times
+/// (best of the repeats, one thread) and measured in a separate untimed
+/// run, then a summary with the ratios and the figures side by side.
+fn cmd_joints(args: &Args) {
+    let threads = args.threads.first().copied().unwrap_or(1);
+    let scenes: Vec<JointScene> = joint_bench::all()
+        .into_iter()
+        .filter(|s| args.names.is_empty() || args.names.iter().any(|n| n == s.name))
+        .map(|mut s| {
+            if let Some(n) = args.substeps {
+                s.desc.settings.substeps = n;
+            }
+            if let Some(n) = args.steps {
+                s.desc.steps = n;
+            }
+            s
+        })
+        .collect();
+    println!(
+        "joint scenes: {} substeps, 1/60 s, sleep off | {threads} thread(s) | ms/step best of {} repeats | figures from one untimed run, read after every step | build: {}",
+        args.substeps.unwrap_or(4),
+        args.repeats,
+        build_label()
+    );
+    let mut table: Vec<(String, Vec<JointRow>)> = Vec::new();
+    for scene in &scenes {
+        let mut rows = Vec::new();
+        for engine in &args.engines {
+            let timing = time_on(engine, &scene.desc, threads, args);
+            let figures = measure_joint_scene(engine, scene);
+            let ms = timing.as_ref().ok().map(Timing::ms_per_step);
+            match (&timing, &figures) {
+                (Ok(_), Ok(f)) => {
+                    let shown: Vec<String> = scene
+                        .figures
+                        .iter()
+                        .zip(&f.values)
+                        .map(|(n, v)| format!("{n} {}", figure_text(*v)))
+                        .collect();
+                    println!(
+                        "{:<16} {engine:<8} {:>9.4} ms/step  {}",
+                        scene.name,
+                        ms.unwrap_or_default(),
+                        shown.join(", ")
+                    );
+                }
+                (Err(e), _) | (_, Err(e)) => {
+                    println!("{:<16} {engine:<8}       n/a  {e}", scene.name)
+                }
+            }
+            rows.push(JointRow {
+                engine: engine.clone(),
+                ms_per_step: ms,
+                figures,
+            });
+        }
+        table.push((scene.name.to_string(), rows));
+    }
+    let summary = joints_summary(&scenes, &table);
+    println!("\n{summary}");
+    if let Some(path) = &args.md {
+        std::fs::write(path, &summary).expect("write markdown");
+        println!("wrote {}", path.display());
+    }
+}
+
+/// A figure as printed: 4 decimals, `never` for NaN.
+fn figure_text(v: f64) -> String {
+    if v.is_nan() {
+        "never".into()
+    } else {
+        format!("{v:.4}")
+    }
+}
+
+/// The summary table (Markdown): per scene and figure, janus2d ÷ Box2D and
+/// ÷ Rapier time ratios and the three engines' figures; `n/a` where an
+/// engine could not build the scene.
+fn joints_summary(scenes: &[JointScene], table: &[(String, Vec<JointRow>)]) -> String {
+    fn get<'a>(rows: &'a [JointRow], e: &str) -> Option<&'a JointRow> {
+        rows.iter().find(|r| r.engine == e)
+    }
+    let ratio = |rows: &[JointRow], peer: &str| match (
+        get(rows, "janus2d").and_then(|r| r.ms_per_step),
+        get(rows, peer).and_then(|r| r.ms_per_step),
+    ) {
+        (Some(a), Some(b)) => format!("{:.2}", a / b),
+        _ => "n/a".into(),
+    };
+    let mut md = String::from(
+        "| scene | janus2d ÷ Box2D | janus2d ÷ Rapier | figure | janus2d | Box2D | Rapier |\n|---|---|---|---|---|---|---|\n",
+    );
+    for (scene, (name, rows)) in scenes.iter().zip(table) {
+        for (k, figure) in scene.figures.iter().enumerate() {
+            let value = |e: &str| {
+                get(rows, e)
+                    .and_then(|r| r.figures.as_ref().ok())
+                    .and_then(|f| f.values.get(k).copied())
+                    .map_or("n/a".to_string(), figure_text)
+            };
+            let (n, rb, rr) = if k == 0 {
+                (name.as_str(), ratio(rows, "Box2D"), ratio(rows, "Rapier"))
+            } else {
+                ("", String::new(), String::new())
+            };
+            let _ = writeln!(
+                md,
+                "| {n} | {rb} | {rr} | {figure} | {} | {} | {} |",
+                value("janus2d"),
+                value("Box2D"),
+                value("Rapier")
+            );
+        }
+    }
+    md
+}
+
 fn main() {
     let args = parse_args();
     match args.command.as_str() {
@@ -795,6 +936,7 @@ fn main() {
         "hard" => cmd_hard(&args),
         "sweep" => cmd_sweep(&args),
         "chart" => cmd_chart(&args),
+        "joints" => cmd_joints(&args),
         _ => cmd_all(&args),
     }
 }

@@ -41,6 +41,11 @@
 //! | `motor` alone               | a velocity motor: target speed, near-rigid damping, `max_force` = max torque (`f64::MAX` → `f32::MAX`) |
 //! | `spring` (with or without a motor) | one acceleration-based position motor to angle 0 with stiffness (2πf)² and damping 2ζ·2πf, unbounded |
 //! | `collide_connected == false`| `contacts_enabled(false)`                                     |
+//! | `JointDesc` frames          | a `GenericJoint`'s `local_frame1/2` (anchor and angle as given), the scene's joint softness on its locked axes |
+//! | `JointDesc::Weld`           | locked `LIN_X`, `LIN_Y`, `ANG_X`; a nonzero hertz frees that part and holds it with an acceleration-based position motor to 0 instead (stiffness (2πf)², damping 2ζ·2πf) |
+//! | `JointDesc::Prismatic`      | locked `LIN_Y`, `ANG_X`; `LinX` limits; the spring (target translation) or else the motor on `LinX`, as the revolute's |
+//! | `JointDesc::Wheel`          | locked `LIN_Y`; `LinX` limits and spring (position motor to 0); `AngX` velocity motor |
+//! | `JointDesc::Distance`       | coupled `LIN_X`, `LIN_Y` (`LinX` is then the distance, as Rapier's rope and spring joints): no spring, limits [length, length]; a spring, a position motor to the length, max force = the larger spring force bound, with the length limits; the motor when there is no spring |
 //! | `Action::Target`            | velocity = (target − current) / dt, angular likewise (wrapped) |
 //! | `portals`                   | `build` fails: Rapier has no portals                          |
 //! | `EngineOptions::threads`    | the step runs in a rayon pool of that many threads, built once in `build` (`parallel` feature; without it, one thread) |
@@ -90,7 +95,8 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use janus2d_testbed::desc::{
-    Action, BodyDesc, BodyKind, FilterDesc, Geometry, RevoluteDesc, SceneDesc, ShapeDesc, v,
+    Action, BodyDesc, BodyKind, FilterDesc, FrameDesc, Geometry, JointDesc, RevoluteDesc,
+    SceneDesc, ShapeDesc, v,
 };
 use janus2d_testbed::engine::{BodyReading, Engine, EngineOptions, StageTimes};
 use rapier2d::prelude::*;
@@ -282,6 +288,118 @@ fn revolute(j: &RevoluteDesc, softness: SpringCoefficients<Real>) -> RevoluteJoi
     joint
 }
 
+/// An acceleration-based position motor to `target` on `axis` with Box2D's
+/// soft spring (k = ω², c = 2ζω, ω = 2πf).
+fn spring_motor(
+    builder: GenericJointBuilder,
+    axis: JointAxis,
+    target: f64,
+    (hertz, zeta): (f64, f64),
+    max_force: f64,
+) -> GenericJointBuilder {
+    let omega = 2.0 * std::f64::consts::PI * hertz;
+    builder
+        .motor_model(axis, MotorModel::AccelerationBased)
+        .motor_position(
+            axis,
+            real(target),
+            real(omega * omega),
+            real(2.0 * zeta * omega),
+        )
+        .motor_max_force(axis, real(max_force))
+}
+
+/// A rigid velocity motor on `axis` up to `max_force`, as the revolute's.
+fn velocity_motor(
+    builder: GenericJointBuilder,
+    axis: JointAxis,
+    (speed, max_force): (f64, f64),
+) -> GenericJointBuilder {
+    builder
+        .motor_model(axis, MotorModel::AccelerationBased)
+        .motor_velocity(axis, speed as Real, RIGID_MOTOR_DAMPING)
+        .motor_max_force(axis, real(max_force))
+}
+
+/// The generic joint of a non-revolute description (body a is Rapier's
+/// body 1): frames as given, the table in the module documentation.
+fn generic(j: &JointDesc, softness: SpringCoefficients<Real>) -> Option<GenericJoint> {
+    let base = j.base()?;
+    let pose = |f: &FrameDesc| Pose::new(vec2(f.anchor.x, f.anchor.y), f.angle as Real);
+    let start = |locked: JointAxesMask| {
+        GenericJointBuilder::new(locked)
+            .local_frame1(pose(&base.frame_a))
+            .local_frame2(pose(&base.frame_b))
+            .contacts_enabled(base.collide_connected)
+            .softness(softness)
+    };
+    let limit = |b: GenericJointBuilder, axis, limit: Option<(f64, f64)>| match limit {
+        Some((lo, hi)) => b.limits(axis, [lo as Real, hi as Real]),
+        None => b,
+    };
+    Some(match j {
+        JointDesc::Revolute(_) => return None,
+        JointDesc::Weld(w) => {
+            let mut locked = JointAxesMask::empty();
+            if w.linear_hertz == 0.0 {
+                locked |= JointAxesMask::LIN_AXES;
+            }
+            if w.angular_hertz == 0.0 {
+                locked |= JointAxesMask::ANG_X;
+            }
+            let mut b = start(locked);
+            if w.linear_hertz > 0.0 {
+                let spring = (w.linear_hertz, w.linear_damping_ratio);
+                for axis in [JointAxis::LinX, JointAxis::LinY] {
+                    b = spring_motor(b, axis, 0.0, spring, f64::MAX);
+                }
+            }
+            if w.angular_hertz > 0.0 {
+                let spring = (w.angular_hertz, w.angular_damping_ratio);
+                b = spring_motor(b, JointAxis::AngX, 0.0, spring, f64::MAX);
+            }
+            b.build()
+        }
+        JointDesc::Prismatic(p) => {
+            let mut b = start(JointAxesMask::LIN_Y | JointAxesMask::ANG_X);
+            b = limit(b, JointAxis::LinX, p.limit);
+            match (p.spring, p.motor) {
+                (Some(spring), _) => {
+                    b = spring_motor(b, JointAxis::LinX, p.target_translation, spring, f64::MAX)
+                }
+                (None, Some(motor)) => b = velocity_motor(b, JointAxis::LinX, motor),
+                (None, None) => {}
+            }
+            b.build()
+        }
+        JointDesc::Wheel(w) => {
+            let mut b = limit(start(JointAxesMask::LIN_Y), JointAxis::LinX, w.limit);
+            if let Some(spring) = w.spring {
+                b = spring_motor(b, JointAxis::LinX, 0.0, spring, f64::MAX);
+            }
+            if let Some(motor) = w.motor {
+                b = velocity_motor(b, JointAxis::AngX, motor);
+            }
+            b.build()
+        }
+        JointDesc::Distance(d) => {
+            let mut b = start(JointAxesMask::empty()).coupled_axes(JointAxesMask::LIN_AXES);
+            match (d.spring, d.motor) {
+                (None, _) => b = b.limits(JointAxis::LinX, [d.length as Real; 2]),
+                (Some(spring), _) => {
+                    let max_force = d.spring_force.0.abs().max(d.spring_force.1.abs());
+                    b = limit(b, JointAxis::LinX, d.limit);
+                    b = spring_motor(b, JointAxis::LinX, d.length, spring, max_force);
+                }
+            }
+            if let (None, Some(motor)) = (d.spring, d.motor) {
+                b = velocity_motor(b, JointAxis::LinX, motor);
+            }
+            b.build()
+        }
+    })
+}
+
 /// A scene built in Rapier's sets.
 pub struct Rapier {
     pipeline: PhysicsPipeline,
@@ -359,6 +477,25 @@ impl Rapier {
         };
         self.impulse_joints
             .insert(a, b, revolute(j, self.joint_softness), true);
+        Ok(())
+    }
+
+    /// Creates one joint of any kind between bodies of `handles`.
+    fn create_any_joint(
+        &mut self,
+        j: &JointDesc,
+        handles: &[RigidBodyHandle],
+    ) -> Result<(), String> {
+        let joint = match j {
+            JointDesc::Revolute(r) => return self.create_joint(r, handles),
+            other => generic(other, self.joint_softness)
+                .ok_or_else(|| format!("no generic joint for a {}", other.kind_name()))?,
+        };
+        let (a, b) = j.bodies();
+        let (Some(&a), Some(&b)) = (handles.get(a), handles.get(b)) else {
+            return Err(format!("joint between missing bodies {a} and {b}"));
+        };
+        self.impulse_joints.insert(a, b, joint, true);
         Ok(())
     }
 
@@ -500,6 +637,9 @@ impl Engine for Rapier {
         let initial = r.initial.clone();
         for j in &desc.joints {
             r.create_joint(j, &initial)?;
+        }
+        for j in &desc.extra_joints {
+            r.create_any_joint(j, &initial)?;
         }
         Ok(r)
     }

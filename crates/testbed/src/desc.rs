@@ -5,6 +5,8 @@
 //!  SceneDesc ── settings   gravity, dt, substeps, sleep, softness
 //!            ├─ bodies[]   BodyDesc ── shapes[] ShapeDesc ── Geometry
 //!            ├─ joints[]   RevoluteDesc (indices into bodies[])
+//!            ├─ extra_joints[]  JointDesc: any kind (revolute, weld,
+//!            │             prismatic, wheel, distance), built after joints[]
 //!            ├─ script     per-step Actions: spawn / despawn a group,
 //!            │             drive a kinematic body to a target
 //!            ├─ probe      the body whose pose the sanity line reports
@@ -262,6 +264,312 @@ impl RevoluteDesc {
     }
 }
 
+/// A joint's frame on one body: an origin (the joint's anchor) and an
+/// angle, both in the body's frame. Box2D 3.2's `localFrameA/B`, janus2d's
+/// `JointFrame`, Rapier's `local_frame1/2`: axes (prismatic, wheel) are the
+/// frame's x axis on body a, held angles are the frames' relative angle.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameDesc {
+    /// Origin in the body's frame, m.
+    pub anchor: DVec2,
+    /// Angle in the body's frame, rad.
+    pub angle: f64,
+}
+
+impl FrameDesc {
+    /// A frame at `anchor`, angle 0.
+    #[must_use]
+    pub const fn at(anchor: DVec2) -> Self {
+        FrameDesc { anchor, angle: 0.0 }
+    }
+
+    /// A frame at `anchor` turned by `angle`.
+    #[must_use]
+    pub const fn new(anchor: DVec2, angle: f64) -> Self {
+        FrameDesc { anchor, angle }
+    }
+
+    /// The frame's x axis in the body's frame (a unit vector).
+    #[must_use]
+    pub fn axis(&self) -> DVec2 {
+        DVec2::from_angle(self.angle)
+    }
+}
+
+/// What every joint kind of [`JointDesc`] shares (Box2D 3.2's joint
+/// definition base): two bodies of the same list and a frame on each.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointBaseDesc {
+    /// Index of body a.
+    pub body_a: usize,
+    /// Index of body b.
+    pub body_b: usize,
+    /// The joint's frame on body a.
+    pub frame_a: FrameDesc,
+    /// The joint's frame on body b.
+    pub frame_b: FrameDesc,
+    /// Whether the two bodies collide.
+    pub collide_connected: bool,
+}
+
+impl JointBaseDesc {
+    /// Frames at the given local anchors, angle 0, bodies not colliding.
+    #[must_use]
+    pub fn new(body_a: usize, body_b: usize, anchor_a: DVec2, anchor_b: DVec2) -> Self {
+        JointBaseDesc {
+            body_a,
+            body_b,
+            frame_a: FrameDesc::at(anchor_a),
+            frame_b: FrameDesc::at(anchor_b),
+            collide_connected: false,
+        }
+    }
+
+    /// The same with both frames turned by `angle`: the axis of a prismatic
+    /// or wheel joint is then `(cos, sin)(angle)` in a's frame, and the held
+    /// relative angle is zero (right for two bodies created at the same
+    /// angle).
+    #[must_use]
+    pub fn with_axis_angle(mut self, angle: f64) -> Self {
+        self.frame_a.angle = angle;
+        self.frame_b.angle = angle;
+        self
+    }
+}
+
+/// A weld joint: holds the frames together (anchors and angle), rigidly or
+/// with springs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WeldDesc {
+    /// Bodies and frames (held angle: the frames' relative angle).
+    pub base: JointBaseDesc,
+    /// Stiffness of the point rows, Hz (0: rigid).
+    pub linear_hertz: f64,
+    /// Damping ratio of the point rows.
+    pub linear_damping_ratio: f64,
+    /// Stiffness of the angle row, Hz (0: rigid).
+    pub angular_hertz: f64,
+    /// Damping ratio of the angle row.
+    pub angular_damping_ratio: f64,
+}
+
+impl WeldDesc {
+    /// A rigid weld at the given local anchors, holding angle 0.
+    #[must_use]
+    pub fn new(body_a: usize, body_b: usize, anchor_a: DVec2, anchor_b: DVec2) -> Self {
+        WeldDesc {
+            base: JointBaseDesc::new(body_a, body_b, anchor_a, anchor_b),
+            linear_hertz: 0.0,
+            linear_damping_ratio: 0.0,
+            angular_hertz: 0.0,
+            angular_damping_ratio: 0.0,
+        }
+    }
+
+    /// True when both hertz are 0.
+    #[must_use]
+    pub fn is_rigid(&self) -> bool {
+        self.linear_hertz == 0.0 && self.angular_hertz == 0.0
+    }
+}
+
+/// A prismatic (slider) joint: b's frame slides along a's frame x axis, the
+/// frames' relative angle held at 0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PrismaticDesc {
+    /// Bodies and frames (the axis is frame a's x axis).
+    pub base: JointBaseDesc,
+    /// Translation limits (lower, upper), m.
+    pub limit: Option<(f64, f64)>,
+    /// Motor (speed m/s, max force N).
+    pub motor: Option<(f64, f64)>,
+    /// Spring along the axis (Hz, damping ratio) to `target_translation`.
+    pub spring: Option<(f64, f64)>,
+    /// The spring's rest translation, m.
+    pub target_translation: f64,
+}
+
+impl PrismaticDesc {
+    /// A free slider along `base`'s axis.
+    #[must_use]
+    pub fn new(base: JointBaseDesc) -> Self {
+        PrismaticDesc {
+            base,
+            limit: None,
+            motor: None,
+            spring: None,
+            target_translation: 0.0,
+        }
+    }
+}
+
+/// A wheel joint: b's frame origin stays on a's frame x axis (the
+/// suspension axis), b turns freely; a spring along the axis and a
+/// rotational motor.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WheelDesc {
+    /// Bodies and frames (the suspension axis is frame a's x axis).
+    pub base: JointBaseDesc,
+    /// Translation limits along the axis (lower, upper), m.
+    pub limit: Option<(f64, f64)>,
+    /// Rotational motor (speed rad/s of b relative to a, max torque N·m).
+    pub motor: Option<(f64, f64)>,
+    /// Suspension spring (Hz, damping ratio) to translation 0; `None`
+    /// leaves the axis free.
+    pub spring: Option<(f64, f64)>,
+}
+
+impl WheelDesc {
+    /// A wheel free along `base`'s axis, no motor.
+    #[must_use]
+    pub fn new(base: JointBaseDesc) -> Self {
+        WheelDesc {
+            base,
+            limit: None,
+            motor: None,
+            spring: None,
+        }
+    }
+}
+
+/// A distance joint between the two frame origins: a rigid rod at `length`
+/// without a spring, a spring to `length` with one; either way held within
+/// `limit`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DistanceDesc {
+    /// Bodies and anchors (frame angles unused).
+    pub base: JointBaseDesc,
+    /// Rest length, m.
+    pub length: f64,
+    /// Length limits (min, max), m (a rope: max only, min 0).
+    pub limit: Option<(f64, f64)>,
+    /// Spring (Hz, damping ratio) to `length`; `None`: rigid.
+    pub spring: Option<(f64, f64)>,
+    /// The spring's force range (lower, upper), N: tension is positive
+    /// (Box2D's `lowerSpringForce`, `upperSpringForce`).
+    pub spring_force: (f64, f64),
+    /// Motor along the line (speed m/s, max force N).
+    pub motor: Option<(f64, f64)>,
+}
+
+impl DistanceDesc {
+    /// A rigid rod of `length` between the anchors.
+    #[must_use]
+    pub fn new(base: JointBaseDesc, length: f64) -> Self {
+        DistanceDesc {
+            base,
+            length,
+            limit: None,
+            spring: None,
+            spring_force: (f64::MIN, f64::MAX),
+            motor: None,
+        }
+    }
+}
+
+/// A joint of any kind, as Box2D 3.2 has them.
+#[derive(Clone, Debug, PartialEq)]
+pub enum JointDesc {
+    /// A hinge.
+    Revolute(RevoluteDesc),
+    /// A weld.
+    Weld(WeldDesc),
+    /// A slider.
+    Prismatic(PrismaticDesc),
+    /// A wheel on a suspension axis.
+    Wheel(WheelDesc),
+    /// A rod, spring or rope between two points.
+    Distance(DistanceDesc),
+}
+
+impl JointDesc {
+    /// The kind's name (`revolute`, `weld`, `prismatic`, `wheel`,
+    /// `distance`).
+    #[must_use]
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            JointDesc::Revolute(_) => "revolute",
+            JointDesc::Weld(_) => "weld",
+            JointDesc::Prismatic(_) => "prismatic",
+            JointDesc::Wheel(_) => "wheel",
+            JointDesc::Distance(_) => "distance",
+        }
+    }
+
+    /// The shared part, for every kind but the revolute (which keeps its
+    /// own fields).
+    #[must_use]
+    pub fn base(&self) -> Option<&JointBaseDesc> {
+        match self {
+            JointDesc::Revolute(_) => None,
+            JointDesc::Weld(j) => Some(&j.base),
+            JointDesc::Prismatic(j) => Some(&j.base),
+            JointDesc::Wheel(j) => Some(&j.base),
+            JointDesc::Distance(j) => Some(&j.base),
+        }
+    }
+
+    /// Indices of body a and body b.
+    #[must_use]
+    pub fn bodies(&self) -> (usize, usize) {
+        match (self, self.base()) {
+            (JointDesc::Revolute(j), _) => (j.body_a, j.body_b),
+            (_, Some(b)) => (b.body_a, b.body_b),
+            (_, None) => unreachable!("every kind but the revolute has a base"),
+        }
+    }
+
+    /// The local anchors on a and b, m.
+    #[must_use]
+    pub fn anchors(&self) -> (DVec2, DVec2) {
+        match (self, self.base()) {
+            (JointDesc::Revolute(j), _) => (j.local_a, j.local_b),
+            (_, Some(b)) => (b.frame_a.anchor, b.frame_b.anchor),
+            (_, None) => unreachable!("every kind but the revolute has a base"),
+        }
+    }
+
+    /// Whether the two bodies collide.
+    #[must_use]
+    pub fn collide_connected(&self) -> bool {
+        match (self, self.base()) {
+            (JointDesc::Revolute(j), _) => j.collide_connected,
+            (_, Some(b)) => b.collide_connected,
+            (_, None) => unreachable!("every kind but the revolute has a base"),
+        }
+    }
+}
+
+impl From<RevoluteDesc> for JointDesc {
+    fn from(j: RevoluteDesc) -> Self {
+        JointDesc::Revolute(j)
+    }
+}
+
+impl From<WeldDesc> for JointDesc {
+    fn from(j: WeldDesc) -> Self {
+        JointDesc::Weld(j)
+    }
+}
+
+impl From<PrismaticDesc> for JointDesc {
+    fn from(j: PrismaticDesc) -> Self {
+        JointDesc::Prismatic(j)
+    }
+}
+
+impl From<WheelDesc> for JointDesc {
+    fn from(j: WheelDesc) -> Self {
+        JointDesc::Wheel(j)
+    }
+}
+
+impl From<DistanceDesc> for JointDesc {
+    fn from(j: DistanceDesc) -> Self {
+        JointDesc::Distance(j)
+    }
+}
+
 /// World settings a scene runs with.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
@@ -495,8 +803,14 @@ pub struct SceneDesc {
     pub settings: Settings,
     /// Bodies present at the start.
     pub bodies: Vec<BodyDesc>,
-    /// Joints present at the start (indices into `bodies`).
+    /// Revolute joints present at the start (indices into `bodies`): the
+    /// benchmarks', the hard cases' and what the command line's scene
+    /// export reads.
     pub joints: Vec<RevoluteDesc>,
+    /// Joints of any kind present at the start (indices into `bodies`),
+    /// created after `joints`. An engine without a kind refuses the scene
+    /// at build.
+    pub extra_joints: Vec<JointDesc>,
     /// Per-step script.
     pub script: Script,
     /// The body the sanity line reports.
@@ -521,6 +835,7 @@ impl SceneDesc {
             settings: Settings::default(),
             bodies: Vec::new(),
             joints: Vec::new(),
+            extra_joints: Vec::new(),
             script: Script::None,
             probe: None,
             probe_label: "",
@@ -536,9 +851,23 @@ impl SceneDesc {
         self.bodies.len() - 1
     }
 
-    /// Adds a joint.
+    /// Adds a revolute joint.
     pub fn join(&mut self, joint: RevoluteDesc) {
         self.joints.push(joint);
+    }
+
+    /// Adds a joint of any kind (to `extra_joints`).
+    pub fn join_any(&mut self, joint: impl Into<JointDesc>) {
+        self.extra_joints.push(joint.into());
+    }
+
+    /// Every joint at the start: `joints`, then `extra_joints`.
+    pub fn all_joints(&self) -> impl Iterator<Item = JointDesc> + '_ {
+        self.joints
+            .iter()
+            .cloned()
+            .map(JointDesc::Revolute)
+            .chain(self.extra_joints.iter().cloned())
     }
 
     /// Dynamic bodies at the start.

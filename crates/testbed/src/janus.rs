@@ -11,11 +11,14 @@
 //! | `sleep_threshold`      | `BodyDef::sleep_threshold`                   |
 //! | `hit_events`           | `ShapeDef::enable_hit_events`                |
 //! | `Action::Target`       | velocity = (target − current) / dt           |
+//! | `JointDesc::Revolute`  | `RevoluteJointDef` (as `joints`)             |
+//! | `JointDesc::Weld`      | `WeldJointDef::from_base` (frames as given) `.with_stiffness` |
+//! | `JointDesc::Prismatic`, `Wheel`, `Distance` | not supported yet: [`unsupported_joint`] names them and [`Engine::build`] refuses the scene |
 
 use std::collections::BTreeMap;
 
 use glam::DVec2;
-use janus2d_constraints::RevoluteJointDef;
+use janus2d_constraints::{JointDefBase, JointFrame, RevoluteJointDef, WeldJointDef};
 use janus2d_core::body::{BodyDef, BodyHandle, BodyType};
 use janus2d_core::geometry::{Capsule, Circle, Polygon, Segment, Shape, make_chain};
 use janus2d_core::math::{Real, Vec2, from_f64, to_f64, wrap_angle};
@@ -177,13 +180,64 @@ pub fn create_joint(
     world.create_revolute_joint(&def)
 }
 
+/// The kind of the first joint of `desc` janus2d cannot build yet (`None`:
+/// every joint can be built).
+#[must_use]
+pub fn unsupported_joint(desc: &SceneDesc) -> Option<&'static str> {
+    desc.extra_joints
+        .iter()
+        .find(|j| !matches!(j, JointDesc::Revolute(_) | JointDesc::Weld(_)))
+        .map(JointDesc::kind_name)
+}
+
+/// janus2d's frame of a description's.
+fn frame(f: &FrameDesc) -> JointFrame {
+    JointFrame::new(vec(f.anchor), f.angle as Real)
+}
+
+/// janus2d's shared joint definition of a description's, bodies from
+/// `handles`.
+fn base_def(b: &JointBaseDesc, handles: &[BodyHandle]) -> JointDefBase {
+    let mut base = JointDefBase::new(handles[b.body_a], handles[b.body_b]);
+    base.local_frame_a = frame(&b.frame_a);
+    base.local_frame_b = frame(&b.frame_b);
+    base.collide_connected = b.collide_connected;
+    base
+}
+
+/// Creates one joint of any kind between bodies of `handles`. The kinds
+/// janus2d does not have yet (prismatic, wheel, distance) give
+/// `WorldError::OutOfRange` and create nothing.
+pub fn create_any_joint(
+    world: &mut World,
+    j: &JointDesc,
+    handles: &[BodyHandle],
+) -> Result<JointHandle, WorldError> {
+    match j {
+        JointDesc::Revolute(r) => create_joint(world, r, handles),
+        JointDesc::Weld(w) => {
+            let def = WeldJointDef::from_base(base_def(&w.base, handles)).with_stiffness(
+                w.linear_hertz as Real,
+                w.linear_damping_ratio as Real,
+                w.angular_hertz as Real,
+                w.angular_damping_ratio as Real,
+            );
+            world.create_weld_joint(&def)
+        }
+        JointDesc::Prismatic(_) | JointDesc::Wheel(_) | JointDesc::Distance(_) => Err(
+            WorldError::OutOfRange("joint kind not supported yet by the janus2d adapter"),
+        ),
+    }
+}
+
 /// A scene built in a janus2d world.
 pub struct Janus {
     /// The world.
     pub world: World,
     /// Handles of the scene's initial bodies, by index.
     pub bodies: Vec<BodyHandle>,
-    /// Handles of the scene's initial joints, by index.
+    /// Handles of the scene's initial joints, by index: `joints`, then
+    /// `extra_joints`.
     pub joints: Vec<JointHandle>,
     /// Handles of the scene's portal pairs, by index.
     #[cfg(feature = "portals")]
@@ -205,6 +259,9 @@ impl Janus {
         let mut joints = Vec::with_capacity(desc.joints.len());
         for j in &desc.joints {
             joints.push(create_joint(&mut world, j, &bodies)?);
+        }
+        for j in &desc.extra_joints {
+            joints.push(create_any_joint(&mut world, j, &bodies)?);
         }
         #[cfg(feature = "portals")]
         let mut portals = Vec::new();
@@ -298,6 +355,11 @@ impl Engine for Janus {
     const NAME: &'static str = "janus2d";
 
     fn build(desc: &SceneDesc, _options: EngineOptions) -> Result<Self, String> {
+        if let Some(kind) = unsupported_joint(desc) {
+            return Err(format!(
+                "not supported yet: the janus2d adapter has no {kind} joint"
+            ));
+        }
         Janus::new(desc).map_err(|e| format!("{e:?}"))
     }
 

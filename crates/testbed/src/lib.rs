@@ -11,6 +11,7 @@
 //! | [`desc`]        | the data: bodies, shapes, filters, joints, settings, scripts    |
 //! | [`benchmarks`]  | the benchmark scenes as descriptions                            |
 //! | [`hard`]        | the hard cases: description, run length, pass bounds            |
+//! | [`joint_bench`] | the peers benchmark's joint scenes and their accuracy figures   |
 //! | [`engine`]      | the [`Engine`](engine::Engine) interface an adapter implements  |
 //! | [`janus`]       | janus2d's adapter                                               |
 //! | [`measure`]     | metric code shared by all engines (penetration, joint gap, …)  |
@@ -35,6 +36,7 @@ pub mod desc;
 pub mod engine;
 pub mod hard;
 pub mod janus;
+pub mod joint_bench;
 pub mod measure;
 pub mod metrics;
 #[cfg(feature = "portals")]

@@ -54,10 +54,12 @@ impl ShapeIndex {
             }
         }
         let joined = desc
-            .joints
-            .iter()
-            .filter(|j| !j.collide_connected)
-            .map(|j| (j.body_a.min(j.body_b), j.body_a.max(j.body_b)))
+            .all_joints()
+            .filter(|j| !j.collide_connected())
+            .map(|j| {
+                let (a, b) = j.bodies();
+                (a.min(b), a.max(b))
+            })
             .collect();
         ShapeIndex { shapes, joined }
     }
@@ -116,7 +118,8 @@ impl ShapeIndex {
     }
 }
 
-/// Largest distance between the world anchors of the scene's joints.
+/// Largest distance between the world anchors of the scene's revolute
+/// `joints` (the other kinds' anchors need not meet).
 #[must_use]
 pub fn max_joint_gap(desc: &SceneDesc, states: &[Option<BodyReading>]) -> f64 {
     let world_point =
