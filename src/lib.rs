@@ -37,8 +37,8 @@ pub use janus2d_world as world;
 
 #[doc(inline)]
 pub use janus2d_constraints::{
-    Joint, JointDef, JointError, JointKind, PortalError, RevoluteJoint, RevoluteJointDef,
-    WeldJoint, WeldJointDef,
+    Joint, JointDef, JointError, JointKind, PortalError, PrismaticJoint, PrismaticJointDef,
+    RevoluteJoint, RevoluteJointDef, WeldJoint, WeldJointDef, WheelJoint, WheelJointDef,
 };
 #[doc(inline)]
 pub use janus2d_core::{
@@ -62,7 +62,8 @@ pub use janus2d_world::{
 /// The names most programs need.
 pub mod prelude {
     pub use janus2d_constraints::{
-        Joint, JointDef, JointKind, RevoluteJoint, RevoluteJointDef, WeldJoint, WeldJointDef,
+        Joint, JointDef, JointKind, PrismaticJoint, PrismaticJointDef, RevoluteJoint,
+        RevoluteJointDef, WeldJoint, WeldJointDef, WheelJoint, WheelJointDef,
     };
     pub use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
     pub use janus2d_core::constraint::SolverMode;

@@ -16,6 +16,8 @@
 //! |-------------|-----------------|-----------------------------------------------|----------------------|
 //! | `Revolute`  | `revolute.rs`   | point (2), spring, motor, lower, upper (1 each) | point (2)          |
 //! | `Weld`      | `weld.rs`       | point (2), angle (1)                          | point + angle (3) when rigid, else none |
+//! | `Prismatic` | `prismatic.rs`  | perpendicular + angle (2×2 block), spring, motor, lower, upper (1 each, along the axis) | none |
+//! | `Wheel`     | `wheel.rs`      | perpendicular (1), spring, lower, upper (1 each, along the axis), motor (angular) | none |
 //!
 //! Everything the solver needs from a joint that is not its own rows is in
 //! [`JointBase`]: the state indices, the masses loaded at prepare, whether
@@ -47,8 +49,10 @@ use crate::JointError;
 use crate::joint_base::JointBase;
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::parts::{BOTH, PairOf, PairStates, PointPart};
+use crate::prismatic::{PrismaticJoint, PrismaticJointDef};
 use crate::revolute::{RevoluteJoint, RevoluteJointDef};
 use crate::weld::{WeldJoint, WeldJointDef};
+use crate::wheel::{WheelJoint, WheelJointDef};
 
 /// What a joint kind's solver form supplies: its rows' stages, read-backs
 /// and what the tree solve may take. Dispatched by [`Joint`]'s match
@@ -377,6 +381,12 @@ joint_kinds! {
     /// A weld: two anchors coincide and the relative angle is held,
     /// rigidly or through springs.
     Weld(WeldJoint, WeldJointDef),
+    /// A slide: b moves along an axis fixed in a, the relative angle
+    /// locked; optional limits, linear motor and spring.
+    Prismatic(PrismaticJoint, PrismaticJointDef),
+    /// A wheel: b's centre moves along a's suspension axis on a spring and
+    /// turns freely; optional limits and a rotational motor.
+    Wheel(WheelJoint, WheelJointDef),
 }
 
 impl JointDef {

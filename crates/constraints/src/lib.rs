@@ -7,6 +7,8 @@
 //! | [`joint::Joint`]              | per kind | 2  | one file per kind ([`joint`]) |
 //! | [`revolute::RevoluteJoint`]   | 2–6  | 2      | point + angle parts     |
 //! | [`weld::WeldJoint`]           | 3    | 2      | point + angle parts     |
+//! | [`prismatic::PrismaticJoint`] | 2–6  | 2      | axis rows + angle row   |
+//! | [`wheel::WheelJoint`]         | 1–5  | 2      | axis rows + angle motor |
 //! | [`portal::PortalConstraint`]  | 3    | 4      | portal part + portal map |
 //! | [`contact::ContactConstraint`]| 2–4  | 2      | contact rows (normal, friction) |
 //!
@@ -38,8 +40,10 @@ pub mod lane;
 pub mod parts;
 pub mod portal;
 pub mod portal_map;
+pub mod prismatic;
 pub mod revolute;
 pub mod weld;
+pub mod wheel;
 
 pub use contact::{ContactConstraint, ContactPointInput};
 pub use contact_solver::{ContactBatch, ContactSolver, ObjectMass, PointImpulse};
@@ -51,8 +55,10 @@ pub use joint_solver::JointBatch;
 pub use joint_tree::JointForest;
 pub use portal::{PortalBatch, PortalConstraint, PortalConstraintDef};
 pub use portal_map::{Portal, PortalError, PortalMap, PortalPair};
+pub use prismatic::{PrismaticJoint, PrismaticJointDef};
 pub use revolute::{RevoluteJoint, RevoluteJointDef};
 pub use weld::{WeldJoint, WeldJointDef};
+pub use wheel::{WheelJoint, WheelJointDef};
 
 /// Invalid joint input at the API boundary.
 #[derive(Clone, Debug, PartialEq)]
