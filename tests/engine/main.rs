@@ -15,6 +15,7 @@ mod effects;
 mod joint_tree_properties;
 mod kinematic_targets;
 mod pendulum;
+mod prismatic;
 mod queries;
 mod reliability;
 mod revolute_properties;
