@@ -23,3 +23,4 @@ mod setters;
 mod snapshot;
 mod stages;
 mod weld;
+mod wheel;
