@@ -11,9 +11,13 @@ mod portal_edges;
 mod portal_grazing;
 #[cfg(feature = "portals")]
 mod portal_joints;
+#[cfg(feature = "portals")]
+mod portal_prismatic;
 mod portal_properties;
 #[cfg(feature = "portals")]
 mod portal_scenes;
 mod portal_sim;
+#[cfg(feature = "portals")]
+mod portal_wheel;
 #[cfg(feature = "portals")]
 mod portal_stiff;
