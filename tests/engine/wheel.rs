@@ -94,8 +94,10 @@ const BUMPS: [Real; 7] = [10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0];
 /// to stand 5 cm proud) every 10 m from x = 10 m. Default world
 /// (g = −10 m/s², 4 substeps) but for `continuous`, 8 s at 60 Hz.
 fn car(continuous: bool) -> Car {
-    let mut def = WorldDef::default();
-    def.enable_continuous = continuous;
+    let def = WorldDef {
+        enable_continuous: continuous,
+        ..WorldDef::default()
+    };
     let mut world = World::new(def).unwrap();
     let ground = world
         .create_body(&BodyDef::fixed(Vec2::new(240.0, -0.5)))
@@ -133,7 +135,11 @@ fn car(continuous: bool) -> Car {
             .create_body(&BodyDef::dynamic(Vec2::new(x, RADIUS)))
             .unwrap();
         world
-            .create_shape(wheel, &wheel_shape, Circle::new(Vec2::ZERO, RADIUS).unwrap())
+            .create_shape(
+                wheel,
+                &wheel_shape,
+                Circle::new(Vec2::ZERO, RADIUS).unwrap(),
+            )
             .unwrap();
         let mut def = WheelJointDef::new(
             chassis,
@@ -164,9 +170,7 @@ fn car(continuous: bool) -> Car {
             out.off_axis = out.off_axis.max(perp.abs());
             out.travel = (out.travel.0.min(t), out.travel.1.max(t));
         }
-        out.top_speed = out
-            .top_speed
-            .max(world.linear_velocity(chassis).unwrap().x);
+        out.top_speed = out.top_speed.max(world.linear_velocity(chassis).unwrap().x);
     }
     out.end_speed = world.linear_velocity(chassis).unwrap().x;
     out.distance = world.position(chassis).unwrap().x;
@@ -179,7 +183,13 @@ fn report_car(what: &str, c: &Car) {
         eprintln!(
             "car ({what}): off-axis {:.3e} m, top speed {:.3} m/s, end speed {:.3} m/s, \
              travel [{:.3}, {:.3}] m, {:.1} m, {} bumps passed",
-            c.off_axis, c.top_speed, c.end_speed, c.travel.0, c.travel.1, c.distance, c.bumps_passed
+            c.off_axis,
+            c.top_speed,
+            c.end_speed,
+            c.travel.0,
+            c.travel.1,
+            c.distance,
+            c.bumps_passed
         );
     }
 }
@@ -276,6 +286,9 @@ fn bad_wheel_input_is_a_typed_error_and_changes_nothing() {
     world.set_joint_spring(joint, 4.0, 0.5).unwrap();
     let d = world.joint_of::<WheelJoint>(joint).unwrap().def.clone();
     assert!(d.enable_limit && d.enable_motor && d.enable_spring);
-    assert_eq!((d.max_motor_torque, d.hertz, d.damping_ratio), (30.0, 4.0, 0.5));
+    assert_eq!(
+        (d.max_motor_torque, d.hertz, d.damping_ratio),
+        (30.0, 4.0, 0.5)
+    );
     assert_eq!(world.joint(joint).unwrap().kind(), JointKind::Wheel);
 }

@@ -18,6 +18,6 @@ mod portal_properties;
 mod portal_scenes;
 mod portal_sim;
 #[cfg(feature = "portals")]
-mod portal_wheel;
-#[cfg(feature = "portals")]
 mod portal_stiff;
+#[cfg(feature = "portals")]
+mod portal_wheel;

@@ -79,10 +79,8 @@ pub(super) fn run(
             r.worst = Real::INFINITY;
         }
     }
-    r.through = world.crossing_count() == 0
-        && bodies
-            .iter()
-            .all(|&b| world.position(b).unwrap().x < 0.0);
+    r.through =
+        world.crossing_count() == 0 && bodies.iter().all(|&b| world.position(b).unwrap().x < 0.0);
     r
 }
 
@@ -92,8 +90,7 @@ pub(super) fn falling_pair(world: &mut World) -> (BodyHandle, BodyHandle) {
     let make = |world: &mut World, y: Real| {
         let b = world
             .create_body(
-                &BodyDef::dynamic(Vec2::new(ENTRY_CENTER.x, y))
-                    .with_velocity(Vec2::new(0.0, -3.0)),
+                &BodyDef::dynamic(Vec2::new(ENTRY_CENTER.x, y)).with_velocity(Vec2::new(0.0, -3.0)),
             )
             .unwrap();
         world
@@ -121,7 +118,7 @@ fn prismatic_pair_through_a_scaled_turned_portal_keeps_its_axis() {
         Vec2::new(0.0, -0.4),
         Vec2::Y,
     )
-        .with_spring(4.0, 0.7);
+    .with_spring(4.0, 0.7);
     let joint = world.create_joint(&def.into()).unwrap();
     let r = run(&mut world, pair, joint, [lower, upper]);
     let j = world.joint_of::<PrismaticJoint>(joint).unwrap();
@@ -135,9 +132,5 @@ fn prismatic_pair_through_a_scaled_turned_portal_keeps_its_axis() {
     assert!(j.is_enabled());
     assert_eq!(r.completed, 2, "both boxes cross");
     assert!(r.through, "the pair did not come out");
-    assert!(
-        r.worst <= 1e-3,
-        "worst perpendicular error {} m",
-        r.worst
-    );
+    assert!(r.worst <= 1e-3, "worst perpendicular error {} m", r.worst);
 }

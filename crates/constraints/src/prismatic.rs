@@ -668,8 +668,14 @@ impl PrismaticJoint {
         }
         if self.def.enable_motor {
             let max_impulse = ctx.h * self.def.max_motor_force;
-            self.motor
-                .solve_motor(&mut sa, &mut sb, &m, &axial, self.def.motor_speed, max_impulse);
+            self.motor.solve_motor(
+                &mut sa,
+                &mut sb,
+                &m,
+                &axial,
+                self.def.motor_speed,
+                max_impulse,
+            );
         }
         if self.def.enable_limit {
             let soft = self.linear_softness;
@@ -733,7 +739,8 @@ impl PrismaticJoint {
         let c_dot_t = sb.w - sa.w;
         let (i_a, i_b) = (m.a.inv_inertia, m.b.inv_inertia);
         if block_is_regular(&m) {
-            let k11 = m.a.inv_mass + m.b.inv_mass + i_a * perp.s_a * perp.s_a + i_b * perp.s_b * perp.s_b;
+            let k11 =
+                m.a.inv_mass + m.b.inv_mass + i_a * perp.s_a * perp.s_a + i_b * perp.s_b * perp.s_b;
             let k12 = i_a * perp.s_a + i_b * perp.s_b;
             let k22 = i_a + i_b;
             let x = janus2d_core::math::solve22(
@@ -751,8 +758,12 @@ impl PrismaticJoint {
             sb.w += i_b * d_angle;
         } else {
             if i_a + i_b > 0.0 {
-                let d_angle =
-                    soft_impulse(ms_t / (i_a + i_b), c_dot_t + bias_t, is_t, self.angle_impulse);
+                let d_angle = soft_impulse(
+                    ms_t / (i_a + i_b),
+                    c_dot_t + bias_t,
+                    is_t,
+                    self.angle_impulse,
+                );
                 self.angle_impulse += d_angle;
                 sa.w -= i_a * d_angle;
                 sb.w += i_b * d_angle;
@@ -873,7 +884,8 @@ impl Constraint for PrismaticJoint {
         out.rows
             .push(at.angle_row(1.0, self.angle(bodies), angular, free, self.angle_impulse));
         let (i_a, i_b) = (m.a.inv_inertia, m.b.inv_inertia);
-        let k11 = m.a.inv_mass + m.b.inv_mass + i_a * perp.s_a * perp.s_a + i_b * perp.s_b * perp.s_b;
+        let k11 =
+            m.a.inv_mass + m.b.inv_mass + i_a * perp.s_a * perp.s_a + i_b * perp.s_b * perp.s_b;
         let k12 = i_a * perp.s_a + i_b * perp.s_b;
         let k22 = i_a + i_b;
         if block_is_regular(&m) {
@@ -892,10 +904,8 @@ impl Constraint for PrismaticJoint {
             }
         }
         let axial = &rows.axial;
-        let k_axial = m.a.inv_mass
-            + m.b.inv_mass
-            + i_a * axial.s_a * axial.s_a
-            + i_b * axial.s_b * axial.s_b;
+        let k_axial =
+            m.a.inv_mass + m.b.inv_mass + i_a * axial.s_a * axial.s_a + i_b * axial.s_b * axial.s_b;
         let t = rows.translation;
         let mut axial_row =
             |sign: Real, c: Real, softness: Softness, bounds: (Real, Real), impulse: Real| {
