@@ -40,7 +40,8 @@ pub use janus2d_constraints::{FilterJoint, FilterJointDef, MotorJoint, MotorJoin
 #[doc(inline)]
 pub use janus2d_constraints::{
     Joint, JointDef, JointDefBase, JointError, JointFrame, JointKind, JointOfKind, PortalError,
-    RevoluteJoint, RevoluteJointDef, WeldJoint, WeldJointDef,
+    PrismaticJoint, PrismaticJointDef, RevoluteJoint, RevoluteJointDef, WeldJoint, WeldJointDef,
+    WheelJoint, WheelJointDef,
 };
 #[doc(inline)]
 pub use janus2d_core::{
@@ -65,8 +66,9 @@ pub use janus2d_world::{
 pub mod prelude {
     pub use janus2d_constraints::{FilterJoint, FilterJointDef, MotorJoint, MotorJointDef};
     pub use janus2d_constraints::{
-        Joint, JointDef, JointDefBase, JointFrame, JointKind, JointOfKind, RevoluteJoint,
-        RevoluteJointDef, WeldJoint, WeldJointDef,
+        Joint, JointDef, JointDefBase, JointFrame, JointKind, JointOfKind, PrismaticJoint,
+        PrismaticJointDef, RevoluteJoint, RevoluteJointDef, WeldJoint, WeldJointDef, WheelJoint,
+        WheelJointDef,
     };
     pub use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
     pub use janus2d_core::constraint::SolverMode;

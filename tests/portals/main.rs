@@ -15,9 +15,12 @@ mod portal_grazing;
 mod portal_joints;
 #[cfg(feature = "portals")]
 mod portal_motor;
+mod portal_prismatic;
 mod portal_properties;
 #[cfg(feature = "portals")]
 mod portal_scenes;
 mod portal_sim;
 #[cfg(feature = "portals")]
 mod portal_stiff;
+#[cfg(feature = "portals")]
+mod portal_wheel;

@@ -18,6 +18,8 @@
 //! | `Weld`      | `weld.rs`       | point (2), angle (1)                          | point + angle (3) when rigid, else none |
 //! | `Motor`     | `motor.rs`      | linear (2, force-bounded), angular (1, torque-bounded) | none            |
 //! | `Filter`    | `filter.rs`     | none (only `collide_connected = false`)       | none                 |
+//! | `Prismatic` | `prismatic.rs`  | perpendicular + angle (2×2 block), spring, motor, lower, upper (1 each, along the axis) | none |
+//! | `Wheel`     | `wheel.rs`      | perpendicular (1), spring, lower, upper (1 each, along the axis), motor (angular) | none |
 //!
 //! Everything the solver needs from a joint that is not its own rows is in
 //! [`JointBase`]: the state indices, the masses loaded at prepare, whether
@@ -51,8 +53,10 @@ use crate::joint_base::JointBase;
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::motor::{MotorJoint, MotorJointDef};
 use crate::parts::{BOTH, PairOf, PairStates, PointPart};
+use crate::prismatic::{PrismaticJoint, PrismaticJointDef};
 use crate::revolute::{RevoluteJoint, RevoluteJointDef};
 use crate::weld::{WeldJoint, WeldJointDef};
+use crate::wheel::{WheelJoint, WheelJointDef};
 
 /// What a joint kind's solver form supplies: its rows' stages, read-backs
 /// and what the tree solve may take. Dispatched by [`Joint`]'s match
@@ -398,6 +402,12 @@ joint_kinds! {
     Motor(MotorJoint, MotorJointDef),
     /// A filter: no rows; its two bodies do not collide.
     Filter(FilterJoint, FilterJointDef),
+    /// A slide: b moves along an axis fixed in a, the relative angle
+    /// locked; optional limits, linear motor and spring.
+    Prismatic(PrismaticJoint, PrismaticJointDef),
+    /// A wheel: b's centre moves along a's suspension axis on a spring and
+    /// turns freely; optional limits and a rotational motor.
+    Wheel(WheelJoint, WheelJointDef),
 }
 
 impl JointDef {

@@ -239,6 +239,26 @@ impl RowsAt {
         }
     }
 
+    /// A row along a direction `n` (an [`AxisRow`](crate::parts::AxisRow)):
+    /// `J = [−n, −s_a │ n, s_b]` with impulse bounds.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn axis_row(
+        &self,
+        n: Vec2,
+        (s_a, s_b): (Real, Real),
+        c: Real,
+        softness: Softness,
+        (lower, upper): (Real, Real),
+        impulse: Real,
+    ) -> Row {
+        Row {
+            lower,
+            upper,
+            impulse,
+            ..self.row([-n, n], [-s_a, s_b], c, softness)
+        }
+    }
+
     /// An angle row `J = [0, −sign │ 0, sign]` with impulse bounds.
     pub(crate) fn angle_row(
         &self,

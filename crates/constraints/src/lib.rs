@@ -9,6 +9,8 @@
 //! | [`weld::WeldJoint`]           | 3    | 2      | point + angle parts     |
 //! | [`motor::MotorJoint`]         | 3    | 2      | point + angle parts, force- and torque-bounded |
 //! | [`filter::FilterJoint`]       | 0    | 2      | nothing (only stops the pair colliding) |
+//! | [`prismatic::PrismaticJoint`] | 2–6  | 2      | axis rows + angle row   |
+//! | [`wheel::WheelJoint`]         | 1–5  | 2      | axis rows + angle motor |
 //! | [`portal::PortalConstraint`]  | 3    | 4      | portal part + portal map |
 //! | [`contact::ContactConstraint`]| 2–4  | 2      | contact rows (normal, friction) |
 //!
@@ -42,8 +44,10 @@ pub mod motor;
 pub mod parts;
 pub mod portal;
 pub mod portal_map;
+pub mod prismatic;
 pub mod revolute;
 pub mod weld;
+pub mod wheel;
 
 pub use contact::{ContactConstraint, ContactPointInput};
 pub use contact_solver::{ContactBatch, ContactSolver, ObjectMass, PointImpulse};
@@ -57,8 +61,10 @@ pub use joint_tree::JointForest;
 pub use motor::{MotorJoint, MotorJointDef};
 pub use portal::{PortalBatch, PortalConstraint, PortalConstraintDef};
 pub use portal_map::{Portal, PortalError, PortalMap, PortalPair};
+pub use prismatic::{PrismaticJoint, PrismaticJointDef};
 pub use revolute::{RevoluteJoint, RevoluteJointDef};
 pub use weld::{WeldJoint, WeldJointDef};
+pub use wheel::{WheelJoint, WheelJointDef};
 
 /// Invalid joint input at the API boundary.
 #[derive(Clone, Debug, PartialEq)]

@@ -402,6 +402,7 @@ impl AnglePart {
 /// line), with its effective mass `1 / K`, `K = J M⁻¹ Jᵀ`. Built by the
 /// kind every iteration from the states' deltas; used by [`AxisPart`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct AxisRow {
     /// The row's direction (unit), world frame.
     pub n: Vec2,
