@@ -18,6 +18,8 @@
 //! | `Weld`      | `weld.rs`       | point (2), angle (1)                          | point + angle (3) when rigid, else none |
 //! | `Motor`     | `motor.rs`      | linear (2, force-bounded), angular (1, torque-bounded) | none            |
 //! | `Filter`    | `filter.rs`     | none (only `collide_connected = false`)       | none                 |
+//! | `Distance`  | `distance.rs`   | length or spring, motor, lower, upper (1 each, along the line) | none |
+//! | `Mouse`     | `mouse.rs`      | point toward the target (2, body b only), angular damping (1) | none |
 //!
 //! Everything the solver needs from a joint that is not its own rows is in
 //! [`JointBase`]: the state indices, the masses loaded at prepare, whether
@@ -51,6 +53,8 @@ use crate::joint_base::JointBase;
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::motor::{MotorJoint, MotorJointDef};
 use crate::parts::{BOTH, PairOf, PairStates, PointPart};
+use crate::distance::{DistanceJoint, DistanceJointDef};
+use crate::mouse::{MouseJoint, MouseJointDef};
 use crate::revolute::{RevoluteJoint, RevoluteJointDef};
 use crate::weld::{WeldJoint, WeldJointDef};
 
@@ -398,6 +402,12 @@ joint_kinds! {
     Motor(MotorJoint, MotorJointDef),
     /// A filter: no rows; its two bodies do not collide.
     Filter(FilterJoint, FilterJointDef),
+    /// A distance: two anchors at a length (rigid or spring), between a
+    /// minimum and a maximum (a rope), with a motor along the line.
+    Distance(DistanceJoint, DistanceJointDef),
+    /// A mouse (target) joint: pulls a point of body b toward a world
+    /// target with a spring of bounded force.
+    Mouse(MouseJoint, MouseJointDef),
 }
 
 impl JointDef {

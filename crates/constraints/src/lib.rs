@@ -9,6 +9,8 @@
 //! | [`weld::WeldJoint`]           | 3    | 2      | point + angle parts     |
 //! | [`motor::MotorJoint`]         | 3    | 2      | point + angle parts, force- and torque-bounded |
 //! | [`filter::FilterJoint`]       | 0    | 2      | nothing (only stops the pair colliding) |
+//! | [`distance::DistanceJoint`]   | 0–4  | 2      | axis rows along the anchors' line |
+//! | [`mouse::MouseJoint`]         | 2–3  | 2 (moves b only) | soft point toward a world target + angular damping |
 //! | [`portal::PortalConstraint`]  | 3    | 4      | portal part + portal map |
 //! | [`contact::ContactConstraint`]| 2–4  | 2      | contact rows (normal, friction) |
 //!
@@ -31,6 +33,7 @@ pub mod contact_group;
 pub mod contact_row;
 pub mod contact_solver;
 pub mod filter;
+pub mod distance;
 pub mod joint;
 pub mod joint_base;
 pub mod joint_colour;
@@ -39,6 +42,7 @@ pub mod joint_solver;
 pub mod joint_tree;
 pub mod lane;
 pub mod motor;
+pub mod mouse;
 pub mod parts;
 pub mod portal;
 pub mod portal_map;
@@ -48,6 +52,7 @@ pub mod weld;
 pub use contact::{ContactConstraint, ContactPointInput};
 pub use contact_solver::{ContactBatch, ContactSolver, ObjectMass, PointImpulse};
 pub use filter::{FilterJoint, FilterJointDef};
+pub use distance::{DistanceJoint, DistanceJointDef};
 pub use joint::{Joint, JointDef, JointKind, JointOfKind};
 pub use joint_base::JointBase;
 pub use joint_colour::JointColours;
@@ -55,6 +60,7 @@ pub use joint_def::{JointDefBase, JointFrame, KindDef, LimitsMut, MotorMut, Spri
 pub use joint_solver::JointBatch;
 pub use joint_tree::JointForest;
 pub use motor::{MotorJoint, MotorJointDef};
+pub use mouse::{MouseJoint, MouseJointDef};
 pub use portal::{PortalBatch, PortalConstraint, PortalConstraintDef};
 pub use portal_map::{Portal, PortalError, PortalMap, PortalPair};
 pub use revolute::{RevoluteJoint, RevoluteJointDef};
