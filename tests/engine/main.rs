@@ -19,6 +19,7 @@ mod joint_events;
 mod joint_tree_properties;
 mod kinematic_targets;
 mod motor;
+mod mouse;
 mod pendulum;
 mod queries;
 mod reliability;
