@@ -36,9 +36,7 @@ pub use janus2d_core as base;
 pub use janus2d_world as world;
 
 #[doc(inline)]
-pub use janus2d_constraints::{
-    DistanceJoint, DistanceJointDef, MouseJoint, MouseJointDef,
-};
+pub use janus2d_constraints::{DistanceJoint, DistanceJointDef, MouseJoint, MouseJointDef};
 #[doc(inline)]
 pub use janus2d_constraints::{FilterJoint, FilterJointDef, MotorJoint, MotorJointDef};
 #[doc(inline)]

@@ -123,11 +123,7 @@ fn dist_case(type_a: impl Strategy<Value = BodyType> + Clone) -> impl Strategy<V
             let (pa, pb) = case.world_anchors();
             let len = (pb - pa).length();
             if len < 2.0 {
-                let dir = if len > 0.1 {
-                    (pb - pa) / len
-                } else {
-                    Vec2::X
-                };
+                let dir = if len > 0.1 { (pb - pa) / len } else { Vec2::X };
                 case.b.center += (2.5 - len) * dir;
             }
             case

@@ -150,8 +150,8 @@ fn mouse_k_is_j_inverse_mass_j_transpose() {
                         let (i, j) = (block.first_row + p, block.first_row + q);
                         let jmj = d(rows.jmj(i, j));
                         let e = &rows.rows[i].jacobian[1];
-                        let scale = d(e.inv_mass)
-                            + d(e.inv_inertia) * d(e.angular.abs()).max(1.0).powi(2);
+                        let scale =
+                            d(e.inv_mass) + d(e.inv_inertia) * d(e.angular.abs()).max(1.0).powi(2);
                         let bound = 32.0 * EPS * scale;
                         let err = (d(block.k[p][q]) - jmj).abs();
                         prop_assert!(
@@ -417,7 +417,10 @@ fn mouse_drags_a_box_out_of_pyramid20() {
         "pyramid20 drag: top box from {grab:?} to {p:?} (target {target:?}, {to_target:.4} m off); worst other box moved {:.3} mm",
         1e3 * worst
     );
-    assert!(p.y > grab.y + 1.5 && p.x > grab.x + 1.5, "not dragged out: {p:?}");
+    assert!(
+        p.y > grab.y + 1.5 && p.x > grab.x + 1.5,
+        "not dragged out: {p:?}"
+    );
     assert!(to_target < 0.05, "{to_target} m from the target");
     assert!(worst <= 0.05, "another box moved {worst} m");
 }
@@ -467,7 +470,8 @@ fn mouse_target_moves_through_set_joint_def_and_bad_input_is_rejected() {
         Err(WorldError::OutOfBounds { .. })
     ));
     assert_eq!(
-        w.create_joint(&with(&|d| d.max_force = Real::NAN)).map(|_| ()),
+        w.create_joint(&with(&|d| d.max_force = Real::NAN))
+            .map(|_| ()),
         err(JointError::NonFinite)
     );
     assert_eq!(

@@ -185,13 +185,7 @@ impl DistanceJointDef {
             enable_limit: true,
             min_length: 0.0,
             max_length,
-            ..Self::new(
-                body_a,
-                body_b,
-                local_anchor_a,
-                local_anchor_b,
-                max_length,
-            )
+            ..Self::new(body_a, body_b, local_anchor_a, local_anchor_b, max_length)
         }
     }
 
@@ -823,5 +817,79 @@ impl Constraint for DistanceJoint {
 
     fn is_enabled(&self) -> bool {
         self.base.enabled
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use janus2d_core::body::BodyDef;
+    use janus2d_core::solver::SolverSettings;
+
+    /// Two moving bodies and a distance joint with every row, prepared,
+    /// with nonzero kept impulses.
+    fn prepared() -> (BodySet, DistanceJoint, StepContext) {
+        let mut set = BodySet::new();
+        let a = set
+            .create(
+                &BodyDef::dynamic(Vec2::new(0.3, -0.2))
+                    .with_mass(2.0, 0.3)
+                    .with_angle(0.4),
+            )
+            .unwrap();
+        let b = set
+            .create(
+                &BodyDef::dynamic(Vec2::new(1.7, 0.9))
+                    .with_mass(0.5, 0.05)
+                    .with_angle(-1.1),
+            )
+            .unwrap();
+        let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
+        let def = DistanceJointDef::new(a, b, Vec2::new(0.1, 0.2), Vec2::new(-0.3, 0.1), 1.5)
+            .with_limits(1.0, 2.0)
+            .with_motor(0.5, 10.0);
+        let mut joint = DistanceJoint::new(def);
+        joint.prepare(&ctx, &set);
+        joint.length_row.impulse = 0.3;
+        joint.motor.impulse = -0.2;
+        joint.lower.impulse = 0.05;
+        joint.upper.impulse = 0.7;
+        (set, joint, ctx)
+    }
+
+    #[test]
+    fn warm_start_side_is_the_warm_start_body_by_body() {
+        let (set, mut joint, ctx) = prepared();
+        let mut whole = set.states.clone();
+        joint.warm_start(&ctx, &mut whole);
+        let mut sides = set.states.clone();
+        for (s, side_b) in [(joint.base.state_a, false), (joint.base.state_b, true)] {
+            joint.warm_start_side(&mut sides[s as usize], side_b);
+        }
+        for (w, s) in whole.iter().zip(&sides) {
+            assert_eq!((w.v, w.w), (s.v, s.w));
+        }
+        assert_ne!(
+            whole[joint.base.state_b as usize].v,
+            set.states[joint.base.state_b as usize].v
+        );
+    }
+
+    #[test]
+    fn rows_follow_the_switches() {
+        let (set, joint, ctx) = prepared();
+        assert_eq!(joint.rows(&ctx, &set).rows.len(), 4);
+        let (a, b) = (joint.def.base.body_a, joint.def.base.body_b);
+        let rope = DistanceJoint::new(DistanceJointDef::rope(a, b, Vec2::ZERO, Vec2::ZERO, 2.0));
+        assert!(rope.def.is_rope() && !rope.def.is_rigid());
+        assert_eq!(rope.row_count(), 2);
+        assert_eq!(rope.rows(&ctx, &set).rows.len(), 2);
+        // Limits with no range: the rigid row at the clamped length.
+        let closed = DistanceJointDef::new(a, b, Vec2::ZERO, Vec2::ZERO, 3.0)
+            .with_spring(2.0, 0.5)
+            .with_limits(1.5, 1.5);
+        assert!(closed.is_rigid());
+        assert_eq!(closed.rigid_length(), 1.5);
+        assert_eq!(DistanceJoint::new(closed).row_count(), 1);
     }
 }

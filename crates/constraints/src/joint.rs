@@ -48,13 +48,13 @@ use janus2d_core::constraint::{Constraint, ConstraintRows, StepContext};
 use janus2d_core::math::{Real, Rot, Vec2};
 
 use crate::JointError;
+use crate::distance::{DistanceJoint, DistanceJointDef};
 use crate::filter::{FilterJoint, FilterJointDef};
 use crate::joint_base::JointBase;
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::motor::{MotorJoint, MotorJointDef};
-use crate::parts::{BOTH, PairOf, PairStates, PointPart};
-use crate::distance::{DistanceJoint, DistanceJointDef};
 use crate::mouse::{MouseJoint, MouseJointDef};
+use crate::parts::{BOTH, PairOf, PairStates, PointPart};
 use crate::revolute::{RevoluteJoint, RevoluteJointDef};
 use crate::weld::{WeldJoint, WeldJointDef};
 

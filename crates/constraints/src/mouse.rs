@@ -68,10 +68,10 @@ use crate::{JointError, check_spring};
 /// let mut bodies = BodySet::new();
 /// let ground = bodies.create(&BodyDef::fixed(Vec2::ZERO)).unwrap();
 /// let b = bodies.create(&BodyDef::dynamic(Vec2::new(1.0, 2.0))).unwrap();
-/// // Grab b at the world point (1.2, 2.0), pull with at most 500 N.
-/// let def = MouseJointDef::at_world_point(&bodies, ground, b, Vec2::new(1.2, 2.0), 500.0).unwrap();
-/// assert_eq!(def.base.local_frame_b.anchor, Vec2::new(0.2, 0.0));
-/// assert_eq!(def.target, Vec2::new(1.2, 2.0));
+/// // Grab b at the world point (1.5, 2.0), pull with at most 500 N.
+/// let def = MouseJointDef::at_world_point(&bodies, ground, b, Vec2::new(1.5, 2.0), 500.0).unwrap();
+/// assert_eq!(def.base.local_frame_b.anchor, Vec2::new(0.5, 0.0));
+/// assert_eq!(def.target, Vec2::new(1.5, 2.0));
 /// assert_eq!((def.hertz, def.damping_ratio), (5.0, 0.7));
 /// assert!(def.validate().is_ok());
 /// let mut bad = def.clone();
@@ -367,11 +367,22 @@ impl MouseJoint {
         let c = sb.dp + r_b + self.delta_center;
         let c_dot = sb.v + cross_sv(sb.w, r_b);
         let soft = self.linear_softness;
-        let (k11, k12, k22) = PointPart::effective_mass(&b_only(&self.base.masses), Vec2::ZERO, r_b);
+        let (k11, k12, k22) =
+            PointPart::effective_mass(&b_only(&self.base.masses), Vec2::ZERO, r_b);
         let x = solve22(k11, k12, k22, c_dot + soft.bias_rate * c);
         let step = Vec2::new(
-            soft_impulse(soft.mass_scale, x.x, soft.impulse_scale, self.linear_impulse.x),
-            soft_impulse(soft.mass_scale, x.y, soft.impulse_scale, self.linear_impulse.y),
+            soft_impulse(
+                soft.mass_scale,
+                x.x,
+                soft.impulse_scale,
+                self.linear_impulse.x,
+            ),
+            soft_impulse(
+                soft.mass_scale,
+                x.y,
+                soft.impulse_scale,
+                self.linear_impulse.y,
+            ),
         );
         let old = self.linear_impulse;
         let mut total = old + step;
@@ -512,5 +523,51 @@ impl Constraint for MouseJoint {
 
     fn is_enabled(&self) -> bool {
         self.base.enabled
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use janus2d_core::body::BodyDef;
+    use janus2d_core::solver::SolverSettings;
+
+    #[test]
+    fn warm_start_side_is_the_warm_start_body_by_body_and_leaves_a_alone() {
+        let mut set = BodySet::new();
+        let a = set
+            .create(&BodyDef::dynamic(Vec2::new(-1.0, 0.5)).with_mass(3.0, 0.2))
+            .unwrap();
+        let b = set
+            .create(
+                &BodyDef::dynamic(Vec2::new(0.7, 0.2))
+                    .with_mass(0.5, 0.05)
+                    .with_angle(0.8),
+            )
+            .unwrap();
+        let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
+        let mut def = MouseJointDef::new(a, b, Vec2::new(2.0, 1.0), 100.0);
+        def.base.local_frame_b.anchor = Vec2::new(0.2, -0.1);
+        let mut joint = MouseJoint::new(def);
+        joint.prepare(&ctx, &set);
+        joint.linear_impulse = Vec2::new(0.4, -0.3);
+        joint.angular_impulse = 0.02;
+        let mut whole = set.states.clone();
+        joint.warm_start(&ctx, &mut whole);
+        let mut sides = set.states.clone();
+        for (s, side_b) in [(joint.base.state_a, false), (joint.base.state_b, true)] {
+            joint.warm_start_side(&mut sides[s as usize], side_b);
+        }
+        for (w, s) in whole.iter().zip(&sides) {
+            assert_eq!((w.v, w.w), (s.v, s.w));
+        }
+        let sa = joint.base.state_a as usize;
+        assert_eq!(
+            (whole[sa].v, whole[sa].w),
+            (set.states[sa].v, set.states[sa].w)
+        );
+        assert_eq!(joint.rows(&ctx, &set).rows.len(), 3);
+        let quiet = MouseJoint::new(joint.def.clone().with_angular_damping(0.0, 0.0));
+        assert_eq!(quiet.row_count(), 2);
     }
 }
