@@ -36,6 +36,8 @@ pub use janus2d_core as base;
 pub use janus2d_world as world;
 
 #[doc(inline)]
+pub use janus2d_constraints::{DistanceJoint, DistanceJointDef, MouseJoint, MouseJointDef};
+#[doc(inline)]
 pub use janus2d_constraints::{FilterJoint, FilterJointDef, MotorJoint, MotorJointDef};
 #[doc(inline)]
 pub use janus2d_constraints::{
@@ -64,6 +66,7 @@ pub use janus2d_world::{
 
 /// The names most programs need.
 pub mod prelude {
+    pub use janus2d_constraints::{DistanceJoint, DistanceJointDef, MouseJoint, MouseJointDef};
     pub use janus2d_constraints::{FilterJoint, FilterJointDef, MotorJoint, MotorJointDef};
     pub use janus2d_constraints::{
         Joint, JointDef, JointDefBase, JointFrame, JointKind, JointOfKind, PrismaticJoint,

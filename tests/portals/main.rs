@@ -6,6 +6,8 @@
 #[cfg(feature = "portals")]
 mod portal_apertures;
 #[cfg(feature = "portals")]
+mod portal_distance;
+#[cfg(feature = "portals")]
 mod portal_edges;
 #[cfg(feature = "portals")]
 mod portal_filter;
@@ -15,6 +17,8 @@ mod portal_grazing;
 mod portal_joints;
 #[cfg(feature = "portals")]
 mod portal_motor;
+#[cfg(feature = "portals")]
+mod portal_mouse;
 mod portal_prismatic;
 mod portal_properties;
 #[cfg(feature = "portals")]

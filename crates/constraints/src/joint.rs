@@ -20,6 +20,8 @@
 //! | `Filter`    | `filter.rs`     | none (only `collide_connected = false`)       | none                 |
 //! | `Prismatic` | `prismatic.rs`  | perpendicular + angle (2×2 block), spring, motor, lower, upper (1 each, along the axis) | none |
 //! | `Wheel`     | `wheel.rs`      | perpendicular (1), spring, lower, upper (1 each, along the axis), motor (angular) | none |
+//! | `Distance`  | `distance.rs`   | length or spring, motor, lower, upper (1 each, along the line) | none |
+//! | `Mouse`     | `mouse.rs`      | point toward the target (2, body b only), angular damping (1) | none |
 //!
 //! Everything the solver needs from a joint that is not its own rows is in
 //! [`JointBase`]: the state indices, the masses loaded at prepare, whether
@@ -48,10 +50,12 @@ use janus2d_core::constraint::{Constraint, ConstraintRows, StepContext};
 use janus2d_core::math::{Real, Rot, Vec2};
 
 use crate::JointError;
+use crate::distance::{DistanceJoint, DistanceJointDef};
 use crate::filter::{FilterJoint, FilterJointDef};
 use crate::joint_base::JointBase;
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::motor::{MotorJoint, MotorJointDef};
+use crate::mouse::{MouseJoint, MouseJointDef};
 use crate::parts::{BOTH, PairOf, PairStates, PointPart};
 use crate::prismatic::{PrismaticJoint, PrismaticJointDef};
 use crate::revolute::{RevoluteJoint, RevoluteJointDef};
@@ -394,20 +398,26 @@ macro_rules! joint_kinds {
 joint_kinds! {
     /// A pin: two anchors coincide; optional limit, motor and spring.
     Revolute(RevoluteJoint, RevoluteJointDef),
-    /// A weld: two anchors coincide and the relative angle is held,
-    /// rigidly or through springs.
-    Weld(WeldJoint, WeldJointDef),
-    /// A motor: drives b's pose relative to a toward a target offset and
-    /// angle, with a largest force and torque.
-    Motor(MotorJoint, MotorJointDef),
-    /// A filter: no rows; its two bodies do not collide.
-    Filter(FilterJoint, FilterJointDef),
     /// A slide: b moves along an axis fixed in a, the relative angle
     /// locked; optional limits, linear motor and spring.
     Prismatic(PrismaticJoint, PrismaticJointDef),
+    /// A weld: two anchors coincide and the relative angle is held,
+    /// rigidly or through springs.
+    Weld(WeldJoint, WeldJointDef),
+    /// A distance: two anchors at a length (rigid or spring), between a
+    /// minimum and a maximum (a rope), with a motor along the line.
+    Distance(DistanceJoint, DistanceJointDef),
     /// A wheel: b's centre moves along a's suspension axis on a spring and
     /// turns freely; optional limits and a rotational motor.
     Wheel(WheelJoint, WheelJointDef),
+    /// A motor: drives b's pose relative to a toward a target offset and
+    /// angle, with a largest force and torque.
+    Motor(MotorJoint, MotorJointDef),
+    /// A mouse (target) joint: pulls a point of body b toward a world
+    /// target with a spring of bounded force.
+    Mouse(MouseJoint, MouseJointDef),
+    /// A filter: no rows; its two bodies do not collide.
+    Filter(FilterJoint, FilterJointDef),
 }
 
 impl JointDef {

@@ -11,6 +11,8 @@
 //! | [`filter::FilterJoint`]       | 0    | 2      | nothing (only stops the pair colliding) |
 //! | [`prismatic::PrismaticJoint`] | 2–6  | 2      | axis rows + angle row   |
 //! | [`wheel::WheelJoint`]         | 1–5  | 2      | axis rows + angle motor |
+//! | [`distance::DistanceJoint`]   | 0–4  | 2      | axis rows along the anchors' line |
+//! | [`mouse::MouseJoint`]         | 2–3  | 2 (moves b only) | soft point toward a world target + angular damping |
 //! | [`portal::PortalConstraint`]  | 3    | 4      | portal part + portal map |
 //! | [`contact::ContactConstraint`]| 2–4  | 2      | contact rows (normal, friction) |
 //!
@@ -32,6 +34,7 @@ pub mod contact;
 pub mod contact_group;
 pub mod contact_row;
 pub mod contact_solver;
+pub mod distance;
 pub mod filter;
 pub mod joint;
 pub mod joint_base;
@@ -41,6 +44,7 @@ pub mod joint_solver;
 pub mod joint_tree;
 pub mod lane;
 pub mod motor;
+pub mod mouse;
 pub mod parts;
 pub mod portal;
 pub mod portal_map;
@@ -51,6 +55,7 @@ pub mod wheel;
 
 pub use contact::{ContactConstraint, ContactPointInput};
 pub use contact_solver::{ContactBatch, ContactSolver, ObjectMass, PointImpulse};
+pub use distance::{DistanceJoint, DistanceJointDef};
 pub use filter::{FilterJoint, FilterJointDef};
 pub use joint::{Joint, JointDef, JointKind, JointOfKind};
 pub use joint_base::JointBase;
@@ -59,6 +64,7 @@ pub use joint_def::{JointDefBase, JointFrame, KindDef, LimitsMut, MotorMut, Spri
 pub use joint_solver::JointBatch;
 pub use joint_tree::JointForest;
 pub use motor::{MotorJoint, MotorJointDef};
+pub use mouse::{MouseJoint, MouseJointDef};
 pub use portal::{PortalBatch, PortalConstraint, PortalConstraintDef};
 pub use portal_map::{Portal, PortalError, PortalMap, PortalPair};
 pub use prismatic::{PrismaticJoint, PrismaticJointDef};
