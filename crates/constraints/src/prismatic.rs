@@ -69,7 +69,7 @@ use janus2d_core::constraint::{Block, Constraint, ConstraintRows, StepContext};
 use janus2d_core::math::{Real, Rot, Vec2, cross};
 use janus2d_core::softness::Softness;
 
-use crate::joint::KindRows;
+use crate::joint::{GeneralRows, KindRows, TreeRows};
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, JointFrame, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::parts::{
@@ -706,7 +706,9 @@ impl PrismaticJoint {
                 use_bias,
             );
         }
-        self.solve_block(ctx, &mut sa, &mut sb, &rows, use_bias);
+        if !self.base.in_tree {
+            self.solve_block(ctx, &mut sa, &mut sb, &rows, use_bias);
+        }
         self.perp_row = rows.perp;
         self.axial_row = axial;
         pair.store(&sa, &sb);
@@ -805,6 +807,38 @@ impl KindRows for PrismaticJoint {
     #[inline(always)]
     fn solve_pair<P: PairStates>(&mut self, ctx: &StepContext, pair: &mut P, use_bias: bool) {
         PrismaticJoint::solve_pair(self, ctx, pair, use_bias);
+    }
+    /// The perpendicular and angle rows join the exact tree solve (rigid
+    /// unless the joint has its own constraint softness); its axial rows
+    /// stay iterative, so it always has a Gauss–Seidel pass (which also
+    /// keeps the warm start's rows current).
+    #[inline(always)]
+    fn tree_rows(&self) -> Option<TreeRows<'_>> {
+        (self.def.base.constraint_hertz == 0.0).then_some(TreeRows::General { count: 2 })
+    }
+    #[inline(always)]
+    fn tree_general_rows(&self, sa: &BodyState, sb: &BodyState) -> GeneralRows {
+        let rows = self.frame.rows(sa, sb, &self.base.masses);
+        let p = rows.perp;
+        let c_angle =
+            janus2d_core::math::wrap_angle(self.delta_angle + sa.dq.relative_angle(sb.dq));
+        GeneralRows {
+            count: 2,
+            j_a: [[-p.n.x, -p.n.y, -p.s_a], [0.0, 0.0, -1.0], [0.0; 3]],
+            j_b: [[p.n.x, p.n.y, p.s_b], [0.0, 0.0, 1.0], [0.0; 3]],
+            c: [rows.c_perp, c_angle, 0.0],
+            linear: [true, false, false],
+            impulse: [self.perp_impulse, self.angle_impulse, 0.0],
+        }
+    }
+    #[inline(always)]
+    fn set_tree_impulses(&mut self, impulses: [Real; 3]) {
+        self.perp_impulse = impulses[0];
+        self.angle_impulse = impulses[1];
+    }
+    #[inline(always)]
+    fn has_iterative_rows(&self) -> bool {
+        true
     }
 }
 

@@ -35,7 +35,7 @@ use janus2d_core::constraint::{Block, Constraint, ConstraintRows, StepContext};
 use janus2d_core::math::{Real, Rot, Vec2};
 use janus2d_core::softness::Softness;
 
-use crate::joint::KindRows;
+use crate::joint::{GeneralRows, KindRows, TreeRows};
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, JointFrame, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::parts::{
@@ -462,20 +462,22 @@ impl WheelJoint {
             );
         }
         let perp = rows.perp;
-        let (bias, mass_scale, impulse_scale) = rigid_terms(
-            self.linear_softness,
-            rows.c_perp,
-            ctx.joint_max_correction_speed,
-            use_bias,
-        );
-        let lambda = soft_impulse(
-            mass_scale * perp.mass,
-            perp.c_dot(&sa, &sb) + bias,
-            impulse_scale,
-            self.perp_impulse,
-        );
-        self.perp_impulse += lambda;
-        perp.apply(&mut sa, &mut sb, &m, lambda);
+        if !self.base.in_tree {
+            let (bias, mass_scale, impulse_scale) = rigid_terms(
+                self.linear_softness,
+                rows.c_perp,
+                ctx.joint_max_correction_speed,
+                use_bias,
+            );
+            let lambda = soft_impulse(
+                mass_scale * perp.mass,
+                perp.c_dot(&sa, &sb) + bias,
+                impulse_scale,
+                self.perp_impulse,
+            );
+            self.perp_impulse += lambda;
+            perp.apply(&mut sa, &mut sb, &m, lambda);
+        }
         self.perp_row = perp;
         self.axial_row = axial;
         pair.store(&sa, &sb);
@@ -511,6 +513,35 @@ impl KindRows for WheelJoint {
     #[inline(always)]
     fn solve_pair<P: PairStates>(&mut self, ctx: &StepContext, pair: &mut P, use_bias: bool) {
         WheelJoint::solve_pair(self, ctx, pair, use_bias);
+    }
+    /// The perpendicular row joins the exact tree solve (rigid unless the
+    /// joint has its own constraint softness); the suspension, limits and
+    /// motor stay iterative, so it always has a Gauss–Seidel pass.
+    #[inline(always)]
+    fn tree_rows(&self) -> Option<TreeRows<'_>> {
+        (self.def.base.constraint_hertz == 0.0).then_some(TreeRows::General { count: 1 })
+    }
+    #[inline(always)]
+    fn tree_general_rows(&self, sa: &BodyState, sb: &BodyState) -> GeneralRows {
+        let p = self.frame.rows(sa, sb, &self.base.masses);
+        let c = p.c_perp;
+        let p = p.perp;
+        GeneralRows {
+            count: 1,
+            j_a: [[-p.n.x, -p.n.y, -p.s_a], [0.0; 3], [0.0; 3]],
+            j_b: [[p.n.x, p.n.y, p.s_b], [0.0; 3], [0.0; 3]],
+            c: [c, 0.0, 0.0],
+            linear: [true, false, false],
+            impulse: [self.perp_impulse, 0.0, 0.0],
+        }
+    }
+    #[inline(always)]
+    fn set_tree_impulses(&mut self, impulses: [Real; 3]) {
+        self.perp_impulse = impulses[0];
+    }
+    #[inline(always)]
+    fn has_iterative_rows(&self) -> bool {
+        true
     }
 }
 

@@ -5,7 +5,7 @@
 //! ```text
 //! after the solve's finalize (start and end poses known), before proxies move:
 //!   fast test  (every awake dynamic body with a solid shape)
-//!     travel = |Δc| + |Δq| · (max_extent + |local centre|)
+//!     travel = |Δc| + |Δq| · (core_reach + |local centre|)
 //!     fast when travel > max(½ · min_extent, LINEAR_SLOP)
 //!   sweep      (each fast body; bullets after the others)
 //!     per solid shape: broadphase box query over its start ∪ end box
@@ -117,7 +117,10 @@ impl ContinuousStage {
             let q = sim.transform.q;
             let q0 = sim.rotation0;
             let chord = Vec2::new(q.c - q0.c, q.s - q0.s);
-            let arm = e.max_extent + sim.local_center.length();
+            // A turn moves the covered region by |Δq| times the reach of
+            // the shapes' cores from the centre (their rounding turns in
+            // place): a wheel spinning on its centre is not fast.
+            let arm = e.core_reach + sim.local_center.length();
             let threshold = (FAST_FRACTION * e.min_extent).max(LINEAR_SLOP);
             let lin = dc.length_squared();
             let rot = chord.length_squared() * arm * arm;

@@ -196,6 +196,10 @@ pub struct BodyExtent {
     /// Largest distance from the body origin to the surface of a solid
     /// shape, m (0 without one).
     pub max_extent: Real,
+    /// Largest distance from the body origin to the core of a solid shape
+    /// ([`core_reach`](janus2d_core::geometry::ShapeExtent::core_reach)),
+    /// m (0 without one).
+    pub core_reach: Real,
 }
 
 impl Default for BodyExtent {
@@ -203,6 +207,7 @@ impl Default for BodyExtent {
         BodyExtent {
             min_extent: Real::MAX,
             max_extent: 0.0,
+            core_reach: 0.0,
         }
     }
 }
@@ -300,6 +305,7 @@ impl ShapeStore {
                 let x = janus2d_core::geometry::shape_extent(&shape.geometry, Vec2::ZERO);
                 e.min_extent = e.min_extent.min(x.min_extent);
                 e.max_extent = e.max_extent.max(x.max_extent);
+                e.core_reach = e.core_reach.max(x.core_reach);
             }
         }
         self.body_extents[b] = e;

@@ -302,6 +302,13 @@ pub struct ShapeExtent {
     pub min_extent: Real,
     /// Largest distance from the given point to the shape's surface, m.
     pub max_extent: Real,
+    /// Largest distance from the given point to the shape's core (a
+    /// circle's centre, a capsule's or segment's end points, a polygon's
+    /// vertices: the shape without its rounding), m. A turn by `Δθ` about
+    /// the point moves the region the shape covers by at most
+    /// `|Δθ| · core_reach` (the rounding disc is unchanged by a turn), so
+    /// a circle turning about its centre sweeps nothing new.
+    pub core_reach: Real,
 }
 
 /// The extents of `shape` (body frame); `max_extent` is measured from
@@ -319,7 +326,8 @@ pub struct ShapeExtent {
 #[must_use]
 pub fn shape_extent(shape: &Shape, origin: Vec2) -> ShapeExtent {
     let proxy = ShapeProxy::from_shape(shape);
-    let max_extent = reach(&proxy, origin) + proxy.radius;
+    let core_reach = reach(&proxy, origin);
+    let max_extent = core_reach + proxy.radius;
     let min_extent = match shape {
         Shape::Circle(c) => c.radius,
         Shape::Capsule(c) => c.radius,
@@ -338,6 +346,7 @@ pub fn shape_extent(shape: &Shape, origin: Vec2) -> ShapeExtent {
         Shape::Segment(_) | Shape::ChainSegment(_) => 0.0,
     };
     ShapeExtent {
+        core_reach,
         min_extent,
         max_extent,
     }
