@@ -15,7 +15,7 @@
 //! | `shapes`           | on      | circles ([`DebugDraw::solid_circle`], with a radius line showing the turn), capsules ([`DebugDraw::solid_capsule`]), polygons ([`DebugDraw::solid_polygon`], rounded by their radius), segments and chain segments ([`DebugDraw::segment`]); coloured by body type |
 //! | `sleep`            | on      | shapes of sleeping bodies in [`Palette::sleeping`]                |
 //! | `islands`          | off     | shapes coloured by island; one outline box ([`DebugDraw::polygon`]) per island around its members' boxes, with its id as [`DebugDraw::text`] |
-//! | `joints`           | on      | per joint (every kind): body origin → anchor a → anchor b ← body origin ([`DebugDraw::segment`]), both anchors as [`DebugDraw::point`]; disabled joints in [`Palette::joint_disabled`] |
+//! | `joints`           | on      | per joint (every kind): body origin → anchor a → anchor b ← body origin ([`DebugDraw::segment`]), both anchors as [`DebugDraw::point`]; a prismatic or wheel joint's axis through anchor a (`draw_scale` m long) with its limits as points; a mouse joint's target and pull; a motor joint's target point; a filter joint only as a line between its bodies; disabled joints in [`Palette::joint_disabled`] |
 //! | `contacts`         | off     | one [`DebugDraw::point`] per manifold point of a solid contact: touching in [`Palette::contact_touching`], speculative (separation > 0) in [`Palette::contact_speculative`] |
 //! | `contact_normals`  | off     | a segment of `normal_length` along the contact normal at each point |
 //! | `contact_impulses` | off     | a segment of `impulse_scale × normal impulse` along the normal at each point |
@@ -467,11 +467,18 @@ fn draw_world<D: DebugDraw + ?Sized>(world: &World, draw: &mut D, o: &DrawOption
             } else {
                 o.palette.joint_disabled
             };
+            let scale = joint.def_base().draw_scale;
+            if joint.kind() == janus2d_constraints::JointKind::Filter {
+                // No rows: only a line between the two bodies.
+                draw.segment(xa.p, xb.p, c);
+                continue;
+            }
             draw.segment(xa.p, pa, c);
             draw.segment(pa, pb, c);
             draw.segment(xb.p, pb, c);
             draw.point(pa, o.point_size, c);
             draw.point(pb, o.point_size, c);
+            draw_kind(draw, joint, &xa, pa, scale, c, o.point_size);
         }
     }
     if o.contacts || o.contact_normals || o.contact_impulses {
@@ -588,6 +595,58 @@ fn draw_portals<D: DebugDraw + ?Sized>(world: &World, draw: &mut D, o: &DrawOpti
             draw.point(a, o.point_size * 1.5, o.palette.crossing);
             draw.point(b, o.point_size * 1.5, o.palette.crossing);
         }
+    }
+}
+
+/// What a kind draws beyond its anchors (`scale`: the joint's
+/// `draw_scale`, 1 = 0.5 m): the axis of a prismatic or wheel joint
+/// through anchor a (with its limits as points), a mouse joint's target,
+/// a motor joint's target point on a.
+fn draw_kind<D: DebugDraw + ?Sized>(
+    draw: &mut D,
+    joint: &janus2d_constraints::Joint,
+    xa: &Transform,
+    pa: Vec2,
+    scale: Real,
+    c: Color,
+    point_size: f32,
+) {
+    use janus2d_constraints::Joint as J;
+    let base = joint.def_base();
+    let axis = || xa.q.rotate(base.local_frame_a.axis());
+    let half = 0.5 * scale;
+    let mut axis_with_limits = |limits: Option<(Real, Real)>| {
+        let n = axis();
+        draw.segment(pa - half * n, pa + half * n, c);
+        if let Some((lower, upper)) = limits {
+            draw.point(pa + lower * n, point_size, c);
+            draw.point(pa + upper * n, point_size, c);
+        }
+    };
+    match joint {
+        J::Prismatic(j) => axis_with_limits(
+            j.def
+                .enable_limit
+                .then_some((j.def.lower_translation, j.def.upper_translation)),
+        ),
+        J::Wheel(j) => axis_with_limits(
+            j.def
+                .enable_limit
+                .then_some((j.def.lower_translation, j.def.upper_translation)),
+        ),
+        J::Mouse(j) => {
+            draw.point(j.def.target, 2.0 * point_size, c);
+            draw.segment(pa, j.def.target, c);
+        }
+        J::Motor(j) => {
+            let target = xa.apply(base.local_frame_a.anchor)
+                + xa.q.rotate(
+                    janus2d_core::math::Rot::from_angle(base.local_frame_a.angle)
+                        .rotate(j.def.linear_offset),
+                );
+            draw.point(target, 2.0 * point_size, c);
+        }
+        _ => {}
     }
 }
 
@@ -778,6 +837,40 @@ mod tests {
             (3, 2),
             "one joint: 3 segments, 2 anchors"
         );
+    }
+
+    #[test]
+    fn each_kind_draws_its_own_details() {
+        use janus2d_constraints::{
+            FilterJointDef, JointDef, MouseJointDef, PrismaticJointDef, WeldJointDef,
+        };
+        let count = |def: &dyn Fn(BodyHandle, BodyHandle) -> JointDef| {
+            let mut world = World::new(WorldDef::default()).unwrap();
+            let a = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+            let b = world
+                .create_body(&BodyDef::dynamic(Vec2::new(1.0, 0.0)))
+                .unwrap();
+            world.create_joint(&def(a, b)).unwrap();
+            let mut r = Recorder::default();
+            world.debug_draw(&mut r, &DrawOptions::default());
+            (r.segments, r.points)
+        };
+        let weld = count(&|a, b| WeldJointDef::new(a, b, Vec2::X, Vec2::ZERO).into());
+        assert_eq!(weld, (3, 2), "the anchors only");
+        let slide = count(&|a, b| {
+            PrismaticJointDef::new(a, b, Vec2::X, Vec2::ZERO, Vec2::Y)
+                .with_limits(-1.0, 1.0)
+                .into()
+        });
+        assert_eq!(slide, (4, 4), "the axis, and its two limits as points");
+        let mouse = count(&|a, b| {
+            let mut d = MouseJointDef::new(a, b, Vec2::new(3.0, 2.0), 100.0);
+            d.base.local_frame_b.anchor = Vec2::ZERO;
+            d.into()
+        });
+        assert_eq!(mouse, (4, 3), "the pull and the target");
+        let filter = count(&|a, b| FilterJointDef::new(a, b).into());
+        assert_eq!(filter, (1, 0), "a line between the bodies");
     }
 
     #[test]
