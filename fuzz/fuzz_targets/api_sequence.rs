@@ -150,11 +150,25 @@ fn call(
         6 => {
             let (ba, bb) = (pick(&i.bodies, b.byte(), f), pick(&i.bodies, b.byte(), f));
             let anchor = b.vec();
-            let mut def = RevoluteJointDef::new(ba, bb, anchor, -anchor);
-            if b.byte().is_multiple_of(2) {
-                def = def.with_limits(b.real(), b.real());
+            // Every kind, picked by a byte; limits where the kind has them.
+            let mut def: JointDef = match b.byte() % 8 {
+                0 => RevoluteJointDef::new(ba, bb, anchor, -anchor).into(),
+                1 => PrismaticJointDef::new(ba, bb, anchor, -anchor, b.vec()).into(),
+                2 => WeldJointDef::new(ba, bb, anchor, -anchor).into(),
+                3 => DistanceJointDef::new(ba, bb, anchor, -anchor, b.real()).into(),
+                4 => WheelJointDef::new(ba, bb, anchor, -anchor, b.vec()).into(),
+                5 => MotorJointDef::new(ba, bb).with_offset(anchor, b.real()).into(),
+                6 => MouseJointDef::new(ba, bb, anchor, b.real()).into(),
+                _ => FilterJointDef::new(ba, bb).into(),
+            };
+            if b.byte().is_multiple_of(2)
+                && let Some(l) = def.limits_mut()
+            {
+                *l.enable = true;
+                *l.lower = b.real();
+                *l.upper = b.real();
             }
-            i.joints.push(w.create_revolute_joint(&def)?);
+            i.joints.push(w.create_joint(&def)?);
             Ok(())
         }
         7 => match i.joints.get(b.byte() as usize % i.joints.len().max(1)) {

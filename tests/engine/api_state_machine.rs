@@ -93,6 +93,7 @@ enum Op {
     },
     DestroyShape(usize),
     CreateJoint {
+        kind: usize,
         a: usize,
         b: usize,
         anchor: Vec2,
@@ -146,8 +147,8 @@ fn op() -> impl Strategy<Value = Op> {
         4 => (pick(), geometry(), prop_oneof![3 => Just(1.0 as Real), 1 => real()], prop_oneof![3 => Just(0.6 as Real), 1 => real()], proptest::bool::weighted(0.1))
             .prop_map(|(body, geometry, density, friction, sensor)| Op::CreateShape { body, geometry, density, friction, sensor }),
         1 => pick().prop_map(Op::DestroyShape),
-        2 => (pick(), pick(), place(), proptest::option::weighted(0.3, (real(), real())), any::<bool>())
-            .prop_map(|(a, b, anchor, limits, collide)| Op::CreateJoint { a, b, anchor, limits, collide }),
+        2 => (any::<usize>(), pick(), pick(), place(), proptest::option::weighted(0.3, (real(), real())), any::<bool>())
+            .prop_map(|(kind, a, b, anchor, limits, collide)| Op::CreateJoint { kind, a, b, anchor, limits, collide }),
         1 => pick().prop_map(Op::DestroyJoint),
         1 => (pick(), pick(), place(), size(), proptest::option::weighted(0.5, real()), proptest::bool::weighted(0.2))
             .prop_map(|(a, b, anchor, half_width, eta, coincident)| Op::CreatePortalPair { a, b, anchor, half_width, eta, coincident }),
@@ -293,19 +294,23 @@ fn apply(
         }
         Op::DestroyShape(k) => w.destroy_shape(pick(&issued.shapes, *k, issued.foreign_shape)),
         Op::CreateJoint {
+            kind,
             a,
             b,
             anchor,
             limits,
             collide,
         } => {
-            let mut def =
-                RevoluteJointDef::new(body(*a, issued), body(*b, issued), *anchor, -*anchor);
-            def.base.collide_connected = *collide;
-            if let Some((lo, hi)) = limits {
-                def = def.with_limits(*lo, *hi);
-            }
-            let h = w.create_revolute_joint(&def)?;
+            let kinds = janus2d_constraints::JointKind::ALL;
+            let def = janus2d_testbed::support::joint_def_of_kind(
+                kinds[*kind % kinds.len()],
+                body(*a, issued),
+                body(*b, issued),
+                *anchor,
+                *limits,
+                *collide,
+            );
+            let h = w.create_joint(&def)?;
             issued.joints.push(h);
             Ok(())
         }

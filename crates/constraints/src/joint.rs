@@ -196,6 +196,11 @@ macro_rules! joint_kinds {
             }
         )*
 
+        impl JointKind {
+            /// Every kind, in the order of the kind list.
+            pub const ALL: &'static [JointKind] = &[$(JointKind::$kind,)*];
+        }
+
         impl JointDef {
             /// The kind of joint this defines.
             #[must_use]

@@ -662,3 +662,40 @@ pub fn check<S: Strategy>(
         );
     }
 }
+
+/// A definition of joint kind `kind` between `a` and `b` with anchors
+/// `anchor` on a and `−anchor` on b, its limits (where the kind has them)
+/// at `limits`, for the API state machine, the fuzz target and the
+/// determinism scene: every kind through one call. The values are
+/// whatever the caller passes, so a bad `anchor` or `limits` reaches the
+/// kind's validation.
+#[must_use]
+pub fn joint_def_of_kind(
+    kind: janus2d_constraints::JointKind,
+    a: BodyHandle,
+    b: BodyHandle,
+    anchor: Vec2,
+    limits: Option<(Real, Real)>,
+    collide_connected: bool,
+) -> janus2d_constraints::JointDef {
+    use janus2d_constraints::*;
+    let mut def: JointDef = match kind {
+        JointKind::Revolute => RevoluteJointDef::new(a, b, anchor, -anchor).into(),
+        JointKind::Prismatic => {
+            PrismaticJointDef::new(a, b, anchor, -anchor, Vec2::new(1.0, 0.5)).into()
+        }
+        JointKind::Weld => WeldJointDef::new(a, b, anchor, -anchor).into(),
+        JointKind::Distance => DistanceJointDef::new(a, b, anchor, -anchor, 1.0).into(),
+        JointKind::Wheel => WheelJointDef::new(a, b, anchor, -anchor, Vec2::Y).into(),
+        JointKind::Motor => MotorJointDef::new(a, b).with_offset(anchor, 0.25).into(),
+        JointKind::Mouse => MouseJointDef::new(a, b, anchor, 500.0).into(),
+        JointKind::Filter => FilterJointDef::new(a, b).into(),
+    };
+    if let (Some((lower, upper)), Some(l)) = (limits, def.limits_mut()) {
+        *l.enable = true;
+        *l.lower = lower;
+        *l.upper = upper;
+    }
+    def.base_mut().collide_connected = collide_connected;
+    def
+}
