@@ -59,7 +59,7 @@ use janus2d_core::limits::{MAX_EXTENT, MAX_SPEED};
 use janus2d_core::math::{Real, Rot, Vec2, cross, vec_is_finite};
 use janus2d_core::softness::Softness;
 
-use crate::joint::KindRows;
+use crate::joint::{GeneralRows, KindRows, TreeRows};
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::parts::{AxisPart, AxisRow, BOTH, PairMass, PairOf, PairStates, load_pair};
@@ -604,7 +604,7 @@ impl DistanceJoint {
                 ctx.h * def.max_motor_force,
             );
         }
-        if def.is_rigid() {
+        if def.is_rigid() && !self.base.in_tree {
             let (c, softness) = if use_bias {
                 let c = length - def.rigid_length();
                 let soft = self.rigid_softness;
@@ -690,6 +690,41 @@ impl KindRows for DistanceJoint {
     #[inline(always)]
     fn solve_pair<P: PairStates>(&mut self, ctx: &StepContext, pair: &mut P, use_bias: bool) {
         DistanceJoint::solve_pair(self, ctx, pair, use_bias);
+    }
+    /// A rigid length row joins the exact tree solve (unless the joint has
+    /// its own constraint softness); the spring, limits and motor stay
+    /// iterative, so it always has a Gauss–Seidel pass (which also keeps
+    /// the line's direction current).
+    #[inline(always)]
+    fn tree_rows(&self) -> Option<TreeRows<'_>> {
+        (self.def.is_rigid() && self.def.base.constraint_hertz == 0.0)
+            .then_some(TreeRows::General { count: 1 })
+    }
+    #[inline(always)]
+    fn tree_general_rows(&self, sa: &BodyState, sb: &BodyState) -> GeneralRows {
+        let (r_a, r_b, d) = self.arms(sa, sb);
+        let length = d.length();
+        let n = if length > MIN_AXIS_LENGTH {
+            d / length
+        } else {
+            self.axis
+        };
+        GeneralRows {
+            count: 1,
+            j_a: [[-n.x, -n.y, -cross(r_a, n)], [0.0; 3], [0.0; 3]],
+            j_b: [[n.x, n.y, cross(r_b, n)], [0.0; 3], [0.0; 3]],
+            c: [length - self.def.rigid_length(), 0.0, 0.0],
+            linear: [true, false, false],
+            impulse: [self.length_row.impulse, 0.0, 0.0],
+        }
+    }
+    #[inline(always)]
+    fn set_tree_impulses(&mut self, impulses: [Real; 3]) {
+        self.length_row.impulse = impulses[0];
+    }
+    #[inline(always)]
+    fn has_iterative_rows(&self) -> bool {
+        true
     }
 }
 
