@@ -6,10 +6,9 @@
 //! - After the crossing the joint has followed them (enabled, on a and b,
 //!   none disabled) and still keeps them apart: laid over each other again
 //!   on the exit side, they fall 1 s with zero contacts between them.
-//! - While they cross, their clones collide with each other (ignored test,
-//!   below): the world keeps a joint's pair from colliding by body pair
-//!   (`NoCollide`), and a crossing's clones are other bodies. A world-side
-//!   question, reported, not fixed here.
+//! - While they cross, no copy of one touches a copy of the other: a
+//!   crossing's clone answers for its original in the joints' no-collide
+//!   pairs (`NoCollide` aliases, set by the step from the crossings).
 //!
 //! Set `JANUS2D_REPORT=1` to print the figures.
 
@@ -140,14 +139,10 @@ fn filter_joined_pair_never_collides_after_a_portal() {
 }
 
 /// While the overlapping pair crosses, no copy of one touches a copy of
-/// the other. Ignored: not met. Measured (f32): the two clones touch at
-/// steps 31–34 (one contact; the joint's no-collide pair names the
-/// originals only), which pushes the pair 2.72 m apart (0.4 m expected).
-/// A world-side change (a crossing's clones inheriting their originals'
-/// no-collide pairs) is needed; the filter joint itself has nothing to
-/// solve.
+/// the other. Guards the clones' no-collide aliases: without them the two
+/// clones touched at steps 31–34 and pushed the pair 2.72 m apart (0.4 m
+/// expected).
 #[test]
-#[ignore = "a crossing's clones collide with each other (see the doc comment)"]
 fn filter_joined_pair_never_collides_while_crossing() {
     let r = cross(240);
     let apart = (r.world.position(r.b).unwrap() - r.world.position(r.a).unwrap()).length();

@@ -68,6 +68,12 @@ pub struct JointEvent {
 pub struct NoCollide {
     #[cfg_attr(feature = "serde", serde(with = "crate::serde_maps::sorted_map"))]
     pairs: HashMap<(u32, u32), u32>,
+    /// `(clone, original)` body slots of the crossings in progress (set by
+    /// the step from the portal stage; derived, so not in snapshots): a
+    /// clone answers for its original, so the clones of two joined bodies
+    /// do not collide with each other or with the other original.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    aliases: Vec<(u32, u32)>,
 }
 
 impl NoCollide {
@@ -75,10 +81,39 @@ impl NoCollide {
     #[inline]
     #[must_use]
     pub fn contains(&self, a: BodyHandle, b: BodyHandle) -> bool {
-        !self.pairs.is_empty()
-            && self
-                .pairs
-                .contains_key(&crate::contacts::pair_key(a.index, b.index))
+        if self.pairs.is_empty() {
+            return false;
+        }
+        if self
+            .pairs
+            .contains_key(&crate::contacts::pair_key(a.index, b.index))
+        {
+            return true;
+        }
+        if self.aliases.is_empty() {
+            return false;
+        }
+        let (ca, cb) = (self.original(a.index), self.original(b.index));
+        (ca, cb) != (a.index, b.index)
+            && ca != cb
+            && self.pairs.contains_key(&crate::contacts::pair_key(ca, cb))
+    }
+
+    /// The original a clone's slot answers for (the slot itself when it
+    /// is no clone).
+    #[inline]
+    fn original(&self, slot: u32) -> u32 {
+        self.aliases
+            .iter()
+            .find(|(clone, _)| *clone == slot)
+            .map_or(slot, |(_, original)| *original)
+    }
+
+    /// Sets the `(clone, original)` slot pairs of the crossings in
+    /// progress.
+    pub(crate) fn set_aliases(&mut self, aliases: impl Iterator<Item = (u32, u32)>) {
+        self.aliases.clear();
+        self.aliases.extend(aliases);
     }
 
     fn add(&mut self, a: BodyHandle, b: BodyHandle) {

@@ -28,6 +28,9 @@ impl PortalStage {
         &mut self.constraints
     }
     pub(crate) fn clear_events(&mut self) {}
+    pub(crate) fn clone_aliases(&self) -> std::iter::Empty<(u32, u32)> {
+        std::iter::empty()
+    }
     pub(crate) fn counters_for_step(&self, _ran: bool) -> (usize, usize, usize) {
         (0, 0, 0)
     }

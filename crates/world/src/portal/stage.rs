@@ -824,6 +824,13 @@ impl PortalStage {
         })
     }
 
+    /// `(clone, original)` body slots of the crossings in progress.
+    pub(crate) fn clone_aliases(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        self.crossings
+            .iter()
+            .map(|c| (c.clone.index, c.original.index))
+    }
+
     /// The clone of `body` while it crosses, if any.
     pub(crate) fn clone_of(&self, body: BodyHandle) -> Option<BodyHandle> {
         self.crossings

@@ -53,6 +53,11 @@ impl World {
             sp.portals += lap();
         }
         if has_shapes {
+            // Clones answer for their originals in the joints' no-collide
+            // pairs (set every step: crossings come and go).
+            self.joints
+                .no_collide
+                .set_aliases(self.portals.clone_aliases());
             self.collision
                 .update_pairs(&self.bodies, &self.joints.no_collide);
             sp.broadphase += lap();
