@@ -16,6 +16,7 @@ mod effects;
 mod filter;
 mod joint_api;
 mod joint_events;
+mod joint_tree_mixed;
 mod joint_tree_properties;
 mod kinematic_targets;
 mod motor;
