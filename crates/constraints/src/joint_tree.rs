@@ -126,8 +126,11 @@
 //! Jacobian column, so its `Δv` there is exactly zero.
 //!
 //! Only joint components without a loop, and without a joint the tree
-//! cannot take (a soft weld: `Joint::tree_rows` is `None`), are solved
-//! directly (found by
+//! cannot take (a soft weld, a motor joint: `Joint::tree_rows` is `None`)
+//! between two of their moving bodies, are solved directly; a joint the
+//! tree cannot take to a fixed end (a mouse joint to the ground) closes no
+//! loop, and its rows stay iterative on the tree's body as a contact's
+//! do; a joint with no rows at all (a filter joint) is no edge (found by
 //! union–find over the moving bodies; a static, kinematic or sleeping body
 //! is a fixed end, so a bridge pinned at both ends is still a tree). A
 //! component with a loop (a joint grid, a cloth) stays wholly iterative:
@@ -623,7 +626,8 @@ fn moving_pair(j: &Joint, states: &[BodyState]) -> [u32; 3] {
         } else {
             ITERATIVE
         };
-    if !base.enabled {
+    if !base.enabled || j.row_count() == 0 {
+        // Nothing to solve (a filter joint): not an edge at all.
         return [0, 0, flags];
     }
     let end = |s: u32| if is_moving(states, s) { s } else { 0 };
@@ -724,18 +728,21 @@ impl JointForest {
         self.cyclic.clear();
         self.cyclic.resize(n, false);
         for &[a, b, flags] in &self.pairs {
-            if flags & ITERATIVE != 0 {
-                // A joint the tree cannot take: its component stays
-                // iterative, like one with a loop.
-                for s in [a, b] {
-                    if s != 0 {
-                        let root = find(&mut self.union, s);
-                        self.cyclic[root as usize] = true;
-                    }
-                }
-            }
             if a == 0 || b == 0 {
+                // A joint to a fixed end closes no loop; one the tree
+                // cannot take (a mouse, a motor joint, a spring to the
+                // ground) is no tree edge: its rows stay iterative on
+                // the tree's body, as a contact's do.
                 continue;
+            }
+            if flags & ITERATIVE != 0 {
+                // Between two moving bodies a joint the tree cannot take
+                // would couple exact rows to soft ones around a loop: its
+                // component stays iterative, like one with a loop.
+                for s in [a, b] {
+                    let root = find(&mut self.union, s);
+                    self.cyclic[root as usize] = true;
+                }
             }
             match union(&mut self.union, a, b) {
                 None => {
@@ -748,8 +755,8 @@ impl JointForest {
             }
         }
         // Pass 2: the joints of loop-free components form the forest.
-        for (i, &[a, b, _]) in self.pairs.iter().enumerate() {
-            if a == 0 && b == 0 {
+        for (i, &[a, b, flags]) in self.pairs.iter().enumerate() {
+            if (a == 0 && b == 0) || flags & ITERATIVE != 0 {
                 continue;
             }
             let root = find(&mut self.union, if a != 0 { a } else { b });
