@@ -2,7 +2,7 @@
 //! fall into a floor portal and come out of a wall portal with η = 0.5
 //! (and η = 1). When both ends have crossed, the world scales the joint's
 //! anchors by η about each body's centre of mass, and the joint scales its
-//! world-space lengths by η too (`DistanceJoint::carry_impulses`): the rod
+//! world-space lengths by η too (`DistanceJoint::carry_through_portal`): the rod
 //! comes out η times as long and holds that length.
 //!
 //! The figure is the rod's worst length error `|gap − length|` over the

@@ -3,7 +3,7 @@
 //! floor portal of `jointed_portal_world` and come out of the wall portal
 //! twice as large. The joint follows them (no joint disabled), its linear
 //! offset scales with the pair (0.6 m → 1.2 m: a length in a's frame, see
-//! `MotorJoint::carry_impulses`), and the drive's error — b's anchor
+//! `MotorJoint::carry_through_portal`), and the drive's error — b's anchor
 //! against its target on a — stays within 1 cm measured through the map
 //! while a copy crosses (in the metres of the side it is measured on), and
 //! within 1 cm on the exit side after.

@@ -51,7 +51,7 @@
 //! **Through a portal** both ends are carried to their clones, scaled by
 //! `η` about each object's centre of mass: the world-space lengths (rest,
 //! minimum, maximum) and the motor speed scale by `η` too
-//! ([`DistanceJoint::carry_impulses`]).
+//! ([`DistanceJoint::carry_through_portal`]).
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState};
 use janus2d_core::constraint::{Block, Constraint, ConstraintRows, StepContext};
@@ -471,7 +471,7 @@ impl DistanceJoint {
     /// scale by `1/η` like the revolute joint's point impulse (their
     /// direction follows the line, recomputed from the bodies); the kept
     /// direction turns by `Q`.
-    pub fn carry_impulses(&mut self, rotation: Rot, scale: Real) {
+    pub fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
         let eta = 1.0 / scale;
         let def = &mut self.def;
         def.length *= eta;
@@ -680,8 +680,8 @@ impl KindRows for DistanceJoint {
     fn constraint_torque(&self) -> Real {
         DistanceJoint::constraint_torque(self)
     }
-    fn carry_impulses(&mut self, rotation: Rot, scale: Real) {
-        DistanceJoint::carry_impulses(self, rotation, scale);
+    fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
+        DistanceJoint::carry_through_portal(self, rotation, scale);
     }
     #[inline(always)]
     fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {

@@ -9,7 +9,7 @@
 //! `collide_connected = true` is accepted and does nothing at all.
 //!
 //! Through a portal it follows its bodies as every joint does; with no
-//! impulses, [`FilterJoint::carry_impulses`] has nothing to carry.
+//! impulses, [`FilterJoint::carry_through_portal`] has nothing to carry.
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState};
 use janus2d_core::constraint::{Constraint, ConstraintRows, StepContext};
@@ -100,7 +100,7 @@ impl FilterJoint {
     }
 
     /// Nothing to carry through a portal (no impulses).
-    pub fn carry_impulses(&mut self, _rotation: Rot, _scale: Real) {}
+    pub fn carry_through_portal(&mut self, _rotation: Rot, _scale: Real) {}
 
     /// False when the joint is disabled.
     #[must_use]
@@ -137,8 +137,8 @@ impl KindRows for FilterJoint {
     fn constraint_torque(&self) -> Real {
         FilterJoint::constraint_torque(self)
     }
-    fn carry_impulses(&mut self, rotation: Rot, scale: Real) {
-        FilterJoint::carry_impulses(self, rotation, scale);
+    fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
+        FilterJoint::carry_through_portal(self, rotation, scale);
     }
     #[inline(always)]
     fn warm_start_side(&self, _st: &mut BodyState, _side_b: bool) {}

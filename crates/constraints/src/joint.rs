@@ -81,10 +81,12 @@ pub(crate) trait KindRows: Constraint {
     fn constraint_force(&self) -> Vec2;
     /// Torque on body b over the last solved step, N·m.
     fn constraint_torque(&self) -> Real;
-    /// Turns and scales the kept impulses when both ends cross a portal
-    /// (`rotation = Q`, `scale = 1/η`: linear impulses turn and scale,
-    /// angular ones are kept).
-    fn carry_impulses(&mut self, rotation: Rot, scale: Real);
+    /// Carries the joint through a portal when both ends cross (`rotation
+    /// = Q`, `scale = 1/η`): linear impulses turn and scale, angular ones
+    /// are kept, and the world-space lengths the definition holds
+    /// (distances, translations, linear offsets and speeds) scale by `η`
+    /// as the anchors do.
+    fn carry_through_portal(&mut self, rotation: Rot, scale: Real);
     /// The warm start's share on one body (`side_b`: body b, else a).
     fn warm_start_side(&self, st: &mut BodyState, side_b: bool);
     /// One velocity iteration of the Gauss–Seidel rows.
@@ -326,11 +328,12 @@ macro_rules! joint_kinds {
                 match self { $( Joint::$kind(j) => KindRows::constraint_torque(j), )* }
             }
 
-            /// Carries the accumulated impulses through a portal when both
-            /// ends move to the other side (`rotation = Q`, `scale = 1/η`;
-            /// see [`RevoluteJoint::carry_impulses`]).
-            pub fn carry_impulses(&mut self, rotation: Rot, scale: Real) {
-                match self { $( Joint::$kind(j) => KindRows::carry_impulses(j, rotation, scale), )* }
+            /// Carries the joint through a portal when both ends move to
+            /// the other side (`rotation = Q`, `scale = 1/η`): its kept
+            /// impulses turned and scaled, its lengths scaled by `η` (see
+            /// [`RevoluteJoint::carry_through_portal`]).
+            pub fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
+                match self { $( Joint::$kind(j) => KindRows::carry_through_portal(j, rotation, scale), )* }
             }
 
             #[inline(always)]

@@ -42,7 +42,7 @@
 //!
 //! **Through a portal.** The linear offset is a length in a's frame: when
 //! both ends cross a portal of scale `η` the pair is `η` times larger on the
-//! exit side, so [`MotorJoint::carry_impulses`] scales the offset by `η`
+//! exit side, so [`MotorJoint::carry_through_portal`] scales the offset by `η`
 //! (as it scales the anchors), turns the linear impulse by `Q` and scales
 //! it by `1/η`; the angular offset, impulse and the largest force and
 //! torque are kept.
@@ -271,11 +271,11 @@ impl MotorJoint {
 
     /// Carries the joint through a portal when both ends move to the
     /// other side (`rotation = Q`, `scale = 1/η`): the linear impulse
-    /// turns and scales as [`crate::RevoluteJoint::carry_impulses`], and
+    /// turns and scales as [`crate::RevoluteJoint::carry_through_portal`], and
     /// the linear offset, a length in a's frame, scales by `η` with the
     /// pair (the frames' angles are kept, so it does not turn). The
     /// angular offset and impulse, `max_force` and `max_torque` are kept.
-    pub fn carry_impulses(&mut self, rotation: Rot, scale: Real) {
+    pub fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
         self.point.impulse = scale * rotation.rotate(self.point.impulse);
         if scale > 0.0 && scale.is_finite() {
             self.def.linear_offset /= scale;
@@ -402,8 +402,8 @@ impl KindRows for MotorJoint {
     fn constraint_torque(&self) -> Real {
         MotorJoint::constraint_torque(self)
     }
-    fn carry_impulses(&mut self, rotation: Rot, scale: Real) {
-        MotorJoint::carry_impulses(self, rotation, scale);
+    fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
+        MotorJoint::carry_through_portal(self, rotation, scale);
     }
     #[inline(always)]
     fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {

@@ -275,7 +275,7 @@ impl MouseJoint {
     /// and scales by `scale = 1/η` (as the revolute joint's), the angular
     /// one is kept. The target is a world point the caller owns: it is not
     /// mapped (move it with `World::set_joint_def`).
-    pub fn carry_impulses(&mut self, rotation: Rot, scale: Real) {
+    pub fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
         self.linear_impulse = scale * rotation.rotate(self.linear_impulse);
     }
 
@@ -418,8 +418,8 @@ impl KindRows for MouseJoint {
     fn constraint_torque(&self) -> Real {
         MouseJoint::constraint_torque(self)
     }
-    fn carry_impulses(&mut self, rotation: Rot, scale: Real) {
-        MouseJoint::carry_impulses(self, rotation, scale);
+    fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
+        MouseJoint::carry_through_portal(self, rotation, scale);
     }
     #[inline(always)]
     fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {

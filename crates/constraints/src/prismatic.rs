@@ -530,8 +530,18 @@ impl PrismaticJoint {
     /// move to the other side: the linear rows' impulses (perpendicular,
     /// spring, motor, limits) scale by `scale = 1/η` (their directions
     /// turn with body a's clone, so `rotation` is already in them); the
-    /// angle impulse is kept (see [`crate::RevoluteJoint::carry_impulses`]).
-    pub fn carry_impulses(&mut self, _rotation: Rot, scale: Real) {
+    /// angle impulse is kept (see [`crate::RevoluteJoint::carry_through_portal`]);
+    /// the limits, the spring's target and the motor speed scale by `η`,
+    /// as translations along the axis do.
+    pub fn carry_through_portal(&mut self, _rotation: Rot, scale: Real) {
+        // The anchors scale by η about each copy's centre of mass, so
+        // translations along the axis do the same.
+        let eta = 1.0 / scale;
+        let def = &mut self.def;
+        def.lower_translation *= eta;
+        def.upper_translation *= eta;
+        def.target_translation *= eta;
+        def.motor_speed *= eta;
         self.perp_impulse *= scale;
         for part in [
             &mut self.spring,
@@ -797,8 +807,8 @@ impl KindRows for PrismaticJoint {
     fn constraint_torque(&self) -> Real {
         PrismaticJoint::constraint_torque(self)
     }
-    fn carry_impulses(&mut self, rotation: Rot, scale: Real) {
-        PrismaticJoint::carry_impulses(self, rotation, scale);
+    fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
+        PrismaticJoint::carry_through_portal(self, rotation, scale);
     }
     #[inline(always)]
     fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
@@ -1011,6 +1021,23 @@ mod tests {
             .create(&BodyDef::dynamic(Vec2::new(1.0, 0.3)).with_mass(1.0, 0.2))
             .unwrap();
         (set, a, b)
+    }
+
+    #[test]
+    fn a_portal_scales_the_translations_by_eta() {
+        let (_, a, b) = pair();
+        let def = PrismaticJointDef::new(a, b, Vec2::ZERO, Vec2::ZERO, Vec2::X)
+            .with_limits(-1.0, 2.0)
+            .with_motor(0.5, 10.0)
+            .with_spring(2.0, 0.5)
+            .with_target_translation(0.75);
+        let mut joint = PrismaticJoint::new(def);
+        // η = 0.5: the portal's `scale` is 1/η = 2.
+        joint.carry_through_portal(Rot::IDENTITY, 2.0);
+        let d = &joint.def;
+        assert_eq!((d.lower_translation, d.upper_translation), (-0.5, 1.0));
+        assert_eq!((d.target_translation, d.motor_speed), (0.375, 0.25));
+        assert_eq!(d.max_motor_force, 10.0, "forces are left as set");
     }
 
     #[test]

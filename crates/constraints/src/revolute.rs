@@ -284,7 +284,7 @@ impl RevoluteJoint {
     /// since the portal rows keep `p₁ + η Qᵀ p₂`); the angle rows' impulses
     /// are unchanged (the rows keep `I₁ω₁ + I₂ω₂`, and `r × P` is the same
     /// on both sides).
-    pub fn carry_impulses(&mut self, rotation: janus2d_core::math::Rot, scale: Real) {
+    pub fn carry_through_portal(&mut self, rotation: janus2d_core::math::Rot, scale: Real) {
         self.point.impulse = scale * rotation.rotate(self.point.impulse);
     }
 
@@ -468,8 +468,8 @@ impl KindRows for RevoluteJoint {
     fn constraint_torque(&self) -> Real {
         RevoluteJoint::constraint_torque(self)
     }
-    fn carry_impulses(&mut self, rotation: janus2d_core::math::Rot, scale: Real) {
-        RevoluteJoint::carry_impulses(self, rotation, scale);
+    fn carry_through_portal(&mut self, rotation: janus2d_core::math::Rot, scale: Real) {
+        RevoluteJoint::carry_through_portal(self, rotation, scale);
     }
     #[inline(always)]
     fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {

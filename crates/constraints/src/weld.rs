@@ -230,9 +230,9 @@ impl WeldJoint {
     }
 
     /// Carries the accumulated impulses through a portal when both ends
-    /// move to the other side (as [`crate::RevoluteJoint::carry_impulses`]:
+    /// move to the other side (as [`crate::RevoluteJoint::carry_through_portal`]:
     /// the point impulse turns and scales, the angle impulse is kept).
-    pub fn carry_impulses(&mut self, rotation: janus2d_core::math::Rot, scale: Real) {
+    pub fn carry_through_portal(&mut self, rotation: janus2d_core::math::Rot, scale: Real) {
         self.point.impulse = scale * rotation.rotate(self.point.impulse);
     }
 
@@ -369,8 +369,8 @@ impl KindRows for WeldJoint {
     fn constraint_torque(&self) -> Real {
         WeldJoint::constraint_torque(self)
     }
-    fn carry_impulses(&mut self, rotation: janus2d_core::math::Rot, scale: Real) {
-        WeldJoint::carry_impulses(self, rotation, scale);
+    fn carry_through_portal(&mut self, rotation: janus2d_core::math::Rot, scale: Real) {
+        WeldJoint::carry_through_portal(self, rotation, scale);
     }
     #[inline(always)]
     fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {

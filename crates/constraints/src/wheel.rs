@@ -308,8 +308,14 @@ impl WheelJoint {
     /// Carries the accumulated impulses through a portal when both ends
     /// move to the other side: the linear rows' impulses scale by
     /// `scale = 1/η` (their directions turn with body a's clone); the
-    /// motor's angular impulse is kept.
-    pub fn carry_impulses(&mut self, _rotation: Rot, scale: Real) {
+    /// motor's angular impulse is kept; the translation limits scale by
+    /// `η`, as translations along the axis do.
+    pub fn carry_through_portal(&mut self, _rotation: Rot, scale: Real) {
+        // The anchors scale by η about each copy's centre of mass, so
+        // translations along the axis do the same.
+        let eta = 1.0 / scale;
+        self.def.lower_translation *= eta;
+        self.def.upper_translation *= eta;
         self.perp_impulse *= scale;
         for part in [&mut self.spring, &mut self.lower, &mut self.upper] {
             part.impulse *= scale;
@@ -503,8 +509,8 @@ impl KindRows for WheelJoint {
     fn constraint_torque(&self) -> Real {
         WheelJoint::constraint_torque(self)
     }
-    fn carry_impulses(&mut self, rotation: Rot, scale: Real) {
-        WheelJoint::carry_impulses(self, rotation, scale);
+    fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
+        WheelJoint::carry_through_portal(self, rotation, scale);
     }
     #[inline(always)]
     fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {

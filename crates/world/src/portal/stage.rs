@@ -1408,7 +1408,7 @@ impl PortalStage {
                     });
                 }
                 if let Ok(j) = stores.joints.joint_mut(joint) {
-                    j.carry_impulses(q, impulse_scale);
+                    j.carry_through_portal(q, impulse_scale);
                 }
             }
             None => {
