@@ -68,6 +68,12 @@ fn hard_case_world(case: &hard::HardCase) -> World {
 #[test]
 fn restored_snapshot_continues_bit_exactly_on_the_determinism_scenes() {
     continues_bit_exactly("chains", chains(), 40, 80);
+    continues_bit_exactly(
+        "every joint kind",
+        janus2d_testbed::support::every_joint_kind_world(),
+        40,
+        60,
+    );
     let def = scenes::shared_settings();
     continues_bit_exactly("pyramid 20", scenes::large_pyramid(&def, 20).world, 40, 60);
     #[cfg(feature = "portals")]
@@ -160,7 +166,14 @@ mod bytes {
 
     #[test]
     fn snapshot_bytes_round_trip_continues_bit_exactly() {
-        let mut scenes_to_check = vec![("chains", chains()), ("pyramid 4", small_world())];
+        let mut scenes_to_check = vec![
+            ("chains", chains()),
+            ("pyramid 4", small_world()),
+            (
+                "every joint kind",
+                janus2d_testbed::support::every_joint_kind_world(),
+            ),
+        ];
         #[cfg(feature = "portals")]
         scenes_to_check.push((
             "portal drop",

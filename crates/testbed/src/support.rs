@@ -699,3 +699,49 @@ pub fn joint_def_of_kind(
     def.base_mut().collide_connected = collide_connected;
     def
 }
+
+/// A scene holding every joint kind: per kind, 16 chains of 4 boxes
+/// hanging from a static beam (each box joined to the one before, the
+/// first to the beam), with limits on every other joint where the kind
+/// has them; 512 joints, so the joint prepare and colours take their
+/// blocked paths on the team.
+pub fn every_joint_kind_world() -> janus2d_world::World {
+    use janus2d_constraints::JointKind;
+    use janus2d_core::geometry::Polygon;
+    use janus2d_world::{ShapeDef, World, WorldDef};
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    world
+        .create_shape(
+            ground,
+            &ShapeDef::default(),
+            Polygon::make_offset_box(80.0, 0.5, Vec2::new(0.0, -0.5), 0.0),
+        )
+        .unwrap();
+    for (k, &kind) in JointKind::ALL.iter().enumerate() {
+        for chain in 0..16 {
+            let x = -76.0 + 19.0 * k as Real + 1.1 * (chain % 4) as Real;
+            let y = 3.0 + 6.0 * (chain / 4) as Real;
+            let mut previous = ground;
+            for i in 0..4 {
+                let p = Vec2::new(x + 1.1 * i as Real, y + 0.3 * i as Real);
+                let b = world.create_body(&BodyDef::dynamic(p)).unwrap();
+                world
+                    .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.4, 0.4))
+                    .unwrap();
+                let anchor = Vec2::new(0.55, 0.0);
+                // Angles or translations of ±0.5; a distance joint's lengths.
+                let range = if kind == JointKind::Distance {
+                    (0.5, 1.5)
+                } else {
+                    (-0.5, 0.5)
+                };
+                let limits = (i % 2 == 0).then_some(range);
+                let def = joint_def_of_kind(kind, previous, b, anchor, limits, false);
+                world.create_joint(&def).unwrap();
+                previous = b;
+            }
+        }
+    }
+    world
+}
