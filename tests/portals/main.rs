@@ -27,4 +27,6 @@ mod portal_sim;
 #[cfg(feature = "portals")]
 mod portal_stiff;
 #[cfg(feature = "portals")]
+mod portal_weld;
+#[cfg(feature = "portals")]
 mod portal_wheel;
