@@ -21,7 +21,9 @@
 //!     portals: a centre that crosses an aperture from its front stops just
 //!       behind the aperture plane, so the crossing stage sees it straddle
 //!   move back  (first fraction t < 1): pose at t; velocity kept, so the
-//!     next step's speculative contact stops the body
+//!     next step's speculative contact stops the body; a jointed body
+//!     moves back with every moving body its enabled joints reach, all to
+//!     the group's smallest t (its joints stay as the solve left them)
 //! ```
 //!
 //! A scene where nothing is fast does one cheap test per awake dynamic body
@@ -35,7 +37,7 @@ use janus2d_core::math::{Real, Vec2, cross};
 
 use crate::aperture::ContactClipping;
 use crate::broadphase::BroadPhase;
-use crate::joints::NoCollide;
+use crate::joints::{JointSet, NoCollide};
 use crate::shapes::ShapeStore;
 
 /// Fraction of a body's smallest extent it may travel in one step before it
@@ -61,6 +63,9 @@ pub(crate) struct ContinuousInput<'a> {
     pub(crate) no_collide: &'a NoCollide,
     /// The portal stage's aperture clipping (empty without portals).
     pub(crate) clipping: &'a ContactClipping,
+    /// The joints: a jointed body is moved back with the bodies its
+    /// enabled joints join it to.
+    pub(crate) joints: &'a JointSet,
 }
 
 /// The continuous stage: the switch, its scratch lists and its counters.
@@ -72,6 +77,14 @@ pub(crate) struct ContinuousStage {
     fast: Vec<u32>,
     bullets: Vec<u32>,
     candidates: Vec<u32>,
+    /// Scratch of the joint groups' move back: the group, a mark per
+    /// moving body, and each hit body's fraction.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    group: Vec<u32>,
+    #[cfg_attr(feature = "serde", serde(skip))]
+    moved: Vec<bool>,
+    #[cfg_attr(feature = "serde", serde(skip))]
+    fractions: Vec<Real>,
 }
 
 /// How far behind a one-sided chain segment's line a fast shape's centroid
@@ -88,6 +101,9 @@ impl ContinuousStage {
             fast: Vec::new(),
             bullets: Vec::new(),
             candidates: Vec::new(),
+            group: Vec::new(),
+            moved: Vec::new(),
+            fractions: Vec::new(),
         }
     }
 
@@ -161,48 +177,95 @@ impl ContinuousStage {
                         (fraction, calls)
                     })
                     .collect();
+                self.fractions.clear();
+                self.fractions.resize(bodies.sims.len(), 1.0);
                 for (&i, &(fraction, calls)) in fast.iter().zip(&impacts) {
                     self.counters.toi_calls += calls;
-                    self.move_back(i as usize, bodies, fraction);
+                    self.fractions[i as usize] = fraction;
                 }
             }
         } else {
+            // Against static shapes only: no sweep reads another's move, so
+            // every impact is found before any body moves, as on threads.
+            self.fractions.clear();
+            self.fractions.resize(bodies.sims.len(), 1.0);
             for &i in &fast {
-                self.sweep_body(i as usize, bodies, input, false);
+                self.fractions[i as usize] = impact_of(
+                    bodies,
+                    i as usize,
+                    input,
+                    false,
+                    &mut self.candidates,
+                    &mut self.counters.toi_calls,
+                );
             }
+        }
+        self.moved.clear();
+        self.moved.resize(bodies.sims.len(), false);
+        for &i in &fast {
+            self.move_back(i as usize, bodies, input.joints);
         }
         self.fast = fast;
         let bullets = std::mem::take(&mut self.bullets);
         for &i in &bullets {
-            self.sweep_body(i as usize, bodies, input, true);
+            if self.moved[i as usize] {
+                continue; // moved back with a jointed body already
+            }
+            let fraction = impact_of(
+                bodies,
+                i as usize,
+                input,
+                true,
+                &mut self.candidates,
+                &mut self.counters.toi_calls,
+            );
+            self.fractions[i as usize] = fraction;
+            self.move_back(i as usize, bodies, input.joints);
         }
         self.bullets = bullets;
     }
 
-    /// Sweeps moving body `i` and moves it back when it hits.
-    fn sweep_body(
-        &mut self,
-        i: usize,
-        bodies: &mut BodySet,
-        input: &ContinuousInput<'_>,
-        bullet: bool,
-    ) {
-        let fraction = impact_of(
-            bodies,
-            i,
-            input,
-            bullet,
-            &mut self.candidates,
-            &mut self.counters.toi_calls,
-        );
-        self.move_back(i, bodies, fraction);
-    }
-
-    /// Moves body `i` back to `fraction` of its step's sweep (nothing at 1).
-    fn move_back(&mut self, i: usize, bodies: &mut BodySet, fraction: Real) {
-        if fraction < 1.0 {
-            let sweep = sweep_of(bodies, i);
-            let sim = &mut bodies.sims[i];
+    /// Moves body `i` back to its fraction of the step's sweep (nothing
+    /// at 1), and with it every moving body its enabled joints join it to,
+    /// directly or through others, all to the smallest fraction among
+    /// them: a jointed body rewound alone would open its joints by what
+    /// its neighbours travelled after the impact (a link landing at
+    /// 30 m/s, 50 cm a step). Each body moves once per pass.
+    fn move_back(&mut self, i: usize, bodies: &mut BodySet, joints: &JointSet) {
+        if self.moved[i] || self.fractions[i] >= 1.0 {
+            return;
+        }
+        self.group.clear();
+        self.group.push(i as u32);
+        self.moved[i] = true;
+        let mut fraction = self.fractions[i];
+        let mut next = 0;
+        while next < self.group.len() && !joints.is_empty() {
+            let handle = bodies.sims[self.group[next] as usize].handle;
+            next += 1;
+            for &jh in joints.of_body(handle) {
+                let Ok(joint) = joints.get(jh) else { continue };
+                if !joint.is_enabled() {
+                    continue;
+                }
+                let Some(other) = joint.other_body(handle) else {
+                    continue;
+                };
+                let Some(BodyLocation::Moving(k)) = bodies.location(other) else {
+                    continue;
+                };
+                let k = k as usize;
+                if self.moved[k] || bodies.sims[k].body_type != BodyType::Dynamic {
+                    continue;
+                }
+                self.moved[k] = true;
+                fraction = fraction.min(self.fractions[k]);
+                self.group.push(k as u32);
+            }
+        }
+        for &k in &self.group {
+            let sweep = sweep_of(bodies, k as usize);
+            let sim = &mut bodies.sims[k as usize];
             sim.transform = sweep.transform_at(fraction);
             sim.center = sweep.center_at(fraction);
             self.counters.toi_hits += 1;

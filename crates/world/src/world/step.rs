@@ -143,6 +143,7 @@ impl World {
             // collision and the proxy update (`Collision::end_step`).
             let continuous = &mut self.continuous;
             let (no_collide, clipping) = (&self.joints.no_collide, self.portals.clipping());
+            let joints = &self.joints;
             let (builder, solver) = (&self.contact_builder, &self.contact_solver);
             let continuous_time = self.collision.end_step(
                 &mut self.bodies,
@@ -155,6 +156,7 @@ impl World {
                         broadphase,
                         no_collide,
                         clipping,
+                        joints,
                     };
                     continuous.run(bodies, &input);
                     start.elapsed().as_secs_f64()
