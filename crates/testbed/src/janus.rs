@@ -16,13 +16,16 @@
 //! | `JointDesc::Prismatic` | `PrismaticJointDef::from_base` (frame a's x axis: the slide axis) `.with_limits`, `.with_motor`, `.with_spring`, `.with_target_translation` |
 //! | `JointDesc::Wheel`     | `WheelJointDef::from_base`, `enable_spring` = `spring.is_some()` (no spring: a free axis; janus2d's default is on), `.with_limits`, `.with_motor` |
 //! | `JointDesc::Distance`  | `DistanceJointDef::from_base(length)` `.with_limits`, `.with_spring`, `.with_spring_force_range`, `.with_motor` |
+//! | `JointDesc::Motor`     | `MotorJointDef::from_base` `.with_offset`, `.with_max_force`, `.with_max_torque`, `.with_correction_factor` |
+//! | `JointDesc::Mouse`     | `MouseJointDef::from_base(target, max_force)` `.with_spring` (angular damping at its default) |
+//! | `JointDesc::Filter`    | `FilterJointDef::from_base` |
 
 use std::collections::BTreeMap;
 
 use glam::DVec2;
 use janus2d_constraints::{
-    DistanceJointDef, JointDef, JointDefBase, JointFrame, PrismaticJointDef, RevoluteJointDef,
-    WeldJointDef, WheelJointDef,
+    DistanceJointDef, FilterJointDef, JointDef, JointDefBase, JointFrame, MotorJointDef,
+    MouseJointDef, PrismaticJointDef, RevoluteJointDef, WeldJointDef, WheelJointDef,
 };
 use janus2d_core::body::{BodyDef, BodyHandle, BodyType};
 use janus2d_core::geometry::{Capsule, Circle, Polygon, Segment, Shape, make_chain};
@@ -269,6 +272,18 @@ pub fn joint_def(j: &JointDesc, handles: &[BodyHandle]) -> JointDef {
             }
             def.into()
         }
+        JointDesc::Motor(m) => MotorJointDef::from_base(base_def(&m.base, handles))
+            .with_offset(vec(m.linear_offset), m.angular_offset as Real)
+            .with_max_force(cap(m.max_force))
+            .with_max_torque(cap(m.max_torque))
+            .with_correction_factor(m.correction_factor as Real)
+            .into(),
+        JointDesc::Mouse(m) => {
+            MouseJointDef::from_base(base_def(&m.base, handles), vec(m.target), cap(m.max_force))
+                .with_spring(m.hertz as Real, m.damping_ratio as Real)
+                .into()
+        }
+        JointDesc::Filter(f) => FilterJointDef::from_base(base_def(&f.base, handles)).into(),
     }
 }
 
