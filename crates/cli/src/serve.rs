@@ -367,8 +367,8 @@ impl Session {
         let max_force = world.mass(body)? * from_f64(GRAB_MAX_ACCEL);
         let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO))?;
         let made = world.joint_base_at(ground, body, p).and_then(|base| {
-            let def = MouseJointDef::from_base(base, p, max_force)
-                .with_spring(GRAB_HERTZ, GRAB_DAMPING);
+            let def =
+                MouseJointDef::from_base(base, p, max_force).with_spring(GRAB_HERTZ, GRAB_DAMPING);
             world.create_joint(&def.into())
         });
         match made {

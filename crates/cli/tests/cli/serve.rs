@@ -206,7 +206,9 @@ fn grab_drag_and_spawn() {
     let joint = s.grab_joint().expect("a mouse joint");
     {
         let w = s.scene().world();
-        let mouse = w.joint_of::<janus2d_constraints::MouseJoint>(joint).unwrap();
+        let mouse = w
+            .joint_of::<janus2d_constraints::MouseJoint>(joint)
+            .unwrap();
         assert_eq!(mouse.def.base.body_b, body);
         assert_eq!(
             w.body_type(mouse.def.base.body_a),
@@ -252,7 +254,11 @@ fn grab_drag_and_spawn() {
     assert_eq!((w.body_count(), w.joint_count()), (bodies, joints));
     assert!(w.joint(joint).is_err(), "the mouse joint is gone");
     // A reset during a drag starts clean.
-    s.apply(Control::Grab { x: x + 3.0, y: y + 2.0 }).unwrap();
+    s.apply(Control::Grab {
+        x: x + 3.0,
+        y: y + 2.0,
+    })
+    .unwrap();
     assert!(s.grabbed().is_some());
     s.apply(Control::Reset).unwrap();
     assert_eq!(s.grabbed(), None);
@@ -302,6 +308,10 @@ fn the_page_draws_every_joint_kind() {
     );
     s.apply(Control::Grab { x, y }).unwrap();
     assert_eq!(s.grabbed(), Some(b));
-    s.apply(Control::Drag { x: x + 1.0, y: y + 1.0 }).unwrap();
+    s.apply(Control::Drag {
+        x: x + 1.0,
+        y: y + 1.0,
+    })
+    .unwrap();
     assert!(count(&s) > with, "the drag's joint is drawn");
 }
