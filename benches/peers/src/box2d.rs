@@ -32,6 +32,7 @@
 //! | `JointDesc::Weld`             | `b2WeldJointDef`: `linearHertz`, `linearDampingRatio`, `angularHertz`, `angularDampingRatio` (0 Hz: rigid) |
 //! | `JointDesc::Prismatic`        | `b2PrismaticJointDef`: `enableLimit`/`lowerTranslation`/`upperTranslation`, `enableMotor`/`motorSpeed`/`maxMotorForce`, `enableSpring`/`hertz`/`dampingRatio`/`targetTranslation` |
 //! | `JointDesc::Wheel`            | `b2WheelJointDef`: `enableSpring`/`hertz`/`dampingRatio` (no spring: `enableSpring = false`, Box2D's default is on), `enableLimit`/…, `enableMotor`/`motorSpeed`/`maxMotorTorque` |
+//! | `JointDesc::Motor`, `Mouse`, `Filter` | not built (no peers scene uses them): the scene is refused |
 //! | `JointDesc::Distance`         | `b2DistanceJointDef`: `length`, `enableSpring`/`hertz`/`dampingRatio`/`lowerSpringForce`/`upperSpringForce`, `enableLimit`/`minLength`/`maxLength`, `enableMotor`/`motorSpeed`/`maxMotorForce` (forces clamped to ±`f32::MAX`) |
 //! | `Action::Spawn` / `Despawn`   | create the group's bodies then joints / `b2DestroyBody` each body |
 //! | `Action::Target`              | `b2Body_SetTargetTransform(target, dt, wake = true)`              |
@@ -401,6 +402,12 @@ impl Box2d {
                     def = def.hertz(hertz as f32).damping_ratio(zeta as f32);
                 }
                 world.create_distance_joint(&def)
+            }
+            JointDesc::Motor(_) | JointDesc::Mouse(_) | JointDesc::Filter(_) => {
+                return Err(format!(
+                    "the Box2D adapter has no {} joint (no peers scene uses one)",
+                    j.kind_name()
+                ));
             }
         };
         made.map(drop)

@@ -45,6 +45,7 @@
 //! | `JointDesc::Weld`           | locked `LIN_X`, `LIN_Y`, `ANG_X`; a nonzero hertz frees that part and holds it with an acceleration-based position motor to 0 instead (stiffness (2πf)², damping 2ζ·2πf) |
 //! | `JointDesc::Prismatic`      | locked `LIN_Y`, `ANG_X`; `LinX` limits; the spring (target translation) or else the motor on `LinX`, as the revolute's |
 //! | `JointDesc::Wheel`          | locked `LIN_Y`; `LinX` limits and spring (position motor to 0); `AngX` velocity motor |
+//! | `JointDesc::Motor`, `Mouse`, `Filter` | not built (no peers scene uses them): the scene is refused |
 //! | `JointDesc::Distance`       | coupled `LIN_X`, `LIN_Y` (`LinX` is then the distance, as Rapier's rope and spring joints): no spring, limits [length, length]; a spring, a position motor to the length, max force = the larger spring force bound, with the length limits; the motor when there is no spring |
 //! | `Action::Target`            | velocity = (target − current) / dt, angular likewise (wrapped) |
 //! | `portals`                   | `build` fails: Rapier has no portals                          |
@@ -338,7 +339,10 @@ fn generic(j: &JointDesc, softness: SpringCoefficients<Real>) -> Option<GenericJ
         None => b,
     };
     Some(match j {
-        JointDesc::Revolute(_) => return None,
+        JointDesc::Revolute(_)
+        | JointDesc::Motor(_)
+        | JointDesc::Mouse(_)
+        | JointDesc::Filter(_) => return None,
         JointDesc::Weld(w) => {
             let mut locked = JointAxesMask::empty();
             if w.linear_hertz == 0.0 {

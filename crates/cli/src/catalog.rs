@@ -5,13 +5,14 @@
 //! | `benchmark` | Box2D v3's ten benchmark scenes and `pyramid20` ([`janus2d_testbed::benchmarks`]) |
 //! | `hard`      | the hard cases ([`janus2d_testbed::hard`]); those named as a benchmark are `hard/NAME` |
 //! | `portal`    | `portal_drop`, `portal_stream`, `hole_stream` (the last has no portal: the same stream through a hole) |
+//! | `joints`    | the peers' joint scenes (`weld_cantilever`, `car`, `elevator`, `spring_bridge`: [`janus2d_testbed::joint_bench`]) and `joint_zoo`, every joint kind in one scene ([`janus2d_testbed::joint_zoo`]) |
 //!
 //! Every scene runs with its own settings (gravity, step, substeps, sleep,
 //! softness) and for its own number of steps unless told otherwise; the
 //! scenes with a per-step script (`rain`, `junkyard`) run it.
 
 use janus2d_testbed::desc::SceneDesc;
-use janus2d_testbed::{benchmarks, hard};
+use janus2d_testbed::{benchmarks, hard, joint_bench, joint_zoo};
 
 use crate::error::CliError;
 
@@ -20,7 +21,7 @@ use crate::error::CliError;
 pub struct Entry {
     /// The name `janus2d run` takes.
     pub name: String,
-    /// `benchmark`, `hard` or `portal`.
+    /// `benchmark`, `hard`, `portal` or `joints`.
     pub group: &'static str,
     /// Steps it runs by default.
     pub steps: usize,
@@ -34,8 +35,9 @@ impl Entry {
     pub fn about(&self) -> String {
         let d = &self.desc;
         let mut s = format!("{} bodies", d.bodies.len());
-        if !d.joints.is_empty() {
-            s.push_str(&format!(", {} joints", d.joints.len()));
+        let joints = d.joints.len() + d.extra_joints.len();
+        if joints > 0 {
+            s.push_str(&format!(", {joints} joints"));
         }
         if !d.portals.is_empty() {
             s.push_str(&format!(", {} portal pair", d.portals.len()));
@@ -50,7 +52,7 @@ impl Entry {
 const PORTAL_SCENES: [&str; 2] = ["portal_stream", "hole_stream"];
 
 /// Every built-in scene, benchmarks first, then hard cases, then portal
-/// scenes. Without the `portals` feature the scenes with portals are left
+/// scenes, then joint scenes. Without the `portals` feature the scenes with portals are left
 /// out.
 #[must_use]
 pub fn entries() -> Vec<Entry> {
@@ -87,6 +89,16 @@ pub fn entries() -> Vec<Entry> {
         out.push(Entry {
             name: desc.name.to_owned(),
             group: "portal",
+            steps: desc.steps,
+            desc,
+        });
+    }
+    let mut joints: Vec<SceneDesc> = joint_bench::all().into_iter().map(|s| s.desc).collect();
+    joints.push(joint_zoo::joint_zoo());
+    for desc in joints {
+        out.push(Entry {
+            name: desc.name.to_owned(),
+            group: "joints",
             steps: desc.steps,
             desc,
         });

@@ -1,8 +1,8 @@
 //! Scene files: a world described in JSON — settings, bodies with their
-//! shapes, revolute joints and portal pairs — read with `serde` into the
-//! description structs below and built into a [`World`] through the
-//! engine's definition structs (`BodyDef`, `ShapeDef`, the shapes,
-//! `RevoluteJointDef`, `PortalPairDef`).
+//! shapes, joints of every kind and portal pairs — read with `serde` into
+//! the description structs below and built into a [`World`] through the
+//! engine's definition structs (`BodyDef`, `ShapeDef`, the shapes, each
+//! joint kind's definition on a `JointDefBase`, `PortalPairDef`).
 //!
 //! ```json
 //! {
@@ -15,7 +15,11 @@
 //!     { "id": "bar", "position": [1, 2],
 //!       "shapes": [ { "geometry": { "box": { "half": [1, 0.1] } }, "density": 2 } ] }
 //!   ],
-//!   "joints": [ { "body_a": "ground", "body_b": "bar", "anchor": [0, 2] } ]
+//!   "joints": [
+//!     { "body_a": "ground", "body_b": "bar", "anchor": [0, 2] },
+//!     { "type": "prismatic", "body_a": "ground", "body_b": "bar", "anchor": [1, 2],
+//!       "axis": 1.5708, "limit": [0, 3], "motor": { "speed": 1, "max_force": 500 } }
+//!   ]
 //! }
 //! ```
 //!
@@ -26,17 +30,29 @@
 //! | body | `id`, `type` (`static`, `kinematic`, `dynamic`), `position`, `angle`, `linear_velocity`, `angular_velocity`, `linear_damping`, `angular_damping`, `gravity_scale`, `fixed_rotation`, `awake`, `mass` {`mass`, `inertia`, `center`}, `shapes` | dynamic at the origin, mass from the shapes |
 //! | shape | `geometry` (one of below), `density`, `friction`, `restitution`, `sensor`, `filter` {`category`, `mask`, `group`} | 1, 0.6, 0, false, collides with all |
 //! | geometry | `circle` {`center`, `radius`}, `capsule` {`a`, `b`, `radius`}, `box` {`half`, `center`, `angle`, `radius`}, `polygon` {`points`, `radius`} (convex hull), `segment` {`a`, `b`}, `chain` {`points`, `closed`} (one-sided) | |
-//! | joint | `body_a`, `body_b` (index or id), `anchor` (world point) or `anchor_a`/`anchor_b` (body frames), `reference_angle`, `limit` [lower, upper], `motor` {`speed`, `max_torque`}, `spring` {`hertz`, `damping_ratio`}, `collide_connected` | a plain hinge |
+//! | joint | `type` (below), `body_a`, `body_b` (index or id), `anchor` (a world point at creation) or `anchor_a`/`anchor_b` (body frames; motor and filter joints may leave both out: the bodies' origins), `angle_a`/`angle_b` (the frames' angles in the body frames, rad), `collide_connected`, `force_threshold` N and `torque_threshold` N·m (joint events), `constraint_hertz`/`constraint_damping_ratio` (softness of the rigid rows), `user_data`, `draw_scale` | `revolute`; frames at angle 0; not colliding; thresholds ∞; the world's joint softness; 0; 1 |
+//! | `revolute` | `reference_angle` (rad: θ_b − θ_a at angle 0), `limit` [lower, upper] rad, `motor` {`speed` rad/s, `max_torque` N·m}, `spring` {`hertz`, `damping_ratio`}, `target_angle` rad | a plain hinge |
+//! | `prismatic` | `axis` (world angle at creation, rad: the slide axis; or frame a's `angle_a`), `limit` [lower, upper] m, `motor` {`speed` m/s, `max_force` N}, `spring` {`hertz`, `damping_ratio`}, `target_translation` m | a free slide along x, angle held |
+//! | `weld` | `reference_angle`, `linear_spring` and `angular_spring` {`hertz`, `damping_ratio`} | rigid |
+//! | `distance` | `length` m, `limit` [min, max] m, `spring` {`hertz`, `damping_ratio`} (a rope: `spring` at 0 Hz with `limit` [0, max]), `spring_force` [lower, upper] N (tension negative), `motor` {`speed` m/s, `max_force` N} | a rigid rod at the anchors' distance |
+//! | `wheel` | `axis` (the suspension axis, world angle), `spring` {`hertz`, `damping_ratio`}, `limit` [lower, upper] m, `motor` {`speed` rad/s, `max_torque` N·m} | no spring (a free axis), no limits, no motor |
+//! | `motor` | `linear_offset` [x, y] m (in a's joint frame), `angular_offset` rad, `max_force` N, `max_torque` N·m, `correction_factor` [0, 1] | offsets 0, 1 N, 1 N·m, 0.3 |
+//! | `mouse` | `target` [x, y] m (world), `max_force` N (required), `spring` {`hertz`, `damping_ratio`} (the pull), `angular_spring` (angular damping) | target at `anchor`, 5 Hz / ζ 0.7, 0.5 Hz / ζ 0.1 |
+//! | `filter` | none: the two bodies only stop colliding | |
 //! | portal pair | `a`, `b`: {`body`, `anchor`, `direction`, `half_width`}; `eta`, `mass_model` (`same_material`, `energy_preserving`) | η = w_b / w_a |
 //!
-//! Unknown keys are errors. A file that does not parse or does not build
+//! Unknown keys are errors, and so is a key the joint's `type` does not use
+//! (`limit` on a weld). A file that does not parse or does not build
 //! gives a [`SceneFileError`] naming the line, the column and the field
 //! (`bodies[1].shapes[0].density`).
 
 use std::fmt;
 
 use glam::DVec2;
-use janus2d_constraints::RevoluteJointDef;
+use janus2d_constraints::{
+    DistanceJointDef, FilterJointDef, JointDef, JointDefBase, JointFrame, MotorJointDef,
+    MouseJointDef, PrismaticJointDef, RevoluteJointDef, WeldJointDef, WheelJointDef,
+};
 use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
 use janus2d_core::geometry::{Shape, make_chain};
 use janus2d_core::math::{Real, Vec2, from_f64, to_f64};
@@ -60,7 +76,7 @@ pub struct SceneFile {
     /// Bodies, in creation order.
     #[serde(default)]
     pub bodies: Vec<BodyFile>,
-    /// Revolute joints.
+    /// Joints of any kind, created in order after the bodies.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub joints: Vec<JointFile>,
     /// Portal pairs.
@@ -311,17 +327,22 @@ pub enum BodyRef {
     Id(String),
 }
 
-/// A motor.
+/// A motor: a target speed and the largest torque (angular motors:
+/// revolute, wheel) or force (linear motors: prismatic, distance).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MotorFile {
-    /// Target speed, rad/s.
+    /// Target speed, rad/s (angular) or m/s (linear).
     pub speed: f64,
-    /// Torque cap, N·m.
-    pub max_torque: f64,
+    /// Torque cap, N·m (revolute, wheel).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_torque: Option<f64>,
+    /// Force cap, N (prismatic, distance).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_force: Option<f64>,
 }
 
-/// An angular spring.
+/// A spring: stiffness and damping ratio.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SpringFile {
@@ -331,27 +352,67 @@ pub struct SpringFile {
     pub damping_ratio: f64,
 }
 
-/// The joint types a file can hold.
+/// The joint types a file can hold (`type`; default `revolute`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum JointKindFile {
-    /// A revolute joint (the only one the engine has).
+    /// A hinge.
     #[default]
     Revolute,
+    /// A slider along an axis.
+    Prismatic,
+    /// A weld (rigid or sprung).
+    Weld,
+    /// A rod, spring or rope between two points.
+    Distance,
+    /// A wheel on a suspension axis.
+    Wheel,
+    /// A pose drive of b relative to a.
+    Motor,
+    /// A pull of a point of b toward a world target.
+    Mouse,
+    /// No rows: the two bodies only stop colliding.
+    Filter,
 }
 
-/// A revolute joint.
+impl JointKindFile {
+    /// The name a file spells it with.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            JointKindFile::Revolute => "revolute",
+            JointKindFile::Prismatic => "prismatic",
+            JointKindFile::Weld => "weld",
+            JointKindFile::Distance => "distance",
+            JointKindFile::Wheel => "wheel",
+            JointKindFile::Motor => "motor",
+            JointKindFile::Mouse => "mouse",
+            JointKindFile::Filter => "filter",
+        }
+    }
+
+    /// Whether a motor of this kind is linear (a force cap) rather than
+    /// angular (a torque cap).
+    fn linear_motor(self) -> bool {
+        matches!(self, JointKindFile::Prismatic | JointKindFile::Distance)
+    }
+}
+
+/// A joint of any kind. The keys every kind shares come first; the others
+/// belong to the kinds named in their docs, and a key the joint's kind
+/// does not use is an error naming it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct JointFile {
-    /// The joint type (`revolute`).
+    /// The joint type (default `revolute`).
     #[serde(rename = "type", default)]
     pub kind: JointKindFile,
     /// Body a.
     pub body_a: BodyRef,
     /// Body b.
     pub body_b: BodyRef,
-    /// The anchor as a world point at creation, m (or give both locals).
+    /// The anchor as a world point at creation, m (or give both locals;
+    /// motor and filter joints may leave both out: the bodies' origins).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub anchor: Option<[f64; 2]>,
     /// Anchor in a's frame, m.
@@ -360,21 +421,191 @@ pub struct JointFile {
     /// Anchor in b's frame, m.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub anchor_b: Option<[f64; 2]>,
-    /// `θ_b − θ_a` at joint angle zero, rad.
+    /// Angle of the joint's frame on a, in a's frame, rad (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle_a: Option<f64>,
+    /// Angle of the joint's frame on b, in b's frame, rad (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle_b: Option<f64>,
+    /// Prismatic, wheel: the axis as a world angle at creation, rad (both
+    /// frames' x axes along it; instead of `angle_a`/`angle_b`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis: Option<f64>,
+    /// Revolute, weld: `θ_b − θ_a` at joint angle zero, rad (frame a's
+    /// angle; instead of `angle_a`/`angle_b`).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub reference_angle: f64,
-    /// Angle limits [lower, upper], rad.
+    /// Revolute, prismatic, wheel: [lower, upper] (rad or m); distance:
+    /// [min, max] length, m.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub limit: Option<[f64; 2]>,
-    /// Motor.
+    /// Revolute, prismatic, wheel, distance: a motor.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub motor: Option<MotorFile>,
-    /// Spring.
+    /// Revolute (angular), prismatic, wheel (along the axis; none: a free
+    /// axis), distance (the length row), mouse (the pull): a spring.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spring: Option<SpringFile>,
+    /// Revolute: the angle the spring drives toward, rad.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target_angle: Option<f64>,
+    /// Prismatic: the translation the spring drives toward, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target_translation: Option<f64>,
+    /// Weld: the point rows' spring (none: rigid).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub linear_spring: Option<SpringFile>,
+    /// Weld: the angle row's spring (none: rigid); mouse: the angular
+    /// damping row (default 0.5 Hz, ζ 0.1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angular_spring: Option<SpringFile>,
+    /// Distance: rest length, m (default: the anchors' distance at
+    /// creation).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub length: Option<f64>,
+    /// Distance: the spring's force range [lower, upper], N (tension
+    /// negative; default unbounded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spring_force: Option<[f64; 2]>,
+    /// Motor joint: target position of b's anchor in a's joint frame, m
+    /// (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub linear_offset: Option<[f64; 2]>,
+    /// Motor joint: target joint angle, rad (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angular_offset: Option<f64>,
+    /// Motor joint (default 1), mouse (required): the largest force, N.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_force: Option<f64>,
+    /// Motor joint: the largest torque, N·m (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_torque: Option<f64>,
+    /// Motor joint: the fraction of the pose error closed per substep, in
+    /// [0, 1] (default 0.3).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub correction_factor: Option<f64>,
+    /// Mouse: the world point pulled toward, m (default: the anchor).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target: Option<[f64; 2]>,
     /// Whether the two bodies collide.
     #[serde(default, skip_serializing_if = "is_false")]
     pub collide_connected: bool,
+    /// Force above which the joint reports a joint event, N (default ∞).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub force_threshold: Option<f64>,
+    /// Torque above which the joint reports a joint event, N·m (default ∞).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub torque_threshold: Option<f64>,
+    /// Stiffness of the kind's rigid rows, Hz (default 0: the world's
+    /// joint softness).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub constraint_hertz: Option<f64>,
+    /// Damping ratio of the kind's rigid rows (with `constraint_hertz`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub constraint_damping_ratio: Option<f64>,
+    /// An opaque value the world keeps for the joint.
+    #[serde(default, skip_serializing_if = "is_zero_u64")]
+    pub user_data: u64,
+    /// Size of the joint's debug drawing (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub draw_scale: Option<f64>,
+}
+
+impl JointFile {
+    /// A joint of `kind` between two bodies, every other key left out.
+    #[must_use]
+    pub fn new(kind: JointKindFile, body_a: BodyRef, body_b: BodyRef) -> Self {
+        JointFile {
+            kind,
+            body_a,
+            body_b,
+            anchor: None,
+            anchor_a: None,
+            anchor_b: None,
+            angle_a: None,
+            angle_b: None,
+            axis: None,
+            reference_angle: 0.0,
+            limit: None,
+            motor: None,
+            spring: None,
+            target_angle: None,
+            target_translation: None,
+            linear_spring: None,
+            angular_spring: None,
+            length: None,
+            spring_force: None,
+            linear_offset: None,
+            angular_offset: None,
+            max_force: None,
+            max_torque: None,
+            correction_factor: None,
+            target: None,
+            collide_connected: false,
+            force_threshold: None,
+            torque_threshold: None,
+            constraint_hertz: None,
+            constraint_damping_ratio: None,
+            user_data: 0,
+            draw_scale: None,
+        }
+    }
+
+    /// The first key the joint's kind does not use, if any.
+    fn unused_key(&self) -> Option<&'static str> {
+        use JointKindFile as K;
+        let k = self.kind;
+        let keys: [(&'static str, bool, &[K]); 17] = [
+            ("axis", self.axis.is_some(), &[K::Prismatic, K::Wheel]),
+            (
+                "reference_angle",
+                self.reference_angle != 0.0,
+                &[K::Revolute, K::Weld],
+            ),
+            (
+                "limit",
+                self.limit.is_some(),
+                &[K::Revolute, K::Prismatic, K::Wheel, K::Distance],
+            ),
+            (
+                "motor",
+                self.motor.is_some(),
+                &[K::Revolute, K::Prismatic, K::Wheel, K::Distance],
+            ),
+            (
+                "spring",
+                self.spring.is_some(),
+                &[K::Revolute, K::Prismatic, K::Wheel, K::Distance, K::Mouse],
+            ),
+            ("target_angle", self.target_angle.is_some(), &[K::Revolute]),
+            (
+                "target_translation",
+                self.target_translation.is_some(),
+                &[K::Prismatic],
+            ),
+            ("linear_spring", self.linear_spring.is_some(), &[K::Weld]),
+            (
+                "angular_spring",
+                self.angular_spring.is_some(),
+                &[K::Weld, K::Mouse],
+            ),
+            ("length", self.length.is_some(), &[K::Distance]),
+            ("spring_force", self.spring_force.is_some(), &[K::Distance]),
+            ("linear_offset", self.linear_offset.is_some(), &[K::Motor]),
+            ("angular_offset", self.angular_offset.is_some(), &[K::Motor]),
+            ("max_force", self.max_force.is_some(), &[K::Motor, K::Mouse]),
+            ("max_torque", self.max_torque.is_some(), &[K::Motor]),
+            (
+                "correction_factor",
+                self.correction_factor.is_some(),
+                &[K::Motor],
+            ),
+            ("target", self.target.is_some(), &[K::Mouse]),
+        ];
+        keys.iter()
+            .find(|(_, given, kinds)| *given && !kinds.contains(&k))
+            .map(|(key, _, _)| *key)
+    }
 }
 
 /// One portal of a pair.
@@ -438,6 +669,9 @@ fn is_friction(x: &f64) -> bool {
 }
 fn is_zero2(x: &[f64; 2]) -> bool {
     x[0] == 0.0 && x[1] == 0.0
+}
+fn is_zero_u64(x: &u64) -> bool {
+    *x == 0
 }
 fn is_false(x: &bool) -> bool {
     !*x
@@ -762,47 +996,7 @@ impl SceneFile {
             bodies.push(h);
         }
         for (j, jf) in self.joints.iter().enumerate() {
-            let f = |k: &str| format!("joints[{j}].{k}");
-            let a = self.resolve(&jf.body_a, &f("body_a"))?;
-            let b = self.resolve(&jf.body_b, &f("body_b"))?;
-            let (la, lb) = match (jf.anchor, jf.anchor_a, jf.anchor_b) {
-                (_, Some(la), Some(lb)) => (v2(la), v2(lb)),
-                (Some(p), None, None) => {
-                    finite(&f("anchor"), &p)?;
-                    let p = v2(p);
-                    let xa = world
-                        .transform(bodies[a])
-                        .map_err(|e| invalid(f("body_a"), e))?;
-                    let xb = world
-                        .transform(bodies[b])
-                        .map_err(|e| invalid(f("body_b"), e))?;
-                    (xa.apply_inv(p), xb.apply_inv(p))
-                }
-                _ => {
-                    return Err(invalid(
-                        format!("joints[{j}]"),
-                        "give `anchor` (a world point) or both `anchor_a` and `anchor_b`",
-                    ));
-                }
-            };
-            let mut def = RevoluteJointDef::new(bodies[a], bodies[b], la, lb);
-            def = def.with_reference_angle(from_f64(jf.reference_angle));
-            def.base.collide_connected = jf.collide_connected;
-            if let Some([lo, hi]) = jf.limit {
-                def = def.with_limits(from_f64(lo), from_f64(hi));
-            }
-            if let Some(m) = &jf.motor {
-                def = def.with_motor(
-                    from_f64(m.speed),
-                    from_f64(m.max_torque.min(to_f64(Real::MAX))),
-                );
-            }
-            if let Some(s) = &jf.spring {
-                def = def.with_spring(from_f64(s.hertz), from_f64(s.damping_ratio));
-            }
-            world
-                .create_revolute_joint(&def)
-                .map_err(|e| invalid(format!("joints[{j}]"), e))?;
+            self.build_joint(j, jf, &mut world, &bodies)?;
         }
         self.build_portals(&mut world, &bodies)?;
         let probe = match &self.probe {
@@ -816,6 +1010,323 @@ impl SceneFile {
             bodies,
             probe,
         })
+    }
+
+    /// Builds joint `j` of the file into `world` (bodies from `bodies`);
+    /// the error names the key.
+    fn build_joint(
+        &self,
+        j: usize,
+        jf: &JointFile,
+        world: &mut World,
+        bodies: &[BodyHandle],
+    ) -> Result<(), Invalid> {
+        use JointKindFile as K;
+        let f = |k: &str| format!("joints[{j}].{k}");
+        let kind = jf.kind.name();
+        if let Some(key) = jf.unused_key() {
+            return Err(invalid(f(key), format!("a {kind} joint has no `{key}`")));
+        }
+        let a = self.resolve(&jf.body_a, &f("body_a"))?;
+        let b = self.resolve(&jf.body_b, &f("body_b"))?;
+        let (ha, hb) = (bodies[a], bodies[b]);
+        let xa = world.transform(ha).map_err(|e| invalid(f("body_a"), e))?;
+        let xb = world.transform(hb).map_err(|e| invalid(f("body_b"), e))?;
+
+        // Every number finite, every cap and spring non-negative.
+        let opt = |x: Option<f64>| x.into_iter().collect::<Vec<_>>();
+        let pair = |x: Option<[f64; 2]>| x.map_or_else(Vec::new, Vec::from);
+        let spring = |s: &Option<SpringFile>| {
+            s.as_ref()
+                .map_or_else(Vec::new, |s| vec![s.hertz, s.damping_ratio])
+        };
+        let numbers: [(&str, Vec<f64>, bool); 29] = [
+            ("anchor", pair(jf.anchor), false),
+            ("anchor_a", pair(jf.anchor_a), false),
+            ("anchor_b", pair(jf.anchor_b), false),
+            ("angle_a", opt(jf.angle_a), false),
+            ("angle_b", opt(jf.angle_b), false),
+            ("axis", opt(jf.axis), false),
+            ("reference_angle", vec![jf.reference_angle], false),
+            ("limit", pair(jf.limit), false),
+            (
+                "motor.speed",
+                opt(jf.motor.as_ref().map(|m| m.speed)),
+                false,
+            ),
+            (
+                "motor.max_torque",
+                opt(jf.motor.as_ref().and_then(|m| m.max_torque)),
+                true,
+            ),
+            (
+                "motor.max_force",
+                opt(jf.motor.as_ref().and_then(|m| m.max_force)),
+                true,
+            ),
+            ("spring", spring(&jf.spring), true),
+            ("target_angle", opt(jf.target_angle), false),
+            ("target_translation", opt(jf.target_translation), false),
+            ("linear_spring", spring(&jf.linear_spring), true),
+            ("angular_spring", spring(&jf.angular_spring), true),
+            ("length", opt(jf.length), true),
+            ("spring_force", pair(jf.spring_force), false),
+            ("linear_offset", pair(jf.linear_offset), false),
+            ("angular_offset", opt(jf.angular_offset), false),
+            ("max_force", opt(jf.max_force), true),
+            ("max_torque", opt(jf.max_torque), true),
+            ("correction_factor", opt(jf.correction_factor), true),
+            ("target", pair(jf.target), false),
+            ("force_threshold", opt(jf.force_threshold), true),
+            ("torque_threshold", opt(jf.torque_threshold), true),
+            ("constraint_hertz", opt(jf.constraint_hertz), true),
+            (
+                "constraint_damping_ratio",
+                opt(jf.constraint_damping_ratio),
+                true,
+            ),
+            ("draw_scale", opt(jf.draw_scale), true),
+        ];
+        for (key, values, non_negative) in &numbers {
+            finite(&f(key), values)?;
+            if *non_negative && values.iter().any(|v| *v < 0.0) {
+                return Err(invalid(f(key), "must be ≥ 0"));
+            }
+        }
+        if let Some([lo, hi]) = jf.limit
+            && lo > hi
+        {
+            return Err(invalid(f("limit"), "lower > upper"));
+        }
+        if let Some([lo, hi]) = jf.spring_force
+            && lo > hi
+        {
+            return Err(invalid(f("spring_force"), "lower > upper"));
+        }
+        if let Some(m) = &jf.motor {
+            let (want, other, unit) = if jf.kind.linear_motor() {
+                (
+                    m.max_force,
+                    "max_torque",
+                    "a linear motor: give `max_force` (N)",
+                )
+            } else {
+                (
+                    m.max_torque,
+                    "max_force",
+                    "an angular motor: give `max_torque` (N·m)",
+                )
+            };
+            let given_other = if jf.kind.linear_motor() {
+                m.max_torque.is_some()
+            } else {
+                m.max_force.is_some()
+            };
+            if given_other {
+                return Err(invalid(
+                    f(&format!("motor.{other}")),
+                    format!("a {kind} joint's motor is {unit}"),
+                ));
+            }
+            if want.is_none() {
+                return Err(invalid(
+                    f("motor"),
+                    format!("a {kind} joint's motor is {unit}"),
+                ));
+            }
+        }
+
+        // The frames: anchors, then angles.
+        let (la, lb) = match (jf.anchor, jf.anchor_a, jf.anchor_b) {
+            (Some(p), None, None) => (xa.apply_inv(v2(p)), xb.apply_inv(v2(p))),
+            (None, Some(la), Some(lb)) => (v2(la), v2(lb)),
+            (None, None, None) if matches!(jf.kind, K::Motor | K::Filter) => {
+                (Vec2::ZERO, Vec2::ZERO)
+            }
+            _ => {
+                return Err(invalid(
+                    format!("joints[{j}]"),
+                    "give `anchor` (a world point) or both `anchor_a` and `anchor_b`",
+                ));
+            }
+        };
+        let angles_given = jf.angle_a.is_some() || jf.angle_b.is_some();
+        let (phi_a, phi_b) = if let Some(axis) = jf.axis {
+            if angles_given {
+                return Err(invalid(
+                    f("axis"),
+                    "give `axis` or `angle_a`/`angle_b`, not both",
+                ));
+            }
+            let axis = from_f64(axis);
+            (axis - xa.q.angle(), axis - xb.q.angle())
+        } else if jf.reference_angle != 0.0 {
+            if angles_given {
+                return Err(invalid(
+                    f("reference_angle"),
+                    "give `reference_angle` or `angle_a`/`angle_b`, not both",
+                ));
+            }
+            (from_f64(jf.reference_angle), 0.0)
+        } else {
+            (
+                from_f64(jf.angle_a.unwrap_or(0.0)),
+                from_f64(jf.angle_b.unwrap_or(0.0)),
+            )
+        };
+        let mut base = JointDefBase::with_frames(
+            ha,
+            hb,
+            JointFrame::new(la, phi_a),
+            JointFrame::new(lb, phi_b),
+        );
+        base.collide_connected = jf.collide_connected;
+        base.user_data = jf.user_data;
+        if let Some(x) = jf.force_threshold {
+            base.force_threshold = from_f64(x);
+        }
+        if let Some(x) = jf.torque_threshold {
+            base.torque_threshold = from_f64(x);
+        }
+        if let Some(x) = jf.constraint_hertz {
+            base.constraint_hertz = from_f64(x);
+        }
+        if let Some(x) = jf.constraint_damping_ratio {
+            base.constraint_damping_ratio = from_f64(x);
+        }
+        if let Some(x) = jf.draw_scale {
+            base.draw_scale = from_f64(x);
+        }
+
+        let cap = |x: f64| from_f64(x.min(to_f64(Real::MAX)));
+        let limit = jf.limit.map(|[lo, hi]| (from_f64(lo), from_f64(hi)));
+        let motor = jf.motor.as_ref().map(|m| {
+            let max = m.max_force.or(m.max_torque).unwrap_or(0.0);
+            (from_f64(m.speed), cap(max))
+        });
+        let spring = |s: &Option<SpringFile>| {
+            s.as_ref()
+                .map(|s| (from_f64(s.hertz), from_f64(s.damping_ratio)))
+        };
+        let def: JointDef = match jf.kind {
+            K::Revolute => {
+                let mut d = RevoluteJointDef::from_base(base);
+                if let Some((lo, hi)) = limit {
+                    d = d.with_limits(lo, hi);
+                }
+                if let Some((speed, max)) = motor {
+                    d = d.with_motor(speed, max);
+                }
+                if let Some((hz, zeta)) = spring(&jf.spring) {
+                    d = d.with_spring(hz, zeta);
+                }
+                if let Some(t) = jf.target_angle {
+                    d = d.with_target_angle(from_f64(t));
+                }
+                d.into()
+            }
+            K::Weld => {
+                let (lh, lz) = spring(&jf.linear_spring).unwrap_or((0.0, 0.0));
+                let (ah, az) = spring(&jf.angular_spring).unwrap_or((0.0, 0.0));
+                WeldJointDef::from_base(base)
+                    .with_stiffness(lh, lz, ah, az)
+                    .into()
+            }
+            K::Prismatic => {
+                let mut d = PrismaticJointDef::from_base(base)
+                    .with_target_translation(from_f64(jf.target_translation.unwrap_or(0.0)));
+                if let Some((lo, hi)) = limit {
+                    d = d.with_limits(lo, hi);
+                }
+                if let Some((speed, max)) = motor {
+                    d = d.with_motor(speed, max);
+                }
+                if let Some((hz, zeta)) = spring(&jf.spring) {
+                    d = d.with_spring(hz, zeta);
+                }
+                d.into()
+            }
+            K::Wheel => {
+                let mut d = WheelJointDef::from_base(base);
+                d.enable_spring = false;
+                if let Some((hz, zeta)) = spring(&jf.spring) {
+                    d = d.with_spring(hz, zeta);
+                }
+                if let Some((lo, hi)) = limit {
+                    d = d.with_limits(lo, hi);
+                }
+                if let Some((speed, max)) = motor {
+                    d = d.with_motor(speed, max);
+                }
+                d.into()
+            }
+            K::Distance => {
+                let length = match jf.length {
+                    Some(l) => from_f64(l),
+                    None => (xb.apply(lb) - xa.apply(la)).length(),
+                };
+                let mut d = DistanceJointDef::from_base(base, length);
+                if let Some([lo, hi]) = jf.spring_force {
+                    d = d.with_spring_force_range(from_f64(lo), from_f64(hi));
+                }
+                if let Some((lo, hi)) = limit {
+                    d = d.with_limits(lo, hi);
+                }
+                if let Some((hz, zeta)) = spring(&jf.spring) {
+                    d = d.with_spring(hz, zeta);
+                }
+                if let Some((speed, max)) = motor {
+                    d = d.with_motor(speed, max);
+                }
+                d.into()
+            }
+            K::Motor => {
+                let mut d = MotorJointDef::from_base(base).with_offset(
+                    jf.linear_offset.map_or(Vec2::ZERO, v2),
+                    from_f64(jf.angular_offset.unwrap_or(0.0)),
+                );
+                if let Some(x) = jf.max_force {
+                    d = d.with_max_force(cap(x));
+                }
+                if let Some(x) = jf.max_torque {
+                    d = d.with_max_torque(cap(x));
+                }
+                if let Some(x) = jf.correction_factor {
+                    d = d.with_correction_factor(from_f64(x));
+                }
+                d.into()
+            }
+            K::Mouse => {
+                let target = match (jf.target, jf.anchor) {
+                    (Some(t), _) | (None, Some(t)) => v2(t),
+                    (None, None) => {
+                        return Err(invalid(
+                            format!("joints[{j}]"),
+                            "a mouse joint needs `target` (or a world `anchor`)",
+                        ));
+                    }
+                };
+                let Some(max_force) = jf.max_force else {
+                    return Err(invalid(
+                        format!("joints[{j}]"),
+                        "a mouse joint needs `max_force` (N)",
+                    ));
+                };
+                let mut d = MouseJointDef::from_base(base, target, cap(max_force));
+                if let Some((hz, zeta)) = spring(&jf.spring) {
+                    d = d.with_spring(hz, zeta);
+                }
+                if let Some((hz, zeta)) = spring(&jf.angular_spring) {
+                    d = d.with_angular_damping(hz, zeta);
+                }
+                d.into()
+            }
+            K::Filter => FilterJointDef::from_base(base).into(),
+        };
+        world
+            .create_joint(&def)
+            .map(drop)
+            .map_err(|e| invalid(format!("joints[{j}]"), format!("{kind} joint: {e}")))
     }
 
     #[cfg(feature = "portals")]
@@ -968,28 +1479,7 @@ impl SceneFile {
                     .collect(),
             })
             .collect();
-        let joints = d
-            .joints
-            .iter()
-            .map(|j| JointFile {
-                kind: JointKindFile::Revolute,
-                body_a: BodyRef::Index(j.body_a),
-                body_b: BodyRef::Index(j.body_b),
-                anchor: None,
-                anchor_a: Some(a2(j.local_a)),
-                anchor_b: Some(a2(j.local_b)),
-                reference_angle: j.reference_angle,
-                limit: j.limit.map(|(lo, hi)| [lo, hi]),
-                motor: j
-                    .motor
-                    .map(|(speed, max_torque)| MotorFile { speed, max_torque }),
-                spring: j.spring.map(|(hertz, damping_ratio)| SpringFile {
-                    hertz,
-                    damping_ratio,
-                }),
-                collide_connected: j.collide_connected,
-            })
-            .collect();
+        let joints = d.all_joints().map(|j| joint_file(&j)).collect();
         let side = |(body, anchor, direction, half_width): (usize, DVec2, DVec2, f64)| PortalFile {
             body: BodyRef::Index(body),
             anchor: a2(anchor),
@@ -1023,6 +1513,99 @@ impl SceneFile {
         // Serialising plain data with string keys cannot fail.
         serde_json::to_string_pretty(self).unwrap_or_default()
     }
+}
+
+/// The file form of a built-in joint description (local anchors and frame
+/// angles, so the file builds the same definition).
+fn joint_file(j: &desc::JointDesc) -> JointFile {
+    use desc::JointDesc as D;
+    let a2 = |p: DVec2| [p.x, p.y];
+    let pair = |(x, y): (f64, f64)| [x, y];
+    let spring = |(hertz, damping_ratio): (f64, f64)| SpringFile {
+        hertz,
+        damping_ratio,
+    };
+    let angular = |(speed, max): (f64, f64)| MotorFile {
+        speed,
+        max_torque: Some(max),
+        max_force: None,
+    };
+    let linear = |(speed, max): (f64, f64)| MotorFile {
+        speed,
+        max_torque: None,
+        max_force: Some(max),
+    };
+    let kind = match j {
+        D::Revolute(_) => JointKindFile::Revolute,
+        D::Weld(_) => JointKindFile::Weld,
+        D::Prismatic(_) => JointKindFile::Prismatic,
+        D::Wheel(_) => JointKindFile::Wheel,
+        D::Distance(_) => JointKindFile::Distance,
+        D::Motor(_) => JointKindFile::Motor,
+        D::Mouse(_) => JointKindFile::Mouse,
+        D::Filter(_) => JointKindFile::Filter,
+    };
+    let (a, b) = j.bodies();
+    let (anchor_a, anchor_b) = j.anchors();
+    let mut f = JointFile::new(kind, BodyRef::Index(a), BodyRef::Index(b));
+    f.anchor_a = Some(a2(anchor_a));
+    f.anchor_b = Some(a2(anchor_b));
+    f.collide_connected = j.collide_connected();
+    if let Some(base) = j.base() {
+        let angle = |x: f64| (x != 0.0).then_some(x);
+        f.angle_a = angle(base.frame_a.angle);
+        f.angle_b = angle(base.frame_b.angle);
+    }
+    match j {
+        D::Revolute(r) => {
+            f.reference_angle = r.reference_angle;
+            f.limit = r.limit.map(pair);
+            f.motor = r.motor.map(angular);
+            f.spring = r.spring.map(spring);
+        }
+        D::Weld(w) => {
+            let (lh, lz, ah, az) = (
+                w.linear_hertz,
+                w.linear_damping_ratio,
+                w.angular_hertz,
+                w.angular_damping_ratio,
+            );
+            f.linear_spring = (lh != 0.0 || lz != 0.0).then(|| spring((lh, lz)));
+            f.angular_spring = (ah != 0.0 || az != 0.0).then(|| spring((ah, az)));
+        }
+        D::Prismatic(p) => {
+            f.limit = p.limit.map(pair);
+            f.motor = p.motor.map(linear);
+            f.spring = p.spring.map(spring);
+            f.target_translation = (p.target_translation != 0.0).then_some(p.target_translation);
+        }
+        D::Wheel(w) => {
+            f.limit = w.limit.map(pair);
+            f.motor = w.motor.map(angular);
+            f.spring = w.spring.map(spring);
+        }
+        D::Distance(d) => {
+            f.length = Some(d.length);
+            f.limit = d.limit.map(pair);
+            f.motor = d.motor.map(linear);
+            f.spring = d.spring.map(spring);
+            f.spring_force = (d.spring_force != (f64::MIN, f64::MAX)).then(|| pair(d.spring_force));
+        }
+        D::Motor(m) => {
+            f.linear_offset = Some(a2(m.linear_offset));
+            f.angular_offset = Some(m.angular_offset);
+            f.max_force = Some(m.max_force);
+            f.max_torque = Some(m.max_torque);
+            f.correction_factor = Some(m.correction_factor);
+        }
+        D::Mouse(m) => {
+            f.target = Some(a2(m.target));
+            f.spring = Some(spring((m.hertz, m.damping_ratio)));
+            f.max_force = Some(m.max_force);
+        }
+        D::Filter(_) => {}
+    }
+    f
 }
 
 /// Parses and builds a scene file's text; every error carries the line,

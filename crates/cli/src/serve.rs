@@ -22,7 +22,7 @@
 //! | `{"cmd":"substeps","n":8}`            | substeps from now on              |
 //! | `{"cmd":"draw","flags":"+contacts"}`  | draw flags as `run --draw` takes  |
 //! | `{"cmd":"knob","name":"contact_hertz","value":60}` | a solver setting, live ([`Control::Knob`]) |
-//! | `{"cmd":"grab","x":1,"y":2}`, `drag`, `release` | pull a body by a spring (5 Hz, ζ 0.7, at most 1000 g of force) |
+//! | `{"cmd":"grab","x":1,"y":2}`, `drag`, `release` | pull a body by a mouse joint (5 Hz, ζ 0.7, at most 1000 g of force; [`Session::grab_joint`]) |
 //! | `{"cmd":"spawn","x":1,"y":2}`         | drop a 1 m box there              |
 //!
 //! | message out                           | what                              |
@@ -40,11 +40,12 @@ use axum::extract::State;
 use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
 use axum::response::{Html, IntoResponse, Response};
 use axum::routing::get;
+use janus2d_constraints::{MouseJoint, MouseJointDef};
 use janus2d_core::body::{BodyDef, BodyHandle, BodyType};
 use janus2d_core::geometry::{Aabb, Polygon, Shape};
 use janus2d_core::math::{Real, Transform, Vec2, from_f64, to_f64};
 use janus2d_world::debug_draw::{Color, DebugDraw};
-use janus2d_world::{DrawOptions, ShapeDef, World};
+use janus2d_world::{DrawOptions, JointHandle, ShapeDef, World};
 use serde::Deserialize;
 use serde_json::{Value, json};
 
@@ -93,22 +94,22 @@ pub enum Control {
         /// Its new value.
         value: f64,
     },
-    /// Grabs the dynamic body under a world point (m): a spring then pulls
-    /// that point of it towards the drag target.
+    /// Grabs the dynamic body under a world point (m): a mouse joint then
+    /// pulls that point of it towards the drag target.
     Grab {
         /// x, m.
         x: f64,
         /// y, m.
         y: f64,
     },
-    /// Moves the drag target (m).
+    /// Moves the drag target (m): the mouse joint's `target`.
     Drag {
         /// x, m.
         x: f64,
         /// y, m.
         y: f64,
     },
-    /// Lets the grabbed body go.
+    /// Lets the grabbed body go: the mouse joint is destroyed.
     Release,
     /// Drops a 1 m box at a world point (m).
     Spawn {
@@ -264,15 +265,28 @@ pub struct Session {
     step: usize,
     running: bool,
     draw: DrawOptions,
-    /// The grabbed body, the grabbed point in its frame, the target.
-    grab: Option<(BodyHandle, Vec2, Vec2)>,
+    /// The drag in progress.
+    grab: Option<Grab>,
+}
+
+/// A drag in progress: a mouse joint from a static body made for the drag
+/// (no shapes, at the world origin) to the grabbed body. Both go on
+/// release, so a drag leaves the scene's bodies and joints as they were.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Grab {
+    /// The grabbed body (the joint's body b).
+    body: BodyHandle,
+    /// The static body the joint hangs from (its body a).
+    ground: BodyHandle,
+    /// The mouse joint.
+    joint: JointHandle,
 }
 
 /// Drag spring frequency, Hz.
-const GRAB_HERTZ: f64 = 5.0;
+const GRAB_HERTZ: Real = 5.0;
 /// Drag spring damping ratio.
-const GRAB_DAMPING: f64 = 0.7;
-/// Largest drag force per kilogram, N/kg.
+const GRAB_DAMPING: Real = 0.7;
+/// Largest drag force per kilogram, N/kg (1000 g).
 const GRAB_MAX_ACCEL: f64 = 1000.0 * 9.81;
 
 fn point(x: f64, y: f64) -> Result<Vec2, CliError> {
@@ -332,7 +346,72 @@ impl Session {
     /// The grabbed body, if any.
     #[must_use]
     pub fn grabbed(&self) -> Option<BodyHandle> {
-        self.grab.map(|g| g.0)
+        self.grab.map(|g| g.body)
+    }
+
+    /// The mouse joint of the drag in progress, if any.
+    #[must_use]
+    pub fn grab_joint(&self) -> Option<JointHandle> {
+        self.grab.map(|g| g.joint)
+    }
+
+    /// Starts a drag at `p`: a static body at the origin and a mouse joint
+    /// from it to the dynamic body under `p` (grabbed at `p`, target `p`,
+    /// 5 Hz, ζ 0.7, at most 1000 g × its mass). Nothing under `p`: no drag.
+    fn grab_at(&mut self, p: Vec2) -> Result<(), CliError> {
+        self.release();
+        let world = self.scene.world_mut();
+        let Some(body) = body_at(world, p) else {
+            return Ok(());
+        };
+        let max_force = world.mass(body)? * from_f64(GRAB_MAX_ACCEL);
+        let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO))?;
+        let made = world.joint_base_at(ground, body, p).and_then(|base| {
+            let def =
+                MouseJointDef::from_base(base, p, max_force).with_spring(GRAB_HERTZ, GRAB_DAMPING);
+            world.create_joint(&def.into())
+        });
+        match made {
+            Ok(joint) => {
+                self.grab = Some(Grab {
+                    body,
+                    ground,
+                    joint,
+                });
+                Ok(())
+            }
+            Err(e) => {
+                let _ = world.destroy_body(ground);
+                Err(e.into())
+            }
+        }
+    }
+
+    /// Moves the drag's target to `p` (and frame a's anchor with it, so
+    /// the joint is drawn from the target to the grabbed point). A drag
+    /// whose joint is gone (its body destroyed) ends.
+    fn drag_to(&mut self, p: Vec2) -> Result<(), CliError> {
+        let Some(g) = self.grab else {
+            return Ok(());
+        };
+        let world = self.scene.world_mut();
+        let Ok(j) = world.joint_of::<MouseJoint>(g.joint) else {
+            self.release();
+            return Ok(());
+        };
+        let mut def = j.def.clone().with_target(p);
+        def.base.local_frame_a.anchor = p;
+        world.set_joint_def(g.joint, def.into())?;
+        Ok(())
+    }
+
+    /// Ends the drag: the mouse joint and its static body go.
+    fn release(&mut self) {
+        if let Some(g) = self.grab.take() {
+            let world = self.scene.world_mut();
+            let _ = world.destroy_joint(g.joint);
+            let _ = world.destroy_body(g.ground);
+        }
     }
 
     fn knob(&mut self, name: &str, value: f64) -> Result<(), CliError> {
@@ -395,12 +474,14 @@ impl Session {
                 self.advance()?;
             }
             Control::Reset => {
+                self.grab = None;
                 self.scene = runner::load(&self.name)?;
                 self.step = 0;
                 return Ok(Some(scene_message(&self.scene)));
             }
             Control::Scene { name } => {
                 let scene = runner::load(&name)?;
+                self.grab = None;
                 self.scene = scene;
                 self.name = name;
                 self.step = 0;
@@ -416,19 +497,9 @@ impl Session {
             }
             Control::Draw { flags } => self.draw = parse_draw(&flags)?,
             Control::Knob { name, value } => self.knob(&name, value)?,
-            Control::Grab { x, y } => {
-                let p = point(x, y)?;
-                let world = self.scene.world();
-                self.grab = body_at(world, p)
-                    .and_then(|b| Some((b, world.transform(b).ok()?.apply_inv(p), p)));
-            }
-            Control::Drag { x, y } => {
-                let p = point(x, y)?;
-                if let Some(g) = &mut self.grab {
-                    g.2 = p;
-                }
-            }
-            Control::Release => self.grab = None,
+            Control::Grab { x, y } => self.grab_at(point(x, y)?)?,
+            Control::Drag { x, y } => self.drag_to(point(x, y)?)?,
+            Control::Release => self.release(),
             Control::Spawn { x, y } => {
                 let p = point(x, y)?;
                 let world = self.scene.world_mut();
@@ -439,40 +510,14 @@ impl Session {
         Ok(None)
     }
 
-    /// The drag spring's force for this step, applied at the grabbed point.
-    fn pull(&mut self) {
-        let Some((body, local, target)) = self.grab else {
-            return;
-        };
-        let world = self.scene.world_mut();
-        let (Ok(xf), Ok(m), Ok(v), Ok(w), Ok(c)) = (
-            world.transform(body),
-            world.mass(body),
-            world.linear_velocity(body),
-            world.angular_velocity(body),
-            world.center_of_mass(body),
-        ) else {
-            self.grab = None;
-            return;
-        };
-        let anchor = xf.apply(local);
-        let v_anchor = v + janus2d_core::math::cross_sv(w, anchor - c);
-        let omega = 2.0 * std::f64::consts::PI * GRAB_HERTZ;
-        let (k, d) = (
-            from_f64(omega * omega),
-            from_f64(2.0 * GRAB_DAMPING * omega),
-        );
-        let mut accel = k * (target - anchor) - d * v_anchor;
-        let max = from_f64(GRAB_MAX_ACCEL);
-        if accel.length() > max {
-            accel = accel.normalize() * max;
-        }
-        let _ = world.apply_force(body, m * accel, anchor);
-    }
-
     /// One step.
     pub fn advance(&mut self) -> Result<(), CliError> {
-        self.pull();
+        if let Some(g) = self.grab
+            && self.scene.world().joint(g.joint).is_err()
+        {
+            // The grabbed body went (a script destroyed it), its joint with it.
+            self.release();
+        }
         self.scene.step(self.step)?;
         self.step += 1;
         Ok(())

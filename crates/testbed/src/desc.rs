@@ -6,7 +6,8 @@
 //!            ├─ bodies[]   BodyDesc ── shapes[] ShapeDesc ── Geometry
 //!            ├─ joints[]   RevoluteDesc (indices into bodies[])
 //!            ├─ extra_joints[]  JointDesc: any kind (revolute, weld,
-//!            │             prismatic, wheel, distance), built after joints[]
+//!            │             prismatic, wheel, distance, motor, mouse,
+//!            │             filter), built after joints[]
 //!            ├─ script     per-step Actions: spawn / despawn a group,
 //!            │             drive a kinematic body to a target
 //!            ├─ probe      the body whose pose the sanity line reports
@@ -467,6 +468,81 @@ impl DistanceDesc {
     }
 }
 
+/// A motor joint: drives b's frame toward an offset pose in a's frame
+/// with a bounded force and torque (a character on a platform, a top-down
+/// car).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MotorJointDesc {
+    /// Bodies and frames (frame a: the frame the offsets are taken in;
+    /// frame b's anchor: the driven point).
+    pub base: JointBaseDesc,
+    /// Target position of b's frame anchor in a's joint frame, m.
+    pub linear_offset: DVec2,
+    /// Target joint angle, rad.
+    pub angular_offset: f64,
+    /// Largest force, N.
+    pub max_force: f64,
+    /// Largest torque, N·m.
+    pub max_torque: f64,
+    /// Fraction of the pose error closed per substep, in [0, 1].
+    pub correction_factor: f64,
+}
+
+impl MotorJointDesc {
+    /// A motor joint holding offset zero (b's anchor on a's), Box2D's
+    /// defaults: 1 N, 1 N·m, correction 0.3.
+    #[must_use]
+    pub fn new(base: JointBaseDesc) -> Self {
+        MotorJointDesc {
+            base,
+            linear_offset: DVec2::ZERO,
+            angular_offset: 0.0,
+            max_force: 1.0,
+            max_torque: 1.0,
+            correction_factor: 0.3,
+        }
+    }
+}
+
+/// A mouse (target) joint: pulls b's frame anchor toward a world target
+/// through a spring of bounded force; body a is only the reference end
+/// (usually a static ground).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MouseJointDesc {
+    /// Bodies and frames (frame b's anchor: the grabbed point).
+    pub base: JointBaseDesc,
+    /// The world point pulled toward, m.
+    pub target: DVec2,
+    /// Spring stiffness, Hz.
+    pub hertz: f64,
+    /// Spring damping ratio.
+    pub damping_ratio: f64,
+    /// Largest pulling force, N.
+    pub max_force: f64,
+}
+
+impl MouseJointDesc {
+    /// Pulls `base`'s frame b anchor toward `target` with at most
+    /// `max_force`, Box2D's spring (5 Hz, ζ 0.7).
+    #[must_use]
+    pub fn new(base: JointBaseDesc, target: DVec2, max_force: f64) -> Self {
+        MouseJointDesc {
+            base,
+            target,
+            hertz: 5.0,
+            damping_ratio: 0.7,
+            max_force,
+        }
+    }
+}
+
+/// A filter joint: no rows, only stops its two bodies colliding.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilterJointDesc {
+    /// Bodies (frames only drawn).
+    pub base: JointBaseDesc,
+}
+
 /// A joint of any kind, as Box2D 3.2 has them.
 #[derive(Clone, Debug, PartialEq)]
 pub enum JointDesc {
@@ -480,11 +556,17 @@ pub enum JointDesc {
     Wheel(WheelDesc),
     /// A rod, spring or rope between two points.
     Distance(DistanceDesc),
+    /// A pose drive of b relative to a.
+    Motor(MotorJointDesc),
+    /// A pull toward a world target.
+    Mouse(MouseJointDesc),
+    /// No collision between two bodies.
+    Filter(FilterJointDesc),
 }
 
 impl JointDesc {
     /// The kind's name (`revolute`, `weld`, `prismatic`, `wheel`,
-    /// `distance`).
+    /// `distance`, `motor`, `mouse`, `filter`: the scene files' `type`).
     #[must_use]
     pub fn kind_name(&self) -> &'static str {
         match self {
@@ -493,6 +575,9 @@ impl JointDesc {
             JointDesc::Prismatic(_) => "prismatic",
             JointDesc::Wheel(_) => "wheel",
             JointDesc::Distance(_) => "distance",
+            JointDesc::Motor(_) => "motor",
+            JointDesc::Mouse(_) => "mouse",
+            JointDesc::Filter(_) => "filter",
         }
     }
 
@@ -506,6 +591,9 @@ impl JointDesc {
             JointDesc::Prismatic(j) => Some(&j.base),
             JointDesc::Wheel(j) => Some(&j.base),
             JointDesc::Distance(j) => Some(&j.base),
+            JointDesc::Motor(j) => Some(&j.base),
+            JointDesc::Mouse(j) => Some(&j.base),
+            JointDesc::Filter(j) => Some(&j.base),
         }
     }
 
@@ -567,6 +655,24 @@ impl From<WheelDesc> for JointDesc {
 impl From<DistanceDesc> for JointDesc {
     fn from(j: DistanceDesc) -> Self {
         JointDesc::Distance(j)
+    }
+}
+
+impl From<MotorJointDesc> for JointDesc {
+    fn from(j: MotorJointDesc) -> Self {
+        JointDesc::Motor(j)
+    }
+}
+
+impl From<MouseJointDesc> for JointDesc {
+    fn from(j: MouseJointDesc) -> Self {
+        JointDesc::Mouse(j)
+    }
+}
+
+impl From<FilterJointDesc> for JointDesc {
+    fn from(j: FilterJointDesc) -> Self {
+        JointDesc::Filter(j)
     }
 }
 

@@ -13,12 +13,20 @@
 //! | `Action::Target`       | velocity = (target − current) / dt           |
 //! | `JointDesc::Revolute`  | `RevoluteJointDef` (as `joints`)             |
 //! | `JointDesc::Weld`      | `WeldJointDef::from_base` (frames as given) `.with_stiffness` |
-//! | `JointDesc::Prismatic`, `Wheel`, `Distance` | not supported yet: [`unsupported_joint`] names them and [`Engine::build`] refuses the scene |
+//! | `JointDesc::Prismatic` | `PrismaticJointDef::from_base` (frame a's x axis: the slide axis) `.with_limits`, `.with_motor`, `.with_spring`, `.with_target_translation` |
+//! | `JointDesc::Wheel`     | `WheelJointDef::from_base`, `enable_spring` = `spring.is_some()` (no spring: a free axis; janus2d's default is on), `.with_limits`, `.with_motor` |
+//! | `JointDesc::Distance`  | `DistanceJointDef::from_base(length)` `.with_limits`, `.with_spring`, `.with_spring_force_range`, `.with_motor` |
+//! | `JointDesc::Motor`     | `MotorJointDef::from_base` `.with_offset`, `.with_max_force`, `.with_max_torque`, `.with_correction_factor` |
+//! | `JointDesc::Mouse`     | `MouseJointDef::from_base(target, max_force)` `.with_spring` (angular damping at its default) |
+//! | `JointDesc::Filter`    | `FilterJointDef::from_base` |
 
 use std::collections::BTreeMap;
 
 use glam::DVec2;
-use janus2d_constraints::{JointDefBase, JointFrame, RevoluteJointDef, WeldJointDef};
+use janus2d_constraints::{
+    DistanceJointDef, FilterJointDef, JointDef, JointDefBase, JointFrame, MotorJointDef,
+    MouseJointDef, PrismaticJointDef, RevoluteJointDef, WeldJointDef, WheelJointDef,
+};
 use janus2d_core::body::{BodyDef, BodyHandle, BodyType};
 use janus2d_core::geometry::{Capsule, Circle, Polygon, Segment, Shape, make_chain};
 use janus2d_core::math::{Real, Vec2, from_f64, to_f64, wrap_angle};
@@ -153,12 +161,9 @@ pub fn create_body(world: &mut World, b: &BodyDesc) -> Result<BodyHandle, WorldE
     Ok(h)
 }
 
-/// Creates one joint between bodies of `handles`.
-pub fn create_joint(
-    world: &mut World,
-    j: &RevoluteDesc,
-    handles: &[BodyHandle],
-) -> Result<JointHandle, WorldError> {
+/// janus2d's definition of a revolute description, bodies from `handles`.
+#[must_use]
+pub fn revolute_def(j: &RevoluteDesc, handles: &[BodyHandle]) -> RevoluteJointDef {
     let mut def = RevoluteJointDef::new(
         handles[j.body_a],
         handles[j.body_b],
@@ -172,22 +177,21 @@ pub fn create_joint(
         def = def.with_limits(lo as Real, hi as Real);
     }
     if let Some((speed, torque)) = j.motor {
-        def = def.with_motor(speed as Real, from_f64(torque.min(to_f64(Real::MAX))));
+        def = def.with_motor(speed as Real, cap(torque));
     }
     if let Some((hz, zeta)) = j.spring {
         def = def.with_spring(hz as Real, zeta as Real);
     }
-    world.create_revolute_joint(&def)
+    def
 }
 
-/// The kind of the first joint of `desc` janus2d cannot build yet (`None`:
-/// every joint can be built).
-#[must_use]
-pub fn unsupported_joint(desc: &SceneDesc) -> Option<&'static str> {
-    desc.extra_joints
-        .iter()
-        .find(|j| !matches!(j, JointDesc::Revolute(_) | JointDesc::Weld(_)))
-        .map(JointDesc::kind_name)
+/// Creates one revolute joint between bodies of `handles`.
+pub fn create_joint(
+    world: &mut World,
+    j: &RevoluteDesc,
+    handles: &[BodyHandle],
+) -> Result<JointHandle, WorldError> {
+    world.create_revolute_joint(&revolute_def(j, handles))
 }
 
 /// janus2d's frame of a description's.
@@ -205,9 +209,86 @@ fn base_def(b: &JointBaseDesc, handles: &[BodyHandle]) -> JointDefBase {
     base
 }
 
-/// Creates one joint of any kind between bodies of `handles`. The kinds
-/// janus2d does not have yet (prismatic, wheel, distance) give
-/// `WorldError::OutOfRange` and create nothing.
+/// A force or torque cap of a description (N or N·m, possibly `f64::MAX`)
+/// in janus2d's scalar, clamped to its largest finite value.
+fn cap(x: f64) -> Real {
+    from_f64(x.min(to_f64(Real::MAX)))
+}
+
+/// janus2d's definition of a joint description of any kind but the
+/// revolute's own fields (see [`create_joint`]), bodies from `handles`.
+#[must_use]
+pub fn joint_def(j: &JointDesc, handles: &[BodyHandle]) -> JointDef {
+    match j {
+        JointDesc::Revolute(r) => revolute_def(r, handles).into(),
+        JointDesc::Weld(w) => WeldJointDef::from_base(base_def(&w.base, handles))
+            .with_stiffness(
+                w.linear_hertz as Real,
+                w.linear_damping_ratio as Real,
+                w.angular_hertz as Real,
+                w.angular_damping_ratio as Real,
+            )
+            .into(),
+        JointDesc::Prismatic(p) => {
+            let mut def = PrismaticJointDef::from_base(base_def(&p.base, handles))
+                .with_target_translation(p.target_translation as Real);
+            if let Some((lo, hi)) = p.limit {
+                def = def.with_limits(lo as Real, hi as Real);
+            }
+            if let Some((speed, force)) = p.motor {
+                def = def.with_motor(speed as Real, cap(force));
+            }
+            if let Some((hz, zeta)) = p.spring {
+                def = def.with_spring(hz as Real, zeta as Real);
+            }
+            def.into()
+        }
+        JointDesc::Wheel(w) => {
+            let mut def = WheelJointDef::from_base(base_def(&w.base, handles));
+            def.enable_spring = false;
+            if let Some((hz, zeta)) = w.spring {
+                def = def.with_spring(hz as Real, zeta as Real);
+            }
+            if let Some((lo, hi)) = w.limit {
+                def = def.with_limits(lo as Real, hi as Real);
+            }
+            if let Some((speed, torque)) = w.motor {
+                def = def.with_motor(speed as Real, cap(torque));
+            }
+            def.into()
+        }
+        JointDesc::Distance(d) => {
+            let (lower, upper) = d.spring_force;
+            let mut def = DistanceJointDef::from_base(base_def(&d.base, handles), d.length as Real)
+                .with_spring_force_range(lower as Real, upper as Real);
+            if let Some((lo, hi)) = d.limit {
+                def = def.with_limits(lo as Real, hi as Real);
+            }
+            if let Some((hz, zeta)) = d.spring {
+                def = def.with_spring(hz as Real, zeta as Real);
+            }
+            if let Some((speed, force)) = d.motor {
+                def = def.with_motor(speed as Real, cap(force));
+            }
+            def.into()
+        }
+        JointDesc::Motor(m) => MotorJointDef::from_base(base_def(&m.base, handles))
+            .with_offset(vec(m.linear_offset), m.angular_offset as Real)
+            .with_max_force(cap(m.max_force))
+            .with_max_torque(cap(m.max_torque))
+            .with_correction_factor(m.correction_factor as Real)
+            .into(),
+        JointDesc::Mouse(m) => {
+            MouseJointDef::from_base(base_def(&m.base, handles), vec(m.target), cap(m.max_force))
+                .with_spring(m.hertz as Real, m.damping_ratio as Real)
+                .into()
+        }
+        JointDesc::Filter(f) => FilterJointDef::from_base(base_def(&f.base, handles)).into(),
+    }
+}
+
+/// Creates one joint of any kind between bodies of `handles` (the world's
+/// error for a definition it refuses; nothing is created then).
 pub fn create_any_joint(
     world: &mut World,
     j: &JointDesc,
@@ -215,18 +296,7 @@ pub fn create_any_joint(
 ) -> Result<JointHandle, WorldError> {
     match j {
         JointDesc::Revolute(r) => create_joint(world, r, handles),
-        JointDesc::Weld(w) => {
-            let def = WeldJointDef::from_base(base_def(&w.base, handles)).with_stiffness(
-                w.linear_hertz as Real,
-                w.linear_damping_ratio as Real,
-                w.angular_hertz as Real,
-                w.angular_damping_ratio as Real,
-            );
-            world.create_weld_joint(&def)
-        }
-        JointDesc::Prismatic(_) | JointDesc::Wheel(_) | JointDesc::Distance(_) => Err(
-            WorldError::OutOfRange("joint kind not supported yet by the janus2d adapter"),
-        ),
+        _ => world.create_joint(&joint_def(j, handles)),
     }
 }
 
@@ -355,11 +425,6 @@ impl Engine for Janus {
     const NAME: &'static str = "janus2d";
 
     fn build(desc: &SceneDesc, _options: EngineOptions) -> Result<Self, String> {
-        if let Some(kind) = unsupported_joint(desc) {
-            return Err(format!(
-                "not supported yet: the janus2d adapter has no {kind} joint"
-            ));
-        }
         Janus::new(desc).map_err(|e| format!("{e:?}"))
     }
 

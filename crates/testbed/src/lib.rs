@@ -12,6 +12,7 @@
 //! | [`benchmarks`]  | the benchmark scenes as descriptions                            |
 //! | [`hard`]        | the hard cases: description, run length, pass bounds            |
 //! | [`joint_bench`] | the peers benchmark's joint scenes and their accuracy figures   |
+//! | [`joint_zoo`]   | one scene holding every joint kind                              |
 //! | [`engine`]      | the [`Engine`](engine::Engine) interface an adapter implements  |
 //! | [`janus`]       | janus2d's adapter                                               |
 //! | [`measure`]     | metric code shared by all engines (penetration, joint gap, …)  |
@@ -37,6 +38,7 @@ pub mod engine;
 pub mod hard;
 pub mod janus;
 pub mod joint_bench;
+pub mod joint_zoo;
 pub mod measure;
 pub mod metrics;
 #[cfg(feature = "portals")]

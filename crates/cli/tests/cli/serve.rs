@@ -180,8 +180,9 @@ fn the_session_applies_controls() {
     );
 }
 
-/// A drag pulls the body to the target; a click on nothing grabs
-/// nothing; shift-click drops a box.
+/// A drag pulls the body to the target through a mouse joint (gone on
+/// release, with its static body); a click on nothing grabs nothing;
+/// shift-click drops a box.
 #[test]
 fn grab_drag_and_spawn() {
     let mut s = Session::new("single_box").unwrap();
@@ -196,10 +197,25 @@ fn grab_drag_and_spawn() {
         janus2d_core::math::to_f64(p.x),
         janus2d_core::math::to_f64(p.y),
     );
+    let (bodies, joints) = (world.body_count(), world.joint_count());
     s.apply(Control::Grab { x: x + 100.0, y }).unwrap();
     assert_eq!(s.grabbed(), None, "nothing under the cursor");
+    assert_eq!(s.scene().world().joint_count(), joints);
     s.apply(Control::Grab { x, y }).unwrap();
     assert_eq!(s.grabbed(), Some(body));
+    let joint = s.grab_joint().expect("a mouse joint");
+    {
+        let w = s.scene().world();
+        let mouse = w
+            .joint_of::<janus2d_constraints::MouseJoint>(joint)
+            .unwrap();
+        assert_eq!(mouse.def.base.body_b, body);
+        assert_eq!(
+            w.body_type(mouse.def.base.body_a),
+            Ok(janus2d_core::body::BodyType::Static)
+        );
+        assert_eq!((w.body_count(), w.joint_count()), (bodies + 1, joints + 1));
+    }
     s.apply(Control::Drag {
         x: x + 3.0,
         y: y + 2.0,
@@ -217,8 +233,37 @@ fn grab_drag_and_spawn() {
         (janus2d_core::math::to_f64(q.y) - (y + 2.0)).abs() < 0.3,
         "held up against gravity: {q:?}"
     );
+    let target = s
+        .scene()
+        .world()
+        .joint_of::<janus2d_constraints::MouseJoint>(joint)
+        .unwrap()
+        .def
+        .target;
+    assert_eq!(
+        (target.x, target.y),
+        (
+            janus2d_core::math::from_f64(x + 3.0),
+            janus2d_core::math::from_f64(y + 2.0)
+        )
+    );
     s.apply(Control::Release).unwrap();
     assert_eq!(s.grabbed(), None);
+    assert_eq!(s.grab_joint(), None);
+    let w = s.scene().world();
+    assert_eq!((w.body_count(), w.joint_count()), (bodies, joints));
+    assert!(w.joint(joint).is_err(), "the mouse joint is gone");
+    // A reset during a drag starts clean.
+    s.apply(Control::Grab {
+        x: x + 3.0,
+        y: y + 2.0,
+    })
+    .unwrap();
+    assert!(s.grabbed().is_some());
+    s.apply(Control::Reset).unwrap();
+    assert_eq!(s.grabbed(), None);
+    s.apply(Control::Drag { x, y }).unwrap();
+    s.apply(Control::Release).unwrap();
     let before = s.scene().world().body_count();
     s.apply(Control::Spawn { x: 2.0, y: 5.0 }).unwrap();
     assert_eq!(s.scene().world().body_count(), before + 1);
@@ -229,4 +274,44 @@ fn grab_drag_and_spawn() {
         })
         .is_err()
     );
+}
+
+/// The page is sent every joint kind of `joint_zoo`: with the joints flag
+/// on, the frame holds at least one more primitive per joint than with it
+/// off (whatever the debug draw draws per kind).
+#[test]
+fn the_page_draws_every_joint_kind() {
+    let mut s = Session::new("joint_zoo").unwrap();
+    let joints = s.scene().world().joint_count();
+    assert_eq!(joints, 10);
+    let count = |s: &Session| -> usize {
+        let v: Value = serde_json::from_str(&s.frame()).unwrap();
+        v["prims"].as_array().unwrap().len()
+    };
+    s.apply(Control::Draw {
+        flags: "-joints".into(),
+    })
+    .unwrap();
+    let without = count(&s);
+    s.apply(Control::Draw {
+        flags: "+joints".into(),
+    })
+    .unwrap();
+    let with = count(&s);
+    assert!(with >= without + joints, "{with} vs {without}");
+    // Dragging adds the mouse joint, drawn too.
+    let b = s.scene().probe.expect("the zoo's pulled box");
+    let p = s.scene().world().position(b).unwrap();
+    let (x, y) = (
+        janus2d_core::math::to_f64(p.x),
+        janus2d_core::math::to_f64(p.y),
+    );
+    s.apply(Control::Grab { x, y }).unwrap();
+    assert_eq!(s.grabbed(), Some(b));
+    s.apply(Control::Drag {
+        x: x + 1.0,
+        y: y + 1.0,
+    })
+    .unwrap();
+    assert!(count(&s) > with, "the drag's joint is drawn");
 }
