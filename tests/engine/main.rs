@@ -11,6 +11,7 @@ mod collision_api;
 mod contact_data;
 mod contact_properties;
 mod continuous;
+mod continuous_joints;
 mod distance;
 mod effects;
 mod filter;
