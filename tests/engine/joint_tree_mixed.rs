@@ -198,15 +198,16 @@ fn a_free_tree_of_general_rows_keeps_its_momentum() {
         world.create_joint(d).unwrap();
     }
     let momentum = |w: &World| {
+        use janus2d_testbed::support::d;
         let (mut p, mut l) = ([0.0f64; 2], 0.0f64);
         for &b in &bodies {
-            let m = w.mass(b).unwrap() as f64;
+            let m = d(w.mass(b).unwrap());
             let v = w.linear_velocity(b).unwrap();
             let x = w.center_of_mass(b).unwrap();
-            p[0] += m * v.x as f64;
-            p[1] += m * v.y as f64;
-            l += m * (x.x as f64 * v.y as f64 - x.y as f64 * v.x as f64)
-                + w.rotational_inertia(b).unwrap() as f64 * w.angular_velocity(b).unwrap() as f64;
+            p[0] += m * d(v.x);
+            p[1] += m * d(v.y);
+            l += m * (d(x.x) * d(v.y) - d(x.y) * d(v.x))
+                + d(w.rotational_inertia(b).unwrap()) * d(w.angular_velocity(b).unwrap());
         }
         (p, l)
     };
@@ -218,7 +219,7 @@ fn a_free_tree_of_general_rows_keeps_its_momentum() {
     );
     let (p1, l1) = momentum(&world);
     let scale = 10.0;
-    let tol = 1e3 * Real::EPSILON as f64 * scale;
+    let tol = 1e3 * janus2d_testbed::support::d(Real::EPSILON) * scale;
     assert!(
         (p1[0] - p0[0]).abs() < tol && (p1[1] - p0[1]).abs() < tol,
         "{p0:?} -> {p1:?}"

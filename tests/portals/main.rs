@@ -19,6 +19,7 @@ mod portal_joints;
 mod portal_motor;
 #[cfg(feature = "portals")]
 mod portal_mouse;
+#[cfg(feature = "portals")]
 mod portal_prismatic;
 mod portal_properties;
 #[cfg(feature = "portals")]
