@@ -685,7 +685,16 @@ pub fn joint_def_of_kind(
             PrismaticJointDef::new(a, b, anchor, -anchor, Vec2::new(1.0, 0.5)).into()
         }
         JointKind::Weld => WeldJointDef::new(a, b, anchor, -anchor).into(),
-        JointKind::Distance => DistanceJointDef::new(a, b, anchor, -anchor, 1.0).into(),
+        // Between the bodies' origins, at their separation when the anchors
+        // meet (`2 |anchor|`).
+        JointKind::Distance => DistanceJointDef::new(
+            a,
+            b,
+            Vec2::ZERO,
+            Vec2::ZERO,
+            (2.0 * anchor.length()).max(0.1),
+        )
+        .into(),
         JointKind::Wheel => WheelJointDef::new(a, b, anchor, -anchor, Vec2::Y).into(),
         JointKind::Motor => MotorJointDef::new(a, b).with_offset(anchor, 0.25).into(),
         JointKind::Mouse => MouseJointDef::new(a, b, anchor, 500.0).into(),
@@ -701,12 +710,14 @@ pub fn joint_def_of_kind(
 }
 
 /// A scene holding every joint kind: per kind, 16 chains of 4 boxes
-/// hanging from a static beam (each box joined to the one before, the
-/// first to the beam), with limits on every other joint where the kind
-/// has them; 512 joints, so the joint prepare and colours take their
-/// blocked paths on the team.
+/// (0.8 m, 1.1 m apart) side by side in four rows, each chain hung from a
+/// static frame at its first box's left side and each box joined to the
+/// one before at their facing sides, with limits on every other joint
+/// where the kind has them (a mouse joint's target is its box's start);
+/// every joint starts satisfied, nothing overlaps. 512 joints, so the
+/// joint prepare and colours take their blocked paths on the team.
 pub fn every_joint_kind_world() -> janus2d_world::World {
-    use janus2d_constraints::JointKind;
+    use janus2d_constraints::{JointDef, JointKind};
     use janus2d_core::geometry::Polygon;
     use janus2d_world::{ShapeDef, World, WorldDef};
     let mut world = World::new(WorldDef::default()).unwrap();
@@ -715,21 +726,21 @@ pub fn every_joint_kind_world() -> janus2d_world::World {
         .create_shape(
             ground,
             &ShapeDef::default(),
-            Polygon::make_offset_box(80.0, 0.5, Vec2::new(0.0, -0.5), 0.0),
+            Polygon::make_offset_box(90.0, 0.5, Vec2::new(0.0, -0.5), 0.0),
         )
         .unwrap();
+    let half = Vec2::new(0.55, 0.0);
     for (k, &kind) in JointKind::ALL.iter().enumerate() {
         for chain in 0..16 {
-            let x = -76.0 + 19.0 * k as Real + 1.1 * (chain % 4) as Real;
-            let y = 3.0 + 6.0 * (chain / 4) as Real;
+            let x = -88.0 + 22.0 * k as Real + 5.5 * (chain % 4) as Real;
+            let y = 3.0 + 2.0 * (chain / 4) as Real;
             let mut previous = ground;
             for i in 0..4 {
-                let p = Vec2::new(x + 1.1 * i as Real, y + 0.3 * i as Real);
+                let p = Vec2::new(x + 1.1 * i as Real, y);
                 let b = world.create_body(&BodyDef::dynamic(p)).unwrap();
                 world
                     .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.4, 0.4))
                     .unwrap();
-                let anchor = Vec2::new(0.55, 0.0);
                 // Angles or translations of ±0.5; a distance joint's lengths.
                 let range = if kind == JointKind::Distance {
                     (0.5, 1.5)
@@ -737,7 +748,21 @@ pub fn every_joint_kind_world() -> janus2d_world::World {
                     (-0.5, 0.5)
                 };
                 let limits = (i % 2 == 0).then_some(range);
-                let def = joint_def_of_kind(kind, previous, b, anchor, limits, false);
+                let mut def = joint_def_of_kind(kind, previous, b, half, limits, false);
+                if previous == ground {
+                    // The frame on the ground at the box's left side (a
+                    // distance joint's anchors are the bodies' origins:
+                    // one box to the left).
+                    let reach = if kind == JointKind::Distance {
+                        2.0 * half
+                    } else {
+                        half
+                    };
+                    def.base_mut().local_frame_a.anchor = p - reach;
+                }
+                if let JointDef::Mouse(m) = &mut def {
+                    m.target = p;
+                }
                 world.create_joint(&def).unwrap();
                 previous = b;
             }
