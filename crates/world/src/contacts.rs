@@ -503,6 +503,14 @@ impl ContactSet {
                 self.free_ids.len()
             ));
         }
+        let mut seen = vec![false; self.place.len()];
+        for &id in &self.free_ids {
+            let i = id as usize;
+            if self.place.get(i) != Some(&Place::Free) || seen[i] {
+                return Err(format!("free contact id {id} is not a free place once"));
+            }
+            seen[i] = true;
+        }
         Ok(())
     }
 

@@ -206,6 +206,14 @@ impl JointSet {
                 self.joints.len()
             ));
         }
+        self.slots.check().map_err(|e| format!("joint slots: {e}"))?;
+        if self.slots.len() != self.handles.len() {
+            return Err(format!(
+                "{} live joint slots, {} joints",
+                self.slots.len(),
+                self.handles.len()
+            ));
+        }
         let mut no_collide: HashMap<(u32, u32), u32> = HashMap::new();
         for (k, &h) in self.handles.iter().enumerate() {
             let slot = self.slot(h).map_err(|e| format!("joint handle {k}: {e}"))?;
@@ -218,6 +226,14 @@ impl JointSet {
                 .map_err(|e| format!("joint {k}: its definition does not validate: {e}"))?;
             if self.slots.live(h.index).kind != j.kind() {
                 return Err(format!("joint {k}: its slot names another kind"));
+            }
+            let (force, torque) = (j.constraint_force(), j.constraint_torque());
+            if !(force.x.is_finite() && force.y.is_finite() && torque.is_finite()) {
+                return Err(format!("joint {k}: read-back {force:?}, {torque} not finite"));
+            }
+            let inv_h = j.base().inv_h();
+            if !(inv_h.is_finite() && inv_h >= 0.0) {
+                return Err(format!("joint {k}: step rate {inv_h}"));
             }
             let (a, b) = j.bodies();
             for body in [a, b] {
