@@ -821,7 +821,11 @@ mod snapshot_bytes {
             let _ = world.destroy_body(b);
         }
         let _ = world.step(DT);
-        let _ = world.cast_ray_closest(Vec2::new(-30.0, 2.0), Vec2::new(60.0, 0.0), &QueryFilter::default());
+        let _ = world.cast_ray_closest(
+            Vec2::new(-30.0, 2.0),
+            Vec2::new(60.0, 0.0),
+            &QueryFilter::default(),
+        );
         for &b in &bodies {
             let _ = world.destroy_body(b);
         }
@@ -871,8 +875,16 @@ mod snapshot_bytes {
                 Err(_) => panics.push(round),
             }
         }
-        assert!(accepted > 0, "no tampered snapshot was accepted: the test exercises nothing");
-        assert!(panics.is_empty(), "{} of {count} tampered snapshots panicked: rounds {:?}", panics.len(), &panics[..panics.len().min(20)]);
+        assert!(
+            accepted > 0,
+            "no tampered snapshot was accepted: the test exercises nothing"
+        );
+        assert!(
+            panics.is_empty(),
+            "{} of {count} tampered snapshots panicked: rounds {:?}",
+            panics.len(),
+            &panics[..panics.len().min(20)]
+        );
     }
 
     #[test]
@@ -884,5 +896,61 @@ mod snapshot_bytes {
             Snapshot::from_bytes(&bytes),
             Err(SnapshotError::TrailingBytes { extra: 1 })
         ));
+    }
+}
+
+/// Issue 35: a force whose velocity step overflows `|v|²` (1e30 N on a
+/// 1 kg box) leaves the body at its speed limit along the force, not at
+/// rest with its velocity erased.
+#[test]
+fn a_force_whose_speed_overflows_is_clamped_to_the_speed_limit_not_erased() {
+    let mut world = World::new(WorldDef {
+        gravity: Vec2::ZERO,
+        ..WorldDef::default()
+    })
+    .unwrap();
+    let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    world
+        .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    world.set_linear_velocity(b, Vec2::new(3.0, 0.0)).unwrap();
+    world
+        .apply_force_to_center(b, Vec2::new(1e30, 0.0))
+        .unwrap();
+    world.step(DT).unwrap();
+    let v = world.linear_velocity(b).unwrap();
+    let max = BodyDef::default().max_linear_speed;
+    assert!((v.x - max).abs() <= 1e-3 * max && v.y == 0.0, "{v:?}");
+    assert!(world.position(b).unwrap().x > 1.0);
+    world.validate().unwrap();
+}
+
+/// Issue 35: every joint kind hung far from its anchors (the first joint
+/// of each chain tens of metres out, so the joint tree pulls hard): after
+/// each step no body is faster than `max_linear_speed` (the solve and relax
+/// reached 436 m/s at the first step, 7e5 m/s at the third) and every
+/// joint's read-back is finite (it went to inf and NaN).
+#[test]
+fn max_linear_speed_and_finite_joint_read_back_hold_after_every_step() {
+    let mut world = janus2d_testbed::support::every_joint_kind_world();
+    let max = BodyDef::default().max_linear_speed;
+    for step in 0..120 {
+        world.step(DT).unwrap();
+        let bodies: Vec<BodyHandle> = world.body_handles().collect();
+        for b in bodies {
+            let v = world.linear_velocity(b).unwrap().length();
+            assert!(v <= max * (1.0 + 1e-5), "step {step}: {b:?} at {v} m/s");
+        }
+        for &j in world.joint_handles() {
+            let (f, t) = (
+                world.joint_force(j).unwrap(),
+                world.joint_torque(j).unwrap(),
+            );
+            assert!(
+                f.is_finite() && t.is_finite(),
+                "step {step}: {j:?} {f:?} {t}"
+            );
+        }
+        world.validate().unwrap();
     }
 }

@@ -218,7 +218,9 @@ impl Islands {
                 .get(id as usize)
                 .and_then(|island| island.members.get(k as usize));
             if member.map(|m| m.index as usize) != Some(i) {
-                return Err(format!("body slot {i}: island {id} position {k} names another"));
+                return Err(format!(
+                    "body slot {i}: island {id} position {k} names another"
+                ));
             }
         }
         let mut free_seen = vec![false; self.islands.len()];
@@ -346,7 +348,8 @@ impl Islands {
         if ia == ib {
             // One island holds both: membership is unchanged.
             if ia != NONE {
-                self.islands[ia as usize].removed = self.islands[ia as usize].removed.saturating_add(1);
+                self.islands[ia as usize].removed =
+                    self.islands[ia as usize].removed.saturating_add(1);
             }
             return;
         }
@@ -367,7 +370,8 @@ impl Islands {
         self.place(b, ia, pa as usize);
         for id in [ia, ib] {
             if id != NONE {
-                self.islands[id as usize].removed = self.islands[id as usize].removed.saturating_add(1);
+                self.islands[id as usize].removed =
+                    self.islands[id as usize].removed.saturating_add(1);
             }
         }
     }
