@@ -723,7 +723,7 @@ impl BroadPhase {
             }
             live[usize::from(s.is_static)] += 1;
             let full = self.tree(s.is_static).margin();
-            if !(s.margin >= 0.0 && s.margin <= full) || !s.core.is_valid() {
+            if !(s.margin >= 0.0 && s.margin <= full && s.core.is_valid()) {
                 return Err(format!("proxy {id}: margin {} or core box", s.margin));
             }
             match self.tree(s.is_static).leaf(s.leaf) {
