@@ -741,3 +741,216 @@ mod portals {
         }
     }
 }
+
+/// Issue 35: snapshot bytes whose payload was changed (length and checksum
+/// recomputed) are an error or a world that steps, is destroyed piece by
+/// piece and validates without a panic.
+#[cfg(feature = "serde")]
+mod snapshot_bytes {
+    use super::*;
+    use janus2d::constraints::JointKind;
+    use janus2d::world::{Snapshot, SnapshotError};
+    use janus2d_testbed::support::joint_def_of_kind;
+
+    /// A small world with every joint kind, a sleeping stack, an island
+    /// that lost a body and contacts.
+    pub(super) fn small_mixed_world() -> World {
+        let mut world = World::new(WorldDef::default()).unwrap();
+        let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+        world
+            .create_shape(ground, &ShapeDef::default(), Polygon::make_box(30.0, 0.5))
+            .unwrap();
+        for (k, &kind) in JointKind::ALL.iter().enumerate() {
+            let mut previous = ground;
+            for i in 0..3 {
+                let p = Vec2::new(-20.0 + 5.0 * k as Real + 1.1 * i as Real, 4.0);
+                let b = world.create_body(&BodyDef::dynamic(p)).unwrap();
+                world
+                    .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.4, 0.4))
+                    .unwrap();
+                let limits = (kind != JointKind::Distance).then_some((-0.5, 0.5));
+                let def = joint_def_of_kind(kind, previous, b, Vec2::new(0.55, 0.0), limits, false);
+                world.create_joint(&def).unwrap();
+                previous = b;
+            }
+        }
+        let mut stack = Vec::new();
+        for i in 0..4 {
+            let b = world
+                .create_body(&BodyDef::dynamic(Vec2::new(25.0, 1.0 + i as Real)))
+                .unwrap();
+            world
+                .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+                .unwrap();
+            stack.push(b);
+        }
+        for _ in 0..90 {
+            world.step(DT).unwrap();
+        }
+        world.destroy_body(stack[3]).unwrap();
+        world.step(DT).unwrap();
+        world
+    }
+
+    fn fnv(bytes: &[u8]) -> u64 {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for b in bytes {
+            h ^= u64::from(*b);
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        h
+    }
+
+    /// Steps, API calls and destruction of everything on a decoded world.
+    fn exercise(mut world: World) {
+        for _ in 0..3 {
+            let _ = world.step(DT);
+        }
+        let bodies: Vec<BodyHandle> = world.body_handles().collect();
+        for &b in &bodies {
+            let _ = world.is_sleeping(b);
+            world.wake_body(b);
+        }
+        let _ = world.step(DT);
+        for &j in world.joint_handles().to_vec().iter().step_by(2) {
+            let _ = world.joint_force(j);
+            let _ = world.destroy_joint(j);
+        }
+        let _ = world.step(DT);
+        for &b in bodies.iter().step_by(3) {
+            let _ = world.destroy_body(b);
+        }
+        let _ = world.step(DT);
+        let _ = world.cast_ray_closest(
+            Vec2::new(-30.0, 2.0),
+            Vec2::new(60.0, 0.0),
+            &QueryFilter::default(),
+        );
+        for &b in &bodies {
+            let _ = world.destroy_body(b);
+        }
+        let _ = world.step(DT);
+    }
+
+    #[test]
+    fn tampered_snapshot_payloads_never_panic() {
+        let count: usize = std::env::var("JANUS_TAMPER_COUNT")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(1500);
+        let bytes = small_mixed_world().snapshot().to_bytes();
+        let payload_len = bytes.len() - 24;
+        let mut seed: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let (mut accepted, mut panics) = (0usize, Vec::new());
+        for round in 0..count {
+            let mut bad = bytes.clone();
+            let edits = 1 + (next() % 3) as usize;
+            for _ in 0..edits {
+                let k = 24 + (next() as usize) % payload_len;
+                bad[k] = match next() % 4 {
+                    0 => bad[k] ^ (1 << (next() % 8)),
+                    1 => bad[k].wrapping_add(1),
+                    2 => bad[k].wrapping_sub(1),
+                    _ => next() as u8,
+                };
+            }
+            let h = fnv(&bad[24..]);
+            bad[16..24].copy_from_slice(&h.to_le_bytes());
+            let outcome = std::panic::catch_unwind(|| match Snapshot::from_bytes(&bad) {
+                Ok(snapshot) => {
+                    exercise(snapshot.to_world());
+                    true
+                }
+                Err(SnapshotError::Decode(_) | SnapshotError::Invalid(_)) => false,
+                Err(e) => panic!("unexpected error {e:?}"),
+            });
+            match outcome {
+                Ok(ok) => accepted += usize::from(ok),
+                Err(_) => panics.push(round),
+            }
+        }
+        assert!(
+            accepted > 0,
+            "no tampered snapshot was accepted: the test exercises nothing"
+        );
+        assert!(
+            panics.is_empty(),
+            "{} of {count} tampered snapshots panicked: rounds {:?}",
+            panics.len(),
+            &panics[..panics.len().min(20)]
+        );
+    }
+
+    #[test]
+    fn snapshot_bytes_after_the_stated_payload_are_refused() {
+        let mut bytes = small_mixed_world().snapshot().to_bytes();
+        assert!(Snapshot::from_bytes(&bytes).is_ok());
+        bytes.push(0);
+        assert!(matches!(
+            Snapshot::from_bytes(&bytes),
+            Err(SnapshotError::TrailingBytes { extra: 1 })
+        ));
+    }
+}
+
+/// Issue 35: a force whose velocity step overflows `|v|²` (1e30 N on a
+/// 1 kg box) leaves the body at its speed limit along the force, not at
+/// rest with its velocity erased.
+#[test]
+fn a_force_whose_speed_overflows_is_clamped_to_the_speed_limit_not_erased() {
+    let mut world = World::new(WorldDef {
+        gravity: Vec2::ZERO,
+        ..WorldDef::default()
+    })
+    .unwrap();
+    let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    world
+        .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    world.set_linear_velocity(b, Vec2::new(3.0, 0.0)).unwrap();
+    world
+        .apply_force_to_center(b, Vec2::new(1e30, 0.0))
+        .unwrap();
+    world.step(DT).unwrap();
+    let v = world.linear_velocity(b).unwrap();
+    let max = BodyDef::default().max_linear_speed;
+    assert!((v.x - max).abs() <= 1e-3 * max && v.y == 0.0, "{v:?}");
+    assert!(world.position(b).unwrap().x > 1.0);
+    world.validate().unwrap();
+}
+
+/// Issue 35: every joint kind hung far from its anchors (the first joint
+/// of each chain tens of metres out, so the joint tree pulls hard): after
+/// each step no body is faster than `max_linear_speed` (the solve and relax
+/// reached 436 m/s at the first step, 7e5 m/s at the third) and every
+/// joint's read-back is finite (it went to inf and NaN).
+#[test]
+fn max_linear_speed_and_finite_joint_read_back_hold_after_every_step() {
+    let mut world = janus2d_testbed::support::every_joint_kind_world();
+    let max = BodyDef::default().max_linear_speed;
+    for step in 0..120 {
+        world.step(DT).unwrap();
+        let bodies: Vec<BodyHandle> = world.body_handles().collect();
+        for b in bodies {
+            let v = world.linear_velocity(b).unwrap().length();
+            assert!(v <= max * (1.0 + 1e-5), "step {step}: {b:?} at {v} m/s");
+        }
+        for &j in world.joint_handles() {
+            let (f, t) = (
+                world.joint_force(j).unwrap(),
+                world.joint_torque(j).unwrap(),
+            );
+            assert!(
+                f.is_finite() && t.is_finite(),
+                "step {step}: {j:?} {f:?} {t}"
+            );
+        }
+        world.validate().unwrap();
+    }
+}

@@ -63,6 +63,13 @@ impl Default for JointBase {
 }
 
 impl JointBase {
+    /// `1 / h` of the last step the joint was solved in, 1/s (0 before
+    /// its first step).
+    #[must_use]
+    pub fn inv_h(&self) -> Real {
+        self.inv_h
+    }
+
     /// Loads the state indices and masses of the two bodies for a step;
     /// returns the bodies, or `None` when neither moves (the joint rests
     /// this step and keeps its impulses).

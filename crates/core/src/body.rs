@@ -958,6 +958,9 @@ impl BodySet {
         if self.states[0] != BodyState::IDENTITY {
             return Err("the static sentinel state is not the identity".into());
         }
+        self.records
+            .check()
+            .map_err(|e| format!("body slots: {e}"))?;
         let mut live = 0usize;
         for (index, record) in self.records.iter() {
             live += 1;
@@ -1030,6 +1033,23 @@ impl BodySet {
                     "body {:?}: a stored number is not finite",
                     sim.handle
                 ));
+            }
+            if !(sim.transform.q.is_unit() && sim.rotation0.is_unit()) {
+                return Err(format!(
+                    "body {:?}: rotation not of unit length",
+                    sim.handle
+                ));
+            }
+            if !(sim.max_linear_speed >= 0.0
+                && sim.max_linear_speed <= crate::limits::MAX_SPEED
+                && sim.max_rotation >= 0.0
+                && sim.linear_damping >= 0.0
+                && sim.angular_damping >= 0.0
+                && sim
+                    .sleep_threshold
+                    .is_none_or(|t| t.is_finite() && t >= 0.0))
+            {
+                return Err(format!("body {:?}: a setting out of its range", sim.handle));
             }
             if sim.body_type == BodyType::Dynamic && !(sim.mass > 0.0 && sim.inv_mass > 0.0) {
                 return Err(format!(

@@ -22,8 +22,15 @@
 //! | [`MAX_RESTITUTION`]     | 1e3                | a shape's restitution                                  |
 //! | [`ETA_RANGE`]           | 1e-2 … 1e2         | a portal pair's scale η (a clone's mass goes as η², its inertia as η⁴) |
 //! | [`MAX_HERTZ_FRACTION`]  | 0.25               | contact and iterative joint stiffness are capped at this fraction of the substep rate, as Box2D caps them |
+//! | [`UNIT_ROTATION_TOLERANCE`] | 1e-3           | how far `c² + s²` of a rotation given to the API may be from 1 |
 
 use crate::math::Real;
+
+/// How far `c² + s²` of a rotation may be from 1 (1e-3): a body's stored
+/// rotation, and a rotation the API takes (query transforms, kinematic
+/// targets), which is normalised within this tolerance and refused
+/// outside it (see [`Rot::is_unit`](crate::math::Rot::is_unit)).
+pub const UNIT_ROTATION_TOLERANCE: Real = 1e-3;
 
 /// Largest magnitude of a body coordinate, m (1e9).
 pub const MAX_COORDINATE: Real = 1e9;

@@ -204,6 +204,21 @@ impl Rot {
     pub fn is_finite(self) -> bool {
         self.c.is_finite() && self.s.is_finite()
     }
+
+    /// True when `c² + s²` is within
+    /// [`UNIT_ROTATION_TOLERANCE`](crate::limits::UNIT_ROTATION_TOLERANCE)
+    /// of 1 (a rotation, not a scaling).
+    ///
+    /// ```
+    /// use janus2d_core::math::Rot;
+    /// assert!(Rot::from_angle(0.7).is_unit());
+    /// assert!(!Rot { c: 2.0, s: 0.0 }.is_unit());
+    /// ```
+    #[inline]
+    pub fn is_unit(self) -> bool {
+        let m = self.c * self.c + self.s * self.s;
+        (m - 1.0).abs() <= crate::limits::UNIT_ROTATION_TOLERANCE
+    }
 }
 
 /// A rigid transform: rotation then translation.

@@ -161,6 +161,40 @@ impl<T> Slots<T> {
         crate::handle::Handle::new(index, self.generation(index), owner)
     }
 
+    /// Checks the store's own bookkeeping (for a world's validator, after
+    /// decoding a snapshot): the live count matches the live slots, and the
+    /// free list holds every free slot exactly once and nothing else.
+    ///
+    /// ```
+    /// use janus2d_core::slots::Slots;
+    /// let mut s = Slots::default();
+    /// let (i, g) = s.insert(1);
+    /// s.insert(2);
+    /// s.remove(i, g);
+    /// assert_eq!(s.check(), Ok(()));
+    /// ```
+    pub fn check(&self) -> Result<(), String> {
+        let live = self.entries.iter().filter(|e| e.1.is_some()).count();
+        if live != self.live {
+            return Err(format!("{live} live slots, count says {}", self.live));
+        }
+        if self.free.len() != self.entries.len() - live {
+            return Err(format!(
+                "{} free slots, free list holds {}",
+                self.entries.len() - live,
+                self.free.len()
+            ));
+        }
+        let mut seen = vec![false; self.entries.len()];
+        for &i in &self.free {
+            match self.entries.get(i as usize) {
+                Some((_, None)) if !seen[i as usize] => seen[i as usize] = true,
+                _ => return Err(format!("free list entry {i} is not a free slot once")),
+            }
+        }
+        Ok(())
+    }
+
     /// Live values with their index, in index order.
     pub fn iter(&self) -> impl Iterator<Item = (u32, &T)> {
         self.entries

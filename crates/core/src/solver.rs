@@ -448,11 +448,7 @@ pub fn integrate_velocities(ctx: &StepContext, bodies: &mut BodySet) {
         }
         let mut v = linear_damping * (state.v + h * accel);
         let mut w = angular_damping * (state.w + h * sim.inv_inertia * sim.torque);
-        let max_v = sim.max_linear_speed;
-        let v2 = v.length_squared();
-        if v2 > max_v * max_v {
-            v *= max_v / v2.sqrt();
-        }
+        v = clamp_speed(v, sim.max_linear_speed);
         let max_w = sim.max_rotation * ctx.inv_h;
         if w * w > max_w * max_w {
             w = w.clamp(-max_w, max_w);
@@ -533,16 +529,52 @@ fn integrate_terms(terms: &[VelocityTerms], states: &mut [BodyState]) {
         }
         let mut v = t.linear_damping * (state.v + t.dv);
         let mut w = t.angular_damping * (state.w + t.dw);
-        let v2 = v.length_squared();
-        if v2 > t.max_v * t.max_v {
-            v *= t.max_v / v2.sqrt();
-        }
+        v = clamp_speed(v, t.max_v);
         if w * w > t.max_w * t.max_w {
             w = w.clamp(-t.max_w, t.max_w);
         }
         state.v = v;
         state.w = w;
     }
+}
+
+/// `v` shortened to length `max` when longer (direction kept). The length
+/// is taken on `v` scaled by its largest component, so a velocity whose
+/// `|v|²` overflows (a force of 1e30 N) is shortened, not zeroed; a
+/// non-finite `v` is left for the step's finite check.
+#[inline(always)]
+#[must_use]
+pub fn clamp_speed(v: Vec2, max: Real) -> Vec2 {
+    let v2 = v.length_squared();
+    if v2 <= max * max {
+        return v;
+    }
+    if v2.is_finite() {
+        return v * (max / v2.sqrt());
+    }
+    let big = v.x.abs().max(v.y.abs());
+    if !big.is_finite() {
+        return v;
+    }
+    let unit = v / big;
+    unit * (max / unit.length())
+}
+
+/// The speed limit again after a stage that changed velocities (the
+/// constraint solve, relax, restitution): `max_linear_speed` holds
+/// whenever positions are integrated and after the step. (The rotation
+/// limit stays a limit of the integration only: clamping spin after the
+/// solve changes valid scenes, spinner's hash among them.)
+fn clamp_velocity_terms(terms: &[VelocityTerms], states: &mut [BodyState], team: &Team) {
+    team.for_each_chunk_mut(states, BODY_BLOCK, |i, block| {
+        let start = i * BODY_BLOCK;
+        for (t, state) in terms[start..start + block.len()].iter().zip(block) {
+            if !t.dynamic {
+                continue;
+            }
+            state.v = clamp_speed(state.v, t.max_v);
+        }
+    });
 }
 
 /// Integrates positions of moving bodies over one substep (into the deltas).
@@ -689,6 +721,7 @@ fn solve_step_on(
                 batches[i].solve_late_on(ctx, &mut bodies.states, true, team);
             }
         }
+        clamp_velocity_terms(&terms, &mut bodies.states, team);
         first.solve += lap(&mut t);
         integrate_positions_on(ctx, &mut bodies.states, team);
         first.integrate += lap(&mut t);
@@ -713,6 +746,7 @@ fn solve_step_on(
         }
         report.profile.restitution += lap(&mut t);
     }
+    clamp_velocity_terms(&terms, &mut bodies.states, team);
     for &i in &active {
         batches[i].store_impulses();
     }

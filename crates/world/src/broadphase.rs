@@ -325,7 +325,7 @@ impl BroadPhase {
                 tight.upper + sweep.max(Vec2::ZERO),
             ))
         } else {
-            tight
+            bounded(tight)
         };
         // Static proxies do not move; a proxy with the tree's whole margin
         // (a large shape, or any in a world with uniform margins) keeps one
@@ -722,6 +722,10 @@ impl BroadPhase {
                 continue;
             }
             live[usize::from(s.is_static)] += 1;
+            let full = self.tree(s.is_static).margin();
+            if !(s.margin >= 0.0 && s.margin <= full && s.core.is_valid()) {
+                return Err(format!("proxy {id}: margin {} or core box", s.margin));
+            }
             match self.tree(s.is_static).leaf(s.leaf) {
                 Some((user, fat)) if user as usize == id && fat == s.fat => {}
                 Some(_) => return Err(format!("proxy {id}: leaf link or fat box")),
@@ -738,6 +742,13 @@ impl BroadPhase {
         let in_range = |&p: &u32| (p as usize) < self.proxies.len();
         if !self.free_proxies.iter().all(in_range) || !self.move_buffer.iter().all(in_range) {
             return Err("a free or moved proxy id out of range".into());
+        }
+        let mut free = vec![false; self.proxies.len()];
+        for &p in &self.free_proxies {
+            if self.proxies[p as usize].alive || free[p as usize] {
+                return Err(format!("free proxy {p} is live or listed twice"));
+            }
+            free[p as usize] = true;
         }
         Ok(())
     }

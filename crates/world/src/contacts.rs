@@ -368,6 +368,23 @@ impl ContactSet {
         }
     }
 
+    /// Forgets the kept impulses of `body`'s contacts (a body reset for a
+    /// non-finite state starts again from rest, not from the impulses that
+    /// carried it there).
+    pub(crate) fn forget_impulses(&mut self, body: BodyHandle) {
+        let ids: SmallVec<[u32; 4]> = SmallVec::from_slice(self.of_body(body));
+        for id in ids {
+            if let Some(c) = self.get_mut(id) {
+                for p in &mut c.points {
+                    p.normal_impulse = 0.0;
+                    p.tangent_impulse = 0.0;
+                    p.total_normal_impulse = 0.0;
+                    p.total_tangent_impulse = 0.0;
+                }
+            }
+        }
+    }
+
     /// Mutable access to the contact with id `id`.
     pub(crate) fn get_mut(&mut self, id: u32) -> Option<&mut Contact> {
         match *self.place.get(id as usize)? {
@@ -502,6 +519,14 @@ impl ContactSet {
                 "{free} free places, {} free ids",
                 self.free_ids.len()
             ));
+        }
+        let mut seen = vec![false; self.place.len()];
+        for &id in &self.free_ids {
+            let i = id as usize;
+            if self.place.get(i) != Some(&Place::Free) || seen[i] {
+                return Err(format!("free contact id {id} is not a free place once"));
+            }
+            seen[i] = true;
         }
         Ok(())
     }

@@ -200,9 +200,47 @@ impl Islands {
     /// position, members live and dynamic, free ids empty, an island that
     /// sleeps has only sleeping members, pending bodies live.
     pub(crate) fn check(&self, bodies: &BodySet) -> Result<(), String> {
+        if self.island_of.len() != self.position.len() {
+            return Err(format!(
+                "{} island ids, {} positions",
+                self.island_of.len(),
+                self.position.len()
+            ));
+        }
+        // Every recorded place names a member (the members below name their
+        // places back): no id or position out of range.
+        for (i, (&id, &k)) in self.island_of.iter().zip(&self.position).enumerate() {
+            if id == NONE {
+                continue;
+            }
+            let member = self
+                .islands
+                .get(id as usize)
+                .and_then(|island| island.members.get(k as usize));
+            if member.map(|m| m.index as usize) != Some(i) {
+                return Err(format!(
+                    "body slot {i}: island {id} position {k} names another"
+                ));
+            }
+        }
+        let mut free_seen = vec![false; self.islands.len()];
+        for &id in &self.free {
+            match free_seen.get_mut(id as usize) {
+                Some(seen) if !*seen => *seen = true,
+                _ => return Err(format!("free island id {id} out of range or repeated")),
+            }
+        }
+        // Scratch kept between steps: `min_time` all at MAX, `seen` never
+        // ahead of the stamp (so a split visits every member).
+        if self.min_time.iter().any(|&t| t != Real::MAX) {
+            return Err("island scratch times not reset".into());
+        }
+        if self.seen.iter().any(|&s| s > self.stamp) {
+            return Err("island scratch stamps ahead of the stamp".into());
+        }
         let mut members = 0usize;
         for (id, island) in self.islands.iter().enumerate() {
-            let free = self.free.contains(&(id as u32));
+            let free = free_seen[id];
             if free != island.members.is_empty() {
                 return Err(format!(
                     "island {id}: free {free} with {} members",
@@ -216,7 +254,9 @@ impl Islands {
                         "island {id}: member {m:?} is not a live dynamic body"
                     ));
                 }
-                if self.island(m) != id as u32 || self.position[m.index as usize] != k as u32 {
+                if self.island(m) != id as u32
+                    || self.position.get(m.index as usize) != Some(&(k as u32))
+                {
                     return Err(format!("island {id}: member {m:?} records another place"));
                 }
                 if island.asleep && !bodies.is_sleeping(m) {
@@ -255,7 +295,7 @@ impl Islands {
         self.set_island(body, NONE);
         let island = &mut self.islands[id as usize];
         island.members.swap_remove(k);
-        island.removed += 1;
+        island.removed = island.removed.saturating_add(1);
         if let Some(&moved) = island.members.get(k) {
             self.position[moved.index as usize] = k as u32;
         }
@@ -288,7 +328,7 @@ impl Islands {
         }
         let island = &mut self.islands[big as usize];
         island.members.extend(moved.members);
-        island.removed += moved.removed;
+        island.removed = island.removed.saturating_add(moved.removed);
         island.asleep = false;
         self.free.push(small);
     }
@@ -297,7 +337,7 @@ impl Islands {
     pub(crate) fn note_removed(&mut self, body: BodyHandle) {
         let id = self.island(body);
         if id != NONE {
-            self.islands[id as usize].removed += 1;
+            self.islands[id as usize].removed = self.islands[id as usize].removed.saturating_add(1);
         }
     }
 
@@ -308,7 +348,8 @@ impl Islands {
         if ia == ib {
             // One island holds both: membership is unchanged.
             if ia != NONE {
-                self.islands[ia as usize].removed += 1;
+                self.islands[ia as usize].removed =
+                    self.islands[ia as usize].removed.saturating_add(1);
             }
             return;
         }
@@ -329,7 +370,8 @@ impl Islands {
         self.place(b, ia, pa as usize);
         for id in [ia, ib] {
             if id != NONE {
-                self.islands[id as usize].removed += 1;
+                self.islands[id as usize].removed =
+                    self.islands[id as usize].removed.saturating_add(1);
             }
         }
     }

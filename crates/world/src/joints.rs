@@ -193,6 +193,36 @@ impl JointSet {
             .map_or(&[], |l| l.as_slice())
     }
 
+    /// Forgets the kept impulses of `body`'s joints: each starts again as
+    /// when created from its definition (enabled or not as it was), so a
+    /// body reset for a non-finite state is not driven there again by its
+    /// joints' warm start.
+    pub(crate) fn forget_impulses(&mut self, body: BodyHandle) {
+        for j in self.of_body(body).to_vec() {
+            if let Ok(joint) = self.get_mut(j) {
+                let enabled = joint.is_enabled();
+                *joint = Joint::new(joint.def());
+                joint.set_enabled(enabled);
+            }
+        }
+    }
+
+    /// Starts afresh (as [`forget_impulses`](Self::forget_impulses)) every
+    /// joint whose read-back is no longer finite: its kept impulses
+    /// overflowed, and warm starting from them would carry its bodies off.
+    /// Run after each solve, so `joint_force` and `joint_torque` stay
+    /// finite for any accepted step.
+    pub(crate) fn forget_non_finite(&mut self) {
+        for joint in &mut self.joints {
+            let (f, t) = (joint.constraint_force(), joint.constraint_torque());
+            if !(f.x.is_finite() && f.y.is_finite() && t.is_finite()) {
+                let enabled = joint.is_enabled();
+                *joint = Joint::new(joint.def());
+                joint.set_enabled(enabled);
+            }
+        }
+    }
+
     /// Checks the set against the bodies (for `World::validate`): handles
     /// ↔ slots ↔ storage, each joint's definition valid and of its slot's
     /// kind, each joint's bodies live and listing it, every
@@ -204,6 +234,16 @@ impl JointSet {
                 self.handles.len(),
                 self.slots.len(),
                 self.joints.len()
+            ));
+        }
+        self.slots
+            .check()
+            .map_err(|e| format!("joint slots: {e}"))?;
+        if self.slots.len() != self.handles.len() {
+            return Err(format!(
+                "{} live joint slots, {} joints",
+                self.slots.len(),
+                self.handles.len()
             ));
         }
         let mut no_collide: HashMap<(u32, u32), u32> = HashMap::new();
@@ -218,6 +258,16 @@ impl JointSet {
                 .map_err(|e| format!("joint {k}: its definition does not validate: {e}"))?;
             if self.slots.live(h.index).kind != j.kind() {
                 return Err(format!("joint {k}: its slot names another kind"));
+            }
+            let (force, torque) = (j.constraint_force(), j.constraint_torque());
+            if !(force.x.is_finite() && force.y.is_finite() && torque.is_finite()) {
+                return Err(format!(
+                    "joint {k}: read-back {force:?}, {torque} not finite"
+                ));
+            }
+            let inv_h = j.base().inv_h();
+            if !(inv_h.is_finite() && inv_h >= 0.0) {
+                return Err(format!("joint {k}: step rate {inv_h}"));
             }
             let (a, b) = j.bodies();
             for body in [a, b] {

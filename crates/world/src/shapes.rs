@@ -316,6 +316,9 @@ impl ShapeStore {
     /// shapes of that body once, the geometry is valid, material and box
     /// finite, and the hit-event count matches.
     pub(crate) fn check(&self, bodies: &janus2d_core::body::BodySet) -> Result<(), String> {
+        self.slots
+            .check()
+            .map_err(|e| format!("shape slots: {e}"))?;
         let mut hits = 0;
         for (index, shape) in self.slots.iter() {
             hits += usize::from(shape.def.enable_hit_events);

@@ -101,8 +101,8 @@ impl World {
 /// | 16..24  | FNV-1a 64 of the payload                                     |
 /// | 24..    | payload: the world (postcard)                                |
 ///
-/// Decoding checks every field of the header and the checksum before it
-/// decodes, then runs [`World::validate`] on the result: truncated,
+/// Decoding checks every field of the header (bytes after the stated
+/// payload length are refused) and the checksum before it decodes, then runs [`World::validate`] on the result: truncated,
 /// corrupted or foreign bytes are a [`SnapshotError`](bytes::SnapshotError), never a panic.
 #[cfg(feature = "serde")]
 pub mod bytes {
@@ -150,6 +150,11 @@ pub mod bytes {
             /// Portals feature in the snapshot.
             portals: bool,
         },
+        /// More bytes than the header and the stated payload length.
+        TrailingBytes {
+            /// Bytes after the payload.
+            extra: usize,
+        },
         /// The payload's checksum does not match (corrupted bytes).
         Checksum,
         /// The payload does not decode (says where, in words).
@@ -175,6 +180,9 @@ pub mod bytes {
                     f,
                     "snapshot of a build with {real_bytes}-byte reals, portals {portals}"
                 ),
+                SnapshotError::TrailingBytes { extra } => {
+                    write!(f, "snapshot followed by {extra} bytes after its payload")
+                }
                 SnapshotError::Checksum => write!(f, "snapshot checksum mismatch"),
                 SnapshotError::Decode(e) => write!(f, "snapshot does not decode: {e}"),
                 SnapshotError::Invalid(e) => write!(f, "snapshot world invalid: {e}"),
@@ -257,7 +265,11 @@ pub mod bytes {
                     found: bytes.len(),
                 });
             }
-            let payload = &payload[..len];
+            if payload.len() > len {
+                return Err(SnapshotError::TrailingBytes {
+                    extra: payload.len() - len,
+                });
+            }
             if fnv(payload) != word(16) {
                 return Err(SnapshotError::Checksum);
             }

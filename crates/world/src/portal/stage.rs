@@ -533,6 +533,7 @@ impl PortalStage {
     /// constraint per crossing naming its two copies and portal bodies,
     /// copies live, distinct and in no other crossing.
     pub(crate) fn check(&self, bodies: &BodySet) -> Result<(), String> {
+        self.pairs.check().map_err(|e| format!("pair slots: {e}"))?;
         for (index, d) in self.pairs.iter() {
             if !(d.eta.is_finite() && d.eta > 0.0) {
                 return Err(format!("pair {index}: eta {}", d.eta));

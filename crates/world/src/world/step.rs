@@ -171,6 +171,14 @@ impl World {
             sp.continuous += continuous_time;
             sp.broadphase += both - continuous_time;
         }
+        // A body reset for a non-finite state starts from rest: its joints'
+        // and contacts' kept impulses go too, or their warm start would
+        // carry it off again at the next step.
+        for &b in &report.non_finite {
+            self.joints.forget_impulses(b);
+            self.collision.contacts.forget_impulses(b);
+        }
+        self.joints.forget_non_finite();
         if has_portals {
             let (portals, mut stores) = self.portals_and_stores();
             portals.cross(&mut stores);
