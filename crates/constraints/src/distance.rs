@@ -59,9 +59,9 @@ use janus2d_core::limits::{MAX_EXTENT, MAX_SPEED};
 use janus2d_core::math::{Real, Rot, Vec2, cross, vec_is_finite};
 use janus2d_core::softness::Softness;
 
-use crate::joint::{GeneralRows, KindRows, TreeRows};
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
+use crate::kind_rows::{GeneralRows, KindRows, TreeRows};
 use crate::parts::{AxisPart, AxisRow, BOTH, PairMass, PairOf, PairStates, load_pair};
 use crate::{JointError, check_spring};
 

@@ -16,9 +16,9 @@ use janus2d_core::constraint::{Constraint, ConstraintRows, StepContext};
 use janus2d_core::math::{Real, Rot, Vec2};
 
 use crate::JointError;
-use crate::joint::KindRows;
 use crate::joint_base::JointBase;
 use crate::joint_def::{JointDefBase, KindDef};
+use crate::kind_rows::KindRows;
 use crate::parts::PairStates;
 
 /// Everything needed to create a filter joint: only the shared base

@@ -106,20 +106,6 @@ pub(crate) fn is_moving(states: &[BodyState], s: u32) -> bool {
     s != 0 && states.get(s as usize).is_some_and(BodyState::moves)
 }
 
-/// The world points of two local anchors: `anchor_a` on `body_a`, `anchor_b`
-/// on `body_b` (each in its body's frame, from the body's origin), m. Every
-/// kind's `world_anchors` and gap read.
-#[must_use]
-pub fn world_anchors(
-    bodies: &BodySet,
-    (body_a, anchor_a): (BodyHandle, Vec2),
-    (body_b, anchor_b): (BodyHandle, Vec2),
-) -> (Vec2, Vec2) {
-    let a = bodies.solver_body(body_a).sim;
-    let b = bodies.solver_body(body_b).sim;
-    (a.transform.apply(anchor_a), b.transform.apply(anchor_b))
-}
-
 /// The relative angle `θ_b − θ_a − reference`, rad, wrapped to `[−π, π]`.
 #[must_use]
 pub fn relative_angle(
@@ -131,22 +117,6 @@ pub fn relative_angle(
     let a = bodies.solver_body(body_a).sim;
     let b = bodies.solver_body(body_b).sim;
     wrap_angle(a.transform.q.relative_angle(b.transform.q) - reference)
-}
-
-/// The world's joint softness built on the heavier end, for a joint's
-/// rigid rows: with `w_a`, `w_b` the two ends' inverse masses (point rows)
-/// or inverse inertias (angle rows), `ρ = min((w_a + w_b) / min(w_a, w_b),
-/// ρ_max)`, and `ρ_max` when one end does not move
-/// ([`Softness::with_mass_ratio`]).
-#[must_use]
-pub(crate) fn mass_ratio_softness(ctx: &StepContext, w_a: Real, w_b: Real) -> Softness {
-    let w_heavy = w_a.min(w_b);
-    let rho = if w_heavy > 0.0 {
-        ((w_a + w_b) / w_heavy).min(ctx.joint_mass_ratio_cap)
-    } else {
-        ctx.joint_mass_ratio_cap
-    };
-    ctx.joint_softness.with_mass_ratio(rho)
 }
 
 /// A two-body joint's geometry at the bodies' current poses, from which

@@ -1,6 +1,6 @@
-//! Colours of the revolute joints: their Gauss–Seidel rows on the team.
+//! Colours of the joints: their Gauss–Seidel rows on the team.
 //!
-//! The Gauss–Seidel rows of the revolute joints (the point rows of joints
+//! The Gauss–Seidel rows of the joints (the equality rows of joints
 //! outside a tree, and every joint's angle rows: springs, motors, limits)
 //! are solved colour by colour. Two joints of one colour never share a
 //! body that the solve moves (dynamic and awake); static, kinematic and
@@ -27,7 +27,7 @@
 //! | warm start             | a moving body: its joints' impulses | blocks of bodies                    |
 //! | solve, relax           | a colour's joints                   | blocks of a colour, colour by colour |
 //! | overflow               | a joint                             | leader, after (reverse: before) the colours |
-//! | restitution            | none (a revolute joint has none)    | leader                              |
+//! | restitution            | none (no joint kind has any)        | leader                              |
 //!
 //! - **Colouring** is greedy over the joints in storage order (the lowest
 //!   colour in which neither moving body appears, [`ColourGraph`]), so it
@@ -93,7 +93,7 @@ const JOINTS_PER_BLOCK: usize = 64;
 /// Body states per block of the warm start on the team.
 const WARM_START_BLOCK: usize = 256;
 
-/// The colouring of the revolute joints and the order they are solved in.
+/// The colouring of the joints and the order they are solved in.
 /// See the module docs.
 #[derive(Clone, Debug, Default)]
 pub struct JointColours {

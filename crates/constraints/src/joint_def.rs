@@ -30,7 +30,6 @@ use janus2d_core::constraint::StepContext;
 use janus2d_core::math::{Real, Rot, Vec2, vec_is_finite};
 use janus2d_core::softness::Softness;
 
-use crate::joint_base::mass_ratio_softness;
 use crate::{JointError, check_anchor, check_spring};
 
 /// A frame fixed on a body: an origin (the joint's anchor) and an angle,
@@ -229,7 +228,7 @@ impl JointDefBase {
     /// (`constraint_hertz > 0`), else the world's joint softness built on
     /// the heavier end (`w_a`, `w_b`: the ends' inverse masses for linear
     /// rows, inverse inertias for angular rows; see
-    /// `joint_base::mass_ratio_softness`).
+    /// [`mass_ratio_softness`]).
     #[must_use]
     pub fn rigid_softness(&self, ctx: &StepContext, w_a: Real, w_b: Real) -> Softness {
         if self.constraint_hertz > 0.0 {
@@ -284,7 +283,7 @@ impl JointDefBase {
     /// The world anchors of the two frames at the bodies' current poses, m.
     #[must_use]
     pub fn world_anchors(&self, bodies: &BodySet) -> (Vec2, Vec2) {
-        crate::joint_base::world_anchors(
+        world_anchors(
             bodies,
             (self.body_a, self.local_frame_a.anchor),
             (self.body_b, self.local_frame_b.anchor),
@@ -356,4 +355,34 @@ pub trait KindDef: Clone + Into<crate::JointDef> {
     fn spring_mut(&mut self) -> Option<SpringMut<'_>> {
         None
     }
+}
+
+/// The world points of two local anchors: `anchor_a` on `body_a`, `anchor_b`
+/// on `body_b` (each in its body's frame, from the body's origin), m. Every
+/// kind's `world_anchors` and gap read.
+#[must_use]
+pub fn world_anchors(
+    bodies: &BodySet,
+    (body_a, anchor_a): (BodyHandle, Vec2),
+    (body_b, anchor_b): (BodyHandle, Vec2),
+) -> (Vec2, Vec2) {
+    let a = bodies.solver_body(body_a).sim;
+    let b = bodies.solver_body(body_b).sim;
+    (a.transform.apply(anchor_a), b.transform.apply(anchor_b))
+}
+
+/// The world's joint softness built on the heavier end, for a joint's
+/// rigid rows: with `w_a`, `w_b` the two ends' inverse masses (point rows)
+/// or inverse inertias (angle rows), `ρ = min((w_a + w_b) / min(w_a, w_b),
+/// ρ_max)`, and `ρ_max` when one end does not move
+/// ([`Softness::with_mass_ratio`]).
+#[must_use]
+pub(crate) fn mass_ratio_softness(ctx: &StepContext, w_a: Real, w_b: Real) -> Softness {
+    let w_heavy = w_a.min(w_b);
+    let rho = if w_heavy > 0.0 {
+        ((w_a + w_b) / w_heavy).min(ctx.joint_mass_ratio_cap)
+    } else {
+        ctx.joint_mass_ratio_cap
+    };
+    ctx.joint_softness.with_mass_ratio(rho)
 }

@@ -155,8 +155,9 @@ use janus2d_core::math::{Real, Vec2, cross, cross_sv, from_f64, to_f64};
 use janus2d_core::parallel::Team;
 use janus2d_core::union_find::{find, union};
 
-use crate::joint::{GeneralRows, Joint, TreeRows};
+use crate::joint::Joint;
 use crate::joint_base::is_moving;
+use crate::kind_rows::{GeneralRows, TreeRows};
 use crate::parts::{PairMass, PointPart, clamp_length};
 use janus2d_core::math::wrap_angle;
 

@@ -52,9 +52,9 @@ use janus2d_core::constraint::{Block, Constraint, ConstraintRows, StepContext};
 use janus2d_core::math::{Real, Rot, Vec2, cross_sv, solve22, vec_is_finite, wrap_angle};
 use janus2d_core::softness::Softness;
 
-use crate::joint::KindRows;
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef};
+use crate::kind_rows::KindRows;
 use crate::parts::{
     AnglePart, BOTH, PairOf, PairStates, PointPart, apply_pair, clamp_length, load_pair, store_pair,
 };
@@ -285,7 +285,7 @@ impl MotorJoint {
     /// The world points the drive brings together: the target on a and
     /// b's frame anchor, m.
     pub fn world_targets(&self, bodies: &BodySet) -> (Vec2, Vec2) {
-        crate::joint_base::world_anchors(
+        crate::joint_def::world_anchors(
             bodies,
             (self.def.base.body_a, self.def.target_anchor_a()),
             (self.def.base.body_b, self.def.base.local_frame_b.anchor),

@@ -54,9 +54,9 @@ use janus2d_core::limits::MAX_COORDINATE;
 use janus2d_core::math::{Real, Rot, Vec2, cross, cross_sv, solve22, vec_is_finite};
 use janus2d_core::softness::Softness;
 
-use crate::joint::KindRows;
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef};
+use crate::kind_rows::KindRows;
 use crate::parts::{BOTH, PairMass, PairOf, PairStates, PointPart, load_pair, soft_impulse};
 use crate::{JointError, check_spring};
 

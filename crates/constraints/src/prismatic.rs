@@ -69,9 +69,9 @@ use janus2d_core::constraint::{Block, Constraint, ConstraintRows, StepContext};
 use janus2d_core::math::{Real, Rot, Vec2, cross};
 use janus2d_core::softness::Softness;
 
-use crate::joint::{GeneralRows, KindRows, TreeRows};
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, JointFrame, KindDef, LimitsMut, MotorMut, SpringMut};
+use crate::kind_rows::{GeneralRows, KindRows, TreeRows};
 use crate::parts::{
     AxisPart, AxisRow, BOTH, PairMass, PairOf, PairStates, load_pair, soft_impulse, store_pair,
 };

@@ -37,9 +37,9 @@ use janus2d_core::constraint::{Block, Constraint, ConstraintRows, StepContext};
 use janus2d_core::math::{Real, Vec2};
 use janus2d_core::softness::Softness;
 
-use crate::joint::{KindRows, TreeRows};
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
+use crate::kind_rows::{KindRows, TreeRows};
 use crate::parts::{
     AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, load_pair, store_pair,
 };

@@ -35,9 +35,9 @@ use janus2d_core::constraint::{Block, Constraint, ConstraintRows, StepContext};
 use janus2d_core::math::{Real, Rot, Vec2};
 use janus2d_core::softness::Softness;
 
-use crate::joint::{GeneralRows, KindRows, TreeRows};
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, JointFrame, KindDef, LimitsMut, MotorMut, SpringMut};
+use crate::kind_rows::{GeneralRows, KindRows, TreeRows};
 use crate::parts::{
     AnglePart, AxisPart, AxisRow, BOTH, PairOf, PairStates, load_pair, soft_impulse, store_pair,
 };

@@ -26,11 +26,7 @@
 
 use crate::math::Real;
 
-/// How far `c² + s²` of a rotation may be from 1 (1e-3): a body's stored
-/// rotation, and a rotation the API takes (query transforms, kinematic
-/// targets), which is normalised within this tolerance and refused
-/// outside it (see [`Rot::is_unit`](crate::math::Rot::is_unit)).
-pub const UNIT_ROTATION_TOLERANCE: Real = 1e-3;
+pub use crate::math::UNIT_ROTATION_TOLERANCE;
 
 /// Largest magnitude of a body coordinate, m (1e9).
 pub const MAX_COORDINATE: Real = 1e9;

@@ -97,6 +97,13 @@ pub fn vec_is_finite(v: Vec2) -> bool {
     v.x.is_finite() && v.y.is_finite()
 }
 
+/// How far `c² + s²` of a rotation may be from 1 (1e-3): a body's stored
+/// rotation, and a rotation the API takes (query transforms, kinematic
+/// targets), which is normalised within this tolerance and refused
+/// outside it (see [`Rot::is_unit`]). Listed with the other limits in
+/// [`crate::limits`].
+pub const UNIT_ROTATION_TOLERANCE: Real = 1e-3;
+
 /// A rotation stored as cosine and sine (unit length).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -206,7 +213,7 @@ impl Rot {
     }
 
     /// True when `c² + s²` is within
-    /// [`UNIT_ROTATION_TOLERANCE`](crate::limits::UNIT_ROTATION_TOLERANCE)
+    /// [`UNIT_ROTATION_TOLERANCE`](UNIT_ROTATION_TOLERANCE)
     /// of 1 (a rotation, not a scaling).
     ///
     /// ```
@@ -217,7 +224,7 @@ impl Rot {
     #[inline]
     pub fn is_unit(self) -> bool {
         let m = self.c * self.c + self.s * self.s;
-        (m - 1.0).abs() <= crate::limits::UNIT_ROTATION_TOLERANCE
+        (m - 1.0).abs() <= UNIT_ROTATION_TOLERANCE
     }
 }
 
