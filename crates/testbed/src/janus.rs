@@ -258,9 +258,20 @@ pub fn joint_def(j: &JointDesc, handles: &[BodyHandle]) -> JointDef {
             def.into()
         }
         JointDesc::Distance(d) => {
+            // The description's unbounded range is (f64::MIN, f64::MAX):
+            // the definition's is ±∞ (in f32 the casts round there anyway).
+            let bound = |x: f64| {
+                if x >= f64::MAX {
+                    Real::INFINITY
+                } else if x <= f64::MIN {
+                    Real::NEG_INFINITY
+                } else {
+                    x as Real
+                }
+            };
             let (lower, upper) = d.spring_force;
             let mut def = DistanceJointDef::from_base(base_def(&d.base, handles), d.length as Real)
-                .with_spring_force_range(lower as Real, upper as Real);
+                .with_spring_force_range(bound(lower), bound(upper));
             if let Some((lo, hi)) = d.limit {
                 def = def.with_limits(lo as Real, hi as Real);
             }
