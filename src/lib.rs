@@ -167,6 +167,9 @@ pub use janus2d_core::{
 pub use janus2d_world::SnapshotError;
 #[doc(inline)]
 pub use janus2d_world::aperture::ContactClipping;
+#[cfg(feature = "portals")]
+#[doc(inline)]
+pub use janus2d_world::portal::PortalCounters;
 #[doc(inline)]
 pub use janus2d_world::{
     CollisionCounters, CollisionEvents, Color, Contact, ContactPointData, ContinuousCounters,
@@ -181,9 +184,6 @@ pub use janus2d_world::{
     CrossingRole, MassModel, PlaneSide, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle,
     PortalSide,
 };
-#[cfg(feature = "portals")]
-#[doc(inline)]
-pub use janus2d_world::portal::PortalCounters;
 
 /// The names most programs need: `use janus2d::prelude::*;`.
 pub mod prelude {
