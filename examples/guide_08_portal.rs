@@ -88,12 +88,13 @@ fn main() -> Result<(), WorldError> {
             hit.portal_hops
         );
     }
-    // The map from one portal's side to the other's: η scales sizes.
+    // The pair's map takes a point that went into the floor portal to where
+    // it comes out of the wall (η scales distances; 1 here).
     let map = world.portal_map(pair)?;
+    let out = map.map_point(Vec2::new(0.0, -0.5));
     println!(
-        "the pair's scale η = {}; (0, 0.5) on the floor maps to {:?}",
-        map.eta,
-        map.map_point(Vec2::new(0.0, 0.5))
+        "half a metre into the floor portal, (0, -0.5), comes out at ({:.2}, {:.2}), half a metre out of the wall (η = {})",
+        out.x, out.y, map.eta
     );
     Ok(())
 }
