@@ -782,8 +782,14 @@ pub fn print_summary<W: Write>(
     )?;
     writeln!(
         out,
-        "  bodies {} (awake {}, asleep {}), joints {}, touching contacts {}",
-        s.bodies, s.awake, s.sleeping, s.joints, s.contacts
+        "  bodies {} (awake {}, asleep {}, static {}), joints {}, touching contacts {}",
+        s.bodies,
+        s.awake,
+        s.sleeping,
+        // Static bodies are neither awake nor asleep.
+        s.bodies.saturating_sub(s.awake + s.sleeping),
+        s.joints,
+        s.contacts
     )?;
     if s.crossings.iter().any(|&c| c > 0) {
         writeln!(

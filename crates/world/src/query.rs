@@ -10,7 +10,7 @@
 //! | `overlap_aabb`                     | shapes whose surface meets a box (not just their fat boxes) | [`shapes_overlap`] |
 //! | `overlap_shape`                    | shapes that touch or overlap a shape          | [`shapes_overlap`] |
 //! | `overlap_point`                    | solid shapes that contain a point (picking)   | [`shapes_overlap`] |
-//! | `shape_distance`                   | distance and closest points of two shapes     | [`shape_distance`] |
+//! | `shape_distance`                   | distance and closest points of two shapes     | [`shape_distance`](janus2d_core::geometry::shape_distance) |
 //!
 //! **Rules shared by every query.**
 //! - A shape is tested when [`QueryFilter::accepts`] it: category/mask as
@@ -53,9 +53,6 @@ use janus2d_core::math::{Real, Rot, Transform, Vec2, cross, vec_is_finite};
 use crate::broadphase::BroadPhase;
 use crate::error::WorldError;
 use crate::shapes::{ShapeData, ShapeHandle, ShapeStore};
-
-#[cfg(doc)]
-use janus2d_core::geometry::shape_distance;
 
 /// Most portal apertures one ray or shape cast goes through (a count; usual 4).
 pub const MAX_PORTAL_HOPS: u32 = 4;
