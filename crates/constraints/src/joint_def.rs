@@ -228,7 +228,7 @@ impl JointDefBase {
     /// (`constraint_hertz > 0`), else the world's joint softness built on
     /// the heavier end (`w_a`, `w_b`: the ends' inverse masses for linear
     /// rows, inverse inertias for angular rows; see
-    /// [`mass_ratio_softness`]).
+    /// `mass_ratio_softness`).
     #[must_use]
     pub fn rigid_softness(&self, ctx: &StepContext, w_a: Real, w_b: Real) -> Softness {
         if self.constraint_hertz > 0.0 {

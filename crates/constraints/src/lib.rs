@@ -42,7 +42,7 @@ pub mod joint_colour;
 pub mod joint_def;
 pub mod joint_solver;
 pub mod joint_tree;
-pub mod kind_rows;
+pub(crate) mod kind_rows;
 pub mod lane;
 pub mod motor;
 pub mod mouse;

@@ -213,7 +213,7 @@ impl Rot {
     }
 
     /// True when `c² + s²` is within
-    /// [`UNIT_ROTATION_TOLERANCE`](UNIT_ROTATION_TOLERANCE)
+    /// [`UNIT_ROTATION_TOLERANCE`]
     /// of 1 (a rotation, not a scaling).
     ///
     /// ```
