@@ -182,3 +182,42 @@ fn reference_angle_is_the_difference_of_the_frames() {
     let angle = world.joint_angle(j).unwrap();
     assert!((angle + 0.3).abs() < 1e-3, "joint angle {angle}");
 }
+
+/// Every kind's definition has a `Default` (placeholder bodies, refused as
+/// one body) that validates once its bodies are set: struct-update syntax
+/// works as for Box2D's `b2Default…JointDef`.
+#[test]
+fn every_default_definition_validates_once_its_bodies_are_set() {
+    use janus2d::{
+        DistanceJointDef, FilterJointDef, MotorJointDef, MouseJointDef, PrismaticJointDef,
+        WheelJointDef,
+    };
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let a = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    let b = world.create_body(&BodyDef::dynamic(Vec2::X)).unwrap();
+    let defaults: Vec<JointDef> = vec![
+        RevoluteJointDef::default().into(),
+        PrismaticJointDef::default().into(),
+        WeldJointDef::default().into(),
+        DistanceJointDef::default().into(),
+        WheelJointDef::default().into(),
+        MotorJointDef::default().into(),
+        MouseJointDef::default().into(),
+        FilterJointDef::default().into(),
+    ];
+    assert_eq!(defaults.len(), janus2d::JointKind::ALL.len());
+    for mut def in defaults {
+        assert_eq!(
+            def.validate(),
+            Err(JointError::SameBody),
+            "{:?}",
+            def.kind()
+        );
+        def.base_mut().body_a = a;
+        def.base_mut().body_b = b;
+        assert_eq!(def.validate(), Ok(()), "{:?}", def.kind());
+        world.create_joint(&def).unwrap();
+    }
+    world.step(1.0 / 60.0).unwrap();
+    assert_eq!(world.validate(), Ok(()));
+}

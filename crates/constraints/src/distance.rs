@@ -127,6 +127,15 @@ pub struct DistanceJointDef {
     pub max_motor_force: Real,
 }
 
+impl Default for DistanceJointDef {
+    /// A rigid rod of 1 m between two placeholder bodies
+    /// ([`JointDefBase::default`]: set `base.body_a` and `base.body_b`
+    /// before use; `validate` refuses the placeholders as one body).
+    fn default() -> Self {
+        Self::from_base(JointDefBase::default(), 1.0)
+    }
+}
+
 impl DistanceJointDef {
     /// A rigid rod of `length` (m) between two bodies at the given local
     /// anchors (m, in each body's frame).

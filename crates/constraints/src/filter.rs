@@ -42,6 +42,15 @@ pub struct FilterJointDef {
     pub base: JointDefBase,
 }
 
+impl Default for FilterJointDef {
+    /// A filter joint between two placeholder bodies
+    /// ([`JointDefBase::default`]: set `base.body_a` and `base.body_b`
+    /// before use; `validate` refuses the placeholders as one body).
+    fn default() -> Self {
+        Self::from_base(JointDefBase::default())
+    }
+}
+
 impl FilterJointDef {
     /// A filter joint between `body_a` and `body_b`: they no longer
     /// collide with each other.

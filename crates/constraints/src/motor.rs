@@ -107,6 +107,15 @@ pub struct MotorJointDef {
     pub correction_factor: Real,
 }
 
+impl Default for MotorJointDef {
+    /// A motor joint at zero offsets with the default force and torque between two placeholder bodies
+    /// ([`JointDefBase::default`]: set `base.body_a` and `base.body_b`
+    /// before use; `validate` refuses the placeholders as one body).
+    fn default() -> Self {
+        Self::from_base(JointDefBase::default())
+    }
+}
+
 impl MotorJointDef {
     /// A motor joint between `body_a` and `body_b`: frames at the bodies'
     /// origins, both offsets 0 (b driven onto a's origin and angle), and

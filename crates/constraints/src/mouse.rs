@@ -101,6 +101,15 @@ pub struct MouseJointDef {
     pub angular_damping_ratio: Real,
 }
 
+impl Default for MouseJointDef {
+    /// A mouse joint toward the origin with no force (set `target` and `max_force`) between two placeholder bodies
+    /// ([`JointDefBase::default`]: set `base.body_a` and `base.body_b`
+    /// before use; `validate` refuses the placeholders as one body).
+    fn default() -> Self {
+        Self::from_base(JointDefBase::default(), Vec2::ZERO, 0.0)
+    }
+}
+
 impl MouseJointDef {
     /// Pulls the point `local_anchor_b` (m, in b's frame) of `body_b`
     /// toward `target` (m, world) with at most `max_force` (N); body a is

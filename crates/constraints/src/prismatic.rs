@@ -283,6 +283,15 @@ pub struct PrismaticJointDef {
     pub target_translation: Real,
 }
 
+impl Default for PrismaticJointDef {
+    /// A plain slide along frame a's x axis between two placeholder bodies
+    /// ([`JointDefBase::default`]: set `base.body_a` and `base.body_b`
+    /// before use; `validate` refuses the placeholders as one body).
+    fn default() -> Self {
+        Self::from_base(JointDefBase::default())
+    }
+}
+
 impl PrismaticJointDef {
     /// A plain slide between two bodies at the given local anchors along
     /// `local_axis_a` (in a's frame, any nonzero length; zero is the x

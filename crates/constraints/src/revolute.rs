@@ -87,6 +87,15 @@ pub struct RevoluteJointDef {
     pub target_angle: Real,
 }
 
+impl Default for RevoluteJointDef {
+    /// A plain hinge between two placeholder bodies
+    /// ([`JointDefBase::default`]: set `base.body_a` and `base.body_b`
+    /// before use; `validate` refuses the placeholders as one body).
+    fn default() -> Self {
+        Self::from_base(JointDefBase::default())
+    }
+}
+
 impl RevoluteJointDef {
     /// A plain hinge between two bodies at the given local anchors.
     pub fn new(

@@ -77,6 +77,15 @@ pub struct WeldJointDef {
     pub angular_damping_ratio: Real,
 }
 
+impl Default for WeldJointDef {
+    /// A rigid weld between two placeholder bodies
+    /// ([`JointDefBase::default`]: set `base.body_a` and `base.body_b`
+    /// before use; `validate` refuses the placeholders as one body).
+    fn default() -> Self {
+        Self::from_base(JointDefBase::default())
+    }
+}
+
 impl WeldJointDef {
     /// A rigid weld between two bodies at the given local anchors, holding
     /// the relative angle they have at zero (`reference_angle` 0).

@@ -94,6 +94,15 @@ pub struct WheelJointDef {
     pub max_motor_torque: Real,
 }
 
+impl Default for WheelJointDef {
+    /// A wheel on frame a's x axis with the default suspension between two placeholder bodies
+    /// ([`JointDefBase::default`]: set `base.body_a` and `base.body_b`
+    /// before use; `validate` refuses the placeholders as one body).
+    fn default() -> Self {
+        Self::from_base(JointDefBase::default())
+    }
+}
+
 impl WheelJointDef {
     /// A wheel at the given local anchors with the suspension along
     /// `local_axis_a` (in a's frame, any nonzero length; zero is the x
