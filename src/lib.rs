@@ -10,7 +10,8 @@
 //! | [`world`]             | the stepping loop, collision pipeline, portals            |
 //!
 //! What a program needs is also re-exported here, at the root: the world
-//! and its definitions, handles, joints, shapes, events, queries, errors
+//! and its definitions, handles, joints, shapes, events, queries, the
+//! character mover and controller, errors
 //! (and, with the `portals` feature, the portal types). [`prelude`] holds
 //! the names most programs use.
 //!
@@ -51,6 +52,11 @@ pub use janus2d_core::{
 };
 #[doc(inline)]
 pub use janus2d_world::{
+    Autostep, CharacterController, CollisionPlane, Ground, MoveResult, MoverCast, PlaneResult,
+    PlaneSolution, clip_vector, solve_planes,
+};
+#[doc(inline)]
+pub use janus2d_world::{
     CollisionCounters, CollisionEvents, Color, Contact, ContactPointData, DebugDraw, DrawOptions,
     Filter, HitEvent, Invariant, InvariantError, JointEvent, JointHandle, JointSet, Palette,
     PortalHop, PreSolve, PreSolveFn, QueryFilter, QueryProblem, RayHit, ShapeData, ShapeDef,
@@ -80,6 +86,7 @@ pub mod prelude {
     };
     pub use janus2d_core::math::{Real, Rot, Transform, Vec2};
     pub use janus2d_core::solver::SolverSettings;
+    pub use janus2d_world::{Autostep, CharacterController, MoveResult};
     pub use janus2d_world::{
         Filter, JointEvent, JointHandle, QueryFilter, RayHit, ShapeDef, ShapeHandle, ShapeOverlap,
         StepEvents, World, WorldDef, WorldError,
