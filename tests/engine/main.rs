@@ -21,6 +21,7 @@ mod joint_tree_mixed;
 mod joint_tree_properties;
 mod kinematic_targets;
 mod motor;
+mod mover;
 mod mouse;
 mod pendulum;
 mod prismatic;

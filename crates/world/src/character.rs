@@ -27,8 +27,9 @@
 //!    character does not climb it but slides down it;
 //! 4. blocked by a wall while on the ground: try a step (up, across, down
 //!    onto walkable ground);
-//! 5. off the ground after walking: snap down to ground within
-//!    `snap_to_ground`;
+//! 5. off the ground after walking: slide down at most `snap_to_ground`,
+//!    kept if it ends on walkable ground (a rounded bottom rolling off an
+//!    edge slips past the corner onto the step below);
 //! 6. the velocity clipped against what it touches; the ground remembered.
 //!
 //! **Portals.** The controller does not cross portals yet: the wall that
@@ -416,15 +417,16 @@ impl CharacterController {
             && let Some(d) = self.snap_to_ground
             && d > 0.0
         {
-            let down = -d * self.up;
-            let cast = mv.cast(p, down, &touch.passing)?;
-            if let Some(hit) = cast.hit
-                && hit.normal.dot(self.up) >= mv.cos_slope
-            {
-                p += cast.fraction * down;
+            // A slide down, so that a rounded bottom rolling off an edge
+            // slips past the corner onto the ground below.
+            let (q, n) = mv.slide(p, -d * self.up)?;
+            iterations += n;
+            let t = mv.touch(q)?;
+            if let Some(g) = mv.ground(&t.contacts) {
+                p = q;
                 snapped = true;
-                touch = mv.touch(p)?;
-                ground = mv.ground(&touch.contacts);
+                touch = t;
+                ground = Some(g);
             }
         }
 

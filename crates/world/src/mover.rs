@@ -124,19 +124,23 @@ impl CollisionPlane {
 pub struct PlaneSolution {
     /// The displacement that satisfies the planes, m.
     pub translation: Vec2,
-    /// Gauss–Seidel sweeps used (1 to [`PLANE_SOLVER_ITERATIONS`]).
+    /// Gauss–Seidel sweeps used (0 when solved exactly, else 1 to
+    /// [`PLANE_SOLVER_ITERATIONS`]).
     pub iterations: usize,
 }
 
 /// The displacement closest to `target` that keeps in front of every plane
 /// (`normal · δ ≥ offset`), each plane pushing at most its `push_limit`.
 ///
-/// Projected Gauss–Seidel on the accumulated pushes (each clamped to
-/// `[0, push_limit]`, so a push applied too early is taken back): for a
-/// single plane it is the exact projection, for several it converges to the
-/// closest point of their intersection (a crease stops the mover). Each
-/// plane's `push` is left at the push it applied. Non-finite planes are
-/// skipped. Deterministic: the planes are visited in order.
+/// In 2D the answer is `target` itself, its projection on one plane or the
+/// corner of two: when no plane has a push limit, the closest feasible one
+/// of these is taken (exact, whatever the angle between the planes: a steep
+/// face and a wall meeting at 30° stop the mover dead). Otherwise, or when
+/// the planes leave no room at all (squeezed), projected Gauss–Seidel on
+/// the accumulated pushes (each clamped to `[0, push_limit]`, so a push
+/// applied too early is taken back) gives the compromise. Each plane's
+/// `push` is left at the push it applied. Non-finite planes are skipped.
+/// Deterministic: the planes are visited in order.
 ///
 /// ```
 /// use janus2d_world::mover::{CollisionPlane, solve_planes};
@@ -156,6 +160,17 @@ pub fn solve_planes(target: Vec2, planes: &mut [CollisionPlane]) -> PlaneSolutio
     let usable = |p: &CollisionPlane| {
         p.normal.is_finite() && p.offset.is_finite() && !p.push_limit.is_nan()
     };
+    if planes.iter().filter(|p| usable(p)).all(|p| p.push_limit >= Real::MAX)
+        && let Some(translation) = solve_exact(target, planes, &usable)
+    {
+        return PlaneSolution {
+            translation,
+            iterations: 0,
+        };
+    }
+    for p in planes.iter_mut() {
+        p.push = 0.0;
+    }
     let mut delta = target;
     let mut iterations = 0;
     for _ in 0..PLANE_SOLVER_ITERATIONS {
@@ -180,6 +195,64 @@ pub fn solve_planes(target: Vec2, planes: &mut [CollisionPlane]) -> PlaneSolutio
         translation: delta,
         iterations,
     }
+}
+
+/// The closest feasible point among `target`, its projections on single
+/// planes and the corners of pairs (with the pushes that give it), or
+/// `None` when none is feasible.
+fn solve_exact(
+    target: Vec2,
+    planes: &mut [CollisionPlane],
+    usable: &impl Fn(&CollisionPlane) -> bool,
+) -> Option<Vec2> {
+    let ok: Vec<usize> = (0..planes.len()).filter(|&i| usable(&planes[i])).collect();
+    let feasible = |d: Vec2| {
+        ok.iter().all(|&i| {
+            let p = &planes[i];
+            p.normal.dot(d) >= p.offset - PLANE_SOLVER_TOLERANCE
+        })
+    };
+    if feasible(target) {
+        return Some(target);
+    }
+    // (squared distance, δ, active planes and their pushes)
+    let mut best: Option<(Real, Vec2, [(usize, Real); 2])> = None;
+    let mut consider = |d: Vec2, active: [(usize, Real); 2]| {
+        let dist = (d - target).length_squared();
+        if best.is_none_or(|b| dist < b.0) && feasible(d) {
+            best = Some((dist, d, active));
+        }
+    };
+    for &i in &ok {
+        let p = &planes[i];
+        let push = p.offset - p.normal.dot(target);
+        if push > 0.0 {
+            consider(target + push * p.normal, [(i, push), (i, 0.0)]);
+        }
+    }
+    for (a, &i) in ok.iter().enumerate() {
+        for &j in &ok[a + 1..] {
+            let (ni, nj) = (planes[i].normal, planes[j].normal);
+            let k12 = ni.dot(nj);
+            let (k11, k22) = (ni.dot(ni), nj.dot(nj));
+            let det = k11 * k22 - k12 * k12;
+            if det.abs() <= 1e-6 * k11 * k22 {
+                continue; // parallel
+            }
+            let bi = planes[i].offset - ni.dot(target);
+            let bj = planes[j].offset - nj.dot(target);
+            let pi = (k22 * bi - k12 * bj) / det;
+            let pj = (k11 * bj - k12 * bi) / det;
+            if pi >= 0.0 && pj >= 0.0 {
+                consider(target + pi * ni + pj * nj, [(i, pi), (j, pj)]);
+            }
+        }
+    }
+    let (_, d, active) = best?;
+    for (i, push) in active {
+        planes[i].push += push;
+    }
+    Some(d)
 }
 
 /// `vector` with what points into the planes removed: for each plane with
@@ -261,7 +334,7 @@ mod tests {
         let mut p = [CollisionPlane::new(Vec2::Y, -0.2)];
         let s = solve_planes(Vec2::new(0.0, -0.1), &mut p);
         assert_eq!(s.translation, Vec2::new(0.0, -0.1));
-        assert_eq!((p[0].push, s.iterations), (0.0, 1));
+        assert_eq!((p[0].push, s.iterations), (0.0, 0));
     }
 
     #[test]
@@ -283,6 +356,19 @@ mod tests {
         assert!(s.translation.length() < 1e-4, "{s:?}");
         let v = clip_vector(Vec2::new(0.3, -1.0), &p);
         assert!(v.dot(a) >= -1e-6 && v.dot(b) >= -1e-6, "{v:?}");
+    }
+
+    #[test]
+    fn a_steep_face_and_its_wall_stop_the_mover_exactly() {
+        // The creep that Gauss–Seidel leaves between planes 30° apart.
+        let steep = Vec2::new(-(0.75 as Real).sqrt(), 0.5);
+        let mut p = [CollisionPlane::new(steep, 0.0), CollisionPlane::new(-Vec2::X, 0.0)];
+        let s = solve_planes(Vec2::new(0.033, 0.0), &mut p);
+        assert!(s.translation.length() < 1e-7, "{s:?}");
+        // With a push limit the iterative path is taken, and creeps.
+        p[0].push_limit = 10.0;
+        let s = solve_planes(Vec2::new(0.033, 0.0), &mut p);
+        assert_eq!(s.iterations, PLANE_SOLVER_ITERATIONS);
     }
 
     #[test]
