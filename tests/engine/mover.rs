@@ -80,7 +80,10 @@ fn walks_up_a_30_degree_slope_and_not_a_60_degree_one() {
         end.position.x, end.position.y, err, end.grounded
     );
     assert!(end.position.x > 5.5 && err < 0.01 && end.grounded);
-    assert!(run.iter().skip(1).all(|r| r.grounded), "grounded all the way up");
+    assert!(
+        run.iter().skip(1).all(|r| r.grounded),
+        "grounded all the way up"
+    );
 
     let mut world = world_with_floor();
     ramp(&mut world, 60.0);
@@ -125,7 +128,9 @@ fn steps_a_20_cm_stair_and_not_a_50_cm_one() {
     let run = walk(&world, &mut cc, v(0.0, 0.01), 2.0, 180);
     let max_y = run.iter().map(|r| r.position.y).fold(Real::MIN, Real::max);
     let max_x = run.iter().map(|r| r.position.x).fold(Real::MIN, Real::max);
-    println!("0.5 m stair: highest y = {max_y:.4} (bound < 0.02), furthest x = {max_x:.4} (bound ≤ 1.75)");
+    println!(
+        "0.5 m stair: highest y = {max_y:.4} (bound < 0.02), furthest x = {max_x:.4} (bound ≤ 1.75)"
+    );
     assert!(max_y < 0.02 && max_x <= 1.75);
     assert!(run.iter().all(|r| !r.stepped));
 }
@@ -134,9 +139,7 @@ fn steps_a_20_cm_stair_and_not_a_50_cm_one() {
 /// on it for 2 s; the largest drift of its offset from the platform.
 fn ride(velocity: Vec2) -> Real {
     let mut world = World::new(WorldDef::default()).unwrap();
-    let platform = world
-        .create_body(&BodyDef::kinematic(v(0.0, 5.0)))
-        .unwrap();
+    let platform = world.create_body(&BodyDef::kinematic(v(0.0, 5.0))).unwrap();
     world
         .create_shape(platform, &ShapeDef::default(), Polygon::make_box(1.5, 0.1))
         .unwrap();
@@ -145,7 +148,14 @@ fn ride(velocity: Vec2) -> Real {
     let (mut p, mut vy) = (v(0.3, 5.1 + cc.skin), 0.0);
     // Placed on the platform: the first move finds the ground it stands on.
     let first = cc
-        .move_and_slide(&world, &capsule(), p, Vec2::ZERO, DT, &QueryFilter::default())
+        .move_and_slide(
+            &world,
+            &capsule(),
+            p,
+            Vec2::ZERO,
+            DT,
+            &QueryFilter::default(),
+        )
         .unwrap();
     assert!(first.grounded);
     let mut offset0 = None;
@@ -153,7 +163,14 @@ fn ride(velocity: Vec2) -> Real {
     for _ in 0..120 {
         world.step(DT).unwrap();
         let r = cc
-            .move_and_slide(&world, &capsule(), p, v(0.0, vy), DT, &QueryFilter::default())
+            .move_and_slide(
+                &world,
+                &capsule(),
+                p,
+                v(0.0, vy),
+                DT,
+                &QueryFilter::default(),
+            )
             .unwrap();
         p = r.position;
         vy = if r.grounded { 0.0 } else { r.velocity.y } - G * DT;
@@ -205,7 +222,14 @@ fn never_tunnels_a_5_cm_wall() {
     let mut deepest = Real::MIN;
     for _ in 0..30 {
         let r = cc
-            .move_and_slide(&world, &capsule(), p, v(20.0, 5.0), DT, &QueryFilter::default())
+            .move_and_slide(
+                &world,
+                &capsule(),
+                p,
+                v(20.0, 5.0),
+                DT,
+                &QueryFilter::default(),
+            )
             .unwrap();
         p = r.position;
         deepest = deepest.max(p.x + 0.25 - 4.975);
@@ -234,7 +258,14 @@ fn jumps_up_through_a_one_way_platform_and_lands_on_it() {
         let mut top = Real::MIN;
         for _ in 0..180 {
             let r = cc
-                .move_and_slide(&world, &capsule(), p, v(0.0, vy), DT, &QueryFilter::default())
+                .move_and_slide(
+                    &world,
+                    &capsule(),
+                    p,
+                    v(0.0, vy),
+                    DT,
+                    &QueryFilter::default(),
+                )
                 .unwrap();
             p = r.position;
             top = top.max(p.y);
@@ -248,7 +279,10 @@ fn jumps_up_through_a_one_way_platform_and_lands_on_it() {
             assert!(top > 2.1 && (0.0..0.02).contains(&above));
         } else {
             // A solid ledge: the head (1 m up) stops under it, y ≤ 0.9.
-            println!("solid ledge: highest {top:.4} (bound ≤ 0.9), ends on the floor at {:.4}", p.y);
+            println!(
+                "solid ledge: highest {top:.4} (bound ≤ 0.9), ends on the floor at {:.4}",
+                p.y
+            );
             assert!(top <= 0.9 && p.y < 0.02);
         }
     }
@@ -262,7 +296,11 @@ fn snaps_down_stairs_and_slopes() {
     fixed(&mut world, v(-5.0, 0.4), Polygon::make_box(5.0, 0.05));
     for k in 0..3 {
         let top = 0.3 - 0.15 * k as Real;
-        fixed(&mut world, v(0.5 + k as Real, top - 0.05), Polygon::make_box(0.5, 0.05));
+        fixed(
+            &mut world,
+            v(0.5 + k as Real, top - 0.05),
+            Polygon::make_box(0.5, 0.05),
+        );
     }
     let t = (20.0 as Real).to_radians();
     let tri = Polygon::from_hull(&[v(0.0, 0.0), v(0.0, 2.0 * t.tan()), v(2.0, 0.0)], 0.0).unwrap();
@@ -288,11 +326,13 @@ fn snaps_down_stairs_and_slopes() {
 #[test]
 fn cast_and_collide_mover_read_the_world() {
     let mut world = world_with_floor();
-    let crate_body = world
-        .create_body(&BodyDef::dynamic(v(3.0, 0.5)))
-        .unwrap();
+    let crate_body = world.create_body(&BodyDef::dynamic(v(3.0, 0.5))).unwrap();
     world
-        .create_shape(crate_body, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .create_shape(
+            crate_body,
+            &ShapeDef::default(),
+            Polygon::make_box(0.5, 0.5),
+        )
         .unwrap();
     let mover = Capsule::new(v(0.0, 0.3), v(0.0, 0.8), 0.25).unwrap();
     let f = QueryFilter::default();
@@ -307,7 +347,13 @@ fn cast_and_collide_mover_read_the_world() {
     assert_eq!((along.fraction, along.hit), (1.0, None));
     // A filter that leaves the box out.
     let f2 = QueryFilter::default().excluding(crate_body);
-    assert_eq!(world.cast_mover(&mover, v(10.0, 0.0), &f2).unwrap().fraction, 1.0);
+    assert_eq!(
+        world
+            .cast_mover(&mover, v(10.0, 0.0), &f2)
+            .unwrap()
+            .fraction,
+        1.0
+    );
     // Planes: the floor within 6 cm.
     let mut planes: Vec<PlaneResult> = Vec::new();
     world
@@ -330,7 +376,14 @@ fn bad_mover_input_is_a_typed_error() {
     let mut cc = CharacterController::new();
     let nan = cc.move_and_slide(&world, &capsule(), v(Real::NAN, 0.0), Vec2::X, DT, &f);
     assert_eq!(nan, Err(WorldError::NonFinite("position")));
-    let nanv = cc.move_and_slide(&world, &capsule(), Vec2::ZERO, v(0.0, Real::INFINITY), DT, &f);
+    let nanv = cc.move_and_slide(
+        &world,
+        &capsule(),
+        Vec2::ZERO,
+        v(0.0, Real::INFINITY),
+        DT,
+        &f,
+    );
     assert_eq!(nanv, Err(WorldError::NonFinite("velocity")));
     let negative = Capsule {
         center1: Vec2::ZERO,
@@ -396,4 +449,3 @@ fn the_mover_is_deterministic() {
     };
     assert_eq!(run(), run());
 }
-

@@ -25,8 +25,9 @@
 //!    answer ([`World::cast_mover`]: never tunnels), until it stops; a face
 //!    steeper than `max_slope` also gets a vertical wall plane, so the
 //!    character does not climb it but slides down it;
-//! 4. blocked by a wall while on the ground: try a step (up, across, down
-//!    onto walkable ground);
+//! 4. blocked by a face too steep to walk while on the ground: try a step
+//!    (up, across, down onto walkable ground at most `max_height` above
+//!    the ground it stood on);
 //! 5. off the ground after walking: slide down at most `snap_to_ground`,
 //!    kept if it ends on walkable ground (a rounded bottom rolling off an
 //!    edge slips past the corner onto the step below);
@@ -63,7 +64,8 @@ pub const SLIDE_TOLERANCE: Real = 0.01 * LINEAR_SLOP;
 /// Stepping up ledges (Rapier's autostep).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Autostep {
-    /// Highest ledge stepped up, m (usual 0.3).
+    /// Highest ledge stepped up, m, measured from the ground point the
+    /// character stands on to where it lands on the ledge (usual 0.3).
     pub max_height: Real,
     /// Least free room on top of the ledge, m: a step moves the character
     /// at least this far onto it (usual 0.1).
@@ -287,7 +289,10 @@ impl CharacterController {
         )?;
         range(self.skin.is_finite() && self.skin >= 0.0, "skin")?;
         if let Some(a) = self.autostep {
-            range(a.max_height.is_finite() && a.max_height >= 0.0, "max_height")?;
+            range(
+                a.max_height.is_finite() && a.max_height >= 0.0,
+                "max_height",
+            )?;
             range(a.min_width.is_finite() && a.min_width >= 0.0, "min_width")?;
         }
         if let Some(d) = self.snap_to_ground {
@@ -381,7 +386,9 @@ impl CharacterController {
         let delta = match start_ground {
             Some(g) if !rising => {
                 let lat = lateral(desired, self.up);
+                // Along the ground, and down onto it by what exceeds the skin.
                 lat - (g.normal.dot(lat) / g.normal.dot(self.up)) * self.up
+                    - (g.separation - self.skin).max(0.0) * g.normal
             }
             _ => desired,
         };
@@ -400,7 +407,9 @@ impl CharacterController {
             let progress = (p - before).dot(dir);
             if progress < lat_len - 0.1 * LINEAR_SLOP
                 && let Some(a) = self.autostep
-                && let Some(q) = mv.step(p, dir, lat_len - progress, a)?
+                && let Some(g) = start_ground
+                && mv.walled(p, dir)?
+                && let Some(q) = mv.step(p, dir, lat_len - progress, g.point, a)?
             {
                 p = q;
                 stepped = true;
@@ -554,7 +563,12 @@ impl Mover<'_> {
 
     /// Sweeps the capsule (grown by the skin) from `pos` along `delta`,
     /// one-way shapes blocking only from above.
-    fn cast(&self, pos: Vec2, delta: Vec2, passing: &[ShapeHandle]) -> Result<MoverCast, WorldError> {
+    fn cast(
+        &self,
+        pos: Vec2,
+        delta: Vec2,
+        passing: &[ShapeHandle],
+    ) -> Result<MoverCast, WorldError> {
         let accept = |hit: &RayHit| {
             if !self.is_one_way(hit.shape) {
                 return true;
@@ -588,13 +602,27 @@ impl Mover<'_> {
         Ok((p, rounds))
     }
 
+    /// Whether the capsule at `pos` touches a face too steep to walk that
+    /// faces against `dir` (what a step may get over).
+    fn walled(&self, pos: Vec2, dir: Vec2) -> Result<bool, WorldError> {
+        let up = self.cc.up;
+        Ok(self
+            .touch(pos)?
+            .contacts
+            .iter()
+            .any(|c| c.normal.dot(up) < self.cos_slope && c.normal.dot(dir) < 0.0))
+    }
+
     /// A step up from `pos` (blocked walking along `dir` with `remaining`
-    /// to go): up by the step height, across, down onto walkable ground.
+    /// to go, standing on the ground at `foot`): up by the step height,
+    /// across, down onto walkable ground whose edge is at most the step
+    /// height above `foot`.
     fn step(
         &self,
         pos: Vec2,
         dir: Vec2,
         remaining: Real,
+        foot: Vec2,
         a: Autostep,
     ) -> Result<Option<Vec2>, WorldError> {
         let up = self.cc.up;
@@ -623,7 +651,11 @@ impl Mover<'_> {
             return Ok(None);
         };
         let landed = over - down.fraction * drop * up;
-        if hit.normal.dot(up) < self.cos_slope || (landed - pos).dot(up) <= LINEAR_SLOP {
+        let ledge = (hit.point - foot).dot(up);
+        if hit.normal.dot(up) < self.cos_slope
+            || (landed - pos).dot(up) <= LINEAR_SLOP
+            || ledge > a.max_height
+        {
             return Ok(None);
         }
         Ok(Some(landed))

@@ -60,12 +60,12 @@ mod stores;
 pub(crate) mod validate;
 pub mod world;
 
+pub use character::{Autostep, CharacterController, Ground, MoveResult};
 pub use contacts::{CollisionEvents, Contact, ContactPointData, HitEvent, ShapePairEvent};
 pub use continuous::ContinuousCounters;
 pub use debug_draw::{Color, DebugDraw, DrawOptions, Palette};
 pub use error::WorldError;
 pub use islands::SleepSettings;
-pub use character::{Autostep, CharacterController, Ground, MoveResult};
 pub use joints::{JointEvent, JointHandle, JointKind, JointSet};
 pub use mover::{CollisionPlane, MoverCast, PlaneResult, PlaneSolution, clip_vector, solve_planes};
 pub use narrowphase::{PreSolve, PreSolveFn};

@@ -157,10 +157,12 @@ pub fn solve_planes(target: Vec2, planes: &mut [CollisionPlane]) -> PlaneSolutio
     for p in planes.iter_mut() {
         p.push = 0.0;
     }
-    let usable = |p: &CollisionPlane| {
-        p.normal.is_finite() && p.offset.is_finite() && !p.push_limit.is_nan()
-    };
-    if planes.iter().filter(|p| usable(p)).all(|p| p.push_limit >= Real::MAX)
+    let usable =
+        |p: &CollisionPlane| p.normal.is_finite() && p.offset.is_finite() && !p.push_limit.is_nan();
+    if planes
+        .iter()
+        .filter(|p| usable(p))
+        .all(|p| p.push_limit >= Real::MAX)
         && let Some(translation) = solve_exact(target, planes, &usable)
     {
         return PlaneSolution {
@@ -197,6 +199,10 @@ pub fn solve_planes(target: Vec2, planes: &mut [CollisionPlane]) -> PlaneSolutio
     }
 }
 
+/// A candidate answer: squared distance to the target, the displacement,
+/// the active planes and their pushes.
+type Candidate = (Real, Vec2, [(usize, Real); 2]);
+
 /// The closest feasible point among `target`, its projections on single
 /// planes and the corners of pairs (with the pushes that give it), or
 /// `None` when none is feasible.
@@ -215,8 +221,7 @@ fn solve_exact(
     if feasible(target) {
         return Some(target);
     }
-    // (squared distance, δ, active planes and their pushes)
-    let mut best: Option<(Real, Vec2, [(usize, Real); 2])> = None;
+    let mut best: Option<Candidate> = None;
     let mut consider = |d: Vec2, active: [(usize, Real); 2]| {
         let dist = (d - target).length_squared();
         if best.is_none_or(|b| dist < b.0) && feasible(d) {
@@ -362,7 +367,10 @@ mod tests {
     fn a_steep_face_and_its_wall_stop_the_mover_exactly() {
         // The creep that Gauss–Seidel leaves between planes 30° apart.
         let steep = Vec2::new(-(0.75 as Real).sqrt(), 0.5);
-        let mut p = [CollisionPlane::new(steep, 0.0), CollisionPlane::new(-Vec2::X, 0.0)];
+        let mut p = [
+            CollisionPlane::new(steep, 0.0),
+            CollisionPlane::new(-Vec2::X, 0.0),
+        ];
         let s = solve_planes(Vec2::new(0.033, 0.0), &mut p);
         assert!(s.translation.length() < 1e-7, "{s:?}");
         // With a push limit the iterative path is taken, and creeps.

@@ -178,8 +178,14 @@ impl World {
                     continue;
                 }
             }
-            if let Some(h) = shape_cast(&proxy_a, &xf, &caster, &Transform::IDENTITY, translation, 1.0)
-            {
+            if let Some(h) = shape_cast(
+                &proxy_a,
+                &xf,
+                &caster,
+                &Transform::IDENTITY,
+                translation,
+                1.0,
+            ) {
                 hits.push((
                     h.fraction,
                     slot,
@@ -281,7 +287,11 @@ impl World {
     /// Velocity of the point `point` (world, m) of `body`, m/s:
     /// `v + ω × (point − centre of mass)` (0 for a static body), what a
     /// moving platform gives a rider.
-    pub(crate) fn mover_point_velocity(&self, body: BodyHandle, point: Vec2) -> Result<Vec2, WorldError> {
+    pub(crate) fn mover_point_velocity(
+        &self,
+        body: BodyHandle,
+        point: Vec2,
+    ) -> Result<Vec2, WorldError> {
         if !vec_is_finite(point) {
             return Err(WorldError::NonFinite("point"));
         }
