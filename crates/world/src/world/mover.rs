@@ -86,8 +86,8 @@ impl World {
     ///
     /// **Portals**: the mover does not go through portals
     /// (`filter.through_portals` is ignored): the wall that carries a portal
-    /// is a wall to it. Crossing is the caller's (the portal map of
-    /// [`World::portal_pair`] moves a point across).
+    /// is a wall to it. Crossing is the caller's for now (move the
+    /// character with the pair's portal map, see [`crate::portal`]).
     ///
     /// Errors: an invalid capsule (non-positive radius, non-finite,
     /// degenerate core: `BadQuery { field: "mover" }`), a non-finite
