@@ -14,6 +14,7 @@
 //! | shapes and their material             | [`Polygon`], [`Circle`], [`Capsule`], [`Segment`], [`make_chain`], [`ShapeDef`], [`Filter`] |
 //! | joints (eight kinds)                  | [`JointDef`], [`World::create_joint`], [`RevoluteJointDef`] and the other `…JointDef`s |
 //! | scene queries: rays, casts, overlaps  | [`query`], [`QueryFilter`], [`RayHit`], [`World::cast_ray_closest`] |
+//! | a character mover and controller      | [`CharacterController`], [`World::cast_mover`], [`World::collide_mover`], [`solve_planes`], [`clip_vector`] |
 //! | events after a step                   | [`StepEvents`] ([`World::events`]): [`CollisionEvents`], [`HitEvent`], [`JointEvent`]; [`PortalEvent`] ([`World::portal_events`]) |
 //! | changing contacts before the solve    | [`PreSolve`], [`World::set_pre_solve`]                      |
 //! | portals (feature `portals`, default)  | [`portal`], [`PortalPairDef`], [`PortalDef`], [`World::create_portal_pair`] |
@@ -172,6 +173,11 @@ pub use janus2d_world::aperture::ContactClipping;
 pub use janus2d_world::portal::PortalCounters;
 #[doc(inline)]
 pub use janus2d_world::{
+    Autostep, CharacterController, CollisionPlane, Ground, MoveResult, MoverCast, PlaneResult,
+    PlaneSolution, clip_vector, solve_planes,
+};
+#[doc(inline)]
+pub use janus2d_world::{
     CollisionCounters, CollisionEvents, Color, Contact, ContactPointData, ContinuousCounters,
     DebugDraw, DrawOptions, Filter, HitEvent, Invariant, InvariantError, JointEvent, JointHandle,
     JointSet, Palette, PortalHop, PreSolve, PreSolveFn, QueryFilter, QueryProblem, RayHit,
@@ -201,6 +207,7 @@ pub mod prelude {
     };
     pub use janus2d_core::math::{Real, Rot, Transform, Vec2};
     pub use janus2d_core::solver::SolverSettings;
+    pub use janus2d_world::{Autostep, CharacterController, MoveResult};
     pub use janus2d_world::{
         Filter, JointEvent, JointHandle, QueryFilter, RayHit, ShapeDef, ShapeHandle, ShapeOverlap,
         StepEvents, World, WorldDef, WorldError,

@@ -22,6 +22,7 @@ mod joint_tree_properties;
 mod kinematic_targets;
 mod motor;
 mod mouse;
+mod mover;
 mod pendulum;
 mod prismatic;
 mod queries;

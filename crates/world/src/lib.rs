@@ -5,7 +5,7 @@
 //!
 //! The public surface is [`World`] and the types re-exported at this
 //! crate's root; [`world`], [`query`], [`portal`], [`debug_draw`] and
-//! [`dynamic_tree`] and [`aperture`] are public modules, the stages are private to the crate:
+//! [`dynamic_tree`], [`aperture`], [`mover`] and [`character`] are public modules, the stages are private to the crate:
 //!
 //! | module           | what                                                     |
 //! |------------------|----------------------------------------------------------|
@@ -26,6 +26,8 @@
 //! | [`aperture`]     | aperture clipping: the geometry the portal stage hands the narrowphase and continuous collision |
 //! | `profile`        | per-stage timings and work counters                      |
 //! | [`query`]        | scene queries: rays, shape casts, overlaps, distances    |
+//! | [`mover`]        | the character mover's planes: solve them, clip a velocity (`World::cast_mover`, `World::collide_mover`) |
+//! | [`character`]    | [`CharacterController`]: slope limit, autostep, snap to ground, one-way and moving platforms |
 //! | `hash`           | the state hash of determinism checks                     |
 //! | `snapshot`       | [`Snapshot`]: `World::snapshot` and `World::restore`      |
 //! | `validate`       | [`World::validate`]: every cross-structure invariant     |
@@ -34,6 +36,7 @@
 
 pub mod aperture;
 pub(crate) mod broadphase;
+pub mod character;
 pub(crate) mod collision;
 pub(crate) mod contact_build;
 pub(crate) mod contacts;
@@ -44,6 +47,7 @@ pub(crate) mod error;
 pub(crate) mod hash;
 pub(crate) mod islands;
 pub(crate) mod joints;
+pub mod mover;
 pub(crate) mod narrowphase;
 pub mod portal;
 pub(crate) mod profile;
@@ -56,12 +60,14 @@ mod stores;
 pub(crate) mod validate;
 pub mod world;
 
+pub use character::{Autostep, CharacterController, Ground, MoveResult};
 pub use contacts::{CollisionEvents, Contact, ContactPointData, HitEvent, ShapePairEvent};
 pub use continuous::ContinuousCounters;
 pub use debug_draw::{Color, DebugDraw, DrawOptions, Palette};
 pub use error::WorldError;
 pub use islands::SleepSettings;
 pub use joints::{JointEvent, JointHandle, JointKind, JointSet};
+pub use mover::{CollisionPlane, MoverCast, PlaneResult, PlaneSolution, clip_vector, solve_planes};
 pub use narrowphase::{PreSolve, PreSolveFn};
 #[cfg(feature = "portals")]
 pub use portal::{

@@ -8,6 +8,7 @@
 //! | `shapes.rs`     | shapes and their materials, contacts as read after the step  |
 //! | `joints.rs`     | joints of every kind: create, destroy, typed reads, setters   |
 //! | `queries.rs`    | scene queries (the logic is `crate::query`'s)               |
+//! | `mover.rs`      | the character mover: cast and collide a capsule (the plane logic is `crate::mover`'s) |
 //! | `events.rs`     | events and hooks: the pre-solve hook, user data              |
 //! | `step.rs`       | [`World::step`]: the pipeline that calls the stages in order |
 //! | `portals.rs`    | portal pairs: create, destroy, read (the logic is the portal stage's; with the `portals` feature) |
@@ -332,6 +333,7 @@ mod bodies;
 mod events;
 mod internal;
 mod joints;
+mod mover;
 #[cfg(feature = "portals")]
 mod portals;
 mod queries;
