@@ -954,3 +954,89 @@ fn max_linear_speed_and_finite_joint_read_back_hold_after_every_step() {
         world.validate().unwrap();
     }
 }
+
+/// One of every shape kind at (0, 10), each on its own static body.
+fn one_of_every_shape_kind() -> World {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let shapes: [Shape; 6] = [
+        Shape::Circle(Circle::new(Vec2::ZERO, 0.5).unwrap()),
+        Shape::Capsule(Capsule::new(Vec2::new(-0.5, 0.0), Vec2::new(0.5, 0.0), 0.5).unwrap()),
+        Shape::Polygon(Polygon::make_box(0.5, 0.5)),
+        Shape::Polygon(Polygon::make_rounded_box(0.5, 0.5, 0.25)),
+        Shape::Segment(Segment::new(Vec2::new(-0.5, 0.0), Vec2::new(0.5, 0.0)).unwrap()),
+        // Going +x: its front faces −y, towards the rays from below.
+        Shape::ChainSegment(
+            make_chain(&[Vec2::new(-0.5, 0.0), Vec2::new(0.5, 0.0)], false).unwrap()[0],
+        ),
+    ];
+    for shape in shapes {
+        let b = world
+            .create_body(&BodyDef::fixed(Vec2::new(0.0, 10.0)))
+            .unwrap();
+        world.create_shape(b, &ShapeDef::default(), shape).unwrap();
+    }
+    world
+}
+
+/// Issue 35: a ray of translation ≥ ~1e20 against a circle gave a hit
+/// with a NaN point and fraction (`b² − |d|² c` overflowed to ∞ − ∞).
+/// Every shape kind, every magnitude of translation and origin the
+/// queries accept: every hit finite, the fraction in `[0, 1]`.
+#[test]
+fn circle_ray_casts_at_huge_translations_stay_finite() {
+    let filter = QueryFilter::default();
+    // The issue's case: a circle of radius 0.5 at (0, 10).
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let b = world
+        .create_body(&BodyDef::fixed(Vec2::new(0.0, 10.0)))
+        .unwrap();
+    world
+        .create_shape(
+            b,
+            &ShapeDef::default(),
+            Circle::new(Vec2::ZERO, 0.5).unwrap(),
+        )
+        .unwrap();
+    let hit = world
+        .cast_ray_closest(Vec2::ZERO, Vec2::new(0.0, 1e20), &filter)
+        .unwrap()
+        .expect("the ray meets the shapes above");
+    assert!(hit.fraction > 0.0 && hit.fraction < 1e-18, "{hit:?}");
+    assert!((hit.point - Vec2::new(0.0, 9.5)).length() < 1e-3, "{hit:?}");
+    let world = one_of_every_shape_kind();
+    let mut checked = 0;
+    for e in -38..=38 {
+        let len = (10.0 as Real).powi(e);
+        for dir in [
+            Vec2::new(0.0, 1.0),
+            Vec2::new(1e-3, 1.0),
+            Vec2::new(-1.0, 1.0),
+        ] {
+            for origin in [
+                Vec2::ZERO,
+                Vec2::new(0.0, 9.0),
+                Vec2::new(0.0, -1e20),
+                Vec2::new(0.0, -3e38),
+                Vec2::new(-3e38, -3e38),
+            ] {
+                let t = dir * len;
+                if !t.is_finite() || t.length_squared() == 0.0 {
+                    continue; // refused: not finite, or too short to have a direction
+                }
+                world
+                    .cast_ray_with(origin, t, &filter, |h| {
+                        assert!(
+                            h.point.is_finite() && h.normal.is_finite() && h.fraction.is_finite(),
+                            "{origin:?} + {t:?}: {h:?}"
+                        );
+                        assert!((0.0..=1.0).contains(&h.fraction), "{h:?}");
+                        assert!((h.normal.length() - 1.0).abs() < 1e-3, "{h:?}");
+                        checked += 1;
+                        1.0
+                    })
+                    .unwrap();
+            }
+        }
+    }
+    assert!(checked > 100, "{checked} hits");
+}
