@@ -155,10 +155,23 @@ fn a_pose_carried_out_of_the_world_is_reset_and_reported() {
     assert!((55..=65).contains(&step), "reported at step {step}");
 }
 
+/// A step of huge `dt` (1e30) once had to keep every number finite; since
+/// issue 35 it is refused (`TIME_STEP_RANGE`), and the largest accepted
+/// step keeps every number finite.
 #[test]
 fn a_step_of_huge_dt_keeps_every_number_finite() {
     let (mut world, _, b) = ground_and_box();
-    world.step(1e30).unwrap();
+    let (min, max) = limits::TIME_STEP_RANGE;
+    let e = unchanged(&mut world, |w| w.step(1e30));
+    assert_eq!(
+        e,
+        WorldError::OutOfBounds {
+            field: "dt",
+            min,
+            max
+        }
+    );
+    world.step(max).unwrap();
     world.validate().unwrap();
     let p = world.position(b).unwrap();
     assert!(p.is_finite() && p.x.abs() <= 2.0 * limits::MAX_COORDINATE);
@@ -1039,4 +1052,54 @@ fn circle_ray_casts_at_huge_translations_stay_finite() {
         }
     }
     assert!(checked > 100, "{checked} hits");
+}
+
+/// Every joint's force and torque read-back is finite.
+fn joint_read_back_finite(world: &World, what: &str) {
+    for &j in world.joint_handles() {
+        let f = world.joint_force(j).unwrap();
+        let t = world.joint_torque(j).unwrap();
+        assert!(f.is_finite() && t.is_finite(), "{what}: {j:?} {f:?} {t}");
+    }
+}
+
+/// Issue 35: `joint_force`/`joint_torque` were ±∞ after
+/// `step(f32::MIN_POSITIVE)` and NaN after `step(1e10)` (NaN persisting
+/// for 100 normal steps). The smallest and the largest accepted steps
+/// keep the read-back finite; a step outside `TIME_STEP_RANGE` is refused.
+#[test]
+fn joint_read_back_stays_finite_at_the_smallest_and_largest_dt() {
+    let mut world = janus2d_testbed::support::every_joint_kind_world();
+    for _ in 0..10 {
+        world.step(DT).unwrap();
+    }
+    let (min, max) = limits::TIME_STEP_RANGE;
+    for dt in [min, DT, max, min, max, DT] {
+        world.step(dt).unwrap();
+        world.validate().unwrap();
+        joint_read_back_finite(&world, &format!("after a step of {dt:e}"));
+    }
+    for dt in [
+        Real::MIN_POSITIVE,
+        1e-30,
+        0.5 * min,
+        1.5 * max,
+        1e10,
+        Real::MAX,
+    ] {
+        let e = unchanged(&mut world, |w| w.step(dt));
+        assert_eq!(
+            e,
+            WorldError::OutOfBounds {
+                field: "dt",
+                min,
+                max
+            }
+        );
+    }
+    for _ in 0..100 {
+        world.step(DT).unwrap();
+        world.validate().unwrap();
+        joint_read_back_finite(&world, "after a normal step");
+    }
 }

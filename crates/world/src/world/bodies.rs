@@ -371,9 +371,7 @@ impl World {
         if target.q.c == 0.0 && target.q.s == 0.0 {
             return Err(WorldError::OutOfRange("target"));
         }
-        if !(dt.is_finite() && dt > 0.0) {
-            return Err(WorldError::InvalidTimeStep);
-        }
+        super::step::check_time_step(dt)?;
         if self.body_type(body)? == BodyType::Static {
             return Err(WorldError::NotMovable);
         }
