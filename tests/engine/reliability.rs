@@ -1103,3 +1103,113 @@ fn joint_read_back_stays_finite_at_the_smallest_and_largest_dt() {
         joint_read_back_finite(&world, "after a normal step");
     }
 }
+
+/// Issue 35: query transforms took non-unit rotations (`Rot { c: 2, s: 0 }`
+/// scaled the cast shape, `Rot { 0, 0 }` collapsed it, `Rot { 1e30, 0 }`
+/// hit at fraction 0 at (−2.5e29, −2.5e29)), and `set_target_transform`
+/// treated `(1e20, 1e20)` and `(1e-20, 1e-20)` as no rotation. A rotation
+/// within `UNIT_ROTATION_TOLERANCE` of unit length is normalised, any
+/// other refused with the world unchanged.
+#[test]
+fn query_and_target_rotations_must_be_unit_length() {
+    use janus2d::world::QueryProblem;
+    let (mut world, _, b) = ground_and_box();
+    let filter = QueryFilter::default();
+    let ball = Shape::Circle(Circle::new(Vec2::new(0.5, 0.0), 0.25).unwrap());
+    let at = |q: Rot| Transform {
+        p: Vec2::new(0.0, 6.0),
+        q,
+    };
+    let down = Vec2::new(0.0, -10.0);
+    for q in [
+        Rot { c: 2.0, s: 0.0 },
+        Rot { c: 0.0, s: 0.0 },
+        Rot { c: 1e30, s: 0.0 },
+        Rot { c: 1e20, s: 1e20 },
+        Rot { c: 1e-20, s: 1e-20 },
+        Rot { c: 0.99, s: 0.0 },
+    ] {
+        let e = world.cast_shape_closest(&ball, &at(q), down, &filter);
+        let refused = WorldError::BadQuery {
+            field: "transform",
+            problem: QueryProblem::NotUnitRotation,
+        };
+        assert_eq!(e, Err(refused.clone()), "{q:?}");
+        let e = world.overlap_shape(&ball, &at(q), &filter, |_| true);
+        assert_eq!(e, Err(refused), "{q:?}");
+        let e = unchanged(&mut world, |w| {
+            w.set_target_transform(
+                b,
+                Transform {
+                    p: Vec2::new(0.0, 2.0),
+                    q,
+                },
+                DT,
+            )
+        });
+        assert_eq!(e, WorldError::OutOfRange("target"), "{q:?}");
+    }
+    // Within the tolerance: normalised, the same hit as the unit rotation.
+    let unit = world
+        .cast_shape_closest(&ball, &at(Rot::IDENTITY), down, &filter)
+        .unwrap()
+        .unwrap();
+    let near = world
+        .cast_shape_closest(&ball, &at(Rot { c: 1.0004, s: 0.0 }), down, &filter)
+        .unwrap()
+        .unwrap();
+    assert_eq!(unit, near);
+    // A target turned by π/4 given as (0.7074, 0.7074): the body turns π/4.
+    let k = world
+        .create_body(&BodyDef::kinematic(Vec2::new(5.0, 5.0)))
+        .unwrap();
+    let q = Rot {
+        c: 0.7074,
+        s: 0.7074,
+    };
+    world
+        .set_target_transform(
+            k,
+            Transform {
+                p: Vec2::new(5.0, 5.0),
+                q,
+            },
+            DT,
+        )
+        .unwrap();
+    world.step(DT).unwrap();
+    let angle = world.transform(k).unwrap().q.angle();
+    assert!(
+        (angle - std::f32::consts::FRAC_PI_4 as Real).abs() < 1e-4,
+        "{angle}"
+    );
+}
+
+/// Issue 35: a shape cast with translation `(1, −f32::MAX)` (any length
+/// beyond ~1.8e19, whose square overflows) missed the box right below.
+/// A ball 5.25 m above the ground box meets it at any length of cast.
+#[test]
+fn shape_casts_at_huge_translations_meet_the_shape_below() {
+    let (world, ground, _) = ground_and_box();
+    let filter = QueryFilter::default();
+    let ball = Shape::Circle(Circle::new(Vec2::ZERO, 0.25).unwrap());
+    let start = Transform::new(Vec2::new(3.0, 6.0), 0.0);
+    for t in [
+        Vec2::new(0.0, -10.0),
+        Vec2::new(1e-3, -1e6),
+        Vec2::new(0.0, -1e20),
+        Vec2::new(0.0, -1e30),
+        Vec2::new(1.0, -Real::MAX),
+        Vec2::new(0.0, -Real::MAX),
+    ] {
+        let hit = world
+            .cast_shape_closest(&ball, &start, t, &filter)
+            .unwrap()
+            .unwrap_or_else(|| panic!("{t:?} misses the ground"));
+        assert_eq!(hit.body, ground);
+        let travelled = hit.fraction * t.y.abs();
+        assert!((travelled - 5.25).abs() < 1e-3, "{t:?}: {hit:?}");
+        assert!(hit.point.is_finite() && hit.normal.is_finite());
+        assert!((hit.point - Vec2::new(3.0, 0.5)).length() < 1e-3, "{hit:?}");
+    }
+}

@@ -343,8 +343,12 @@ impl World {
     /// velocities stay until set again. Wakes the body.
     ///
     /// Errors: a stale handle, a non-finite target (`NonFinite("target")`),
-    /// a `dt` that is not finite and positive, a static body
-    /// ([`WorldError::NotMovable`]).
+    /// a target rotation that is not unit length (`OutOfRange("target")`:
+    /// `c² + s²` farther than
+    /// [`UNIT_ROTATION_TOLERANCE`](janus2d_core::limits::UNIT_ROTATION_TOLERANCE)
+    /// from 1; one within it is normalised), a `dt` outside
+    /// [`TIME_STEP_RANGE`](janus2d_core::limits::TIME_STEP_RANGE), a static
+    /// body ([`WorldError::NotMovable`]).
     ///
     /// ```
     /// use janus2d_world::{World, WorldDef};
@@ -368,15 +372,14 @@ impl World {
             return Err(WorldError::NonFinite("target"));
         }
         janus2d_core::body::check_position(target.p, "target")?;
-        if target.q.c == 0.0 && target.q.s == 0.0 {
+        let Some(q2) = target.q.to_unit() else {
             return Err(WorldError::OutOfRange("target"));
-        }
+        };
         super::step::check_time_step(dt)?;
         if self.body_type(body)? == BodyType::Static {
             return Err(WorldError::NotMovable);
         }
         let sim = self.bodies.sim(body).ok_or_else(|| self.body_error(body))?;
-        let q2 = target.q.normalize();
         let center2 = q2.rotate(sim.local_center) + target.p;
         let v = (center2 - sim.center) / dt;
         let delta = sim.transform.q.relative_angle(q2);
