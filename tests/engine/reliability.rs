@@ -1213,3 +1213,198 @@ fn shape_casts_at_huge_translations_meet_the_shape_below() {
         assert!((hit.point - Vec2::new(3.0, 0.5)).length() < 1e-3, "{hit:?}");
     }
 }
+
+/// Issue 35: portal definitions had no magnitude limits (half-width 1e30
+/// or `f32::MAX`, anchor (1e30, 0.5) accepted; with half-width 1e30 every
+/// resting body fell through). Anchor coordinates and half-widths are
+/// within the shape limit `MAX_EXTENT`.
+#[cfg(feature = "portals")]
+#[test]
+fn portal_geometry_beyond_the_shape_limits_is_refused() {
+    use janus2d::world::{PortalDef, PortalPairDef};
+    let (mut world, ground, _) = ground_and_box();
+    let wall = world
+        .create_body(&BodyDef::fixed(Vec2::new(20.0, 0.0)))
+        .unwrap();
+    let max = limits::MAX_EXTENT;
+    let at = |body, anchor, half_width| PortalDef {
+        body,
+        anchor,
+        direction: Vec2::Y,
+        half_width,
+    };
+    for (a, field) in [
+        (at(ground, Vec2::new(0.0, 0.5), 1e30), "half_width"),
+        (at(ground, Vec2::new(0.0, 0.5), Real::MAX), "half_width"),
+        (at(ground, Vec2::new(0.0, 0.5), 2.0 * max), "half_width"),
+        (at(ground, Vec2::new(1e30, 0.5), 0.5), "anchor"),
+        (at(ground, Vec2::new(0.0, -2.0 * max), 0.5), "anchor"),
+    ] {
+        let b = at(wall, Vec2::ZERO, a.half_width.min(1.0));
+        for def in [PortalPairDef::new(a, b), PortalPairDef::new(b, a)] {
+            let def = def.with_eta(1.0);
+            let e = unchanged(&mut world, |w| w.create_portal_pair(&def).map(|_| ()));
+            let min = if field == "anchor" { -max } else { 0.0 };
+            assert_eq!(e, WorldError::OutOfBounds { field, min, max }, "{def:?}");
+        }
+    }
+    // At the limits themselves: accepted.
+    let def = PortalPairDef::new(
+        at(ground, Vec2::new(max, 0.5), max),
+        at(wall, Vec2::new(0.0, -max), 1.0),
+    )
+    .with_eta(1.0);
+    world.create_portal_pair(&def).unwrap();
+    world.step(DT).unwrap();
+    world.validate().unwrap();
+}
+
+/// Issue 35: `max_motor_torque = ∞` was accepted. The joint motors'
+/// largest torque and force are finite, on creation and through the
+/// setters.
+#[test]
+fn infinite_motor_torques_and_forces_are_refused() {
+    use janus2d::constraints::{JointError, JointKind};
+    use janus2d_testbed::support::joint_def_of_kind;
+    let (mut world, ground, b) = ground_and_box();
+    for kind in [
+        JointKind::Revolute,
+        JointKind::Wheel,
+        JointKind::Prismatic,
+        JointKind::Distance,
+    ] {
+        let mut def = joint_def_of_kind(kind, ground, b, Vec2::new(0.5, 0.0), None, false);
+        let linear = matches!(kind, JointKind::Prismatic | JointKind::Distance);
+        {
+            let m = def.motor_mut().unwrap();
+            *m.enable = true;
+            *m.speed = 1.0;
+            *m.max = Real::INFINITY;
+        }
+        let e = unchanged(&mut world, |w| w.create_joint(&def).map(|_| ()));
+        assert_eq!(e, WorldError::Joint(JointError::NonFinite), "{kind:?}");
+        *def.motor_mut().unwrap().max = 10.0;
+        let j = world.create_joint(&def).unwrap();
+        let e = unchanged(&mut world, |w| {
+            if linear {
+                w.set_joint_max_motor_force(j, Real::INFINITY)
+            } else {
+                w.set_joint_max_motor_torque(j, Real::INFINITY)
+            }
+        });
+        let field = if linear {
+            "max_motor_force"
+        } else {
+            "max_motor_torque"
+        };
+        assert_eq!(e, WorldError::NonFinite(field), "{kind:?}");
+        world.destroy_joint(j).unwrap();
+    }
+}
+
+/// Issue 35: `baumgarte = 1e30` was accepted (bodies were reset). Every
+/// solver setting is within its stated range (`SolverSettings::validate`).
+#[test]
+fn solver_settings_beyond_their_ranges_are_refused() {
+    let (mut world, _, _) = ground_and_box();
+    let d = SolverSettings::default;
+    for (s, name) in [
+        (
+            SolverSettings {
+                baumgarte: 1e30,
+                ..d()
+            },
+            "baumgarte",
+        ),
+        (
+            SolverSettings {
+                baumgarte: 1.5,
+                ..d()
+            },
+            "baumgarte",
+        ),
+        (
+            SolverSettings {
+                direct_joint_hertz: 1e30,
+                ..d()
+            },
+            "direct_joint_hertz",
+        ),
+        (
+            SolverSettings {
+                contact_push_max_velocity: 1e30,
+                ..d()
+            },
+            "contact_push_max_velocity",
+        ),
+        (
+            SolverSettings {
+                restitution_threshold: 1e30,
+                ..d()
+            },
+            "restitution_threshold",
+        ),
+        (
+            SolverSettings {
+                direct_joint_max_correction_speed: 1e30,
+                ..d()
+            },
+            "direct_joint_max_correction_speed",
+        ),
+        (
+            SolverSettings {
+                contact_mass_ratio_cap: 1e30,
+                ..d()
+            },
+            "contact_mass_ratio_cap",
+        ),
+        (
+            SolverSettings {
+                joint_mass_ratio_cap: 1e30,
+                ..d()
+            },
+            "joint_mass_ratio_cap",
+        ),
+    ] {
+        let e = unchanged(&mut world, |w| w.set_settings(s.clone()));
+        assert_eq!(e, WorldError::OutOfRange(name));
+        let def = WorldDef {
+            solver: s,
+            ..WorldDef::default()
+        };
+        assert!(World::new(def).is_err(), "{name}");
+    }
+    // The ends of the ranges are accepted, and the documented unbounded
+    // values (no hertz cap, no Gauss–Seidel correction cap).
+    world
+        .set_settings(SolverSettings {
+            baumgarte: 1.0,
+            contact_hertz_fraction: Real::INFINITY,
+            joint_max_correction_speed: Real::MAX,
+            ..d()
+        })
+        .unwrap();
+    world.step(DT).unwrap();
+    world.validate().unwrap();
+}
+
+/// Issue 35: a static body created with a velocity was accepted and the
+/// velocity silently dropped. It is refused as setting a static body's
+/// velocity is (`NotMovable`).
+#[test]
+fn a_static_body_created_with_a_velocity_is_refused() {
+    let (mut world, _, _) = ground_and_box();
+    for def in [
+        BodyDef::fixed(Vec2::ZERO).with_velocity(Vec2::new(3.0, 0.0)),
+        BodyDef {
+            angular_velocity: 1.0,
+            ..BodyDef::fixed(Vec2::ZERO)
+        },
+    ] {
+        let e = unchanged(&mut world, |w| w.create_body(&def).map(|_| ()));
+        assert_eq!(e, WorldError::NotMovable);
+    }
+    let nan = BodyDef::fixed(Vec2::ZERO).with_velocity(Vec2::new(Real::NAN, 0.0));
+    let e = unchanged(&mut world, |w| w.create_body(&nan).map(|_| ()));
+    assert!(matches!(e, WorldError::Body(_)), "{e:?}");
+}

@@ -538,6 +538,11 @@ impl PortalStage {
             if !(d.eta.is_finite() && d.eta > 0.0) {
                 return Err(format!("pair {index}: eta {}", d.eta));
             }
+            for portal in &d.local {
+                if portal.validate().is_err() || check_portal_extent(portal).is_err() {
+                    return Err(format!("pair {index}: portal {portal:?}"));
+                }
+            }
             if let Some(p) = d.portals.iter().find(|p| !bodies.contains(p.body)) {
                 return Err(format!(
                     "pair {index}: portal body {:?} is not live",
@@ -647,6 +652,28 @@ fn push_body(stores: &mut Stores<'_>, body: BodyHandle, impulse: Vec2, point: Ve
     }
 }
 
+/// A portal's anchor coordinates and half-width within the shape limit
+/// [`MAX_EXTENT`](janus2d_core::limits::MAX_EXTENT) (a half-width of 1e30
+/// let every resting body fall through).
+fn check_portal_extent(p: &Portal) -> Result<(), WorldError> {
+    let max = janus2d_core::limits::MAX_EXTENT;
+    if p.anchor.x.abs() > max || p.anchor.y.abs() > max {
+        return Err(WorldError::OutOfBounds {
+            field: "anchor",
+            min: -max,
+            max,
+        });
+    }
+    if p.half_width > max {
+        return Err(WorldError::OutOfBounds {
+            field: "half_width",
+            min: 0.0,
+            max,
+        });
+    }
+    Ok(())
+}
+
 /// The pair API's logic: the world's portal methods (`world/portals.rs`)
 /// pass what each reads and changes.
 impl PortalStage {
@@ -673,11 +700,11 @@ impl PortalStage {
             if self.crossing_of(p.body).is_some() {
                 return Err(WorldError::PortalBody);
             }
-            local.push(
-                Portal::new(p.anchor, p.direction, p.half_width)
-                    .map_err(WorldError::Portal)?
-                    .normalized(),
-            );
+            let portal = Portal::new(p.anchor, p.direction, p.half_width)
+                .map_err(WorldError::Portal)?
+                .normalized();
+            check_portal_extent(&portal)?;
+            local.push(portal);
         }
         let local = [local[0], local[1]];
         let eta = def.eta.unwrap_or(local[1].half_width / local[0].half_width);

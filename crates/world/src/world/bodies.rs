@@ -23,7 +23,18 @@ impl World {
     ///
     /// A kinematic body given a velocity is created awake even with
     /// `awake: false` (a sleeping kinematic body would never move).
+    ///
+    /// Errors (nothing created): an invalid definition; a static body
+    /// given a linear or angular velocity ([`WorldError::NotMovable`], as
+    /// [`set_linear_velocity`](Self::set_linear_velocity) on one: a static
+    /// body never moves, and the velocity would be silently dropped).
     pub fn create_body(&mut self, def: &BodyDef) -> Result<BodyHandle, WorldError> {
+        janus2d_core::body::validate_body_def(def)?;
+        if def.body_type == BodyType::Static
+            && (def.linear_velocity != Vec2::ZERO || def.angular_velocity != 0.0)
+        {
+            return Err(WorldError::NotMovable);
+        }
         let handle = self.insert_body(def)?;
         let moving_kinematic = def.body_type == BodyType::Kinematic
             && (def.linear_velocity != Vec2::ZERO || def.angular_velocity != 0.0);

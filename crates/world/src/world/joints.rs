@@ -165,7 +165,7 @@ impl World {
         self.wake_pair(r)
     }
 
-    /// Sets the largest torque of a joint's angular motor, N·m (≥ 0):
+    /// Sets the largest torque of a joint's angular motor, N·m (finite, ≥ 0):
     /// revolute, wheel. A joint without an angular motor gets
     /// `Err(WrongJointKind)` and is left unchanged.
     pub fn set_joint_max_motor_torque(
@@ -177,7 +177,7 @@ impl World {
         self.wake_pair(r)
     }
 
-    /// Sets the largest force of a joint's linear motor, N (≥ 0):
+    /// Sets the largest force of a joint's linear motor, N (finite, ≥ 0):
     /// prismatic, distance. A joint without a linear motor gets
     /// `Err(WrongJointKind)` and is left unchanged.
     pub fn set_joint_max_motor_force(

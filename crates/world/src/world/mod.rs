@@ -354,12 +354,11 @@ pub(super) fn check_gravity(gravity: Vec2) -> Result<(), WorldError> {
     Ok(())
 }
 
-/// Solver settings: [`SolverSettings::validate`], then every real finite
-/// (`inf` Hz or an infinite damping ratio give NaN softness) and the
-/// damping ratios at most
-/// [`MAX_DAMPING_RATIO`](janus2d_core::limits::MAX_DAMPING_RATIO).
+/// Solver settings: every real finite (`inf` Hz or an infinite damping
+/// ratio give NaN softness), the damping ratios at most
+/// [`MAX_DAMPING_RATIO`](janus2d_core::limits::MAX_DAMPING_RATIO)
+/// (`OutOfBounds`), then [`SolverSettings::validate`]'s stated ranges.
 pub(crate) fn check_settings(s: &SolverSettings) -> Result<(), WorldError> {
-    s.validate()?;
     let reals = [
         (s.baumgarte, "baumgarte"),
         (s.contact_hertz, "contact_hertz"),
@@ -395,6 +394,8 @@ pub(crate) fn check_settings(s: &SolverSettings) -> Result<(), WorldError> {
             });
         }
     }
+    // Then every stated range (NaN, negative, beyond its largest value).
+    s.validate()?;
     Ok(())
 }
 

@@ -12,7 +12,10 @@ impl World {
     /// Creates a linked pair of portals.
     ///
     /// Rejects stale body handles, non-finite values, a zero direction, a
-    /// non-positive half-width, `η ≤ 0` and an `η` outside
+    /// non-positive half-width, an anchor coordinate or a half-width beyond
+    /// the shape limit [`MAX_EXTENT`](janus2d_core::limits::MAX_EXTENT)
+    /// ([`WorldError::OutOfBounds`], field `anchor` or `half_width`),
+    /// `η ≤ 0` and an `η` outside
     /// [`ETA_RANGE`](janus2d_core::limits::ETA_RANGE); a body that is
     /// crossing a portal ([`WorldError::PortalBody`]).
     pub fn create_portal_pair(
