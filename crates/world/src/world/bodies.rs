@@ -170,7 +170,7 @@ impl World {
     pub fn set_linear_velocity(&mut self, body: BodyHandle, v: Vec2) -> Result<(), WorldError> {
         janus2d_core::body::check_velocity(v, "linear_velocity")?;
         self.check_movable(body)?;
-        self.wake_body(body);
+        self.wake_island(body);
         if let Some(s) = self.bodies.state_mut(body) {
             s.v = v;
         }
@@ -183,7 +183,7 @@ impl World {
     pub fn set_angular_velocity(&mut self, body: BodyHandle, w: Real) -> Result<(), WorldError> {
         janus2d_core::body::check_angular_velocity(w, "angular_velocity")?;
         self.check_movable(body)?;
-        self.wake_body(body);
+        self.wake_island(body);
         if let Some(s) = self.bodies.state_mut(body) {
             s.w = w;
         }
@@ -202,7 +202,7 @@ impl World {
         }
         janus2d_core::body::check_position(position, "transform")?;
         self.check_body(body)?;
-        self.wake_body(body);
+        self.wake_island(body);
         let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
         sim.transform = Transform {
             p: position,
@@ -230,7 +230,7 @@ impl World {
         if ty != BodyType::Dynamic {
             return Err(WorldError::NotDynamic);
         }
-        self.wake_body(body);
+        self.wake_island(body);
         self.bodies.apply_mass(body, mass, fixed);
         if let Some(r) = self.bodies.record_mut(body) {
             r.mass_override = true;
@@ -257,7 +257,7 @@ impl World {
         if !(vec_is_finite(f) && t.is_finite()) {
             return Err(accumulated("force"));
         }
-        self.wake_body(body);
+        self.wake_island(body);
         let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
         sim.force = f;
         sim.torque = t;
@@ -284,7 +284,7 @@ impl World {
         if !(sim.torque + torque).is_finite() {
             return Err(accumulated("torque"));
         }
-        self.wake_body(body);
+        self.wake_island(body);
         let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
         sim.torque += torque;
         Ok(())
@@ -307,7 +307,7 @@ impl World {
         let v = v0 + im * impulse;
         let w = w0 + ii * cross(point - c, impulse);
         check_resulting_velocity(v, w)?;
-        self.wake_body(body);
+        self.wake_island(body);
         if let Some(st) = self.bodies.state_mut(body) {
             st.v = v;
             st.w = w;
@@ -333,7 +333,7 @@ impl World {
         let v = self.linear_velocity(body)?;
         let w = self.angular_velocity(body)? + ii * impulse;
         check_resulting_velocity(v, w)?;
-        self.wake_body(body);
+        self.wake_island(body);
         if let Some(st) = self.bodies.state_mut(body) {
             st.w = w;
         }
@@ -405,7 +405,7 @@ impl World {
         };
         janus2d_core::body::check_velocity(v, "target")?;
         janus2d_core::body::check_angular_velocity(w, "target")?;
-        self.wake_body(body);
+        self.wake_island(body);
         if let Some(s) = self.bodies.state_mut(body) {
             s.v = v;
             s.w = w;
@@ -446,7 +446,7 @@ impl World {
     pub fn set_awake(&mut self, body: BodyHandle, awake: bool) -> Result<(), WorldError> {
         self.check_body(body)?;
         if awake {
-            self.wake_body(body);
+            self.wake_island(body);
         } else if let Some(BodyLocation::Moving(_)) = self.bodies.location(body) {
             self.islands
                 .sleep_now(body, &mut self.bodies, &mut self.collision.contacts);
@@ -467,7 +467,7 @@ impl World {
     pub fn set_body_enable_sleep(&mut self, body: BodyHandle, on: bool) -> Result<(), WorldError> {
         self.check_body(body)?;
         if !on {
-            self.wake_body(body);
+            self.wake_island(body);
         }
         if let Some(s) = self.bodies.sim_mut(body) {
             s.enable_sleep = on;
@@ -554,7 +554,7 @@ impl World {
             r.mass_override = false;
         }
         if self.bodies.body_type(body) == Some(BodyType::Dynamic) {
-            self.wake_body(body);
+            self.wake_island(body);
             self.update_mass_from_shapes(body);
         }
         Ok(())
@@ -589,7 +589,7 @@ impl World {
         if self.portals.involves(body) {
             return Err(WorldError::PortalBody);
         }
-        self.wake_body(body);
+        self.wake_island(body);
         self.wake_touching(body);
         self.collision.remove_contacts_of(body);
         if old == BodyType::Dynamic {
@@ -607,7 +607,7 @@ impl World {
                 continue;
             };
             let other = if a == body { b } else { a };
-            self.wake_body(other);
+            self.wake_island(other);
             let enabled = self.joints.get(j).is_ok_and(|r| r.is_enabled());
             if ty == BodyType::Dynamic && enabled {
                 self.islands.link(a, b, &self.bodies);

@@ -246,20 +246,30 @@ impl World {
     // ----- sleep --------------------------------------------------------------
 
     /// Wakes the island of `body` (no effect on awake or static bodies).
-    pub fn wake_body(&mut self, body: BodyHandle) {
+    /// Errors: a stale or foreign handle (the world unchanged).
+    pub fn wake_body(&mut self, body: BodyHandle) -> Result<(), WorldError> {
+        self.check_body(body)?;
+        self.wake_island(body);
+        Ok(())
+    }
+
+    /// Wakes the island of `body`, a handle known to be live (or
+    /// harmlessly stale: nothing happens).
+    pub(crate) fn wake_island(&mut self, body: BodyHandle) {
         self.stores().wake_body(body);
     }
 
     /// Wakes every island in the list.
     pub(super) fn wake_all(&mut self, bodies: &[BodyHandle]) {
         for b in bodies {
-            self.wake_body(*b);
+            self.wake_island(*b);
         }
     }
 
-    /// True when the body sleeps.
-    pub fn is_sleeping(&self, body: BodyHandle) -> bool {
-        self.bodies.is_sleeping(body)
+    /// True when the body sleeps. Errors: a stale or foreign handle.
+    pub fn is_sleeping(&self, body: BodyHandle) -> Result<bool, WorldError> {
+        self.check_body(body)?;
+        Ok(self.bodies.is_sleeping(body))
     }
 
     /// Number of sleeping bodies.

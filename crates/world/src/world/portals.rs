@@ -42,7 +42,11 @@ impl World {
         self.portals.crossings.len()
     }
 
-    /// Portal events of the last step.
+    /// Portal events of the last step. Events of calls between steps
+    /// (`CrossingCancelled` and `JointDisabled` from
+    /// [`destroy_portal_pair`](Self::destroy_portal_pair) or from
+    /// destroying a crossing's copy or a portal body) are kept and reported
+    /// with the next step's, first, as collision events are.
     pub fn portal_events(&self) -> &[PortalEvent] {
         &self.portals.events
     }

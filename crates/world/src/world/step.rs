@@ -212,8 +212,6 @@ impl World {
             let (portals, mut stores) = self.portals_and_stores();
             portals.cross(&mut stores);
             sp.portals += lap();
-        } else {
-            self.portals.clear_events();
         }
         if self.sleep_settings.enabled {
             let keep_awake = self.portals.keep_awake();
@@ -246,6 +244,7 @@ impl World {
             continuous: self.continuous.counters(),
         });
         self.step_profile = sp;
+        self.portals.publish_events();
         self.events = StepEvents {
             non_finite_bodies: report.non_finite,
             collision: std::mem::take(&mut self.collision.events),
