@@ -97,7 +97,8 @@ fn usable(ray: &RayInput) -> bool {
 /// The root is taken from `|d|² s² + 2 (m·d) s + |m|² − r² = 0` directly
 /// when those products are finite; when they overflow (a translation or
 /// an origin beyond ~1e19 m in `f32`) the same root is found in scaled
-/// units ([`ray_disc_scaled`]), so every hit is finite.
+/// units (a unit direction, the offset and radius over their largest), so
+/// every hit is finite.
 pub fn ray_disc(ray: &RayInput, c: Vec2, r: Real) -> Option<CastHit> {
     if !usable(ray) {
         return None;
