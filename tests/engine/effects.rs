@@ -170,7 +170,7 @@ fn resting_stack_falls_asleep_and_costs_no_solver_work() {
     let c = world.counters();
     assert_eq!((c.awake_bodies, c.contacts, c.pairs_tested), (0, 0, 0));
     for b in &bodies {
-        assert!(world.is_sleeping(*b));
+        assert!(world.is_sleeping(*b).unwrap());
         assert_eq!(world.linear_velocity(*b).unwrap(), Vec2::ZERO);
     }
 }
@@ -181,7 +181,7 @@ fn api_change_wakes_the_whole_island() {
     for _ in 0..240 {
         world.step(DT).unwrap();
     }
-    assert!(world.is_sleeping(bodies[4]));
+    assert!(world.is_sleeping(bodies[4]).unwrap());
     world
         .apply_linear_impulse(
             bodies[4],
@@ -190,7 +190,10 @@ fn api_change_wakes_the_whole_island() {
         )
         .unwrap();
     for b in &bodies {
-        assert!(!world.is_sleeping(*b), "island member still asleep");
+        assert!(
+            !world.is_sleeping(*b).unwrap(),
+            "island member still asleep"
+        );
     }
     assert!(world.linear_velocity(bodies[4]).unwrap().x > 0.0);
 }
@@ -215,7 +218,7 @@ fn contact_from_an_awake_body_wakes_the_island() {
     let mut woke = false;
     for _ in 0..120 {
         world.step(DT).unwrap();
-        woke |= !world.is_sleeping(bodies[0]);
+        woke |= !world.is_sleeping(bodies[0]).unwrap();
     }
     assert!(woke, "the falling ball did not wake the stack");
 }
@@ -234,9 +237,9 @@ fn joint_change_wakes_both_bodies() {
     for _ in 0..240 {
         world.step(DT).unwrap();
     }
-    assert!(world.is_sleeping(bodies[4]));
+    assert!(world.is_sleeping(bodies[4]).unwrap());
     world.enable_joint_motor(j, true).unwrap();
-    assert!(!world.is_sleeping(bodies[3]) && !world.is_sleeping(bodies[4]));
+    assert!(!world.is_sleeping(bodies[3]).unwrap() && !world.is_sleeping(bodies[4]).unwrap());
 }
 
 #[cfg(feature = "portals")]
@@ -248,8 +251,8 @@ fn portal_crossing_keeps_bodies_awake() {
         scene.world.step(DT).unwrap();
         if scene.world.crossing_count() > 0 {
             let clone = scene.world.clone_of(scene.probe).unwrap();
-            asleep_while_crossing |=
-                scene.world.is_sleeping(scene.probe) || scene.world.is_sleeping(clone);
+            asleep_while_crossing |= scene.world.is_sleeping(scene.probe).unwrap()
+                || scene.world.is_sleeping(clone).unwrap();
         }
     }
     assert!(!asleep_while_crossing);
@@ -299,6 +302,9 @@ fn bodies_created_asleep_cost_nothing_until_touched() {
     for _ in 0..60 {
         world.step(DT).unwrap();
     }
-    assert!(!world.is_sleeping(asleep[0]), "the hit box is still asleep");
+    assert!(
+        !world.is_sleeping(asleep[0]).unwrap(),
+        "the hit box is still asleep"
+    );
     assert!(world.linear_velocity(asleep[0]).unwrap().x > 0.0);
 }

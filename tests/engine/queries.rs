@@ -536,14 +536,14 @@ fn queries_see_sleeping_bodies() {
     for _ in 0..200 {
         w.step(1.0 / 60.0).unwrap();
     }
-    assert!(w.is_sleeping(b));
+    assert!(w.is_sleeping(b).unwrap());
     let hit = w
         .cast_ray_closest(v(-3.0, 0.5), v(6.0, 0.0), &QueryFilter::default())
         .unwrap()
         .unwrap();
     assert_eq!(hit.body, b);
     assert!((hit.point.x + 0.5).abs() < 0.01);
-    assert!(w.is_sleeping(b), "a query does not wake anything");
+    assert!(w.is_sleeping(b).unwrap(), "a query does not wake anything");
 }
 
 #[test]

@@ -155,10 +155,23 @@ fn a_pose_carried_out_of_the_world_is_reset_and_reported() {
     assert!((55..=65).contains(&step), "reported at step {step}");
 }
 
+/// A step of huge `dt` (1e30) once had to keep every number finite; since
+/// issue 35 it is refused (`TIME_STEP_RANGE`), and the largest accepted
+/// step keeps every number finite.
 #[test]
 fn a_step_of_huge_dt_keeps_every_number_finite() {
     let (mut world, _, b) = ground_and_box();
-    world.step(1e30).unwrap();
+    let (min, max) = limits::TIME_STEP_RANGE;
+    let e = unchanged(&mut world, |w| w.step(1e30));
+    assert_eq!(
+        e,
+        WorldError::OutOfBounds {
+            field: "dt",
+            min,
+            max
+        }
+    );
+    world.step(max).unwrap();
     world.validate().unwrap();
     let p = world.position(b).unwrap();
     assert!(p.is_finite() && p.x.abs() <= 2.0 * limits::MAX_COORDINATE);
@@ -262,7 +275,7 @@ fn a_tiny_density_gives_a_clamped_finite_mass_and_the_body_falls() {
     }
     world.validate().unwrap();
     assert!(world.position(b).unwrap().y < 4.0);
-    assert!(!world.is_sleeping(b));
+    assert!(!world.is_sleeping(b).unwrap());
 }
 
 #[test]
@@ -456,7 +469,7 @@ fn kinematic_body_created_asleep_with_a_velocity_moves() {
     for _ in 0..60 {
         world.step(DT).unwrap();
     }
-    assert!(!world.is_sleeping(k));
+    assert!(!world.is_sleeping(k).unwrap());
     assert!((world.position(k).unwrap().x - 1.0).abs() < 1e-4);
     // Without a velocity, `awake: false` still creates it asleep.
     let still = world
@@ -466,7 +479,7 @@ fn kinematic_body_created_asleep_with_a_velocity_moves() {
         })
         .unwrap();
     world.step(DT).unwrap();
-    assert!(world.is_sleeping(still));
+    assert!(world.is_sleeping(still).unwrap());
     world.validate().unwrap();
 }
 
@@ -809,7 +822,7 @@ mod snapshot_bytes {
         let bodies: Vec<BodyHandle> = world.body_handles().collect();
         for &b in &bodies {
             let _ = world.is_sleeping(b);
-            world.wake_body(b);
+            let _ = world.wake_body(b);
         }
         let _ = world.step(DT);
         for &j in world.joint_handles().to_vec().iter().step_by(2) {
@@ -953,4 +966,536 @@ fn max_linear_speed_and_finite_joint_read_back_hold_after_every_step() {
         }
         world.validate().unwrap();
     }
+}
+
+/// One of every shape kind at (0, 10), each on its own static body.
+fn one_of_every_shape_kind() -> World {
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let shapes: [Shape; 6] = [
+        Shape::Circle(Circle::new(Vec2::ZERO, 0.5).unwrap()),
+        Shape::Capsule(Capsule::new(Vec2::new(-0.5, 0.0), Vec2::new(0.5, 0.0), 0.5).unwrap()),
+        Shape::Polygon(Polygon::make_box(0.5, 0.5)),
+        Shape::Polygon(Polygon::make_rounded_box(0.5, 0.5, 0.25)),
+        Shape::Segment(Segment::new(Vec2::new(-0.5, 0.0), Vec2::new(0.5, 0.0)).unwrap()),
+        // Going +x: its front faces −y, towards the rays from below.
+        Shape::ChainSegment(
+            make_chain(&[Vec2::new(-0.5, 0.0), Vec2::new(0.5, 0.0)], false).unwrap()[0],
+        ),
+    ];
+    for shape in shapes {
+        let b = world
+            .create_body(&BodyDef::fixed(Vec2::new(0.0, 10.0)))
+            .unwrap();
+        world.create_shape(b, &ShapeDef::default(), shape).unwrap();
+    }
+    world
+}
+
+/// Issue 35: a ray of translation ≥ ~1e20 against a circle gave a hit
+/// with a NaN point and fraction (`b² − |d|² c` overflowed to ∞ − ∞).
+/// Every shape kind, every magnitude of translation and origin the
+/// queries accept: every hit finite, the fraction in `[0, 1]`.
+#[test]
+fn circle_ray_casts_at_huge_translations_stay_finite() {
+    let filter = QueryFilter::default();
+    // The issue's case: a circle of radius 0.5 at (0, 10).
+    let mut world = World::new(WorldDef::default()).unwrap();
+    let b = world
+        .create_body(&BodyDef::fixed(Vec2::new(0.0, 10.0)))
+        .unwrap();
+    world
+        .create_shape(
+            b,
+            &ShapeDef::default(),
+            Circle::new(Vec2::ZERO, 0.5).unwrap(),
+        )
+        .unwrap();
+    let hit = world
+        .cast_ray_closest(Vec2::ZERO, Vec2::new(0.0, 1e20), &filter)
+        .unwrap()
+        .expect("the ray meets the shapes above");
+    assert!(hit.fraction > 0.0 && hit.fraction < 1e-18, "{hit:?}");
+    assert!((hit.point - Vec2::new(0.0, 9.5)).length() < 1e-3, "{hit:?}");
+    let world = one_of_every_shape_kind();
+    let mut checked = 0;
+    for e in -38..=38 {
+        let len = (10.0 as Real).powi(e);
+        for dir in [
+            Vec2::new(0.0, 1.0),
+            Vec2::new(1e-3, 1.0),
+            Vec2::new(-1.0, 1.0),
+        ] {
+            for origin in [
+                Vec2::ZERO,
+                Vec2::new(0.0, 9.0),
+                Vec2::new(0.0, -1e20),
+                Vec2::new(0.0, -3e38),
+                Vec2::new(-3e38, -3e38),
+            ] {
+                let t = dir * len;
+                if !t.is_finite() || t.length_squared() == 0.0 {
+                    continue; // refused: not finite, or too short to have a direction
+                }
+                world
+                    .cast_ray_with(origin, t, &filter, |h| {
+                        assert!(
+                            h.point.is_finite() && h.normal.is_finite() && h.fraction.is_finite(),
+                            "{origin:?} + {t:?}: {h:?}"
+                        );
+                        assert!((0.0..=1.0).contains(&h.fraction), "{h:?}");
+                        assert!((h.normal.length() - 1.0).abs() < 1e-3, "{h:?}");
+                        checked += 1;
+                        1.0
+                    })
+                    .unwrap();
+            }
+        }
+    }
+    assert!(checked > 100, "{checked} hits");
+}
+
+/// Every joint's force and torque read-back is finite.
+fn joint_read_back_finite(world: &World, what: &str) {
+    for &j in world.joint_handles() {
+        let f = world.joint_force(j).unwrap();
+        let t = world.joint_torque(j).unwrap();
+        assert!(f.is_finite() && t.is_finite(), "{what}: {j:?} {f:?} {t}");
+    }
+}
+
+/// Issue 35: `joint_force`/`joint_torque` were ±∞ after
+/// `step(f32::MIN_POSITIVE)` and NaN after `step(1e10)` (NaN persisting
+/// for 100 normal steps). The smallest and the largest accepted steps
+/// keep the read-back finite; a step outside `TIME_STEP_RANGE` is refused.
+#[test]
+fn joint_read_back_stays_finite_at_the_smallest_and_largest_dt() {
+    let mut world = janus2d_testbed::support::every_joint_kind_world();
+    for _ in 0..10 {
+        world.step(DT).unwrap();
+    }
+    let (min, max) = limits::TIME_STEP_RANGE;
+    for dt in [min, DT, max, min, max, DT] {
+        world.step(dt).unwrap();
+        world.validate().unwrap();
+        joint_read_back_finite(&world, &format!("after a step of {dt:e}"));
+    }
+    for dt in [
+        Real::MIN_POSITIVE,
+        1e-30,
+        0.5 * min,
+        1.5 * max,
+        1e10,
+        Real::MAX,
+    ] {
+        let e = unchanged(&mut world, |w| w.step(dt));
+        assert_eq!(
+            e,
+            WorldError::OutOfBounds {
+                field: "dt",
+                min,
+                max
+            }
+        );
+    }
+    for _ in 0..100 {
+        world.step(DT).unwrap();
+        world.validate().unwrap();
+        joint_read_back_finite(&world, "after a normal step");
+    }
+}
+
+/// Issue 35: query transforms took non-unit rotations (`Rot { c: 2, s: 0 }`
+/// scaled the cast shape, `Rot { 0, 0 }` collapsed it, `Rot { 1e30, 0 }`
+/// hit at fraction 0 at (−2.5e29, −2.5e29)), and `set_target_transform`
+/// treated `(1e20, 1e20)` and `(1e-20, 1e-20)` as no rotation. A rotation
+/// within `UNIT_ROTATION_TOLERANCE` of unit length is normalised, any
+/// other refused with the world unchanged.
+#[test]
+fn query_and_target_rotations_must_be_unit_length() {
+    use janus2d::world::QueryProblem;
+    let (mut world, _, b) = ground_and_box();
+    let filter = QueryFilter::default();
+    let ball = Shape::Circle(Circle::new(Vec2::new(0.5, 0.0), 0.25).unwrap());
+    let at = |q: Rot| Transform {
+        p: Vec2::new(0.0, 6.0),
+        q,
+    };
+    let down = Vec2::new(0.0, -10.0);
+    for q in [
+        Rot { c: 2.0, s: 0.0 },
+        Rot { c: 0.0, s: 0.0 },
+        Rot { c: 1e30, s: 0.0 },
+        Rot { c: 1e20, s: 1e20 },
+        Rot { c: 1e-20, s: 1e-20 },
+        Rot { c: 0.99, s: 0.0 },
+    ] {
+        let e = world.cast_shape_closest(&ball, &at(q), down, &filter);
+        let refused = WorldError::BadQuery {
+            field: "transform",
+            problem: QueryProblem::NotUnitRotation,
+        };
+        assert_eq!(e, Err(refused.clone()), "{q:?}");
+        let e = world.overlap_shape(&ball, &at(q), &filter, |_| true);
+        assert_eq!(e, Err(refused), "{q:?}");
+        let e = unchanged(&mut world, |w| {
+            w.set_target_transform(
+                b,
+                Transform {
+                    p: Vec2::new(0.0, 2.0),
+                    q,
+                },
+                DT,
+            )
+        });
+        assert_eq!(e, WorldError::OutOfRange("target"), "{q:?}");
+    }
+    // Within the tolerance: normalised, the same hit as the unit rotation.
+    let unit = world
+        .cast_shape_closest(&ball, &at(Rot::IDENTITY), down, &filter)
+        .unwrap()
+        .unwrap();
+    let near = world
+        .cast_shape_closest(&ball, &at(Rot { c: 1.0004, s: 0.0 }), down, &filter)
+        .unwrap()
+        .unwrap();
+    assert_eq!(unit, near);
+    // A target turned by π/4 given as (0.7074, 0.7074): the body turns π/4.
+    let k = world
+        .create_body(&BodyDef::kinematic(Vec2::new(5.0, 5.0)))
+        .unwrap();
+    let q = Rot {
+        c: 0.7074,
+        s: 0.7074,
+    };
+    world
+        .set_target_transform(
+            k,
+            Transform {
+                p: Vec2::new(5.0, 5.0),
+                q,
+            },
+            DT,
+        )
+        .unwrap();
+    world.step(DT).unwrap();
+    let angle = world.transform(k).unwrap().q.angle();
+    assert!(
+        (angle - std::f32::consts::FRAC_PI_4 as Real).abs() < 1e-4,
+        "{angle}"
+    );
+}
+
+/// Issue 35: a shape cast with translation `(1, −f32::MAX)` (any length
+/// beyond ~1.8e19, whose square overflows) missed the box right below.
+/// A ball 5.25 m above the ground box meets it at any length of cast.
+#[test]
+fn shape_casts_at_huge_translations_meet_the_shape_below() {
+    let (world, ground, _) = ground_and_box();
+    let filter = QueryFilter::default();
+    let ball = Shape::Circle(Circle::new(Vec2::ZERO, 0.25).unwrap());
+    let start = Transform::new(Vec2::new(3.0, 6.0), 0.0);
+    for t in [
+        Vec2::new(0.0, -10.0),
+        Vec2::new(1e-3, -1e6),
+        Vec2::new(0.0, -1e20),
+        Vec2::new(0.0, -1e30),
+        Vec2::new(1.0, -Real::MAX),
+        Vec2::new(0.0, -Real::MAX),
+    ] {
+        let hit = world
+            .cast_shape_closest(&ball, &start, t, &filter)
+            .unwrap()
+            .unwrap_or_else(|| panic!("{t:?} misses the ground"));
+        assert_eq!(hit.body, ground);
+        let travelled = hit.fraction * t.y.abs();
+        assert!((travelled - 5.25).abs() < 1e-3, "{t:?}: {hit:?}");
+        assert!(hit.point.is_finite() && hit.normal.is_finite());
+        assert!((hit.point - Vec2::new(3.0, 0.5)).length() < 1e-3, "{hit:?}");
+    }
+}
+
+/// Issue 35: portal definitions had no magnitude limits (half-width 1e30
+/// or `f32::MAX`, anchor (1e30, 0.5) accepted; with half-width 1e30 every
+/// resting body fell through). Anchor coordinates and half-widths are
+/// within the shape limit `MAX_EXTENT`.
+#[cfg(feature = "portals")]
+#[test]
+fn portal_geometry_beyond_the_shape_limits_is_refused() {
+    use janus2d::world::{PortalDef, PortalPairDef};
+    let (mut world, ground, _) = ground_and_box();
+    let wall = world
+        .create_body(&BodyDef::fixed(Vec2::new(20.0, 0.0)))
+        .unwrap();
+    let max = limits::MAX_EXTENT;
+    let at = |body, anchor, half_width| PortalDef {
+        body,
+        anchor,
+        direction: Vec2::Y,
+        half_width,
+    };
+    for (a, field) in [
+        (at(ground, Vec2::new(0.0, 0.5), 1e30), "half_width"),
+        (at(ground, Vec2::new(0.0, 0.5), Real::MAX), "half_width"),
+        (at(ground, Vec2::new(0.0, 0.5), 2.0 * max), "half_width"),
+        (at(ground, Vec2::new(1e30, 0.5), 0.5), "anchor"),
+        (at(ground, Vec2::new(0.0, -2.0 * max), 0.5), "anchor"),
+    ] {
+        let b = at(wall, Vec2::ZERO, a.half_width.min(1.0));
+        for def in [PortalPairDef::new(a, b), PortalPairDef::new(b, a)] {
+            let def = def.with_eta(1.0);
+            let e = unchanged(&mut world, |w| w.create_portal_pair(&def).map(|_| ()));
+            let min = if field == "anchor" { -max } else { 0.0 };
+            assert_eq!(e, WorldError::OutOfBounds { field, min, max }, "{def:?}");
+        }
+    }
+    // At the limits themselves: accepted.
+    let def = PortalPairDef::new(
+        at(ground, Vec2::new(max, 0.5), max),
+        at(wall, Vec2::new(0.0, -max), 1.0),
+    )
+    .with_eta(1.0);
+    world.create_portal_pair(&def).unwrap();
+    world.step(DT).unwrap();
+    world.validate().unwrap();
+}
+
+/// Issue 35: `max_motor_torque = ∞` was accepted. The joint motors'
+/// largest torque and force are finite, on creation and through the
+/// setters.
+#[test]
+fn infinite_motor_torques_and_forces_are_refused() {
+    use janus2d::constraints::{JointError, JointKind};
+    use janus2d_testbed::support::joint_def_of_kind;
+    let (mut world, ground, b) = ground_and_box();
+    for kind in [
+        JointKind::Revolute,
+        JointKind::Wheel,
+        JointKind::Prismatic,
+        JointKind::Distance,
+    ] {
+        let mut def = joint_def_of_kind(kind, ground, b, Vec2::new(0.5, 0.0), None, false);
+        let linear = matches!(kind, JointKind::Prismatic | JointKind::Distance);
+        {
+            let m = def.motor_mut().unwrap();
+            *m.enable = true;
+            *m.speed = 1.0;
+            *m.max = Real::INFINITY;
+        }
+        let e = unchanged(&mut world, |w| w.create_joint(&def).map(|_| ()));
+        assert_eq!(e, WorldError::Joint(JointError::NonFinite), "{kind:?}");
+        *def.motor_mut().unwrap().max = 10.0;
+        let j = world.create_joint(&def).unwrap();
+        let e = unchanged(&mut world, |w| {
+            if linear {
+                w.set_joint_max_motor_force(j, Real::INFINITY)
+            } else {
+                w.set_joint_max_motor_torque(j, Real::INFINITY)
+            }
+        });
+        let field = if linear {
+            "max_motor_force"
+        } else {
+            "max_motor_torque"
+        };
+        assert_eq!(e, WorldError::NonFinite(field), "{kind:?}");
+        world.destroy_joint(j).unwrap();
+    }
+}
+
+/// Issue 35: `baumgarte = 1e30` was accepted (bodies were reset). Every
+/// solver setting is within its stated range (`SolverSettings::validate`).
+#[test]
+fn solver_settings_beyond_their_ranges_are_refused() {
+    let (mut world, _, _) = ground_and_box();
+    let d = SolverSettings::default;
+    for (s, name) in [
+        (
+            SolverSettings {
+                baumgarte: 1e30,
+                ..d()
+            },
+            "baumgarte",
+        ),
+        (
+            SolverSettings {
+                baumgarte: 1.5,
+                ..d()
+            },
+            "baumgarte",
+        ),
+        (
+            SolverSettings {
+                direct_joint_hertz: 1e30,
+                ..d()
+            },
+            "direct_joint_hertz",
+        ),
+        (
+            SolverSettings {
+                contact_push_max_velocity: 1e30,
+                ..d()
+            },
+            "contact_push_max_velocity",
+        ),
+        (
+            SolverSettings {
+                restitution_threshold: 1e30,
+                ..d()
+            },
+            "restitution_threshold",
+        ),
+        (
+            SolverSettings {
+                direct_joint_max_correction_speed: 1e30,
+                ..d()
+            },
+            "direct_joint_max_correction_speed",
+        ),
+        (
+            SolverSettings {
+                contact_mass_ratio_cap: 1e30,
+                ..d()
+            },
+            "contact_mass_ratio_cap",
+        ),
+        (
+            SolverSettings {
+                joint_mass_ratio_cap: 1e30,
+                ..d()
+            },
+            "joint_mass_ratio_cap",
+        ),
+    ] {
+        let e = unchanged(&mut world, |w| w.set_settings(s.clone()));
+        assert_eq!(e, WorldError::OutOfRange(name));
+        let def = WorldDef {
+            solver: s,
+            ..WorldDef::default()
+        };
+        assert!(World::new(def).is_err(), "{name}");
+    }
+    // The ends of the ranges are accepted, and the documented unbounded
+    // values (no hertz cap, no Gauss–Seidel correction cap).
+    world
+        .set_settings(SolverSettings {
+            baumgarte: 1.0,
+            contact_hertz_fraction: Real::INFINITY,
+            joint_max_correction_speed: Real::MAX,
+            ..d()
+        })
+        .unwrap();
+    world.step(DT).unwrap();
+    world.validate().unwrap();
+}
+
+/// Issue 35: a static body created with a velocity was accepted and the
+/// velocity silently dropped. It is refused as setting a static body's
+/// velocity is (`NotMovable`).
+#[test]
+fn a_static_body_created_with_a_velocity_is_refused() {
+    let (mut world, _, _) = ground_and_box();
+    for def in [
+        BodyDef::fixed(Vec2::ZERO).with_velocity(Vec2::new(3.0, 0.0)),
+        BodyDef {
+            angular_velocity: 1.0,
+            ..BodyDef::fixed(Vec2::ZERO)
+        },
+    ] {
+        let e = unchanged(&mut world, |w| w.create_body(&def).map(|_| ()));
+        assert_eq!(e, WorldError::NotMovable);
+    }
+    let nan = BodyDef::fixed(Vec2::ZERO).with_velocity(Vec2::new(Real::NAN, 0.0));
+    let e = unchanged(&mut world, |w| w.create_body(&nan).map(|_| ()));
+    assert!(matches!(e, WorldError::Body(_)), "{e:?}");
+}
+
+/// Issue 35: portal events pushed by calls between steps (destroying a
+/// crossing's clone, its original or the portal pair: `CrossingCancelled`)
+/// were cleared by the next step before anyone read them, and "started −
+/// completed − cancelled = crossing_count" failed. They are reported with
+/// the next step's events, first, and the count adds up after every step.
+#[cfg(feature = "portals")]
+#[test]
+fn portal_events_of_calls_between_steps_are_reported_with_the_next_step() {
+    use janus2d::world::PortalEvent;
+    let def = janus2d_testbed::scenes::shared_settings();
+    // (what is destroyed mid-crossing: 0 the clone, 1 the original, 2 the pair)
+    for what in 0..3 {
+        let (mut scene, _) = janus2d_testbed::scenes::portal_drop(&def);
+        let world = &mut scene.world;
+        let mut open: i64 = 0;
+        let mut count = |world: &World| {
+            for e in world.portal_events() {
+                match e {
+                    PortalEvent::CrossingStarted { .. } => open += 1,
+                    PortalEvent::CrossingCompleted { .. }
+                    | PortalEvent::CrossingCancelled { .. } => open -= 1,
+                    PortalEvent::JointDisabled { .. } => {}
+                }
+            }
+            assert_eq!(open, world.crossing_count() as i64, "case {what}");
+        };
+        let mut crossing = None;
+        for _ in 0..600 {
+            world.step(DT).unwrap();
+            count(world);
+            crossing = world
+                .body_handles()
+                .find_map(|b| world.clone_of(b).map(|c| (b, c)));
+            if crossing.is_some() {
+                break;
+            }
+        }
+        let (original, clone) = crossing.expect("a body starts a crossing");
+        let pair = world.portal_pairs().next().unwrap().0;
+        match what {
+            0 => world.destroy_body(clone).unwrap(),
+            1 => world.destroy_body(original).unwrap(),
+            _ => world.destroy_portal_pair(pair).unwrap(),
+        }
+        assert_eq!(world.crossing_count(), 0);
+        world.step(DT).unwrap();
+        let cancelled = world
+            .portal_events()
+            .iter()
+            .filter(|e| matches!(e, PortalEvent::CrossingCancelled { pair: p, .. } if *p == pair))
+            .count();
+        assert!(cancelled >= 1, "case {what}: {:?}", world.portal_events());
+        assert!(
+            matches!(
+                world.portal_events()[0],
+                PortalEvent::CrossingCancelled { .. }
+            ),
+            "case {what}: the call's events come first: {:?}",
+            world.portal_events()
+        );
+        count(world);
+        for _ in 0..120 {
+            world.step(DT).unwrap();
+            count(world);
+            world.validate().unwrap();
+        }
+    }
+}
+
+/// Issue 35: `is_sleeping` and `wake_body` accepted stale handles
+/// silently. Both refuse a destroyed body's handle (and another world's),
+/// the world unchanged.
+#[test]
+fn is_sleeping_and_wake_body_reject_stale_handles() {
+    let (mut world, _, b) = ground_and_box();
+    let gone = world
+        .create_body(&BodyDef::dynamic(Vec2::new(5.0, 5.0)))
+        .unwrap();
+    world.destroy_body(gone).unwrap();
+    assert_eq!(world.is_sleeping(gone), Err(WorldError::StaleBody));
+    let e = unchanged(&mut world, |w| w.wake_body(gone));
+    assert_eq!(e, WorldError::StaleBody);
+    let mut other = World::new(WorldDef::default()).unwrap();
+    let foreign = other.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    assert_eq!(world.is_sleeping(foreign), Err(WorldError::ForeignHandle));
+    let e = unchanged(&mut world, |w| w.wake_body(foreign));
+    assert_eq!(e, WorldError::ForeignHandle);
+    assert_eq!(world.is_sleeping(b), Ok(false));
+    assert_eq!(world.wake_body(b), Ok(()));
 }

@@ -150,7 +150,7 @@ fn joint_read_back_is_the_force_over_the_step_and_holds_after_sleep() {
         for _ in 0..120 {
             world.step(1.0 / 60.0).unwrap();
         }
-        assert!(world.is_sleeping(bob), "the bob sleeps");
+        assert!(world.is_sleeping(bob).unwrap(), "the bob sleeps");
         let f = world.joint_force(joint).unwrap();
         assert!((f.y - 100.0).abs() < 1.0, "asleep: {f}");
         assert!(world.joint_torque(joint).unwrap().abs() < 1e-3);

@@ -123,7 +123,7 @@ pub struct DistanceJointDef {
     pub enable_motor: bool,
     /// Motor target speed of the length, m/s (positive lengthens).
     pub motor_speed: Real,
-    /// Maximum motor force, N.
+    /// Maximum motor force, N (finite, ≥ 0).
     pub max_motor_force: Real,
 }
 
@@ -310,7 +310,7 @@ impl DistanceJointDef {
             && !self.lower_force.is_nan()
             && !self.upper_force.is_nan()
             && self.motor_speed.is_finite()
-            && !self.max_motor_force.is_nan();
+            && self.max_motor_force.is_finite();
         if !finite {
             return Err(JointError::NonFinite);
         }

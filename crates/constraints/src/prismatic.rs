@@ -271,7 +271,7 @@ pub struct PrismaticJointDef {
     pub enable_motor: bool,
     /// Motor target speed along the axis, m/s.
     pub motor_speed: Real,
-    /// Maximum motor force, N.
+    /// Maximum motor force, N (finite, ≥ 0).
     pub max_motor_force: Real,
     /// Enables the spring along the axis.
     pub enable_spring: bool,
@@ -400,7 +400,7 @@ impl PrismaticJointDef {
         let finite = self.lower_translation.is_finite()
             && self.upper_translation.is_finite()
             && self.motor_speed.is_finite()
-            && !self.max_motor_force.is_nan()
+            && self.max_motor_force.is_finite()
             && self.hertz.is_finite()
             && self.damping_ratio.is_finite()
             && self.target_translation.is_finite();

@@ -75,7 +75,7 @@ pub struct RevoluteJointDef {
     pub enable_motor: bool,
     /// Motor target speed, rad/s.
     pub motor_speed: Real,
-    /// Maximum motor torque, N·m.
+    /// Maximum motor torque, N·m (finite, ≥ 0).
     pub max_motor_torque: Real,
     /// Enables the angular spring.
     pub enable_spring: bool,
@@ -179,7 +179,7 @@ impl RevoluteJointDef {
         let finite = self.lower_angle.is_finite()
             && self.upper_angle.is_finite()
             && self.motor_speed.is_finite()
-            && !self.max_motor_torque.is_nan()
+            && self.max_motor_torque.is_finite()
             && self.hertz.is_finite()
             && self.damping_ratio.is_finite()
             && self.target_angle.is_finite();

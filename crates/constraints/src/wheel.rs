@@ -90,7 +90,7 @@ pub struct WheelJointDef {
     pub enable_motor: bool,
     /// Motor target speed `ω_b − ω_a`, rad/s.
     pub motor_speed: Real,
-    /// Maximum motor torque, N·m.
+    /// Maximum motor torque, N·m (finite, ≥ 0).
     pub max_motor_torque: Real,
 }
 
@@ -207,7 +207,7 @@ impl WheelJointDef {
         let finite = self.lower_translation.is_finite()
             && self.upper_translation.is_finite()
             && self.motor_speed.is_finite()
-            && !self.max_motor_torque.is_nan()
+            && self.max_motor_torque.is_finite()
             && self.hertz.is_finite()
             && self.damping_ratio.is_finite();
         if !finite {

@@ -23,10 +23,22 @@
 //! | [`ETA_RANGE`]           | 1e-2 … 1e2         | a portal pair's scale η (a clone's mass goes as η², its inertia as η⁴) |
 //! | [`MAX_HERTZ_FRACTION`]  | 0.25               | contact and iterative joint stiffness are capped at this fraction of the substep rate, as Box2D caps them |
 //! | [`UNIT_ROTATION_TOLERANCE`] | 1e-3           | how far `c² + s²` of a rotation given to the API may be from 1 |
+//! | [`TIME_STEP_RANGE`]     | 1e-6 … 1 s         | the `dt` of a step                                     |
 
 use crate::math::Real;
 
 pub use crate::math::UNIT_ROTATION_TOLERANCE;
+
+/// Allowed time step of `World::step(dt)`, s: `[1e-6, 1]`.
+///
+/// The upper bound: a step is one explicit integration and one
+/// sleep-timer increment; at a second per step gravity alone moves a body
+/// 10 m between collision checks, and a longer step would put a swinging
+/// body to sleep in one step (its sleep timer gaining `dt`). Simulate a
+/// longer span as several steps. The lower bound keeps the substep rate
+/// (`substeps / dt`, up to 1024 substeps) and every force read back from
+/// an impulse (`impulse / h`) finite: at `f32::MIN_POSITIVE` they were ∞.
+pub const TIME_STEP_RANGE: (Real, Real) = (1e-6, 1.0);
 
 /// Largest magnitude of a body coordinate, m (1e9).
 pub const MAX_COORDINATE: Real = 1e9;

@@ -226,6 +226,23 @@ impl Rot {
         let m = self.c * self.c + self.s * self.s;
         (m - 1.0).abs() <= UNIT_ROTATION_TOLERANCE
     }
+
+    /// The rotation normalised to unit length when it
+    /// [`is_unit`](Self::is_unit) (within the tolerance), `None` otherwise
+    /// (a scaling, a zero, a NaN or a component whose square overflows):
+    /// how the API takes a rotation.
+    ///
+    /// ```
+    /// use janus2d_core::math::Rot;
+    /// let q = Rot { c: 0.9995, s: 0.0 }.to_unit().unwrap();
+    /// assert_eq!((q.c, q.s), (1.0, 0.0));
+    /// assert_eq!(Rot { c: 1e20, s: 1e20 }.to_unit(), None);
+    /// assert_eq!(Rot { c: 0.0, s: 0.0 }.to_unit(), None);
+    /// ```
+    #[inline]
+    pub fn to_unit(self) -> Option<Rot> {
+        self.is_unit().then(|| self.normalize())
+    }
 }
 
 /// A rigid transform: rotation then translation.

@@ -56,6 +56,11 @@ pub const JOINT_HERTZ_PER_SUBSTEP_RATE: Real = 0.25;
 /// See [`SolverSettings::direct_joint_hertz`].
 pub const DEFAULT_DIRECT_JOINT_HERTZ: Real = 500.0;
 
+/// Largest `contact_mass_ratio_cap` and `joint_mass_ratio_cap` (1e3): the
+/// factor multiplies a row's effective mass; the defaults are 1.3 and a
+/// joint grid already diverges near 2.
+pub const MAX_MASS_RATIO_CAP: Real = 1e3;
+
 /// Accuracy and softness settings of the solver. Every knob that trades
 /// accuracy for time lives here.
 #[derive(Clone, Debug, PartialEq)]
@@ -176,52 +181,107 @@ impl Default for SolverSettings {
 /// A solver setting that is out of its range, named by its field.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SettingsError {
-    /// The field is NaN.
+    /// The field is NaN (or infinite where its range is finite).
     NonFinite(&'static str),
-    /// The field is negative, or an iteration count is 0 (substeps) or
-    /// above 1024.
+    /// The field is outside its stated range (see
+    /// [`SolverSettings::validate`]).
     OutOfRange(&'static str),
 }
 
 impl SolverSettings {
-    /// Checks every field: no real is NaN or negative, `substeps` is in
-    /// `1..=1024`, the iteration counts at most 1024. The error names the
-    /// first field that is wrong.
+    /// Checks every field against its stated range; the error names the
+    /// first field that is wrong: NaN (or ∞ where the range is finite) is
+    /// `NonFinite`, a value outside its range `OutOfRange`.
+    ///
+    /// | field                                   | range                                   |
+    /// |-----------------------------------------|-----------------------------------------|
+    /// | `substeps`                              | 1 … 1024                                |
+    /// | `velocity_iterations`, `relax_iterations` | 0 … 1024                              |
+    /// | `baumgarte`                             | 0 … 1 (β > 1 overshoots every error)    |
+    /// | `contact_hertz`, `joint_hertz`          | 0 … `Real::MAX` (a world caps them at [`MAX_HERTZ_FRACTION`](crate::limits::MAX_HERTZ_FRACTION) of the substep rate) |
+    /// | `direct_joint_hertz`                    | 0 … [`MAX_SPRING_HERTZ`](crate::limits::MAX_SPRING_HERTZ) (1e6 Hz) |
+    /// | `contact_damping_ratio`, `joint_damping_ratio` | 0 … [`MAX_DAMPING_RATIO`](crate::limits::MAX_DAMPING_RATIO) (1e4) |
+    /// | `contact_push_max_velocity`, `restitution_threshold`, `direct_joint_max_correction_speed` | 0 … [`MAX_SPEED`](crate::limits::MAX_SPEED) (1e9 m/s) |
+    /// | `joint_max_correction_speed`            | 0 … `Real::MAX` (the default: no cap)   |
+    /// | `contact_mass_ratio_cap`, `joint_mass_ratio_cap` | 0 … [`MAX_MASS_RATIO_CAP`] (1e3) |
+    /// | `contact_hertz_fraction`, `joint_hertz_fraction` | ≥ 0, `∞` allowed (no cap)      |
     ///
     /// ```
     /// use janus2d_core::solver::{SettingsError, SolverSettings};
     /// let bad = SolverSettings { contact_hertz: -1.0, ..SolverSettings::default() };
     /// assert_eq!(bad.validate(), Err(SettingsError::OutOfRange("contact_hertz")));
+    /// let bad = SolverSettings { baumgarte: 1e30, ..SolverSettings::default() };
+    /// assert_eq!(bad.validate(), Err(SettingsError::OutOfRange("baumgarte")));
     /// assert!(SolverSettings::default().validate().is_ok());
     /// ```
     pub fn validate(&self) -> Result<(), SettingsError> {
+        use crate::limits::{MAX_DAMPING_RATIO, MAX_SPEED, MAX_SPRING_HERTZ};
+        // (value, name, largest value; ∞: unbounded, ∞ allowed)
         let reals = [
-            (self.baumgarte, "baumgarte"),
-            (self.contact_hertz, "contact_hertz"),
-            (self.contact_hertz_fraction, "contact_hertz_fraction"),
-            (self.contact_damping_ratio, "contact_damping_ratio"),
-            (self.contact_push_max_velocity, "contact_push_max_velocity"),
-            (self.joint_hertz, "joint_hertz"),
-            (self.joint_hertz_fraction, "joint_hertz_fraction"),
-            (self.joint_damping_ratio, "joint_damping_ratio"),
+            (self.baumgarte, "baumgarte", 1.0),
+            (self.contact_hertz, "contact_hertz", Real::MAX),
+            (
+                self.contact_hertz_fraction,
+                "contact_hertz_fraction",
+                Real::INFINITY,
+            ),
+            (
+                self.contact_damping_ratio,
+                "contact_damping_ratio",
+                MAX_DAMPING_RATIO,
+            ),
+            (
+                self.contact_push_max_velocity,
+                "contact_push_max_velocity",
+                MAX_SPEED,
+            ),
+            (self.joint_hertz, "joint_hertz", Real::MAX),
+            (
+                self.joint_hertz_fraction,
+                "joint_hertz_fraction",
+                Real::INFINITY,
+            ),
+            (
+                self.joint_damping_ratio,
+                "joint_damping_ratio",
+                MAX_DAMPING_RATIO,
+            ),
             (
                 self.joint_max_correction_speed,
                 "joint_max_correction_speed",
+                Real::MAX,
             ),
-            (self.restitution_threshold, "restitution_threshold"),
-            (self.contact_mass_ratio_cap, "contact_mass_ratio_cap"),
-            (self.joint_mass_ratio_cap, "joint_mass_ratio_cap"),
-            (self.direct_joint_hertz, "direct_joint_hertz"),
+            (
+                self.restitution_threshold,
+                "restitution_threshold",
+                MAX_SPEED,
+            ),
+            (
+                self.contact_mass_ratio_cap,
+                "contact_mass_ratio_cap",
+                MAX_MASS_RATIO_CAP,
+            ),
+            (
+                self.joint_mass_ratio_cap,
+                "joint_mass_ratio_cap",
+                MAX_MASS_RATIO_CAP,
+            ),
+            (
+                self.direct_joint_hertz,
+                "direct_joint_hertz",
+                MAX_SPRING_HERTZ,
+            ),
             (
                 self.direct_joint_max_correction_speed,
                 "direct_joint_max_correction_speed",
+                MAX_SPEED,
             ),
         ];
-        for (v, name) in reals {
-            if v.is_nan() {
+        for (v, name, max) in reals {
+            if v.is_nan() || (v.is_infinite() && max.is_finite()) {
                 return Err(SettingsError::NonFinite(name));
             }
-            if v < 0.0 {
+            if v < 0.0 || v > max {
                 return Err(SettingsError::OutOfRange(name));
             }
         }

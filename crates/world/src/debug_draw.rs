@@ -342,7 +342,7 @@ pub fn box_corners(b: &Aabb) -> [Vec2; 4] {
 fn shape_color(world: &World, body: BodyHandle, island: Option<u32>, o: &DrawOptions) -> Color {
     let p = &o.palette;
     let ty = world.body_type(body).unwrap_or(BodyType::Static);
-    if o.sleep && world.is_sleeping(body) {
+    if o.sleep && world.is_sleeping(body) == Ok(true) {
         return p.sleeping;
     }
     if o.islands

@@ -153,6 +153,10 @@ pub enum QueryProblem {
     Inverted,
     /// The query shape is invalid.
     Shape(GeometryError),
+    /// A transform's rotation is not a unit rotation: `c² + s²` is
+    /// farther than [`UNIT_ROTATION_TOLERANCE`](janus2d_core::limits::UNIT_ROTATION_TOLERANCE)
+    /// from 1 (a rotation within it is normalised).
+    NotUnitRotation,
 }
 
 impl std::fmt::Display for QueryProblem {
@@ -162,6 +166,7 @@ impl std::fmt::Display for QueryProblem {
             QueryProblem::ZeroLength => write!(f, "has zero length"),
             QueryProblem::Inverted => write!(f, "has its lower corner above its upper corner"),
             QueryProblem::Shape(e) => write!(f, "is an invalid shape: {e}"),
+            QueryProblem::NotUnitRotation => write!(f, "has a rotation that is not unit length"),
         }
     }
 }

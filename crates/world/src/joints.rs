@@ -583,7 +583,7 @@ impl JointSet {
         } else {
             "max_motor_torque"
         };
-        if max.is_nan() {
+        if !max.is_finite() {
             return Err(WorldError::NonFinite(field));
         }
         if max < 0.0 {

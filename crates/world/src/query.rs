@@ -219,12 +219,16 @@ fn check_translation(v: Vec2) -> Result<(), WorldError> {
     }
 }
 
-fn check_transform(xf: &Transform) -> Result<(), WorldError> {
-    if vec_is_finite(xf.p) && xf.q.is_finite() {
-        Ok(())
-    } else {
-        Err(bad("transform", QueryProblem::NonFinite))
+/// A finite transform whose rotation is unit within the tolerance,
+/// returned with its rotation normalised.
+fn check_transform(xf: &Transform) -> Result<Transform, WorldError> {
+    if !(vec_is_finite(xf.p) && xf.q.is_finite()) {
+        return Err(bad("transform", QueryProblem::NonFinite));
     }
+    let q =
+        xf.q.to_unit()
+            .ok_or(bad("transform", QueryProblem::NotUnitRotation))?;
+    Ok(Transform { p: xf.p, q })
 }
 
 /// One straight piece of a cast: before the first aperture or after one.
@@ -461,7 +465,7 @@ pub(crate) fn cast_shape<F: FnMut(&RayHit) -> Real>(
     shape
         .validate()
         .map_err(|e| bad("shape", QueryProblem::Shape(e)))?;
-    check_transform(xf)?;
+    let xf = &check_transform(xf)?;
     check_translation(translation)?;
     let gather = |leg: &Leg, max_u: Real, may_cross: bool, out: &mut Vec<(Real, u32, CastHit)>| {
         let caster = if leg.scale == 1.0 {
@@ -599,7 +603,7 @@ pub(crate) fn overlap_shape<F: FnMut(ShapeOverlap) -> bool>(
     shape
         .validate()
         .map_err(|e| bad("shape", QueryProblem::Shape(e)))?;
-    check_transform(xf)?;
+    let xf = &check_transform(xf)?;
     let proxy = ShapeProxy::from_shape(shape);
     let exact = |data: &ShapeData, xf_a: &Transform| {
         let p = ShapeProxy::from_shape(&data.geometry);

@@ -120,8 +120,10 @@ pub mod bytes {
     /// contact's colour lives only in the narrowphase's colour list; 8:
     /// joints are stored as `Joint` (one variant per kind) with their
     /// common solver data in `JointBase`, and the constraint graph and
-    /// solved list belong to constraint building, not the narrowphase).
-    pub const SNAPSHOT_VERSION: u16 = 8;
+    /// solved list belong to constraint building, not the narrowphase; 9:
+    /// the portal stage keeps the events pushed between steps apart from
+    /// the last step's).
+    pub const SNAPSHOT_VERSION: u16 = 9;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.

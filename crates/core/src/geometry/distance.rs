@@ -432,7 +432,10 @@ pub fn shape_cast(
 ) -> Option<CastHit> {
     let radii = a.radius + b.radius;
     let mut t: Real = 0.0;
-    let mut last_normal = -translation_b.normalize_or_zero();
+    // The translation's length and direction without overflow: `|d|²`
+    // overflows beyond ~1.8e19 in f32 (a cast then missed everything).
+    let (length, direction) = length_and_direction(translation_b);
+    let mut last_normal = -direction;
     for iteration in 0..CAST_MAX_ITERATIONS {
         let xf = Transform {
             p: xf_b.p + t * translation_b,
@@ -459,7 +462,7 @@ pub fn shape_cast(
             });
         }
         let closing = -translation_b.dot(out.normal);
-        if closing <= EPSILON * translation_b.length() {
+        if closing <= EPSILON * length {
             return None; // not approaching along the separating axis: never meets
         }
         // Aim a little short of touching so that the loop ends on the near side.
@@ -469,6 +472,23 @@ pub fn shape_cast(
         }
     }
     None
+}
+
+/// `(|v|, v / |v|)` (zero direction for a zero `v`), `|v|` computed as
+/// `m |v / m|` with `m = max(|x|, |y|)` when `|v|²` overflows (the
+/// length may still be ∞ beyond `Real::MAX`, the direction is unit).
+fn length_and_direction(v: Vec2) -> (Real, Vec2) {
+    let length = v.length();
+    if length.is_finite() {
+        return (length, v.normalize_or_zero());
+    }
+    let m = v.abs().max_element();
+    if !m.is_finite() || m == 0.0 {
+        return (length, Vec2::ZERO);
+    }
+    let unit = v / m;
+    let unit_length = unit.length();
+    (m * unit_length, unit / unit_length)
 }
 
 #[cfg(test)]

@@ -93,6 +93,12 @@ fn usable(ray: &RayInput) -> bool {
 }
 
 /// Ray against the disc of centre `c` and radius `r` (`r > 0`).
+///
+/// The root is taken from `|d|² s² + 2 (m·d) s + |m|² − r² = 0` directly
+/// when those products are finite; when they overflow (a translation or
+/// an origin beyond ~1e19 m in `f32`) the same root is found in scaled
+/// units (a unit direction, the offset and radius over their largest), so
+/// every hit is finite.
 pub fn ray_disc(ray: &RayInput, c: Vec2, r: Real) -> Option<CastHit> {
     if !usable(ray) {
         return None;
@@ -100,15 +106,18 @@ pub fn ray_disc(ray: &RayInput, c: Vec2, r: Real) -> Option<CastHit> {
     let d = ray.translation;
     let m = ray.origin - c;
     let cc = m.length_squared() - r * r;
+    let dd = d.length_squared();
+    let b = m.dot(d);
+    let disc = b * b - dd * cc;
+    if !(cc.is_finite() && dd.is_finite() && disc.is_finite()) {
+        return ray_disc_scaled(ray, c, r);
+    }
     if cc <= 0.0 {
         return None; // origin inside (or on) the disc
     }
-    let dd = d.length_squared();
-    let b = m.dot(d);
     if b >= 0.0 {
         return None; // moving away
     }
-    let disc = b * b - dd * cc;
     if disc < 0.0 {
         return None;
     }
@@ -121,6 +130,48 @@ pub fn ray_disc(ray: &RayInput, c: Vec2, r: Real) -> Option<CastHit> {
     let normal = (point - c).try_normalize().unwrap_or(-d.normalize());
     Some(CastHit {
         point,
+        normal,
+        fraction: s,
+    })
+}
+
+/// [`ray_disc`] for magnitudes whose squares overflow: the translation as
+/// a unit direction `u` and a length `L`, the offset `m` and the radius in
+/// units of `w = max(|m|∞, r)`; the root is the distance `t` along `u` in
+/// units of `w`, and the fraction `t w / L`.
+fn ray_disc_scaled(ray: &RayInput, c: Vec2, r: Real) -> Option<CastHit> {
+    let d = ray.translation;
+    let m = ray.origin - c;
+    let d_max = d.abs().max_element();
+    let w = m.abs().max_element().max(r);
+    if !(m.is_finite() && d_max > 0.0 && w > 0.0 && w.is_finite()) {
+        return None;
+    }
+    let d1 = d / d_max;
+    let d1_len = d1.length(); // in [1, √2]
+    let u = d1 / d1_len;
+    let length = d_max * d1_len; // may be ∞: then every hit is at fraction 0
+    let (m, r) = (m / w, r / w);
+    let cc = m.length_squared() - r * r;
+    if cc <= 0.0 {
+        return None; // origin inside (or on) the disc
+    }
+    let b = m.dot(u);
+    if b >= 0.0 {
+        return None; // moving away
+    }
+    let disc = b * b - cc;
+    if disc < 0.0 {
+        return None;
+    }
+    let t = cc / (-b + disc.sqrt());
+    let s = t * (w / length);
+    if !(s >= 0.0 && s <= ray.max_fraction) {
+        return None; // beyond the ray (or ∞)
+    }
+    let normal = (m + t * u).try_normalize().unwrap_or(-u);
+    Some(CastHit {
+        point: ray.origin + s * d,
         normal,
         fraction: s,
     })

@@ -342,7 +342,13 @@ pub(crate) struct PortalStage {
     pub(crate) crossings: Vec<Crossing>,
     /// One constraint per crossing, same order.
     pub(crate) constraints: Vec<PortalConstraint>,
+    /// The events of the last step (what `World::portal_events` reads).
     pub(crate) events: Vec<PortalEvent>,
+    /// Events pushed since the last step ended, by calls between steps
+    /// (`destroy_portal_pair`, destroying a copy or a portal body) and by
+    /// the step under way: reported with the next step's, as collision
+    /// events are.
+    pub(crate) pending_events: Vec<PortalEvent>,
     pub(crate) counters: PortalCounters,
     pub(crate) clipping: ContactClipping,
 }
@@ -363,9 +369,10 @@ impl PortalStage {
         &mut self.constraints
     }
 
-    /// Clears the events of a step in which the stage did not run.
-    pub(crate) fn clear_events(&mut self) {
-        self.events.clear();
+    /// Ends a step's events: those pushed since the last step (between
+    /// steps, then by this step) become the step's, in order.
+    pub(crate) fn publish_events(&mut self) {
+        self.events = std::mem::take(&mut self.pending_events);
     }
 
     /// Portal rows, bodies tested and crossings of the step.
@@ -538,6 +545,11 @@ impl PortalStage {
             if !(d.eta.is_finite() && d.eta > 0.0) {
                 return Err(format!("pair {index}: eta {}", d.eta));
             }
+            for portal in &d.local {
+                if portal.validate().is_err() || check_portal_extent(portal).is_err() {
+                    return Err(format!("pair {index}: portal {portal:?}"));
+                }
+            }
             if let Some(p) = d.portals.iter().find(|p| !bodies.contains(p.body)) {
                 return Err(format!(
                     "pair {index}: portal body {:?} is not live",
@@ -647,6 +659,28 @@ fn push_body(stores: &mut Stores<'_>, body: BodyHandle, impulse: Vec2, point: Ve
     }
 }
 
+/// A portal's anchor coordinates and half-width within the shape limit
+/// [`MAX_EXTENT`](janus2d_core::limits::MAX_EXTENT) (a half-width of 1e30
+/// let every resting body fall through).
+fn check_portal_extent(p: &Portal) -> Result<(), WorldError> {
+    let max = janus2d_core::limits::MAX_EXTENT;
+    if p.anchor.x.abs() > max || p.anchor.y.abs() > max {
+        return Err(WorldError::OutOfBounds {
+            field: "anchor",
+            min: -max,
+            max,
+        });
+    }
+    if p.half_width > max {
+        return Err(WorldError::OutOfBounds {
+            field: "half_width",
+            min: 0.0,
+            max,
+        });
+    }
+    Ok(())
+}
+
 /// The pair API's logic: the world's portal methods (`world/portals.rs`)
 /// pass what each reads and changes.
 impl PortalStage {
@@ -673,11 +707,11 @@ impl PortalStage {
             if self.crossing_of(p.body).is_some() {
                 return Err(WorldError::PortalBody);
             }
-            local.push(
-                Portal::new(p.anchor, p.direction, p.half_width)
-                    .map_err(WorldError::Portal)?
-                    .normalized(),
-            );
+            let portal = Portal::new(p.anchor, p.direction, p.half_width)
+                .map_err(WorldError::Portal)?
+                .normalized();
+            check_portal_extent(&portal)?;
+            local.push(portal);
         }
         let local = [local[0], local[1]];
         let eta = def.eta.unwrap_or(local[1].half_width / local[0].half_width);
@@ -875,7 +909,6 @@ impl PortalStage {
     /// entries (reading bodies, shapes and the broadphase), then carries
     /// out each decision in order.
     pub(crate) fn cross(&mut self, stores: &mut Stores<'_>) {
-        self.events.clear();
         let mut counters = PortalCounters::default();
         let mut crossed: Vec<BodyHandle> = Vec::new();
         // 0. A joint between the two copies of one object would hold it
@@ -920,7 +953,8 @@ impl PortalStage {
             let pair = self.pair_handle(index, stores.bodies.owner());
             for joint in between {
                 stores.apply(PortalCommand::DisableJoint(joint));
-                self.events.push(PortalEvent::JointDisabled { joint, pair });
+                self.pending_events
+                    .push(PortalEvent::JointDisabled { joint, pair });
             }
         }
     }
@@ -1130,7 +1164,7 @@ impl PortalStage {
         });
         self.constraints.push(constraint);
         let pair = self.pair_handle(index, owner);
-        self.events
+        self.pending_events
             .push(PortalEvent::CrossingStarted { body, clone, pair });
         Some(())
     }
@@ -1232,7 +1266,7 @@ impl PortalStage {
             }
         }
         stores.apply(PortalCommand::DestroyBody(c.clone));
-        self.events.push(PortalEvent::CrossingCompleted {
+        self.pending_events.push(PortalEvent::CrossingCompleted {
             body: c.original,
             pair,
         });
@@ -1265,7 +1299,7 @@ impl PortalStage {
             stores.apply(PortalCommand::DestroyBody(c.clone));
         }
         let pair = self.pair_handle(c.pair, stores.bodies.owner());
-        self.events.push(PortalEvent::CrossingCancelled {
+        self.pending_events.push(PortalEvent::CrossingCancelled {
             body: c.original,
             pair,
         });
@@ -1415,7 +1449,8 @@ impl PortalStage {
             None => {
                 stores.apply(PortalCommand::DisableJoint(joint));
                 let pair = self.pair_handle(c.pair, stores.bodies.owner());
-                self.events.push(PortalEvent::JointDisabled { joint, pair });
+                self.pending_events
+                    .push(PortalEvent::JointDisabled { joint, pair });
             }
         }
     }

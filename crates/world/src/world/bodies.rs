@@ -23,7 +23,18 @@ impl World {
     ///
     /// A kinematic body given a velocity is created awake even with
     /// `awake: false` (a sleeping kinematic body would never move).
+    ///
+    /// Errors (nothing created): an invalid definition; a static body
+    /// given a linear or angular velocity ([`WorldError::NotMovable`], as
+    /// [`set_linear_velocity`](Self::set_linear_velocity) on one: a static
+    /// body never moves, and the velocity would be silently dropped).
     pub fn create_body(&mut self, def: &BodyDef) -> Result<BodyHandle, WorldError> {
+        janus2d_core::body::validate_body_def(def)?;
+        if def.body_type == BodyType::Static
+            && (def.linear_velocity != Vec2::ZERO || def.angular_velocity != 0.0)
+        {
+            return Err(WorldError::NotMovable);
+        }
         let handle = self.insert_body(def)?;
         let moving_kinematic = def.body_type == BodyType::Kinematic
             && (def.linear_velocity != Vec2::ZERO || def.angular_velocity != 0.0);
@@ -159,7 +170,7 @@ impl World {
     pub fn set_linear_velocity(&mut self, body: BodyHandle, v: Vec2) -> Result<(), WorldError> {
         janus2d_core::body::check_velocity(v, "linear_velocity")?;
         self.check_movable(body)?;
-        self.wake_body(body);
+        self.wake_island(body);
         if let Some(s) = self.bodies.state_mut(body) {
             s.v = v;
         }
@@ -172,7 +183,7 @@ impl World {
     pub fn set_angular_velocity(&mut self, body: BodyHandle, w: Real) -> Result<(), WorldError> {
         janus2d_core::body::check_angular_velocity(w, "angular_velocity")?;
         self.check_movable(body)?;
-        self.wake_body(body);
+        self.wake_island(body);
         if let Some(s) = self.bodies.state_mut(body) {
             s.w = w;
         }
@@ -191,7 +202,7 @@ impl World {
         }
         janus2d_core::body::check_position(position, "transform")?;
         self.check_body(body)?;
-        self.wake_body(body);
+        self.wake_island(body);
         let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
         sim.transform = Transform {
             p: position,
@@ -219,7 +230,7 @@ impl World {
         if ty != BodyType::Dynamic {
             return Err(WorldError::NotDynamic);
         }
-        self.wake_body(body);
+        self.wake_island(body);
         self.bodies.apply_mass(body, mass, fixed);
         if let Some(r) = self.bodies.record_mut(body) {
             r.mass_override = true;
@@ -246,7 +257,7 @@ impl World {
         if !(vec_is_finite(f) && t.is_finite()) {
             return Err(accumulated("force"));
         }
-        self.wake_body(body);
+        self.wake_island(body);
         let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
         sim.force = f;
         sim.torque = t;
@@ -273,7 +284,7 @@ impl World {
         if !(sim.torque + torque).is_finite() {
             return Err(accumulated("torque"));
         }
-        self.wake_body(body);
+        self.wake_island(body);
         let sim = self.bodies.sim_mut(body).ok_or(WorldError::StaleBody)?;
         sim.torque += torque;
         Ok(())
@@ -296,7 +307,7 @@ impl World {
         let v = v0 + im * impulse;
         let w = w0 + ii * cross(point - c, impulse);
         check_resulting_velocity(v, w)?;
-        self.wake_body(body);
+        self.wake_island(body);
         if let Some(st) = self.bodies.state_mut(body) {
             st.v = v;
             st.w = w;
@@ -322,7 +333,7 @@ impl World {
         let v = self.linear_velocity(body)?;
         let w = self.angular_velocity(body)? + ii * impulse;
         check_resulting_velocity(v, w)?;
-        self.wake_body(body);
+        self.wake_island(body);
         if let Some(st) = self.bodies.state_mut(body) {
             st.w = w;
         }
@@ -343,8 +354,12 @@ impl World {
     /// velocities stay until set again. Wakes the body.
     ///
     /// Errors: a stale handle, a non-finite target (`NonFinite("target")`),
-    /// a `dt` that is not finite and positive, a static body
-    /// ([`WorldError::NotMovable`]).
+    /// a target rotation that is not unit length (`OutOfRange("target")`:
+    /// `c² + s²` farther than
+    /// [`UNIT_ROTATION_TOLERANCE`](janus2d_core::limits::UNIT_ROTATION_TOLERANCE)
+    /// from 1; one within it is normalised), a `dt` outside
+    /// [`TIME_STEP_RANGE`](janus2d_core::limits::TIME_STEP_RANGE), a static
+    /// body ([`WorldError::NotMovable`]).
     ///
     /// ```
     /// use janus2d_world::{World, WorldDef};
@@ -368,17 +383,14 @@ impl World {
             return Err(WorldError::NonFinite("target"));
         }
         janus2d_core::body::check_position(target.p, "target")?;
-        if target.q.c == 0.0 && target.q.s == 0.0 {
+        let Some(q2) = target.q.to_unit() else {
             return Err(WorldError::OutOfRange("target"));
-        }
-        if !(dt.is_finite() && dt > 0.0) {
-            return Err(WorldError::InvalidTimeStep);
-        }
+        };
+        super::step::check_time_step(dt)?;
         if self.body_type(body)? == BodyType::Static {
             return Err(WorldError::NotMovable);
         }
         let sim = self.bodies.sim(body).ok_or_else(|| self.body_error(body))?;
-        let q2 = target.q.normalize();
         let center2 = q2.rotate(sim.local_center) + target.p;
         let v = (center2 - sim.center) / dt;
         let delta = sim.transform.q.relative_angle(q2);
@@ -393,7 +405,7 @@ impl World {
         };
         janus2d_core::body::check_velocity(v, "target")?;
         janus2d_core::body::check_angular_velocity(w, "target")?;
-        self.wake_body(body);
+        self.wake_island(body);
         if let Some(s) = self.bodies.state_mut(body) {
             s.v = v;
             s.w = w;
@@ -434,7 +446,7 @@ impl World {
     pub fn set_awake(&mut self, body: BodyHandle, awake: bool) -> Result<(), WorldError> {
         self.check_body(body)?;
         if awake {
-            self.wake_body(body);
+            self.wake_island(body);
         } else if let Some(BodyLocation::Moving(_)) = self.bodies.location(body) {
             self.islands
                 .sleep_now(body, &mut self.bodies, &mut self.collision.contacts);
@@ -455,7 +467,7 @@ impl World {
     pub fn set_body_enable_sleep(&mut self, body: BodyHandle, on: bool) -> Result<(), WorldError> {
         self.check_body(body)?;
         if !on {
-            self.wake_body(body);
+            self.wake_island(body);
         }
         if let Some(s) = self.bodies.sim_mut(body) {
             s.enable_sleep = on;
@@ -542,7 +554,7 @@ impl World {
             r.mass_override = false;
         }
         if self.bodies.body_type(body) == Some(BodyType::Dynamic) {
-            self.wake_body(body);
+            self.wake_island(body);
             self.update_mass_from_shapes(body);
         }
         Ok(())
@@ -577,7 +589,7 @@ impl World {
         if self.portals.involves(body) {
             return Err(WorldError::PortalBody);
         }
-        self.wake_body(body);
+        self.wake_island(body);
         self.wake_touching(body);
         self.collision.remove_contacts_of(body);
         if old == BodyType::Dynamic {
@@ -595,7 +607,7 @@ impl World {
                 continue;
             };
             let other = if a == body { b } else { a };
-            self.wake_body(other);
+            self.wake_island(other);
             let enabled = self.joints.get(j).is_ok_and(|r| r.is_enabled());
             if ty == BodyType::Dynamic && enabled {
                 self.islands.link(a, b, &self.bodies);

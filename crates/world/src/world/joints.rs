@@ -33,8 +33,8 @@ impl World {
         let (a, b) = def.bodies();
         self.check_body(a)?;
         self.check_body(b)?;
-        self.wake_body(a);
-        self.wake_body(b);
+        self.wake_island(a);
+        self.wake_island(b);
         let handle = self.joints.insert(def);
         self.islands.link(a, b, &self.bodies);
         if !def.collide_connected() {
@@ -126,8 +126,8 @@ impl World {
         bodies: Result<(BodyHandle, BodyHandle), WorldError>,
     ) -> Result<(), WorldError> {
         let (a, b) = bodies?;
-        self.wake_body(a);
-        self.wake_body(b);
+        self.wake_island(a);
+        self.wake_island(b);
         Ok(())
     }
 
@@ -165,7 +165,7 @@ impl World {
         self.wake_pair(r)
     }
 
-    /// Sets the largest torque of a joint's angular motor, N·m (≥ 0):
+    /// Sets the largest torque of a joint's angular motor, N·m (finite, ≥ 0):
     /// revolute, wheel. A joint without an angular motor gets
     /// `Err(WrongJointKind)` and is left unchanged.
     pub fn set_joint_max_motor_torque(
@@ -177,7 +177,7 @@ impl World {
         self.wake_pair(r)
     }
 
-    /// Sets the largest force of a joint's linear motor, N (≥ 0):
+    /// Sets the largest force of a joint's linear motor, N (finite, ≥ 0):
     /// prismatic, distance. A joint without a linear motor gets
     /// `Err(WrongJointKind)` and is left unchanged.
     pub fn set_joint_max_motor_force(
@@ -247,8 +247,8 @@ impl World {
     /// again).
     pub fn set_joint_enabled(&mut self, joint: JointHandle, on: bool) -> Result<(), WorldError> {
         let (a, b) = self.switch_joint(joint, on)?;
-        self.wake_body(a);
-        self.wake_body(b);
+        self.wake_island(a);
+        self.wake_island(b);
         Ok(())
     }
 

@@ -247,20 +247,30 @@ impl World {
     // ----- sleep --------------------------------------------------------------
 
     /// Wakes the island of `body` (no effect on awake or static bodies).
-    pub fn wake_body(&mut self, body: BodyHandle) {
+    /// Errors: a stale or foreign handle (the world unchanged).
+    pub fn wake_body(&mut self, body: BodyHandle) -> Result<(), WorldError> {
+        self.check_body(body)?;
+        self.wake_island(body);
+        Ok(())
+    }
+
+    /// Wakes the island of `body`, a handle known to be live (or
+    /// harmlessly stale: nothing happens).
+    pub(crate) fn wake_island(&mut self, body: BodyHandle) {
         self.stores().wake_body(body);
     }
 
     /// Wakes every island in the list.
     pub(super) fn wake_all(&mut self, bodies: &[BodyHandle]) {
         for b in bodies {
-            self.wake_body(*b);
+            self.wake_island(*b);
         }
     }
 
-    /// True when the body sleeps.
-    pub fn is_sleeping(&self, body: BodyHandle) -> bool {
-        self.bodies.is_sleeping(body)
+    /// True when the body sleeps. Errors: a stale or foreign handle.
+    pub fn is_sleeping(&self, body: BodyHandle) -> Result<bool, WorldError> {
+        self.check_body(body)?;
+        Ok(self.bodies.is_sleeping(body))
     }
 
     /// Number of sleeping bodies.
@@ -356,12 +366,11 @@ pub(super) fn check_gravity(gravity: Vec2) -> Result<(), WorldError> {
     Ok(())
 }
 
-/// Solver settings: [`SolverSettings::validate`], then every real finite
-/// (`inf` Hz or an infinite damping ratio give NaN softness) and the
-/// damping ratios at most
-/// [`MAX_DAMPING_RATIO`](janus2d_core::limits::MAX_DAMPING_RATIO).
+/// Solver settings: every real finite (`inf` Hz or an infinite damping
+/// ratio give NaN softness), the damping ratios at most
+/// [`MAX_DAMPING_RATIO`](janus2d_core::limits::MAX_DAMPING_RATIO)
+/// (`OutOfBounds`), then [`SolverSettings::validate`]'s stated ranges.
 pub(crate) fn check_settings(s: &SolverSettings) -> Result<(), WorldError> {
-    s.validate()?;
     let reals = [
         (s.baumgarte, "baumgarte"),
         (s.contact_hertz, "contact_hertz"),
@@ -397,6 +406,8 @@ pub(crate) fn check_settings(s: &SolverSettings) -> Result<(), WorldError> {
             });
         }
     }
+    // Then every stated range (NaN, negative, beyond its largest value).
+    s.validate()?;
     Ok(())
 }
 

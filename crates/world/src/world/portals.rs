@@ -12,7 +12,10 @@ impl World {
     /// Creates a linked pair of portals.
     ///
     /// Rejects stale body handles, non-finite values, a zero direction, a
-    /// non-positive half-width, `η ≤ 0` and an `η` outside
+    /// non-positive half-width, an anchor coordinate or a half-width beyond
+    /// the shape limit [`MAX_EXTENT`](janus2d_core::limits::MAX_EXTENT)
+    /// ([`WorldError::OutOfBounds`], field `anchor` or `half_width`),
+    /// `η ≤ 0` and an `η` outside
     /// [`ETA_RANGE`](janus2d_core::limits::ETA_RANGE); a body that is
     /// crossing a portal ([`WorldError::PortalBody`]).
     pub fn create_portal_pair(
@@ -39,7 +42,11 @@ impl World {
         self.portals.crossings.len()
     }
 
-    /// Portal events of the last step.
+    /// Portal events of the last step. Events of calls between steps
+    /// (`CrossingCancelled` and `JointDisabled` from
+    /// [`destroy_portal_pair`](Self::destroy_portal_pair) or from
+    /// destroying a crossing's copy or a portal body) are kept and reported
+    /// with the next step's, first, as collision events are.
     pub fn portal_events(&self) -> &[PortalEvent] {
         &self.portals.events
     }

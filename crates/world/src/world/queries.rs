@@ -95,7 +95,11 @@ impl World {
     /// as [`cast_ray_with`](Self::cast_ray_with)). A hit's point and normal
     /// are on the surface of the shape hit; shapes the swept shape already
     /// overlaps at the start are hits at fraction 0. Errors: an invalid
-    /// shape, a non-finite transform or translation, a zero translation.
+    /// shape, a non-finite transform or translation, a zero translation, a
+    /// transform whose rotation is not unit length
+    /// ([`QueryProblem::NotUnitRotation`](crate::QueryProblem::NotUnitRotation);
+    /// within [`UNIT_ROTATION_TOLERANCE`](janus2d_core::limits::UNIT_ROTATION_TOLERANCE)
+    /// it is normalised).
     pub fn cast_shape_with<F: FnMut(&crate::query::RayHit) -> Real>(
         &self,
         shape: &Shape,
@@ -171,7 +175,10 @@ impl World {
 
     /// Hands `callback` every shape that touches or overlaps `shape` placed
     /// by `transform`, in shape slot order, until it returns `false`.
-    /// Errors: an invalid shape or a non-finite transform.
+    /// Errors: an invalid shape, a non-finite transform or one whose
+    /// rotation is not unit length ([`QueryProblem::NotUnitRotation`](crate::QueryProblem::NotUnitRotation);
+    /// within [`UNIT_ROTATION_TOLERANCE`](janus2d_core::limits::UNIT_ROTATION_TOLERANCE)
+    /// it is normalised).
     pub fn overlap_shape<F: FnMut(crate::query::ShapeOverlap) -> bool>(
         &self,
         shape: &Shape,

@@ -51,7 +51,7 @@ impl World {
         }
         // Wakes a sleeping island; a body created asleep stays pending.
         if self.bodies.is_sleeping(body) {
-            self.wake_body(body);
+            self.wake_island(body);
         }
         let handle = self
             .collision
@@ -66,7 +66,7 @@ impl World {
     pub fn destroy_shape(&mut self, shape: ShapeHandle) -> Result<(), WorldError> {
         let slot = self.collision.shapes.slot(shape, self.bodies.owner())?;
         let body = self.collision.shapes.at(slot).body;
-        self.wake_body(body);
+        self.wake_island(body);
         self.collision.remove_shape(slot);
         let mass_override = self
             .bodies
@@ -332,7 +332,7 @@ impl World {
         self.collision.shapes.at_mut(slot).def.density = density;
         let follows = self.bodies.record(body).is_some_and(|r| !r.mass_override);
         if follows && self.bodies.body_type(body) == Some(BodyType::Dynamic) {
-            self.wake_body(body);
+            self.wake_island(body);
             self.update_mass_from_shapes(body);
         }
         Ok(())
@@ -342,7 +342,7 @@ impl World {
     /// broadphase report its pairs again, under its new filter or sensor flag.
     pub(super) fn repair_shape(&mut self, slot: u32) {
         let body = self.collision.shapes.at(slot).body;
-        self.wake_body(body);
+        self.wake_island(body);
         let c = &mut self.collision;
         c.contacts.destroy_of_body(body, &mut c.events, |x| {
             x.shape_a == slot || x.shape_b == slot

@@ -3,6 +3,23 @@
 
 use super::*;
 
+/// `dt` finite, positive and within
+/// [`TIME_STEP_RANGE`](janus2d_core::limits::TIME_STEP_RANGE).
+pub(super) fn check_time_step(dt: Real) -> Result<(), WorldError> {
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(WorldError::InvalidTimeStep);
+    }
+    let (min, max) = janus2d_core::limits::TIME_STEP_RANGE;
+    if !(min..=max).contains(&dt) {
+        return Err(WorldError::OutOfBounds {
+            field: "dt",
+            min,
+            max,
+        });
+    }
+    Ok(())
+}
+
 impl World {
     // ----- stepping ---------------------------------------------------------
 
@@ -28,11 +45,23 @@ impl World {
         capped.context(dt, self.gravity)
     }
 
-    /// Advances the world by `dt` seconds (finite, > 0).
+    /// Advances the world by `dt` seconds, within
+    /// [`TIME_STEP_RANGE`](janus2d_core::limits::TIME_STEP_RANGE)
+    /// (1 µs … 1 s).
+    ///
+    /// Errors (the world unchanged): a NaN, infinite, zero or negative
+    /// `dt` is [`WorldError::InvalidTimeStep`]; a positive `dt` outside
+    /// the range is [`WorldError::OutOfBounds`] (`field: "dt"`). The upper
+    /// bound keeps a step one sane explicit integration: the sleep timer
+    /// gains `dt` each step, so a longer step would put a swinging body to
+    /// sleep mid-swing, and every body would move metres between collision
+    /// checks; step a long span as several steps (the solver's accuracy is
+    /// for steps of a few milliseconds to 1/30 s). The lower bound keeps
+    /// the substep rate and the joints' force and torque read-back
+    /// (impulse over substep) finite. Every accepted `dt` keeps every
+    /// number finite.
     pub fn step(&mut self, dt: Real) -> Result<(), WorldError> {
-        if !(dt.is_finite() && dt > 0.0) {
-            return Err(WorldError::InvalidTimeStep);
-        }
+        check_time_step(dt)?;
         let mut ctx = self.step_context(dt);
         let start = std::time::Instant::now();
         let mut t = start;
@@ -183,8 +212,6 @@ impl World {
             let (portals, mut stores) = self.portals_and_stores();
             portals.cross(&mut stores);
             sp.portals += lap();
-        } else {
-            self.portals.clear_events();
         }
         if self.sleep_settings.enabled {
             let keep_awake = self.portals.keep_awake();
@@ -217,6 +244,7 @@ impl World {
             continuous: self.continuous.counters(),
         });
         self.step_profile = sp;
+        self.portals.publish_events();
         self.events = StepEvents {
             non_finite_bodies: report.non_finite,
             collision: std::mem::take(&mut self.collision.events),
