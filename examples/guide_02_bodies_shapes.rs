@@ -49,7 +49,7 @@ fn main() -> Result<(), WorldError> {
             "after 4 s the {name} is at ({:.2}, {:.2}), {}",
             p.x,
             p.y,
-            if world.is_sleeping(body) {
+            if world.is_sleeping(body)? {
                 "asleep"
             } else {
                 "awake"
