@@ -12,10 +12,11 @@
 //! of the terms; the central difference `8 eps/ε + 4 ε²` times `C`'s size,
 //! with the line at least 2 m long so its curvature stays small).
 
+use super::joint_checks::*;
 use janus2d::prelude::*;
 use janus2d_constraints::{DistanceJoint, DistanceJointDef, JointError};
 use janus2d_core::body::{BodySet, BodyType};
-use janus2d_core::constraint::{Constraint, ConstraintRows, StepContext};
+use janus2d_core::constraint::{Constraint, ConstraintRows};
 use janus2d_testbed::support::*;
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
@@ -130,26 +131,11 @@ fn dist_case(type_a: impl Strategy<Value = BodyType> + Clone) -> impl Strategy<V
         })
 }
 
-fn ctx() -> StepContext {
-    SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO)
-}
-
 /// Row order with everything on.
 const MOTOR: usize = 0;
 const LENGTH: usize = 1;
 const LOWER: usize = 2;
 const UPPER: usize = 3;
-
-#[cfg(feature = "f64")]
-const FD_STEP: Real = 1.0e-5;
-#[cfg(not(feature = "f64"))]
-const FD_STEP: Real = 5.0e-3;
-
-/// `(8 eps / ε + 4 ε²) M`: rounding over the step plus truncation.
-fn fd_tolerance(c_mag: f64) -> f64 {
-    let step = d(FD_STEP);
-    (8.0 * EPS / step + 4.0 * step * step) * c_mag
-}
 
 #[test]
 fn distance_jacobian_is_the_derivative_of_c() {
@@ -197,20 +183,6 @@ fn distance_jacobian_is_the_derivative_of_c() {
     );
 }
 
-/// `Σ inv_m |J_i,lin| |J_j,lin| + inv_i |J_i,ang| |J_j,ang|` over shared bodies.
-fn jmj_scale(rows: &ConstraintRows, i: usize, j: usize) -> f64 {
-    let mut scale = 0.0f64;
-    for a in &rows.rows[i].jacobian {
-        for b in &rows.rows[j].jacobian {
-            if a.body == b.body {
-                scale += d(a.inv_mass) * d(a.linear.length()) * d(b.linear.length())
-                    + d(a.inv_inertia) * d(a.angular.abs()) * d(b.angular.abs());
-            }
-        }
-    }
-    scale
-}
-
 #[test]
 fn distance_k_is_j_inverse_mass_j_transpose() {
     check(
@@ -219,34 +191,10 @@ fn distance_k_is_j_inverse_mass_j_transpose() {
         |case| {
             let built = case.build();
             let rows = built.joint.rows(&ctx(), &built.set);
-            let mut worst = 0.0f64;
-            let mut covered = 0;
-            for block in &rows.blocks {
-                covered += block.len;
-                prop_assert_eq!(block.len, 1);
-                let i = block.first_row;
-                let jmj = d(rows.jmj(i, i));
-                let bound = 32.0 * EPS * jmj_scale(&rows, i, i);
-                let err = (d(block.k[0][0]) - jmj).abs();
-                prop_assert!(
-                    err <= bound,
-                    "K[{i}] = {} vs {jmj} (error {err:.3e} > {bound:.3e})",
-                    block.k[0][0]
-                );
-                if bound > 0.0 {
-                    worst = worst.max(err / bound);
-                }
-            }
-            prop_assert_eq!(covered, rows.rows.len());
-            Ok(worst)
+            k_blocks_match(&rows)
         },
     );
 }
-
-#[cfg(feature = "f64")]
-const CONSERVATION_TOL: f64 = 1e-12;
-#[cfg(not(feature = "f64"))]
-const CONSERVATION_TOL: f64 = 1e-5;
 
 /// Total linear and angular momentum unchanged, relative to `scale` (the
 /// size of the terms and of the momentum the impulses carried).

@@ -16,6 +16,7 @@ mod distance;
 mod effects;
 mod filter;
 mod joint_api;
+mod joint_checks;
 mod joint_events;
 mod joint_tree_mixed;
 mod joint_tree_properties;

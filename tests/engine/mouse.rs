@@ -7,10 +7,11 @@
 //!
 //! Property bounds are those of `revolute_properties.rs`.
 
+use super::joint_checks::*;
 use janus2d::prelude::*;
 use janus2d_constraints::{JointError, MouseJoint, MouseJointDef};
 use janus2d_core::body::{BodySet, BodyType};
-use janus2d_core::constraint::{Constraint, StepContext};
+use janus2d_core::constraint::Constraint;
 use janus2d_testbed::support::*;
 use proptest::prelude::*;
 
@@ -78,20 +79,6 @@ fn mouse_case(type_a: impl Strategy<Value = BodyType> + Clone) -> impl Strategy<
             target,
             max_force,
         })
-}
-
-fn ctx() -> StepContext {
-    SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO)
-}
-
-#[cfg(feature = "f64")]
-const FD_STEP: Real = 1.0e-5;
-#[cfg(not(feature = "f64"))]
-const FD_STEP: Real = 5.0e-3;
-
-fn fd_tolerance(c_mag: f64) -> f64 {
-    let step = d(FD_STEP);
-    (8.0 * EPS / step + 4.0 * step * step) * c_mag
 }
 
 #[test]

@@ -17,10 +17,11 @@
 //! `JANUS2D_REPORT=1` prints the worst error as a fraction of its bound
 //! and the scene figures.
 
+use super::joint_checks::*;
 use janus2d::prelude::*;
 use janus2d_constraints::{JointDefBase, JointError, JointFrame};
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
-use janus2d_core::constraint::{Constraint, ConstraintRows, StepContext};
+use janus2d_core::constraint::{Constraint, ConstraintRows};
 use janus2d_core::math::wrap_angle;
 use janus2d_testbed::support::*;
 use proptest::prelude::*;
@@ -116,21 +117,6 @@ pub(super) fn axis_case(
         )
 }
 
-fn ctx() -> StepContext {
-    SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO)
-}
-
-#[cfg(feature = "f64")]
-const FD_STEP: Real = 1.0e-5;
-#[cfg(not(feature = "f64"))]
-const FD_STEP: Real = 5.0e-3;
-
-/// `(8 eps / ε + 4 ε²) M`: rounding over the step plus truncation.
-fn fd_tolerance(c_mag: f64) -> f64 {
-    let step = d(FD_STEP);
-    (8.0 * EPS / step + 4.0 * step * step) * c_mag
-}
-
 pub(super) fn check_jacobian(kind: &KindUnderTest) {
     let dir = (vec2(1.0), real(-1.0, 1.0));
     check(
@@ -169,20 +155,6 @@ pub(super) fn check_jacobian(kind: &KindUnderTest) {
     );
 }
 
-/// `Σ inv_m |J_i,lin| |J_j,lin| + inv_i |J_i,ang| |J_j,ang|` over shared bodies.
-fn jmj_scale(rows: &ConstraintRows, i: usize, j: usize) -> f64 {
-    let mut scale = 0.0f64;
-    for a in &rows.rows[i].jacobian {
-        for b in &rows.rows[j].jacobian {
-            if a.body == b.body {
-                scale += d(a.inv_mass) * d(a.linear.length()) * d(b.linear.length())
-                    + d(a.inv_inertia) * d(a.angular.abs()) * d(b.angular.abs());
-            }
-        }
-    }
-    scale
-}
-
 pub(super) fn check_effective_mass(kind: &KindUnderTest, blocks: &'static [usize]) {
     check(
         &format!("{}: K = J M⁻¹ Jᵀ for every block", kind.name),
@@ -193,37 +165,10 @@ pub(super) fn check_effective_mass(kind: &KindUnderTest, blocks: &'static [usize
             let lens: Vec<usize> = rows.blocks.iter().map(|b| b.len).collect();
             // A static or kinematic a with a dynamic b: the block is regular.
             prop_assert_eq!(&lens[..], blocks);
-            let mut worst = 0.0f64;
-            let mut covered = 0;
-            for block in &rows.blocks {
-                covered += block.len;
-                for p in 0..block.len {
-                    for q in 0..block.len {
-                        let (i, j) = (block.first_row + p, block.first_row + q);
-                        let jmj = d(rows.jmj(i, j));
-                        let bound = 32.0 * EPS * jmj_scale(&rows, i, j);
-                        let err = (d(block.k[p][q]) - jmj).abs();
-                        prop_assert!(
-                            err <= bound,
-                            "K[{i}][{j}] = {} vs {jmj} (error {err:.3e} > {bound:.3e})",
-                            block.k[p][q]
-                        );
-                        if bound > 0.0 {
-                            worst = worst.max(err / bound);
-                        }
-                    }
-                }
-            }
-            prop_assert_eq!(covered, rows.rows.len());
-            Ok(worst)
+            k_blocks_match(&rows)
         },
     );
 }
-
-#[cfg(feature = "f64")]
-const CONSERVATION_TOL: f64 = 1e-12;
-#[cfg(not(feature = "f64"))]
-const CONSERVATION_TOL: f64 = 1e-5;
 
 fn conserved(
     before: ([f64; 3], f64),

@@ -12,11 +12,11 @@
 //! size of the terms, except the central difference (`eps/ε + ε²`).
 //! `JANUS2D_REPORT=1` prints the worst error as a fraction of its bound.
 
+use super::joint_checks::*;
 use janus2d_constraints::revolute::{RevoluteJoint, RevoluteJointDef};
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
-use janus2d_core::constraint::{Constraint, ConstraintRows, StepContext};
+use janus2d_core::constraint::{Constraint, ConstraintRows};
 use janus2d_core::math::{Real, Vec2, wrap_angle};
-use janus2d_core::solver::SolverSettings;
 use janus2d_testbed::support::*;
 use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
@@ -113,22 +113,6 @@ fn joint_case(type_a: impl Strategy<Value = BodyType> + Clone) -> impl Strategy<
         )
 }
 
-fn ctx() -> StepContext {
-    SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO)
-}
-
-#[cfg(feature = "f64")]
-const FD_STEP: Real = 1.0e-5;
-#[cfg(not(feature = "f64"))]
-const FD_STEP: Real = 5.0e-3;
-
-/// `(8 eps / ε + 4 ε²) M`: rounding over the step plus truncation (see
-/// `tests/portals/portal_properties.rs`).
-fn fd_tolerance(c_mag: f64) -> f64 {
-    let step = d(FD_STEP);
-    (8.0 * EPS / step + 4.0 * step * step) * c_mag
-}
-
 #[test]
 fn revolute_jacobian_is_the_derivative_of_c() {
     let dir = (vec2(1.0), real(-1.0, 1.0));
@@ -168,20 +152,6 @@ fn revolute_jacobian_is_the_derivative_of_c() {
     );
 }
 
-/// `Σ inv_m |J_i,lin| |J_j,lin| + inv_i |J_i,ang| |J_j,ang|` over shared bodies.
-fn jmj_scale(rows: &ConstraintRows, i: usize, j: usize) -> f64 {
-    let mut scale = 0.0f64;
-    for a in &rows.rows[i].jacobian {
-        for b in &rows.rows[j].jacobian {
-            if a.body == b.body {
-                scale += d(a.inv_mass) * d(a.linear.length()) * d(b.linear.length())
-                    + d(a.inv_inertia) * d(a.angular.abs()) * d(b.angular.abs());
-            }
-        }
-    }
-    scale
-}
-
 #[test]
 fn revolute_k_is_j_inverse_mass_j_transpose() {
     check(
@@ -190,37 +160,10 @@ fn revolute_k_is_j_inverse_mass_j_transpose() {
         |case| {
             let built = case.build();
             let rows = built.joint.rows(&ctx(), &built.set);
-            let mut worst = 0.0f64;
-            let mut covered = 0;
-            for block in &rows.blocks {
-                covered += block.len;
-                for p in 0..block.len {
-                    for q in 0..block.len {
-                        let (i, j) = (block.first_row + p, block.first_row + q);
-                        let jmj = d(rows.jmj(i, j));
-                        let bound = 32.0 * EPS * jmj_scale(&rows, i, j);
-                        let err = (d(block.k[p][q]) - jmj).abs();
-                        prop_assert!(
-                            err <= bound,
-                            "K[{i}][{j}] = {} vs {jmj} (error {err:.3e} > {bound:.3e})",
-                            block.k[p][q]
-                        );
-                        if bound > 0.0 {
-                            worst = worst.max(err / bound);
-                        }
-                    }
-                }
-            }
-            prop_assert_eq!(covered, rows.rows.len());
-            Ok(worst)
+            k_blocks_match(&rows)
         },
     );
 }
-
-#[cfg(feature = "f64")]
-const CONSERVATION_TOL: f64 = 1e-12;
-#[cfg(not(feature = "f64"))]
-const CONSERVATION_TOL: f64 = 1e-5;
 
 fn conserved(
     before: ([f64; 3], f64),
