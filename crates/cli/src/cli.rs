@@ -195,10 +195,10 @@ impl RunArgs {
 
 /// Prints the built-in scenes.
 pub fn list<W: Write>(out: &mut W) -> std::io::Result<()> {
-    let entries = catalog::entries();
+    let entries: Vec<&catalog::Entry> = catalog::entries().collect();
     let width = entries.iter().map(|e| e.name.len()).max().unwrap_or(4);
     let mut group = "";
-    for e in &entries {
+    for e in entries {
         if e.group != group {
             group = e.group;
             writeln!(out, "{group}:")?;
@@ -239,7 +239,7 @@ pub fn execute<W: Write + Send>(cli: &Cli, out: &mut W) -> Result<(), CliError> 
         }),
         Command::Export { scene, out: file } => {
             let e = catalog::find(scene)?;
-            let text = SceneFile::from_desc(&e.desc)
+            let text = SceneFile::from_desc(&e.build())
                 .map_err(CliError::Invalid)?
                 .to_json();
             match file {

@@ -149,7 +149,7 @@ pub fn load(scene: &str) -> Result<Loaded, CliError> {
     }
     let e = catalog::find(scene)?;
     let source = format!("built-in {}", e.group);
-    Loaded::from_desc(&e.name, &source, e.desc, e.steps)
+    Loaded::from_desc(e.name, &source, e.build(), e.steps)
 }
 
 /// How the camera of the pictures fits the scene (`--fit`).

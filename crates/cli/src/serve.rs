@@ -588,7 +588,7 @@ async fn page() -> Html<&'static str> {
 }
 
 async fn scenes() -> Response {
-    let names: Vec<String> = catalog::entries().into_iter().map(|e| e.name).collect();
+    let names: Vec<String> = catalog::entries().map(|e| e.name.to_owned()).collect();
     axum::Json(json!({ "scenes": names })).into_response()
 }
 

@@ -31,10 +31,10 @@ fn example() -> PathBuf {
 #[test]
 fn every_small_built_in_scene_runs() {
     for e in catalog::entries() {
-        if e.desc.bodies.len() > 700 {
+        if e.bodies > 700 {
             continue; // the big ones run in the CI smoke line and the benchmarks
         }
-        let mut scene = runner::load(&e.name).unwrap();
+        let mut scene = runner::load(e.name).unwrap();
         let mut out = Vec::new();
         let s = runner::run(&mut scene, &quiet(3), &mut out).unwrap();
         assert_eq!(s.steps, 3, "{}", e.name);
@@ -74,7 +74,7 @@ fn export_round_trip_is_bit_identical() {
     }
     for name in names {
         let e = catalog::find(name).unwrap();
-        let file = SceneFile::from_desc(&e.desc).unwrap();
+        let file = SceneFile::from_desc(&e.build()).unwrap();
         let json = file.to_json();
         let back = scene_file::parse(&json, name).unwrap();
         assert_eq!(back, file, "{name}: serialise → parse is the identity");
@@ -94,7 +94,7 @@ fn export_round_trip_is_bit_identical() {
     // A scripted scene is refused with a message.
     let rain = catalog::find("rain").unwrap();
     assert!(
-        SceneFile::from_desc(&rain.desc)
+        SceneFile::from_desc(&rain.build())
             .unwrap_err()
             .contains("script")
     );
