@@ -3,7 +3,7 @@
 //! | command | what |
 //! |---------|------|
 //! | `janus2d list` | the built-in scenes, by group, with their bodies and steps |
-//! | `janus2d run SCENE [--steps N] [--substeps N] [--threads N] [--png DIR \| --gif FILE \| --svg DIR] [--every K] [--size WxH] [--follow] [--fit once\|each\|grow\|N] [--draw FLAGS] [--profile] [--csv FILE]` | runs a built-in scene or a scene file, prints what happened and a summary |
+//! | `janus2d run SCENE [--steps N] [--substeps N] [--threads N] [--png DIR \| --gif FILE \| --svg DIR] [--every K] [--size WxH] [--follow] [--fit once\|each\|grow\|N] [--draw FLAGS] [--overlay] [--profile] [--csv FILE]` | runs a built-in scene or a scene file, prints what happened and a summary |
 //! | `janus2d export SCENE [-o FILE]` | writes a built-in scene (one without a script) as a scene file |
 //! | `janus2d serve [SCENE] [--port P]` | runs the scene and streams it to a page on `http://127.0.0.1:P/` ([`crate::serve`]) |
 
@@ -97,6 +97,9 @@ pub struct RunArgs {
     /// the default, `-flag` removes).
     #[arg(long)]
     pub draw: Option<String>,
+    /// Write step, time, bodies and ms/step on PNG and GIF frames.
+    #[arg(long)]
+    pub overlay: bool,
     /// Print the per-stage profile table and the last step's counters.
     #[arg(long)]
     pub profile: bool,
@@ -185,6 +188,7 @@ impl RunArgs {
                 Some(d) => parse_draw(d)?,
                 None => DrawOptions::default(),
             },
+            overlay: self.overlay,
             profile: self.profile,
             csv: self.csv.clone(),
             progress: !self.no_progress,

@@ -213,8 +213,21 @@ fn frames_and_csv_are_written() {
     let s = runner::run(&mut scene, &options, &mut Vec::new()).unwrap();
     // The first frame and one every 2 steps.
     assert_eq!(s.frames, 4);
-    let pngs = std::fs::read_dir(&dir).unwrap().count();
-    assert_eq!(pngs, 4);
+    // Named by step, not by index.
+    let mut pngs: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    pngs.sort();
+    assert_eq!(
+        pngs,
+        [
+            "frame_00000.png",
+            "frame_00002.png",
+            "frame_00004.png",
+            "frame_00006.png"
+        ]
+    );
     let rows = std::fs::read_to_string(&csv).unwrap();
     let lines: Vec<&str> = rows.lines().collect();
     assert_eq!(lines.len(), 7, "header + one row per step");
@@ -231,7 +244,7 @@ fn frames_and_csv_are_written() {
     };
     let s = runner::run(&mut scene, &options, &mut Vec::new()).unwrap();
     assert_eq!(s.frames, 3);
-    let doc = std::fs::read_to_string(svg_dir.join("frame_00002.svg")).unwrap();
+    let doc = std::fs::read_to_string(svg_dir.join("frame_00006.svg")).unwrap();
     assert_eq!(doc.matches("<polygon").count(), 2, "the ground and the box");
 
     let mut scene = runner::load("single_box").unwrap();
@@ -245,6 +258,41 @@ fn frames_and_csv_are_written() {
     assert_eq!(s.frames, 6, "the first and every 2nd step");
     let bytes = std::fs::read(&gif).unwrap();
     assert_eq!(&bytes[..6], b"GIF89a");
+}
+
+/// `--overlay` writes step, time, bodies and ms/step in the frame's top
+/// left corner and nowhere else.
+#[test]
+fn the_overlay_marks_the_corner_and_long_runs_pad_wider() {
+    let plain = temp("overlay-off");
+    let marked = temp("overlay-on");
+    for (dir, overlay) in [(&plain, false), (&marked, true)] {
+        let mut scene = runner::load("single_box").unwrap();
+        let options = RunOptions {
+            frames: Frames::Png(dir.clone()),
+            every: Some(3),
+            size: (320, 120),
+            overlay,
+            ..quiet(3)
+        };
+        runner::run(&mut scene, &options, &mut Vec::new()).unwrap();
+    }
+    let read = |d: &PathBuf| {
+        let bytes = std::fs::read(d.join("frame_00003.png")).unwrap();
+        let pm = tiny_skia::Pixmap::decode_png(&bytes).unwrap();
+        pm.pixels()
+            .iter()
+            .map(|p| [p.red(), p.green(), p.blue()])
+            .collect::<Vec<_>>()
+    };
+    let (a, b) = (read(&plain), read(&marked));
+    let changed: Vec<usize> = (0..a.len()).filter(|&i| a[i] != b[i]).collect();
+    assert!(changed.len() > 200, "{} px changed", changed.len());
+    // One line at the top left: within 24 px of the top.
+    assert!(
+        changed.iter().all(|&i| i / 320 < 24),
+        "the overlay stays in its corner"
+    );
 }
 
 #[test]
