@@ -178,7 +178,8 @@ mod tests {
         let rgba = r.rgba();
         for y in 0..40usize {
             for x in 0..120usize {
-                let inside = x >= 2 && x < 2 + text_width("step 42") as usize && y >= 2 && y < 18;
+                let inside =
+                    (2..2 + text_width("step 42") as usize).contains(&x) && (2..18).contains(&y);
                 if !inside {
                     assert_eq!(
                         rgba[4 * (y * 120 + x)],
