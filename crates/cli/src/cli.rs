@@ -3,9 +3,9 @@
 //! | command | what |
 //! |---------|------|
 //! | `janus2d list` | the built-in scenes, by group, with their bodies and steps |
-//! | `janus2d run SCENE [--steps N] [--substeps N] [--threads N] [--png DIR \| --gif FILE \| --svg DIR] [--every K] [--size WxH] [--follow] [--fit once\|each\|grow\|N] [--draw FLAGS] [--profile] [--csv FILE]` | runs a built-in scene or a scene file, prints what happened and a summary |
+//! | `janus2d run SCENE [--steps N] [--substeps N] [--threads N] [--png DIR \| --gif FILE \| --svg DIR] [--every K] [--size WxH] [--follow] [--fit once\|each\|grow\|N] [--draw FLAGS] [--overlay] [--profile] [--csv FILE]` | runs a built-in scene or a scene file, prints what happened and a summary |
 //! | `janus2d export SCENE [-o FILE]` | writes a built-in scene (one without a script) as a scene file |
-//! | `janus2d serve [SCENE] [--port P]` | runs the scene and streams it to a page on `http://127.0.0.1:P/` ([`crate::serve`]) |
+//! | `janus2d serve [SCENE] [--port P] [--fit once\|each\|grow\|N]` | runs the scene and streams it to a page on `http://127.0.0.1:P/` ([`crate::serve`]) |
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -42,6 +42,12 @@ pub enum Command {
         /// The port (0: any free one).
         #[arg(long, default_value_t = 8080)]
         port: u16,
+        /// When the page's camera fits the scene: `once` (at the start and
+        /// on reset), `each` frame, `grow` (only zooms out) or every N
+        /// steps. Zooming or panning by hand stops it; a double-click
+        /// fits again.
+        #[arg(long, default_value = "once")]
+        fit: String,
     },
     /// Write a built-in scene as a JSON scene file.
     Export {
@@ -97,6 +103,9 @@ pub struct RunArgs {
     /// the default, `-flag` removes).
     #[arg(long)]
     pub draw: Option<String>,
+    /// Write step, time, bodies and ms/step on PNG and GIF frames.
+    #[arg(long)]
+    pub overlay: bool,
     /// Print the per-stage profile table and the last step's counters.
     #[arg(long)]
     pub profile: bool,
@@ -185,6 +194,7 @@ impl RunArgs {
                 Some(d) => parse_draw(d)?,
                 None => DrawOptions::default(),
             },
+            overlay: self.overlay,
             profile: self.profile,
             csv: self.csv.clone(),
             progress: !self.no_progress,
@@ -195,10 +205,10 @@ impl RunArgs {
 
 /// Prints the built-in scenes.
 pub fn list<W: Write>(out: &mut W) -> std::io::Result<()> {
-    let entries = catalog::entries();
+    let entries: Vec<&catalog::Entry> = catalog::entries().collect();
     let width = entries.iter().map(|e| e.name.len()).max().unwrap_or(4);
     let mut group = "";
-    for e in &entries {
+    for e in entries {
         if e.group != group {
             group = e.group;
             writeln!(out, "{group}:")?;
@@ -230,16 +240,19 @@ pub fn execute<W: Write + Send>(cli: &Cli, out: &mut W) -> Result<(), CliError> 
             let mut scene = runner::load(&args.scene)?;
             runner::run(&mut scene, &options, out).map(|_| ())
         }
-        Command::Serve { scene, port } => crate::serve::serve(scene, *port, |addr| {
-            let _ = writeln!(
-                out,
-                "janus2d serve {scene}: open http://{addr}/ (Ctrl-C stops)"
-            );
-            let _ = out.flush();
-        }),
+        Command::Serve { scene, port, fit } => {
+            let fit = fit.parse()?;
+            crate::serve::serve_fit(scene, *port, fit, |addr| {
+                let _ = writeln!(
+                    out,
+                    "janus2d serve {scene}: open http://{addr}/ (Ctrl-C stops)"
+                );
+                let _ = out.flush();
+            })
+        }
         Command::Export { scene, out: file } => {
             let e = catalog::find(scene)?;
-            let text = SceneFile::from_desc(&e.desc)
+            let text = SceneFile::from_desc(&e.build())
                 .map_err(CliError::Invalid)?
                 .to_json();
             match file {

@@ -149,7 +149,7 @@ pub fn load(scene: &str) -> Result<Loaded, CliError> {
     }
     let e = catalog::find(scene)?;
     let source = format!("built-in {}", e.group);
-    Loaded::from_desc(&e.name, &source, e.desc, e.steps)
+    Loaded::from_desc(e.name, &source, e.build(), e.steps)
 }
 
 /// How the camera of the pictures fits the scene (`--fit`).
@@ -193,11 +193,14 @@ impl std::str::FromStr for Fit {
 pub enum Frames {
     /// None.
     None,
-    /// PNG files `frame_00000.png`, … in this folder.
+    /// PNG files named by step, `frame_00000.png`, `frame_00001.png`, …
+    /// (zero-padded to five digits, or to the last step's digits) in this
+    /// folder.
     Png(PathBuf),
     /// One GIF file.
     Gif(PathBuf),
-    /// SVG files `frame_00000.svg`, … in this folder.
+    /// SVG files named by step as the PNG ones, `frame_00000.svg`, … in
+    /// this folder.
     Svg(PathBuf),
 }
 
@@ -222,6 +225,9 @@ pub struct RunOptions {
     pub fit: Fit,
     /// What the pictures show.
     pub draw: DrawOptions,
+    /// PNG and GIF frames carry a line of text in their top left corner:
+    /// step, time, bodies and the mean ms/step since the previous frame.
+    pub overlay: bool,
     /// Print the per-stage profile table and the counters.
     pub profile: bool,
     /// One CSV row per step.
@@ -244,6 +250,7 @@ impl Default for RunOptions {
             follow: false,
             fit: Fit::Once,
             draw: DrawOptions::default(),
+            overlay: false,
             profile: false,
             csv: None,
             progress: true,
@@ -403,10 +410,41 @@ struct Pictures {
     dir: Option<PathBuf>,
     svg: bool,
     written: usize,
+    /// Digits of the step in a frame's file name.
+    digits: usize,
+}
+
+/// What a frame's overlay says.
+struct Caption {
+    step: usize,
+    time: f64,
+    bodies: usize,
+    /// Mean wall time of the steps since the previous frame (none on the
+    /// first frame).
+    ms_per_step: Option<f64>,
+}
+
+impl Caption {
+    fn items(&self) -> Vec<String> {
+        let mut items = vec![
+            format!("step {}", self.step),
+            format!("t {:.3} s", self.time),
+            format!("bodies {}", self.bodies),
+        ];
+        if let Some(ms) = self.ms_per_step {
+            items.push(format!("{ms:.3} ms/step"));
+        }
+        items
+    }
 }
 
 impl Pictures {
-    fn new(frames: &Frames, camera: Camera, delay_cs: u16) -> Result<Option<Pictures>, CliError> {
+    fn new(
+        frames: &Frames,
+        camera: Camera,
+        delay_cs: u16,
+        last_step: usize,
+    ) -> Result<Option<Pictures>, CliError> {
         let (gif, dir) = match frames {
             Frames::None => return Ok(None),
             Frames::Png(dir) | Frames::Svg(dir) => {
@@ -430,26 +468,38 @@ impl Pictures {
             dir,
             svg: matches!(frames, Frames::Svg(_)),
             written: 0,
+            digits: last_step.to_string().len().max(5),
         }))
     }
 
-    fn shoot(&mut self, world: &World, draw: &DrawOptions) -> Result<(), CliError> {
+    /// The frame of step `caption.step`, with the overlay when `overlay`.
+    fn shoot(
+        &mut self,
+        world: &World,
+        draw: &DrawOptions,
+        caption: &Caption,
+        overlay: bool,
+    ) -> Result<(), CliError> {
+        let name = |ext: &str| format!("frame_{:0w$}.{ext}", caption.step, w = self.digits);
         if self.svg {
             if let Some(dir) = &self.dir {
                 let mut svg = janus2d_render::Svg::new(self.raster.camera);
                 svg.draw_world(world, draw);
-                svg.save(&dir.join(format!("frame_{:05}.svg", self.written)))?;
+                svg.save(&dir.join(name("svg")))?;
             }
             self.written += 1;
             return Ok(());
         }
         self.raster.draw_world(world, draw);
+        if overlay {
+            let lines = janus2d_render::text::wrap(&caption.items(), self.raster.camera.width);
+            self.raster.overlay(&lines);
+        }
         if let Some(g) = &mut self.gif {
             g.add(&self.raster)?;
         }
         if let Some(dir) = &self.dir {
-            self.raster
-                .save_png(&dir.join(format!("frame_{:05}.png", self.written)))?;
+            self.raster.save_png(&dir.join(name("png")))?;
         }
         self.written += 1;
         Ok(())
@@ -568,7 +618,7 @@ fn run_here<W: Write>(
         .max(1);
     let delay_cs = ((every as f64 * to_f64(scene.dt) * 100.0).round() as u16).max(2);
     let mut camera = Camera::fit_world(scene.world(), width, height);
-    let mut pictures = Pictures::new(&options.frames, camera, delay_cs)?;
+    let mut pictures = Pictures::new(&options.frames, camera, delay_cs, steps)?;
     let mut csv = match &options.csv {
         Some(p) => {
             let f = std::fs::File::create(p).map_err(|e| CliError::io(p, &e))?;
@@ -606,8 +656,16 @@ fn run_here<W: Write>(
     if let Some(pics) = &mut pictures {
         aim(&mut camera, scene, 0);
         pics.raster.camera = camera;
-        pics.shoot(scene.world(), &options.draw)?;
+        let caption = Caption {
+            step: 0,
+            time: 0.0,
+            bodies: scene.world().body_count(),
+            ms_per_step: None,
+        };
+        pics.shoot(scene.world(), &options.draw, &caption, options.overlay)?;
     }
+    // Wall time of the steps since the last frame, and how many.
+    let mut since_frame = (0.0f64, 0usize);
 
     let start = Instant::now();
     let mut bar: Option<indicatif::ProgressBar> = None;
@@ -621,7 +679,9 @@ fn run_here<W: Write>(
     for step in 0..steps {
         let t0 = Instant::now();
         scene.step(step)?;
-        wall += t0.elapsed().as_secs_f64();
+        let took = t0.elapsed().as_secs_f64();
+        wall += took;
+        since_frame = (since_frame.0 + took, since_frame.1 + 1);
         let world = scene.world();
         sum.add(&StageMs::of(world));
         let time = (step + 1) as f64 * to_f64(scene.dt);
@@ -697,7 +757,14 @@ fn run_here<W: Write>(
         {
             aim(&mut camera, scene, step + 1);
             pics.raster.camera = camera;
-            pics.shoot(scene.world(), &options.draw)?;
+            let caption = Caption {
+                step: step + 1,
+                time,
+                bodies: scene.world().body_count(),
+                ms_per_step: Some(since_frame.0 * 1e3 / since_frame.1.max(1) as f64),
+            };
+            pics.shoot(scene.world(), &options.draw, &caption, options.overlay)?;
+            since_frame = (0.0, 0);
         }
         if options.progress
             && bar.is_none()

@@ -3,9 +3,15 @@
 //! where a canvas draws them.
 //!
 //! ```text
-//!  browser ── GET /        the page (self-contained: no network needed)
+//!  browser ── GET /[?scene=NAME]  the page (self-contained: no network
+//!                                 needed) with the scene picked and its
+//!                                 first frame as an inline SVG, so the page
+//!                                 shows the scene before (or without) scripts
 //!          ── GET /scenes  the built-in scene names (JSON)
-//!          ══ /ws          WebSocket: controls in, frames out
+//!          ══ /ws[?scene=NAME]  WebSocket: controls in, frames out
+//!
+//!  NAME: a built-in scene, or the served one (a scene file only when
+//!  `janus2d serve` was given it).
 //!
 //!  per connection: a simulation thread ── frames (bounded channel: the
 //!  page's pace throttles it) ──▶ the socket task ──▶ the page
@@ -28,7 +34,7 @@
 //! | message out                           | what                              |
 //! |---------------------------------------|-----------------------------------|
 //! | `{"type":"scene",…}`                  | name, bounds to fit, dt, substeps (after load and reset) |
-//! | `{"type":"frame",…}`                  | step, time, counts, the stage profile (ms) and the primitives ([`FrameRecorder`]) |
+//! | `{"type":"frame",…}`                  | step, time, counts, the stage profile (ms), the primitives ([`FrameRecorder`]) and, when `--fit` is not `once` and it is time, `fit`: the bounds to fit |
 //! | `{"type":"error","message":…}`        | a control that failed (unknown scene, bad flags) |
 
 use std::sync::Arc;
@@ -36,8 +42,8 @@ use std::sync::mpsc as std_mpsc;
 use std::time::{Duration, Instant};
 
 use axum::Router;
-use axum::extract::State;
 use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
+use axum::extract::{Query, State};
 use axum::response::{Html, IntoResponse, Response};
 use axum::routing::get;
 use janus2d_constraints::{MouseJoint, MouseJointDef};
@@ -52,7 +58,7 @@ use serde_json::{Value, json};
 use crate::catalog;
 use crate::cli::parse_draw;
 use crate::error::CliError;
-use crate::runner::{self, Loaded};
+use crate::runner::{self, Fit, Loaded};
 
 /// The page (HTML, CSS and script in one file).
 pub const PAGE: &str = include_str!("serve_page.html");
@@ -225,6 +231,19 @@ pub fn scene_message(scene: &Loaded) -> String {
 /// The `frame` message: counts, the stage profile and the primitives.
 #[must_use]
 pub fn frame_message(scene: &Loaded, step: usize, draw: &DrawOptions, running: bool) -> String {
+    frame_message_fit(scene, step, draw, running, None)
+}
+
+/// The `frame` message with the bounds the page fits its camera to, if
+/// given.
+#[must_use]
+pub fn frame_message_fit(
+    scene: &Loaded,
+    step: usize,
+    draw: &DrawOptions,
+    running: bool,
+    fit: Option<Aabb>,
+) -> String {
     let w = scene.world();
     let mut rec = FrameRecorder::default();
     w.debug_draw(&mut rec, draw);
@@ -248,6 +267,7 @@ pub fn frame_message(scene: &Loaded, step: usize, draw: &DrawOptions, running: b
             "total": ms(p.total),
         },
         "prims": rec.prims,
+        "fit": fit.map(|b| json!([q(b.lower.x), q(b.lower.y), q(b.upper.x), q(b.upper.y)])),
     })
     .to_string()
 }
@@ -267,6 +287,10 @@ pub struct Session {
     draw: DrawOptions,
     /// The drag in progress.
     grab: Option<Grab>,
+    /// When the page's camera fits the scene again.
+    fit: Fit,
+    /// The union of the scene's boxes so far (`Fit::Grow`).
+    seen: Option<Aabb>,
 }
 
 /// A drag in progress: a mouse joint from a static body made for the drag
@@ -340,7 +364,34 @@ impl Session {
             running: true,
             draw: DrawOptions::default(),
             grab: None,
+            fit: Fit::Once,
+            seen: None,
         })
+    }
+
+    /// A session whose page camera fits the scene as `fit` says (as
+    /// `janus2d run --fit`).
+    pub fn with_fit(name: &str, fit: Fit) -> Result<Session, CliError> {
+        let mut s = Session::new(name)?;
+        s.fit = fit;
+        Ok(s)
+    }
+
+    /// The bounds the page fits now, if `fit` says it is time.
+    fn fit_bounds(&mut self) -> Option<Aabb> {
+        let world = self.scene.world();
+        match self.fit {
+            Fit::Once => None,
+            Fit::Each => Some(janus2d_render::scene_bounds(world)),
+            Fit::Grow => {
+                let b = janus2d_render::scene_bounds(world);
+                let all = self.seen.map_or(b, |s| s.union(&b));
+                self.seen = Some(all);
+                Some(all)
+            }
+            Fit::Every(n) => (self.step > 0 && self.step.is_multiple_of(n))
+                .then(|| janus2d_render::scene_bounds(world)),
+        }
     }
 
     /// The grabbed body, if any.
@@ -477,6 +528,7 @@ impl Session {
                 self.grab = None;
                 self.scene = runner::load(&self.name)?;
                 self.step = 0;
+                self.seen = None;
                 return Ok(Some(scene_message(&self.scene)));
             }
             Control::Scene { name } => {
@@ -485,6 +537,7 @@ impl Session {
                 self.scene = scene;
                 self.name = name;
                 self.step = 0;
+                self.seen = None;
                 return Ok(Some(scene_message(&self.scene)));
             }
             Control::Substeps { n } => {
@@ -529,6 +582,13 @@ impl Session {
         frame_message(&self.scene, self.step, &self.draw, self.running)
     }
 
+    /// The current frame message as the loop sends it: with the bounds to
+    /// fit when `--fit` says it is time.
+    pub fn next_frame(&mut self) -> String {
+        let fit = self.fit_bounds();
+        frame_message_fit(&self.scene, self.step, &self.draw, self.running, fit)
+    }
+
     /// The loop of a connection's thread: controls in, a frame per tick
     /// out, until either side goes.
     pub fn run(
@@ -569,7 +629,7 @@ impl Session {
                     return;
                 }
             }
-            if !send(self.frame()) {
+            if !send(self.next_frame()) {
                 return;
             }
             if let Some(rest) = tick.checked_sub(start.elapsed()) {
@@ -581,24 +641,122 @@ impl Session {
 
 struct AppState {
     scene: String,
+    fit: Fit,
 }
 
-async fn page() -> Html<&'static str> {
-    Html(PAGE)
+/// `?scene=NAME` on the page and the WebSocket.
+#[derive(Debug, Default, Deserialize)]
+struct SceneQuery {
+    scene: Option<String>,
+}
+
+impl AppState {
+    /// The scene a request asks for: a built-in one or the served one;
+    /// anything else (a path) gets the served one.
+    fn pick(&self, q: &SceneQuery) -> String {
+        match &q.scene {
+            Some(n) if *n == self.scene || catalog::find(n).is_ok() => n.clone(),
+            _ => self.scene.clone(),
+        }
+    }
+}
+
+/// `<`, `>`, `&` and quotes escaped.
+fn html_escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '&' => out.push_str("&amp;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&#39;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// Size of the page's first-frame picture, px (it scales to the stage).
+pub const STILL_SIZE: (u32, u32) = (1000, 620);
+
+/// The page for `scene`: the picker lists the built-in scenes (and
+/// `scene` when it is a file) with `scene` selected, and the stage shows
+/// its first frame as an inline SVG drawn here, so the page shows the
+/// scene with scripts off, and before the first frame arrives over the
+/// WebSocket.
+pub fn page_html(scene: &str) -> Result<String, CliError> {
+    let loaded = runner::load(scene)?;
+    let world = loaded.world();
+    let (w, h) = STILL_SIZE;
+    let camera = janus2d_render::Camera::fit(&janus2d_render::scene_bounds(world), w, h, 0.05);
+    let mut svg = janus2d_render::Svg::new(camera);
+    svg.draw_world(world, &DrawOptions::default());
+    let mut options = String::new();
+    let mut listed = false;
+    for e in catalog::entries() {
+        let selected = e.name == scene;
+        listed |= selected;
+        options.push_str(&format!(
+            "<option value=\"{n}\"{sel}>{n}</option>",
+            n = html_escape(e.name),
+            sel = if selected { " selected" } else { "" }
+        ));
+    }
+    if !listed {
+        options.push_str(&format!(
+            "<option value=\"{n}\" selected>{n}</option>",
+            n = html_escape(scene)
+        ));
+    }
+    let status = format!(
+        "{}: {} bodies, step 0\nconnecting…",
+        loaded.name,
+        world.body_count()
+    );
+    // A JSON string is a JS string; `</` closed so it cannot end the script.
+    let served = json!(scene).to_string().replace("</", "<\\/");
+    Ok(PAGE
+        .replacen("{{OPTIONS}}", &options, 1)
+        .replacen("{{STILL}}", &svg.finish(), 1)
+        .replacen("{{STATUS}}", &html_escape(&status), 1)
+        .replacen("{{SCENE}}", &served, 1))
+}
+
+async fn page(State(state): State<Arc<AppState>>, Query(q): Query<SceneQuery>) -> Response {
+    let scene = state.pick(&q);
+    match tokio::task::spawn_blocking(move || page_html(&scene)).await {
+        Ok(Ok(html)) => Html(html).into_response(),
+        Ok(Err(e)) => (
+            axum::http::StatusCode::INTERNAL_SERVER_ERROR,
+            format!("error: {e}"),
+        )
+            .into_response(),
+        Err(e) => (
+            axum::http::StatusCode::INTERNAL_SERVER_ERROR,
+            format!("error: {e}"),
+        )
+            .into_response(),
+    }
 }
 
 async fn scenes() -> Response {
-    let names: Vec<String> = catalog::entries().into_iter().map(|e| e.name).collect();
+    let names: Vec<String> = catalog::entries().map(|e| e.name.to_owned()).collect();
     axum::Json(json!({ "scenes": names })).into_response()
 }
 
-async fn ws(ws: WebSocketUpgrade, State(state): State<Arc<AppState>>) -> Response {
-    let scene = state.scene.clone();
-    ws.on_upgrade(move |socket| connection(socket, scene))
+async fn ws(
+    ws: WebSocketUpgrade,
+    State(state): State<Arc<AppState>>,
+    Query(q): Query<SceneQuery>,
+) -> Response {
+    let scene = state.pick(&q);
+    let fit = state.fit;
+    ws.on_upgrade(move |socket| connection(socket, scene, fit))
 }
 
-async fn connection(mut socket: WebSocket, scene: String) {
-    let session = match Session::new(&scene) {
+async fn connection(mut socket: WebSocket, scene: String, fit: Fit) {
+    let session = match Session::with_fit(&scene, fit) {
         Ok(s) => s,
         Err(e) => {
             let _ = socket.send(Message::Text(error_message(e).into())).await;
@@ -648,12 +806,18 @@ async fn connection(mut socket: WebSocket, scene: String) {
 
 /// The routes: the page, the scene list, the WebSocket.
 pub fn app(scene: &str) -> Router {
+    app_fit(scene, Fit::Once)
+}
+
+/// The routes, the page's camera fitting the scene as `fit` says.
+pub fn app_fit(scene: &str, fit: Fit) -> Router {
     Router::new()
         .route("/", get(page))
         .route("/scenes", get(scenes))
         .route("/ws", get(ws))
         .with_state(Arc::new(AppState {
             scene: scene.to_owned(),
+            fit,
         }))
 }
 
@@ -662,6 +826,16 @@ pub fn app(scene: &str) -> Router {
 pub fn serve(
     scene: &str,
     port: u16,
+    ready: impl FnOnce(std::net::SocketAddr),
+) -> Result<(), CliError> {
+    serve_fit(scene, port, Fit::Once, ready)
+}
+
+/// [`serve`] with the page's camera fitting the scene as `fit` says.
+pub fn serve_fit(
+    scene: &str,
+    port: u16,
+    fit: Fit,
     ready: impl FnOnce(std::net::SocketAddr),
 ) -> Result<(), CliError> {
     // Fail before binding on a scene that does not load.
@@ -679,7 +853,7 @@ pub fn serve(
             .local_addr()
             .map_err(|e| CliError::Invalid(e.to_string()))?;
         ready(addr);
-        axum::serve(listener, app(scene))
+        axum::serve(listener, app_fit(scene, fit))
             .await
             .map_err(|e| CliError::Invalid(format!("server: {e}")))
     })

@@ -119,7 +119,8 @@ fn union(acc: Option<Aabb>, b: &Aabb) -> Option<Aabb> {
     Some(acc.map_or(*b, |a| a.union(b)))
 }
 
-/// The box around every shape of the world; when the static shapes reach
+/// The box around every shape of the world, a moving body's shapes as the
+/// disc they sweep turning about its centre of mass; when the static shapes reach
 /// more than 20 times beyond the moving ones both ways (a huge static
 /// box around a small pile), the moving bodies' box grown to 3 times its
 /// size, clipped to the whole. A moving body without shapes counts as a
@@ -131,12 +132,36 @@ pub fn scene_bounds(world: &World) -> Aabb {
     for body in world.body_handles() {
         let dynamic = world.body_type(body).is_ok_and(|t| t != BodyType::Static);
         let shapes = world.body_shapes(body).unwrap_or_default();
+        let mut own: Option<Aabb> = None;
         for s in &shapes {
             if let Ok(d) = world.shape(*s) {
-                all = union(all, &d.aabb);
-                if dynamic {
-                    moving = union(moving, &d.aabb);
+                own = union(own, &d.aabb);
+            }
+        }
+        if let Some(mut b) = own {
+            // A moving body counts as the disc its shapes sweep turning
+            // about its centre of mass: a drum turning on a pin stays in
+            // view at every angle, not only at the first.
+            if dynamic
+                && let Ok(c) = world.center_of_mass(body)
+                && c.is_finite()
+            {
+                let reach = [
+                    b.lower,
+                    b.upper,
+                    Vec2::new(b.lower.x, b.upper.y),
+                    Vec2::new(b.upper.x, b.lower.y),
+                ]
+                .iter()
+                .map(|p| (*p - c).length())
+                .fold(0.0 as Real, Real::max);
+                if reach.is_finite() {
+                    b = b.union(&Aabb::new(c - Vec2::splat(reach), c + Vec2::splat(reach)));
                 }
+            }
+            all = union(all, &b);
+            if dynamic {
+                moving = union(moving, &b);
             }
         }
         // A moving body without shapes (the bridge's planks have a mass

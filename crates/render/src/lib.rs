@@ -10,7 +10,8 @@
 //! | [`camera`] | [`Camera`]: fit a box or the scene, follow a body, world ↔ pixels  |
 //! | [`raster`] | [`Raster`]: a `DebugDraw` into a pixmap, saved as PNG              |
 //! | [`svg`]    | [`Svg`]: a `DebugDraw` writing SVG elements                        |
-//! | [`clip`]   | [`GifWriter`]: frames of a run as one looping GIF                  |
+//! | [`clip`]   | [`GifWriter`]: frames of a run as one looping GIF (a palette made from the first frame) |
+//! | [`text`]   | text in PNG / GIF frames: labels and the run's overlay ([`Raster::overlay`]) |
 //!
 //! ```
 //! use janus2d_render::{Camera, Raster};
@@ -31,6 +32,7 @@ pub mod camera;
 pub mod clip;
 pub mod raster;
 pub mod svg;
+pub mod text;
 
 pub use camera::{Camera, scene_bounds};
 pub use clip::GifWriter;

@@ -7,7 +7,7 @@
 //! | solid capsule    | as a rounded two-vertex polygon                         |
 //! | polygon, circle, segment | 1 px outlines / lines                           |
 //! | point            | a filled square of the given size, px                   |
-//! | text             | not drawn (tiny-skia has no fonts; the SVG renderer draws text) |
+//! | text             | 16 px Noto Sans Mono, its top left corner at the point ([`crate::text`]) |
 //!
 //! Coordinates go through the [`Camera`]; everything is anti-aliased.
 
@@ -94,6 +94,11 @@ impl Raster {
     #[must_use]
     pub fn pixmap(&self) -> &Pixmap {
         &self.pixmap
+    }
+
+    /// The pixels, to change (the text module blends into them).
+    pub(crate) fn pixmap_mut(&mut self) -> &mut Pixmap {
+        &mut self.pixmap
     }
 
     /// The picture as straight (not premultiplied) RGBA bytes, row by row.
@@ -209,6 +214,13 @@ impl DebugDraw for Raster {
     fn segment(&mut self, p1: Vec2, p2: Vec2, color: Color) {
         if let Some(path) = self.path_of(&[p1, p2], false) {
             self.stroke_path(&path, 1.0, color);
+        }
+    }
+
+    fn text(&mut self, p: Vec2, text: &str, color: Color) {
+        let (x, y) = self.xy(p);
+        if x.is_finite() && y.is_finite() {
+            self.text_at(x as i32, y as i32, text, color);
         }
     }
 

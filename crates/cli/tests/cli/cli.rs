@@ -31,10 +31,10 @@ fn example() -> PathBuf {
 #[test]
 fn every_small_built_in_scene_runs() {
     for e in catalog::entries() {
-        if e.desc.bodies.len() > 700 {
+        if e.bodies > 700 {
             continue; // the big ones run in the CI smoke line and the benchmarks
         }
-        let mut scene = runner::load(&e.name).unwrap();
+        let mut scene = runner::load(e.name).unwrap();
         let mut out = Vec::new();
         let s = runner::run(&mut scene, &quiet(3), &mut out).unwrap();
         assert_eq!(s.steps, 3, "{}", e.name);
@@ -74,7 +74,7 @@ fn export_round_trip_is_bit_identical() {
     }
     for name in names {
         let e = catalog::find(name).unwrap();
-        let file = SceneFile::from_desc(&e.desc).unwrap();
+        let file = SceneFile::from_desc(&e.build()).unwrap();
         let json = file.to_json();
         let back = scene_file::parse(&json, name).unwrap();
         assert_eq!(back, file, "{name}: serialise → parse is the identity");
@@ -94,7 +94,7 @@ fn export_round_trip_is_bit_identical() {
     // A scripted scene is refused with a message.
     let rain = catalog::find("rain").unwrap();
     assert!(
-        SceneFile::from_desc(&rain.desc)
+        SceneFile::from_desc(&rain.build())
             .unwrap_err()
             .contains("script")
     );
@@ -213,8 +213,21 @@ fn frames_and_csv_are_written() {
     let s = runner::run(&mut scene, &options, &mut Vec::new()).unwrap();
     // The first frame and one every 2 steps.
     assert_eq!(s.frames, 4);
-    let pngs = std::fs::read_dir(&dir).unwrap().count();
-    assert_eq!(pngs, 4);
+    // Named by step, not by index.
+    let mut pngs: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    pngs.sort();
+    assert_eq!(
+        pngs,
+        [
+            "frame_00000.png",
+            "frame_00002.png",
+            "frame_00004.png",
+            "frame_00006.png"
+        ]
+    );
     let rows = std::fs::read_to_string(&csv).unwrap();
     let lines: Vec<&str> = rows.lines().collect();
     assert_eq!(lines.len(), 7, "header + one row per step");
@@ -231,7 +244,7 @@ fn frames_and_csv_are_written() {
     };
     let s = runner::run(&mut scene, &options, &mut Vec::new()).unwrap();
     assert_eq!(s.frames, 3);
-    let doc = std::fs::read_to_string(svg_dir.join("frame_00002.svg")).unwrap();
+    let doc = std::fs::read_to_string(svg_dir.join("frame_00006.svg")).unwrap();
     assert_eq!(doc.matches("<polygon").count(), 2, "the ground and the box");
 
     let mut scene = runner::load("single_box").unwrap();
@@ -245,6 +258,41 @@ fn frames_and_csv_are_written() {
     assert_eq!(s.frames, 6, "the first and every 2nd step");
     let bytes = std::fs::read(&gif).unwrap();
     assert_eq!(&bytes[..6], b"GIF89a");
+}
+
+/// `--overlay` writes step, time, bodies and ms/step in the frame's top
+/// left corner and nowhere else.
+#[test]
+fn the_overlay_marks_the_corner_and_long_runs_pad_wider() {
+    let plain = temp("overlay-off");
+    let marked = temp("overlay-on");
+    for (dir, overlay) in [(&plain, false), (&marked, true)] {
+        let mut scene = runner::load("single_box").unwrap();
+        let options = RunOptions {
+            frames: Frames::Png(dir.clone()),
+            every: Some(3),
+            size: (320, 120),
+            overlay,
+            ..quiet(3)
+        };
+        runner::run(&mut scene, &options, &mut Vec::new()).unwrap();
+    }
+    let read = |d: &PathBuf| {
+        let bytes = std::fs::read(d.join("frame_00003.png")).unwrap();
+        let pm = tiny_skia::Pixmap::decode_png(&bytes).unwrap();
+        pm.pixels()
+            .iter()
+            .map(|p| [p.red(), p.green(), p.blue()])
+            .collect::<Vec<_>>()
+    };
+    let (a, b) = (read(&plain), read(&marked));
+    let changed: Vec<usize> = (0..a.len()).filter(|&i| a[i] != b[i]).collect();
+    assert!(changed.len() > 200, "{} px changed", changed.len());
+    // One line at the top left: within 24 px of the top.
+    assert!(
+        changed.iter().all(|&i| i / 320 < 24),
+        "the overlay stays in its corner"
+    );
 }
 
 #[test]

@@ -5,6 +5,7 @@
 use std::time::Duration;
 
 use futures_util::{SinkExt, StreamExt};
+use janus2d_cli::runner::Fit;
 use janus2d_cli::serve::{Control, Session, app};
 use serde_json::Value;
 use tokio::io::{AsyncReadExt, AsyncWriteExt};
@@ -61,6 +62,21 @@ async fn page_scenes_and_the_websocket_protocol() {
     assert!(page.contains("<canvas") && page.contains("/ws"));
     let scenes = get(addr, "/scenes").await;
     assert!(scenes.contains("\"single_box\"") && scenes.contains("\"tumbler\""));
+    // The served scene is the one picked, and its first frame is in the
+    // page as an SVG (the ground and the box), before any script runs.
+    assert!(page.contains(r#"<option value="single_box" selected>"#));
+    assert_eq!(page.matches(" selected>").count(), 1);
+    assert!(page.contains("<svg") && page.matches("<polygon").count() >= 2);
+    assert!(!page.contains("{{"), "every placeholder filled");
+    // `?scene=` picks another built-in scene; a path does not load.
+    let tumbler = get(addr, "/?scene=tumbler").await;
+    assert!(tumbler.contains(r#"<option value="tumbler" selected>"#));
+    assert!(
+        tumbler.matches("<polygon").count() > 2000,
+        "the drum's boxes"
+    );
+    let sneaky = get(addr, "/?scene=/etc/passwd").await;
+    assert!(sneaky.contains(r#"<option value="single_box" selected>"#));
 
     let (mut ws, _) = tokio_tungstenite::connect_async(format!("ws://{addr}/ws"))
         .await
@@ -274,6 +290,29 @@ fn grab_drag_and_spawn() {
         })
         .is_err()
     );
+}
+
+/// `--fit each` sends the bounds with every frame; `once` never.
+#[test]
+fn the_page_camera_follows_fit() {
+    let mut each = Session::with_fit("single_box", Fit::Each).unwrap();
+    let mut once = Session::new("single_box").unwrap();
+    for _ in 0..3 {
+        each.advance().unwrap();
+        once.advance().unwrap();
+        let e: Value = serde_json::from_str(&each.next_frame()).unwrap();
+        let o: Value = serde_json::from_str(&once.next_frame()).unwrap();
+        assert_eq!(e["fit"].as_array().unwrap().len(), 4);
+        assert!(o["fit"].is_null());
+    }
+    let mut every = Session::with_fit("single_box", Fit::Every(2)).unwrap();
+    let mut sent = Vec::new();
+    for _ in 0..4 {
+        every.advance().unwrap();
+        let f: Value = serde_json::from_str(&every.next_frame()).unwrap();
+        sent.push(!f["fit"].is_null());
+    }
+    assert_eq!(sent, [false, true, false, true]);
 }
 
 /// The page is sent every joint kind of `joint_zoo`: with the joints flag
