@@ -364,20 +364,15 @@ fn weld_tree_solve_satisfies_every_soft_row() {
 /// took the lever arm in (see `weld_tree_residual`).
 #[test]
 fn weld_tree_residual_of_a_light_inertia_under_a_long_arm() {
-    let body = |mass: Real, inertia: Real| BodySpec::dynamic(Vec2::ZERO, mass, inertia);
+    // The figures as the f64 run printed them, rounded to f32 in that build.
+    let body =
+        |mass: f64, inertia: f64| BodySpec::dynamic(Vec2::ZERO, mass as Real, inertia as Real);
+    let v = |x: f64, y: f64| Vec2::new(x as Real, y as Real);
     let case = WeldCase {
         bodies: vec![body(92.240_438, 144.022_87), body(995.063_35, 0.130_313_58)],
         links: vec![
-            (
-                0,
-                Vec2::new(-0.523_266_3, 0.0),
-                Vec2::new(-1.170_456_6, 0.0),
-            ),
-            (
-                1,
-                Vec2::new(0.441_738_7, 0.0),
-                Vec2::new(1.156_770_8, -1.345_968_9),
-            ),
+            (0, v(-0.523_266_3, 0.0), v(-1.170_456_6, 0.0)),
+            (1, v(0.441_738_7, 0.0), v(1.156_770_8, -1.345_968_9)),
         ],
         use_bias: true,
     };
