@@ -192,6 +192,28 @@ impl BodyDef {
         self
     }
 
+    /// Locks or frees the rotation (builder style): a body with fixed
+    /// rotation never turns.
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let def = BodyDef::dynamic(Vec2::ZERO).with_fixed_rotation(true).with_user_data(7);
+    /// assert!(def.fixed_rotation);
+    /// assert_eq!(def.user_data, 7);
+    /// ```
+    #[must_use]
+    pub fn with_fixed_rotation(mut self, fixed: bool) -> Self {
+        self.fixed_rotation = fixed;
+        self
+    }
+
+    /// Sets the opaque user value (builder style).
+    #[must_use]
+    pub fn with_user_data(mut self, value: u64) -> Self {
+        self.user_data = value;
+        self
+    }
+
     /// Sets the angle (builder style).
     #[must_use]
     pub fn with_angle(mut self, angle: Real) -> Self {

@@ -568,12 +568,7 @@ pub fn portal_def(
     direction: Vec2,
     half_width: Real,
 ) -> janus2d_world::PortalDef {
-    janus2d_world::PortalDef {
-        body,
-        anchor,
-        direction,
-        half_width,
-    }
+    janus2d_world::PortalDef::new(body, anchor, direction, half_width)
 }
 
 /// The determinism scene: three chains of 12 hinged bodies from a static

@@ -102,6 +102,34 @@ impl Default for ShapeDef {
 }
 
 impl ShapeDef {
+    /// A sensor: it reports overlaps and never pushes (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::ShapeDef;
+    /// let def = ShapeDef::default().sensor().with_hit_events(false).with_user_data(3);
+    /// assert!(def.is_sensor && !def.enable_hit_events);
+    /// assert_eq!(def.user_data, 3);
+    /// ```
+    #[must_use]
+    pub fn sensor(mut self) -> Self {
+        self.is_sensor = true;
+        self
+    }
+
+    /// Turns the shape's hit events on or off (builder style).
+    #[must_use]
+    pub fn with_hit_events(mut self, on: bool) -> Self {
+        self.enable_hit_events = on;
+        self
+    }
+
+    /// Sets the opaque user value (builder style).
+    #[must_use]
+    pub fn with_user_data(mut self, value: u64) -> Self {
+        self.user_data = value;
+        self
+    }
+
     /// Sets the friction (builder style).
     #[must_use]
     pub fn with_friction(mut self, friction: Real) -> Self {

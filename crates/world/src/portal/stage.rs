@@ -144,6 +144,31 @@ pub struct PortalDef {
     pub half_width: Real,
 }
 
+impl PortalDef {
+    /// A portal on `body`: an aperture centred at `anchor` (body frame,
+    /// m), its face looking along `direction` (body frame; normalised on
+    /// creation), `half_width` m to each side (> 0). Checked when the pair
+    /// is created.
+    ///
+    /// ```
+    /// use janus2d_world::{PortalDef, World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let floor = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    /// let p = PortalDef::new(floor, Vec2::new(0.0, 0.5), Vec2::Y, 1.0);
+    /// assert_eq!(p.half_width, 1.0);
+    /// ```
+    #[must_use]
+    pub fn new(body: BodyHandle, anchor: Vec2, direction: Vec2, half_width: Real) -> Self {
+        PortalDef {
+            body,
+            anchor,
+            direction,
+            half_width,
+        }
+    }
+}
+
 /// A linked pair of portals.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PortalPairDef {
