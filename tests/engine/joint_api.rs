@@ -104,8 +104,12 @@ fn a_softer_joint_constraint_stretches_more() {
 
 #[test]
 fn user_data_from_the_definition_is_kept() {
-    let (world, _, j) = pendulum(|d| d.base.user_data = 42);
+    let (mut world, _, j) = pendulum(|d| d.base.user_data = 42);
     assert_eq!(world.joint_user_data(j), Ok(42));
+    // One value: the setter changes the definition the joint reports.
+    world.set_joint_user_data(j, 7).unwrap();
+    assert_eq!(world.joint_user_data(j), Ok(7));
+    assert_eq!(world.joint(j).unwrap().def_base().user_data, 7);
 }
 
 #[test]

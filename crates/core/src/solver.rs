@@ -620,9 +620,9 @@ pub fn clamp_speed(v: Vec2, max: Real) -> Vec2 {
     unit * (max / unit.length())
 }
 
-/// The speed limit again after a stage that changed velocities (the
-/// constraint solve, relax, restitution): `max_linear_speed` holds
-/// whenever positions are integrated and after the step. (The rotation
+/// The speed limit again after the last stages that changed velocities
+/// (relax, restitution), before the step ends; positions are integrated
+/// under it too (`integrate_positions_on`). (The rotation
 /// limit stays a limit of the integration only: clamping spin after the
 /// solve changes valid scenes, spinner's hash among them.)
 fn clamp_velocity_terms(terms: &[VelocityTerms], states: &mut [BodyState], team: &Team) {
@@ -647,12 +647,25 @@ pub fn integrate_positions(ctx: &StepContext, bodies: &mut BodySet) {
 }
 
 /// [`integrate_positions`] on the team, in blocks of bodies.
-fn integrate_positions_on(ctx: &StepContext, states: &mut [BodyState], team: &Team) {
+/// The speed limit is applied on the way (the solve may have changed the
+/// velocities), in the same pass: a dynamic body's velocity is clamped to
+/// its `max_linear_speed` before it moves.
+fn integrate_positions_on(
+    ctx: &StepContext,
+    terms: &[VelocityTerms],
+    states: &mut [BodyState],
+    team: &Team,
+) {
     let h = ctx.h;
     team.for_each_chunk_mut(states, BODY_BLOCK, |i, block| {
+        let start = i * BODY_BLOCK;
         // State 0 is the static identity: it never moves.
         let skip = usize::from(i == 0);
-        for state in block.iter_mut().skip(skip) {
+        let terms = &terms[start..start + block.len()];
+        for (t, state) in terms.iter().zip(block.iter_mut()).skip(skip) {
+            if t.dynamic {
+                state.v = clamp_speed(state.v, t.max_v);
+            }
             state.dq = state.dq.integrate(h * state.w);
             state.dp += h * state.v;
         }
@@ -781,9 +794,8 @@ fn solve_step_on(
                 batches[i].solve_late_on(ctx, &mut bodies.states, true, team);
             }
         }
-        clamp_velocity_terms(&terms, &mut bodies.states, team);
         first.solve += lap(&mut t);
-        integrate_positions_on(ctx, &mut bodies.states, team);
+        integrate_positions_on(ctx, &terms, &mut bodies.states, team);
         first.integrate += lap(&mut t);
         for _ in 0..relax_iterations {
             for &i in &active {

@@ -154,6 +154,10 @@ impl ContinuousStage {
             }
         }
         self.counters.toi_bodies = self.fast.len() + self.bullets.len();
+        if self.counters.toi_bodies == 0 {
+            // Nothing fast: no per-body scratch to fill.
+            return;
+        }
         let fast = std::mem::take(&mut self.fast);
         // Fast bodies that are not bullets sweep against static shapes
         // only, so no one's sweep reads another's move: with threads their

@@ -41,7 +41,6 @@ pub type JointHandle = Handle<JointTag>;
 struct JointSlot {
     kind: JointKind,
     index: u32,
-    user_data: u64,
 }
 
 /// A joint whose force or torque passed its threshold in the last step
@@ -307,9 +306,9 @@ impl JointSet {
             .map_err(|e| WorldError::of_handle(e, WorldError::StaleJoint))
     }
 
-    /// A joint's opaque user value (0 until set).
+    /// A joint's opaque user value (its definition's `base.user_data`).
     pub fn user_data(&self, joint: JointHandle) -> Result<u64, WorldError> {
-        Ok(self.slot(joint)?.user_data)
+        Ok(self.get(joint)?.def_base().user_data)
     }
 
     /// Sets a joint's opaque user value.
@@ -318,8 +317,10 @@ impl JointSet {
         joint: JointHandle,
         value: u64,
     ) -> Result<(), WorldError> {
-        self.slot(joint)?;
-        self.slots.live_mut(joint.index).user_data = value;
+        let j = self.get_mut(joint)?;
+        let mut def = j.def();
+        def.base_mut().user_data = value;
+        j.set_def(def)?;
         Ok(())
     }
 
@@ -381,7 +382,6 @@ impl JointSet {
         let (index, generation) = self.slots.insert(JointSlot {
             kind: def.kind(),
             index: self.joints.len() as u32,
-            user_data: def.base().user_data,
         });
         let handle = JointHandle::new(index, generation, self.owner);
         self.joints.push(Joint::new(def.clone()));
@@ -665,7 +665,7 @@ impl JointSet {
                 let joint = self.handles[k];
                 out.push(JointEvent {
                     joint,
-                    user_data: self.slots.live(joint.index).user_data,
+                    user_data: j.def_base().user_data,
                     force: j.constraint_force(),
                     torque: j.constraint_torque(),
                 });

@@ -123,7 +123,7 @@ pub mod bytes {
     /// solved list belong to constraint building, not the narrowphase; 9:
     /// the portal stage keeps the events pushed between steps apart from
     /// the last step's).
-    pub const SNAPSHOT_VERSION: u16 = 9;
+    pub const SNAPSHOT_VERSION: u16 = 10;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.
