@@ -90,7 +90,7 @@ pub struct ObjectMass {
 /// velocity iterations and restitution read and write) and which bodies
 /// and contacts the lanes hold.
 #[derive(Clone, Debug)]
-struct WideContact {
+pub(crate) struct WideContact {
     /// State index of body a per lane (0: static identity or padding).
     state_a: [u32; LANES],
     /// State index of body b per lane.
@@ -439,6 +439,74 @@ impl ContactSolver {
         &self.overflow
     }
 
+    /// Number of colour slots (the colours' chunk lists).
+    pub(crate) fn colour_slots(&self) -> usize {
+        self.colours.len()
+    }
+
+    /// Per body state, the colours in which a contact lane moves it: bit
+    /// `c` of `out[s]` (the overflow takes no colour).
+    pub(crate) fn moving_colours(&self, state_count: usize, out: &mut Vec<u32>) {
+        out.clear();
+        out.resize(state_count, 0);
+        for (c, chunks) in self.colours.iter().enumerate() {
+            for chunk in chunks {
+                for k in 0..chunk.len {
+                    for (side, states) in [&chunk.state_a, &chunk.state_b].into_iter().enumerate() {
+                        let moving = chunk.moving & (1 << (side * LANES + k)) != 0;
+                        if let Some(bits) = out.get_mut(states[k] as usize).filter(|_| moving) {
+                            *bits |= 1 << c;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// True when a stage should spread the colours over `team`.
+    pub(crate) fn wants_team(&self, team: &Team) -> bool {
+        team.threads() > 1 && self.colours.iter().any(|c| c.len() > SERIAL_CHUNKS)
+    }
+
+    /// The plan of the colours' chunks (built at prepare on a team of more
+    /// than one thread).
+    pub(crate) fn plan(&self) -> &StatePlan<PLAN_SLOTS> {
+        &self.plan
+    }
+
+    /// Colour `c`'s chunks and the plan whose group `c` they are, when the
+    /// plan has that group; chunks per block for `team`.
+    pub(crate) fn colour_group(
+        &mut self,
+        c: usize,
+        team: &Team,
+    ) -> (&StatePlan<PLAN_SLOTS>, &mut [WideContact], usize) {
+        let chunks = self.colours.get_mut(c).map_or(&mut [][..], |v| &mut v[..]);
+        let per_block = block_len(team, chunks.len());
+        (&self.plan, chunks, per_block)
+    }
+
+    /// Runs `stage` over colour `c`'s chunks (on the team when the colour
+    /// is long, see `colour_stage`).
+    pub(crate) fn run_colour(
+        &mut self,
+        c: usize,
+        stage: Stage,
+        states: &mut [BodyState],
+        team: &Team,
+    ) {
+        if let Some(chunks) = self.colours.get_mut(c) {
+            colour_stage(team, &self.plan, c, chunks, states, stage);
+        }
+    }
+
+    /// Whether colour `c` runs on the caller alone (short, or a serial
+    /// team): see `colour_stage`.
+    pub(crate) fn colour_is_short(&self, c: usize, team: &Team) -> bool {
+        let chunks = self.colours.get(c).map_or(0, Vec::len);
+        team.threads() == 1 || chunks <= SERIAL_CHUNKS || c >= self.plan.group_count()
+    }
+
     fn prepare(
         &mut self,
         ctx: &StepContext,
@@ -543,7 +611,7 @@ impl ContactSolver {
 
     /// The overflow: its contacts one by one, then the coupled groups of
     /// light clusters ([`crate::contact_group`]).
-    fn solve_overflow(
+    pub(crate) fn solve_overflow(
         &mut self,
         states: &mut [BodyState],
         use_bias: bool,
@@ -619,7 +687,7 @@ fn block_len(team: &Team, chunks: usize) -> usize {
 
 /// A velocity stage of the contact chunks.
 #[derive(Clone, Copy)]
-enum Stage {
+pub(crate) enum Stage {
     WarmStart,
     Solve {
         use_bias: bool,
@@ -631,9 +699,20 @@ enum Stage {
     },
 }
 
+impl Stage {
+    /// The solve (`use_bias`) or relax stage of a step.
+    pub(crate) fn solve(ctx: &StepContext, use_bias: bool) -> Self {
+        Stage::Solve {
+            use_bias,
+            inv_h: ctx.inv_h,
+            push_max: ctx.contact_push_max_velocity,
+        }
+    }
+}
+
 impl WideContact {
     #[inline(always)]
-    fn run<S: LaneStates>(&mut self, stage: Stage, states: &mut S) {
+    pub(crate) fn run<S: LaneStates>(&mut self, stage: Stage, states: &mut S) {
         match stage {
             Stage::WarmStart => self.warm_start(states),
             Stage::Solve {
@@ -689,7 +768,7 @@ const B: usize = 1;
 
 /// The body states as the lanes of one chunk see them: the state of side
 /// `side` (a or b) of lane `k`, and its velocities written back.
-trait LaneStates {
+pub(crate) trait LaneStates {
     fn load(&self, side: usize, k: usize) -> BodyState;
     fn store(&mut self, side: usize, k: usize, v: Vec2, w: Real);
 }
@@ -716,7 +795,7 @@ impl LaneStates for Direct<'_> {
 }
 
 /// Slots per chunk in the parallel stages' plan: both bodies of every lane.
-const PLAN_SLOTS: usize = 2 * LANES;
+pub(crate) const PLAN_SLOTS: usize = 2 * LANES;
 
 /// The parallel view: the chunk's slots of the verified plan (slot `k`:
 /// body a of lane `k`, slot `LANES + k`: body b); only moving bodies are

@@ -68,9 +68,10 @@
 use janus2d_core::body::BodyState;
 use janus2d_core::constraint::StepContext;
 use janus2d_core::graph::{COLOURS, ColourGraph};
-use janus2d_core::parallel::{StatePlan, Team};
+use janus2d_core::parallel::{CrossPlan, StatePlan, Team};
 use smallvec::SmallVec;
 
+use crate::contact_solver::ContactSolver;
 use crate::joint::Joint;
 use crate::joint_base::is_moving;
 use crate::parts::{PairOf, WRITE_A, WRITE_B};
@@ -97,11 +98,12 @@ const WARM_START_BLOCK: usize = 256;
 /// See the module docs.
 #[derive(Clone, Debug, Default)]
 pub struct JointColours {
-    /// Per joint: `[state a, state b, flags]` of this step (zeros for a
-    /// joint that is not solved).
-    keys: Vec<[u32; 3]>,
+    /// Per joint: `[state a, state b, flags, contact colours of a, contact
+    /// colours of b]` of this step (zeros for a joint that is not solved;
+    /// the colours the contacts hold on each moving end).
+    keys: Vec<Key>,
     /// The keys and the state count of the last colouring.
-    built_keys: Vec<[u32; 3]>,
+    built_keys: Vec<Key>,
     built_states: usize,
     graph: ColourGraph,
     /// The solved joints (storage indices), colour by colour, each colour
@@ -129,6 +131,12 @@ pub struct JointColours {
     body_joints: Vec<u32>,
     /// The states that have a joint in `body_joints`, ascending.
     jointed: Vec<u32>,
+    /// Per state: the colours in which the step's contacts move it
+    /// (empty without contacts).
+    occupied: Vec<u32>,
+    /// The colours' plan checked against the contacts' plan: a colour's
+    /// joints and contacts then run as one job on the team.
+    cross: CrossPlan,
 }
 
 impl JointColours {
@@ -164,17 +172,27 @@ impl JointColours {
     /// colours the joints again if a key or the state count changed since
     /// the last colouring.
     pub fn update(&mut self, joints: &[Joint], states: &[BodyState]) {
-        self.update_on(joints, states, &Team::serial());
+        self.update_on(joints, states, &[], &Team::serial());
     }
 
-    /// [`JointColours::update`] with the keys read in blocks on the step's
-    /// team (a colouring, when needed, runs on the caller).
-    pub fn update_on(&mut self, joints: &[Joint], states: &[BodyState], team: &Team) {
+    /// [`JointColours::update`] around the contacts' colours, with the keys
+    /// read in blocks on the step's team (a colouring, when needed, runs on
+    /// the caller). `occupied[s]` holds the colours in which the contacts
+    /// already move body state `s` (empty: no contact); a joint takes a
+    /// colour that neither of its moving ends holds there, so that a
+    /// colour's joints and contacts can run as one job.
+    pub fn update_on(
+        &mut self,
+        joints: &[Joint],
+        states: &[BodyState],
+        occupied: &[u32],
+        team: &Team,
+    ) {
         const BLOCK: usize = 1024;
-        self.keys.resize(joints.len(), [0; 3]);
+        self.keys.resize(joints.len(), [0; 5]);
         team.for_each_chunk_mut(&mut self.keys, BLOCK, |i, block| {
             for (k, j) in block.iter_mut().zip(&joints[i * BLOCK..]) {
-                *k = key(j, states);
+                *k = key(j, states, occupied);
             }
         });
         if self.keys == self.built_keys
@@ -193,6 +211,10 @@ impl JointColours {
     fn recolour(&mut self) {
         let keys = &self.built_keys;
         self.graph.reset(self.built_states);
+        for k in keys.iter().filter(|k| k[2] & COLOURED != 0) {
+            self.graph.mark(k[0], k[3]);
+            self.graph.mark(k[1], k[4]);
+        }
         // The colour of each joint (COLOURS: overflow), reusing `position`.
         let mut counts = [0u32; COLOURS + 1];
         self.position.clear();
@@ -208,8 +230,8 @@ impl JointColours {
             counts[colour] += 1;
             self.position.push(colour as u32);
         }
-        // Greedy colours are contiguous (colour c is taken only where c − 1
-        // is blocked), so this is the number of non-empty colours.
+        // One past the last colour in use (around the contacts' colours a
+        // colour below it may be empty).
         let used = counts[..COLOURS]
             .iter()
             .rposition(|&n| n > 0)
@@ -319,6 +341,127 @@ impl JointColours {
         });
     }
 
+    /// [`JointColours::update_on`] around the colours of `contacts` (the
+    /// graph batch's prepare, after the contacts' own): the joints take
+    /// colours in which the contacts move neither of their bodies; then,
+    /// on a team of several threads, the plans are checked against each
+    /// other ([`CrossPlan`]).
+    pub(crate) fn update_around(
+        &mut self,
+        joints: &[Joint],
+        states: &[BodyState],
+        contacts: &ContactSolver,
+        team: &Team,
+    ) {
+        let mut occupied = std::mem::take(&mut self.occupied);
+        if joints.is_empty() || contacts.is_empty() {
+            occupied.clear();
+        } else {
+            contacts.moving_colours(states.len(), &mut occupied);
+        }
+        self.update_on(joints, states, &occupied, team);
+        self.occupied = occupied;
+        if team.threads() > 1 && !joints.is_empty() && !contacts.is_empty() {
+            self.cross.verify(&self.plan, contacts.plan(), states.len());
+        }
+    }
+
+    /// The check of the colours' plan against the contacts' (see
+    /// [`JointColours::update_around`]).
+    pub(crate) fn cross(&self) -> &CrossPlan {
+        &self.cross
+    }
+
+    /// Which ends each joint of segment `s` writes, in solve order.
+    pub(crate) fn segment_writes(&self, s: usize) -> &[u8] {
+        match (self.starts.get(s), self.starts.get(s + 1)) {
+            (Some(&a), Some(&b)) => &self.writes[a as usize..b as usize],
+            _ => &[],
+        }
+    }
+
+    /// Colours the joints if they changed since the last colouring (a
+    /// stage called without the batch's prepare).
+    pub(crate) fn ensure_coloured(&mut self, joints: &[Joint], states: &[BodyState]) {
+        if self.position.len() != joints.len() || states.len() != self.built_states {
+            self.update(joints, states);
+        }
+    }
+
+    /// True when a stage should spread the colours over `team`: more than
+    /// one thread and a colour of more than one block.
+    pub(crate) fn wants_team(&self, team: &Team) -> bool {
+        team.threads() > 1
+            && (0..self.colour_count()).any(|c| self.joints_in(c).len() > JOINTS_PER_BLOCK)
+    }
+
+    /// Joints per block for a colour of `len` joints on `team`: about four
+    /// blocks per thread, at least [`JOINTS_PER_BLOCK`].
+    pub(crate) fn block_len(len: usize, team: &Team) -> usize {
+        len.div_ceil(4 * team.threads()).max(JOINTS_PER_BLOCK)
+    }
+
+    /// The plan of the colours' states (group `c`: colour `c`).
+    pub(crate) fn plan(&self) -> &StatePlan<2> {
+        &self.plan
+    }
+
+    /// Solves segment `s` (colour `s`, or the overflow for
+    /// `s == colour_count()`) on the caller, in solve order.
+    pub(crate) fn solve_segment(
+        &self,
+        s: usize,
+        ctx: &StepContext,
+        joints: &mut [Joint],
+        states: &mut [BodyState],
+        use_bias: bool,
+    ) {
+        let (Some(&start), Some(&end)) = (self.starts.get(s), self.starts.get(s + 1)) else {
+            return;
+        };
+        for p in start as usize..end as usize {
+            let j = &mut joints[self.order[p] as usize];
+            let mut pair = PairOf::new(states, j.base().state_a, j.base().state_b, self.writes[p]);
+            j.solve_pair(ctx, &mut pair, use_bias);
+        }
+    }
+
+    /// The solved joints in solve order, for a stage on the team
+    /// ([`JointColours::split`] cuts it by colour; hand it back with
+    /// [`JointColours::put_refs`]).
+    pub(crate) fn take_refs<'j>(&mut self, joints: &'j mut [Joint]) -> Vec<Option<&'j mut Joint>> {
+        let mut refs = self.scratch.take();
+        refs.resize_with(self.order.len(), || None);
+        for (j, &p) in joints.iter_mut().zip(&self.position) {
+            if p != NONE {
+                refs[p as usize] = Some(j);
+            }
+        }
+        refs
+    }
+
+    /// Keeps the allocation of `refs` for the next stage.
+    pub(crate) fn put_refs(&mut self, refs: Vec<Option<&mut Joint>>) {
+        self.scratch.put(refs);
+    }
+
+    /// `refs` (from [`JointColours::take_refs`]) cut into its segments:
+    /// colour by colour, then the overflow.
+    pub(crate) fn split<'r, 'j>(
+        &self,
+        refs: &'r mut [Option<&'j mut Joint>],
+    ) -> SmallVec<[&'r mut [Option<&'j mut Joint>]; COLOURS + 1]> {
+        let mut parts = SmallVec::new();
+        let mut rest = refs;
+        for s in 0..self.colour_count() + 1 {
+            let len = (self.starts[s + 1] - self.starts[s]) as usize;
+            let (part, tail) = std::mem::take(&mut rest).split_at_mut(len);
+            parts.push(part);
+            rest = tail;
+        }
+        parts
+    }
+
     /// One velocity iteration of the joints' Gauss–Seidel rows, colour by
     /// colour (`reverse`: the overflow first, then the colours from the
     /// last), each colour's joints spread over `team`.
@@ -331,49 +474,22 @@ impl JointColours {
         reverse: bool,
         team: &Team,
     ) {
-        if self.position.len() != joints.len() || states.len() != self.built_states {
-            // Not coloured since the joints changed (a stage called without
-            // the batch's prepare).
-            self.update(joints, states);
-        }
+        self.ensure_coloured(joints, states);
         let segments = self.colour_count() + 1;
-        let threads = team.threads();
-        let parallel =
-            threads > 1 && (0..segments - 1).any(|c| self.joints_in(c).len() > JOINTS_PER_BLOCK);
-        if !parallel {
+        if !self.wants_team(team) {
             for s in 0..segments {
                 let s = if reverse { segments - 1 - s } else { s };
-                let range = self.starts[s] as usize..self.starts[s + 1] as usize;
-                for p in range {
-                    let j = &mut joints[self.order[p] as usize];
-                    let mut pair =
-                        PairOf::new(states, j.base().state_a, j.base().state_b, self.writes[p]);
-                    j.solve_pair(ctx, &mut pair, use_bias);
-                }
+                self.solve_segment(s, ctx, joints, states, use_bias);
             }
             return;
         }
-        // The joints in solve order, split by colour.
-        let mut refs = self.scratch.take();
-        refs.resize_with(self.order.len(), || None);
-        for (j, &p) in joints.iter_mut().zip(&self.position) {
-            if p != NONE {
-                refs[p as usize] = Some(j);
-            }
-        }
+        let mut refs = self.take_refs(joints);
         {
-            let mut parts: SmallVec<[&mut [Option<&mut Joint>]; COLOURS + 1]> = SmallVec::new();
-            let mut rest = &mut refs[..];
-            for s in 0..segments {
-                let len = (self.starts[s + 1] - self.starts[s]) as usize;
-                let (part, tail) = std::mem::take(&mut rest).split_at_mut(len);
-                parts.push(part);
-                rest = tail;
-            }
+            let mut parts = self.split(&mut refs);
             for s in 0..segments {
                 let s = if reverse { segments - 1 - s } else { s };
                 let part = &mut *parts[s];
-                let per_block = part.len().div_ceil(4 * threads).max(JOINTS_PER_BLOCK);
+                let per_block = Self::block_len(part.len(), team);
                 if s + 1 == segments || part.len() <= per_block {
                     let writes = &self.writes[self.starts[s] as usize..];
                     for (j, &w) in part.iter_mut().zip(writes) {
@@ -390,18 +506,20 @@ impl JointColours {
                 });
             }
         }
-        self.scratch.put(refs);
+        self.put_refs(refs);
     }
 }
 
-/// A joint's colouring key: its state indices and which ends move (see
-/// [`JointColours::update`]).
+/// A joint's colouring key: its state indices, which ends move, and the
+/// contacts' colours on its moving ends (see [`JointColours::update_on`]).
+type Key = [u32; 5];
+
 #[inline]
-fn key(j: &Joint, states: &[BodyState]) -> [u32; 3] {
+fn key(j: &Joint, states: &[BodyState], occupied: &[u32]) -> Key {
     let base = j.base();
     let (a, b) = (base.state_a, base.state_b);
     if !base.enabled || (a == 0 && b == 0) {
-        return [0, 0, 0];
+        return [0; 5];
     }
     let coloured = if j.has_iterative_rows() { COLOURED } else { 0 };
     let flags = ACTIVE
@@ -416,7 +534,17 @@ fn key(j: &Joint, states: &[BodyState]) -> [u32; 3] {
         } else {
             0
         };
-    [a, b, flags]
+    if coloured == 0 || occupied.is_empty() {
+        return [a, b, flags, 0, 0];
+    }
+    let taken = |s: u32, bit: u8| {
+        if flags & u32::from(bit) != 0 {
+            occupied.get(s as usize).copied().unwrap_or(0)
+        } else {
+            0
+        }
+    };
+    [a, b, flags, taken(a, WRITE_A), taken(b, WRITE_B)]
 }
 
 /// The allocation of a stage's joint references, kept empty between

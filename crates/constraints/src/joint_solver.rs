@@ -31,6 +31,22 @@ pub struct JointBatch<'a> {
     pub colours: &'a mut JointColours,
 }
 
+impl JointBatch<'_> {
+    /// The prepare without the colouring: each joint's rows, then the
+    /// forest from the prepared joints (the same as `JointForest::prepare`).
+    /// Each joint's prepare reads the bodies and writes only itself: blocks
+    /// of joints on the team.
+    pub(crate) fn prepare_rows_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
+        team.for_each_chunk_mut(self.joints, PREPARE_BLOCK, |_, block| {
+            for j in block.iter_mut().filter(|j| j.is_enabled()) {
+                j.prepare(ctx, bodies);
+            }
+        });
+        self.forest
+            .build_on(self.joints, &bodies.states, ctx.direct_joints, team);
+    }
+}
+
 impl ConstraintBatch for JointBatch<'_> {
     fn count(&self) -> usize {
         self.joints.len()
@@ -60,17 +76,9 @@ impl ConstraintBatch for JointBatch<'_> {
         // Joints keep their impulses in place.
     }
     fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
-        // Each joint's prepare reads the bodies and writes only itself:
-        // blocks of joints on the team, then the forest and the colours
-        // from the prepared joints (the same as `JointForest::prepare`).
-        team.for_each_chunk_mut(self.joints, PREPARE_BLOCK, |_, block| {
-            for j in block.iter_mut().filter(|j| j.is_enabled()) {
-                j.prepare(ctx, bodies);
-            }
-        });
-        self.forest
-            .build_on(self.joints, &bodies.states, ctx.direct_joints, team);
-        self.colours.update_on(self.joints, &bodies.states, team);
+        self.prepare_rows_on(ctx, bodies, team);
+        self.colours
+            .update_on(self.joints, &bodies.states, &[], team);
     }
     fn warm_start_on(&mut self, _ctx: &StepContext, states: &mut [BodyState], team: &Team) {
         self.colours.warm_start(self.joints, states, team);

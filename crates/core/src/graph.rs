@@ -46,6 +46,15 @@ impl ColourGraph {
         self.body_colours.resize(state_count, 0);
     }
 
+    /// Marks body state `state` in the colours of `bits` (colours that
+    /// other constraints already hold there), so that
+    /// [`ColourGraph::assign`] colours around them. Out of range: ignored.
+    pub fn mark(&mut self, state: u32, bits: u32) {
+        if let Some(b) = self.body_colours.get_mut(state as usize) {
+            *b |= bits;
+        }
+    }
+
     /// Assigns the lowest colour in which neither body appears and marks
     /// both in it; `None` for a body means it takes no colour (static or
     /// kinematic). Returns `None` when no colour is free (overflow), or

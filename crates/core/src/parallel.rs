@@ -65,7 +65,11 @@
 //!    item by exactly one thread (point 2), through [`PlannedStates`],
 //!    which reaches only that item's slots. So every state is either
 //!    written by one item and touched by no other, or only read, during the
-//!    job: no data race. A plan runs on threads only if it was verified
+//!    job: no data race. Two plans' groups run as one job
+//!    ([`Team::for_each_planned_pair`]) only after a [`CrossPlan`] checked
+//!    that no state written by an item of either group is a slot of an
+//!    item of the other, for exactly these two verifications (ids) and
+//!    this state count: the same argument then covers the items of both. A plan runs on threads only if it was verified
 //!    against the very slice length it is given; otherwise it runs
 //!    serially.
 //!
@@ -385,7 +389,15 @@ pub struct StatePlan<const N: usize> {
     writer_generation: Vec<u32>,
     writer_item: Vec<u32>,
     generation: u32,
+    /// A number no other verification of any plan has given (set by a
+    /// successful [`StatePlan::verify`]): a [`CrossPlan`] names the two
+    /// plans it checked by it.
+    id: u64,
 }
+
+/// The source of [`StatePlan`] ids: each successful verification takes
+/// the next one, so an id names one verified content of one plan.
+static PLAN_IDS: AtomicU64 = AtomicU64::new(1);
 
 impl<const N: usize> StatePlan<N> {
     /// Forgets every item and group.
@@ -479,8 +491,119 @@ impl<const N: usize> StatePlan<N> {
             }
         }
         self.verified = Some(state_count);
+        self.id = PLAN_IDS.fetch_add(1, SeqCst);
         true
     }
+}
+
+/// Two verified plans checked against each other, so that group `g` of
+/// the one and group `g` of the other can run as one job
+/// ([`Team::for_each_planned_pair`]): no state that an item of either
+/// group writes is read or written by an item of the other.
+///
+/// The check names the two plans' verifications (their ids) and the state
+/// count; a plan changed since (cleared, pushed to, verified again) no
+/// longer matches, and the pair then runs as two jobs.
+#[derive(Clone, Debug, Default)]
+pub struct CrossPlan {
+    /// The plan ids and state count of the last successful check.
+    verified: Option<(u64, u64, usize)>,
+    /// Per state: the generation that last marked it written.
+    marks: Vec<u32>,
+    generation: u32,
+}
+
+impl CrossPlan {
+    /// An unchecked pair.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Whether `a` and `b`, as they are now, were checked together for
+    /// `state_count` states.
+    #[must_use]
+    pub fn holds<const N: usize, const M: usize>(
+        &self,
+        a: &StatePlan<N>,
+        b: &StatePlan<M>,
+        state_count: usize,
+    ) -> bool {
+        a.verified == Some(state_count)
+            && b.verified == Some(state_count)
+            && self.verified == Some((a.id, b.id, state_count))
+    }
+
+    /// Checks `a` against `b` (both verified for `state_count` states):
+    /// for every group index both have, no state written by an item of
+    /// one is a slot of an item of the other. Returns whether it holds; a
+    /// check already made for the same verifications returns at once.
+    pub fn verify<const N: usize, const M: usize>(
+        &mut self,
+        a: &StatePlan<N>,
+        b: &StatePlan<M>,
+        state_count: usize,
+    ) -> bool {
+        if self.holds(a, b, state_count) {
+            return true;
+        }
+        self.verified = None;
+        if a.verified != Some(state_count) || b.verified != Some(state_count) {
+            return false;
+        }
+        if self.marks.len() < state_count {
+            self.marks.resize(state_count, 0);
+        }
+        for g in 0..a.group_count().min(b.group_count()) {
+            if !self.disjoint(a, b, g) || !self.disjoint(b, a, g) {
+                return false;
+            }
+        }
+        self.verified = Some((a.id, b.id, state_count));
+        true
+    }
+
+    /// No state written by group `g` of `w` is a slot of group `g` of `r`.
+    fn disjoint<const N: usize, const M: usize>(
+        &mut self,
+        w: &StatePlan<N>,
+        r: &StatePlan<M>,
+        g: usize,
+    ) -> bool {
+        if self.generation == u32::MAX {
+            self.marks.fill(0);
+            self.generation = 0;
+        }
+        self.generation += 1;
+        let generation = self.generation;
+        for item in w.group(g) {
+            for (k, &index) in w.slots[item].iter().enumerate() {
+                if w.writes[item] & (1 << k) != 0 {
+                    // In range: `w` was verified for this state count.
+                    self.marks[index as usize] = generation;
+                }
+            }
+        }
+        r.group(g).all(|item| {
+            r.slots[item]
+                .iter()
+                .all(|&index| self.marks[index as usize] != generation)
+        })
+    }
+}
+
+/// One side of [`Team::for_each_planned_pair`]: the items of group
+/// `group` of `plan` (`items[i]` is the group's `i`-th item), run
+/// `per_block` to a block.
+pub struct PlannedGroup<'i, T, const N: usize> {
+    /// The verified plan.
+    pub plan: &'i StatePlan<N>,
+    /// The group of the plan.
+    pub group: usize,
+    /// One item per planned item of the group.
+    pub items: &'i mut [T],
+    /// Items per block on the team.
+    pub per_block: usize,
 }
 
 /// The states one planned item may touch: its slots of the plan.
@@ -563,6 +686,86 @@ impl Team<'_> {
         self.for_each_chunk_mut(items, per_block, |block, chunk| {
             for (j, item) in chunk.iter_mut().enumerate() {
                 run_item(item, block * per_block.max(1) + j);
+            }
+        });
+    }
+}
+
+impl Team<'_> {
+    /// Runs the items of two planned groups as one job on the team: every
+    /// item of `a` with `fa`, every item of `b` with `fb`, each seeing the
+    /// states of its own slots. The two groups must have been checked
+    /// together ([`CrossPlan::verify`]); otherwise, on a serial team, or
+    /// when either plan is not verified for `states`, `a`'s items run
+    /// first and then `b`'s ([`Team::for_each_planned`] each), which gives
+    /// the same states: no item of one group touches a state that an item
+    /// of the other writes.
+    ///
+    /// One job instead of two is one wait for the team instead of two
+    /// (the joints and the contacts of a colour).
+    ///
+    /// # Panics
+    ///
+    /// When a group's item count differs from its plan's (a bug of the
+    /// caller, not input).
+    pub fn for_each_planned_pair<A: Send, B: Send, const N: usize, const M: usize>(
+        &self,
+        cross: &CrossPlan,
+        a: PlannedGroup<'_, A, N>,
+        b: PlannedGroup<'_, B, M>,
+        states: &mut [BodyState],
+        fa: impl Fn(&mut A, &mut PlannedStates<'_, N>) + Sync,
+        fb: impl Fn(&mut B, &mut PlannedStates<'_, M>) + Sync,
+    ) {
+        let len = states.len();
+        if self.shared.is_none() || !cross.holds(a.plan, b.plan, len) {
+            self.for_each_planned(a.plan, a.group, a.items, states, a.per_block, fa);
+            self.for_each_planned(b.plan, b.group, b.items, states, b.per_block, fb);
+            return;
+        }
+        let (range_a, range_b) = (a.plan.group(a.group), b.plan.group(b.group));
+        assert_eq!(range_a.len(), a.items.len(), "one item per planned item");
+        assert_eq!(range_b.len(), b.items.len(), "one item per planned item");
+        let (slots_a, writes_a) = (&a.plan.slots[range_a.clone()], &a.plan.writes[range_a]);
+        let (slots_b, writes_b) = (&b.plan.slots[range_b.clone()], &b.plan.writes[range_b]);
+        let (per_a, per_b) = (a.per_block.max(1), b.per_block.max(1));
+        let (count_a, count_b) = (a.items.len(), b.items.len());
+        let blocks_a = count_a.div_ceil(per_a);
+        let blocks_b = count_b.div_ceil(per_b);
+        let base = Base(states.as_mut_ptr());
+        let (items_a, items_b) = (Base(a.items.as_mut_ptr()), Base(b.items.as_mut_ptr()));
+        let (base, items_a, items_b) = (&base, &items_a, &items_b);
+        self.run(blocks_a + blocks_b, &|i| {
+            if i < blocks_a {
+                let start = i * per_a;
+                let count = per_a.min(count_a - start);
+                // SAFETY: `start + count ≤ count_a`; block `i` runs once per
+                // job and the blocks of `a` do not overlap (module docs,
+                // point 2); `a.items` stays borrowed until `run` returns.
+                let chunk = unsafe { std::slice::from_raw_parts_mut(items_a.0.add(start), count) };
+                for (j, item) in chunk.iter_mut().enumerate() {
+                    let mut view = PlannedStates {
+                        base: base.0,
+                        len,
+                        slots: &slots_a[start + j],
+                        writes: writes_a[start + j],
+                    };
+                    fa(item, &mut view);
+                }
+            } else {
+                let start = (i - blocks_a) * per_b;
+                let count = per_b.min(count_b - start);
+                // SAFETY: as for `a`, with `b`'s blocks.
+                let chunk = unsafe { std::slice::from_raw_parts_mut(items_b.0.add(start), count) };
+                for (j, item) in chunk.iter_mut().enumerate() {
+                    let mut view = PlannedStates {
+                        base: base.0,
+                        len,
+                        slots: &slots_b[start + j],
+                        writes: writes_b[start + j],
+                    };
+                    fb(item, &mut view);
+                }
             }
         });
     }
@@ -708,6 +911,121 @@ mod tests {
                     }
                 });
             });
+        }
+    }
+
+    /// A cross check fails where one plan's group writes a state the other
+    /// plan's group of the same index reads, holds where they are apart,
+    /// and no longer holds once either plan changes.
+    #[test]
+    fn a_cross_plan_refuses_a_state_both_groups_touch() {
+        let mut a = StatePlan::<2>::default();
+        a.begin_group();
+        a.push([1, 2], 0b11);
+        a.begin_group();
+        a.push([3, 0], 0b01);
+        let mut b = StatePlan::<2>::default();
+        b.begin_group();
+        b.push([4, 5], 0b11);
+        b.begin_group();
+        // Reads state 3, which `a`'s group 1 writes.
+        b.push([6, 3], 0b01);
+        assert!(a.verify(8) && b.verify(8));
+        let mut cross = CrossPlan::new();
+        assert!(!cross.verify(&a, &b, 8));
+        assert!(!cross.holds(&a, &b, 8));
+        // Group 1 of `b` moved to state 7: apart.
+        b.clear();
+        b.begin_group();
+        b.push([4, 5], 0b11);
+        b.begin_group();
+        b.push([6, 7], 0b01);
+        assert!(b.verify(8));
+        assert!(cross.verify(&a, &b, 8));
+        assert!(cross.holds(&a, &b, 8));
+        // The same content verified again is a new verification.
+        assert!(a.verify(8));
+        assert!(!cross.holds(&a, &b, 8));
+        // A state count of which the plans know nothing: refused.
+        assert!(!cross.verify(&a, &b, 9));
+    }
+
+    /// Two planned groups run as one job give the states of running the
+    /// first, then the second, for any team size.
+    #[test]
+    fn planned_pairs_give_the_serial_result() {
+        const N: usize = 600;
+        let states0: Vec<BodyState> = (0..N)
+            .map(|i| BodyState {
+                v: Vec2::new(i as Real, 0.5),
+                w: 0.25 * i as Real,
+                ..BodyState::IDENTITY
+            })
+            .collect();
+        // Group 0: `a` moves states 4k (reading 4k + 1), `b` moves states
+        // 4k + 3: apart.
+        let (mut a, mut b) = (StatePlan::<2>::default(), StatePlan::<1>::default());
+        a.begin_group();
+        let mut items_a = Vec::new();
+        for k in (0..N / 4).map(|k| 4 * k) {
+            a.push([k as u32, k as u32 + 1], 0b01);
+            items_a.push(k as Real);
+        }
+        b.begin_group();
+        let mut items_b = Vec::new();
+        for k in (0..N / 4).map(|k| 4 * k + 3) {
+            b.push([k as u32], 0b1);
+            items_b.push(k as Real);
+        }
+        assert!(a.verify(N) && b.verify(N));
+        let mut cross = CrossPlan::new();
+        assert!(cross.verify(&a, &b, N));
+        let run = |team: &Team| {
+            let mut states = states0.clone();
+            let (mut ia, mut ib) = (items_a.clone(), items_b.clone());
+            for _ in 0..3 {
+                team.for_each_planned_pair(
+                    &cross,
+                    PlannedGroup {
+                        plan: &a,
+                        group: 0,
+                        items: &mut ia,
+                        per_block: 8,
+                    },
+                    PlannedGroup {
+                        plan: &b,
+                        group: 0,
+                        items: &mut ib,
+                        per_block: 5,
+                    },
+                    &mut states,
+                    |x, view| {
+                        let (s, t) = (view.get(0), view.get(1));
+                        *x += 1.0;
+                        view.set_velocity(0, s.v + t.v * 0.5, s.w - t.w + *x);
+                    },
+                    |x, view| {
+                        let s = view.get(0);
+                        view.set_velocity(0, s.v * 2.0, s.w + *x);
+                    },
+                );
+            }
+            let bits: Vec<u64> = states
+                .iter()
+                .flat_map(|s| [s.v.x, s.v.y, s.w])
+                .map(|x| crate::math::to_f64(x).to_bits())
+                .collect();
+            (bits, ia)
+        };
+        let serial = run(&Team::serial());
+        assert_eq!(with_team(run), serial);
+        #[cfg(feature = "parallel")]
+        for threads in [2, 4] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            assert_eq!(pool.install(|| with_team(run)), serial, "{threads} threads");
         }
     }
 

@@ -1,5 +1,6 @@
 //! Joints and portal rows solved together: while a crossing copy carries a
-//! joint, the step's three batches (joints, contacts, portals) run as one
+//! joint, the step's two batches (the graph of joints and contacts, the
+//! portals) run as one
 //! whose late pass repeats the exact joint trees and the stiff portal rows.
 //!
 //! ```text
@@ -15,7 +16,7 @@
 //! corrected times the substep, every substep. Alternating the two exact
 //! blocks a few more times closes that (measured in `docs/portal.md`,
 //! *Joints through portals*). Every other phase (and each phase's team
-//! form, `*_on`) runs the three batches in the order the world uses
+//! form, `*_on`) runs the two batches in the order the world uses
 //! without coupling, so a world with no jointed crossing copy solves
 //! exactly as before.
 
@@ -26,10 +27,11 @@ use janus2d_core::parallel::Team;
 /// Extra (trees, portal rows) passes of the coupled late pass.
 pub const COUPLING_PASSES: usize = 4;
 
-/// The joint, contact and portal batches run as one (see the module docs).
+/// The graph (joint and contact) batch and the portal batch run as one
+/// (see the module docs).
 pub(crate) struct CoupledBatches<'a> {
-    /// Joints, contacts, portals, in that order.
-    pub(crate) batches: [&'a mut dyn ConstraintBatch; 3],
+    /// The graph (joints and contacts), then the portals.
+    pub(crate) batches: [&'a mut dyn ConstraintBatch; 2],
     /// Extra late passes of the trees and the portal rows.
     pub(crate) passes: usize,
 }
@@ -63,12 +65,12 @@ impl ConstraintBatch for CoupledBatches<'_> {
         for b in self.batches.iter_mut().filter(|b| b.count() > 0) {
             b.solve_late(ctx, states, use_bias);
         }
-        let [joints, _, portals] = &mut self.batches;
-        if joints.count() == 0 || portals.count() == 0 {
+        let [graph, portals] = &mut self.batches;
+        if graph.count() == 0 || portals.count() == 0 {
             return;
         }
         for _ in 0..self.passes {
-            joints.solve_late(ctx, states, use_bias);
+            graph.solve_late(ctx, states, use_bias);
             portals.solve_late(ctx, states, use_bias);
         }
     }
@@ -116,12 +118,12 @@ impl ConstraintBatch for CoupledBatches<'_> {
         for b in self.batches.iter_mut().filter(|b| b.count() > 0) {
             b.solve_late_on(ctx, states, use_bias, team);
         }
-        let [joints, _, portals] = &mut self.batches;
-        if joints.count() == 0 || portals.count() == 0 {
+        let [graph, portals] = &mut self.batches;
+        if graph.count() == 0 || portals.count() == 0 {
             return;
         }
         for _ in 0..self.passes {
-            joints.solve_late_on(ctx, states, use_bias, team);
+            graph.solve_late_on(ctx, states, use_bias, team);
             portals.solve_late_on(ctx, states, use_bias, team);
         }
     }

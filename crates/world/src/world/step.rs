@@ -133,10 +133,12 @@ impl World {
         // No restitution anywhere: no restitution pass.
         ctx.restitution = has_shapes && self.collision.counters.restitution_contacts > 0;
         let couple = has_portals && self.portals.copies_carry_joints(&self.joints);
-        let mut joints = self.joints.batch();
-        let mut contacts = janus2d_constraints::ContactBatch {
-            solver: &mut self.contact_solver,
-            object_masses: &self.object_masses,
+        let mut graph = janus2d_constraints::GraphBatch {
+            joints: self.joints.batch(),
+            contacts: janus2d_constraints::ContactBatch {
+                solver: &mut self.contact_solver,
+                object_masses: &self.object_masses,
+            },
         };
         let mut portals = janus2d_constraints::PortalBatch {
             constraints: self.portals.constraints_mut(),
@@ -148,14 +150,13 @@ impl World {
         };
         let mut report = if passes > 0 {
             let mut coupled = crate::portal::coupling::CoupledBatches {
-                batches: [&mut joints, &mut contacts, &mut portals],
+                batches: [&mut graph, &mut portals],
                 passes,
             };
             let mut batches: [&mut dyn ConstraintBatch; 1] = [&mut coupled];
             solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches)
         } else {
-            let mut batches: [&mut dyn ConstraintBatch; 3] =
-                [&mut joints, &mut contacts, &mut portals];
+            let mut batches: [&mut dyn ConstraintBatch; 2] = [&mut graph, &mut portals];
             solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches)
         };
         // The solver checks velocities and deltas; a pose they carried out

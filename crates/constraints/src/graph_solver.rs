@@ -1,0 +1,425 @@
+//! Joints and contacts in one colour sequence: the solver's graph batch.
+//!
+//! The contacts keep their colours from step to step (the persistent
+//! [`ConstraintGraph`](janus2d_core::graph::ConstraintGraph)); the joints
+//! take, around them, the lowest colour in which neither of their moving
+//! bodies is moved by a contact or by another joint ([`JointColours`],
+//! recoloured only when a joint's key or the contacts' colours on its
+//! bodies change). So colour `c` holds joints and contacts that share no
+//! moving body, and one velocity iteration is one sweep of the colours:
+//!
+//! ```text
+//!   forward (solve)                       reverse (alternate sweeps)
+//!   colour 0:  joints₀ ∥ contacts₀        joint overflow
+//!   colour 1:  joints₁ ∥ contacts₁        colour 23: joints₂₃ ∥ contacts₂₃
+//!   …          (one job per colour:       …
+//!   colour 23:  one wait for the team)    colour 0:  joints₀ ∥ contacts₀
+//!   joint overflow                        contact overflow (+ light clusters)
+//!   contact overflow (+ light clusters)
+//! ```
+//!
+//! On the team a colour is one job whose blocks are its joints' blocks and
+//! its contacts' chunks ([`Team::for_each_planned_pair`]), checked once
+//! per step to share no written state ([`CrossPlan`]); a short colour runs
+//! on the leader, joints first. Either way each colour's joints and
+//! contacts touch different moving bodies, so the states are bit-identical
+//! for any thread count.
+//!
+//! | stage            | joints                                   | contacts                           |
+//! |------------------|------------------------------------------|------------------------------------|
+//! | prepare          | rows, forest, colours around the contacts | lanes, overflow, plan              |
+//! | warm start       | per moving body (storage order)          | colour by colour, overflow         |
+//! | solve, relax     | colour by colour, together with the contacts of the colour; then the overflows |
+//! | late solve       | the exact trees                          | —                                  |
+//! | restitution      | —                                        | colour by colour, overflow         |
+//!
+//! The warm start stays two passes: the joints' is per body and needs no
+//! colours (see [`crate::joint_colour`]).
+
+use janus2d_core::body::{BodySet, BodyState};
+use janus2d_core::constraint::{ConstraintBatch, StepContext};
+use janus2d_core::parallel::{PlannedGroup, Team};
+
+use crate::contact_solver::{ContactBatch, Stage};
+use crate::joint_colour::JointColours;
+use crate::joint_solver::JointBatch;
+
+/// The joints and the contacts of a step as one solver batch (see the
+/// module docs).
+pub struct GraphBatch<'a> {
+    /// The joints: rows, tree solve, colours.
+    pub joints: JointBatch<'a>,
+    /// The contacts: chunks per colour and the overflow.
+    pub contacts: ContactBatch<'a>,
+}
+
+impl GraphBatch<'_> {
+    /// One velocity iteration over the shared colours (`reverse`: the
+    /// overflows first, then the colours from the last).
+    fn solve_colours(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+        team: &Team,
+    ) {
+        let joints = &mut **self.joints.joints;
+        let colours = &mut *self.joints.colours;
+        let contacts = &mut *self.contacts.solver;
+        colours.ensure_coloured(joints, states);
+        let stage = Stage::solve(ctx, use_bias);
+        let joint_colours = colours.colour_count();
+        let slots = joint_colours.max(contacts.colour_slots());
+        let (inv_h, push_max) = (ctx.inv_h, ctx.contact_push_max_velocity);
+        // The joints' overflow closes a forward sweep and opens a reverse
+        // one; the contacts' overflow (and light clusters) always comes
+        // after the colours, as the contact solve alone has it.
+        let joint_overflow = joint_colours;
+        if reverse {
+            colours.solve_segment(joint_overflow, ctx, joints, states, use_bias);
+        }
+        if !colours.wants_team(team) && !contacts.wants_team(team) {
+            // Every colour on the caller: its joints, then its contacts.
+            for k in 0..slots {
+                let c = if reverse { slots - 1 - k } else { k };
+                if c < joint_colours {
+                    colours.solve_segment(c, ctx, joints, states, use_bias);
+                }
+                contacts.run_colour(c, stage, states, team);
+            }
+        } else {
+            let mut refs = colours.take_refs(joints);
+            {
+                let mut parts = colours.split(&mut refs);
+                for k in 0..slots {
+                    let c = if reverse { slots - 1 - k } else { k };
+                    let joint_part: &mut [Option<&mut crate::Joint>] = if c < joint_colours {
+                        &mut *parts[c]
+                    } else {
+                        &mut []
+                    };
+                    let joint_block = JointColours::block_len(joint_part.len(), team);
+                    let joints_short = joint_part.len() <= joint_block;
+                    let solve_joint = |j: &mut Option<&mut crate::Joint>,
+                                       view: &mut janus2d_core::parallel::PlannedStates<'_, 2>| {
+                        if let Some(j) = j {
+                            j.solve_pair(ctx, view, use_bias);
+                        }
+                    };
+                    if joints_short && contacts.colour_is_short(c, team) {
+                        // Both short: on the caller, joints first.
+                        for (j, &w) in joint_part.iter_mut().zip(colours.segment_writes(c)) {
+                            let Some(j) = j else { continue };
+                            let (a, b) = (j.base().state_a, j.base().state_b);
+                            let mut pair = crate::parts::PairOf::new(states, a, b, w);
+                            j.solve_pair(ctx, &mut pair, use_bias);
+                        }
+                        contacts.run_colour(c, stage, states, team);
+                        continue;
+                    }
+                    if joint_part.is_empty() {
+                        contacts.run_colour(c, stage, states, team);
+                        continue;
+                    }
+                    let (plan, chunks, chunk_block) = contacts.colour_group(c, team);
+                    if chunks.is_empty() || c >= plan.group_count() {
+                        team.for_each_planned(
+                            colours.plan(),
+                            c,
+                            joint_part,
+                            states,
+                            joint_block,
+                            solve_joint,
+                        );
+                        contacts.run_colour(c, stage, states, team);
+                        continue;
+                    }
+                    team.for_each_planned_pair(
+                        colours.cross(),
+                        PlannedGroup {
+                            plan: colours.plan(),
+                            group: c,
+                            items: joint_part,
+                            per_block: joint_block,
+                        },
+                        PlannedGroup {
+                            plan,
+                            group: c,
+                            items: chunks,
+                            per_block: chunk_block,
+                        },
+                        states,
+                        solve_joint,
+                        |chunk, view| chunk.run(stage, view),
+                    );
+                }
+            }
+            colours.put_refs(refs);
+        }
+        if !reverse {
+            colours.solve_segment(joint_overflow, ctx, joints, states, use_bias);
+        }
+        contacts.solve_overflow(states, use_bias, inv_h, push_max);
+    }
+}
+
+impl ConstraintBatch for GraphBatch<'_> {
+    fn count(&self) -> usize {
+        self.joints.count() + self.contacts.count()
+    }
+    fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
+        self.prepare_on(ctx, bodies, &Team::serial());
+    }
+    fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+        self.warm_start_on(ctx, states, &Team::serial());
+    }
+    fn solve(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+    ) {
+        self.solve_colours(ctx, states, use_bias, reverse, &Team::serial());
+    }
+    fn solve_late(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
+        self.joints.solve_late(ctx, states, use_bias);
+    }
+    fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
+        self.contacts.apply_restitution(ctx, states);
+    }
+    fn store_impulses(&mut self) {
+        // Joints keep their impulses in place; the pipeline reads the
+        // contacts' back from the solver.
+    }
+    fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
+        self.contacts.prepare_on(ctx, bodies, team);
+        self.joints.prepare_rows_on(ctx, bodies, team);
+        let (colours, contacts) = (&mut *self.joints.colours, &*self.contacts.solver);
+        colours.update_around(self.joints.joints, &bodies.states, contacts, team);
+    }
+    fn warm_start_on(&mut self, ctx: &StepContext, states: &mut [BodyState], team: &Team) {
+        if self.joints.count() > 0 {
+            self.joints.warm_start_on(ctx, states, team);
+        }
+        if self.contacts.count() > 0 {
+            self.contacts.warm_start_on(ctx, states, team);
+        }
+    }
+    fn solve_on(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        reverse: bool,
+        team: &Team,
+    ) {
+        self.solve_colours(ctx, states, use_bias, reverse, team);
+    }
+    fn solve_late_on(
+        &mut self,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        team: &Team,
+    ) {
+        if self.joints.count() > 0 {
+            self.joints.solve_late_on(ctx, states, use_bias, team);
+        }
+    }
+    fn apply_restitution_on(&mut self, ctx: &StepContext, states: &mut [BodyState], team: &Team) {
+        if self.contacts.count() > 0 {
+            self.contacts.apply_restitution_on(ctx, states, team);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact_solver::{ContactLane, ContactSolver};
+    use crate::joint::Joint;
+    use crate::joint_tree::JointForest;
+    use crate::revolute::{RevoluteJoint, RevoluteJointDef};
+    use crate::{ContactPointInput, ObjectMass};
+    use janus2d_core::body::{BodyDef, BodyHandle};
+    use janus2d_core::graph::{COLOURS, ColourGraph};
+    use janus2d_core::math::{Real, Vec2};
+    use janus2d_core::solver::SolverSettings;
+
+    /// A row of `n` bodies: contacts between bodies 6k and 6k + 1 and
+    /// between 12k and 12k + 3 (coloured greedily), motor joints
+    /// between bodies two apart (angle rows: every joint takes a colour,
+    /// some beside contacts in colours the contacts use).
+    fn row(n: usize) -> (BodySet, ContactSolver, Vec<Joint>) {
+        let mut set = BodySet::new();
+        let ids: Vec<BodyHandle> = (0..n)
+            .map(|i| {
+                let def = BodyDef::dynamic(Vec2::new(i as Real, 0.0))
+                    .with_angular_velocity(0.01 * i as Real);
+                set.create(&def).unwrap()
+            })
+            .collect();
+        let state = |h: BodyHandle| set.state_index(h).unwrap();
+        let mut graph = ColourGraph::new();
+        graph.reset(set.states.len());
+        let mut contacts = ContactSolver::new();
+        contacts.begin();
+        let mut index = 0;
+        for (gap, every) in [(1, 6), (3, 12)] {
+            for i in (0..n - gap).filter(|i| i % every == 0) {
+                let (a, b) = (ids[i], ids[i + gap]);
+                let (sa, sb) = (state(a), state(b));
+                let colour = graph.assign(Some(sa), Some(sb)).unwrap_or(COLOURS);
+                let point = ContactPointInput {
+                    anchor_a: Vec2::new(0.5, 0.0),
+                    anchor_b: Vec2::new(-0.5, 0.0),
+                    separation: -0.01,
+                    normal_impulse: 0.02,
+                    tangent_impulse: 0.001,
+                };
+                let lane = ContactLane {
+                    body_a: a,
+                    body_b: b,
+                    state_a: sa,
+                    state_b: sb,
+                    inv_masses: [1.0, 2.0, 1.0, 2.0],
+                    normal: Vec2::X,
+                    points: [point; crate::contact::MAX_MANIFOLD_POINTS],
+                    point_count: 1,
+                    friction: 0.6,
+                    restitution: 0.0,
+                    contact_index: index,
+                    cluster: [crate::contact_group::NO_CLUSTER; 2],
+                };
+                index += 1;
+                contacts.push(colour as u8, &lane);
+            }
+        }
+        let mut joints = Vec::new();
+        for i in 0..n - 2 {
+            let mut def = RevoluteJointDef::new(
+                ids[i],
+                ids[i + 2],
+                Vec2::new(1.0, 0.0),
+                Vec2::new(-1.0, 0.0),
+            );
+            def.enable_motor = true;
+            def.max_motor_torque = 2.0;
+            def.motor_speed = 0.5;
+            joints.push(Joint::from(RevoluteJoint::new(def)));
+        }
+        (set, contacts, joints)
+    }
+
+    /// Prepares the row's graph batch on `team`, runs three substeps'
+    /// stages and returns the bits of every velocity, the colours, and
+    /// whether the colours ran as one job each (the plans checked together).
+    fn run_stages(team: &Team) -> (Vec<u64>, Vec<Vec<u32>>, bool) {
+        let (mut set, mut contacts, mut joints) = row(3000);
+        let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::new(0.0, -10.0));
+        let (mut forest, mut colours) = (JointForest::default(), JointColours::new());
+        let objects: [ObjectMass; 0] = [];
+        let mut batch = GraphBatch {
+            joints: JointBatch {
+                joints: &mut joints,
+                forest: &mut forest,
+                colours: &mut colours,
+            },
+            contacts: ContactBatch {
+                solver: &mut contacts,
+                object_masses: &objects,
+            },
+        };
+        batch.prepare_on(&ctx, &set, team);
+        for flip in [false, true, false] {
+            let states = &mut set.states;
+            batch.warm_start_on(&ctx, states, team);
+            batch.solve_on(&ctx, states, true, flip, team);
+            batch.solve_late_on(&ctx, states, true, team);
+            batch.solve_on(&ctx, states, false, !flip, team);
+        }
+        let bits = set
+            .states
+            .iter()
+            .flat_map(|s| [s.v.x, s.v.y, s.w])
+            .map(|x| janus2d_core::math::to_f64(x).to_bits())
+            .collect();
+        let by_colour = (0..=colours.colour_count())
+            .map(|c| colours.joints_in(c).to_vec())
+            .collect();
+        // A colour of several blocks of both joints and contacts.
+        let shared = (0..colours.colour_count())
+            .any(|c| colours.joints_in(c).len() > 64 && contacts.count_in(c as u8) > 8 * 32);
+        let paired = shared
+            && colours
+                .cross()
+                .holds(colours.plan(), contacts.plan(), set.states.len());
+        (bits, by_colour, paired)
+    }
+
+    /// The joints take colours around the contacts: within a colour no
+    /// moving body carries both a joint and a contact (nor two joints).
+    #[test]
+    fn a_colour_holds_a_moving_body_once_across_joints_and_contacts() {
+        let (set, mut contacts, mut joints) = row(400);
+        let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
+        let (mut forest, mut colours) = (JointForest::default(), JointColours::new());
+        let objects: [ObjectMass; 0] = [];
+        let mut batch = GraphBatch {
+            joints: JointBatch {
+                joints: &mut joints,
+                forest: &mut forest,
+                colours: &mut colours,
+            },
+            contacts: ContactBatch {
+                solver: &mut contacts,
+                object_masses: &objects,
+            },
+        };
+        batch.prepare(&ctx, &set);
+        let mut occupied = Vec::new();
+        contacts.moving_colours(set.states.len(), &mut occupied);
+        assert!(colours.colour_count() >= 2);
+        let mut coloured = 0;
+        for c in 0..colours.colour_count() {
+            let mut seen = std::collections::HashSet::new();
+            for &i in colours.joints_in(c) {
+                let base = joints[i as usize].base();
+                for s in [base.state_a, base.state_b] {
+                    assert_eq!(occupied[s as usize] & (1 << c), 0, "state {s}, colour {c}");
+                    assert!(seen.insert(s), "state {s} twice in colour {c}");
+                }
+                coloured += 1;
+            }
+        }
+        // Two contacts and two joints per body at most leave colours free:
+        // no joint waits in the overflow.
+        assert_eq!(colours.overflow_len(), 0);
+        assert_eq!(coloured, joints.len());
+    }
+
+    /// One job per colour on the team (joints and contacts together) gives
+    /// the serial sweep's states, bit for bit, for 1, 2 and 4 threads.
+    #[test]
+    fn the_graph_batch_on_the_team_gives_the_serial_result() {
+        let (bits, colours, _) = run_stages(&Team::serial());
+        // Colours of more than one block of joints.
+        assert!(colours.iter().any(|c| c.len() > 64));
+        let (team_bits, team_colours, _) = janus2d_core::parallel::with_team(run_stages);
+        assert_eq!((team_bits, team_colours), (bits.clone(), colours.clone()));
+        #[cfg(feature = "parallel")]
+        for threads in [2, 4] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let (team_bits, team_colours, paired) =
+                pool.install(|| janus2d_core::parallel::with_team(run_stages));
+            assert!(paired, "{threads} threads: one job per colour");
+            assert_eq!(team_bits, bits, "{threads} threads");
+            assert_eq!(team_colours, colours, "{threads} threads");
+        }
+    }
+}
