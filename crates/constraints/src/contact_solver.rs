@@ -281,9 +281,9 @@ impl ContactSolver {
     /// into colour `colours[i]` with the lane data `lane(i)`, and its place
     /// into `places[i]`. The result is the one of pushing them in order;
     /// with the `parallel` feature and more than one thread the chunks are
-    /// filled on rayon (each chunk from its own contacts, so the order
-    /// within a colour is kept).
-    pub fn push_all<F>(&mut self, colours: &[u8], lane: F, places: &mut Vec<LanePlace>)
+    /// filled in blocks on `team` (each chunk from its own contacts, so
+    /// the order within a colour is kept).
+    pub fn push_all<F>(&mut self, colours: &[u8], lane: F, places: &mut Vec<LanePlace>, team: &Team)
     where
         F: Fn(usize) -> ContactLane + Sync,
     {
@@ -295,10 +295,7 @@ impl ContactSolver {
         // are then read in order and the open chunks (one per colour) stay
         // in cache; the per-colour lists below read the contacts out of
         // order, which only pays when threads share the filling.
-        #[cfg(feature = "parallel")]
-        let serial = rayon::current_num_threads() == 1 || colours.len() < PARALLEL_PUSH;
-        #[cfg(not(feature = "parallel"))]
-        let serial = true;
+        let serial = team.threads() == 1 || colours.len() < PARALLEL_PUSH;
         if serial || self.colours.iter().any(|c| !c.is_empty()) {
             // Open chunks: keep push's order exactly.
             for (i, &colour) in colours.iter().enumerate() {
@@ -338,13 +335,16 @@ impl ContactSolver {
             chunk
         };
         for (chunks, list) in self.colours.iter_mut().zip(&lists) {
-            #[cfg(feature = "parallel")]
-            if rayon::current_num_threads() > 1 && list.len() > 16 * LANES {
-                use rayon::prelude::*;
-                list.par_chunks(LANES)
-                    .with_min_len(8)
-                    .map(build)
-                    .collect_into_vec(chunks);
+            if list.len() > 16 * LANES {
+                // Blocks of 8 chunks on the team, in order.
+                const CHUNKS: usize = 8;
+                let blocks = list.len().div_ceil(CHUNKS * LANES);
+                let built = team.map_blocks(blocks, |b| {
+                    let items =
+                        &list[b * CHUNKS * LANES..((b + 1) * CHUNKS * LANES).min(list.len())];
+                    items.chunks(LANES).map(build).collect::<Vec<_>>()
+                });
+                chunks.extend(built.into_iter().flatten());
                 continue;
             }
             chunks.extend(list.chunks(LANES).map(build));
@@ -675,7 +675,6 @@ const SERIAL_CHUNKS: usize = 32;
 /// Contacts from which [`ContactSolver::push_all`] fills the chunks on
 /// threads (fewer are pushed in order on the caller: the lists and tasks
 /// cost more than the filling).
-#[cfg(feature = "parallel")]
 const PARALLEL_PUSH: usize = 4096;
 
 /// Chunks per block for `chunks` chunks on `team`: about four blocks per

@@ -741,7 +741,9 @@ pub fn solve_step(
 /// Bodies per block of the integration stages.
 const BODY_BLOCK: usize = 256;
 
-fn solve_step_on(
+/// [`solve_step`] on a team the caller holds (the world runs its whole
+/// step on one team: collision stages and the solve share its workers).
+pub fn solve_step_on(
     settings: &SolverSettings,
     ctx: &StepContext,
     bodies: &mut BodySet,

@@ -50,6 +50,7 @@
 
 use janus2d_core::geometry::Aabb;
 use janus2d_core::math::{Real, Vec2};
+use janus2d_core::parallel::Team;
 
 pub use crate::dynamic_tree::{DEFAULT_AABB_MARGIN, DynamicTree, NULL_NODE};
 
@@ -58,9 +59,8 @@ pub use crate::dynamic_tree::{DEFAULT_AABB_MARGIN, DynamicTree, NULL_NODE};
 /// moved.
 const BULK_DIVISOR: usize = 4;
 
-/// Fewest moved proxies for which the pair search runs on rayon (with the
-/// `parallel` feature).
-#[cfg(feature = "parallel")]
+/// Fewest moved proxies for which the pair search runs in blocks on the
+/// step's team (of more than one thread).
 const PARALLEL_MOVES: usize = 256;
 
 /// Per-proxy record of the [`BroadPhase`].
@@ -498,14 +498,17 @@ impl BroadPhase {
     /// depend on insertion history. `filter(a, b)` (with `a <= b` payloads) is
     /// called once per candidate proxy pair; returning `false` drops it. Two
     /// distinct proxies with the same payload yield a pair `(p, p)`, which the
-    /// filter may reject.
+    /// filter may reject. With `team` of several threads and many proxies
+    /// moved, the search runs in blocks on it; the pairs are the same for
+    /// any team.
     pub fn update_pairs<F: Fn(u32, u32) -> bool + Sync>(
         &mut self,
         filter: F,
         out: &mut Vec<(u32, u32)>,
+        team: &Team,
     ) {
         let bulk = self.move_buffer.len() * BULK_DIVISOR >= self.proxy_count();
-        self.update_pairs_with(bulk, filter, out);
+        self.update_pairs_with(bulk, filter, out, team);
     }
 
     /// [`update_pairs`](Self::update_pairs) with the search strategy chosen
@@ -517,6 +520,7 @@ impl BroadPhase {
         bulk: bool,
         filter: F,
         out: &mut Vec<(u32, u32)>,
+        team: &Team,
     ) {
         out.clear();
         if self.static_tree.is_unbalanced() {
@@ -550,15 +554,10 @@ impl BroadPhase {
                 tree.mark_paths(leaves, marks);
             }
         }
-        #[cfg(feature = "parallel")]
-        let threads = rayon::current_num_threads() > 1 && moves.len() >= PARALLEL_MOVES;
-        #[cfg(not(feature = "parallel"))]
-        let threads = false;
-        if threads {
+        if team.threads() > 1 && moves.len() >= PARALLEL_MOVES {
             // The filter runs on the threads; the kept pairs come back in
             // block order.
-            #[cfg(feature = "parallel")]
-            self.find_pairs_parallel(bulk, &moves, &filter, out);
+            self.find_pairs_parallel(bulk, &moves, &filter, out, team);
         } else {
             let mut report = |pa: u32, pb: u32| keep_pair(&filter, out, pa, pb);
             self.find_pairs_serial(bulk, &moves, &mut report);
@@ -618,25 +617,24 @@ impl BroadPhase {
         }
     }
 
-    /// [`BroadPhase::find_pairs_serial`] on rayon: the moved proxies' queries
-    /// (or the seeds of the bulk descent) in blocks, each block's pairs
-    /// (ordered, and kept by `filter`) collected on its own, then appended
-    /// to `out` in block order. The pairs are sorted afterwards, so the
-    /// result is the serial one.
-    #[cfg(feature = "parallel")]
+    /// [`BroadPhase::find_pairs_serial`] on the team: the moved proxies'
+    /// queries (or the seeds of the bulk descent) in blocks, each block's
+    /// pairs (ordered, and kept by `filter`) collected on its own, then
+    /// appended to `out` in block order. The pairs are sorted afterwards,
+    /// so the result is the serial one.
     fn find_pairs_parallel(
         &mut self,
         bulk: bool,
         moves: &[u32],
         filter: &(impl Fn(u32, u32) -> bool + Sync),
         out: &mut Vec<(u32, u32)>,
+        team: &Team,
     ) {
-        use rayon::prelude::*;
         let proxies = &self.proxies;
         let (dynamic, fixed) = (&self.dynamic_tree, &self.static_tree);
         let [dynamic_marks, static_marks] = &self.moved_marks;
         let found: Vec<Vec<(u32, u32)>> = if bulk {
-            let want = 64 * rayon::current_num_threads();
+            let want = 64 * team.threads();
             let mut seeds = Vec::new();
             dynamic.pair_seeds(None, want, &mut seeds);
             let mut cross = Vec::new();
@@ -646,52 +644,44 @@ impl BroadPhase {
                 .map(|s| (false, s))
                 .chain(cross.into_iter().map(|s| (true, s)))
                 .collect();
-            tasks
-                .par_chunks(8)
-                .map(|block| {
-                    let mut pairs = Vec::new();
-                    let mut stack = Vec::new();
-                    for &(is_cross, seed) in block {
-                        let other = is_cross.then_some((fixed, &static_marks[..]));
-                        dynamic.for_each_pair_from(
-                            other,
-                            dynamic_marks,
-                            seed,
-                            &mut stack,
-                            |x, y| {
-                                let (sx, sy) = (&proxies[x as usize], &proxies[y as usize]);
-                                if (sx.moved || sy.moved) && pair_overlaps(sx, sy) {
-                                    keep_pair(filter, &mut pairs, sx.payload, sy.payload);
-                                }
-                            },
-                        );
-                    }
-                    pairs
-                })
-                .collect()
-        } else {
-            moves
-                .par_chunks(PARALLEL_MOVES / 4)
-                .map(|block| {
-                    let mut pairs = Vec::new();
-                    for &m in block {
-                        let slot = proxies[m as usize];
-                        let fat = slot.fat;
-                        let mut visit = |other: u32| {
-                            let o = &proxies[other as usize];
-                            if other != m && !(o.moved && other < m) && pair_overlaps(&slot, o) {
-                                keep_pair(filter, &mut pairs, slot.payload, o.payload);
-                            }
-                            true
-                        };
-                        dynamic.query(&fat, &mut visit);
-                        if !slot.is_static {
-                            fixed.query(&fat, &mut visit);
+            const SEEDS: usize = 8;
+            team.map_blocks(tasks.len().div_ceil(SEEDS), |b| {
+                let block = &tasks[b * SEEDS..(b * SEEDS + SEEDS).min(tasks.len())];
+                let mut pairs = Vec::new();
+                let mut stack = Vec::new();
+                for &(is_cross, seed) in block {
+                    let other = is_cross.then_some((fixed, &static_marks[..]));
+                    dynamic.for_each_pair_from(other, dynamic_marks, seed, &mut stack, |x, y| {
+                        let (sx, sy) = (&proxies[x as usize], &proxies[y as usize]);
+                        if (sx.moved || sy.moved) && pair_overlaps(sx, sy) {
+                            keep_pair(filter, &mut pairs, sx.payload, sy.payload);
                         }
+                    });
+                }
+                pairs
+            })
+        } else {
+            const QUERIES: usize = PARALLEL_MOVES / 4;
+            team.map_blocks(moves.len().div_ceil(QUERIES), |b| {
+                let block = &moves[b * QUERIES..(b * QUERIES + QUERIES).min(moves.len())];
+                let mut pairs = Vec::new();
+                for &m in block {
+                    let slot = proxies[m as usize];
+                    let fat = slot.fat;
+                    let mut visit = |other: u32| {
+                        let o = &proxies[other as usize];
+                        if other != m && !(o.moved && other < m) && pair_overlaps(&slot, o) {
+                            keep_pair(filter, &mut pairs, slot.payload, o.payload);
+                        }
+                        true
+                    };
+                    dynamic.query(&fat, &mut visit);
+                    if !slot.is_static {
+                        fixed.query(&fat, &mut visit);
                     }
-                    pairs
-                })
-                .collect()
+                }
+                pairs
+            })
         };
         for pairs in found {
             out.extend(pairs);
@@ -896,6 +886,17 @@ mod tests {
     /// copy of `bp` report exactly `expected`, each pair once (payloads are
     /// unique).
     fn check_both_strategies(bp: &BroadPhase, expected: &[(u32, u32)], label: &str) {
+        janus2d_core::parallel::with_team(|team| {
+            check_both_strategies_on(bp, expected, label, team)
+        });
+    }
+
+    fn check_both_strategies_on(
+        bp: &BroadPhase,
+        expected: &[(u32, u32)],
+        label: &str,
+        team: &Team,
+    ) {
         for bulk in [false, true] {
             let mut copy = bp.clone();
             let mut pairs = Vec::new();
@@ -907,6 +908,7 @@ mod tests {
                     true
                 },
                 &mut pairs,
+                team,
             );
             assert_eq!(pairs, expected, "{label}, bulk = {bulk}");
             assert_eq!(calls.into_inner(), expected.len(), "{label}, bulk = {bulk}");
@@ -932,10 +934,10 @@ mod tests {
         // Both search strategies (per-proxy queries and bulk descent).
         check_both_strategies(&bp, &expected, "serial");
         let mut pairs = Vec::new();
-        bp.update_pairs(|_, _| true, &mut pairs);
+        bp.update_pairs(|_, _| true, &mut pairs, &Team::serial());
         assert_eq!(pairs, expected);
         // Nothing moved since: no new pairs.
-        bp.update_pairs(|_, _| true, &mut pairs);
+        bp.update_pairs(|_, _| true, &mut pairs, &Team::serial());
         assert!(pairs.is_empty());
         // No static-static pair was reported.
         let statics: BTreeSet<u32> = ids
@@ -950,7 +952,7 @@ mod tests {
         );
     }
 
-    /// The pair search on rayon (both strategies) reports each pair once,
+    /// The pair search on the team (both strategies) reports each pair once,
     /// the same pairs as brute force, with 2 and 4 threads.
     #[cfg(feature = "parallel")]
     #[test]
@@ -973,7 +975,7 @@ mod tests {
         let mut rng = Lcg(2);
         let (mut bp, ids) = random_scene(&mut rng);
         let mut first = Vec::new();
-        bp.update_pairs(|_, _| true, &mut first);
+        bp.update_pairs(|_, _| true, &mut first, &Team::serial());
         let by_payload: BTreeMap<u32, u32> = ids.iter().map(|&p| (bp.payload(p), p)).collect();
 
         // 500 distinct proxies: small, medium and large displacements.
@@ -1025,6 +1027,7 @@ mod tests {
                     true
                 },
                 &mut pairs,
+                &Team::serial(),
             );
             let counts = counts.into_inner().unwrap();
             assert!(counts.values().all(|&c| c == 1), "a pair was found twice");
@@ -1033,7 +1036,7 @@ mod tests {
         }
         assert_eq!(results[0], results[1]);
         let mut new_pairs = Vec::new();
-        bp.update_pairs(|_, _| true, &mut new_pairs);
+        bp.update_pairs(|_, _| true, &mut new_pairs, &Team::serial());
         assert_eq!(new_pairs, results[0]);
 
         let all = brute_force(&bp, &ids);
@@ -1066,7 +1069,7 @@ mod tests {
         let a = bp.create_proxy(boxed(-49.0, 0.5, 0.5, 0.5), 7, false);
         let b = bp.create_proxy(boxed(-48.2, 0.5, 0.5, 0.5), 3, false);
         let mut pairs = Vec::new();
-        bp.update_pairs(|_, _| true, &mut pairs);
+        bp.update_pairs(|_, _| true, &mut pairs, &Team::serial());
         // Static fat boxes are not fattened; ground and wall touch but are
         // both static.
         assert_eq!(bp.fat_aabb(ground), boxed(0.0, -1.0, 50.0, 1.0));
@@ -1076,14 +1079,14 @@ mod tests {
         bp.touch_proxy(a);
         bp.move_proxy(b, boxed(10.0, 0.5, 0.5, 0.5));
         bp.destroy_proxy(b);
-        bp.update_pairs(|x, y| (x, y) != (7, 101), &mut pairs);
+        bp.update_pairs(|x, y| (x, y) != (7, 101), &mut pairs, &Team::serial());
         assert_eq!(pairs, vec![(7, 100)]);
         assert!(!bp.is_moved(a));
 
         // Slot reuse: a new proxy in the freed slot is reported once.
         let c = bp.create_proxy(boxed(-49.0, 0.5, 0.5, 0.5), 9, false);
         assert_eq!(c, b);
-        bp.update_pairs(|_, _| true, &mut pairs);
+        bp.update_pairs(|_, _| true, &mut pairs, &Team::serial());
         assert_eq!(pairs, vec![(7, 9), (9, 100), (9, 101)]);
         assert!(bp.test_overlap(a, c));
         assert!(bp.test_overlap(c, ground));
@@ -1091,7 +1094,7 @@ mod tests {
 
         // Two proxies with one payload give a (p, p) pair.
         let d = bp.create_proxy(boxed(-49.0, 0.5, 0.5, 0.5), 9, false);
-        bp.update_pairs(|_, _| true, &mut pairs);
+        bp.update_pairs(|_, _| true, &mut pairs, &Team::serial());
         assert_eq!(pairs, vec![(7, 9), (9, 9), (9, 100), (9, 101)]);
         bp.destroy_proxy(d);
         bp.validate();
@@ -1136,7 +1139,7 @@ mod tests {
                 bp.destroy_proxy(p);
                 tights.remove(&p);
             }
-            bp.update_pairs(|a, b| (a + b + step) % 7 != 0, &mut pairs);
+            bp.update_pairs(|a, b| (a + b + step) % 7 != 0, &mut pairs, &Team::serial());
             outputs.push(pairs.clone());
         }
         bp.validate();
@@ -1167,7 +1170,7 @@ mod tests {
                 bp.create_proxy(boxes[i], payload_of(i as u32), i % 5 == 0);
             }
             let mut pairs = Vec::new();
-            bp.update_pairs(|_, _| true, &mut pairs);
+            bp.update_pairs(|_, _| true, &mut pairs, &Team::serial());
             pairs
         };
         let forward = run(false);
@@ -1183,7 +1186,7 @@ mod tests {
         let b = bp.create_proxy_with_margin(boxed(1.0, 0.0, 0.1, 0.1), 2, false, m);
         let wall = bp.create_proxy(boxed(1.5, 0.0, 0.1, 2.0), 3, true);
         let mut out = Vec::new();
-        bp.update_pairs(|_, _| true, &mut out);
+        bp.update_pairs(|_, _| true, &mut out, &Team::serial());
         assert!(out.is_empty(), "{out:?}");
         // a moves 0.05 m and is swept 1.5 m to the right: its tree box now
         // covers b and the wall, its core only its own neighbourhood.
@@ -1191,7 +1194,7 @@ mod tests {
         assert!(bp.move_proxy_in_batch_swept(a, tight, Vec2::new(1.5, 0.0)));
         bp.finish_moves();
         assert!(bp.fat_aabb(a).overlaps(&bp.fat_aabb(b)));
-        bp.update_pairs(|_, _| true, &mut out);
+        bp.update_pairs(|_, _| true, &mut out, &Team::serial());
         assert_eq!(
             out,
             vec![(1, 3)],
@@ -1205,7 +1208,7 @@ mod tests {
         let near_b = boxed(0.75, 0.0, 0.1, 0.1);
         assert!(bp.move_proxy_in_batch_swept(a, near_b, Vec2::ZERO));
         bp.finish_moves();
-        bp.update_pairs(|_, _| true, &mut out);
+        bp.update_pairs(|_, _| true, &mut out, &Team::serial());
         assert_eq!(out, vec![(1, 2), (1, 3)]);
         assert!(bp.test_overlap(a, b));
         bp.validate();

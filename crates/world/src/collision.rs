@@ -27,6 +27,7 @@ use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::geometry::Shape;
 use janus2d_core::material::{mix_friction, mix_restitution};
 use janus2d_core::math::{Real, Transform, Vec2};
+use janus2d_core::parallel::Team;
 
 use crate::broadphase::BroadPhase;
 pub use crate::contacts::CollisionEvents;
@@ -197,7 +198,7 @@ impl Collision {
     }
 
     /// Finds new pairs among moved proxies and creates their contacts.
-    pub(crate) fn update_pairs(&mut self, bodies: &BodySet, no_collide: &NoCollide) {
+    pub(crate) fn update_pairs(&mut self, bodies: &BodySet, no_collide: &NoCollide, team: &Team) {
         let mut candidates = std::mem::take(&mut self.candidates);
         candidates.clear();
         // Only new pairs are kept, as the broadphase finds them (on the
@@ -209,7 +210,7 @@ impl Collision {
             let (a, b) = crate::contacts::pair_key(a, b);
             !contacts.has_pair(a, b) && should_pair(shapes, bodies, no_collide, a, b)
         };
-        self.broadphase.update_pairs(keep, &mut candidates);
+        self.broadphase.update_pairs(keep, &mut candidates, team);
         let mut created = 0;
         for &(a, b) in &candidates {
             let (a, b) = crate::contacts::pair_key(a, b);
@@ -282,38 +283,23 @@ impl Collision {
     }
 
     /// The step's end for the pipeline: the solved impulses go back into
-    /// the contacts while `advance` (continuous collision: it moves fast
-    /// bodies, reading the shapes and the broadphase) runs and the proxies
-    /// then follow the new poses. The two halves share no data: with
-    /// threads they run side by side (`rayon::join`), on one thread one
-    /// after the other; the result is the same. Returns what `advance`
-    /// returned.
-    pub(crate) fn end_step<R: Send>(
+    /// the contacts (`store`), `advance` (continuous collision: it moves
+    /// fast bodies, reading the shapes and the broadphase) runs, and the
+    /// proxies then follow the new poses; each on the step's team. Returns
+    /// what `advance` returned.
+    pub(crate) fn end_step<R>(
         &mut self,
         bodies: &mut BodySet,
         dt: Real,
-        store: impl FnOnce(&mut ContactSet) + Send,
-        advance: impl FnOnce(&mut BodySet, &ShapeStore, &BroadPhase) -> R + Send,
+        store: impl FnOnce(&mut ContactSet, &Team),
+        advance: impl FnOnce(&mut BodySet, &ShapeStore, &BroadPhase, &Team) -> R,
+        team: &Team,
     ) -> R {
-        let Collision {
-            shapes,
-            broadphase,
-            contacts,
-            counters,
-            ..
-        } = self;
-        let store = move || store(contacts);
-        let rest = move || {
-            let out = advance(bodies, shapes, broadphase);
-            counters.proxies_moved = Self::update_proxies(shapes, broadphase, bodies, dt);
-            out
-        };
-        #[cfg(feature = "parallel")]
-        if rayon::current_num_threads() > 1 {
-            return rayon::join(store, rest).1;
-        }
-        store();
-        rest()
+        store(&mut self.contacts, team);
+        let out = advance(bodies, &self.shapes, &self.broadphase, team);
+        self.counters.proxies_moved =
+            Self::update_proxies(&mut self.shapes, &mut self.broadphase, bodies, dt, team);
+        out
     }
 
     /// Recomputes the boxes of the shapes of moving bodies and moves their
@@ -328,10 +314,10 @@ impl Collision {
         broadphase: &mut BroadPhase,
         bodies: &BodySet,
         dt: Real,
+        team: &Team,
     ) -> usize {
-        #[cfg(feature = "parallel")]
-        if rayon::current_num_threads() > 1 && bodies.sims.len() > 1024 {
-            return Self::update_proxies_parallel(shapes, broadphase, bodies, dt);
+        if team.threads() > 1 && bodies.sims.len() > 1024 {
+            return Self::update_proxies_parallel(shapes, broadphase, bodies, dt, team);
         }
         let mut moved = 0;
         for (sim, state) in bodies.sims.iter().zip(&bodies.states).skip(1) {
@@ -355,25 +341,25 @@ impl Collision {
         moved
     }
 
-    /// [`Collision::update_proxies`] with the boxes computed on rayon, in
-    /// blocks of bodies; the proxies are then moved here, in body order, as
-    /// the serial version does.
-    #[cfg(feature = "parallel")]
+    /// [`Collision::update_proxies`] with the boxes computed on the team,
+    /// in blocks of bodies; the proxies are then moved here, in body order,
+    /// as the serial version does.
     fn update_proxies_parallel(
         shapes: &mut ShapeStore,
         broadphase: &mut BroadPhase,
         bodies: &BodySet,
         dt: Real,
+        team: &Team,
     ) -> usize {
         use janus2d_core::geometry::Aabb;
-        use rayon::prelude::*;
+        const BLOCK: usize = 256;
         let read = &*shapes;
-        let blocks: Vec<Vec<(u32, Aabb, Vec2)>> = bodies.sims[1..]
-            .par_chunks(256)
-            .zip(bodies.states[1..].par_chunks(256))
-            .map(|(sims, states)| {
-                let mut out = Vec::with_capacity(sims.len());
-                for (sim, state) in sims.iter().zip(states) {
+        let (sims, states) = (&bodies.sims[1..], &bodies.states[1..]);
+        let blocks: Vec<Vec<(u32, Aabb, Vec2)>> =
+            team.map_blocks(sims.len().div_ceil(BLOCK), |b| {
+                let range = b * BLOCK..(b * BLOCK + BLOCK).min(sims.len());
+                let mut out = Vec::with_capacity(range.len());
+                for (sim, state) in sims[range.clone()].iter().zip(&states[range]) {
                     let sweep = dt * state.v;
                     for &s in read.of_body(sim.handle) {
                         let tight = read.at(s).geometry.compute_aabb(&sim.transform);
@@ -381,8 +367,7 @@ impl Collision {
                     }
                 }
                 out
-            })
-            .collect();
+            });
         let mut moved = 0;
         for (s, tight, sweep) in blocks.into_iter().flatten() {
             let shape = shapes.at_mut(s);

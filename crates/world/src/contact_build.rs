@@ -23,20 +23,17 @@ use janus2d_constraints::contact_solver::{
 use janus2d_core::body::{BodyHandle, BodySet};
 use janus2d_core::graph::{ConstraintGraph, NO_BODY};
 use janus2d_core::math::{Real, Vec2};
+use janus2d_core::parallel::Team;
 
-#[cfg(feature = "parallel")]
-use crate::contacts::Contact;
 use crate::contacts::ContactSet;
 use crate::narrowphase::{Handoff, PreSolve, PreSolveFn, StagedContact, solve_body, stage};
 use crate::profile::CollisionCounters;
 
 /// Touching contacts from which constraint building's first pass runs on
 /// threads (below, the tasks cost more than the pass).
-#[cfg(feature = "parallel")]
 const PARALLEL_BUILD: usize = 4096;
 
 /// [`Narrowphase::place_of`] of a contact that is not solved this step.
-#[cfg_attr(not(feature = "parallel"), allow(dead_code))]
 const UNSOLVED: LanePlace = LanePlace {
     colour: u8::MAX,
     lane: 0,
@@ -147,6 +144,7 @@ impl ContactBuilder {
         mut pre_solve: Option<&mut PreSolveFn>,
         solver: &mut ContactSolver,
         counters: &mut CollisionCounters,
+        team: &Team,
     ) {
         let solved = &mut self.solved;
         let staged = handoff.staged;
@@ -227,44 +225,35 @@ impl ContactBuilder {
             }
         };
         // With threads, no hook and nothing woken since the narrowphase, the
-        // entries are made on rayon (order kept): on two threads this pass was
+        // entries are made on the team (order kept): on two threads this pass was
         // most of what the leader did alone between the narrowphase and the
         // solve.
-        #[cfg(feature = "parallel")]
         let parallel = pre_solve.is_none()
             && !woke
             && scanned == n
-            && rayon::current_num_threads() > 1
+            && team.threads() > 1
             && handoff.touching.len() >= PARALLEL_BUILD;
-        #[cfg(not(feature = "parallel"))]
-        let parallel = false;
         if parallel {
-            #[cfg(feature = "parallel")]
-            {
-                use rayon::prelude::*;
-                let staged = &*staged;
-                // Written in place (an indexed collect): a filtering
-                // `par_extend` gathers per-thread pieces and copies them all
-                // into `solved` on one thread (0.9% of many_pyramids' samples
-                // at 2 threads). A contact whose bodies are both still is
-                // marked and dropped after (phase 1 leaves none in
-                // `touching`, so the drop is a check).
-                const STILL: u32 = u32::MAX;
-                handoff
-                    .touching
-                    .par_iter()
-                    .map(|&k| {
-                        let record = &staged[k as usize];
-                        let mut s = entry(k as usize, record);
-                        if record.still == [true, true] {
-                            s.index = STILL;
-                        }
-                        s
-                    })
-                    .collect_into_vec(solved);
-                if solved.par_iter().any(|s| s.index == STILL) {
-                    solved.retain(|s| s.index != STILL);
+            let staged = &*staged;
+            // Written in place: each block of `solved` from its own
+            // contacts. A contact whose bodies are both still is marked and
+            // dropped after (phase 1 leaves none in `touching`, so the drop
+            // is a check).
+            const STILL: u32 = u32::MAX;
+            const BLOCK: usize = 1024;
+            let touching = handoff.touching;
+            solved.resize(touching.len(), entry(0, &StagedContact::default()));
+            team.for_each_chunk_mut(solved, BLOCK, |i, block| {
+                for (s, &k) in block.iter_mut().zip(&touching[i * BLOCK..]) {
+                    let record = &staged[k as usize];
+                    *s = entry(k as usize, record);
+                    if record.still == [true, true] {
+                        s.index = STILL;
+                    }
                 }
+            });
+            if solved.iter().any(|s| s.index == STILL) {
+                solved.retain(|s| s.index != STILL);
             }
         } else {
             for k in candidates {
@@ -373,13 +362,13 @@ impl ContactBuilder {
                 }
             },
             places,
+            team,
         );
         // By contact, for storing the impulses on the threads (one thread
         // stores by the solver's order and needs none of it).
         let place_of = &mut self.place_of;
         place_of.clear();
-        #[cfg(feature = "parallel")]
-        if rayon::current_num_threads() > 1 {
+        if team.threads() > 1 {
             place_of.resize(n, UNSOLVED);
             for (s, &place) in solved.iter().zip(places.iter()) {
                 place_of[s.index as usize] = place;
@@ -393,10 +382,13 @@ impl ContactBuilder {
     /// `places` is where the solver holds each awake contact's impulses
     /// (`place_of`). Touches only the contacts: it runs beside continuous
     /// collision and the proxy update (`Collision::end_step`).
-    pub(crate) fn store_impulses(&self, contacts: &mut ContactSet, solver: &ContactSolver) {
+    pub(crate) fn store_impulses(
+        &self,
+        contacts: &mut ContactSet,
+        solver: &ContactSolver,
+        team: &Team,
+    ) {
         let places = &self.place_of[..];
-        #[cfg(not(feature = "parallel"))]
-        let _ = places;
         // A non-finite impulse (a solve that blew up) is not kept for warm
         // starting: the contact starts cold next step instead of carrying
         // NaN into it.
@@ -407,32 +399,22 @@ impl ContactBuilder {
             p.total_normal_impulse = finite(impulse.total_normal);
             p.total_tangent_impulse = finite(impulse.total_tangent);
         };
-        #[cfg(feature = "parallel")]
-        {
-            if rayon::current_num_threads() > 1
-                && places.len() > 4096
-                && places.len() == contacts.awake().len()
-            {
-                // On the threads, in contact order: each contact written
-                // once, in place, reading its lanes from the chunks. (On one
-                // thread the scatter below measured faster: 6.8% of
-                // many_pyramids' samples against 10.2% for this gather.)
-                use rayon::prelude::*;
-                let store = |(c, place): (&mut Contact, &LanePlace)| {
+        if team.threads() > 1 && places.len() > 4096 && places.len() == contacts.awake().len() {
+            // On the team, in contact order: each contact written once, in
+            // place, reading its lanes from the chunks. (On one thread the
+            // scatter below measured faster: 6.8% of many_pyramids' samples
+            // against 10.2% for this gather.)
+            const BLOCK: usize = 1024;
+            team.for_each_chunk_mut(contacts.awake_slice_mut(), BLOCK, |i, block| {
+                for (c, place) in block.iter_mut().zip(&places[i * BLOCK..]) {
                     if Self::is_solved(place) {
-                        for i in 0..c.point_count {
-                            keep(&mut c.points[i], solver.point_impulse_at(*place, i));
+                        for k in 0..c.point_count {
+                            keep(&mut c.points[k], solver.point_impulse_at(*place, k));
                         }
                     }
-                };
-                contacts
-                    .awake_slice_mut()
-                    .par_iter_mut()
-                    .zip(places.par_iter())
-                    .with_min_len(1024)
-                    .for_each(store);
-                return;
-            }
+                }
+            });
+            return;
         }
         solver.for_each_impulse(|index, point, impulse| {
             keep(

@@ -34,6 +34,7 @@ use janus2d_core::geometry::{
     LINEAR_SLOP, Shape, ShapeProxy, Sweep, ToiState, shape_distance, shape_extent, time_of_impact,
 };
 use janus2d_core::math::{Real, Vec2, cross};
+use janus2d_core::parallel::Team;
 
 use crate::aperture::ContactClipping;
 use crate::broadphase::BroadPhase;
@@ -114,7 +115,7 @@ impl ContinuousStage {
 
     /// Sweeps the fast bodies and moves those that hit something back to
     /// their time of impact.
-    pub(crate) fn run(&mut self, bodies: &mut BodySet, input: &ContinuousInput<'_>) {
+    pub(crate) fn run(&mut self, bodies: &mut BodySet, input: &ContinuousInput<'_>, team: &Team) {
         self.counters = ContinuousCounters::default();
         self.fast.clear();
         self.bullets.clear();
@@ -162,31 +163,33 @@ impl ContinuousStage {
         // Fast bodies that are not bullets sweep against static shapes
         // only, so no one's sweep reads another's move: with threads their
         // impacts are found at once and applied after, in the same order.
-        #[cfg(feature = "parallel")]
-        let parallel = rayon::current_num_threads() > 1 && fast.len() >= PARALLEL_FAST;
-        #[cfg(not(feature = "parallel"))]
-        let parallel = false;
-        if parallel {
-            #[cfg(feature = "parallel")]
-            {
-                use rayon::prelude::*;
-                let read = &*bodies;
-                let impacts: Vec<(Real, usize)> = fast
-                    .par_iter()
-                    .with_min_len(8)
-                    .map_init(Vec::new, |candidates, &i| {
-                        let mut calls = 0;
-                        let fraction =
-                            impact_of(read, i as usize, input, false, candidates, &mut calls);
-                        (fraction, calls)
-                    })
-                    .collect();
-                self.fractions.clear();
-                self.fractions.resize(bodies.sims.len(), 1.0);
-                for (&i, &(fraction, calls)) in fast.iter().zip(&impacts) {
-                    self.counters.toi_calls += calls;
-                    self.fractions[i as usize] = fraction;
-                }
+        if team.threads() > 1 && fast.len() >= PARALLEL_FAST {
+            const BLOCK: usize = 8;
+            let read = &*bodies;
+            let impacts: Vec<Vec<(Real, usize)>> =
+                team.map_blocks(fast.len().div_ceil(BLOCK), |b| {
+                    let mut candidates = Vec::new();
+                    fast[b * BLOCK..(b * BLOCK + BLOCK).min(fast.len())]
+                        .iter()
+                        .map(|&i| {
+                            let mut calls = 0;
+                            let fraction = impact_of(
+                                read,
+                                i as usize,
+                                input,
+                                false,
+                                &mut candidates,
+                                &mut calls,
+                            );
+                            (fraction, calls)
+                        })
+                        .collect()
+                });
+            self.fractions.clear();
+            self.fractions.resize(bodies.sims.len(), 1.0);
+            for (&i, &(fraction, calls)) in fast.iter().zip(impacts.iter().flatten()) {
+                self.counters.toi_calls += calls;
+                self.fractions[i as usize] = fraction;
             }
         } else {
             // Against static shapes only: no sweep reads another's move, so
@@ -278,7 +281,6 @@ impl ContinuousStage {
 }
 
 /// Fast bodies from which the non-bullet sweeps run on threads.
-#[cfg(feature = "parallel")]
 const PARALLEL_FAST: usize = 32;
 
 /// Body `i`'s sweep over the step (start pose to the solve's end pose).

@@ -43,7 +43,7 @@ use janus2d_core::body::{BodyDef, BodyHandle, BodySet, BodyType, validate_mass};
 use janus2d_core::constraint::{ConstraintBatch, StepContext};
 use janus2d_core::geometry::Shape;
 use janus2d_core::math::{Real, Rot, Transform, Vec2, cross, vec_is_finite};
-use janus2d_core::solver::{SolverProfile, SolverSettings, solve_step};
+use janus2d_core::solver::{SolverProfile, SolverSettings, solve_step_on};
 
 use crate::collision::{Collision, CollisionCounters, CollisionEvents};
 use crate::contacts::Contact;

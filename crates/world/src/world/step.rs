@@ -62,6 +62,15 @@ impl World {
     /// number finite.
     pub fn step(&mut self, dt: Real) -> Result<(), WorldError> {
         check_time_step(dt)?;
+        janus2d_core::parallel::with_team(|team| self.step_on(dt, team));
+        Ok(())
+    }
+
+    /// The pipeline of one step of `dt` (checked), every threaded stage on
+    /// `team`: the step's one worker team, held from the pair search to
+    /// the store of the impulses (with the `parallel` feature and a rayon
+    /// pool of more than one thread; serial otherwise).
+    fn step_on(&mut self, dt: Real, team: &janus2d_core::parallel::Team) {
         let mut ctx = self.step_context(dt);
         let start = std::time::Instant::now();
         let mut t = start;
@@ -88,7 +97,7 @@ impl World {
                 .no_collide
                 .set_aliases(self.portals.clone_aliases());
             self.collision
-                .update_pairs(&self.bodies, &self.joints.no_collide);
+                .update_pairs(&self.bodies, &self.joints.no_collide, team);
             sp.broadphase += lap();
             let mut wake = std::mem::take(&mut self.wake_list);
             wake.clear();
@@ -107,6 +116,7 @@ impl World {
                 &mut c.events,
                 &mut c.counters,
                 &mut wake,
+                team,
             );
             self.wake_all(&wake);
             let woke = !wake.is_empty();
@@ -125,6 +135,7 @@ impl World {
                 self.pre_solve.as_mut(),
                 &mut self.contact_solver,
                 &mut self.collision.counters,
+                team,
             );
             sp.narrowphase += lap();
         } else {
@@ -154,10 +165,10 @@ impl World {
                 passes,
             };
             let mut batches: [&mut dyn ConstraintBatch; 1] = [&mut coupled];
-            solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches)
+            solve_step_on(&self.settings, &ctx, &mut self.bodies, &mut batches, team)
         } else {
             let mut batches: [&mut dyn ConstraintBatch; 2] = [&mut graph, &mut portals];
-            solve_step(&self.settings, &ctx, &mut self.bodies, &mut batches)
+            solve_step_on(&self.settings, &ctx, &mut self.bodies, &mut batches, team)
         };
         // The solver checks velocities and deltas; a pose they carried out
         // of the world (or to inf) is put back here, before any box is
@@ -178,8 +189,8 @@ impl World {
             let continuous_time = self.collision.end_step(
                 &mut self.bodies,
                 dt,
-                |contacts| builder.store_impulses(contacts, solver),
-                |bodies, shapes, broadphase| {
+                |contacts, team| builder.store_impulses(contacts, solver, team),
+                |bodies, shapes, broadphase, team| {
                     let start = std::time::Instant::now();
                     let input = crate::continuous::ContinuousInput {
                         shapes,
@@ -188,9 +199,10 @@ impl World {
                         clipping,
                         joints,
                     };
-                    continuous.run(bodies, &input);
+                    continuous.run(bodies, &input, team);
                     start.elapsed().as_secs_f64()
                 },
+                team,
             );
             if self.collision.shapes.hit_event_shapes() > 0 {
                 let (solver, threshold) = (&self.contact_solver, self.hit_event_threshold);
@@ -252,7 +264,6 @@ impl World {
             joints: self.joints.threshold_events(),
         };
         self.step_count += 1;
-        Ok(())
     }
 
     /// The world-level part of [`World::validate`]: gravity and settings
