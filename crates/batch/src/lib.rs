@@ -40,7 +40,7 @@
 //! [`WorldBatch::set_world`]): the handle's world id is replaced by the id
 //! of the world it is used in.
 
-use janus2d::{BodyHandle, JointHandle, Real, Snapshot, Vec2, World, WorldError};
+use janus2d::{BodyHandle, JointHandle, QueryFilter, Real, Snapshot, Vec2, World, WorldError};
 use rayon::prelude::*;
 
 /// Reals per body in [`WorldBatch::read_state`]: `x, y, angle, vx, vy, ω`.
@@ -52,6 +52,8 @@ pub const POSE_WIDTH: usize = 3;
 /// Reals per body in [`WorldBatch::apply_forces`]: `fx, fy, torque`
 /// (the force at the centre of mass).
 pub const FORCE_WIDTH: usize = 3;
+/// Reals per ray in [`WorldBatch::cast_rays`]: `ox, oy, tx, ty`.
+pub const RAY_WIDTH: usize = 4;
 /// Reals per body in [`WorldBatch::apply_impulses`]: `ix, iy, px, py`
 /// (a linear impulse at a world point).
 pub const IMPULSE_WIDTH: usize = 4;
@@ -494,6 +496,34 @@ impl WorldBatch {
                 .collect()
         };
         first_error(results)
+    }
+
+    /// Casts rays in every world and fills `out` (`len() × rays`) with the
+    /// fraction of the closest hit along each ray (1 where nothing is hit).
+    /// `rays` holds `ox, oy, tx, ty` (origin and translation) per ray per
+    /// world (`len() × rays × 4`). A lidar, as in a walker.
+    pub fn cast_rays(
+        &self,
+        rays: &[Real],
+        filter: &QueryFilter,
+        out: &mut [Real],
+    ) -> Result<(), BatchError> {
+        let per_world = out.len() / self.worlds.len();
+        self.check_len("out", out.len(), self.worlds.len() * per_world)?;
+        self.check_len("rays", rays.len(), out.len() * RAY_WIDTH)?;
+        if per_world == 0 {
+            return Ok(());
+        }
+        for (i, (row, world)) in out.chunks_mut(per_world).zip(&self.worlds).enumerate() {
+            let ray_row = &rays[i * per_world * RAY_WIDTH..(i + 1) * per_world * RAY_WIDTH];
+            for (k, r) in ray_row.chunks(RAY_WIDTH).enumerate() {
+                let hit = world
+                    .cast_ray_closest(Vec2::new(r[0], r[1]), Vec2::new(r[2], r[3]), filter)
+                    .map_err(|error| BatchError::World { index: i, error })?;
+                row[k] = hit.map_or(1.0, |h| h.fraction);
+            }
+        }
+        Ok(())
     }
 
     fn per_body<F>(

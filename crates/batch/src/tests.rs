@@ -318,3 +318,28 @@ fn errors_are_typed_and_leave_the_batch_usable() {
     assert!(batch.world(2).is_err());
     assert!(!batch.is_empty());
 }
+
+#[test]
+fn rays_find_the_ground_at_the_height_of_each_world() {
+    let (world, bodies, _) = template();
+    let mut batch = WorldBatch::new(&world, 2).unwrap();
+    // World 1's bottom box moves away; world 0's stays at x = 0.
+    batch
+        .write_poses(&bodies[..1], &[0.0, 0.5, 0.0, 10.0, 0.5, 0.0])
+        .unwrap();
+    // Straight down from (0, 10), 20 m: both worlds meet the stack's top
+    // box (centre 2.7, top face at 3.2; it has not moved, no step taken).
+    let rays = [0.0, 10.0, 0.0, -20.0, 0.0, 10.0, 0.0, -20.0];
+    let mut out = vec![0.0; 2];
+    batch.cast_rays(&rays, &QueryFilter::default(), &mut out).unwrap();
+    assert!((out[0] - (10.0 - 3.2) / 20.0).abs() < 1e-4, "{}", out[0]);
+    // A ray upward finds nothing: fraction 1.
+    let up = [0.0, 10.0, 0.0, 5.0, 0.0, 10.0, 0.0, 5.0];
+    batch.cast_rays(&up, &QueryFilter::default(), &mut out).unwrap();
+    assert_eq!(out, vec![1.0, 1.0]);
+    let mut bad = vec![0.0; 2];
+    assert!(matches!(
+        batch.cast_rays(&rays[..4], &QueryFilter::default(), &mut bad),
+        Err(BatchError::Length { what: "rays", .. })
+    ));
+}

@@ -213,6 +213,37 @@ impl PyWorldBatch {
         batch.set_max_motor_torques(&handles, &reals(v)).pyb()
     }
 
+    /// Ray casts in every world: `rays` is `(worlds, rays, 4)` (`ox, oy,
+    /// tx, ty`: origin and translation); returns `(worlds, rays)` float64,
+    /// the closest hit's fraction along each ray (1 where none).
+    #[pyo3(signature = (rays, mask_bits = u64::MAX, category_bits = 1))]
+    fn cast_rays<'py>(
+        &self,
+        py: Python<'py>,
+        rays: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+        mask_bits: u64,
+        category_bits: u64,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let batch = self.inner.lock();
+        let shape = rays.as_array().shape().to_vec();
+        if shape.len() != 3 || shape[0] != batch.len() || shape[2] != 4 {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "`rays` has shape {shape:?}, ({}, n, 4) needed",
+                batch.len()
+            )));
+        }
+        let v = values_of(&rays, &shape, "rays")?;
+        let filter = janus2d::QueryFilter {
+            category_bits,
+            mask_bits,
+            ..janus2d::QueryFilter::default()
+        };
+        let mut out = vec![0.0 as Real; shape[0] * shape[1]];
+        batch.cast_rays(&reals(v), &filter, &mut out).pyb()?;
+        let out: Vec<f64> = out.into_iter().map(f64::from).collect();
+        PyArray1::from_vec(py, out).reshape([shape[0], shape[1]])
+    }
+
     /// Each world's state hash, `(worlds,)` uint64.
     fn state_hashes<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u64>> {
         PyArray1::from_vec(py, self.inner.lock().state_hashes())
