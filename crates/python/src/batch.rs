@@ -295,4 +295,3 @@ impl PyWorldBatch {
         format!("WorldBatch(worlds={}, threads={})", b.len(), b.threads())
     }
 }
-

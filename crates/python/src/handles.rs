@@ -53,10 +53,7 @@ macro_rules! handle_class {
             }
 
             fn __repr__(&self) -> String {
-                format!(
-                    "{}({}v{}@{})",
-                    $py, self.index, self.generation, self.owner
-                )
+                format!("{}({}v{}@{})", $py, self.index, self.generation, self.owner)
             }
 
             fn __getnewargs__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
@@ -68,7 +65,11 @@ macro_rules! handle_class {
 
 handle_class!(Body, "Body", "A body handle (`World.create_body`).");
 handle_class!(Shape, "Shape", "A shape handle (`World.create_box`, …).");
-handle_class!(Joint, "Joint", "A joint handle (`World.create_revolute_joint`, …).");
+handle_class!(
+    Joint,
+    "Joint",
+    "A joint handle (`World.create_revolute_joint`, …)."
+);
 handle_class!(
     PortalPair,
     "PortalPair",

@@ -117,9 +117,8 @@ impl<'py> Take<'py> {
     pub fn pop<T: Field>(&mut self, name: &'static str) -> PyResult<Option<T>> {
         match self.left.get_item(name)? {
             Some(v) => {
-                let value = T::load(&v).map_err(|e| {
-                    PyTypeError::new_err(format!("keyword `{name}`: {e}"))
-                })?;
+                let value = T::load(&v)
+                    .map_err(|e| PyTypeError::new_err(format!("keyword `{name}`: {e}")))?;
                 self.left.del_item(name)?;
                 Ok(Some(value))
             }
@@ -261,9 +260,7 @@ pub fn defaults<'py>(py: Python<'py>, kind: &str) -> PyResult<Bound<'py, PyDict>
     let mut dump = Dump {
         dict: PyDict::new(py),
     };
-    let b = janus2d::BodyHandle::new(0, 0, 0);
     let mut base = JointDefBase::default();
-    base.body_a = b;
     match kind {
         "world" => world_def(&mut WorldDef::default(), &mut dump)?,
         "body" => body_def(&mut BodyDef::dynamic(Vec2::ZERO), &mut dump)?,
@@ -274,7 +271,10 @@ pub fn defaults<'py>(py: Python<'py>, kind: &str) -> PyResult<Bound<'py, PyDict>
         "distance" => distance(&mut DistanceJointDef::from_base(base, 1.0), &mut dump)?,
         "wheel" => wheel(&mut WheelJointDef::from_base(base), &mut dump)?,
         "motor" => motor(&mut MotorJointDef::from_base(base), &mut dump)?,
-        "mouse" => mouse(&mut MouseJointDef::from_base(base, Vec2::ZERO, 1.0), &mut dump)?,
+        "mouse" => mouse(
+            &mut MouseJointDef::from_base(base, Vec2::ZERO, 1.0),
+            &mut dump,
+        )?,
         "filter" => joint_base(&mut base, &mut dump)?,
         other => {
             return Err(PyValueError::new_err(format!(

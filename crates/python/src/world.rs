@@ -167,7 +167,11 @@ impl PyWorld {
             def.solver.mode = match mode {
                 0 => janus2d::SolverMode::SoftStep,
                 1 => janus2d::SolverMode::PgsBaumgarte,
-                _ => return Err(PyValueError::new_err("solver_mode: 0 (soft step) or 1 (PGS)")),
+                _ => {
+                    return Err(PyValueError::new_err(
+                        "solver_mode: 0 (soft step) or 1 (PGS)",
+                    ));
+                }
             };
         }
         take.finish("World")?;
@@ -329,7 +333,9 @@ impl PyWorld {
 
     /// `"dynamic"`, `"static"` or `"kinematic"`.
     fn body_type(&self, body: Body) -> PyResult<&'static str> {
-        Ok(body_type_name(self.inner.lock().body_type(body.raw()).py()?))
+        Ok(body_type_name(
+            self.inner.lock().body_type(body.raw()).py()?,
+        ))
     }
 
     /// Whether the body is awake.
@@ -390,7 +396,10 @@ impl PyWorld {
 
     /// A torque for the next step, N·m.
     fn apply_torque(&self, body: Body, torque: f64) -> PyResult<()> {
-        self.inner.lock().apply_torque(body.raw(), torque as Real).py()
+        self.inner
+            .lock()
+            .apply_torque(body.raw(), torque as Real)
+            .py()
     }
 
     /// A linear impulse at a world point (default: the centre of mass), N·s.
@@ -743,7 +752,11 @@ impl PyWorld {
     /// The shapes of a body.
     fn body_shapes(&self, body: Body) -> PyResult<Vec<Shape>> {
         let w = self.inner.lock();
-        Ok(w.body_shapes(body.raw()).py()?.into_iter().map(Shape::from).collect())
+        Ok(w.body_shapes(body.raw())
+            .py()?
+            .into_iter()
+            .map(Shape::from)
+            .collect())
     }
 
     // ---- joints ---------------------------------------------------------
@@ -789,7 +802,12 @@ impl PyWorld {
         let base = self
             .inner
             .lock()
-            .joint_base_along(body_a.raw(), body_b.raw(), vec2(anchor)?, axis.y.atan2(axis.x))
+            .joint_base_along(
+                body_a.raw(),
+                body_b.raw(),
+                vec2(anchor)?,
+                axis.y.atan2(axis.x),
+            )
             .py()?;
         let mut def = PrismaticJointDef::from_base(base);
         let mut take = Take::new(py, kwargs)?;
@@ -816,7 +834,12 @@ impl PyWorld {
         let base = self
             .inner
             .lock()
-            .joint_base_along(body_a.raw(), body_b.raw(), vec2(anchor)?, axis.y.atan2(axis.x))
+            .joint_base_along(
+                body_a.raw(),
+                body_b.raw(),
+                vec2(anchor)?,
+                axis.y.atan2(axis.x),
+            )
             .py()?;
         let mut def = WheelJointDef::from_base(base);
         let mut take = Take::new(py, kwargs)?;
@@ -1201,7 +1224,10 @@ impl PyWorld {
         let w = self.inner.lock();
         let e = w.events();
         let d = PyDict::new(py);
-        d.set_item("contact_begin", shape_pairs(py, &e.collision.contact_begin)?)?;
+        d.set_item(
+            "contact_begin",
+            shape_pairs(py, &e.collision.contact_begin)?,
+        )?;
         d.set_item("contact_end", shape_pairs(py, &e.collision.contact_end)?)?;
         d.set_item("sensor_begin", shape_pairs(py, &e.collision.sensor_begin)?)?;
         d.set_item("sensor_end", shape_pairs(py, &e.collision.sensor_end)?)?;
