@@ -331,11 +331,15 @@ fn rays_find_the_ground_at_the_height_of_each_world() {
     // box (centre 2.7, top face at 3.2; it has not moved, no step taken).
     let rays = [0.0, 10.0, 0.0, -20.0, 0.0, 10.0, 0.0, -20.0];
     let mut out = vec![0.0; 2];
-    batch.cast_rays(&rays, &QueryFilter::default(), &mut out).unwrap();
+    batch
+        .cast_rays(&rays, &QueryFilter::default(), &mut out)
+        .unwrap();
     assert!((out[0] - (10.0 - 3.2) / 20.0).abs() < 1e-4, "{}", out[0]);
     // A ray upward finds nothing: fraction 1.
     let up = [0.0, 10.0, 0.0, 5.0, 0.0, 10.0, 0.0, 5.0];
-    batch.cast_rays(&up, &QueryFilter::default(), &mut out).unwrap();
+    batch
+        .cast_rays(&up, &QueryFilter::default(), &mut out)
+        .unwrap();
     assert_eq!(out, vec![1.0, 1.0]);
     let mut bad = vec![0.0; 2];
     assert!(matches!(
