@@ -1,0 +1,158 @@
+"""janus2d's Python side, measured: the batch's thread scaling, and
+LunarLander steps per second beside Gymnasium's Box2D one (when
+``gymnasium[box2d]`` is installed), single and vectorised, with the random
+policy's returns.
+
+    python crates/python/bench/bench.py            # everything
+    python crates/python/bench/bench.py --quick    # fewer repeats
+
+Run it on an idle machine: nothing else compiling.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+import janus2d
+from janus2d.envs.lander import build_world
+
+
+def best_of(repeats, fn):
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def batch_scaling(worlds=256, steps=100, repeats=5):
+    """Steps/s of a batch of `worlds` lander worlds (a lander on its legs
+    above random ground, falling and landing) on 1 and 2 threads."""
+    world, h = build_world(np.random.default_rng(0))
+    rows = []
+    for threads in (1, 2):
+        def run():
+            batch = janus2d.WorldBatch(world, worlds, threads=threads)
+            batch.step(1 / 50, steps=steps)
+
+        # The batch's creation is outside the timing: time a build alone.
+        build = best_of(repeats, lambda: janus2d.WorldBatch(world, worlds, threads=threads))
+        t = best_of(repeats, run) - build
+        rows.append((threads, worlds * steps / t))
+    return rows
+
+
+def lander_returns(make_env, episodes, seed):
+    env = make_env()
+    out = []
+    for k in range(episodes):
+        env.reset(seed=seed + k)
+        env.action_space.seed(seed + k)
+        total, done = 0.0, False
+        while not done:
+            _, r, term, trunc, _ = env.step(env.action_space.sample())
+            total += r
+            done = term or trunc
+        out.append(total)
+    return np.array(out)
+
+
+def env_rate(make_env, steps, seed=0):
+    env = make_env()
+    env.reset(seed=seed)
+    rng = np.random.default_rng(seed)
+    actions = rng.integers(0, 4, size=steps)
+    t0 = time.perf_counter()
+    for a in actions:
+        _, _, term, trunc, _ = env.step(int(a))
+        if term or trunc:
+            env.reset()
+    return steps / (time.perf_counter() - t0)
+
+
+def vector_rate(make_vec, n, steps, seed=0):
+    envs = make_vec(n)
+    envs.reset(seed=seed)
+    rng = np.random.default_rng(seed)
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        envs.step(rng.integers(0, 4, size=n))
+    dt = time.perf_counter() - t0
+    envs.close()
+    return n * steps / dt
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--threads", type=int, default=2, help="threads of janus2d's vector envs")
+    args = ap.parse_args()
+    repeats = 2 if args.quick else 5
+    episodes = 20 if args.quick else 100
+
+    print("== WorldBatch: 256 lander worlds, 100 steps, best of", repeats)
+    rows = batch_scaling(repeats=repeats)
+    print(f"{'threads':>8} {'world-steps/s':>14} {'speed-up':>9}")
+    for threads, rate in rows:
+        print(f"{threads:>8} {rate:>14.0f} {rate / rows[0][1]:>9.2f}")
+
+    import gymnasium as gym
+
+    import janus2d.envs  # noqa: F401
+    from janus2d.envs import LunarLanderVector
+
+    try:
+        import Box2D  # noqa: F401
+
+        have_box2d = True
+    except ImportError:
+        have_box2d = False
+
+    print()
+    print("== LunarLander, random actions: environment steps per second")
+    single_steps = 5000 if args.quick else 20000
+    j_single = env_rate(lambda: gym.make("janus2d/LunarLander-v0"), single_steps)
+    g_single = (
+        env_rate(lambda: gym.make("LunarLander-v3"), single_steps) if have_box2d else None
+    )
+    print(f"{'envs':>6} {'janus2d':>12} {'gymnasium+Box2D':>16} {'ratio':>7}")
+
+    def line(n, j, g):
+        gs = f"{g:>16.0f}" if g else f"{'n/a':>16}"
+        ratio = f"{j / g:>7.2f}" if g else f"{'':>7}"
+        print(f"{n:>6} {j:>12.0f} {gs} {ratio}")
+
+    line(1, j_single, g_single)
+    for n in (8, 64, 256):
+        steps = max(20, (2000 if args.quick else 8000) // n)
+        j = vector_rate(lambda k: LunarLanderVector(k, threads=args.threads), n, steps)
+        g = None
+        if have_box2d:
+            g = vector_rate(
+                lambda k: gym.make_vec("LunarLander-v3", num_envs=k, vectorization_mode="sync"),
+                n,
+                steps,
+            )
+        line(n, j, g)
+
+    print()
+    print(f"== random policy returns over {episodes} episodes")
+    for name, make in [("janus2d", lambda: gym.make("janus2d/LunarLander-v0"))] + (
+        [("gymnasium+Box2D", lambda: gym.make("LunarLander-v3"))] if have_box2d else []
+    ):
+        r = lander_returns(make, episodes, seed=1000)
+        q = np.percentile(r, [10, 50, 90])
+        print(
+            f"{name:>16}: mean {r.mean():7.1f}  std {r.std():6.1f}  "
+            f"p10 {q[0]:7.1f}  median {q[1]:7.1f}  p90 {q[2]:7.1f}"
+        )
+    if not have_box2d:
+        print("(gymnasium[box2d] is not installed: no Box2D column)")
+
+
+if __name__ == "__main__":
+    main()
