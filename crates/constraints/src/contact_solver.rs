@@ -446,6 +446,7 @@ impl ContactSolver {
 
     /// Per body state, the colours in which a contact lane moves it: bit
     /// `c` of `out[s]` (the overflow takes no colour).
+    #[cfg(test)]
     pub(crate) fn moving_colours(&self, state_count: usize, out: &mut Vec<u32>) {
         out.clear();
         out.resize(state_count, 0);

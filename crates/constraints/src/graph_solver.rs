@@ -1,12 +1,15 @@
 //! Joints and contacts in one colour sequence: the solver's graph batch.
 //!
-//! The contacts keep their colours from step to step (the persistent
-//! [`ConstraintGraph`](janus2d_core::graph::ConstraintGraph)); the joints
-//! take, around them, the lowest colour in which neither of their moving
-//! bodies is moved by a contact or by another joint ([`JointColours`],
-//! recoloured only when a joint's key or the contacts' colours on its
-//! bodies change). So colour `c` holds joints and contacts that share no
-//! moving body, and one velocity iteration is one sweep of the colours:
+//! The joints are coloured greedily over their moving bodies
+//! ([`JointColours`], again only when a joint's key changes); the contacts
+//! keep their colours from step to step in the persistent
+//! [`ConstraintGraph`](janus2d_core::graph::ConstraintGraph), which takes
+//! none of the colours the joints hold on a body
+//! ([`JointColours::reserve`] →
+//! [`ConstraintGraph::set_reserved`](janus2d_core::graph::ConstraintGraph::set_reserved)),
+//! as Box2D's graph holds both. So colour `c` holds joints and contacts
+//! that share no moving body, and one velocity iteration is one sweep of
+//! the colours:
 //!
 //! ```text
 //!   forward (solve)                       reverse (alternate sweeps)
@@ -20,14 +23,17 @@
 //!
 //! On the team a colour is one job whose blocks are its joints' blocks and
 //! its contacts' chunks ([`Team::for_each_planned_pair`]), checked once
-//! per step to share no written state ([`CrossPlan`]); a short colour runs
-//! on the leader, joints first. Either way each colour's joints and
-//! contacts touch different moving bodies, so the states are bit-identical
-//! for any thread count.
+//! per step to share no written state
+//! ([`CrossPlan`](janus2d_core::parallel::CrossPlan)); a short colour runs
+//! on the leader, joints first. A step whose joints were coloured after
+//! the contacts took theirs (a joint created or woken since the last step)
+//! may hold a body in both halves of a colour: the check then fails and
+//! the colour runs as two jobs, joints first, the order of the serial
+//! sweep. Either way the states are bit-identical for any thread count.
 //!
 //! | stage            | joints                                   | contacts                           |
 //! |------------------|------------------------------------------|------------------------------------|
-//! | prepare          | rows, forest, colours around the contacts | lanes, overflow, plan              |
+//! | prepare          | rows, forest, colours (on a change)      | lanes, overflow, plan              |
 //! | warm start       | per moving body (storage order)          | colour by colour, overflow         |
 //! | solve, relax     | colour by colour, together with the contacts of the colour; then the overflows |
 //! | late solve       | the exact trees                          | —                                  |
@@ -197,7 +203,7 @@ impl ConstraintBatch for GraphBatch<'_> {
         self.contacts.prepare_on(ctx, bodies, team);
         self.joints.prepare_rows_on(ctx, bodies, team);
         let (colours, contacts) = (&mut *self.joints.colours, &*self.contacts.solver);
-        colours.update_around(self.joints.joints, &bodies.states, contacts, team);
+        colours.update_beside(self.joints.joints, &bodies.states, contacts, team);
     }
     fn warm_start_on(&mut self, ctx: &StepContext, states: &mut [BodyState], team: &Team) {
         if self.joints.count() > 0 {
@@ -244,15 +250,26 @@ mod tests {
     use crate::revolute::{RevoluteJoint, RevoluteJointDef};
     use crate::{ContactPointInput, ObjectMass};
     use janus2d_core::body::{BodyDef, BodyHandle};
-    use janus2d_core::graph::{COLOURS, ColourGraph};
+    use janus2d_core::graph::ConstraintGraph;
     use janus2d_core::math::{Real, Vec2};
     use janus2d_core::solver::SolverSettings;
 
-    /// A row of `n` bodies: contacts between bodies 6k and 6k + 1 and
-    /// between 12k and 12k + 3 (coloured greedily), motor joints
-    /// between bodies two apart (angle rows: every joint takes a colour,
-    /// some beside contacts in colours the contacts use).
-    fn row(n: usize) -> (BodySet, ContactSolver, Vec<Joint>) {
+    /// The pieces of a graph batch over a row of `n` bodies.
+    struct Row {
+        set: BodySet,
+        contacts: ContactSolver,
+        joints: Vec<Joint>,
+        forest: JointForest,
+        colours: JointColours,
+    }
+
+    /// A row of `n` bodies: motor joints between bodies 6k + 2 and 6k + 4
+    /// and between 6k + 3 and 6k + 5 (angle rows: every joint takes a
+    /// colour), coloured first; then contacts
+    /// between bodies 6k and 6k + 1 and between 12k and 12k + 3, coloured
+    /// in the persistent graph around the joints' colours, as the world
+    /// does.
+    fn row(n: usize) -> Row {
         let mut set = BodySet::new();
         let ids: Vec<BodyHandle> = (0..n)
             .map(|i| {
@@ -261,44 +278,8 @@ mod tests {
                 set.create(&def).unwrap()
             })
             .collect();
-        let state = |h: BodyHandle| set.state_index(h).unwrap();
-        let mut graph = ColourGraph::new();
-        graph.reset(set.states.len());
-        let mut contacts = ContactSolver::new();
-        contacts.begin();
-        let mut index = 0;
-        for (gap, every) in [(1, 6), (3, 12)] {
-            for i in (0..n - gap).filter(|i| i % every == 0) {
-                let (a, b) = (ids[i], ids[i + gap]);
-                let (sa, sb) = (state(a), state(b));
-                let colour = graph.assign(Some(sa), Some(sb)).unwrap_or(COLOURS);
-                let point = ContactPointInput {
-                    anchor_a: Vec2::new(0.5, 0.0),
-                    anchor_b: Vec2::new(-0.5, 0.0),
-                    separation: -0.01,
-                    normal_impulse: 0.02,
-                    tangent_impulse: 0.001,
-                };
-                let lane = ContactLane {
-                    body_a: a,
-                    body_b: b,
-                    state_a: sa,
-                    state_b: sb,
-                    inv_masses: [1.0, 2.0, 1.0, 2.0],
-                    normal: Vec2::X,
-                    points: [point; crate::contact::MAX_MANIFOLD_POINTS],
-                    point_count: 1,
-                    friction: 0.6,
-                    restitution: 0.0,
-                    contact_index: index,
-                    cluster: [crate::contact_group::NO_CLUSTER; 2],
-                };
-                index += 1;
-                contacts.push(colour as u8, &lane);
-            }
-        }
         let mut joints = Vec::new();
-        for i in 0..n - 2 {
+        for i in (0..n - 2).filter(|i| matches!(i % 6, 2 | 3)) {
             let mut def = RevoluteJointDef::new(
                 ids[i],
                 ids[i + 2],
@@ -310,16 +291,74 @@ mod tests {
             def.motor_speed = 0.5;
             joints.push(Joint::from(RevoluteJoint::new(def)));
         }
-        (set, contacts, joints)
+        let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
+        let (mut forest, mut colours) = (JointForest::default(), JointColours::new());
+        JointBatch {
+            joints: &mut joints,
+            forest: &mut forest,
+            colours: &mut colours,
+        }
+        .prepare(&ctx, &set);
+        let mut reserved = Vec::new();
+        colours.reserve(&joints, &mut reserved);
+        let mut graph = ConstraintGraph::new();
+        graph.set_reserved(&reserved);
+        graph.begin_step();
+        let state = |h: BodyHandle| set.state_index(h).unwrap();
+        let mut contacts = ContactSolver::new();
+        contacts.begin();
+        let mut index = 0;
+        for (gap, every) in [(1, 6), (3, 12)] {
+            for i in (0..n - gap).filter(|i| i % every == 0) {
+                let (a, b) = (ids[i], ids[i + gap]);
+                let colour = graph.keep(index, [a.index, b.index]);
+                let point = ContactPointInput {
+                    anchor_a: Vec2::new(0.5, 0.0),
+                    anchor_b: Vec2::new(-0.5, 0.0),
+                    separation: -0.01,
+                    normal_impulse: 0.02,
+                    tangent_impulse: 0.001,
+                };
+                let lane = ContactLane {
+                    body_a: a,
+                    body_b: b,
+                    state_a: state(a),
+                    state_b: state(b),
+                    inv_masses: [1.0, 2.0, 1.0, 2.0],
+                    normal: Vec2::X,
+                    points: [point; crate::contact::MAX_MANIFOLD_POINTS],
+                    point_count: 1,
+                    friction: 0.6,
+                    restitution: 0.0,
+                    contact_index: index,
+                    cluster: [crate::contact_group::NO_CLUSTER; 2],
+                };
+                index += 1;
+                contacts.push(colour, &lane);
+            }
+        }
+        graph.sweep();
+        Row {
+            set,
+            contacts,
+            joints,
+            forest,
+            colours,
+        }
     }
 
     /// Prepares the row's graph batch on `team`, runs three substeps'
     /// stages and returns the bits of every velocity, the colours, and
     /// whether the colours ran as one job each (the plans checked together).
     fn run_stages(team: &Team) -> (Vec<u64>, Vec<Vec<u32>>, bool) {
-        let (mut set, mut contacts, mut joints) = row(3000);
+        let Row {
+            mut set,
+            mut contacts,
+            mut joints,
+            mut forest,
+            mut colours,
+        } = row(3000);
         let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::new(0.0, -10.0));
-        let (mut forest, mut colours) = (JointForest::default(), JointColours::new());
         let objects: [ObjectMass; 0] = [];
         let mut batch = GraphBatch {
             joints: JointBatch {
@@ -359,30 +398,21 @@ mod tests {
         (bits, by_colour, paired)
     }
 
-    /// The joints take colours around the contacts: within a colour no
+    /// The contacts take colours around the joints': within a colour no
     /// moving body carries both a joint and a contact (nor two joints).
     #[test]
     fn a_colour_holds_a_moving_body_once_across_joints_and_contacts() {
-        let (set, mut contacts, mut joints) = row(400);
-        let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
-        let (mut forest, mut colours) = (JointForest::default(), JointColours::new());
-        let objects: [ObjectMass; 0] = [];
-        let mut batch = GraphBatch {
-            joints: JointBatch {
-                joints: &mut joints,
-                forest: &mut forest,
-                colours: &mut colours,
-            },
-            contacts: ContactBatch {
-                solver: &mut contacts,
-                object_masses: &objects,
-            },
-        };
-        batch.prepare(&ctx, &set);
+        let Row {
+            set,
+            contacts,
+            joints,
+            colours,
+            ..
+        } = row(400);
         let mut occupied = Vec::new();
         contacts.moving_colours(set.states.len(), &mut occupied);
-        assert!(colours.colour_count() >= 2);
-        let mut coloured = 0;
+        assert!(colours.colour_count() >= 1);
+        let mut shared = 0;
         for c in 0..colours.colour_count() {
             let mut seen = std::collections::HashSet::new();
             for &i in colours.joints_in(c) {
@@ -391,13 +421,15 @@ mod tests {
                     assert_eq!(occupied[s as usize] & (1 << c), 0, "state {s}, colour {c}");
                     assert!(seen.insert(s), "state {s} twice in colour {c}");
                 }
-                coloured += 1;
+            }
+            if !colours.joints_in(c).is_empty() && contacts.count_in(c as u8) > 0 {
+                shared += 1;
             }
         }
-        // Two contacts and two joints per body at most leave colours free:
-        // no joint waits in the overflow.
+        // The two kinds do share colours (on different bodies).
+        assert!(shared > 0);
         assert_eq!(colours.overflow_len(), 0);
-        assert_eq!(coloured, joints.len());
+        assert_eq!(contacts.count_in(crate::contact_solver::OVERFLOW), 0);
     }
 
     /// One job per colour on the team (joints and contacts together) gives

@@ -65,7 +65,7 @@
 //! angle rows (a plain hinge of a chain, a rope, a bridge) takes no colour:
 //! its only Gauss–Seidel part is the warm start.
 
-use janus2d_core::body::BodyState;
+use janus2d_core::body::{BodySet, BodyState};
 use janus2d_core::constraint::StepContext;
 use janus2d_core::graph::{COLOURS, ColourGraph};
 use janus2d_core::parallel::{CrossPlan, StatePlan, Team};
@@ -98,9 +98,8 @@ const WARM_START_BLOCK: usize = 256;
 /// See the module docs.
 #[derive(Clone, Debug, Default)]
 pub struct JointColours {
-    /// Per joint: `[state a, state b, flags, contact colours of a, contact
-    /// colours of b]` of this step (zeros for a joint that is not solved;
-    /// the colours the contacts hold on each moving end).
+    /// Per joint: `[state a, state b, flags]` of this step (zeros for a
+    /// joint that is not solved).
     keys: Vec<Key>,
     /// The keys and the state count of the last colouring.
     built_keys: Vec<Key>,
@@ -131,13 +130,19 @@ pub struct JointColours {
     body_joints: Vec<u32>,
     /// The states that have a joint in `body_joints`, ascending.
     jointed: Vec<u32>,
-    /// Per state: the colours in which the step's contacts move it
-    /// (empty without contacts).
-    occupied: Vec<u32>,
+    /// Per joint: its colour in the last colouring ([`COLOURS`]: the
+    /// overflow; [`NO_COLOUR`]: none, not solved or no Gauss–Seidel rows).
+    colour_of: Vec<u8>,
+    /// Counts the colourings (a cache of what they give can tell it is
+    /// stale).
+    generation: u64,
     /// The colours' plan checked against the contacts' plan: a colour's
     /// joints and contacts then run as one job on the team.
     cross: CrossPlan,
 }
+
+/// [`JointColours::colour_of`] of a joint that takes no colour.
+const NO_COLOUR: u8 = u8::MAX;
 
 impl JointColours {
     /// No joint coloured yet.
@@ -172,56 +177,66 @@ impl JointColours {
     /// colours the joints again if a key or the state count changed since
     /// the last colouring.
     pub fn update(&mut self, joints: &[Joint], states: &[BodyState]) {
-        self.update_on(joints, states, &[], &Team::serial());
+        self.update_on(joints, states, &Team::serial());
     }
 
-    /// [`JointColours::update`] around the contacts' colours, with the keys
-    /// read in blocks on the step's team (a colouring, when needed, runs on
-    /// the caller). `occupied[s]` holds the colours in which the contacts
-    /// already move body state `s` (empty: no contact); a joint takes a
-    /// colour that neither of its moving ends holds there, so that a
-    /// colour's joints and contacts can run as one job.
-    pub fn update_on(
-        &mut self,
-        joints: &[Joint],
-        states: &[BodyState],
-        occupied: &[u32],
-        team: &Team,
-    ) {
+    /// [`JointColours::update`] with the keys read in blocks on the step's
+    /// team (a colouring, when needed, runs on the caller).
+    pub fn update_on(&mut self, joints: &[Joint], states: &[BodyState], team: &Team) {
         const BLOCK: usize = 1024;
-        self.keys.resize(joints.len(), [0; 5]);
+        self.keys.resize(joints.len(), [0; 3]);
         team.for_each_chunk_mut(&mut self.keys, BLOCK, |i, block| {
             for (k, j) in block.iter_mut().zip(&joints[i * BLOCK..]) {
-                *k = key(j, states, occupied);
+                *k = key(j, states);
             }
         });
+        self.recolour_if_changed(joints.len(), states.len());
+    }
+
+    /// [`JointColours::update`] before the joints' prepare: the state
+    /// indices read from `bodies` (where the prepare will load them), not
+    /// from the joints (where the last prepare left them). The contacts'
+    /// graph reads the result ([`JointColours::reserve`]); the prepare then
+    /// finds the same keys and keeps the colours.
+    pub fn update_from(&mut self, joints: &[Joint], bodies: &BodySet) {
+        self.keys.clear();
+        self.keys.extend(joints.iter().map(|j| {
+            let (a, b) = j.bodies();
+            let index = |h| bodies.state_index(h).unwrap_or(0);
+            key_at(j, index(a), index(b), &bodies.states)
+        }));
+        self.recolour_if_changed(joints.len(), bodies.states.len());
+    }
+
+    /// Colours the joints again when this step's keys (in `keys`) or the
+    /// state count differ from the last colouring's.
+    fn recolour_if_changed(&mut self, joint_count: usize, state_count: usize) {
         if self.keys == self.built_keys
-            && states.len() == self.built_states
-            && self.position.len() == joints.len()
+            && state_count == self.built_states
+            && self.position.len() == joint_count
         {
             return;
         }
         std::mem::swap(&mut self.keys, &mut self.built_keys);
-        self.built_states = states.len();
+        self.built_states = state_count;
         self.recolour();
     }
 
     /// Greedy colouring of the joints in storage order, then the solve
     /// order (a counting sort by colour, stable) and the plan.
     fn recolour(&mut self) {
+        self.generation += 1;
         let keys = &self.built_keys;
         self.graph.reset(self.built_states);
-        for k in keys.iter().filter(|k| k[2] & COLOURED != 0) {
-            self.graph.mark(k[0], k[3]);
-            self.graph.mark(k[1], k[4]);
-        }
         // The colour of each joint (COLOURS: overflow), reusing `position`.
         let mut counts = [0u32; COLOURS + 1];
         self.position.clear();
+        self.colour_of.clear();
         for k in keys {
             let flags = k[2];
             if flags & COLOURED == 0 {
                 self.position.push(NONE);
+                self.colour_of.push(NO_COLOUR);
                 continue;
             }
             let a = (flags & u32::from(WRITE_A) != 0).then_some(k[0]);
@@ -229,9 +244,10 @@ impl JointColours {
             let colour = self.graph.assign(a, b).unwrap_or(COLOURS);
             counts[colour] += 1;
             self.position.push(colour as u32);
+            self.colour_of.push(colour as u8);
         }
-        // One past the last colour in use (around the contacts' colours a
-        // colour below it may be empty).
+        // Greedy colours are contiguous (colour c is taken only where c − 1
+        // is blocked), so this is the number of non-empty colours.
         let used = counts[..COLOURS]
             .iter()
             .rposition(|&n| n > 0)
@@ -341,28 +357,54 @@ impl JointColours {
         });
     }
 
-    /// [`JointColours::update_on`] around the colours of `contacts` (the
-    /// graph batch's prepare, after the contacts' own): the joints take
-    /// colours in which the contacts move neither of their bodies; then,
-    /// on a team of several threads, the plans are checked against each
-    /// other ([`CrossPlan`]).
-    pub(crate) fn update_around(
+    /// [`JointColours::update_on`] beside the colours of `contacts` (the
+    /// graph batch's prepare, after the contacts' own), then, on a team of
+    /// several threads, the two plans checked against each other
+    /// ([`CrossPlan`]): the contacts took their colours around the joints'
+    /// ([`JointColours::reserve`]), so a colour's joints and contacts can
+    /// run as one job.
+    pub(crate) fn update_beside(
         &mut self,
         joints: &[Joint],
         states: &[BodyState],
         contacts: &ContactSolver,
         team: &Team,
     ) {
-        let mut occupied = std::mem::take(&mut self.occupied);
-        if joints.is_empty() || contacts.is_empty() {
-            occupied.clear();
-        } else {
-            contacts.moving_colours(states.len(), &mut occupied);
-        }
-        self.update_on(joints, states, &occupied, team);
-        self.occupied = occupied;
+        self.update_on(joints, states, team);
         if team.threads() > 1 && !joints.is_empty() && !contacts.is_empty() {
             self.cross.verify(&self.plan, contacts.plan(), states.len());
+        }
+    }
+
+    /// Counts the colourings: a value that changes whenever
+    /// [`JointColours::reserve`] would give something else.
+    #[must_use]
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+
+    /// The colours the joints hold, by body slot (`BodyHandle::index`):
+    /// bit `c` of `out[k]` when a joint of colour `c` moves body slot `k`.
+    /// The contacts' persistent graph takes none of them
+    /// ([`ConstraintGraph::set_reserved`](janus2d_core::graph::ConstraintGraph::set_reserved)),
+    /// so that joints and contacts share the colours as Box2D's graph
+    /// does. From the last colouring (`joints` as they were then).
+    pub fn reserve(&self, joints: &[Joint], out: &mut Vec<u32>) {
+        out.clear();
+        for ((j, &colour), k) in joints.iter().zip(&self.colour_of).zip(&self.built_keys) {
+            if (colour as usize) >= COLOURS {
+                continue;
+            }
+            let (a, b) = j.bodies();
+            for (body, bit) in [(a, WRITE_A), (b, WRITE_B)] {
+                if k[2] & u32::from(bit) != 0 {
+                    let slot = body.index as usize;
+                    if out.len() <= slot {
+                        out.resize(slot + 1, 0);
+                    }
+                    out[slot] |= 1 << colour;
+                }
+            }
         }
     }
 
@@ -510,16 +552,22 @@ impl JointColours {
     }
 }
 
-/// A joint's colouring key: its state indices, which ends move, and the
-/// contacts' colours on its moving ends (see [`JointColours::update_on`]).
-type Key = [u32; 5];
+/// A joint's colouring key: its state indices and which ends move (see
+/// [`JointColours::update`]).
+type Key = [u32; 3];
 
 #[inline]
-fn key(j: &Joint, states: &[BodyState], occupied: &[u32]) -> Key {
+fn key(j: &Joint, states: &[BodyState]) -> Key {
     let base = j.base();
-    let (a, b) = (base.state_a, base.state_b);
+    key_at(j, base.state_a, base.state_b, states)
+}
+
+/// [`key`] with the bodies on state indices `a` and `b`.
+#[inline]
+fn key_at(j: &Joint, a: u32, b: u32, states: &[BodyState]) -> Key {
+    let base = j.base();
     if !base.enabled || (a == 0 && b == 0) {
-        return [0; 5];
+        return [0; 3];
     }
     let coloured = if j.has_iterative_rows() { COLOURED } else { 0 };
     let flags = ACTIVE
@@ -534,17 +582,7 @@ fn key(j: &Joint, states: &[BodyState], occupied: &[u32]) -> Key {
         } else {
             0
         };
-    if coloured == 0 || occupied.is_empty() {
-        return [a, b, flags, 0, 0];
-    }
-    let taken = |s: u32, bit: u8| {
-        if flags & u32::from(bit) != 0 {
-            occupied.get(s as usize).copied().unwrap_or(0)
-        } else {
-            0
-        }
-    };
-    [a, b, flags, taken(a, WRITE_A), taken(b, WRITE_B)]
+    [a, b, flags]
 }
 
 /// The allocation of a stage's joint references, kept empty between

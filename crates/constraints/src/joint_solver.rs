@@ -77,8 +77,7 @@ impl ConstraintBatch for JointBatch<'_> {
     }
     fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
         self.prepare_rows_on(ctx, bodies, team);
-        self.colours
-            .update_on(self.joints, &bodies.states, &[], team);
+        self.colours.update_on(self.joints, &bodies.states, team);
     }
     fn warm_start_on(&mut self, _ctx: &StepContext, states: &mut [BodyState], team: &Team) {
         self.colours.warm_start(self.joints, states, team);

@@ -46,15 +46,6 @@ impl ColourGraph {
         self.body_colours.resize(state_count, 0);
     }
 
-    /// Marks body state `state` in the colours of `bits` (colours that
-    /// other constraints already hold there), so that
-    /// [`ColourGraph::assign`] colours around them. Out of range: ignored.
-    pub fn mark(&mut self, state: u32, bits: u32) {
-        if let Some(b) = self.body_colours.get_mut(state as usize) {
-            *b |= bits;
-        }
-    }
-
     /// Assigns the lowest colour in which neither body appears and marks
     /// both in it; `None` for a body means it takes no colour (static or
     /// kinematic). Returns `None` when no colour is free (overflow), or
@@ -152,6 +143,11 @@ pub struct ConstraintGraph {
     /// pass (a settled scene's usual step).
     #[cfg_attr(feature = "serde", serde(skip))]
     kept: usize,
+    /// By body key: colours held by other constraints this step (the
+    /// joints', [`ConstraintGraph::set_reserved`]); no constraint of the
+    /// graph takes one of them on that body.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    reserved: Vec<u32>,
 }
 
 impl ConstraintGraph {
@@ -159,6 +155,25 @@ impl ConstraintGraph {
     #[must_use]
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// The colours other constraints hold this step, by body key (bit `c`
+    /// of `bits[k]`: body `k` is moved in colour `c` by a joint): a
+    /// constraint kept afterwards takes none of them on its bodies, and
+    /// one that holds such a colour takes another. Call before the step's
+    /// [`ConstraintGraph::keep`]s; an empty slice reserves nothing.
+    pub fn set_reserved(&mut self, bits: &[u32]) {
+        self.reserved.clear();
+        self.reserved.extend_from_slice(bits);
+    }
+
+    /// The colours reserved on either key (see
+    /// [`ConstraintGraph::set_reserved`]).
+    fn reserved_on(&self, keys: [u32; 2]) -> u32 {
+        keys.iter()
+            .filter(|&&k| k != NO_BODY)
+            .map(|&k| self.reserved.get(k as usize).copied().unwrap_or(0))
+            .fold(0, |a, b| a | b)
     }
 
     /// Starts a step: [`ConstraintGraph::keep`] then marks what stays.
@@ -187,7 +202,10 @@ impl ConstraintGraph {
         if entry.colour != GraphEntry::OUT {
             // (A second keep of the same id in a step counts once.)
             self.kept += usize::from(entry.stamp != self.stamp);
-            if entry.keys == keys && (entry.colour as usize) < COLOURS {
+            if entry.keys == keys
+                && (entry.colour as usize) < COLOURS
+                && self.reserved_on(keys) & (1 << entry.colour) == 0
+            {
                 self.entries[i].stamp = self.stamp;
                 return entry.colour;
             }
@@ -291,7 +309,7 @@ impl ConstraintGraph {
     /// The lowest colour (both sides move) or the highest (one side
     /// moves) in which no keyed body appears; [`COLOURS`] when none.
     fn find_colour(&mut self, keys: [u32; 2]) -> u8 {
-        let mut used = 0u32;
+        let mut used = self.reserved_on(keys);
         let mut moving = 0;
         for k in keys {
             if k != NO_BODY {

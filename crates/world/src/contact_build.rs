@@ -142,6 +142,7 @@ impl ContactBuilder {
         objects: &[ObjectMass],
         driven: impl Iterator<Item = BodyHandle>,
         mut pre_solve: Option<&mut PreSolveFn>,
+        reserved: &[u32],
         solver: &mut ContactSolver,
         counters: &mut CollisionCounters,
         team: &Team,
@@ -296,6 +297,10 @@ impl ContactBuilder {
         // many_pyramids at 2 threads they were most of the leader's serial
         // build time.)
         let graph = &mut self.graph;
+        // The joints' colours stay theirs: a contact takes none of them on
+        // a body a joint moves in it (the solve runs a colour's joints and
+        // contacts as one job).
+        graph.set_reserved(reserved);
         graph.begin_step();
         let colours = &mut self.colours;
         colours.clear();

@@ -24,7 +24,7 @@ pub use janus2d_constraints::JointKind;
 use janus2d_constraints::{
     Joint, JointBatch, JointColours, JointDef, JointForest, JointOfKind, RevoluteJoint, WeldJoint,
 };
-use janus2d_core::body::BodyHandle;
+use janus2d_core::body::{BodyHandle, BodySet};
 use janus2d_core::handle::{Handle, JointTag};
 use janus2d_core::math::Real;
 use janus2d_core::slots::Slots;
@@ -154,6 +154,13 @@ pub struct JointSet {
     /// forest, and like it not in snapshot bytes).
     #[cfg_attr(feature = "serde", serde(skip))]
     pub(crate) colours: JointColours,
+    /// The colours the joints hold, by body slot, for the contacts' graph
+    /// to leave free ([`JointSet::refresh_reserved`]; derived).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    reserved: Vec<u32>,
+    /// The colouring (generation, joint count) `reserved` was made from.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    reserved_for: Option<(u64, usize)>,
 }
 
 impl JointSet {
@@ -538,6 +545,31 @@ impl JointSet {
             *d.limits_mut().ok_or(WorldError::WrongJointKind)?.enable = on;
             Ok(())
         })
+    }
+
+    /// Colours the joints over `bodies` if a joint's key changed since
+    /// the last colouring (the same colouring the solve's prepare keeps),
+    /// and the colours they hold by body slot from it: what the contacts'
+    /// persistent graph leaves free ([`JointSet::reserved`]). Everything it
+    /// reads is in a snapshot, so a restored world reserves the same.
+    pub(crate) fn refresh_reserved(&mut self, bodies: &BodySet) {
+        if self.joints.is_empty() {
+            self.reserved.clear();
+            self.reserved_for = None;
+            return;
+        }
+        self.colours.update_from(&self.joints, bodies);
+        let made_from = (self.colours.generation(), self.joints.len());
+        if self.reserved_for != Some(made_from) {
+            self.colours.reserve(&self.joints, &mut self.reserved);
+            self.reserved_for = Some(made_from);
+        }
+    }
+
+    /// The colours the joints hold, by body slot, as of
+    /// [`JointSet::refresh_reserved`].
+    pub(crate) fn reserved(&self) -> &[u32] {
+        &self.reserved
     }
 
     /// The bodies an enabled motor (of nonzero torque) turns: both bodies

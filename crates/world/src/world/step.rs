@@ -125,6 +125,7 @@ impl World {
             self.islands.apply_touch_changes(touches, &self.bodies);
             self.portals
                 .object_masses(&self.bodies, &mut self.object_masses);
+            self.joints.refresh_reserved(&self.bodies);
             self.contact_builder.build(
                 self.collision.narrowphase.handoff(),
                 &mut self.collision.contacts,
@@ -133,6 +134,7 @@ impl World {
                 &self.object_masses,
                 self.joints.driven_bodies(),
                 self.pre_solve.as_mut(),
+                self.joints.reserved(),
                 &mut self.contact_solver,
                 &mut self.collision.counters,
                 team,
