@@ -2,14 +2,14 @@
 //! blocks that the workers claim through atomics.
 //!
 //! ```text
-//! solve_step ── with_team ── rayon::broadcast (once per step) ─────────────┐
+//! World::step ── with_team ── rayon::broadcast (once per step) ────────────┐
 //!   thread 0 (leader)                  threads 1..n (followers)            │
 //!   runs the stage sequence            wait for a job (spin, then yield)   │
 //!   ├ team.run(blocks, job) ─publish─▶ claim block i (swap) → job(i)       │
 //!   │   claims blocks itself            … until every block is claimed     │
 //!   │   waits: done == blocks                                              │
 //!   │   retires the job, waits until no follower holds it                  │
-//!   ├ serial work (colourings, overflows, portals): followers spin         │
+//!   ├ serial work (merges, colourings, overflows): followers spin          │
 //!   ├ team.run(...) …                                                      │
 //!   └ stop ─────────────────────────▶ return to rayon ─────────────────────┘
 //! ```

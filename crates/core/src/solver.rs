@@ -725,10 +725,11 @@ fn finalize_bodies(bodies: &mut BodySet, report: &mut SolveReport, team: &Team) 
 ///
 /// `batches` holds one entry per constraint type (each a `Vec<C>`).
 ///
-/// With the `parallel` feature the stages run on the step's worker team
-/// ([`crate::parallel`]): one rayon broadcast for the whole step, the
-/// stages' blocks claimed through atomics; the result does not depend on
-/// the number of threads.
+/// With the `parallel` feature the stages run on a worker team of their
+/// own ([`crate::parallel`]; the world's step passes its own team to
+/// [`solve_step_on`] instead): one rayon broadcast, the stages' blocks
+/// claimed through atomics; the result does not depend on the number of
+/// threads.
 pub fn solve_step(
     settings: &SolverSettings,
     ctx: &StepContext,
