@@ -268,7 +268,9 @@ impl WorldBatch {
     pub fn step_many(&mut self, dt: Real, steps: usize) -> Result<(), BatchError> {
         self.for_each_world(|_, world| {
             for _ in 0..steps {
-                world.step(dt)?;
+                // One thread per world: the batch's pool is the parallelism
+                // (a world's own team would only compete with it).
+                world.step_serial(dt)?;
             }
             Ok(())
         })

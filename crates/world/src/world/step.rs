@@ -66,6 +66,32 @@ impl World {
         Ok(())
     }
 
+    /// [`World::step`] on the calling thread alone, whatever rayon pool it
+    /// runs in: for a world stepped beside many others on threads of their
+    /// own (as a batch of worlds does), where the step's own team would
+    /// only compete with them. The same state as [`World::step`], bit for
+    /// bit, and the same errors.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let build = || {
+    ///     let mut world = World::new(WorldDef::default()).unwrap();
+    ///     let body = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 4.0))).unwrap();
+    ///     (world, body)
+    /// };
+    /// let ((mut a, body), (mut b, _)) = (build(), build());
+    /// a.step(1.0 / 60.0).unwrap();
+    /// b.step_serial(1.0 / 60.0).unwrap();
+    /// assert_eq!(a.state_hash(), b.state_hash());
+    /// assert!(a.position(body).unwrap().y < 4.0);
+    /// ```
+    pub fn step_serial(&mut self, dt: Real) -> Result<(), WorldError> {
+        check_time_step(dt)?;
+        self.step_on(dt, &janus2d_core::parallel::Team::serial());
+        Ok(())
+    }
+
     /// The pipeline of one step of `dt` (checked), every threaded stage on
     /// `team`: the step's one worker team, held from the pair search to
     /// the store of the impulses (with the `parallel` feature and a rayon
