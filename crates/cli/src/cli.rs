@@ -70,8 +70,8 @@ pub struct RunArgs {
     /// Substeps per step (the scene's own by default).
     #[arg(long)]
     pub substeps: Option<u32>,
-    /// Worker threads of the step (above 1 needs the
-    /// `parallel` feature).
+    /// Worker threads of the step (above 1 needs the `parallel` feature,
+    /// on by default).
     #[arg(long, default_value_t = 1)]
     pub threads: usize,
     /// Write a PNG frame into this folder every `--every` steps.

@@ -537,7 +537,7 @@ pub fn run<W: Write + Send>(
     }
     if options.threads > 1 && cfg!(not(feature = "parallel")) {
         return Err(CliError::Invalid(format!(
-            "--threads {} needs the parallel feature: build with `--features parallel` (cargo run --release -p janus2d-cli --features parallel -- …)",
+            "--threads {} needs the parallel feature (on by default): build without `--no-default-features`",
             options.threads
         )));
     }
