@@ -17,6 +17,7 @@ mod effects;
 mod filter;
 mod joint_api;
 mod joint_checks;
+mod joint_correction;
 mod joint_events;
 mod joint_tree_mixed;
 mod joint_tree_properties;

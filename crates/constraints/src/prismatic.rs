@@ -73,7 +73,8 @@ use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, JointFrame, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::kind_rows::{GeneralRows, KindRows, TreeRows};
 use crate::parts::{
-    AxisPart, AxisRow, BOTH, PairMass, PairOf, PairStates, load_pair, soft_impulse, store_pair,
+    AxisPart, AxisRow, BOTH, PairMass, PairOf, PairStates, angular_correction_cap, cap, load_pair,
+    soft_impulse, store_pair,
 };
 use crate::{JointError, check_spring};
 
@@ -217,7 +218,7 @@ pub(crate) fn rigid_terms(
 ) -> (Real, Real, Real) {
     if use_bias {
         (
-            (softness.bias_rate * c).clamp(-max, max),
+            cap(softness.bias_rate * c, max),
             softness.mass_scale,
             softness.impulse_scale,
         )
@@ -707,6 +708,7 @@ impl PrismaticJoint {
                 soft,
                 ctx.inv_h,
                 use_bias,
+                ctx.joint_max_correction_speed,
             );
             let down = AxisRow {
                 n: -axial.n,
@@ -723,6 +725,7 @@ impl PrismaticJoint {
                 soft,
                 ctx.inv_h,
                 use_bias,
+                ctx.joint_max_correction_speed,
             );
         }
         if !self.base.in_tree {
@@ -754,8 +757,12 @@ impl PrismaticJoint {
             ctx.joint_max_correction_speed,
             use_bias,
         );
-        let (bias_t, ms_t, is_t) =
-            rigid_terms(self.angular_softness, c_angle, Real::INFINITY, use_bias);
+        let (bias_t, ms_t, is_t) = rigid_terms(
+            self.angular_softness,
+            c_angle,
+            angular_correction_cap(ctx.joint_max_correction_speed),
+            use_bias,
+        );
         let c_dot_p = perp.c_dot(sa, sb);
         let c_dot_t = sb.w - sa.w;
         let (i_a, i_b) = (m.a.inv_inertia, m.b.inv_inertia);
