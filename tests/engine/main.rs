@@ -14,6 +14,7 @@ mod continuous;
 mod continuous_joints;
 mod distance;
 mod effects;
+mod event_replay;
 mod filter;
 mod joint_api;
 mod joint_checks;
