@@ -33,6 +33,7 @@ mod reliability;
 mod revolute_properties;
 mod setters;
 mod snapshot;
+mod soak;
 mod stages;
 mod weld;
 mod wheel;
