@@ -613,6 +613,37 @@ impl ContactSet {
                 if !finite {
                     return Err(format!("contact {}: a stored number is not finite", c.id));
                 }
+                // A manifold's normal is a unit vector (a decoded one of
+                // length 1.7e38 spun its body to 1e35 rad/s in one step),
+                // within 1 % (rotations of unit length within
+                // `UNIT_ROTATION_TOLERANCE` turn it), and the mixed
+                // materials are within the shapes' limits.
+                let n2 = c.normal.length_squared();
+                if (c.point_count > 0 && (n2 - 1.0).abs() > 0.01)
+                    || !(0.0..=janus2d_core::limits::MAX_FRICTION).contains(&c.friction)
+                    || !(0.0..=janus2d_core::limits::MAX_RESTITUTION).contains(&c.restitution)
+                {
+                    return Err(format!(
+                        "contact {}: normal {:?}, friction {}, restitution {}",
+                        c.id, c.normal, c.friction, c.restitution
+                    ));
+                }
+                // The recycling cache feeds the next narrowphase: a NaN
+                // separation kept there became a touching point's (a
+                // decoded snapshot, found by the snapshot fuzz target).
+                let r = &c.recycle;
+                if r.valid
+                    && !(r.q_a.is_unit()
+                        && r.q_b.is_unit()
+                        && r.relative.q.is_unit()
+                        && janus2d_core::math::vec_is_finite(r.relative.p)
+                        && r.separation.iter().all(|s| s.is_finite()))
+                {
+                    return Err(format!(
+                        "contact {}: its recycling cache is not finite or not of unit rotations",
+                        c.id
+                    ));
+                }
             }
         }
         for (b, list) in self.body_contacts.iter().enumerate() {

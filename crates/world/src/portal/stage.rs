@@ -593,11 +593,32 @@ impl PortalStage {
             if self.pairs.at(c.pair).is_none() {
                 return Err(format!("crossing {k}: its pair is gone"));
             }
+            // (A decoded entry of 32 indexed the pair's two portals.)
+            if c.entry > 1 {
+                return Err(format!("crossing {k}: entry portal {}", c.entry));
+            }
             if c.original == c.clone || !bodies.contains(c.original) || !bodies.contains(c.clone) {
                 return Err(format!(
                     "crossing {k}: copies {:?}, {:?}",
                     c.original, c.clone
                 ));
+            }
+            // The copies' full masses, which the crossing hands back to
+            // them: within the body limits (a decoded snapshot's denormal
+            // inertia gave the copy an infinite inverse inertia at the
+            // next step).
+            for m in [c.mass_original, c.mass_clone] {
+                let inertia_ok = m.rotational_inertia == 0.0
+                    || janus2d_core::limits::in_range(
+                        m.rotational_inertia,
+                        janus2d_core::limits::INERTIA_RANGE,
+                    );
+                if !(janus2d_core::limits::in_range(m.mass, janus2d_core::limits::MASS_RANGE)
+                    && inertia_ok
+                    && janus2d_core::math::vec_is_finite(m.center))
+                {
+                    return Err(format!("crossing {k}: a copy's mass {m:?}"));
+                }
             }
             let def = pc.def();
             if def.body != c.original || def.clone != c.clone {
