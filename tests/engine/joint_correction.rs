@@ -99,8 +99,8 @@ const STEPS: usize = 60;
 /// joint created 10 m open or turned 3 rad from its reference angle.
 /// Whatever the joint's error, its feedback asks for at most the linear
 /// correction cap `v` plus the angular cap `ω` at the anchor's arm, so no
-/// box moves faster than `v + ω · ARM + g T` over the run `T` (50 + 27.5
-/// + 9.8 = 87.3 m/s). Uncapped, the Gauss–Seidel joints moved their box at
+/// box moves faster than `v + ω · ARM + g T` over the run `T` (87.3 m/s:
+/// 50, 27.5 and 9.8). Uncapped, the Gauss–Seidel joints moved their box at
 /// 190–420 m/s in the first step (every kind 10 m open), the tree's
 /// turned weld at 98 m/s and its prismatic joint's violated limits at
 /// 304 m/s.
@@ -137,7 +137,7 @@ fn a_joint_created_far_from_satisfied_moves_its_body_no_faster_than_the_correcti
 /// the one before. Each joint's linear feedback is capped at the tree's
 /// correction speed `v` and its angle feedback at `ω`, so the outermost box
 /// (at most `n · 2 ARM` from the pin) moves no faster than the caps added
-/// along the chain, `n v + n ω (n · 2 ARM) + g T` (8 + 35.2 + 9.8 = 53 m/s).
+/// along the chain, `n v + n ω (n · 2 ARM) + g T` (53 m/s: 8, 35.2, 9.8).
 /// With the angle rows uncapped the turned prismatic chain's rails swung
 /// its sliders at 1,400 m/s, and the turned welds moved at 111 m/s.
 #[test]

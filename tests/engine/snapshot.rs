@@ -403,6 +403,7 @@ mod bytes {
     /// A corpus file of the snapshot fuzz target as the target reads it:
     /// mode byte even, a payload behind this build's header; odd, the
     /// bytes as they are.
+    #[cfg(all(feature = "portals", not(feature = "f64")))]
     fn fuzz_input(data: &[u8]) -> Result<Snapshot, SnapshotError> {
         let Some((&mode, rest)) = data.split_first() else {
             return Err(SnapshotError::Truncated {
@@ -430,6 +431,7 @@ mod bytes {
     }
 
     /// The committed corpus files named `prefix…`, with their names.
+    #[cfg(all(feature = "portals", not(feature = "f64")))]
     fn fuzz_corpus_files(prefix: &str) -> Vec<(String, Vec<u8>)> {
         let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(fuzz_corpus_dir())
             .unwrap()

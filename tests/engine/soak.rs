@@ -555,10 +555,6 @@ impl Soak {
             let max = BodyDef::default().max_linear_speed;
             self.report.worst_speed = self.report.worst_speed.max(v);
             self.report.worst_speed_ratio = self.report.worst_speed_ratio.max(v / max);
-            if v > max * (1.0 + 1e-5) {
-                eprintln!("portal events {:?}", self.world.portal_events());
-                eprintln!("clone_of {:?}", self.world.clone_of(b));
-            }
             assert!(
                 v <= max * (1.0 + 1e-5),
                 "seed {}, step {}: {b:?} at {v} m/s, over its {max} m/s",
