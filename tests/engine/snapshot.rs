@@ -479,6 +479,7 @@ mod bytes {
     /// | `contact-normal` | a manifold normal of length 1.7e38 | the body spun at 1e35 rad/s, a non-finite point |
     /// | `contact-normal-tolerance` | rotations just within their tolerance | normals 0.2 % off unit after a step (the check allows 1 %) |
     /// | `crossing-entry` | a crossing's entry portal 32 | `validate` itself indexed out of bounds |
+    /// | `unused-point-nan` | a NaN in a contact's unused second point | copied into the recycling cache two steps later |
     #[test]
     #[cfg(all(feature = "portals", not(feature = "f64")))]
     fn snapshot_fuzz_regressions_are_refused_or_stay_valid() {

@@ -600,7 +600,9 @@ impl ContactSet {
                     && c.friction.is_finite()
                     && c.restitution.is_finite()
                     && c.point_count <= 2
-                    && c.points[..c.point_count].iter().all(|p| {
+                    // Both slots, the unused one too: recycling copies it
+                    // (a decoded NaN there reached the recycling cache).
+                    && c.points.iter().all(|p| {
                         janus2d_core::math::vec_is_finite(p.point)
                             && janus2d_core::math::vec_is_finite(p.anchor_a)
                             && janus2d_core::math::vec_is_finite(p.anchor_b)
@@ -631,11 +633,16 @@ impl ContactSet {
                 // The recycling cache feeds the next narrowphase: a NaN
                 // separation kept there became a touching point's (a
                 // decoded snapshot, found by the snapshot fuzz target).
+                // Its rotations within 1 % of unit length, as the normal:
+                // bodies' rotations may be off by `UNIT_ROTATION_TOLERANCE`,
+                // and the relative one composes two of them.
                 let r = &c.recycle;
+                let near_unit =
+                    |q: janus2d_core::math::Rot| (q.c * q.c + q.s * q.s - 1.0).abs() <= 0.01;
                 if r.valid
-                    && !(r.q_a.is_unit()
-                        && r.q_b.is_unit()
-                        && r.relative.q.is_unit()
+                    && !(near_unit(r.q_a)
+                        && near_unit(r.q_b)
+                        && near_unit(r.relative.q)
                         && janus2d_core::math::vec_is_finite(r.relative.p)
                         && r.separation.iter().all(|s| s.is_finite()))
                 {
