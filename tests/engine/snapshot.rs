@@ -307,4 +307,195 @@ mod bytes {
             SnapshotError::BadMagic
         );
     }
+
+    /// The worlds the snapshot fuzz target's corpus is seeded from, by
+    /// name: empty, hinged chains, a small pyramid, two links of every
+    /// joint kind beside a sensor and a sleeping stack, and (with portals)
+    /// the portal drop with its box crossing.
+    fn fuzz_seed_worlds() -> Vec<(&'static str, World)> {
+        let mut worlds = vec![
+            ("empty", World::new(WorldDef::default()).unwrap()),
+            ("chains", chains()),
+            ("pyramid", small_world()),
+        ];
+        let mut mixed = World::new(WorldDef::default()).unwrap();
+        let ground = mixed.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+        mixed
+            .create_shape(ground, &ShapeDef::default(), Polygon::make_box(30.0, 0.5))
+            .unwrap();
+        mixed
+            .create_shape(
+                ground,
+                &ShapeDef::default().sensor(),
+                Polygon::make_offset_box(1.0, 1.0, Vec2::new(20.0, 2.0), 0.0),
+            )
+            .unwrap();
+        for (k, &kind) in janus2d::constraints::JointKind::ALL.iter().enumerate() {
+            let mut previous = ground;
+            for i in 0..2 {
+                let p = Vec2::new(-20.0 + 5.0 * k as Real + 1.1 * i as Real, 4.0);
+                let b = mixed.create_body(&BodyDef::dynamic(p)).unwrap();
+                mixed
+                    .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.4, 0.4))
+                    .unwrap();
+                let def = janus2d_testbed::support::joint_def_of_kind(
+                    kind,
+                    previous,
+                    b,
+                    Vec2::new(0.55, 0.0),
+                    Some((0.5, 1.5)),
+                    false,
+                );
+                mixed.create_joint(&def).unwrap();
+                previous = b;
+            }
+        }
+        for i in 0..3 {
+            let b = mixed
+                .create_body(&BodyDef::dynamic(Vec2::new(25.0, 1.0 + i as Real)))
+                .unwrap();
+            mixed
+                .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+                .unwrap();
+        }
+        for _ in 0..120 {
+            mixed.step(DT).unwrap();
+        }
+        worlds.push(("mixed", mixed));
+        #[cfg(feature = "portals")]
+        {
+            let mut drop = scenes::portal_drop(&scenes::shared_settings()).0.world;
+            while drop.crossing_count() == 0 && drop.step_count() < 600 {
+                drop.step(DT).unwrap();
+            }
+            assert!(drop.crossing_count() > 0, "the portal drop's box crosses");
+            worlds.push(("portal-crossing", drop));
+        }
+        worlds
+    }
+
+    /// A corpus seed: mode byte 0 (the target writes the header) and the
+    /// snapshot's payload.
+    fn fuzz_seed(world: &World) -> Vec<u8> {
+        let bytes = world.snapshot().to_bytes();
+        let mut seed = vec![0u8];
+        seed.extend_from_slice(&bytes[24..]);
+        seed
+    }
+
+    fn fuzz_corpus_dir() -> std::path::PathBuf {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/snapshot_bytes")
+    }
+
+    /// Writes the snapshot fuzz target's seeds (`fuzz/corpus/snapshot_bytes/
+    /// seed-NAME`); run again whenever the snapshot format changes:
+    /// `cargo test --features serde --test engine -- --ignored write_the_snapshot_fuzz_corpus`.
+    #[test]
+    #[ignore = "writes fuzz/corpus/snapshot_bytes"]
+    fn write_the_snapshot_fuzz_corpus() {
+        let dir = fuzz_corpus_dir();
+        std::fs::create_dir_all(&dir).unwrap();
+        for (name, world) in fuzz_seed_worlds() {
+            std::fs::write(dir.join(format!("seed-{name}")), fuzz_seed(&world)).unwrap();
+        }
+    }
+
+    /// A corpus file of the snapshot fuzz target as the target reads it:
+    /// mode byte even, a payload behind this build's header; odd, the
+    /// bytes as they are.
+    #[cfg(all(feature = "portals", not(feature = "f64")))]
+    fn fuzz_input(data: &[u8]) -> Result<Snapshot, SnapshotError> {
+        let Some((&mode, rest)) = data.split_first() else {
+            return Err(SnapshotError::Truncated {
+                needed: 1,
+                found: 0,
+            });
+        };
+        if mode % 2 == 1 {
+            return Snapshot::from_bytes(rest);
+        }
+        let template = World::new(WorldDef::default())
+            .unwrap()
+            .snapshot()
+            .to_bytes();
+        let mut bytes = template[..8].to_vec();
+        bytes.extend_from_slice(&(rest.len() as u64).to_le_bytes());
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for b in rest {
+            h ^= u64::from(*b);
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        bytes.extend_from_slice(&h.to_le_bytes());
+        bytes.extend_from_slice(rest);
+        Snapshot::from_bytes(&bytes)
+    }
+
+    /// The committed corpus files named `prefix…`, with their names.
+    #[cfg(all(feature = "portals", not(feature = "f64")))]
+    fn fuzz_corpus_files(prefix: &str) -> Vec<(String, Vec<u8>)> {
+        let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(fuzz_corpus_dir())
+            .unwrap()
+            .map(|e| e.unwrap())
+            .filter(|e| e.file_name().to_string_lossy().starts_with(prefix))
+            .map(|e| {
+                let name = e.file_name().to_string_lossy().into_owned();
+                (name, std::fs::read(e.path()).unwrap())
+            })
+            .collect();
+        files.sort();
+        files
+    }
+
+    /// The committed seeds of the snapshot fuzz target are this build's
+    /// snapshots (mode 0, payload): each decodes behind a correct header,
+    /// so a format change cannot leave the fuzzer a corpus that stops at
+    /// the decoder. (The f64 build and a build without portals write
+    /// other payloads: the check is for the fuzz target's build.)
+    #[test]
+    #[cfg(all(feature = "portals", not(feature = "f64")))]
+    fn the_snapshot_fuzz_corpus_seeds_are_current_snapshots() {
+        let seeds = fuzz_corpus_files("seed-");
+        for (name, data) in &seeds {
+            let world = fuzz_input(data)
+                .unwrap_or_else(|e| panic!("{name}: {e} (rewrite the corpus)"))
+                .to_world();
+            assert!(world.body_count() > 0 || name == "seed-empty", "{name}");
+        }
+        assert_eq!(seeds.len(), fuzz_seed_worlds().len(), "seeds in the corpus");
+    }
+
+    /// Inputs the snapshot fuzz target failed on (issue 35), kept in its
+    /// corpus as `regression-*`: each is refused, or decodes to a world
+    /// that stays valid through steps. Each passed `validate` when decoded
+    /// and broke it (or panicked) later:
+    ///
+    /// | input | what the decoded world held | what followed |
+    /// |-------|-----------------------------|---------------|
+    /// | `recycle-nan` | a NaN in a contact's recycling cache | a touching point's NaN separation after one step |
+    /// | `negative-tree-margin` | a negative broadphase tree margin | a new shape's proxy refused by the check |
+    /// | `graph-entry-colour` | a constraint-graph entry of colour 251 outside the members | `keep` took it for a member: colour bits wrong |
+    /// | `graph-entry-outside-members` | one more graph entry than members | the same |
+    /// | `crossing-mass` | a crossing copy's inertia of 6e-39 | an infinite inverse inertia at the next step |
+    /// | `contact-normal` | a manifold normal of length 1.7e38 | the body spun at 1e35 rad/s, a non-finite point |
+    /// | `contact-normal-tolerance` | rotations just within their tolerance | normals 0.2 % off unit after a step (the check allows 1 %) |
+    /// | `crossing-entry` | a crossing's entry portal 32 | `validate` itself indexed out of bounds |
+    /// | `unused-point-nan` | a NaN in a contact's unused second point | copied into the recycling cache two steps later |
+    #[test]
+    #[cfg(all(feature = "portals", not(feature = "f64")))]
+    fn snapshot_fuzz_regressions_are_refused_or_stay_valid() {
+        let inputs = fuzz_corpus_files("regression-");
+        assert!(!inputs.is_empty());
+        for (name, data) in inputs {
+            let Ok(snapshot) = fuzz_input(&data) else {
+                continue;
+            };
+            let mut world = snapshot.to_world();
+            for step in 0..5 {
+                world.step(DT).unwrap();
+                if let Err(e) = world.validate() {
+                    panic!("{name}, step {step}: {e}");
+                }
+            }
+        }
+    }
 }

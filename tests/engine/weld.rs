@@ -423,7 +423,10 @@ fn weld_tree_residual(case: &WeldCase) -> Result<(f64, f64), TestCaseError> {
             let len = bias.length();
             let cap = ctx.direct_joint_max_correction_speed;
             let bias = if len > cap { bias * (cap / len) } else { bias };
-            [d(bias.x), d(bias.y), d(soft.bias_rate * rows.rows[2].c)]
+            // The angle row's feedback is capped at the same number in rad/s.
+            let angle_cap = janus2d_constraints::parts::angular_correction_cap(cap);
+            let angle = (soft.bias_rate * rows.rows[2].c).clamp(-angle_cap, angle_cap);
+            [d(bias.x), d(bias.y), d(angle)]
         } else {
             [0.0; 3]
         };

@@ -647,8 +647,17 @@ impl DistanceJoint {
             } else {
                 capped(lower_c, soft, cap)
             };
+            // (`lower_c` is capped already: no second cap.)
             self.lower.solve_limit(
-                &mut sa, &mut sb, m, &row, lower_c, soft, ctx.inv_h, use_bias,
+                &mut sa,
+                &mut sb,
+                m,
+                &row,
+                lower_c,
+                soft,
+                ctx.inv_h,
+                use_bias,
+                Real::INFINITY,
             );
             let flipped = AxisRow {
                 n: -row.n,
@@ -663,7 +672,15 @@ impl DistanceJoint {
                 capped(upper_c, soft, cap)
             };
             self.upper.solve_limit(
-                &mut sa, &mut sb, m, &flipped, upper_c, soft, ctx.inv_h, use_bias,
+                &mut sa,
+                &mut sb,
+                m,
+                &flipped,
+                upper_c,
+                soft,
+                ctx.inv_h,
+                use_bias,
+                Real::INFINITY,
             );
         }
         pair.store(&sa, &sb);

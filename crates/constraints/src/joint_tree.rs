@@ -24,7 +24,10 @@
 //! ```
 //!
 //! (the third row only for a 3-row joint, a rigid weld; its bias is
-//! `β C_θ`, uncapped, its `K = J M⁻¹ Jᵀ` the full 3×3 block with the
+//! `β C_θ` capped at the angular counterpart of the correction speed,
+//! [`angular_correction_cap`] (the point rows' `β C` at the correction
+//! speed itself, and a `General` joint's rows likewise by kind of row),
+//! its `K = J M⁻¹ Jᵀ` the full 3×3 block with the
 //! coupling `K₀₂ = −i_a r_a.y − i_b r_b.y`, `K₁₂ = i_a r_a.x + i_b r_b.x`,
 //! `K₂₂ = i_a + i_b`, `i = I⁻¹`; see [`crate::weld`]).
 //!
@@ -158,7 +161,7 @@ use janus2d_core::union_find::{find, union};
 use crate::joint::Joint;
 use crate::joint_base::is_moving;
 use crate::kind_rows::{GeneralRows, TreeRows};
-use crate::parts::{PairMass, PointPart, clamp_length};
+use crate::parts::{PairMass, PointPart, angular_correction_cap, cap, clamp_length};
 use janus2d_core::math::wrap_angle;
 
 const NONE: u32 = u32::MAX;
@@ -1277,7 +1280,10 @@ fn eliminate_three(
     let rhs = if params.use_bias {
         let softness = params.softness;
         let bias = clamp_length(softness.bias_rate * row.c, params.max_correction_speed);
-        let bias_angle = softness.bias_rate * row.c_angle;
+        let bias_angle = cap(
+            softness.bias_rate * row.c_angle,
+            angular_correction_cap(params.max_correction_speed),
+        );
         let lambda = DVec3::new(
             to_f64(row.impulse.x),
             to_f64(row.impulse.y),
@@ -1452,12 +1458,20 @@ fn eliminate_general(
     let c_dot = rows_times(&row.g_parent, parent) + rows_times(&row.g_child, other);
     let compliance = params.compliance;
     let mut rhs = if params.use_bias {
+        // Linear rows at the correction speed (m/s), angle rows at its
+        // angular counterpart (rad/s).
         let max = to_f64(params.max_correction_speed);
+        let max_angular = to_f64(angular_correction_cap(params.max_correction_speed));
         let mut bias = row.g_c * to_f64(params.softness.bias_rate);
         for (i, linear) in row.g_linear.iter().enumerate() {
-            if *linear {
-                bias[i] = bias[i].clamp(-max, max);
-            }
+            let max = if *linear { max } else { max_angular };
+            bias[i] = if bias[i] > max {
+                max
+            } else if bias[i] < -max {
+                -max
+            } else {
+                bias[i]
+            };
         }
         let held = (row.g_k * wide_rows(row.g_impulse)) * compliance;
         -(c_dot + bias + held)

@@ -175,6 +175,42 @@ pub fn apply_pair(
     sb.w += m.b.inv_inertia * (cross(r_b, p) + l);
 }
 
+/// The lever arm, m, at which an angular correction speed is compared
+/// with the linear one (1 m): a joint's angle error is fed back at most at
+/// [`angular_correction_cap`]`(max)` rad/s where its linear errors are fed
+/// back at most at `max` m/s, so a point 1 m from the axis of the
+/// correction moves no faster than the linear cap allows.
+///
+/// Without an angular cap a rigid angle row (a weld's, a prismatic
+/// joint's, a violated angle limit) corrects an error of θ rad at
+/// `bias_rate · θ`: a prismatic chain whose links start 3 rad from their
+/// reference angle turned at hundreds of rad/s in the exact tree solve
+/// (500 Hz), and its rails swung the sliding bodies out at over 1,000 m/s.
+pub const CORRECTION_ARM: Real = 1.0;
+
+/// The largest angular correction speed, rad/s, that goes with the
+/// linear correction cap `max` (m/s): `max / CORRECTION_ARM`.
+#[inline(always)]
+#[must_use]
+pub fn angular_correction_cap(max: Real) -> Real {
+    max / CORRECTION_ARM
+}
+
+/// `v` limited to `[−max, max]`, and unchanged inside it (bit for bit). Never
+/// panics: a NaN `v` stays NaN and a NaN `max` leaves `v` as it is (unlike
+/// `Real::clamp`, which panics on NaN bounds).
+#[inline(always)]
+#[must_use]
+pub fn cap(v: Real, max: Real) -> Real {
+    if v > max {
+        max
+    } else if v < -max {
+        -max
+    } else {
+        v
+    }
+}
+
 /// Clamps the length of a bias velocity to `max` (m/s).
 #[inline(always)]
 pub fn clamp_length(v: Vec2, max: Real) -> Vec2 {
@@ -317,7 +353,9 @@ impl AnglePart {
         sb.w += m.b.inv_inertia * lambda;
     }
 
-    /// A soft equality row: drives `c` to zero with `softness`.
+    /// A soft equality row: drives `c` (rad) to zero with `softness`, its
+    /// feedback speed `bias_rate · c` capped at `±max_bias` (rad/s;
+    /// `Real::INFINITY` for a spring, whose feedback is its force).
     #[inline(always)]
     pub fn solve_soft(
         &mut self,
@@ -326,9 +364,10 @@ impl AnglePart {
         m: &PairMass,
         c: Real,
         softness: Softness,
+        max_bias: Real,
     ) {
         let c_dot = Self::c_dot(sa, sb);
-        let bias = softness.bias_rate * c;
+        let bias = cap(softness.bias_rate * c, max_bias);
         let lambda = soft_impulse(
             softness.mass_scale * self.mass,
             c_dot + bias,
@@ -358,7 +397,8 @@ impl AnglePart {
     }
 
     /// A one-sided row `sign · c ≥ 0` (a limit): speculative when apart,
-    /// soft when violated (only with `use_bias`).
+    /// soft when violated (only with `use_bias`), the violated row's
+    /// feedback speed capped at `max_bias` (rad/s).
     #[inline(always)]
     pub fn solve_limit(
         &mut self,
@@ -370,12 +410,13 @@ impl AnglePart {
         softness: Softness,
         inv_h: Real,
         use_bias: bool,
+        max_bias: Real,
     ) {
         let (bias, mass_scale, impulse_scale) = if c > 0.0 {
             (c * inv_h, 1.0, 0.0)
         } else if use_bias {
             (
-                softness.bias_rate * c,
+                cap(softness.bias_rate * c, max_bias),
                 softness.mass_scale,
                 softness.impulse_scale,
             )
@@ -529,7 +570,8 @@ impl AxisPart {
 
     /// A one-sided row `c ≥ 0` along `row` (a limit; the caller negates
     /// the row for an upper limit): speculative when apart, soft when
-    /// violated (only with `use_bias`).
+    /// violated (only with `use_bias`), the violated row's feedback speed
+    /// capped at `max_bias` (m/s).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     pub fn solve_limit(
@@ -542,12 +584,13 @@ impl AxisPart {
         softness: Softness,
         inv_h: Real,
         use_bias: bool,
+        max_bias: Real,
     ) {
         let (bias, mass_scale, impulse_scale) = if c > 0.0 {
             (c * inv_h, 1.0, 0.0)
         } else if use_bias {
             (
-                softness.bias_rate * c,
+                cap(softness.bias_rate * c, max_bias),
                 softness.mass_scale,
                 softness.impulse_scale,
             )

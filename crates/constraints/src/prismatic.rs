@@ -57,6 +57,19 @@
 //! neither moves linearly the block is singular and the two rows are
 //! solved one after the other.
 //!
+//! **Order.** One iteration solves the spring, the motor, the rigid block,
+//! then the limits (Box2D v3 solves the limits before the block). A limit
+//! row's angular entry on body a is `(r_a + d) × n`, which grows with the
+//! anchors' separation `d`: solved before the block, a violated limit far
+//! down the rail corrected mostly by turning body a, the block's angle row
+//! took the turn back, and the two fought, their kept impulses growing
+//! step after step (a slider created 24 m beyond its limits on a rail at
+//! 2.5 rad reached 400 m/s and wandered 260 m away). Solved after the
+//! block, the limit has the last word in the iteration and the block
+//! takes the turn back at the next: the same slider returns within its
+//! limits below the correction speed. (A joint in the tree has its block
+//! solved by the tree, after this pass.)
+//!
 //! **Warm start geometry.** The warm start is applied one body at a time
 //! (the colour stage's per-body share), and a body's share here depends on
 //! both bodies' positions (`n`, `d`). So the joint keeps the rows of its
@@ -73,7 +86,8 @@ use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, JointFrame, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::kind_rows::{GeneralRows, KindRows, TreeRows};
 use crate::parts::{
-    AxisPart, AxisRow, BOTH, PairMass, PairOf, PairStates, load_pair, soft_impulse, store_pair,
+    AxisPart, AxisRow, BOTH, PairMass, PairOf, PairStates, angular_correction_cap, cap, load_pair,
+    soft_impulse, store_pair,
 };
 use crate::{JointError, check_spring};
 
@@ -217,7 +231,7 @@ pub(crate) fn rigid_terms(
 ) -> (Real, Real, Real) {
     if use_bias {
         (
-            (softness.bias_rate * c).clamp(-max, max),
+            cap(softness.bias_rate * c, max),
             softness.mass_scale,
             softness.impulse_scale,
         )
@@ -657,7 +671,7 @@ impl PrismaticJoint {
     }
 
     /// One velocity iteration on the joint's two states: spring, motor,
-    /// limits, then the perpendicular and angle rows as a block.
+    /// the perpendicular and angle rows as a block, then the limits.
     #[inline(always)]
     pub(crate) fn solve_pair<P: PairStates>(
         &mut self,
@@ -696,6 +710,10 @@ impl PrismaticJoint {
                 max_impulse,
             );
         }
+        // The rigid block before the limits (module docs, "Order").
+        if !self.base.in_tree {
+            self.solve_block(ctx, &mut sa, &mut sb, &rows, use_bias);
+        }
         if self.def.enable_limit {
             let soft = self.linear_softness;
             self.lower.solve_limit(
@@ -707,6 +725,7 @@ impl PrismaticJoint {
                 soft,
                 ctx.inv_h,
                 use_bias,
+                ctx.joint_max_correction_speed,
             );
             let down = AxisRow {
                 n: -axial.n,
@@ -723,10 +742,8 @@ impl PrismaticJoint {
                 soft,
                 ctx.inv_h,
                 use_bias,
+                ctx.joint_max_correction_speed,
             );
-        }
-        if !self.base.in_tree {
-            self.solve_block(ctx, &mut sa, &mut sb, &rows, use_bias);
         }
         self.perp_row = rows.perp;
         self.axial_row = axial;
@@ -754,8 +771,12 @@ impl PrismaticJoint {
             ctx.joint_max_correction_speed,
             use_bias,
         );
-        let (bias_t, ms_t, is_t) =
-            rigid_terms(self.angular_softness, c_angle, Real::INFINITY, use_bias);
+        let (bias_t, ms_t, is_t) = rigid_terms(
+            self.angular_softness,
+            c_angle,
+            angular_correction_cap(ctx.joint_max_correction_speed),
+            use_bias,
+        );
         let c_dot_p = perp.c_dot(sa, sb);
         let c_dot_t = sb.w - sa.w;
         let (i_a, i_b) = (m.a.inv_inertia, m.b.inv_inertia);

@@ -41,7 +41,8 @@ use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::kind_rows::{KindRows, TreeRows};
 use crate::parts::{
-    AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, load_pair, store_pair,
+    AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, angular_correction_cap, load_pair,
+    store_pair,
 };
 use crate::{JointError, check_motor_speed, check_spring};
 
@@ -403,6 +404,8 @@ impl RevoluteJoint {
                 m,
                 angle - self.def.target_angle,
                 self.spring_softness,
+                // A spring: its feedback is its force, not capped.
+                Real::INFINITY,
             );
         }
         if self.def.enable_motor {
@@ -412,6 +415,7 @@ impl RevoluteJoint {
         }
         if self.def.enable_limit {
             let soft = ctx.joint_softness;
+            let max_bias = angular_correction_cap(ctx.joint_max_correction_speed);
             self.lower.solve_limit(
                 &mut sa,
                 &mut sb,
@@ -421,6 +425,7 @@ impl RevoluteJoint {
                 soft,
                 ctx.inv_h,
                 use_bias,
+                max_bias,
             );
             self.upper.solve_limit(
                 &mut sa,
@@ -431,6 +436,7 @@ impl RevoluteJoint {
                 soft,
                 ctx.inv_h,
                 use_bias,
+                max_bias,
             );
         }
         if !self.base.in_tree {

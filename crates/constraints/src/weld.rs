@@ -44,7 +44,8 @@ use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef};
 use crate::kind_rows::{KindRows, TreeAngle, TreeRows};
 use crate::parts::{
-    AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, load_pair, store_pair,
+    AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, angular_correction_cap, load_pair,
+    store_pair,
 };
 use crate::{JointError, check_spring};
 
@@ -331,13 +332,20 @@ impl WeldJoint {
         if m.a.inv_inertia + m.b.inv_inertia > 0.0 {
             let c = self.current_angle(&sa, &sb);
             // A spring acts in the relax pass too; a rigid row relaxes
-            // without position feedback.
+            // without position feedback, and its feedback speed is capped
+            // (a spring's is its force).
             let softness = if use_bias || angular_spring {
                 self.angular_softness
             } else {
                 Softness::RIGID
             };
-            self.angle.solve_soft(&mut sa, &mut sb, m, c, softness);
+            let max_bias = if angular_spring {
+                Real::INFINITY
+            } else {
+                angular_correction_cap(ctx.joint_max_correction_speed)
+            };
+            self.angle
+                .solve_soft(&mut sa, &mut sb, m, c, softness, max_bias);
         }
         if self.def.linear_hertz > 0.0 {
             // A spring: always on, its bias not capped.

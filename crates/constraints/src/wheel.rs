@@ -458,6 +458,7 @@ impl WheelJoint {
                 soft,
                 ctx.inv_h,
                 use_bias,
+                ctx.joint_max_correction_speed,
             );
             let down = AxisRow {
                 n: -axial.n,
@@ -474,6 +475,7 @@ impl WheelJoint {
                 soft,
                 ctx.inv_h,
                 use_bias,
+                ctx.joint_max_correction_speed,
             );
         }
         let perp = rows.perp;

@@ -293,6 +293,31 @@ impl ConstraintGraph {
         if bits != self.body_colours[..bits.len()] {
             return Err("body colour bits differ from the members' colours".into());
         }
+        // Every entry in the graph is a member, once, of a colour or the
+        // overflow; the others are out. (A decoded snapshot's entry of
+        // colour 251 outside the members passed the check above and was
+        // then taken for a member by `keep`.)
+        let mut seen = vec![false; self.entries.len()];
+        for &id in &self.members {
+            if std::mem::replace(&mut seen[id as usize], true) {
+                return Err(format!("member {id} listed twice"));
+            }
+        }
+        let mut in_graph = 0usize;
+        for e in &self.entries {
+            if e.colour != GraphEntry::OUT {
+                if e.colour as usize > COLOURS {
+                    return Err(format!("an entry of colour {}", e.colour));
+                }
+                in_graph += 1;
+            }
+        }
+        if in_graph != self.members.len() {
+            return Err(format!(
+                "{in_graph} entries in the graph, {} members",
+                self.members.len()
+            ));
+        }
         Ok(())
     }
 

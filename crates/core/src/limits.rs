@@ -9,7 +9,7 @@
 //!
 //! | limit                   | value              | applies to                                             |
 //! |-------------------------|--------------------|--------------------------------------------------------|
-//! | [`MAX_COORDINATE`]      | 1e9 m              | body positions, teleports, targets; a pose beyond twice it after a step is reset and reported |
+//! | [`MAX_COORDINATE`]      | 1e9 m              | body positions, teleports, targets; a pose beyond twice it after a step is reset and reported (f32 resolves 1 mm only within 16,384 m: see below) |
 //! | [`MAX_EXTENT`]          | 1e7 m              | shape coordinates and radii (body frame)               |
 //! | [`MASS_RANGE`]          | 1e-12 … 1e15 kg    | the mass of a dynamic body                             |
 //! | [`INERTIA_RANGE`]       | 1e-20 … 1e25 kg·m² | the rotational inertia of a dynamic, rotating body     |
@@ -24,6 +24,33 @@
 //! | [`MAX_HERTZ_FRACTION`]  | 0.25               | contact and iterative joint stiffness are capped at this fraction of the substep rate, as Box2D caps them |
 //! | [`UNIT_ROTATION_TOLERANCE`] | 1e-3           | how far `c² + s²` of a rotation given to the API may be from 1 |
 //! | [`TIME_STEP_RANGE`]     | 1e-6 … 1 s         | the `dt` of a step                                     |
+//!
+//! # Coordinate resolution
+//!
+//! [`MAX_COORDINATE`] bounds what the API accepts, not where a world stays
+//! precise. A coordinate `x` is stored to the spacing of its floating-point
+//! type at `|x|` (`2^(k−23)` m in f32, `2^(k−52)` m in f64, for `|x|` in
+//! `[2^k, 2^(k+1))`), and rounded to half of it:
+//!
+//! | `|x|` up to        | f32 spacing | f64 spacing |
+//! |--------------------|-------------|-------------|
+//! | 1,024 m            | 0.06 mm     | 1.1e-13 m   |
+//! | **16,384 m** (2^14) | **0.98 mm** | 1.8e-12 m   |
+//! | 131,072 m (2^17)   | 7.8 mm      | 1.5e-11 m   |
+//! | 1,048,576 m (2^20) | 6.3 cm      | 1.2e-10 m   |
+//! | 1.07e9 m (2^30; [`MAX_COORDINATE`] is 1e9) | 64 m | 1.2e-7 m |
+//!
+//! **f32 resolves 1 mm up to 16 km from the origin**: keep an f32 world's
+//! bodies within ±16,384 m (its contacts' 5 mm `LINEAR_SLOP` and a 0.1 m broadphase
+//! margin are resolved well inside that). Beyond it positions, contact
+//! points and joint anchors snap to coarser steps: a body only moves when
+//! its step `v · dt` exceeds half the spacing (at 4e8 m, where the spacing
+//! is 32 m, a body at 400 m/s moves 6.7 m per 1/60 s step and stays where it
+//! is). **For larger worlds build with the `f64` feature**: its spacing is
+//! under a micrometre everywhere up to [`MAX_COORDINATE`] (0.12 µm at
+//! 1e9 m). The limit itself is the same in both builds, so that no sum or
+//! product the engine forms overflows; moving a world's origin (shifting
+//! every body) is the other answer, outside the engine.
 
 use crate::math::Real;
 
@@ -40,7 +67,12 @@ pub use crate::math::UNIT_ROTATION_TOLERANCE;
 /// an impulse (`impulse / h`) finite: at `f32::MIN_POSITIVE` they were ∞.
 pub const TIME_STEP_RANGE: (Real, Real) = (1e-6, 1.0);
 
-/// Largest magnitude of a body coordinate, m (1e9).
+/// Largest magnitude of a body coordinate, m (1e9): what the API accepts,
+/// so that no sum or product the engine forms overflows. Precision is
+/// another matter: f32 resolves 1 mm only up to 16,384 m from the origin
+/// (64 m spacing near this limit); build with the `f64` feature for larger
+/// worlds (0.12 µm spacing at 1e9 m). See the module's "Coordinate
+/// resolution".
 pub const MAX_COORDINATE: Real = 1e9;
 
 /// Largest magnitude of a shape coordinate or radius in its body's frame,

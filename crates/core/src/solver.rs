@@ -103,9 +103,15 @@ pub struct SolverSettings {
     /// Joint damping ratio (usual 2).
     pub joint_damping_ratio: Real,
     /// Maximum correction speed of a joint solved by Gauss–Seidel, m/s
-    /// (usual `Real::MAX`, no cap: 5 m/s raised the 40×40 joint grid's peak
-    /// gap from 0.17 to 0.32 m). Joint trees use
-    /// `direct_joint_max_correction_speed` instead.
+    /// (usual 50; `Real::MAX`: no cap). A rigid row's position feedback
+    /// `β C` is capped here, a violated limit's too, and angle rows at the
+    /// same number in rad/s (`janus2d_constraints::parts::CORRECTION_ARM`);
+    /// springs are not capped. Uncapped, a joint created 10 m open pulled
+    /// its body at 240 m/s, and a prismatic chain with violated limits
+    /// diverged; low caps loosen large Gauss–Seidel meshes (5 m/s raised the
+    /// 40×40 joint grid's peak gap from 0.17 to 0.32 m; the 100×100
+    /// `joint_grid` benchmark's largest feedback is 39 m/s, below the cap).
+    /// Joint trees use `direct_joint_max_correction_speed` instead.
     pub joint_max_correction_speed: Real,
     /// Restitution threshold, m/s (usual 1).
     pub restitution_threshold: Real,
@@ -146,8 +152,11 @@ pub struct SolverSettings {
     /// so the speeds add up along it: uncapped, a chain stretched by 1 m at
     /// each of 40 joints flings its end at 600 m/s; at 2 m/s (500 Hz) it
     /// peaks at 68 m/s, about the 67 m/s the same chain reaches by swinging
-    /// alone (5 m/s: 138 m/s), and every joint is back within 1 cm.
-    /// Iterative joints keep `joint_max_correction_speed`.
+    /// alone (5 m/s: 138 m/s), and every joint is back within 1 cm. The
+    /// tree's angle rows (a rigid weld's, a prismatic joint's) are capped
+    /// at the same number in rad/s: uncapped at 500 Hz, a prismatic chain
+    /// started 3 rad from its reference angles flung its sliders at over
+    /// 1,000 m/s. Iterative joints keep `joint_max_correction_speed`.
     pub direct_joint_max_correction_speed: Real,
 }
 
@@ -166,7 +175,7 @@ impl Default for SolverSettings {
             joint_hertz: 60.0,
             joint_hertz_fraction: JOINT_HERTZ_PER_SUBSTEP_RATE,
             joint_damping_ratio: 2.0,
-            joint_max_correction_speed: Real::MAX,
+            joint_max_correction_speed: 50.0,
             restitution_threshold: 1.0,
             warm_starting: true,
             contact_mass_ratio_cap: DEFAULT_CONTACT_MASS_RATIO_CAP,
@@ -202,7 +211,7 @@ impl SolverSettings {
     /// | `direct_joint_hertz`                    | 0 … [`MAX_SPRING_HERTZ`](crate::limits::MAX_SPRING_HERTZ) (1e6 Hz) |
     /// | `contact_damping_ratio`, `joint_damping_ratio` | 0 … [`MAX_DAMPING_RATIO`](crate::limits::MAX_DAMPING_RATIO) (1e4) |
     /// | `contact_push_max_velocity`, `restitution_threshold`, `direct_joint_max_correction_speed` | 0 … [`MAX_SPEED`](crate::limits::MAX_SPEED) (1e9 m/s) |
-    /// | `joint_max_correction_speed`            | 0 … `Real::MAX` (the default: no cap)   |
+    /// | `joint_max_correction_speed`            | 0 … `Real::MAX` (`Real::MAX`: no cap)   |
     /// | `contact_mass_ratio_cap`, `joint_mass_ratio_cap` | 0 … [`MAX_MASS_RATIO_CAP`] (1e3) |
     /// | `contact_hertz_fraction`, `joint_hertz_fraction` | ≥ 0, `∞` allowed (no cap)      |
     ///

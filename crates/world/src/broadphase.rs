@@ -706,6 +706,16 @@ impl BroadPhase {
         self.static_tree
             .check()
             .map_err(|e| format!("static tree: {e}"))?;
+        // The trees' margins as `with_margin` makes them (a decoded
+        // snapshot's NaN margin let a new proxy's margin fail the check
+        // below).
+        let margin = self.dynamic_tree.margin();
+        if !(margin.is_finite() && margin >= 0.0) || self.static_tree.margin() != 0.0 {
+            return Err(format!(
+                "tree margins {margin} and {}",
+                self.static_tree.margin()
+            ));
+        }
         let mut live = [0usize; 2];
         for (id, s) in self.proxies.iter().enumerate() {
             if !s.alive {

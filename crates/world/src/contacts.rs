@@ -167,6 +167,17 @@ pub struct ShapePairEvent {
 ///
 /// Events of contacts that end because a body or shape was destroyed
 /// between steps are kept and reported with the next step's.
+///
+/// **The net change.** Each list holds every pair at most once: a pair
+/// that began and ended touching between two reports (a contact found by
+/// the narrowphase and then handed over at a portal, a resting contact
+/// ended by `set_shape_filter` and found again by the next step) reports
+/// nothing, and one that ended and began again reports nothing either. So
+/// the touching solid pairs after a step are exactly those after the step
+/// before, minus `contact_end`, plus `contact_begin` (in any order), and the
+/// same for sensor overlaps with `sensor_end` and `sensor_begin`. Within a
+/// list the order is the order the changes were found in, except that a
+/// cancelled event's place is taken by the list's last one.
 #[derive(Clone, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct CollisionEvents {
@@ -181,6 +192,38 @@ pub struct CollisionEvents {
     /// Contacts of shapes with hit events on that pushed this step with an
     /// approach speed above the world's threshold, in contact order.
     pub hits: Vec<HitEvent>,
+    /// Where each pair's begin or end event sits (not part of the value:
+    /// not compared, not stored in snapshots, rebuilt when it does not
+    /// cover the lists).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    index: EventIndex,
+}
+
+/// The four begin/end lists of [`CollisionEvents`], by number.
+const CONTACT_BEGIN: u8 = 0;
+const CONTACT_END: u8 = 1;
+const SENSOR_BEGIN: u8 = 2;
+const SENSOR_END: u8 = 3;
+
+/// A pair of shapes in a fixed order, and whether it is a sensor pair.
+type PairOfShapes = (ShapeHandle, ShapeHandle, bool);
+
+/// Pair → (list, position) of the pairs' events in [`CollisionEvents`]:
+/// looked up when an event is recorded, never iterated. Always equal as a
+/// value (it only speeds up the lists it indexes).
+#[derive(Clone, Default)]
+struct EventIndex(std::collections::HashMap<PairOfShapes, (u8, u32)>);
+
+impl PartialEq for EventIndex {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for EventIndex {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "EventIndex({} pairs)", self.0.len())
+    }
 }
 
 /// A contact that hit hard enough (see `ShapeDef::enable_hit_events` and
@@ -202,18 +245,85 @@ pub struct HitEvent {
 }
 
 impl CollisionEvents {
-    /// Records a begin (`touching`) or end event of a contact.
+    /// Records a begin (`touching`) or end event of a contact, as the net
+    /// change (type docs): an event that undoes the pair's pending opposite
+    /// event removes it instead of being added.
     pub(crate) fn push(&mut self, c: &Contact, touching: bool) {
         let ev = ShapePairEvent {
             shape_a: c.shapes[0],
             shape_b: c.shapes[1],
         };
-        match (touching, c.sensor) {
-            (true, false) => self.contact_begin.push(ev),
-            (false, false) => self.contact_end.push(ev),
-            (true, true) => self.sensor_begin.push(ev),
-            (false, true) => self.sensor_end.push(ev),
+        let (this, opposite) = match (touching, c.sensor) {
+            (true, false) => (CONTACT_BEGIN, CONTACT_END),
+            (false, false) => (CONTACT_END, CONTACT_BEGIN),
+            (true, true) => (SENSOR_BEGIN, SENSOR_END),
+            (false, true) => (SENSOR_END, SENSOR_BEGIN),
+        };
+        let key = pair_of_shapes(&ev, c.sensor);
+        self.sync_index();
+        match self.index.0.get(&key).copied() {
+            Some((list, pos)) if list == opposite => {
+                // The pair is back where it was at the last report.
+                self.index.0.remove(&key);
+                let events = self.list_mut(list);
+                let pos = pos as usize;
+                if pos < events.len() {
+                    events.swap_remove(pos);
+                    if let Some(moved) = events.get(pos).copied() {
+                        let moved = pair_of_shapes(&moved, list >= SENSOR_BEGIN);
+                        self.index.0.insert(moved, (list, pos as u32));
+                    }
+                }
+            }
+            // Already reported this way (touching alternates, so only
+            // a decoded snapshot's lists could hold it): nothing to add.
+            Some(_) => {}
+            None => {
+                let events = self.list_mut(this);
+                events.push(ev);
+                let pos = (events.len() - 1) as u32;
+                self.index.0.insert(key, (this, pos));
+            }
         }
+    }
+
+    /// The begin/end list numbered `list`.
+    fn list_mut(&mut self, list: u8) -> &mut Vec<ShapePairEvent> {
+        match list {
+            CONTACT_BEGIN => &mut self.contact_begin,
+            CONTACT_END => &mut self.contact_end,
+            SENSOR_BEGIN => &mut self.sensor_begin,
+            _ => &mut self.sensor_end,
+        }
+    }
+
+    /// Rebuilds the pair index when it does not cover the lists (after a
+    /// snapshot is decoded, or if the lists were changed from outside).
+    fn sync_index(&mut self) {
+        let total = self.contact_begin.len()
+            + self.contact_end.len()
+            + self.sensor_begin.len()
+            + self.sensor_end.len();
+        if self.index.0.len() == total {
+            return;
+        }
+        let mut index = std::collections::HashMap::with_capacity(total);
+        for list in [CONTACT_BEGIN, CONTACT_END, SENSOR_BEGIN, SENSOR_END] {
+            for (pos, ev) in self.list_mut(list).iter().enumerate() {
+                index.insert(pair_of_shapes(ev, list >= SENSOR_BEGIN), (list, pos as u32));
+            }
+        }
+        self.index.0 = index;
+    }
+}
+
+/// The pair of an event in a fixed order (the lower handle first), with
+/// its kind.
+fn pair_of_shapes(ev: &ShapePairEvent, sensor: bool) -> PairOfShapes {
+    if ev.shape_a <= ev.shape_b {
+        (ev.shape_a, ev.shape_b, sensor)
+    } else {
+        (ev.shape_b, ev.shape_a, sensor)
     }
 }
 
@@ -490,7 +600,9 @@ impl ContactSet {
                     && c.friction.is_finite()
                     && c.restitution.is_finite()
                     && c.point_count <= 2
-                    && c.points[..c.point_count].iter().all(|p| {
+                    // Both slots, the unused one too: recycling copies it
+                    // (a decoded NaN there reached the recycling cache).
+                    && c.points.iter().all(|p| {
                         janus2d_core::math::vec_is_finite(p.point)
                             && janus2d_core::math::vec_is_finite(p.anchor_a)
                             && janus2d_core::math::vec_is_finite(p.anchor_b)
@@ -502,6 +614,42 @@ impl ContactSet {
                     });
                 if !finite {
                     return Err(format!("contact {}: a stored number is not finite", c.id));
+                }
+                // A manifold's normal is a unit vector (a decoded one of
+                // length 1.7e38 spun its body to 1e35 rad/s in one step),
+                // within 1 % (rotations of unit length within
+                // `UNIT_ROTATION_TOLERANCE` turn it), and the mixed
+                // materials are within the shapes' limits.
+                let n2 = c.normal.length_squared();
+                if (c.point_count > 0 && (n2 - 1.0).abs() > 0.01)
+                    || !(0.0..=janus2d_core::limits::MAX_FRICTION).contains(&c.friction)
+                    || !(0.0..=janus2d_core::limits::MAX_RESTITUTION).contains(&c.restitution)
+                {
+                    return Err(format!(
+                        "contact {}: normal {:?}, friction {}, restitution {}",
+                        c.id, c.normal, c.friction, c.restitution
+                    ));
+                }
+                // The recycling cache feeds the next narrowphase: a NaN
+                // separation kept there became a touching point's (a
+                // decoded snapshot, found by the snapshot fuzz target).
+                // Its rotations within 1 % of unit length, as the normal:
+                // bodies' rotations may be off by `UNIT_ROTATION_TOLERANCE`,
+                // and the relative one composes two of them.
+                let r = &c.recycle;
+                let near_unit =
+                    |q: janus2d_core::math::Rot| (q.c * q.c + q.s * q.s - 1.0).abs() <= 0.01;
+                if r.valid
+                    && !(near_unit(r.q_a)
+                        && near_unit(r.q_b)
+                        && near_unit(r.relative.q)
+                        && janus2d_core::math::vec_is_finite(r.relative.p)
+                        && r.separation.iter().all(|s| s.is_finite()))
+                {
+                    return Err(format!(
+                        "contact {}: its recycling cache is not finite or not of unit rotations",
+                        c.id
+                    ));
                 }
             }
         }

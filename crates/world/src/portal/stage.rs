@@ -593,11 +593,32 @@ impl PortalStage {
             if self.pairs.at(c.pair).is_none() {
                 return Err(format!("crossing {k}: its pair is gone"));
             }
+            // (A decoded entry of 32 indexed the pair's two portals.)
+            if c.entry > 1 {
+                return Err(format!("crossing {k}: entry portal {}", c.entry));
+            }
             if c.original == c.clone || !bodies.contains(c.original) || !bodies.contains(c.clone) {
                 return Err(format!(
                     "crossing {k}: copies {:?}, {:?}",
                     c.original, c.clone
                 ));
+            }
+            // The copies' full masses, which the crossing hands back to
+            // them: within the body limits (a decoded snapshot's denormal
+            // inertia gave the copy an infinite inverse inertia at the
+            // next step).
+            for m in [c.mass_original, c.mass_clone] {
+                let inertia_ok = m.rotational_inertia == 0.0
+                    || janus2d_core::limits::in_range(
+                        m.rotational_inertia,
+                        janus2d_core::limits::INERTIA_RANGE,
+                    );
+                if !(janus2d_core::limits::in_range(m.mass, janus2d_core::limits::MASS_RANGE)
+                    && inertia_ok
+                    && janus2d_core::math::vec_is_finite(m.center))
+                {
+                    return Err(format!("crossing {k}: a copy's mass {m:?}"));
+                }
             }
             let def = pc.def();
             if def.body != c.original || def.clone != c.clone {
@@ -659,25 +680,31 @@ fn apply_mass_keep_velocity(bodies: &mut BodySet, body: BodyHandle, mass: BodyMa
     bodies.apply_mass(body, mass, fixed);
 }
 
-/// Wakes a body and sets its velocity (no checks).
+/// Wakes a body and sets its velocity (no checks), its speed within the
+/// body's `max_linear_speed` (a clone leaves the exit at η times the
+/// original's speed, which may be over it).
 fn set_velocity(stores: &mut Stores<'_>, body: BodyHandle, v: Vec2, w: Real) {
     stores.apply(PortalCommand::Wake(body));
-    if let Some(s) = stores.bodies.state_mut(body) {
-        s.v = v;
+    let max = stores.bodies.sim(body).map(|s| s.max_linear_speed);
+    if let (Some(s), Some(max)) = (stores.bodies.state_mut(body), max) {
+        s.v = janus2d_core::solver::clamp_speed(v, max);
         s.w = w;
     }
 }
 
 /// Wakes a body and adds an impulse at a world point to it when it is
-/// dynamic (no checks).
+/// dynamic (no checks), its speed kept within its `max_linear_speed` (a
+/// light portal body taking a heavy crossing's momentum went to 515 m/s
+/// in the random-operation soak, over the 400 m/s limit).
 fn push_body(stores: &mut Stores<'_>, body: BodyHandle, impulse: Vec2, point: Vec2, angular: Real) {
     stores.apply(PortalCommand::Wake(body));
     if let Some(BodyLocation::Moving(i)) = stores.bodies.location(body) {
         let sim = &stores.bodies.sims[i as usize];
         if sim.body_type == BodyType::Dynamic {
             let (im, ii, c) = (sim.inv_mass, sim.inv_inertia, sim.center);
+            let max = sim.max_linear_speed;
             let st = &mut stores.bodies.states[i as usize];
-            st.v += im * impulse;
+            st.v = janus2d_core::solver::clamp_speed(st.v + im * impulse, max);
             st.w += ii * cross(point - c, impulse);
             st.w += ii * angular;
         }
