@@ -641,16 +641,18 @@ fn random_operations_keep_every_body_within_its_speed_limit_and_the_world_valid(
 }
 
 /// The long soak: `JANUS_SOAK_OPS` operations (default 1,000,000) over
-/// worlds of 20,000 operations each; prints its figures.
+/// worlds of 20,000 operations each, the first seeded `JANUS_SOAK_SEED`
+/// (default 3500, the next ones counting up: a failure names its world's
+/// seed, and `JANUS_SOAK_SEED=that JANUS_SOAK_OPS=n` replays it alone);
+/// prints its figures.
 #[test]
 #[ignore = "long: run in release with --ignored"]
 fn random_operation_soak_of_a_million_operations() {
-    let operations: u64 = std::env::var("JANUS_SOAK_OPS")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(1_000_000);
+    let var = |name: &str| std::env::var(name).ok().and_then(|s| s.parse::<u64>().ok());
+    let operations = var("JANUS_SOAK_OPS").unwrap_or(1_000_000);
+    let seed = var("JANUS_SOAK_SEED").unwrap_or(3500);
     let start = std::time::Instant::now();
-    let report = soak(3500, operations, 20_000);
+    let report = soak(seed, operations, 20_000);
     println!(
         "soak of {} operations: {} steps, {} refused, worst speed {:.2} m/s ({:.4} of the limit), \
          {} validate failures, {} non-finite resets, {} joints and {} portal pairs created, \
