@@ -640,6 +640,19 @@ fn random_operations_keep_every_body_within_its_speed_limit_and_the_world_valid(
     assert!(report.worst_speed_ratio <= 1.0 + 1e-5, "{report:?}");
 }
 
+/// The world of seed 3549 to its 1,300th operation: a light dynamic
+/// portal body took a crossing copy's spin (`ΔI ω` over its own tiny
+/// inertia) and left the step with ω = ∞, after the solve's non-finite
+/// check (found by the long soak). Every step validates, every body
+/// within its speed limit.
+#[test]
+fn a_portal_body_handed_a_crossings_spin_keeps_a_finite_angular_velocity() {
+    let report = soak(3549, 1_300, 20_000);
+    assert!(report.steps > 300, "too few steps: {report:?}");
+    assert_eq!(report.validate_failures, 0);
+    assert!(report.worst_speed_ratio <= 1.0 + 1e-5, "{report:?}");
+}
+
 /// The long soak: `JANUS_SOAK_OPS` operations (default 1,000,000) over
 /// worlds of 20,000 operations each, the first seeded `JANUS_SOAK_SEED`
 /// (default 3500, the next ones counting up: a failure names its world's

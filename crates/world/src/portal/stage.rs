@@ -682,14 +682,24 @@ fn apply_mass_keep_velocity(bodies: &mut BodySet, body: BodyHandle, mass: BodyMa
 
 /// Wakes a body and sets its velocity (no checks), its speed within the
 /// body's `max_linear_speed` (a clone leaves the exit at η times the
-/// original's speed, which may be over it).
+/// original's speed, which may be over it) and its angular speed within
+/// [`MAX_ANGULAR_SPEED`](janus2d_core::limits::MAX_ANGULAR_SPEED).
 fn set_velocity(stores: &mut Stores<'_>, body: BodyHandle, v: Vec2, w: Real) {
     stores.apply(PortalCommand::Wake(body));
     let max = stores.bodies.sim(body).map(|s| s.max_linear_speed);
     if let (Some(s), Some(max)) = (stores.bodies.state_mut(body), max) {
         s.v = janus2d_core::solver::clamp_speed(v, max);
-        s.w = w;
+        s.w = bounded_spin(w);
     }
+}
+
+/// `w` within ±[`MAX_ANGULAR_SPEED`](janus2d_core::limits::MAX_ANGULAR_SPEED),
+/// rad/s; a NaN is 0. A light portal body handed a heavy crossing's spin
+/// (`ΔI ω` over its own tiny inertia) reached ω = ∞ in the
+/// random-operation soak (seed 3549), after the solve's non-finite check.
+fn bounded_spin(w: Real) -> Real {
+    let max = janus2d_core::limits::MAX_ANGULAR_SPEED;
+    if w.is_nan() { 0.0 } else { w.clamp(-max, max) }
 }
 
 /// Wakes a body and adds an impulse at a world point to it when it is
@@ -705,8 +715,7 @@ fn push_body(stores: &mut Stores<'_>, body: BodyHandle, impulse: Vec2, point: Ve
             let max = sim.max_linear_speed;
             let st = &mut stores.bodies.states[i as usize];
             st.v = janus2d_core::solver::clamp_speed(st.v + im * impulse, max);
-            st.w += ii * cross(point - c, impulse);
-            st.w += ii * angular;
+            st.w = bounded_spin(st.w + ii * cross(point - c, impulse) + ii * angular);
         }
     }
 }
