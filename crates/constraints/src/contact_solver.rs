@@ -595,19 +595,13 @@ impl ContactSolver {
         reverse: bool,
         team: &Team,
     ) {
-        let (inv_h, push_max) = (ctx.inv_h, ctx.contact_push_max_velocity);
+        let stage = Stage::solve(ctx, use_bias);
         let colours = self.colours.len();
         for k in 0..colours {
             let colour = if reverse { colours - 1 - k } else { k };
-            let stage = Stage::Solve {
-                use_bias,
-                inv_h,
-                push_max,
-            };
-            let chunks = &mut self.colours[colour];
-            colour_stage(team, &self.plan, colour, chunks, states, stage);
+            self.run_colour(colour, stage, states, team);
         }
-        self.solve_overflow(states, use_bias, inv_h, push_max);
+        self.solve_overflow(states, use_bias, ctx.inv_h, ctx.contact_push_max_velocity);
     }
 
     /// The overflow: its contacts one by one, then the coupled groups of

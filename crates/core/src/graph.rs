@@ -169,7 +169,12 @@ impl ConstraintGraph {
 
     /// The colours reserved on either key (see
     /// [`ConstraintGraph::set_reserved`]).
+    #[inline]
     fn reserved_on(&self, keys: [u32; 2]) -> u32 {
+        if self.reserved.is_empty() {
+            // No joint holds a colour: nothing to look up per contact.
+            return 0;
+        }
         keys.iter()
             .filter(|&&k| k != NO_BODY)
             .map(|&k| self.reserved.get(k as usize).copied().unwrap_or(0))

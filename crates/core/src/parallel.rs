@@ -307,45 +307,6 @@ impl Team<'_> {
         }
     }
 
-    /// Runs `a` and `b` on the team, side by side when it has more than
-    /// one thread (one job of two blocks), one after the other otherwise;
-    /// returns both results. The two must share no data they write (the
-    /// borrow checker sees to it).
-    pub fn join<A, B, RA, RB>(&self, a: A, b: B) -> (RA, RB)
-    where
-        A: FnOnce() -> RA + Send,
-        B: FnOnce() -> RB + Send,
-        RA: Send,
-        RB: Send,
-    {
-        if self.shared.is_none() {
-            let ra = a();
-            return (ra, b());
-        }
-        use std::sync::Mutex;
-        let (a, b) = (Mutex::new(Some(a)), Mutex::new(Some(b)));
-        let (ra, rb) = (Mutex::new(None), Mutex::new(None));
-        self.run(2, &|i| {
-            if i == 0 {
-                let f = a.lock().unwrap_or_else(|e| e.into_inner()).take();
-                if let Some(f) = f {
-                    *ra.lock().unwrap_or_else(|e| e.into_inner()) = Some(f());
-                }
-            } else {
-                let f = b.lock().unwrap_or_else(|e| e.into_inner()).take();
-                if let Some(f) = f {
-                    *rb.lock().unwrap_or_else(|e| e.into_inner()) = Some(f());
-                }
-            }
-        });
-        let ra = ra.into_inner().unwrap_or_else(|e| e.into_inner());
-        let rb = rb.into_inner().unwrap_or_else(|e| e.into_inner());
-        (
-            ra.expect("block 0 of a join runs once"),
-            rb.expect("block 1 of a join runs once"),
-        )
-    }
-
     /// `f(i)` for every block `i` in `0..blocks`, spread over the team, the
     /// results in block order (what a parallel map and collect gives, with
     /// the blocks on the step's team).
@@ -1079,35 +1040,23 @@ mod tests {
         }
     }
 
-    /// A join gives both results on any team; a map gives its blocks'
-    /// results in block order.
+    /// A map gives its blocks' results in block order, on any team.
     #[test]
-    fn join_and_map_give_the_serial_results() {
-        let run = |team: &Team| {
-            let (mut x, mut y) = (vec![1u64; 100], vec![2u64; 50]);
-            let (sx, sy) = team.join(
-                || {
-                    x.iter_mut().for_each(|v| *v *= 3);
-                    x.iter().sum::<u64>()
-                },
-                || {
-                    y.iter_mut().for_each(|v| *v += 1);
-                    y.iter().sum::<u64>()
-                },
-            );
-            let squares = team.map_blocks(37, |i| (i * i) as u64);
-            (sx, sy, squares)
-        };
+    fn map_blocks_gives_the_serial_results() {
+        let run = |team: &Team| team.map_blocks(37, |i| (i * i) as u64);
         let expected: Vec<u64> = (0..37).map(|i| i * i).collect();
-        assert_eq!(run(&Team::serial()), (300, 150, expected.clone()));
+        assert_eq!(run(&Team::serial()), expected);
         #[cfg(feature = "parallel")]
         for threads in [2, 4] {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
                 .unwrap();
-            let got = pool.install(|| with_team(run));
-            assert_eq!(got, (300, 150, expected.clone()), "{threads} threads");
+            assert_eq!(
+                pool.install(|| with_team(run)),
+                expected,
+                "{threads} threads"
+            );
         }
     }
 

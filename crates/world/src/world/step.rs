@@ -151,7 +151,12 @@ impl World {
             self.islands.apply_touch_changes(touches, &self.bodies);
             self.portals
                 .object_masses(&self.bodies, &mut self.object_masses);
-            self.joints.refresh_reserved(&self.bodies);
+            // The joints' colours for the contacts' graph to leave free;
+            // a step with no awake contact colours none (joint-only
+            // scenes pay nothing here).
+            if !self.collision.contacts.awake().is_empty() {
+                self.joints.refresh_reserved(&self.bodies);
+            }
             self.contact_builder.build(
                 self.collision.narrowphase.handoff(),
                 &mut self.collision.contacts,
