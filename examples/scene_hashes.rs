@@ -1,10 +1,13 @@
 //! Prints the state hash of each benchmark scene after a number of steps
 //! (`cargo run --release --example scene_hashes -- [steps] [scenes…]`):
 //! a quick check that a change meant to keep results bit-identical does.
+//! Joint scenes (`weld_cantilever`, `car`, `elevator`, `spring_bridge`)
+//! are accepted by name too.
 
 use janus2d_testbed::benchmarks::{BOX2D_TEN, by_name};
 use janus2d_testbed::engine::scripted_step;
 use janus2d_testbed::janus::Janus;
+use janus2d_testbed::joint_bench;
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -14,7 +17,8 @@ fn main() {
         names = BOX2D_TEN.iter().map(|s| s.to_string()).collect();
     }
     for name in names {
-        let Some(desc) = by_name(&name) else {
+        let Some(desc) = by_name(&name).or_else(|| joint_bench::by_name(&name).map(|j| j.desc))
+        else {
             eprintln!("unknown scene {name}");
             continue;
         };
