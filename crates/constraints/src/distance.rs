@@ -61,8 +61,9 @@ use janus2d_core::softness::Softness;
 
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
+use crate::joint_rows::{self, Bounds, RowSolve, Terms, WarmSide};
 use crate::kind_rows::{GeneralRows, KindRows, TreeRows};
-use crate::parts::{AxisPart, AxisRow, BOTH, PairMass, PairOf, PairStates, load_pair};
+use crate::parts::{AxisPart, AxisRow, PairMass};
 use crate::{JointError, check_spring};
 
 /// Below this distance between the anchors (m) the joint keeps the last
@@ -560,131 +561,6 @@ impl DistanceJoint {
         let d = (sb.dp - sa.dp) + self.delta_center + (r_b - r_a);
         (r_a, r_b, d)
     }
-
-    /// The warm start's share on one of its bodies (`side_b`: body b, else
-    /// body a): the kept axial impulse along the last direction, at the
-    /// body's current arm. [`Constraint::warm_start`] is this on a, then
-    /// on b.
-    #[inline(always)]
-    pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        let n = self.axis;
-        let lambda = self.axial_impulse();
-        let m = &self.base.masses;
-        let (frame, s_sign) = if side_b {
-            (self.frame_b, 1.0)
-        } else {
-            (self.frame_a, -1.0)
-        };
-        let r = st.dq.rotate(frame);
-        let inv = if side_b { m.b } else { m.a };
-        st.v += (s_sign * lambda * inv.inv_mass) * n;
-        st.w += s_sign * inv.inv_inertia * lambda * cross(r, n);
-    }
-
-    /// One velocity iteration of the motor, length (or spring) and limit
-    /// rows, in that order (see the module docs).
-    #[inline(always)]
-    pub(crate) fn solve_pair<P: PairStates>(
-        &mut self,
-        ctx: &StepContext,
-        pair: &mut P,
-        use_bias: bool,
-    ) {
-        if self.base.resting {
-            return;
-        }
-        let (mut sa, mut sb) = pair.load();
-        let m = &self.base.masses;
-        let (r_a, r_b, d) = self.arms(&sa, &sb);
-        let length = d.length();
-        if length > MIN_AXIS_LENGTH {
-            self.axis = d / length;
-        }
-        let n = self.axis;
-        let row = AxisRow::new(m, n, cross(r_a, n), cross(r_b, n));
-        let def = &self.def;
-        if def.enable_motor {
-            self.motor.solve_motor(
-                &mut sa,
-                &mut sb,
-                m,
-                &row,
-                def.motor_speed,
-                ctx.h * def.max_motor_force,
-            );
-        }
-        if def.is_rigid() && !self.base.in_tree {
-            let (c, softness) = if use_bias {
-                let c = length - def.rigid_length();
-                let soft = self.rigid_softness;
-                (capped(c, soft, ctx.joint_max_correction_speed), soft)
-            } else {
-                (0.0, Softness::RIGID)
-            };
-            let free = (Real::NEG_INFINITY, Real::INFINITY);
-            self.length_row
-                .solve_soft(&mut sa, &mut sb, m, &row, c, softness, free);
-        } else if def.hertz > 0.0 {
-            // A spring: always on (relax pass too), its bias not capped.
-            let bounds = (ctx.h * def.lower_force, ctx.h * def.upper_force);
-            self.length_row.solve_soft(
-                &mut sa,
-                &mut sb,
-                m,
-                &row,
-                length - def.length,
-                self.spring_softness,
-                bounds,
-            );
-        }
-        if def.limits_open() {
-            let soft = self.rigid_softness;
-            let cap = ctx.joint_max_correction_speed;
-            // Speculative while apart (uncapped), capped feedback when violated.
-            let lower_c = length - def.min_length;
-            let lower_c = if lower_c > 0.0 {
-                lower_c
-            } else {
-                capped(lower_c, soft, cap)
-            };
-            // (`lower_c` is capped already: no second cap.)
-            self.lower.solve_limit(
-                &mut sa,
-                &mut sb,
-                m,
-                &row,
-                lower_c,
-                soft,
-                ctx.inv_h,
-                use_bias,
-                Real::INFINITY,
-            );
-            let flipped = AxisRow {
-                n: -row.n,
-                s_a: -row.s_a,
-                s_b: -row.s_b,
-                mass: row.mass,
-            };
-            let upper_c = def.max_length - length;
-            let upper_c = if upper_c > 0.0 {
-                upper_c
-            } else {
-                capped(upper_c, soft, cap)
-            };
-            self.upper.solve_limit(
-                &mut sa,
-                &mut sb,
-                m,
-                &flipped,
-                upper_c,
-                soft,
-                ctx.inv_h,
-                use_bias,
-                Real::INFINITY,
-            );
-        }
-        pair.store(&sa, &sb);
-    }
 }
 
 impl KindRows for DistanceJoint {
@@ -709,13 +585,87 @@ impl KindRows for DistanceJoint {
     fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
         DistanceJoint::carry_through_portal(self, rotation, scale);
     }
+    /// The kept impulse along the line (every row's, summed), at the
+    /// body's current arm.
     #[inline(always)]
-    fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        DistanceJoint::warm_start_side(self, st, side_b);
+    fn warm_rows(&self, w: &mut WarmSide<'_>) {
+        w.linear_at_arms(
+            self.axis,
+            (self.frame_a, self.frame_b),
+            self.axial_impulse(),
+        );
     }
+    /// The rows along the anchors' line: motor, then the rigid length or
+    /// the spring, then the limits.
     #[inline(always)]
-    fn solve_pair<P: PairStates>(&mut self, ctx: &StepContext, pair: &mut P, use_bias: bool) {
-        DistanceJoint::solve_pair(self, ctx, pair, use_bias);
+    fn solve_rows(&mut self, ctx: &StepContext, use_bias: bool, s: &mut RowSolve) {
+        let (r_a, r_b, d) = self.arms(&s.sa, &s.sb);
+        let length = d.length();
+        if length > MIN_AXIS_LENGTH {
+            self.axis = d / length;
+        }
+        let n = self.axis;
+        let row = AxisRow::new(&s.m, n, cross(r_a, n), cross(r_b, n));
+        let def = &self.def;
+        if def.enable_motor {
+            let bounds = Bounds::symmetric(ctx.h * def.max_motor_force);
+            s.linear(
+                &row,
+                Terms::motor(def.motor_speed),
+                bounds,
+                &mut self.motor.impulse,
+            );
+        }
+        // The length row's impulse is clamped (not summed) even where free.
+        let free = Bounds::Clamp(Real::NEG_INFINITY, Real::INFINITY);
+        if def.is_rigid() && !self.base.in_tree {
+            let t = if use_bias {
+                let soft = self.rigid_softness;
+                let c = capped(
+                    length - def.rigid_length(),
+                    soft,
+                    ctx.joint_max_correction_speed,
+                );
+                Terms::soft(soft, c, Real::INFINITY)
+            } else {
+                Terms::soft(Softness::RIGID, 0.0, Real::INFINITY)
+            };
+            s.linear(&row, t, free, &mut self.length_row.impulse);
+        } else if def.hertz > 0.0 {
+            // A spring: always on (relax pass too), its bias not capped.
+            let t = Terms::soft(self.spring_softness, length - def.length, Real::INFINITY);
+            let bounds = Bounds::Clamp(ctx.h * def.lower_force, ctx.h * def.upper_force);
+            s.linear(&row, t, bounds, &mut self.length_row.impulse);
+        }
+        if def.limits_open() {
+            let soft = self.rigid_softness;
+            let cap = ctx.joint_max_correction_speed;
+            // Speculative while apart (uncapped), capped feedback when
+            // violated (capped here: no second cap in the row).
+            let violated = |c: Real| if c > 0.0 { c } else { capped(c, soft, cap) };
+            let lower = Terms::limit(
+                violated(length - def.min_length),
+                soft,
+                ctx.inv_h,
+                use_bias,
+                Real::INFINITY,
+            );
+            s.linear(&row, lower, Bounds::ONE_SIDED, &mut self.lower.impulse);
+            let flipped = AxisRow {
+                n: -row.n,
+                s_a: -row.s_a,
+                s_b: -row.s_b,
+                mass: row.mass,
+            };
+            let upper = Terms::limit(
+                violated(def.max_length - length),
+                soft,
+                ctx.inv_h,
+                use_bias,
+                Real::INFINITY,
+            );
+            s.linear(&flipped, upper, Bounds::ONE_SIDED, &mut self.upper.impulse);
+        }
     }
     /// A rigid length row joins the exact tree solve (unless the joint has
     /// its own constraint softness); the spring, limits and motor stay
@@ -794,23 +744,13 @@ impl Constraint for DistanceJoint {
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        if self.base.resting {
-            return;
-        }
-        let (a, b) = (self.base.state_a, self.base.state_b);
-        let (mut sa, mut sb) = load_pair(states, a, b);
-        self.warm_start_side(&mut sa, false);
-        self.warm_start_side(&mut sb, true);
-        crate::parts::store_pair(states, a, b, &sa, &sb);
+        joint_rows::warm_start_states(self, states);
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        let mut pair = PairOf::new(states, self.base.state_a, self.base.state_b, BOTH);
-        self.solve_pair(ctx, &mut pair, use_bias);
+        joint_rows::solve_states(self, ctx, states, use_bias);
     }
 
-    /// The rows at the bodies' current poses, in the solve's order: motor,
-    /// length (rigid or spring), lower, upper; one 1×1 block each.
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
         let at = RowsAt::new(bodies, &self.def.base);
         let (m, r_a, r_b, d) = (at.m, at.r_a, at.r_b, at.c);
@@ -925,7 +865,7 @@ mod tests {
         joint.warm_start(&ctx, &mut whole);
         let mut sides = set.states.clone();
         for (s, side_b) in [(joint.base.state_a, false), (joint.base.state_b, true)] {
-            joint.warm_start_side(&mut sides[s as usize], side_b);
+            crate::joint_rows::warm_start_side(&joint, &mut sides[s as usize], side_b);
         }
         for (w, s) in whole.iter().zip(&sides) {
             assert_eq!((w.v, w.w), (s.v, s.w));

@@ -18,8 +18,8 @@ use janus2d_core::math::{Real, Rot, Vec2};
 use crate::JointError;
 use crate::joint_base::JointBase;
 use crate::joint_def::{JointDefBase, KindDef};
+use crate::joint_rows::{RowSolve, WarmSide};
 use crate::kind_rows::KindRows;
-use crate::parts::PairStates;
 
 /// Everything needed to create a filter joint: only the shared base
 /// (`collide_connected` false, its default, is what the joint is for).
@@ -150,9 +150,9 @@ impl KindRows for FilterJoint {
         FilterJoint::carry_through_portal(self, rotation, scale);
     }
     #[inline(always)]
-    fn warm_start_side(&self, _st: &mut BodyState, _side_b: bool) {}
+    fn warm_rows(&self, _w: &mut WarmSide<'_>) {}
     #[inline(always)]
-    fn solve_pair<P: PairStates>(&mut self, _ctx: &StepContext, _pair: &mut P, _use_bias: bool) {}
+    fn solve_rows(&mut self, _ctx: &StepContext, _use_bias: bool, _s: &mut RowSolve) {}
 }
 
 impl Constraint for FilterJoint {

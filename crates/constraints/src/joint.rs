@@ -6,8 +6,8 @@
 //!  ─────────────────────     ───────────────────────       ───────────────────────────────────
 //!  JointDef::Revolute(d) ──▶ Joint::Revolute(j)  ──▶  prepare       each joint (kind's rows)
 //!  (validated, typed error)  one Vec<Joint>,           colours       JointColours (keys from JointBase)
-//!                            dense, swap-remove        warm start    Joint::warm_start_side, per body
-//!                                                      solve, relax  Joint::solve_pair, colour by colour
+//!                            dense, swap-remove        warm start    kind's warm_rows → WarmSide, per body
+//!                                                      solve, relax  kind's solve_rows → RowSolve, colour by colour
 //!                                                      late solve    JointForest (Joint::tree_rows)
 //!                                                      (all driven by joint_solver::JointBatch)
 //! ```
@@ -29,21 +29,20 @@
 //! and the world read joints only through [`Joint`]'s methods, so they
 //! never name a kind.
 //!
-//! **Adding a kind** is one file in this crate (its definition with
-//! `validate`, its solver form with `prepare`, `warm_start_side`,
-//! `solve_pair`, `rows` and read-backs, and a `base: JointBase` field) plus
-//! one variant in [`JointDef`], [`Joint`] and [`JointKind`] and the arms of
-//! the matches below. The weld joint touched, besides `weld.rs`: this file,
-//! `lib.rs` (module, re-export, kind table), the world's `joints.rs`
-//! (`JointSet::weld`), `world/joints.rs` (`World::weld_joint`,
-//! `create_weld_joint`) and `world/mod.rs` (its import), and the facade's
-//! `src/lib.rs` (re-export, prelude). Nothing in the solver, the colouring or the tree
-//! changes; a kind whose rows the tree cannot take (no point part, or
-//! soft) returns `None` from `Joint::tree_rows` and the tree solve leaves
-//! its component iterative. A kind the tree takes describes its equality
-//! rows there (`TreeRows`: the point part, and the angle row when it
-//! holds the relative angle too) and takes back the tree's impulses in
-//! `Joint::set_tree_impulses`.
+//! **Adding a kind** is one file in this crate plus one line in the
+//! `joint_kinds!` list below: the file holds the definition (with
+//! `validate`, and `KindDef`'s limits, motor and spring views when it has
+//! them) and the solver form, whose `prepare` loads the bodies, whose
+//! `solve_rows` hands its rows to [`crate::joint_rows::RowSolve`] in solve
+//! order and whose `warm_rows` hands their kept impulses to
+//! [`crate::joint_rows::WarmSide`]; plus `rows` (the report) and the
+//! read-backs. The macro generates the enums, the conversions and every
+//! dispatch; the world, the colouring, the warm start, the solve and the
+//! tree never name a kind. A kind whose rows the tree cannot take returns
+//! `None` from `KindRows::tree_rows` and the tree leaves its component
+//! iterative; a kind the tree takes describes its equality rows there
+//! (`TreeRows`) and takes back the tree's impulses in
+//! `KindRows::set_tree_impulses`.
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState};
 use janus2d_core::constraint::{Constraint, ConstraintRows, StepContext};
@@ -54,6 +53,7 @@ use crate::distance::{DistanceJoint, DistanceJointDef};
 use crate::filter::{FilterJoint, FilterJointDef};
 use crate::joint_base::JointBase;
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
+use crate::joint_rows;
 use crate::kind_rows::{GeneralRows, KindRows, TreeRows};
 use crate::motor::{MotorJoint, MotorJointDef};
 use crate::mouse::{MouseJoint, MouseJointDef};
@@ -313,7 +313,7 @@ macro_rules! joint_kinds {
 
             #[inline(always)]
             pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-                match self { $( Joint::$kind(j) => KindRows::warm_start_side(j, st, side_b), )* }
+                match self { $( Joint::$kind(j) => joint_rows::warm_start_side(j, st, side_b), )* }
             }
 
             #[inline(always)]
@@ -323,7 +323,7 @@ macro_rules! joint_kinds {
                 pair: &mut P,
                 use_bias: bool,
             ) {
-                match self { $( Joint::$kind(j) => KindRows::solve_pair(j, ctx, pair, use_bias), )* }
+                match self { $( Joint::$kind(j) => joint_rows::solve_pair(j, ctx, pair, use_bias), )* }
             }
         }
 
@@ -332,8 +332,8 @@ macro_rules! joint_kinds {
                 match self { $( Joint::$kind(j) => Constraint::prepare(j, ctx, bodies), )* }
             }
 
-            fn warm_start(&mut self, ctx: &StepContext, states: &mut [BodyState]) {
-                match self { $( Joint::$kind(j) => Constraint::warm_start(j, ctx, states), )* }
+            fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
+                match self { $( Joint::$kind(j) => joint_rows::warm_start_states(j, states), )* }
             }
 
             fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {

@@ -3,7 +3,7 @@
 //!
 //! | item          | read by                                   |
 //! |---------------|-------------------------------------------|
-//! | [`KindRows`]  | [`crate::joint::Joint`]'s dispatch (static, no `dyn`) |
+//! | [`KindRows`]  | [`crate::joint::Joint`]'s dispatch (static, no `dyn`); its rows go to [`crate::joint_rows`] |
 //! | [`TreeRows`]  | the tree build and solve ([`crate::joint_tree`]) |
 //! | [`GeneralRows`] | the tree solve's general path           |
 //!
@@ -16,7 +16,8 @@ use janus2d_core::constraint::{Constraint, StepContext};
 use janus2d_core::math::{Real, Rot, Vec2};
 
 use crate::joint_base::JointBase;
-use crate::parts::{PairStates, PointPart};
+use crate::joint_rows::{RowSolve, WarmSide};
+use crate::parts::PointPart;
 
 /// What a joint kind's solver form supplies: its rows' stages, read-backs
 /// and what the tree solve may take. Dispatched by [`Joint`]'s match
@@ -43,10 +44,14 @@ pub(crate) trait KindRows: Constraint {
     /// (distances, translations, linear offsets and speeds) scale by `η`
     /// as the anchors do.
     fn carry_through_portal(&mut self, rotation: Rot, scale: Real);
-    /// The warm start's share on one body (`side_b`: body b, else a).
-    fn warm_start_side(&self, st: &mut BodyState, side_b: bool);
-    /// One velocity iteration of the Gauss–Seidel rows.
-    fn solve_pair<P: PairStates>(&mut self, ctx: &StepContext, pair: &mut P, use_bias: bool);
+    /// The kind's Gauss–Seidel rows at the current positions (read from
+    /// `s.sa`, `s.sb`), handed to `s` in solve order
+    /// ([`crate::joint_rows`]); called only when the joint has iterative
+    /// rows and is not resting.
+    fn solve_rows(&mut self, ctx: &StepContext, use_bias: bool, s: &mut RowSolve);
+    /// The kept impulses of the kind's rows, handed to `w` for one body's
+    /// share of the warm start ([`crate::joint_rows`]).
+    fn warm_rows(&self, w: &mut WarmSide<'_>);
     /// The equality rows the tree solve may take (`None`: none).
     fn tree_rows(&self) -> Option<TreeRows<'_>> {
         None

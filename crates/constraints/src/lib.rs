@@ -41,6 +41,7 @@ pub mod joint;
 pub mod joint_base;
 pub mod joint_colour;
 pub mod joint_def;
+pub(crate) mod joint_rows;
 pub mod joint_solver;
 pub mod joint_tree;
 pub(crate) mod kind_rows;

@@ -49,15 +49,14 @@
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState};
 use janus2d_core::constraint::{Block, Constraint, ConstraintRows, StepContext};
-use janus2d_core::math::{Real, Rot, Vec2, cross_sv, solve22, vec_is_finite, wrap_angle};
+use janus2d_core::math::{Real, Rot, Vec2, vec_is_finite, wrap_angle};
 use janus2d_core::softness::Softness;
 
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef};
+use crate::joint_rows::{self, Bounds, PointTerms, RowSolve, Terms, WarmSide};
 use crate::kind_rows::KindRows;
-use crate::parts::{
-    AnglePart, BOTH, PairOf, PairStates, PointPart, apply_pair, clamp_length, load_pair, store_pair,
-};
+use crate::parts::{AnglePart, PointPart};
 use crate::{JointError, check_anchor};
 
 /// Everything needed to create a motor joint.
@@ -347,49 +346,6 @@ impl MotorJoint {
     pub fn constraint_torque(&self) -> Real {
         self.angle.impulse * self.base.inv_h
     }
-
-    /// The warm start's share on one of its bodies (`side_b`: body b, else
-    /// body a): the arithmetic of [`Constraint::warm_start`] on that body.
-    #[inline(always)]
-    pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        self.point
-            .warm_start_side(st, &self.base.masses, self.angle.impulse, side_b);
-    }
-
-    /// One velocity iteration: the angular row, then the linear pair (see
-    /// the module docs; the drive ignores `use_bias`).
-    #[inline(always)]
-    pub(crate) fn solve_pair<P: PairStates>(
-        &mut self,
-        _ctx: &StepContext,
-        pair: &mut P,
-        _use_bias: bool,
-    ) {
-        if self.base.resting {
-            return;
-        }
-        let (mut sa, mut sb) = pair.load();
-        let m = &self.base.masses;
-        if m.a.inv_inertia + m.b.inv_inertia > 0.0 {
-            let c = wrap_angle(self.delta_angle + sa.dq.relative_angle(sb.dq));
-            // Ċ + β C / h → 0: a motor row whose target speed is −β C / h.
-            self.angle.solve_motor(
-                &mut sa,
-                &mut sb,
-                m,
-                -self.bias_rate * c,
-                self.max_angular_impulse,
-            );
-        }
-        let (r_a, r_b, c) = self.point.arms(&sa, &sb);
-        let c_dot = (sb.v + cross_sv(sb.w, r_b)) - (sa.v + cross_sv(sa.w, r_a));
-        let (k11, k12, k22) = PointPart::effective_mass(m, r_a, r_b);
-        let x = solve22(k11, k12, k22, c_dot + self.bias_rate * c);
-        let old = self.point.impulse;
-        self.point.impulse = clamp_length(old - x, self.max_linear_impulse);
-        apply_pair(&mut sa, &mut sb, m, r_a, r_b, self.point.impulse - old, 0.0);
-        pair.store(&sa, &sb);
-    }
 }
 
 impl KindRows for MotorJoint {
@@ -414,13 +370,34 @@ impl KindRows for MotorJoint {
     fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
         MotorJoint::carry_through_portal(self, rotation, scale);
     }
+    /// The kept impulses, one body's share: the angle row's, then the
+    /// point's at the body's current arm.
     #[inline(always)]
-    fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        MotorJoint::warm_start_side(self, st, side_b);
+    fn warm_rows(&self, w: &mut WarmSide<'_>) {
+        w.angle(self.angle.impulse);
+        w.point((self.point.frame_a, self.point.frame_b), self.point.impulse);
     }
+    /// The angle row (a motor whose target speed is the feedback
+    /// `−β C / h`), then the point rows toward the offset, the impulse's
+    /// length bounded by the maximum force.
     #[inline(always)]
-    fn solve_pair<P: PairStates>(&mut self, ctx: &StepContext, pair: &mut P, use_bias: bool) {
-        MotorJoint::solve_pair(self, ctx, pair, use_bias);
+    fn solve_rows(&mut self, _ctx: &StepContext, _use_bias: bool, s: &mut RowSolve) {
+        if s.m.a.inv_inertia + s.m.b.inv_inertia > 0.0 {
+            let c = wrap_angle(self.delta_angle + s.sa.dq.relative_angle(s.sb.dq));
+            // Ċ + β C / h → 0: a motor row whose target speed is −β C / h.
+            let t = Terms::motor(-self.bias_rate * c);
+            let bounds = Bounds::symmetric(self.max_angular_impulse);
+            s.angle(1.0, self.angle.mass, t, bounds, &mut self.angle.impulse);
+        }
+        let (r_a, r_b, c) = self.point.arms(&s.sa, &s.sb);
+        let t = PointTerms::feedback(self.bias_rate, c);
+        s.point(
+            r_a,
+            r_b,
+            t,
+            self.max_linear_impulse,
+            &mut self.point.impulse,
+        );
     }
 }
 
@@ -447,7 +424,8 @@ impl Constraint for MotorJoint {
         if ctx.warm_starting {
             // A lowered force or torque (or a shorter substep) bounds the
             // kept impulses before they are applied again.
-            self.point.impulse = clamp_length(self.point.impulse, self.max_linear_impulse);
+            self.point.impulse =
+                crate::parts::clamp_length(self.point.impulse, self.max_linear_impulse);
             self.angle.impulse = self
                 .angle
                 .impulse
@@ -459,26 +437,13 @@ impl Constraint for MotorJoint {
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        if self.base.resting {
-            return;
-        }
-        let (a, b) = (self.base.state_a, self.base.state_b);
-        let (mut sa, mut sb) = load_pair(states, a, b);
-        let m = &self.base.masses;
-        AnglePart::apply(&mut sa, &mut sb, m, self.angle.impulse);
-        self.point.warm_start(&mut sa, &mut sb, m);
-        store_pair(states, a, b, &sa, &sb);
+        joint_rows::warm_start_states(self, states);
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        let mut pair = PairOf::new(states, self.base.state_a, self.base.state_b, BOTH);
-        self.solve_pair(ctx, &mut pair, use_bias);
+        joint_rows::solve_states(self, ctx, states, use_bias);
     }
 
-    /// Two linear rows (between the target on a and b's anchor; the
-    /// reported bounds `±max_force · h` are per row, the solve bounds the
-    /// pair's length) and the angular row, each with the drive's bias rate
-    /// `β / h` as its softness.
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
         let at = RowsAt::at_points(
             bodies,

@@ -51,13 +51,14 @@
 use janus2d_core::body::{BodyHandle, BodySet, BodyState, InvMass};
 use janus2d_core::constraint::{Block, Constraint, ConstraintRows, StepContext};
 use janus2d_core::limits::MAX_COORDINATE;
-use janus2d_core::math::{Real, Rot, Vec2, cross, cross_sv, solve22, vec_is_finite};
+use janus2d_core::math::{Real, Rot, Vec2, vec_is_finite};
 use janus2d_core::softness::Softness;
 
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef};
+use crate::joint_rows::{self, RowSolve, WarmSide};
 use crate::kind_rows::KindRows;
-use crate::parts::{BOTH, PairMass, PairOf, PairStates, PointPart, load_pair, soft_impulse};
+use crate::parts::{PairMass, PointPart};
 use crate::{JointError, check_spring};
 
 /// Everything needed to create a mouse joint.
@@ -330,82 +331,6 @@ impl MouseJoint {
     pub fn constraint_torque(&self) -> Real {
         self.angular_impulse * self.base.inv_h
     }
-
-    /// The warm start's share on one of its bodies: on b the kept angular
-    /// impulse, then the point impulse at b's current arm; nothing on a.
-    /// [`Constraint::warm_start`] is this on b.
-    #[inline(always)]
-    pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        if !side_b {
-            return;
-        }
-        let m_b = &self.base.masses.b;
-        st.w += m_b.inv_inertia * self.angular_impulse;
-        let r_b = st.dq.rotate(self.frame_b);
-        let p = self.linear_impulse;
-        st.v += m_b.inv_mass * p;
-        st.w += m_b.inv_inertia * cross(r_b, p);
-    }
-
-    /// One velocity iteration: the angular damping, then the pull, on
-    /// body b only.
-    #[inline(always)]
-    pub(crate) fn solve_pair<P: PairStates>(
-        &mut self,
-        ctx: &StepContext,
-        pair: &mut P,
-        _use_bias: bool,
-    ) {
-        if self.base.resting {
-            return;
-        }
-        let (sa, mut sb) = pair.load();
-        let m_b = self.base.masses.b;
-        if self.has_angular_row() && m_b.inv_inertia > 0.0 {
-            let soft = self.angular_softness;
-            let lambda = soft_impulse(
-                soft.mass_scale / m_b.inv_inertia,
-                sb.w,
-                soft.impulse_scale,
-                self.angular_impulse,
-            );
-            self.angular_impulse += lambda;
-            sb.w += m_b.inv_inertia * lambda;
-        }
-        let r_b = sb.dq.rotate(self.frame_b);
-        let c = sb.dp + r_b + self.delta_center;
-        let c_dot = sb.v + cross_sv(sb.w, r_b);
-        let soft = self.linear_softness;
-        let (k11, k12, k22) =
-            PointPart::effective_mass(&b_only(&self.base.masses), Vec2::ZERO, r_b);
-        let x = solve22(k11, k12, k22, c_dot + soft.bias_rate * c);
-        let step = Vec2::new(
-            soft_impulse(
-                soft.mass_scale,
-                x.x,
-                soft.impulse_scale,
-                self.linear_impulse.x,
-            ),
-            soft_impulse(
-                soft.mass_scale,
-                x.y,
-                soft.impulse_scale,
-                self.linear_impulse.y,
-            ),
-        );
-        let old = self.linear_impulse;
-        let mut total = old + step;
-        let max_impulse = ctx.h * self.def.max_force;
-        let len2 = total.length_squared();
-        if len2 > max_impulse * max_impulse {
-            total *= max_impulse / len2.sqrt();
-        }
-        self.linear_impulse = total;
-        let p = total - old;
-        sb.v += m_b.inv_mass * p;
-        sb.w += m_b.inv_inertia * cross(r_b, p);
-        pair.store(&sa, &sb);
-    }
 }
 
 impl KindRows for MouseJoint {
@@ -430,13 +355,29 @@ impl KindRows for MouseJoint {
     fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
         MouseJoint::carry_through_portal(self, rotation, scale);
     }
+    /// The kept impulses on body b (nothing on a): the spin row's, then
+    /// the pull's at b's current arm.
     #[inline(always)]
-    fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        MouseJoint::warm_start_side(self, st, side_b);
+    fn warm_rows(&self, w: &mut WarmSide<'_>) {
+        w.spin_b(self.angular_impulse);
+        w.target(self.frame_b, self.linear_impulse);
     }
+    /// The angular damping, then the pull, on body b only.
     #[inline(always)]
-    fn solve_pair<P: PairStates>(&mut self, ctx: &StepContext, pair: &mut P, use_bias: bool) {
-        MouseJoint::solve_pair(self, ctx, pair, use_bias);
+    fn solve_rows(&mut self, ctx: &StepContext, _use_bias: bool, s: &mut RowSolve) {
+        if self.has_angular_row() {
+            s.spin_b(self.angular_softness, &mut self.angular_impulse);
+        }
+        let r_b = s.sb.dq.rotate(self.frame_b);
+        let c = s.sb.dp + r_b + self.delta_center;
+        let max_impulse = ctx.h * self.def.max_force;
+        s.target(
+            r_b,
+            c,
+            self.linear_softness,
+            max_impulse,
+            &mut self.linear_impulse,
+        );
     }
 }
 
@@ -467,26 +408,13 @@ impl Constraint for MouseJoint {
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        if self.base.resting {
-            return;
-        }
-        let b = self.base.state_b;
-        let (_, mut sb) = load_pair(states, self.base.state_a, b);
-        self.warm_start_side(&mut sb, true);
-        let t = &mut states[b as usize];
-        t.v = sb.v;
-        t.w = sb.w;
+        joint_rows::warm_start_states(self, states);
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        let mut pair = PairOf::new(states, self.base.state_a, self.base.state_b, BOTH);
-        self.solve_pair(ctx, &mut pair, use_bias);
+        joint_rows::solve_states(self, ctx, states, use_bias);
     }
 
-    /// The rows at the bodies' current poses: the two point rows (x, y;
-    /// body a's entries zero) as one 2×2 block, each bounded by
-    /// `±max_force · h` (the solve clamps the impulse's length, a disc
-    /// inside that box), then the angular damping row.
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
         let at = RowsAt::new(bodies, &self.def.base);
         let b = bodies.solver_body(self.def.base.body_b);
@@ -565,7 +493,7 @@ mod tests {
         joint.warm_start(&ctx, &mut whole);
         let mut sides = set.states.clone();
         for (s, side_b) in [(joint.base.state_a, false), (joint.base.state_b, true)] {
-            joint.warm_start_side(&mut sides[s as usize], side_b);
+            crate::joint_rows::warm_start_side(&joint, &mut sides[s as usize], side_b);
         }
         for (w, s) in whole.iter().zip(&sides) {
             assert_eq!((w.v, w.w), (s.v, s.w));

@@ -1,9 +1,11 @@
-//! Reusable constraint parts: point and angle, and the soft update every
-//! soft row shares.
+//! Reusable constraint parts: point, angle and axis rows' geometry and
+//! kept impulses, and the soft update every soft row shares.
 //!
 //! Joints are assembled from these parts, in the spirit of Jolt's
-//! constraint parts. Each part owns its accumulated impulse and implements
-//! the same stages (warm start, solve with or without bias).
+//! constraint parts. A part holds what its rows keep between iterations
+//! (arms at the step's start, effective mass, accumulated impulse); the
+//! joints' rows are solved and warm-started by the crate's one row solve
+//! (`joint_rows`), which every kind hands its rows to.
 //!
 //! | part          | rows | C                                         | J (body a │ body b)                          |
 //! |---------------|------|-------------------------------------------|----------------------------------------------|
@@ -11,9 +13,9 @@
 //! | [`AnglePart`] | 1    | `θ_b − θ_a − θ_ref`                       | `0, −1 │ 0, 1`                                |
 //! | [`AxisPart`]  | 1    | the kind's (`n · d`, `‖d‖ − L`, …)        | `−n, −s_a │ n, s_b` ([`AxisRow`], built by the kind) |
 //!
-//! **The soft update.** Every soft row (these parts, the portal rows, the
+//! **The soft update.** Every soft row (the joints' rows, the portal rows, the
 //! contact rows of [`crate::contact_row`]) takes the step of
-//! [`Softness`]: `Δλ = −s_m K⁻¹ (Ċ + b) − s_i λ`, written once in
+//! [`Softness`](janus2d_core::softness::Softness): `Δλ = −s_m K⁻¹ (Ċ + b) − s_i λ`, written once in
 //! [`soft_impulse`]. The caller forms the product `s_m K⁻¹ (Ċ + b)` as its
 //! row needs it (a 2×2 or 3×3 solve scaled by `s_m`, or a scalar effective
 //! mass times `s_m` times the velocity error).
@@ -28,9 +30,8 @@
 //! every impulse on it vanish without a branch.
 
 use janus2d_core::body::{BodyState, InvMass};
-use janus2d_core::math::{Real, Vec2, cross, cross_sv, solve22};
+use janus2d_core::math::{Real, Vec2, cross};
 use janus2d_core::parallel::PlannedStates;
-use janus2d_core::softness::Softness;
 
 use crate::lane::Lane;
 
@@ -246,38 +247,6 @@ impl PointPart {
         (r_a, r_b, c)
     }
 
-    /// Applies the accumulated impulse.
-    #[inline(always)]
-    pub fn warm_start(&self, sa: &mut BodyState, sb: &mut BodyState, m: &PairMass) {
-        let r_a = sa.dq.rotate(self.frame_a);
-        let r_b = sb.dq.rotate(self.frame_b);
-        apply_pair(sa, sb, m, r_a, r_b, self.impulse, 0.0);
-    }
-
-    /// One body's share of a joint's warm start (`side_b`: body b, else
-    /// body a): the kept angle impulse `axial` (positive on b), then the
-    /// kept point impulse at the body's current arm. The arithmetic of
-    /// `AnglePart::apply` then [`PointPart::warm_start`] on that body, so a
-    /// body that takes the shares of its joints in storage order ends
-    /// exactly as after the joints' warm starts in storage order.
-    #[inline(always)]
-    pub fn warm_start_side(&self, st: &mut BodyState, m: &PairMass, axial: Real, side_b: bool) {
-        let p = self.impulse;
-        if side_b {
-            let m_b = &m.b;
-            st.w += m_b.inv_inertia * axial;
-            let r_b = st.dq.rotate(self.frame_b);
-            st.v += m_b.inv_mass * p;
-            st.w += m_b.inv_inertia * (cross(r_b, p) + 0.0);
-        } else {
-            let m_a = &m.a;
-            st.w -= m_a.inv_inertia * axial;
-            let r_a = st.dq.rotate(self.frame_a);
-            st.v -= m_a.inv_mass * p;
-            st.w -= m_a.inv_inertia * (cross(r_a, p) + 0.0);
-        }
-    }
-
     /// The 2×2 effective mass `K = J M⁻¹ Jᵀ` as `(k11, k12, k22)`.
     #[inline(always)]
     pub fn effective_mass(m: &PairMass, r_a: Vec2, r_b: Vec2) -> (Real, Real, Real) {
@@ -286,39 +255,6 @@ impl PointPart {
         let k12 = -r_a.y * r_a.x * i_a - r_b.y * r_b.x * i_b;
         let k22 = m_a + m_b + r_a.x * r_a.x * i_a + r_b.x * r_b.x * i_b;
         (k11, k12, k22)
-    }
-
-    /// One soft iteration. With `use_bias` the position error is fed back
-    /// at `softness.bias_rate`, its speed capped at `max_correction` (m/s).
-    #[inline(always)]
-    pub fn solve(
-        &mut self,
-        sa: &mut BodyState,
-        sb: &mut BodyState,
-        m: &PairMass,
-        softness: Softness,
-        max_correction: Real,
-        use_bias: bool,
-    ) {
-        let (r_a, r_b, c) = self.arms(sa, sb);
-        let c_dot = (sb.v + cross_sv(sb.w, r_b)) - (sa.v + cross_sv(sa.w, r_a));
-        let (bias, mass_scale, impulse_scale) = if use_bias {
-            (
-                clamp_length(softness.bias_rate * c, max_correction),
-                softness.mass_scale,
-                softness.impulse_scale,
-            )
-        } else {
-            (Vec2::ZERO, 1.0, 0.0)
-        };
-        let (k11, k12, k22) = Self::effective_mass(m, r_a, r_b);
-        let b = solve22(k11, k12, k22, c_dot + bias);
-        let impulse = Vec2::new(
-            soft_impulse(mass_scale, b.x, impulse_scale, self.impulse.x),
-            soft_impulse(mass_scale, b.y, impulse_scale, self.impulse.y),
-        );
-        self.impulse += impulse;
-        apply_pair(sa, sb, m, r_a, r_b, impulse, 0.0);
     }
 }
 
@@ -338,101 +274,6 @@ impl AnglePart {
     pub fn prepare(&mut self, m: &PairMass) {
         let k = m.a.inv_inertia + m.b.inv_inertia;
         self.mass = if k > 0.0 { 1.0 / k } else { 0.0 };
-    }
-
-    /// Relative angular velocity `ω_b − ω_a`.
-    #[inline(always)]
-    pub fn c_dot(sa: &BodyState, sb: &BodyState) -> Real {
-        sb.w - sa.w
-    }
-
-    /// Applies an angular impulse (positive on b).
-    #[inline(always)]
-    pub fn apply(sa: &mut BodyState, sb: &mut BodyState, m: &PairMass, lambda: Real) {
-        sa.w -= m.a.inv_inertia * lambda;
-        sb.w += m.b.inv_inertia * lambda;
-    }
-
-    /// A soft equality row: drives `c` (rad) to zero with `softness`, its
-    /// feedback speed `bias_rate · c` capped at `±max_bias` (rad/s;
-    /// `Real::INFINITY` for a spring, whose feedback is its force).
-    #[inline(always)]
-    pub fn solve_soft(
-        &mut self,
-        sa: &mut BodyState,
-        sb: &mut BodyState,
-        m: &PairMass,
-        c: Real,
-        softness: Softness,
-        max_bias: Real,
-    ) {
-        let c_dot = Self::c_dot(sa, sb);
-        let bias = cap(softness.bias_rate * c, max_bias);
-        let lambda = soft_impulse(
-            softness.mass_scale * self.mass,
-            c_dot + bias,
-            softness.impulse_scale,
-            self.impulse,
-        );
-        self.impulse += lambda;
-        Self::apply(sa, sb, m, lambda);
-    }
-
-    /// A velocity row driving `ω_b − ω_a` to `target`, with the accumulated
-    /// impulse clamped to `±max_impulse`.
-    #[inline(always)]
-    pub fn solve_motor(
-        &mut self,
-        sa: &mut BodyState,
-        sb: &mut BodyState,
-        m: &PairMass,
-        target: Real,
-        max_impulse: Real,
-    ) {
-        let c_dot = Self::c_dot(sa, sb) - target;
-        let lambda = -self.mass * c_dot;
-        let old = self.impulse;
-        self.impulse = (old + lambda).clamp(-max_impulse, max_impulse);
-        Self::apply(sa, sb, m, self.impulse - old);
-    }
-
-    /// A one-sided row `sign · c ≥ 0` (a limit): speculative when apart,
-    /// soft when violated (only with `use_bias`), the violated row's
-    /// feedback speed capped at `max_bias` (rad/s).
-    #[inline(always)]
-    pub fn solve_limit(
-        &mut self,
-        sa: &mut BodyState,
-        sb: &mut BodyState,
-        m: &PairMass,
-        c: Real,
-        sign: Real,
-        softness: Softness,
-        inv_h: Real,
-        use_bias: bool,
-        max_bias: Real,
-    ) {
-        let (bias, mass_scale, impulse_scale) = if c > 0.0 {
-            (c * inv_h, 1.0, 0.0)
-        } else if use_bias {
-            (
-                cap(softness.bias_rate * c, max_bias),
-                softness.mass_scale,
-                softness.impulse_scale,
-            )
-        } else {
-            (0.0, 1.0, 0.0)
-        };
-        let c_dot = sign * Self::c_dot(sa, sb);
-        let lambda = soft_impulse(
-            self.mass * mass_scale,
-            c_dot + bias,
-            impulse_scale,
-            self.impulse,
-        );
-        let old = self.impulse;
-        self.impulse = (old + lambda).max(0.0);
-        Self::apply(sa, sb, m, sign * (self.impulse - old));
     }
 }
 
@@ -513,98 +354,11 @@ impl AxisRow {
     }
 }
 
-/// The accumulated impulse of one [`AxisRow`] and its solves: a soft
-/// equality, a motor, a one-sided limit, each as [`AnglePart`]'s but along
-/// a row the kind builds each iteration.
+/// The accumulated impulse of one [`AxisRow`], which the kind builds each
+/// iteration (the row's solve is `joint_rows`' `RowSolve::linear`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct AxisPart {
     /// Accumulated impulse, N·s.
     pub impulse: Real,
-}
-
-impl AxisPart {
-    /// A soft equality row driving `c` (m) to zero, the impulse clamped to
-    /// `[lower, upper]` (N·s; `±∞` for none).
-    #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    pub fn solve_soft(
-        &mut self,
-        sa: &mut BodyState,
-        sb: &mut BodyState,
-        m: &PairMass,
-        row: &AxisRow,
-        c: Real,
-        softness: Softness,
-        (lower, upper): (Real, Real),
-    ) {
-        let c_dot = row.c_dot(sa, sb);
-        let lambda = soft_impulse(
-            softness.mass_scale * row.mass,
-            c_dot + softness.bias_rate * c,
-            softness.impulse_scale,
-            self.impulse,
-        );
-        let old = self.impulse;
-        self.impulse = (old + lambda).clamp(lower, upper);
-        row.apply(sa, sb, m, self.impulse - old);
-    }
-
-    /// A velocity row driving `Ċ` to `target` (m/s), the accumulated
-    /// impulse clamped to `±max_impulse` (N·s).
-    #[inline(always)]
-    pub fn solve_motor(
-        &mut self,
-        sa: &mut BodyState,
-        sb: &mut BodyState,
-        m: &PairMass,
-        row: &AxisRow,
-        target: Real,
-        max_impulse: Real,
-    ) {
-        let lambda = -row.mass * (row.c_dot(sa, sb) - target);
-        let old = self.impulse;
-        self.impulse = (old + lambda).clamp(-max_impulse, max_impulse);
-        row.apply(sa, sb, m, self.impulse - old);
-    }
-
-    /// A one-sided row `c ≥ 0` along `row` (a limit; the caller negates
-    /// the row for an upper limit): speculative when apart, soft when
-    /// violated (only with `use_bias`), the violated row's feedback speed
-    /// capped at `max_bias` (m/s).
-    #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    pub fn solve_limit(
-        &mut self,
-        sa: &mut BodyState,
-        sb: &mut BodyState,
-        m: &PairMass,
-        row: &AxisRow,
-        c: Real,
-        softness: Softness,
-        inv_h: Real,
-        use_bias: bool,
-        max_bias: Real,
-    ) {
-        let (bias, mass_scale, impulse_scale) = if c > 0.0 {
-            (c * inv_h, 1.0, 0.0)
-        } else if use_bias {
-            (
-                cap(softness.bias_rate * c, max_bias),
-                softness.mass_scale,
-                softness.impulse_scale,
-            )
-        } else {
-            (0.0, 1.0, 0.0)
-        };
-        let lambda = soft_impulse(
-            row.mass * mass_scale,
-            row.c_dot(sa, sb) + bias,
-            impulse_scale,
-            self.impulse,
-        );
-        let old = self.impulse;
-        self.impulse = (old + lambda).max(0.0);
-        row.apply(sa, sb, m, self.impulse - old);
-    }
 }

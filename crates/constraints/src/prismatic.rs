@@ -84,11 +84,9 @@ use janus2d_core::softness::Softness;
 
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, JointFrame, KindDef, LimitsMut, MotorMut, SpringMut};
+use crate::joint_rows::{self, Bounds, RowSolve, Terms, WarmSide};
 use crate::kind_rows::{GeneralRows, KindRows, TreeRows};
-use crate::parts::{
-    AxisPart, AxisRow, BOTH, PairMass, PairOf, PairStates, angular_correction_cap, cap, load_pair,
-    soft_impulse, store_pair,
-};
+use crate::parts::{AxisPart, AxisRow, PairMass, angular_correction_cap};
 use crate::{JointError, check_spring};
 
 /// Checks a linear motor speed against
@@ -217,38 +215,6 @@ pub(crate) fn slide_rows_at(bodies: &BodySet, def: &JointDefBase) -> (RowsAt, Sl
 pub(crate) fn row_speed(bodies: &BodySet, def: &JointDefBase, row: &AxisRow) -> Real {
     let state = |h| bodies.state(h).copied().unwrap_or(BodyState::IDENTITY);
     row.c_dot(&state(def.body_a), &state(def.body_b))
-}
-
-/// The bias, mass scale and impulse scale of a rigid row in this pass:
-/// with `use_bias` the softness's, the bias `β C` capped at `±max` (m/s or
-/// rad/s), else a plain velocity row.
-#[inline(always)]
-pub(crate) fn rigid_terms(
-    softness: Softness,
-    c: Real,
-    max: Real,
-    use_bias: bool,
-) -> (Real, Real, Real) {
-    if use_bias {
-        (
-            cap(softness.bias_rate * c, max),
-            softness.mass_scale,
-            softness.impulse_scale,
-        )
-    } else {
-        (0.0, 1.0, 0.0)
-    }
-}
-
-/// Applies an angular impulse `λ` (positive on b) to one body, the
-/// arithmetic of `AnglePart::apply` on that body.
-#[inline(always)]
-pub(crate) fn apply_angle_side(st: &mut BodyState, m: &PairMass, lambda: Real, side_b: bool) {
-    if side_b {
-        st.w += m.b.inv_inertia * lambda;
-    } else {
-        st.w -= m.a.inv_inertia * lambda;
-    }
 }
 
 /// Everything needed to create a prismatic joint.
@@ -655,167 +621,6 @@ impl PrismaticJoint {
     pub fn constraint_torque(&self) -> Real {
         self.angle_impulse * self.base.inv_h
     }
-
-    /// The warm start's share on one of its bodies (`side_b`: body b, else
-    /// body a): the axial impulse along the kept axial row, the
-    /// perpendicular impulse along the kept perpendicular row, then the
-    /// angle impulse, the arithmetic of [`Constraint::warm_start`] on that
-    /// body.
-    #[inline(always)]
-    pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        let m = &self.base.masses;
-        self.axial_row
-            .apply_side(st, m, self.axial_impulse(), side_b);
-        self.perp_row.apply_side(st, m, self.perp_impulse, side_b);
-        apply_angle_side(st, m, self.angle_impulse, side_b);
-    }
-
-    /// One velocity iteration on the joint's two states: spring, motor,
-    /// the perpendicular and angle rows as a block, then the limits.
-    #[inline(always)]
-    pub(crate) fn solve_pair<P: PairStates>(
-        &mut self,
-        ctx: &StepContext,
-        pair: &mut P,
-        use_bias: bool,
-    ) {
-        if self.base.resting {
-            return;
-        }
-        let (mut sa, mut sb) = pair.load();
-        let m = self.base.masses;
-        let rows = self.frame.rows(&sa, &sb, &m);
-        let axial = rows.axial;
-        let t = rows.translation;
-        if self.def.enable_spring && self.def.hertz > 0.0 {
-            let c = t - self.def.target_translation;
-            self.spring.solve_soft(
-                &mut sa,
-                &mut sb,
-                &m,
-                &axial,
-                c,
-                self.spring_softness,
-                (Real::NEG_INFINITY, Real::INFINITY),
-            );
-        }
-        if self.def.enable_motor {
-            let max_impulse = ctx.h * self.def.max_motor_force;
-            self.motor.solve_motor(
-                &mut sa,
-                &mut sb,
-                &m,
-                &axial,
-                self.def.motor_speed,
-                max_impulse,
-            );
-        }
-        // The rigid block before the limits (module docs, "Order").
-        if !self.base.in_tree {
-            self.solve_block(ctx, &mut sa, &mut sb, &rows, use_bias);
-        }
-        if self.def.enable_limit {
-            let soft = self.linear_softness;
-            self.lower.solve_limit(
-                &mut sa,
-                &mut sb,
-                &m,
-                &axial,
-                t - self.def.lower_translation,
-                soft,
-                ctx.inv_h,
-                use_bias,
-                ctx.joint_max_correction_speed,
-            );
-            let down = AxisRow {
-                n: -axial.n,
-                s_a: -axial.s_a,
-                s_b: -axial.s_b,
-                mass: axial.mass,
-            };
-            self.upper.solve_limit(
-                &mut sa,
-                &mut sb,
-                &m,
-                &down,
-                self.def.upper_translation - t,
-                soft,
-                ctx.inv_h,
-                use_bias,
-                ctx.joint_max_correction_speed,
-            );
-        }
-        self.perp_row = rows.perp;
-        self.axial_row = axial;
-        pair.store(&sa, &sb);
-    }
-
-    /// The perpendicular and angle rows: one 2×2 soft block solve, or the
-    /// two rows in turn when the block is singular (module docs).
-    #[inline(always)]
-    fn solve_block(
-        &mut self,
-        ctx: &StepContext,
-        sa: &mut BodyState,
-        sb: &mut BodyState,
-        rows: &SlideRows,
-        use_bias: bool,
-    ) {
-        let m = self.base.masses;
-        let perp = &rows.perp;
-        let c_angle =
-            janus2d_core::math::wrap_angle(self.delta_angle + sa.dq.relative_angle(sb.dq));
-        let (bias_p, ms_p, is_p) = rigid_terms(
-            self.linear_softness,
-            rows.c_perp,
-            ctx.joint_max_correction_speed,
-            use_bias,
-        );
-        let (bias_t, ms_t, is_t) = rigid_terms(
-            self.angular_softness,
-            c_angle,
-            angular_correction_cap(ctx.joint_max_correction_speed),
-            use_bias,
-        );
-        let c_dot_p = perp.c_dot(sa, sb);
-        let c_dot_t = sb.w - sa.w;
-        let (i_a, i_b) = (m.a.inv_inertia, m.b.inv_inertia);
-        if block_is_regular(&m) {
-            let k11 =
-                m.a.inv_mass + m.b.inv_mass + i_a * perp.s_a * perp.s_a + i_b * perp.s_b * perp.s_b;
-            let k12 = i_a * perp.s_a + i_b * perp.s_b;
-            let k22 = i_a + i_b;
-            let x = janus2d_core::math::solve22(
-                k11,
-                k12,
-                k22,
-                Vec2::new(c_dot_p + bias_p, c_dot_t + bias_t),
-            );
-            let d_perp = soft_impulse(ms_p, x.x, is_p, self.perp_impulse);
-            let d_angle = soft_impulse(ms_t, x.y, is_t, self.angle_impulse);
-            self.perp_impulse += d_perp;
-            self.angle_impulse += d_angle;
-            perp.apply(sa, sb, &m, d_perp);
-            sa.w -= i_a * d_angle;
-            sb.w += i_b * d_angle;
-        } else {
-            if i_a + i_b > 0.0 {
-                let d_angle = soft_impulse(
-                    ms_t / (i_a + i_b),
-                    c_dot_t + bias_t,
-                    is_t,
-                    self.angle_impulse,
-                );
-                self.angle_impulse += d_angle;
-                sa.w -= i_a * d_angle;
-                sb.w += i_b * d_angle;
-            }
-            let c_dot_p = perp.c_dot(sa, sb);
-            let d_perp = soft_impulse(ms_p * perp.mass, c_dot_p + bias_p, is_p, self.perp_impulse);
-            self.perp_impulse += d_perp;
-            perp.apply(sa, sb, &m, d_perp);
-        }
-    }
 }
 
 impl KindRows for PrismaticJoint {
@@ -840,13 +645,93 @@ impl KindRows for PrismaticJoint {
     fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
         PrismaticJoint::carry_through_portal(self, rotation, scale);
     }
+    /// The kept impulses along the rows of the last iteration (module
+    /// docs, "Warm start geometry"): the axial rows' sum, the
+    /// perpendicular row's, then the angle row's.
     #[inline(always)]
-    fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        PrismaticJoint::warm_start_side(self, st, side_b);
+    fn warm_rows(&self, w: &mut WarmSide<'_>) {
+        w.linear(&self.axial_row, self.axial_impulse());
+        w.linear(&self.perp_row, self.perp_impulse);
+        w.angle(self.angle_impulse);
     }
+    /// Spring, motor, the rigid block (unless the tree solves it), then
+    /// the limits (module docs, "Order").
     #[inline(always)]
-    fn solve_pair<P: PairStates>(&mut self, ctx: &StepContext, pair: &mut P, use_bias: bool) {
-        PrismaticJoint::solve_pair(self, ctx, pair, use_bias);
+    fn solve_rows(&mut self, ctx: &StepContext, use_bias: bool, s: &mut RowSolve) {
+        let rows = self.frame.rows(&s.sa, &s.sb, &s.m);
+        let axial = rows.axial;
+        let t = rows.translation;
+        let cap = ctx.joint_max_correction_speed;
+        // The axial rows' impulses are clamped (not summed) even where free.
+        let free = Bounds::Clamp(Real::NEG_INFINITY, Real::INFINITY);
+        if self.def.enable_spring && self.def.hertz > 0.0 {
+            let c = t - self.def.target_translation;
+            let terms = Terms::soft(self.spring_softness, c, Real::INFINITY);
+            s.linear(&axial, terms, free, &mut self.spring.impulse);
+        }
+        if self.def.enable_motor {
+            let bounds = Bounds::symmetric(ctx.h * self.def.max_motor_force);
+            let terms = Terms::motor(self.def.motor_speed);
+            s.linear(&axial, terms, bounds, &mut self.motor.impulse);
+        }
+        if !self.base.in_tree {
+            let c_angle =
+                janus2d_core::math::wrap_angle(self.delta_angle + s.sa.dq.relative_angle(s.sb.dq));
+            let t_perp = Terms::equality(self.linear_softness, rows.c_perp, cap, use_bias);
+            let t_angle = Terms::equality(
+                self.angular_softness,
+                c_angle,
+                angular_correction_cap(cap),
+                use_bias,
+            );
+            let k_angle = s.m.a.inv_inertia + s.m.b.inv_inertia;
+            if block_is_regular(&s.m) {
+                s.linear_angle(
+                    &rows.perp,
+                    (t_perp, t_angle),
+                    (&mut self.perp_impulse, &mut self.angle_impulse),
+                );
+            } else {
+                // One of the block's rows is empty: the two rows apart.
+                if k_angle > 0.0 {
+                    s.angle(
+                        1.0,
+                        1.0 / k_angle,
+                        t_angle,
+                        Bounds::Free,
+                        &mut self.angle_impulse,
+                    );
+                }
+                s.linear(&rows.perp, t_perp, Bounds::Free, &mut self.perp_impulse);
+            }
+        }
+        if self.def.enable_limit {
+            let soft = self.linear_softness;
+            let lower = Terms::limit(
+                t - self.def.lower_translation,
+                soft,
+                ctx.inv_h,
+                use_bias,
+                cap,
+            );
+            s.linear(&axial, lower, Bounds::ONE_SIDED, &mut self.lower.impulse);
+            let down = AxisRow {
+                n: -axial.n,
+                s_a: -axial.s_a,
+                s_b: -axial.s_b,
+                mass: axial.mass,
+            };
+            let upper = Terms::limit(
+                self.def.upper_translation - t,
+                soft,
+                ctx.inv_h,
+                use_bias,
+                cap,
+            );
+            s.linear(&down, upper, Bounds::ONE_SIDED, &mut self.upper.impulse);
+        }
+        self.perp_row = rows.perp;
+        self.axial_row = axial;
     }
     /// The perpendicular and angle rows join the exact tree solve (rigid
     /// unless the joint has its own constraint softness); its axial rows
@@ -923,23 +808,13 @@ impl Constraint for PrismaticJoint {
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        if self.base.resting {
-            return;
-        }
-        let (a, b) = (self.base.state_a, self.base.state_b);
-        let (mut sa, mut sb) = load_pair(states, a, b);
-        self.warm_start_side(&mut sa, false);
-        self.warm_start_side(&mut sb, true);
-        store_pair(states, a, b, &sa, &sb);
+        joint_rows::warm_start_states(self, states);
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        let mut pair = PairOf::new(states, self.base.state_a, self.base.state_b, BOTH);
-        self.solve_pair(ctx, &mut pair, use_bias);
+        joint_rows::solve_states(self, ctx, states, use_bias);
     }
 
-    /// Rows in order: perpendicular, angle (one 2×2 block when regular),
-    /// then spring, motor, lower, upper as enabled (one row each).
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
         let (at, rows) = slide_rows_at(bodies, &self.def.base);
         let m = at.m;
@@ -1133,8 +1008,8 @@ mod tests {
         joint.warm_start(&ctx, &mut whole);
         let (sa, sb) = (joint.base.state_a as usize, joint.base.state_b as usize);
         let mut by_body = set.states.clone();
-        joint.warm_start_side(&mut by_body[sa], false);
-        joint.warm_start_side(&mut by_body[sb], true);
+        crate::joint_rows::warm_start_side(&joint, &mut by_body[sa], false);
+        crate::joint_rows::warm_start_side(&joint, &mut by_body[sb], true);
         assert_eq!(whole, by_body);
     }
 }

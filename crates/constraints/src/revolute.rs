@@ -39,11 +39,9 @@ use janus2d_core::softness::Softness;
 
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
+use crate::joint_rows::{self, Bounds, PointTerms, RowSolve, Terms, WarmSide};
 use crate::kind_rows::{KindRows, TreeRows};
-use crate::parts::{
-    AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, angular_correction_cap, load_pair,
-    store_pair,
-};
+use crate::parts::{AnglePart, PairMass, PointPart, angular_correction_cap};
 use crate::{JointError, check_motor_speed, check_spring};
 
 /// Everything needed to create a revolute joint.
@@ -360,98 +358,6 @@ impl RevoluteJoint {
         axial * self.base.inv_h
     }
 
-    /// The warm start's share on one of its bodies (`side_b`: body b, else
-    /// body a): the kept angle impulse, then the kept point impulse at the
-    /// body's current arm. The arithmetic of [`Constraint::warm_start`] on
-    /// that body (which applies both shares), so a body that takes the
-    /// shares of its joints in storage order ends exactly as after the
-    /// joints' warm starts in storage order. For a joint that is solved
-    /// this step (enabled and not resting, as the colours' lists hold).
-    #[inline(always)]
-    pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        let axial =
-            self.spring.impulse + self.motor.impulse + self.lower.impulse - self.upper.impulse;
-        self.point
-            .warm_start_side(st, &self.base.masses, axial, side_b);
-    }
-
-    /// One velocity iteration on the joint's two states as `pair` holds
-    /// them. A tree joint without angle rows has nothing to do here (its
-    /// point rows are the tree's).
-    #[inline(always)]
-    pub(crate) fn solve_pair<P: PairStates>(
-        &mut self,
-        ctx: &StepContext,
-        pair: &mut P,
-        use_bias: bool,
-    ) {
-        if self.base.resting || (self.base.in_tree && !self.has_angle_rows()) {
-            return;
-        }
-        let (mut sa, mut sb) = pair.load();
-        let m = &self.base.masses;
-        // The angle depends on the rotations only, which the rows below do
-        // not change: one atan2 for the spring and the limits.
-        let angle = if self.def.enable_spring || self.def.enable_limit {
-            self.current_angle(&sa, &sb)
-        } else {
-            0.0
-        };
-        if self.def.enable_spring && m.a.inv_inertia + m.b.inv_inertia > 0.0 {
-            self.spring.solve_soft(
-                &mut sa,
-                &mut sb,
-                m,
-                angle - self.def.target_angle,
-                self.spring_softness,
-                // A spring: its feedback is its force, not capped.
-                Real::INFINITY,
-            );
-        }
-        if self.def.enable_motor {
-            let max_impulse = ctx.h * self.def.max_motor_torque;
-            self.motor
-                .solve_motor(&mut sa, &mut sb, m, self.def.motor_speed, max_impulse);
-        }
-        if self.def.enable_limit {
-            let soft = ctx.joint_softness;
-            let max_bias = angular_correction_cap(ctx.joint_max_correction_speed);
-            self.lower.solve_limit(
-                &mut sa,
-                &mut sb,
-                m,
-                angle - self.def.lower_angle,
-                1.0,
-                soft,
-                ctx.inv_h,
-                use_bias,
-                max_bias,
-            );
-            self.upper.solve_limit(
-                &mut sa,
-                &mut sb,
-                m,
-                self.def.upper_angle - angle,
-                -1.0,
-                soft,
-                ctx.inv_h,
-                use_bias,
-                max_bias,
-            );
-        }
-        if !self.base.in_tree {
-            self.point.solve(
-                &mut sa,
-                &mut sb,
-                m,
-                self.point_softness,
-                ctx.joint_max_correction_speed,
-                use_bias,
-            );
-        }
-        pair.store(&sa, &sb);
-    }
-
     /// True when the spring, the motor or the limits are on: the joint has
     /// angle rows, which the Gauss–Seidel pass solves even in a tree.
     #[inline(always)]
@@ -486,13 +392,86 @@ impl KindRows for RevoluteJoint {
     fn carry_through_portal(&mut self, rotation: janus2d_core::math::Rot, scale: Real) {
         RevoluteJoint::carry_through_portal(self, rotation, scale);
     }
+    /// The kept impulses of the joint's rows, one body's share: the angle
+    /// rows' sum, then the point at the body's current arm.
     #[inline(always)]
-    fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        RevoluteJoint::warm_start_side(self, st, side_b);
+    fn warm_rows(&self, w: &mut WarmSide<'_>) {
+        w.angle(self.spring.impulse + self.motor.impulse + self.lower.impulse - self.upper.impulse);
+        w.point((self.point.frame_a, self.point.frame_b), self.point.impulse);
     }
+    /// The joint's rows in Box2D's order: spring, motor, limits, then the
+    /// point (unless the tree solves it).
     #[inline(always)]
-    fn solve_pair<P: PairStates>(&mut self, ctx: &StepContext, pair: &mut P, use_bias: bool) {
-        RevoluteJoint::solve_pair(self, ctx, pair, use_bias);
+    fn solve_rows(&mut self, ctx: &StepContext, use_bias: bool, s: &mut RowSolve) {
+        // The angle depends on the rotations only, which the rows do not
+        // change: one atan2 for the spring and the limits.
+        let angle = if self.def.enable_spring || self.def.enable_limit {
+            self.current_angle(&s.sa, &s.sb)
+        } else {
+            0.0
+        };
+        if self.def.enable_spring && s.m.a.inv_inertia + s.m.b.inv_inertia > 0.0 {
+            // A spring: its feedback is its force, not capped.
+            let t = Terms::soft(
+                self.spring_softness,
+                angle - self.def.target_angle,
+                Real::INFINITY,
+            );
+            s.angle(
+                1.0,
+                self.spring.mass,
+                t,
+                Bounds::Free,
+                &mut self.spring.impulse,
+            );
+        }
+        if self.def.enable_motor {
+            let t = Terms::motor(self.def.motor_speed);
+            let bounds = Bounds::symmetric(ctx.h * self.def.max_motor_torque);
+            s.angle(1.0, self.motor.mass, t, bounds, &mut self.motor.impulse);
+        }
+        if self.def.enable_limit {
+            let soft = ctx.joint_softness;
+            let max_bias = angular_correction_cap(ctx.joint_max_correction_speed);
+            let lower = Terms::limit(
+                angle - self.def.lower_angle,
+                soft,
+                ctx.inv_h,
+                use_bias,
+                max_bias,
+            );
+            s.angle(
+                1.0,
+                self.lower.mass,
+                lower,
+                Bounds::ONE_SIDED,
+                &mut self.lower.impulse,
+            );
+            let upper = Terms::limit(
+                self.def.upper_angle - angle,
+                soft,
+                ctx.inv_h,
+                use_bias,
+                max_bias,
+            );
+            s.angle(
+                -1.0,
+                self.upper.mass,
+                upper,
+                Bounds::ONE_SIDED,
+                &mut self.upper.impulse,
+            );
+        }
+        if !self.base.in_tree {
+            let (r_a, r_b, c) = self.point.arms(&s.sa, &s.sb);
+            let t = PointTerms::equality(
+                self.point_softness,
+                c,
+                ctx.joint_max_correction_speed,
+                use_bias,
+            );
+            s.point(r_a, r_b, t, Real::INFINITY, &mut self.point.impulse);
+        }
     }
     #[inline(always)]
     fn tree_rows(&self) -> Option<TreeRows<'_>> {
@@ -564,22 +543,11 @@ impl Constraint for RevoluteJoint {
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        if self.base.resting {
-            return;
-        }
-        let (a, b) = (self.base.state_a, self.base.state_b);
-        let (mut sa, mut sb) = load_pair(states, a, b);
-        let m = &self.base.masses;
-        let axial =
-            self.spring.impulse + self.motor.impulse + self.lower.impulse - self.upper.impulse;
-        AnglePart::apply(&mut sa, &mut sb, m, axial);
-        self.point.warm_start(&mut sa, &mut sb, m);
-        store_pair(states, a, b, &sa, &sb);
+        joint_rows::warm_start_states(self, states);
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        let mut pair = PairOf::new(states, self.base.state_a, self.base.state_b, BOTH);
-        self.solve_pair(ctx, &mut pair, use_bias);
+        joint_rows::solve_states(self, ctx, states, use_bias);
     }
 
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {

@@ -42,11 +42,9 @@ use janus2d_core::softness::Softness;
 
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef};
+use crate::joint_rows::{self, Bounds, PointTerms, RowSolve, Terms, WarmSide};
 use crate::kind_rows::{KindRows, TreeAngle, TreeRows};
-use crate::parts::{
-    AnglePart, BOTH, PairMass, PairOf, PairStates, PointPart, angular_correction_cap, load_pair,
-    store_pair,
-};
+use crate::parts::{AnglePart, PairMass, PointPart, angular_correction_cap};
 use crate::{JointError, check_spring};
 
 /// Everything needed to create a weld joint.
@@ -303,67 +301,6 @@ impl WeldJoint {
         self.angle.impulse * self.base.inv_h
     }
 
-    /// The warm start's share on one of its bodies (`side_b`: body b, else
-    /// body a): the kept angle impulse, then the kept point impulse at the
-    /// body's current arm (the arithmetic of [`Constraint::warm_start`] on
-    /// that body).
-    #[inline(always)]
-    pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        self.point
-            .warm_start_side(st, &self.base.masses, self.angle.impulse, side_b);
-    }
-
-    /// One velocity iteration on the joint's two states: the angle row,
-    /// then the point rows. A tree joint has nothing to do here (all its
-    /// rows are the tree's).
-    #[inline(always)]
-    pub(crate) fn solve_pair<P: PairStates>(
-        &mut self,
-        ctx: &StepContext,
-        pair: &mut P,
-        use_bias: bool,
-    ) {
-        if self.base.resting || self.base.in_tree {
-            return;
-        }
-        let (mut sa, mut sb) = pair.load();
-        let m = &self.base.masses;
-        let angular_spring = self.def.angular_hertz > 0.0;
-        if m.a.inv_inertia + m.b.inv_inertia > 0.0 {
-            let c = self.current_angle(&sa, &sb);
-            // A spring acts in the relax pass too; a rigid row relaxes
-            // without position feedback, and its feedback speed is capped
-            // (a spring's is its force).
-            let softness = if use_bias || angular_spring {
-                self.angular_softness
-            } else {
-                Softness::RIGID
-            };
-            let max_bias = if angular_spring {
-                Real::INFINITY
-            } else {
-                angular_correction_cap(ctx.joint_max_correction_speed)
-            };
-            self.angle
-                .solve_soft(&mut sa, &mut sb, m, c, softness, max_bias);
-        }
-        if self.def.linear_hertz > 0.0 {
-            // A spring: always on, its bias not capped.
-            self.point
-                .solve(&mut sa, &mut sb, m, self.linear_softness, Real::MAX, true);
-        } else {
-            self.point.solve(
-                &mut sa,
-                &mut sb,
-                m,
-                self.linear_softness,
-                ctx.joint_max_correction_speed,
-                use_bias,
-            );
-        }
-        pair.store(&sa, &sb);
-    }
-
     /// `C_θ` from the states' rotation deltas.
     fn current_angle(&self, sa: &BodyState, sb: &BodyState) -> Real {
         janus2d_core::math::wrap_angle(self.delta_angle + sa.dq.relative_angle(sb.dq))
@@ -389,13 +326,55 @@ impl KindRows for WeldJoint {
     fn carry_through_portal(&mut self, rotation: janus2d_core::math::Rot, scale: Real) {
         WeldJoint::carry_through_portal(self, rotation, scale);
     }
+    /// The kept impulses, one body's share: the angle row's, then the
+    /// point's at the body's current arm.
     #[inline(always)]
-    fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        WeldJoint::warm_start_side(self, st, side_b);
+    fn warm_rows(&self, w: &mut WarmSide<'_>) {
+        w.angle(self.angle.impulse);
+        w.point((self.point.frame_a, self.point.frame_b), self.point.impulse);
     }
+    /// The angle row, then the point rows (a tree joint's rows are all
+    /// the tree's: it has none here).
     #[inline(always)]
-    fn solve_pair<P: PairStates>(&mut self, ctx: &StepContext, pair: &mut P, use_bias: bool) {
-        WeldJoint::solve_pair(self, ctx, pair, use_bias);
+    fn solve_rows(&mut self, ctx: &StepContext, use_bias: bool, s: &mut RowSolve) {
+        let angular_spring = self.def.angular_hertz > 0.0;
+        if s.m.a.inv_inertia + s.m.b.inv_inertia > 0.0 {
+            let c = self.current_angle(&s.sa, &s.sb);
+            // A spring acts in the relax pass too; a rigid row relaxes
+            // without position feedback, and its feedback speed is capped
+            // (a spring's is its force).
+            let softness = if use_bias || angular_spring {
+                self.angular_softness
+            } else {
+                Softness::RIGID
+            };
+            let max_bias = if angular_spring {
+                Real::INFINITY
+            } else {
+                angular_correction_cap(ctx.joint_max_correction_speed)
+            };
+            let t = Terms::soft(softness, c, max_bias);
+            s.angle(
+                1.0,
+                self.angle.mass,
+                t,
+                Bounds::Free,
+                &mut self.angle.impulse,
+            );
+        }
+        let (r_a, r_b, c) = self.point.arms(&s.sa, &s.sb);
+        let t = if self.def.linear_hertz > 0.0 {
+            // A spring: always on, its bias not capped.
+            PointTerms::equality(self.linear_softness, c, Real::MAX, true)
+        } else {
+            PointTerms::equality(
+                self.linear_softness,
+                c,
+                ctx.joint_max_correction_speed,
+                use_bias,
+            )
+        };
+        s.point(r_a, r_b, t, Real::INFINITY, &mut self.point.impulse);
     }
     #[inline(always)]
     fn tree_rows(&self) -> Option<TreeRows<'_>> {
@@ -444,20 +423,11 @@ impl Constraint for WeldJoint {
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        if self.base.resting {
-            return;
-        }
-        let (a, b) = (self.base.state_a, self.base.state_b);
-        let (mut sa, mut sb) = load_pair(states, a, b);
-        let m = &self.base.masses;
-        AnglePart::apply(&mut sa, &mut sb, m, self.angle.impulse);
-        self.point.warm_start(&mut sa, &mut sb, m);
-        store_pair(states, a, b, &sa, &sb);
+        joint_rows::warm_start_states(self, states);
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        let mut pair = PairOf::new(states, self.base.state_a, self.base.state_b, BOTH);
-        self.solve_pair(ctx, &mut pair, use_bias);
+        joint_rows::solve_states(self, ctx, states, use_bias);
     }
 
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {

@@ -37,13 +37,10 @@ use janus2d_core::softness::Softness;
 
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, JointFrame, KindDef, LimitsMut, MotorMut, SpringMut};
+use crate::joint_rows::{self, Bounds, RowSolve, Terms, WarmSide};
 use crate::kind_rows::{GeneralRows, KindRows, TreeRows};
-use crate::parts::{
-    AnglePart, AxisPart, AxisRow, BOTH, PairOf, PairStates, load_pair, soft_impulse, store_pair,
-};
-use crate::prismatic::{
-    SlideFrame, apply_angle_side, check_translation, rigid_terms, row_speed, slide_rows_at,
-};
+use crate::parts::{AnglePart, AxisPart, AxisRow};
+use crate::prismatic::{SlideFrame, check_translation, row_speed, slide_rows_at};
 use crate::{JointError, check_motor_speed, check_spring};
 
 /// Box2D's default suspension stiffness, Hz.
@@ -400,105 +397,6 @@ impl WheelJoint {
     pub fn constraint_torque(&self) -> Real {
         self.motor_torque()
     }
-
-    /// The warm start's share on one of its bodies (`side_b`: body b, else
-    /// body a): the axial impulse along the kept axial row, the
-    /// perpendicular impulse along the kept perpendicular row, then the
-    /// motor's angular impulse.
-    #[inline(always)]
-    pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        let m = &self.base.masses;
-        self.axial_row
-            .apply_side(st, m, self.axial_impulse(), side_b);
-        self.perp_row.apply_side(st, m, self.perp_impulse, side_b);
-        apply_angle_side(st, m, self.motor.impulse, side_b);
-    }
-
-    /// One velocity iteration on the joint's two states: spring, motor,
-    /// limits, then the perpendicular row.
-    #[inline(always)]
-    pub(crate) fn solve_pair<P: PairStates>(
-        &mut self,
-        ctx: &StepContext,
-        pair: &mut P,
-        use_bias: bool,
-    ) {
-        if self.base.resting {
-            return;
-        }
-        let (mut sa, mut sb) = pair.load();
-        let m = self.base.masses;
-        let rows = self.frame.rows(&sa, &sb, &m);
-        let axial = rows.axial;
-        let t = rows.translation;
-        if self.def.enable_spring && self.def.hertz > 0.0 {
-            self.spring.solve_soft(
-                &mut sa,
-                &mut sb,
-                &m,
-                &axial,
-                t,
-                self.spring_softness,
-                (Real::NEG_INFINITY, Real::INFINITY),
-            );
-        }
-        if self.def.enable_motor {
-            let max_impulse = ctx.h * self.def.max_motor_torque;
-            self.motor
-                .solve_motor(&mut sa, &mut sb, &m, self.def.motor_speed, max_impulse);
-        }
-        if self.def.enable_limit {
-            let soft = self.linear_softness;
-            self.lower.solve_limit(
-                &mut sa,
-                &mut sb,
-                &m,
-                &axial,
-                t - self.def.lower_translation,
-                soft,
-                ctx.inv_h,
-                use_bias,
-                ctx.joint_max_correction_speed,
-            );
-            let down = AxisRow {
-                n: -axial.n,
-                s_a: -axial.s_a,
-                s_b: -axial.s_b,
-                mass: axial.mass,
-            };
-            self.upper.solve_limit(
-                &mut sa,
-                &mut sb,
-                &m,
-                &down,
-                self.def.upper_translation - t,
-                soft,
-                ctx.inv_h,
-                use_bias,
-                ctx.joint_max_correction_speed,
-            );
-        }
-        let perp = rows.perp;
-        if !self.base.in_tree {
-            let (bias, mass_scale, impulse_scale) = rigid_terms(
-                self.linear_softness,
-                rows.c_perp,
-                ctx.joint_max_correction_speed,
-                use_bias,
-            );
-            let lambda = soft_impulse(
-                mass_scale * perp.mass,
-                perp.c_dot(&sa, &sb) + bias,
-                impulse_scale,
-                self.perp_impulse,
-            );
-            self.perp_impulse += lambda;
-            perp.apply(&mut sa, &mut sb, &m, lambda);
-        }
-        self.perp_row = perp;
-        self.axial_row = axial;
-        pair.store(&sa, &sb);
-    }
 }
 
 impl KindRows for WheelJoint {
@@ -523,13 +421,65 @@ impl KindRows for WheelJoint {
     fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
         WheelJoint::carry_through_portal(self, rotation, scale);
     }
+    /// The kept impulses along the rows of the last iteration: the axial
+    /// rows' sum, the perpendicular row's, then the motor's angular one.
     #[inline(always)]
-    fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        WheelJoint::warm_start_side(self, st, side_b);
+    fn warm_rows(&self, w: &mut WarmSide<'_>) {
+        w.linear(&self.axial_row, self.axial_impulse());
+        w.linear(&self.perp_row, self.perp_impulse);
+        w.angle(self.motor.impulse);
     }
+    /// Spring, motor, limits, then the perpendicular row (unless the tree
+    /// solves it).
     #[inline(always)]
-    fn solve_pair<P: PairStates>(&mut self, ctx: &StepContext, pair: &mut P, use_bias: bool) {
-        WheelJoint::solve_pair(self, ctx, pair, use_bias);
+    fn solve_rows(&mut self, ctx: &StepContext, use_bias: bool, s: &mut RowSolve) {
+        let rows = self.frame.rows(&s.sa, &s.sb, &s.m);
+        let axial = rows.axial;
+        let t = rows.translation;
+        let cap = ctx.joint_max_correction_speed;
+        if self.def.enable_spring && self.def.hertz > 0.0 {
+            // The spring's impulse is clamped (not summed) though free.
+            let free = Bounds::Clamp(Real::NEG_INFINITY, Real::INFINITY);
+            let terms = Terms::soft(self.spring_softness, t, Real::INFINITY);
+            s.linear(&axial, terms, free, &mut self.spring.impulse);
+        }
+        if self.def.enable_motor {
+            let bounds = Bounds::symmetric(ctx.h * self.def.max_motor_torque);
+            let terms = Terms::motor(self.def.motor_speed);
+            s.angle(1.0, self.motor.mass, terms, bounds, &mut self.motor.impulse);
+        }
+        if self.def.enable_limit {
+            let soft = self.linear_softness;
+            let lower = Terms::limit(
+                t - self.def.lower_translation,
+                soft,
+                ctx.inv_h,
+                use_bias,
+                cap,
+            );
+            s.linear(&axial, lower, Bounds::ONE_SIDED, &mut self.lower.impulse);
+            let down = AxisRow {
+                n: -axial.n,
+                s_a: -axial.s_a,
+                s_b: -axial.s_b,
+                mass: axial.mass,
+            };
+            let upper = Terms::limit(
+                self.def.upper_translation - t,
+                soft,
+                ctx.inv_h,
+                use_bias,
+                cap,
+            );
+            s.linear(&down, upper, Bounds::ONE_SIDED, &mut self.upper.impulse);
+        }
+        let perp = rows.perp;
+        if !self.base.in_tree {
+            let terms = Terms::equality(self.linear_softness, rows.c_perp, cap, use_bias);
+            s.linear(&perp, terms, Bounds::Free, &mut self.perp_impulse);
+        }
+        self.perp_row = perp;
+        self.axial_row = axial;
     }
     /// The perpendicular row joins the exact tree solve (rigid unless the
     /// joint has its own constraint softness); the suspension, limits and
@@ -603,23 +553,13 @@ impl Constraint for WheelJoint {
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        if self.base.resting {
-            return;
-        }
-        let (a, b) = (self.base.state_a, self.base.state_b);
-        let (mut sa, mut sb) = load_pair(states, a, b);
-        self.warm_start_side(&mut sa, false);
-        self.warm_start_side(&mut sb, true);
-        store_pair(states, a, b, &sa, &sb);
+        joint_rows::warm_start_states(self, states);
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        let mut pair = PairOf::new(states, self.base.state_a, self.base.state_b, BOTH);
-        self.solve_pair(ctx, &mut pair, use_bias);
+        joint_rows::solve_states(self, ctx, states, use_bias);
     }
 
-    /// Rows in order: perpendicular, then spring, motor, lower, upper as
-    /// enabled (one row each, one block each).
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
         let (at, rows): (RowsAt, _) = slide_rows_at(bodies, &self.def.base);
         let m = at.m;
@@ -767,8 +707,8 @@ mod tests {
         joint.warm_start(&ctx, &mut whole);
         let (sa, sb) = (joint.base.state_a as usize, joint.base.state_b as usize);
         let mut by_body = set.states.clone();
-        joint.warm_start_side(&mut by_body[sa], false);
-        joint.warm_start_side(&mut by_body[sb], true);
+        crate::joint_rows::warm_start_side(&joint, &mut by_body[sa], false);
+        crate::joint_rows::warm_start_side(&joint, &mut by_body[sb], true);
         assert_eq!(whole, by_body);
     }
 }
