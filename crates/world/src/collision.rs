@@ -58,7 +58,122 @@ pub(crate) struct Collision {
     candidates: Vec<(u32, u32)>,
 }
 
+/// What the collision stage hands to contact building after the
+/// narrowphase: the staged manifolds, with the contact set and the
+/// counters that building writes (the one plain hand-off between the
+/// collision side and the solver side).
+pub(crate) struct ContactHandoff<'a> {
+    /// The narrowphase's staged manifolds and touching list.
+    pub(crate) staged: crate::narrowphase::Handoff<'a>,
+    /// The persistent contacts.
+    pub(crate) contacts: &'a mut ContactSet,
+    /// The step's counters (building adds its rows).
+    pub(crate) counters: &'a mut CollisionCounters,
+}
+
 impl Collision {
+    /// Whether the world has any shape (else the stage does nothing).
+    #[inline]
+    pub(crate) fn has_shapes(&self) -> bool {
+        !self.shapes.is_empty()
+    }
+
+    /// The shapes (read by the portal stage's aperture clipping).
+    #[inline]
+    pub(crate) fn shape_store(&self) -> &ShapeStore {
+        &self.shapes
+    }
+
+    /// The narrowphase over the pairs the broadphase holds: manifolds,
+    /// impulses carried by feature, begin/end events, and in `wake` the
+    /// sleeping bodies a new touch wakes.
+    pub(crate) fn collide(
+        &mut self,
+        bodies: &BodySet,
+        dt: Real,
+        clipping: &crate::aperture::ContactClipping,
+        wake: &mut Vec<BodyHandle>,
+        team: &Team,
+    ) {
+        let input = crate::narrowphase::NarrowphaseInput {
+            shapes: &self.shapes,
+            broadphase: &self.broadphase,
+            bodies,
+            dt,
+            clipping,
+            unclipped: clipping.is_empty(),
+        };
+        self.narrowphase.run(
+            &input,
+            &mut self.contacts,
+            &mut self.events,
+            &mut self.counters,
+            wake,
+            team,
+        );
+    }
+
+    /// The contacts that began or stopped touching since the last call
+    /// (for the islands).
+    #[inline]
+    pub(crate) fn take_touch_changes(&mut self) -> crate::contacts::TouchChanges {
+        self.contacts.take_touch_changes()
+    }
+
+    /// Whether any contact is awake (the contact graph has work).
+    #[inline]
+    pub(crate) fn has_awake_contacts(&self) -> bool {
+        !self.contacts.awake().is_empty()
+    }
+
+    /// The hand-off to contact building (after [`Collision::collide`]).
+    #[inline]
+    pub(crate) fn contact_handoff(&mut self) -> ContactHandoff<'_> {
+        ContactHandoff {
+            staged: self.narrowphase.handoff(),
+            contacts: &mut self.contacts,
+            counters: &mut self.counters,
+        }
+    }
+
+    /// Whether a solved contact has restitution this step.
+    #[inline]
+    pub(crate) fn has_restitution(&self) -> bool {
+        self.counters.restitution_contacts > 0
+    }
+
+    /// Whether some shape asks for hit events.
+    #[inline]
+    pub(crate) fn has_hit_events(&self) -> bool {
+        self.shapes.hit_event_shapes() > 0
+    }
+
+    /// Forgets the kept impulses of a body's contacts (a body reset for a
+    /// non-finite state).
+    #[inline]
+    pub(crate) fn forget_impulses(&mut self, body: BodyHandle) {
+        self.contacts.forget_impulses(body);
+    }
+
+    /// The step's counters.
+    #[inline]
+    pub(crate) fn counters(&self) -> CollisionCounters {
+        self.counters
+    }
+
+    /// The events of the step, taken (the next step starts empty).
+    #[inline]
+    pub(crate) fn take_events(&mut self) -> CollisionEvents {
+        std::mem::take(&mut self.events)
+    }
+
+    /// The shapes and the contacts, for the sleep stage (islands read the
+    /// shapes' sensors and move contacts between awake and asleep).
+    #[inline]
+    pub(crate) fn sleep_parts(&mut self) -> (&ShapeStore, &mut ContactSet) {
+        (&self.shapes, &mut self.contacts)
+    }
+
     /// Empty pipeline for a world with owner id `owner`.
     pub(crate) fn new(owner: u32) -> Self {
         Collision {

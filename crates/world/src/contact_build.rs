@@ -25,9 +25,9 @@ use janus2d_core::graph::{ConstraintGraph, NO_BODY};
 use janus2d_core::math::{Real, Vec2};
 use janus2d_core::parallel::Team;
 
+use crate::collision::ContactHandoff;
 use crate::contacts::ContactSet;
-use crate::narrowphase::{Handoff, PreSolve, PreSolveFn, StagedContact, solve_body, stage};
-use crate::profile::CollisionCounters;
+use crate::narrowphase::{PreSolve, PreSolveFn, StagedContact, solve_body, stage};
 
 /// Touching contacts from which constraint building's first pass runs on
 /// threads (below, the tasks cost more than the pass).
@@ -135,8 +135,7 @@ impl ContactBuilder {
     /// read still are checked again.
     pub(crate) fn build(
         &mut self,
-        handoff: Handoff<'_>,
-        contacts: &mut ContactSet,
+        from: ContactHandoff<'_>,
         bodies: &BodySet,
         woke: bool,
         objects: &[ObjectMass],
@@ -144,9 +143,13 @@ impl ContactBuilder {
         mut pre_solve: Option<&mut PreSolveFn>,
         reserved: &[u32],
         solver: &mut ContactSolver,
-        counters: &mut CollisionCounters,
         team: &Team,
     ) {
+        let ContactHandoff {
+            staged: handoff,
+            contacts,
+            counters,
+        } = from;
         let solved = &mut self.solved;
         let staged = handoff.staged;
         // The contacts to look at: those the narrowphase found touching, then

@@ -164,6 +164,20 @@ pub struct JointSet {
 }
 
 impl JointSet {
+    /// The body pairs the joints keep from colliding (`collide_connected =
+    /// false`), for the pair filter.
+    #[inline]
+    pub(crate) fn no_collide(&self) -> &NoCollide {
+        &self.no_collide
+    }
+
+    /// Clones answer for their originals in the no-collide pairs (set every
+    /// step: crossings come and go).
+    #[inline]
+    pub(crate) fn set_clone_aliases(&mut self, aliases: impl Iterator<Item = (u32, u32)>) {
+        self.no_collide.set_aliases(aliases);
+    }
+
     /// An empty set for world `owner`.
     #[must_use]
     pub fn new(owner: u32) -> Self {

@@ -109,57 +109,39 @@ impl World {
         let mut sp = crate::profile::StepProfile::default();
         self.islands
             .apply_pending(self.sleep_settings.enabled, &mut self.bodies);
-        let has_shapes = !self.collision.shapes.is_empty();
+        let has_shapes = self.collision.has_shapes();
         let has_portals = self.portals.is_active();
         if has_portals {
             self.portals
-                .build_clipping(&self.bodies, &self.collision.shapes);
+                .build_clipping(&self.bodies, self.collision.shape_store());
             sp.portals += lap();
         }
         if has_shapes {
             // Clones answer for their originals in the joints' no-collide
             // pairs (set every step: crossings come and go).
-            self.joints
-                .no_collide
-                .set_aliases(self.portals.clone_aliases());
+            self.joints.set_clone_aliases(self.portals.clone_aliases());
             self.collision
-                .update_pairs(&self.bodies, &self.joints.no_collide, team);
+                .update_pairs(&self.bodies, self.joints.no_collide(), team);
             sp.broadphase += lap();
             let mut wake = std::mem::take(&mut self.wake_list);
             wake.clear();
-            let c = &mut self.collision;
-            let input = crate::narrowphase::NarrowphaseInput {
-                shapes: &c.shapes,
-                broadphase: &c.broadphase,
-                bodies: &self.bodies,
-                dt,
-                clipping: self.portals.clipping(),
-                unclipped: self.portals.clipping().is_empty(),
-            };
-            c.narrowphase.run(
-                &input,
-                &mut c.contacts,
-                &mut c.events,
-                &mut c.counters,
-                &mut wake,
-                team,
-            );
+            self.collision
+                .collide(&self.bodies, dt, self.portals.clipping(), &mut wake, team);
             self.wake_all(&wake);
             let woke = !wake.is_empty();
             self.wake_list = wake;
-            let touches = self.collision.contacts.take_touch_changes();
+            let touches = self.collision.take_touch_changes();
             self.islands.apply_touch_changes(touches, &self.bodies);
             self.portals
                 .object_masses(&self.bodies, &mut self.object_masses);
             // The joints' colours for the contacts' graph to leave free;
             // a step with no awake contact colours none (joint-only
             // scenes pay nothing here).
-            if !self.collision.contacts.awake().is_empty() {
+            if self.collision.has_awake_contacts() {
                 self.joints.refresh_reserved(&self.bodies);
             }
             self.contact_builder.build(
-                self.collision.narrowphase.handoff(),
-                &mut self.collision.contacts,
+                self.collision.contact_handoff(),
                 &self.bodies,
                 woke,
                 &self.object_masses,
@@ -167,7 +149,6 @@ impl World {
                 self.pre_solve.as_mut(),
                 self.joints.reserved(),
                 &mut self.contact_solver,
-                &mut self.collision.counters,
                 team,
             );
             sp.narrowphase += lap();
@@ -175,7 +156,7 @@ impl World {
             self.contact_solver.begin();
         }
         // No restitution anywhere: no restitution pass.
-        ctx.restitution = has_shapes && self.collision.counters.restitution_contacts > 0;
+        ctx.restitution = has_shapes && self.collision.has_restitution();
         let couple = has_portals && self.portals.copies_carry_joints(&self.joints);
         let mut graph = janus2d_constraints::GraphBatch {
             joints: self.joints.batch(),
@@ -216,7 +197,7 @@ impl World {
             // The impulses go back into the contacts beside continuous
             // collision and the proxy update (`Collision::end_step`).
             let continuous = &mut self.continuous;
-            let (no_collide, clipping) = (&self.joints.no_collide, self.portals.clipping());
+            let (no_collide, clipping) = (self.joints.no_collide(), self.portals.clipping());
             let joints = &self.joints;
             let (builder, solver) = (&self.contact_builder, &self.contact_solver);
             let continuous_time = self.collision.end_step(
@@ -237,7 +218,7 @@ impl World {
                 },
                 team,
             );
-            if self.collision.shapes.hit_event_shapes() > 0 {
+            if self.collision.has_hit_events() {
                 let (solver, threshold) = (&self.contact_solver, self.hit_event_threshold);
                 self.collision
                     .collect_hits(|hit| solver.for_each_approach(threshold, hit));
@@ -251,7 +232,7 @@ impl World {
         // carry it off again at the next step.
         for &b in &report.non_finite {
             self.joints.forget_impulses(b);
-            self.collision.contacts.forget_impulses(b);
+            self.collision.forget_impulses(b);
         }
         self.joints.forget_non_finite();
         if has_portals {
@@ -261,25 +242,22 @@ impl World {
         }
         if self.sleep_settings.enabled {
             let keep_awake = self.portals.keep_awake();
+            let (shapes, contacts) = self.collision.sleep_parts();
             let input = SleepInput {
                 dt,
                 settings: self.sleep_settings,
-                shapes: &self.collision.shapes,
+                shapes,
                 keep_awake: &keep_awake,
             };
-            self.islands.update(
-                &input,
-                &mut self.bodies,
-                &mut self.collision.contacts,
-                &self.joints,
-            );
+            self.islands
+                .update(&input, &mut self.bodies, contacts, &self.joints);
             sp.sleep += lap();
         }
         sp.solver = report.profile;
         sp.total = start.elapsed().as_secs_f64();
         self.counters = crate::profile::StepCounters::gather(&crate::profile::CounterSources {
             collision_ran: has_shapes,
-            collision: self.collision.counters,
+            collision: self.collision.counters(),
             contacts: self.contact_solver.len(),
             joint_rows: self.joints.row_count(),
             direct_joint_rows: self.joints.direct_row_count(),
@@ -293,7 +271,7 @@ impl World {
         self.portals.publish_events();
         self.events = StepEvents {
             non_finite_bodies: report.non_finite,
-            collision: std::mem::take(&mut self.collision.events),
+            collision: self.collision.take_events(),
             joints: self.joints.threshold_events(),
         };
         self.step_count += 1;
