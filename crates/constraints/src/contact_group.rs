@@ -108,6 +108,7 @@ use janus2d_core::union_find::{find, union};
 
 use crate::contact::ContactConstraint;
 use crate::contact_row::Delta;
+pub use janus2d_core::contact_input::NO_CLUSTER;
 
 /// How much heavier a moving neighbour makes a body light (dimensionless):
 /// its contacts are solved as one coupled group.
@@ -132,9 +133,6 @@ const MURTY_ROUNDS: usize = 64;
 pub fn is_light(inv_mass: Real, neighbour_inv_mass: Real) -> bool {
     neighbour_inv_mass > 0.0 && inv_mass > LIGHT_RATIO * neighbour_inv_mass
 }
-
-/// No cluster (a side that is static, or not in a light cluster).
-pub const NO_CLUSTER: u32 = u32::MAX;
 
 /// What [`Clusters::assign`] reads of one contact.
 #[derive(Clone, Copy, Debug)]

@@ -111,24 +111,7 @@ use janus2d_core::softness::Softness;
 
 use crate::lane::Lane;
 use crate::parts::soft_impulse;
-
-/// Maximum points per manifold.
-pub const MAX_MANIFOLD_POINTS: usize = 2;
-
-/// One point of a contact, as the collision pipeline hands it over.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct ContactPointInput {
-    /// Anchor on a relative to a's centre of mass (world frame), m.
-    pub anchor_a: Vec2,
-    /// Anchor on b relative to b's centre of mass (world frame), m.
-    pub anchor_b: Vec2,
-    /// Separation along the normal when the manifold was computed, m.
-    pub separation: Real,
-    /// Normal impulse kept from the last step (warm start), N·s.
-    pub normal_impulse: Real,
-    /// Tangent impulse kept from the last step (warm start), N·s.
-    pub tangent_impulse: Real,
-}
+pub use janus2d_core::contact_input::{ContactPointInput, MAX_MANIFOLD_POINTS};
 
 /// The impulses of one manifold point after a step, N·s.
 ///

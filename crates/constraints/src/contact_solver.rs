@@ -48,7 +48,7 @@ use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
 use janus2d_core::math::{Real, Vec2};
 use janus2d_core::parallel::{PlannedStates, StatePlan, Team};
 
-use crate::contact::{ContactConstraint, ContactPointInput, MAX_MANIFOLD_POINTS};
+use crate::contact::{ContactConstraint, MAX_MANIFOLD_POINTS};
 use crate::contact_group::{Groups, solve_group};
 use crate::contact_row::{ContactRows, Delta, Velocity};
 use crate::lane::{Lane, Wide as W};
@@ -110,6 +110,7 @@ pub(crate) struct WideContact {
 }
 
 pub use crate::contact_row::PointImpulse;
+pub use janus2d_core::contact_input::ContactLane;
 
 /// Where a pushed contact lives in the solver: a lane of a colour's chunk,
 /// or a place in the overflow. [`ContactSolver::push_all`] reports one per
@@ -123,40 +124,6 @@ pub struct LanePlace {
     pub lane: u8,
     /// The chunk within its colour, or the index in the overflow.
     pub chunk: u32,
-}
-
-/// What the collision pipeline hands over for one contact: everything a
-/// lane (or an overflow constraint) is built from.
-#[derive(Clone, Copy, Debug)]
-pub struct ContactLane {
-    /// Body a.
-    pub body_a: BodyHandle,
-    /// Body b.
-    pub body_b: BodyHandle,
-    /// State index of body a (0: static or asleep).
-    pub state_a: u32,
-    /// State index of body b.
-    pub state_b: u32,
-    /// Inverse masses and inertias `[m_a⁻¹, i_a⁻¹, m_b⁻¹, i_b⁻¹]` the
-    /// impulses act with (0 for a static, kinematic or sleeping body).
-    pub inv_masses: [Real; 4],
-    /// Unit normal from a to b.
-    pub normal: Vec2,
-    /// The manifold's points (the first `point_count`).
-    pub points: [ContactPointInput; MAX_MANIFOLD_POINTS],
-    /// Number of points (1 or 2).
-    pub point_count: usize,
-    /// Mixed friction.
-    pub friction: Real,
-    /// Mixed restitution.
-    pub restitution: Real,
-    /// The pipeline's index of the contact (impulses are stored back by it).
-    pub contact_index: u32,
-    /// The light cluster of each side ([`crate::contact_group::Clusters`],
-    /// [`NO_CLUSTER`](crate::contact_group::NO_CLUSTER) for none): a
-    /// contact with a side in a cluster goes to the overflow and is solved
-    /// with the cluster's other contacts as one block.
-    pub cluster: [u32; 2],
 }
 
 /// A step's contact constraints in their colours and lanes: the contact

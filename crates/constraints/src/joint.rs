@@ -53,7 +53,7 @@ use crate::distance::{DistanceJoint, DistanceJointDef};
 use crate::filter::{FilterJoint, FilterJointDef};
 use crate::joint_base::JointBase;
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
-use crate::joint_rows;
+
 use crate::kind_rows::{GeneralRows, KindRows, TreeRows};
 use crate::motor::{MotorJoint, MotorJointDef};
 use crate::mouse::{MouseJoint, MouseJointDef};
@@ -313,7 +313,7 @@ macro_rules! joint_kinds {
 
             #[inline(always)]
             pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-                match self { $( Joint::$kind(j) => joint_rows::warm_start_side(j, st, side_b), )* }
+                match self { $( Joint::$kind(j) => crate::kind_rows::warm_start_side(j, st, side_b), )* }
             }
 
             #[inline(always)]
@@ -323,7 +323,7 @@ macro_rules! joint_kinds {
                 pair: &mut P,
                 use_bias: bool,
             ) {
-                match self { $( Joint::$kind(j) => joint_rows::solve_pair(j, ctx, pair, use_bias), )* }
+                match self { $( Joint::$kind(j) => crate::kind_rows::solve_pair(j, ctx, pair, use_bias), )* }
             }
         }
 
@@ -333,7 +333,7 @@ macro_rules! joint_kinds {
             }
 
             fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-                match self { $( Joint::$kind(j) => joint_rows::warm_start_states(j, states), )* }
+                match self { $( Joint::$kind(j) => crate::kind_rows::warm_start_states(j, states), )* }
             }
 
             fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {

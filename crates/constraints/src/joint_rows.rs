@@ -31,16 +31,11 @@
 //! of rows is the kind's, the arithmetic of each is here.
 
 use janus2d_core::body::{BodyState, InvMass};
-use janus2d_core::constraint::StepContext;
 use janus2d_core::math::{Real, Vec2, cross, cross_sv, solve22};
 use janus2d_core::softness::Softness;
 
-use crate::kind_rows::KindRows;
 use crate::lane::Lane;
-use crate::parts::{
-    AxisRow, BOTH, PairMass, PairOf, PairStates, PointPart, apply_pair, cap, clamp_length,
-    load_pair, soft_impulse, store_pair,
-};
+use crate::parts::{AxisRow, PairMass, PointPart, apply_pair, cap, clamp_length, soft_impulse};
 
 /// A row's soft terms: the velocity bias `b` (m/s or rad/s), the mass
 /// scale `s_m` and the impulse scale `s_i` of [`Softness`].
@@ -381,7 +376,14 @@ pub(crate) struct WarmSide<'s> {
     side_b: bool,
 }
 
-impl WarmSide<'_> {
+impl<'s> WarmSide<'s> {
+    /// Body `st`'s share (`side_b`: body b, else body a) of a joint on
+    /// bodies of inverse masses `m`.
+    #[inline(always)]
+    pub(crate) fn new(st: &'s mut BodyState, m: PairMass, side_b: bool) -> Self {
+        WarmSide { st, m, side_b }
+    }
+
     /// A kept angle impulse `λ` (N·m·s, positive on b).
     #[inline(always)]
     pub(crate) fn angle(&mut self, lambda: Real) {
@@ -449,71 +451,6 @@ impl WarmSide<'_> {
             self.st.w += self.m.b.inv_inertia * lambda;
         }
     }
-}
-
-/// Whether the Gauss–Seidel pass has work on the joint this step.
-#[inline(always)]
-fn iterates<K: KindRows>(kind: &K) -> bool {
-    !kind.base().resting && kind.has_iterative_rows()
-}
-
-/// One velocity iteration of a joint's rows over a pair of states.
-#[inline(always)]
-pub(crate) fn solve_pair<K: KindRows, P: PairStates>(
-    kind: &mut K,
-    ctx: &StepContext,
-    pair: &mut P,
-    use_bias: bool,
-) {
-    if !iterates(kind) {
-        return;
-    }
-    let (sa, sb) = pair.load();
-    let mut s = RowSolve {
-        sa,
-        sb,
-        m: kind.base().masses,
-    };
-    kind.solve_rows(ctx, use_bias, &mut s);
-    pair.store(&s.sa, &s.sb);
-}
-
-/// One body's share of a joint's warm start: every kept impulse, the
-/// tree's too (the colour stage warm-starts every active joint body by
-/// body; the tree solve takes its rows' impulses from there).
-#[inline(always)]
-pub(crate) fn warm_start_side<K: KindRows>(kind: &K, st: &mut BodyState, side_b: bool) {
-    let mut w = WarmSide {
-        st,
-        m: kind.base().masses,
-        side_b,
-    };
-    kind.warm_rows(&mut w);
-}
-
-/// A joint's warm start on the whole state slice: body a's share, then
-/// body b's.
-pub(crate) fn warm_start_states<K: KindRows>(kind: &K, states: &mut [BodyState]) {
-    if kind.base().resting {
-        return;
-    }
-    let (a, b) = (kind.base().state_a, kind.base().state_b);
-    let (mut sa, mut sb) = load_pair(states, a, b);
-    warm_start_side(kind, &mut sa, false);
-    warm_start_side(kind, &mut sb, true);
-    store_pair(states, a, b, &sa, &sb);
-}
-
-/// One velocity iteration of a joint's rows on the whole state slice.
-pub(crate) fn solve_states<K: KindRows>(
-    kind: &mut K,
-    ctx: &StepContext,
-    states: &mut [BodyState],
-    use_bias: bool,
-) {
-    let (a, b) = (kind.base().state_a, kind.base().state_b);
-    let mut pair = PairOf::new(states, a, b, BOTH);
-    solve_pair(kind, ctx, &mut pair, use_bias);
 }
 
 #[cfg(test)]

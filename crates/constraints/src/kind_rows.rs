@@ -6,6 +6,7 @@
 //! | [`KindRows`]  | [`crate::joint::Joint`]'s dispatch (static, no `dyn`); its rows go to [`crate::joint_rows`] |
 //! | [`TreeRows`]  | the tree build and solve ([`crate::joint_tree`]) |
 //! | [`GeneralRows`] | the tree solve's general path           |
+//! | [`solve_pair`], [`warm_start_side`] | the colour stages: one iteration / one body's warm start of any kind, through its rows |
 //!
 //! A kind's file imports this module, never `joint`; `joint` imports the
 //! kinds (its enum has a variant per kind), so the two do not form a
@@ -17,7 +18,7 @@ use janus2d_core::math::{Real, Rot, Vec2};
 
 use crate::joint_base::JointBase;
 use crate::joint_rows::{RowSolve, WarmSide};
-use crate::parts::PointPart;
+use crate::parts::{BOTH, PairOf, PairStates, PointPart, load_pair, store_pair};
 
 /// What a joint kind's solver form supplies: its rows' stages, read-backs
 /// and what the tree solve may take. Dispatched by [`Joint`]'s match
@@ -139,4 +140,65 @@ pub(crate) struct GeneralRows {
     pub(crate) linear: [bool; 3],
     /// The rows' accumulated impulses.
     pub(crate) impulse: [Real; 3],
+}
+
+/// Whether the Gauss–Seidel pass has work on the joint this step.
+#[inline(always)]
+fn iterates<K: KindRows>(kind: &K) -> bool {
+    !kind.base().resting && kind.has_iterative_rows()
+}
+
+/// One velocity iteration of a joint's rows over a pair of states.
+#[inline(always)]
+pub(crate) fn solve_pair<K: KindRows, P: PairStates>(
+    kind: &mut K,
+    ctx: &StepContext,
+    pair: &mut P,
+    use_bias: bool,
+) {
+    if !iterates(kind) {
+        return;
+    }
+    let (sa, sb) = pair.load();
+    let mut s = RowSolve {
+        sa,
+        sb,
+        m: kind.base().masses,
+    };
+    kind.solve_rows(ctx, use_bias, &mut s);
+    pair.store(&s.sa, &s.sb);
+}
+
+/// One body's share of a joint's warm start: every kept impulse, the
+/// tree's too (the colour stage warm-starts every active joint body by
+/// body; the tree solve takes its rows' impulses from there).
+#[inline(always)]
+pub(crate) fn warm_start_side<K: KindRows>(kind: &K, st: &mut BodyState, side_b: bool) {
+    let mut w = WarmSide::new(st, kind.base().masses, side_b);
+    kind.warm_rows(&mut w);
+}
+
+/// A joint's warm start on the whole state slice: body a's share, then
+/// body b's.
+pub(crate) fn warm_start_states<K: KindRows>(kind: &K, states: &mut [BodyState]) {
+    if kind.base().resting {
+        return;
+    }
+    let (a, b) = (kind.base().state_a, kind.base().state_b);
+    let (mut sa, mut sb) = load_pair(states, a, b);
+    warm_start_side(kind, &mut sa, false);
+    warm_start_side(kind, &mut sb, true);
+    store_pair(states, a, b, &sa, &sb);
+}
+
+/// One velocity iteration of a joint's rows on the whole state slice.
+pub(crate) fn solve_states<K: KindRows>(
+    kind: &mut K,
+    ctx: &StepContext,
+    states: &mut [BodyState],
+    use_bias: bool,
+) {
+    let (a, b) = (kind.base().state_a, kind.base().state_b);
+    let mut pair = PairOf::new(states, a, b, BOTH);
+    solve_pair(kind, ctx, &mut pair, use_bias);
 }

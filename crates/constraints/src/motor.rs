@@ -54,7 +54,7 @@ use janus2d_core::softness::Softness;
 
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef};
-use crate::joint_rows::{self, Bounds, PointTerms, RowSolve, Terms, WarmSide};
+use crate::joint_rows::{Bounds, PointTerms, RowSolve, Terms, WarmSide};
 use crate::kind_rows::KindRows;
 use crate::parts::{AnglePart, PointPart};
 use crate::{JointError, check_anchor};
@@ -437,11 +437,11 @@ impl Constraint for MotorJoint {
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        joint_rows::warm_start_states(self, states);
+        crate::kind_rows::warm_start_states(self, states);
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        joint_rows::solve_states(self, ctx, states, use_bias);
+        crate::kind_rows::solve_states(self, ctx, states, use_bias);
     }
 
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {

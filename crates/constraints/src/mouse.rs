@@ -56,7 +56,7 @@ use janus2d_core::softness::Softness;
 
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef};
-use crate::joint_rows::{self, RowSolve, WarmSide};
+use crate::joint_rows::{RowSolve, WarmSide};
 use crate::kind_rows::KindRows;
 use crate::parts::{PairMass, PointPart};
 use crate::{JointError, check_spring};
@@ -408,11 +408,11 @@ impl Constraint for MouseJoint {
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        joint_rows::warm_start_states(self, states);
+        crate::kind_rows::warm_start_states(self, states);
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        joint_rows::solve_states(self, ctx, states, use_bias);
+        crate::kind_rows::solve_states(self, ctx, states, use_bias);
     }
 
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
@@ -493,7 +493,7 @@ mod tests {
         joint.warm_start(&ctx, &mut whole);
         let mut sides = set.states.clone();
         for (s, side_b) in [(joint.base.state_a, false), (joint.base.state_b, true)] {
-            crate::joint_rows::warm_start_side(&joint, &mut sides[s as usize], side_b);
+            crate::kind_rows::warm_start_side(&joint, &mut sides[s as usize], side_b);
         }
         for (w, s) in whole.iter().zip(&sides) {
             assert_eq!((w.v, w.w), (s.v, s.w));

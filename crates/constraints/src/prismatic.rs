@@ -84,7 +84,7 @@ use janus2d_core::softness::Softness;
 
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, JointFrame, KindDef, LimitsMut, MotorMut, SpringMut};
-use crate::joint_rows::{self, Bounds, RowSolve, Terms, WarmSide};
+use crate::joint_rows::{Bounds, RowSolve, Terms, WarmSide};
 use crate::kind_rows::{GeneralRows, KindRows, TreeRows};
 use crate::parts::{AxisPart, AxisRow, PairMass, angular_correction_cap};
 use crate::{JointError, check_spring};
@@ -808,11 +808,11 @@ impl Constraint for PrismaticJoint {
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        joint_rows::warm_start_states(self, states);
+        crate::kind_rows::warm_start_states(self, states);
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        joint_rows::solve_states(self, ctx, states, use_bias);
+        crate::kind_rows::solve_states(self, ctx, states, use_bias);
     }
 
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {
@@ -1008,8 +1008,8 @@ mod tests {
         joint.warm_start(&ctx, &mut whole);
         let (sa, sb) = (joint.base.state_a as usize, joint.base.state_b as usize);
         let mut by_body = set.states.clone();
-        crate::joint_rows::warm_start_side(&joint, &mut by_body[sa], false);
-        crate::joint_rows::warm_start_side(&joint, &mut by_body[sb], true);
+        crate::kind_rows::warm_start_side(&joint, &mut by_body[sa], false);
+        crate::kind_rows::warm_start_side(&joint, &mut by_body[sb], true);
         assert_eq!(whole, by_body);
     }
 }

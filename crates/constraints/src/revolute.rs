@@ -39,7 +39,7 @@ use janus2d_core::softness::Softness;
 
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
-use crate::joint_rows::{self, Bounds, PointTerms, RowSolve, Terms, WarmSide};
+use crate::joint_rows::{Bounds, PointTerms, RowSolve, Terms, WarmSide};
 use crate::kind_rows::{KindRows, TreeRows};
 use crate::parts::{AnglePart, PairMass, PointPart, angular_correction_cap};
 use crate::{JointError, check_motor_speed, check_spring};
@@ -543,11 +543,11 @@ impl Constraint for RevoluteJoint {
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
-        joint_rows::warm_start_states(self, states);
+        crate::kind_rows::warm_start_states(self, states);
     }
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
-        joint_rows::solve_states(self, ctx, states, use_bias);
+        crate::kind_rows::solve_states(self, ctx, states, use_bias);
     }
 
     fn rows(&self, ctx: &StepContext, bodies: &BodySet) -> ConstraintRows {

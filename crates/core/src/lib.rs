@@ -21,6 +21,7 @@
 
 pub mod body;
 pub mod constraint;
+pub mod contact_input;
 pub mod geometry;
 pub mod graph;
 pub mod handle;

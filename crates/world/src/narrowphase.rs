@@ -22,10 +22,8 @@
 //! Phase 1 results do not depend on the thread count, since each contact
 //! is computed alone; phase 2 runs in list order.
 
-use janus2d_constraints::ContactPointInput;
-use janus2d_constraints::contact_group::NO_CLUSTER;
-use janus2d_constraints::contact_solver::ContactLane;
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
+use janus2d_core::contact_input::{ContactLane, ContactPointInput, NO_CLUSTER};
 use janus2d_core::geometry::{Aabb, Manifold, collide};
 use janus2d_core::math::{Real, Rot, Transform, Vec2};
 use janus2d_core::parallel::Team;
