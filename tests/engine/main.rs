@@ -27,6 +27,7 @@ mod motor;
 mod mouse;
 mod mover;
 mod pendulum;
+mod point_queries;
 mod prismatic;
 mod queries;
 mod reliability;

@@ -75,7 +75,9 @@ pub use portal::{
     PortalSide,
 };
 pub use profile::{CollisionCounters, StepCounters, StepProfile};
-pub use query::{PortalHop, QueryFilter, QueryProblem, RayHit, ShapeOverlap};
+pub use query::{
+    PointProjection, PortalHop, QueryFilter, QueryPredicate, QueryProblem, RayHit, ShapeOverlap,
+};
 pub use shapes::{Filter, ShapeData, ShapeDef, ShapeHandle};
 pub use snapshot::Snapshot;
 #[cfg(feature = "serde")]
