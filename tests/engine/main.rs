@@ -23,6 +23,7 @@ mod joint_events;
 mod joint_tree_mixed;
 mod joint_tree_properties;
 mod kinematic_targets;
+mod motion_setters;
 mod motor;
 mod mouse;
 mod mover;

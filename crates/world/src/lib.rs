@@ -83,4 +83,4 @@ pub use snapshot::Snapshot;
 #[cfg(feature = "serde")]
 pub use snapshot::bytes::{SNAPSHOT_MAGIC, SNAPSHOT_VERSION, SnapshotError};
 pub use validate::{Invariant, InvariantError};
-pub use world::{StepEvents, World, WorldDef};
+pub use world::{ExplosionDef, StepEvents, World, WorldDef};

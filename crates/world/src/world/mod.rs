@@ -340,6 +340,7 @@ impl World {
 }
 
 mod bodies;
+pub use bodies::ExplosionDef;
 mod events;
 mod internal;
 mod joints;
