@@ -3,6 +3,7 @@
 //! former test file. One binary instead of one per file: each integration
 //! test binary links the engine and the testbed again.
 
+mod api_consistency;
 #[cfg(feature = "portals")]
 mod api_state_machine;
 mod bad_input;

@@ -64,7 +64,10 @@ fn damping_set_after_creation_follows_the_substep_formula() {
         .unwrap();
     w.set_linear_damping(b, 2.0).unwrap();
     w.set_angular_damping(b, 0.5).unwrap();
-    assert_eq!((w.linear_damping(b).unwrap(), w.angular_damping(b).unwrap()), (2.0, 0.5));
+    assert_eq!(
+        (w.linear_damping(b).unwrap(), w.angular_damping(b).unwrap()),
+        (2.0, 0.5)
+    );
     w.step(DT).unwrap();
     // Each of the n substeps of h = dt/n scales by 1/(1 + h c).
     let n = w.settings().substeps as Real;
@@ -92,7 +95,10 @@ fn fixed_rotation_set_after_creation_stops_the_spin_and_gives_the_inertia_back()
         w.step(DT).unwrap();
     }
     assert_eq!(w.angle(b).unwrap(), 0.0);
-    assert!((w.linear_velocity(b).unwrap().y - 0.5).abs() < 1e-5, "1 N·s / 2 kg");
+    assert!(
+        (w.linear_velocity(b).unwrap().y - 0.5).abs() < 1e-5,
+        "1 N·s / 2 kg"
+    );
     w.set_fixed_rotation(b, false).unwrap();
     assert!((w.rotational_inertia(b).unwrap() - 5.0 / 6.0).abs() < 1e-5);
     w.apply_angular_impulse(b, 5.0 / 6.0).unwrap();
@@ -142,7 +148,10 @@ fn velocity_at_point_is_v_plus_omega_cross_r() {
     assert!((p - v(1.0, 1.0)).length() < 1e-6, "{p:?}");
     assert_eq!(w.velocity_at_point(b, v(1.0, 2.0)).unwrap(), v(3.0, -1.0));
     let ground = w.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
-    assert_eq!(w.velocity_at_point(ground, v(7.0, 7.0)).unwrap(), Vec2::ZERO);
+    assert_eq!(
+        w.velocity_at_point(ground, v(7.0, 7.0)).unwrap(),
+        Vec2::ZERO
+    );
     assert_eq!(
         w.velocity_at_point(b, v(Real::NAN, 0.0)),
         Err(WorldError::NonFinite("point"))
@@ -156,24 +165,40 @@ fn explode_gives_each_shape_the_impulse_the_formula_predicts() {
     // A disc r = 0.5 with its nearest point 3.5 m out: full strength,
     // J = 3 × 2 r = 3 N·s along +x, no turn.
     let near = w.create_body(&BodyDef::dynamic(v(4.0, 0.0))).unwrap();
-    w.create_shape(near, &ShapeDef::default(), Circle::new(Vec2::ZERO, 0.5).unwrap())
-        .unwrap();
+    w.create_shape(
+        near,
+        &ShapeDef::default(),
+        Circle::new(Vec2::ZERO, 0.5).unwrap(),
+    )
+    .unwrap();
     // The same disc 5 m out (nearest point): in the falloff band,
     // s = (4 + 2 − 5) / 2 = 0.5, J = 1.5 N·s along −y.
     let banded = w.create_body(&BodyDef::dynamic(v(0.0, -5.5))).unwrap();
-    w.create_shape(banded, &ShapeDef::default(), Circle::new(Vec2::ZERO, 0.5).unwrap())
-        .unwrap();
+    w.create_shape(
+        banded,
+        &ShapeDef::default(),
+        Circle::new(Vec2::ZERO, 0.5).unwrap(),
+    )
+    .unwrap();
     // A 1 × 2 box at (−4, 0.5): its right face x = −3.5 faces the centre
     // off its middle: nearest point (−3.5, 0), width across 2, J = 6 N·s
     // along −x, 0.5 m below the centre: a turn of ΔL = r × J.
     let boxed = dynamic_box(&mut w, v(-4.0, 0.5), 0.5, 1.0);
     // Out of reach, static, or masked out: untouched.
     let far = w.create_body(&BodyDef::dynamic(v(0.0, 7.0))).unwrap();
-    w.create_shape(far, &ShapeDef::default(), Circle::new(Vec2::ZERO, 0.5).unwrap())
-        .unwrap();
+    w.create_shape(
+        far,
+        &ShapeDef::default(),
+        Circle::new(Vec2::ZERO, 0.5).unwrap(),
+    )
+    .unwrap();
     let wall = w.create_body(&BodyDef::fixed(v(2.0, 2.0))).unwrap();
-    w.create_shape(wall, &ShapeDef::default(), Circle::new(Vec2::ZERO, 0.5).unwrap())
-        .unwrap();
+    w.create_shape(
+        wall,
+        &ShapeDef::default(),
+        Circle::new(Vec2::ZERO, 0.5).unwrap(),
+    )
+    .unwrap();
     let other_category = w.create_body(&BodyDef::dynamic(v(-2.0, -2.0))).unwrap();
     let mut cat2 = ShapeDef::default();
     cat2.filter.category_bits = 0b10;
@@ -185,7 +210,10 @@ fn explode_gives_each_shape_the_impulse_the_formula_predicts() {
         .with_mask(0b1);
     assert_eq!(w.explode(&def).unwrap(), 3);
     let m_disc = w.mass(near).unwrap();
-    assert!(w.is_awake(near).unwrap(), "the explosion wakes what it pushes");
+    assert!(
+        w.is_awake(near).unwrap(),
+        "the explosion wakes what it pushes"
+    );
     let vn = w.linear_velocity(near).unwrap();
     assert!((vn - v(3.0 / m_disc, 0.0)).length() < 1e-5, "{vn:?}");
     assert!(w.angular_velocity(near).unwrap().abs() < 1e-6);
@@ -251,7 +279,10 @@ fn bad_setter_and_explosion_input_is_a_typed_error_and_changes_nothing() {
     // An impulse past the speed limit: nothing is pushed.
     assert!(matches!(
         w.explode(&ExplosionDef::new(Vec2::ZERO, 5.0, 1e30)),
-        Err(WorldError::OutOfBounds { field: "impulse", .. })
+        Err(WorldError::OutOfBounds {
+            field: "impulse",
+            ..
+        })
     ));
     assert_eq!(w.gravity_scale(b).unwrap(), 1.0);
     assert_eq!(w.linear_damping(b).unwrap(), 0.0);

@@ -85,7 +85,12 @@ fn project_point_on_turned_rounded_and_curved_shapes() {
     let p = w.shape_project_point(rounded, v(21.15, 0.0)).unwrap();
     assert!(p.inside && (p.distance - 0.1).abs() < 1e-5 && close(p.point, v(21.25, 0.0)));
     // A disc of radius 2 at (0, 10): from (0, 13), the top at (0, 12).
-    let disc = fixed(&mut w, v(0.0, 10.0), 0.0, Circle::new(Vec2::ZERO, 2.0).unwrap());
+    let disc = fixed(
+        &mut w,
+        v(0.0, 10.0),
+        0.0,
+        Circle::new(Vec2::ZERO, 2.0).unwrap(),
+    );
     let p = w.shape_project_point(disc, v(0.0, 13.0)).unwrap();
     assert!(close(p.point, v(0.0, 12.0)) && (p.distance - 1.0).abs() < 1e-5);
     // A capsule from (−1, 0) to (1, 0), radius 0.5, at (0, 20): from (3, 20).
@@ -129,8 +134,12 @@ fn project_point_prefers_the_shape_holding_the_point_and_obeys_the_filter() {
     assert!((p.distance - 0.6).abs() < 1e-5 && close(p.point, v(2.5, 0.0)));
     // Sensors are not seen.
     let zone = w.create_body(&BodyDef::fixed(v(10.0, 0.0))).unwrap();
-    w.create_shape(zone, &ShapeDef::default().sensor(), Polygon::make_box(1.0, 1.0))
-        .unwrap();
+    w.create_shape(
+        zone,
+        &ShapeDef::default().sensor(),
+        Polygon::make_box(1.0, 1.0),
+    )
+    .unwrap();
     let p = w.project_point(v(10.0, 0.0), 5.0, &f).unwrap();
     assert!(p.is_none_or(|p| p.body != zone));
 }
@@ -154,8 +163,15 @@ fn shape_ray_cast_sees_only_its_shape_and_shape_test_point_is_exact() {
         .unwrap();
     assert!((hit.fraction - 0.15).abs() < 1e-6);
     // A miss, a ray too short, and a filter that rejects the shape.
-    assert_eq!(w.shape_ray_cast(far, v(0.0, 2.0), v(10.0, 0.0), &f).unwrap(), None);
-    assert_eq!(w.shape_ray_cast(far, Vec2::ZERO, v(4.0, 0.0), &f).unwrap(), None);
+    assert_eq!(
+        w.shape_ray_cast(far, v(0.0, 2.0), v(10.0, 0.0), &f)
+            .unwrap(),
+        None
+    );
+    assert_eq!(
+        w.shape_ray_cast(far, Vec2::ZERO, v(4.0, 0.0), &f).unwrap(),
+        None
+    );
     assert_eq!(
         w.shape_ray_cast(far, Vec2::ZERO, v(10.0, 0.0), &f.with_mask(0b10))
             .unwrap(),
@@ -172,7 +188,14 @@ fn shape_ray_cast_sees_only_its_shape_and_shape_test_point_is_exact() {
 fn the_predicate_filters_every_query_kind_and_sees_each_candidate() {
     let mut w = world();
     let shapes: Vec<ShapeHandle> = (1..=4)
-        .map(|k| fixed(&mut w, v(2.0 * k as Real, 0.0), 0.0, Polygon::make_box(0.5, 0.5)))
+        .map(|k| {
+            fixed(
+                &mut w,
+                v(2.0 * k as Real, 0.0),
+                0.0,
+                Polygon::make_box(0.5, 0.5),
+            )
+        })
         .collect();
     let asked = Cell::new(0);
     let odd_only = |s: ShapeHandle| {
@@ -240,7 +263,11 @@ fn sensor_overlaps_equal_the_set_the_sensor_events_build_over_a_run() {
         .unwrap();
     let zone = w.create_body(&BodyDef::fixed(v(0.0, 2.0))).unwrap();
     let sensor = w
-        .create_shape(zone, &ShapeDef::default().sensor(), Polygon::make_box(1.5, 1.0))
+        .create_shape(
+            zone,
+            &ShapeDef::default().sensor(),
+            Polygon::make_box(1.5, 1.0),
+        )
         .unwrap();
     // Balls thrown across the zone at different heights and speeds.
     let mut balls = Vec::new();
@@ -252,8 +279,12 @@ fn sensor_overlaps_equal_the_set_the_sensor_events_build_over_a_run() {
             )
             .unwrap();
         balls.push(
-            w.create_shape(b, &ShapeDef::default(), Circle::new(Vec2::ZERO, 0.2).unwrap())
-                .unwrap(),
+            w.create_shape(
+                b,
+                &ShapeDef::default(),
+                Circle::new(Vec2::ZERO, 0.2).unwrap(),
+            )
+            .unwrap(),
         );
     }
     let mut from_events: BTreeSet<ShapeHandle> = BTreeSet::new();
@@ -263,20 +294,32 @@ fn sensor_overlaps_equal_the_set_the_sensor_events_build_over_a_run() {
         let ev = &w.events().collision;
         for e in &ev.sensor_end {
             if e.shape_a == sensor || e.shape_b == sensor {
-                let other = if e.shape_a == sensor { e.shape_b } else { e.shape_a };
+                let other = if e.shape_a == sensor {
+                    e.shape_b
+                } else {
+                    e.shape_a
+                };
                 assert!(from_events.remove(&other), "step {step}: end without begin");
                 ends += 1;
             }
         }
         for e in &ev.sensor_begin {
             if e.shape_a == sensor || e.shape_b == sensor {
-                let other = if e.shape_a == sensor { e.shape_b } else { e.shape_a };
+                let other = if e.shape_a == sensor {
+                    e.shape_b
+                } else {
+                    e.shape_a
+                };
                 assert!(from_events.insert(other), "step {step}: begin twice");
                 begins += 1;
             }
         }
         let now = w.sensor_overlaps(sensor).unwrap();
-        assert_eq!(now, from_events.iter().copied().collect::<Vec<_>>(), "step {step}");
+        assert_eq!(
+            now,
+            from_events.iter().copied().collect::<Vec<_>>(),
+            "step {step}"
+        );
         // And from each ball's side: the sensor while it is inside.
         for &b in &balls {
             let inside = from_events.contains(&b);
@@ -292,7 +335,11 @@ fn new_queries_reject_bad_input_with_typed_errors_and_change_nothing() {
     let s = fixed(&mut w, v(3.0, 0.0), 0.0, Polygon::make_box(1.0, 1.0));
     let b = w.create_body(&BodyDef::dynamic(v(0.0, 3.0))).unwrap();
     let gone = w
-        .create_shape(b, &ShapeDef::default(), Circle::new(Vec2::ZERO, 0.5).unwrap())
+        .create_shape(
+            b,
+            &ShapeDef::default(),
+            Circle::new(Vec2::ZERO, 0.5).unwrap(),
+        )
         .unwrap();
     w.destroy_shape(gone).unwrap();
     w.step(1.0 / 60.0).unwrap();
@@ -327,12 +374,18 @@ fn new_queries_reject_bad_input_with_typed_errors_and_change_nothing() {
         w.shape_project_point(s, v(Real::NAN, 0.0)),
         Err(bad("point", QueryProblem::NonFinite))
     );
-    assert_eq!(w.shape_test_point(gone, Vec2::ZERO), Err(WorldError::StaleShape));
+    assert_eq!(
+        w.shape_test_point(gone, Vec2::ZERO),
+        Err(WorldError::StaleShape)
+    );
     assert_eq!(
         w.shape_ray_cast(gone, Vec2::ZERO, Vec2::X, &f),
         Err(WorldError::StaleShape)
     );
-    assert_eq!(w.shape_project_point(gone, Vec2::ZERO), Err(WorldError::StaleShape));
+    assert_eq!(
+        w.shape_project_point(gone, Vec2::ZERO),
+        Err(WorldError::StaleShape)
+    );
     assert_eq!(w.sensor_overlaps(gone), Err(WorldError::StaleShape));
     let other = world();
     let mut other = other;
@@ -382,7 +435,10 @@ mod through_portals {
         assert_eq!(hit.portal_hops, 1);
         // The wall is hit at its face without portals, and not in its hole
         // with them.
-        let wall = w.shape_ray_cast(wall_a, origin, d, &plain).unwrap().unwrap();
+        let wall = w
+            .shape_ray_cast(wall_a, origin, d, &plain)
+            .unwrap()
+            .unwrap();
         assert!((wall.fraction - 0.5).abs() < 1e-6);
         assert_eq!(w.shape_ray_cast(wall_a, origin, d, &through).unwrap(), None);
         // Beside the aperture (y = 1.5 > 1) the wall stops even a ray through portals.

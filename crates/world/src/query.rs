@@ -109,7 +109,10 @@ impl std::fmt::Debug for QueryFilter<'_> {
             .field("mask_bits", &self.mask_bits)
             .field("exclude_body", &self.exclude_body)
             .field("through_portals", &self.through_portals)
-            .field("predicate", &self.predicate.map(|_| "Fn(ShapeHandle) -> bool"))
+            .field(
+                "predicate",
+                &self.predicate.map(|_| "Fn(ShapeHandle) -> bool"),
+            )
             .finish()
     }
 }
@@ -138,6 +141,19 @@ impl<'a> QueryFilter<'a> {
     #[must_use]
     pub fn with_mask(mut self, mask_bits: u64) -> Self {
         self.mask_bits = mask_bits;
+        self
+    }
+
+    /// Belongs to the categories in `category_bits` (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::QueryFilter;
+    /// let f = QueryFilter::default().with_category(0b100);
+    /// assert_eq!(f.category_bits, 4);
+    /// ```
+    #[must_use]
+    pub fn with_category(mut self, category_bits: u64) -> Self {
+        self.category_bits = category_bits;
         self
     }
 
@@ -355,7 +371,10 @@ impl Leg {
 impl QueryContext<'_> {
     /// Whether `filter` (with its predicate) sees the shape in `slot`.
     fn admits(&self, filter: &QueryFilter, slot: u32) -> bool {
-        filter.accepts_shape(self.shapes.handle_of(slot, self.owner), self.shapes.at(slot))
+        filter.accepts_shape(
+            self.shapes.handle_of(slot, self.owner),
+            self.shapes.at(slot),
+        )
     }
 
     fn transform_of(&self, body: BodyHandle) -> Transform {

@@ -820,7 +820,11 @@ impl World {
     /// assert_eq!(world.set_linear_damping(b, -1.0), Err(WorldError::OutOfRange("linear_damping")));
     /// assert_eq!(world.linear_damping(b).unwrap(), 1.0);
     /// ```
-    pub fn set_linear_damping(&mut self, body: BodyHandle, damping: Real) -> Result<(), WorldError> {
+    pub fn set_linear_damping(
+        &mut self,
+        body: BodyHandle,
+        damping: Real,
+    ) -> Result<(), WorldError> {
         self.check_body(body)?;
         super::shapes::check_material(damping, "linear_damping")?;
         for b in self.with_crossing_copy(body) {
@@ -1058,7 +1062,8 @@ impl World {
                 ((reach - distance) / def.falloff).clamp(0.0, 1.0)
             };
             let across = xf.q.inv_rotate(Vec2::new(-direction.y, direction.x));
-            let magnitude = def.impulse_per_length * projected_width(&data.geometry, across) * scale;
+            let magnitude =
+                def.impulse_per_length * projected_width(&data.geometry, across) * scale;
             let impulse = magnitude * direction;
             let (im, ii, c) = (sim.inv_mass, sim.inv_inertia, sim.center);
             let (dv, dw) = (im * impulse, ii * cross(at - c, impulse));
