@@ -67,7 +67,8 @@ fn every_is_getter_returns_a_result_and_a_stale_handle_is_an_error() {
     let b = w.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
     let gone = w.create_body(&BodyDef::dynamic(Vec2::ONE)).unwrap();
     w.destroy_body(gone).unwrap();
-    let getters: [fn(&World, BodyHandle) -> Result<bool, WorldError>; 4] = [
+    type IsGetter = fn(&World, BodyHandle) -> Result<bool, WorldError>;
+    let getters: [IsGetter; 4] = [
         World::is_awake,
         World::is_sleeping,
         World::is_bullet,

@@ -371,7 +371,7 @@ impl World {
     /// other shape, the sensors it is inside. This is the set the sensor
     /// events describe: after each step it equals the set before it, plus
     /// the step's `sensor_begin` pairs naming `shape`, minus its
-    /// `sensor_end` pairs (see [`CollisionEvents`](crate::CollisionEvents)).
+    /// `sensor_end` pairs (see [`CollisionEvents`]).
     /// A crossing copy is a shape of its own, with its own overlaps.
     ///
     /// Errors: a stale or foreign shape handle.
