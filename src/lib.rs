@@ -179,10 +179,11 @@ pub use janus2d_world::{
 #[doc(inline)]
 pub use janus2d_world::{
     CollisionCounters, CollisionEvents, Color, Contact, ContactPointData, ContinuousCounters,
-    DebugDraw, DrawOptions, Filter, HitEvent, Invariant, InvariantError, JointEvent, JointHandle,
-    JointSet, Palette, PortalHop, PreSolve, PreSolveFn, QueryFilter, QueryProblem, RayHit,
-    ShapeData, ShapeDef, ShapeHandle, ShapeOverlap, ShapePairEvent, SleepSettings, Snapshot,
-    StepCounters, StepEvents, StepProfile, World, WorldDef, WorldError,
+    DebugDraw, DrawOptions, ExplosionDef, Filter, HitEvent, Invariant, InvariantError, JointEvent,
+    JointHandle, JointSet, Palette, PointProjection, PortalHop, PreSolve, PreSolveFn, QueryFilter,
+    QueryPredicate, QueryProblem, RayHit, ShapeData, ShapeDef, ShapeHandle, ShapeOverlap,
+    ShapePairEvent, SleepSettings, Snapshot, StepCounters, StepEvents, StepProfile, World,
+    WorldDef, WorldError,
 };
 #[cfg(feature = "portals")]
 #[doc(inline)]
@@ -209,8 +210,8 @@ pub mod prelude {
     pub use janus2d_core::solver::SolverSettings;
     pub use janus2d_world::{Autostep, CharacterController, MoveResult};
     pub use janus2d_world::{
-        Filter, JointEvent, JointHandle, QueryFilter, RayHit, ShapeDef, ShapeHandle, ShapeOverlap,
-        StepEvents, World, WorldDef, WorldError,
+        ExplosionDef, Filter, JointEvent, JointHandle, PointProjection, QueryFilter, RayHit,
+        ShapeDef, ShapeHandle, ShapeOverlap, StepEvents, World, WorldDef, WorldError,
     };
 }
 

@@ -117,6 +117,18 @@ enum Op {
     Force(usize, Vec2),
     Impulse(usize, Vec2, Vec2),
     Torque(usize, Real),
+    GravityScale(usize, Real),
+    LinearDamping(usize, Real),
+    AngularDamping(usize, Real),
+    FixedRotation(usize, bool),
+    Explode {
+        position: Vec2,
+        radius: Real,
+        falloff: Real,
+        impulse: Real,
+    },
+    /// Queries (they change nothing, errors included).
+    Query(usize, Vec2, Real),
     Settings {
         hertz: Real,
         damping: Real,
@@ -160,6 +172,13 @@ fn op() -> impl Strategy<Value = Op> {
         1 => (pick(), vec2()).prop_map(|(b, f)| Op::Force(b, f)),
         1 => (pick(), vec2(), place()).prop_map(|(b, i, p)| Op::Impulse(b, i, p)),
         1 => (pick(), real()).prop_map(|(b, t)| Op::Torque(b, t)),
+        1 => (pick(), real()).prop_map(|(b, g)| Op::GravityScale(b, g)),
+        1 => (pick(), real()).prop_map(|(b, c)| Op::LinearDamping(b, c)),
+        1 => (pick(), real()).prop_map(|(b, c)| Op::AngularDamping(b, c)),
+        1 => (pick(), any::<bool>()).prop_map(|(b, f)| Op::FixedRotation(b, f)),
+        1 => (place(), size(), size(), real())
+            .prop_map(|(position, radius, falloff, impulse)| Op::Explode { position, radius, falloff, impulse }),
+        1 => (pick(), place(), real()).prop_map(|(s, p, d)| Op::Query(s, p, d)),
         1 => (prop_oneof![3 => Just(30.0 as Real), 1 => real()], prop_oneof![3 => Just(10.0 as Real), 1 => real()], prop_oneof![3 => Just(4u32), 1 => 0u32..12])
             .prop_map(|(hertz, damping, substeps)| Op::Settings { hertz, damping, substeps }),
         1 => prop_oneof![3 => Just(Vec2::new(0.0, -10.0)), 1 => vec2()].prop_map(Op::Gravity),
@@ -363,6 +382,29 @@ fn apply(
         Op::Force(k, f) => w.apply_force_to_center(body(*k, issued), *f),
         Op::Impulse(k, i, p) => w.apply_linear_impulse(body(*k, issued), *i, *p),
         Op::Torque(k, t) => w.apply_torque(body(*k, issued), *t),
+        Op::GravityScale(k, g) => w.set_gravity_scale(body(*k, issued), *g),
+        Op::LinearDamping(k, c) => w.set_linear_damping(body(*k, issued), *c),
+        Op::AngularDamping(k, c) => w.set_angular_damping(body(*k, issued), *c),
+        Op::FixedRotation(k, f) => w.set_fixed_rotation(body(*k, issued), *f),
+        Op::Explode {
+            position,
+            radius,
+            falloff,
+            impulse,
+        } => w
+            .explode(&ExplosionDef::new(*position, *radius, *impulse).with_falloff(*falloff))
+            .map(|_| ()),
+        Op::Query(k, p, d) => {
+            let shape = pick(&issued.shapes, *k, issued.foreign_shape);
+            let f = QueryFilter::default();
+            let _ = w.project_point(*p, *d, &f);
+            let _ = w.shape_project_point(shape, *p);
+            let _ = w.shape_test_point(shape, *p);
+            let _ = w.shape_ray_cast(shape, *p, Vec2::new(*d, 1.0), &f.through_portals());
+            let _ = w.sensor_overlaps(shape);
+            let _ = w.velocity_at_point(body(*k, issued), *p);
+            w.sensor_overlaps(shape).map(|_| ())
+        }
         Op::Settings {
             hertz,
             damping,

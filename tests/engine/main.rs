@@ -3,6 +3,7 @@
 //! former test file. One binary instead of one per file: each integration
 //! test binary links the engine and the testbed again.
 
+mod api_consistency;
 #[cfg(feature = "portals")]
 mod api_state_machine;
 mod bad_input;
@@ -23,10 +24,12 @@ mod joint_events;
 mod joint_tree_mixed;
 mod joint_tree_properties;
 mod kinematic_targets;
+mod motion_setters;
 mod motor;
 mod mouse;
 mod mover;
 mod pendulum;
+mod point_queries;
 mod prismatic;
 mod queries;
 mod reliability;

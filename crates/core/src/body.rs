@@ -235,6 +235,85 @@ impl BodyDef {
         self
     }
 
+    /// Sets the position (builder style).
+    #[must_use]
+    pub fn with_position(mut self, position: Vec2) -> Self {
+        self.position = position;
+        self
+    }
+
+    /// Sets the linear damping, 1/s (builder style).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let def = BodyDef::dynamic(Vec2::ZERO)
+    ///     .with_linear_damping(0.5)
+    ///     .with_angular_damping(0.2)
+    ///     .with_gravity_scale(0.0)
+    ///     .with_awake(false)
+    ///     .with_enable_sleep(true)
+    ///     .with_sleep_threshold(Some(0.01))
+    ///     .with_max_linear_speed(50.0);
+    /// assert_eq!((def.linear_damping, def.angular_damping, def.gravity_scale), (0.5, 0.2, 0.0));
+    /// assert!(!def.awake && def.enable_sleep);
+    /// assert_eq!((def.sleep_threshold, def.max_linear_speed), (Some(0.01), 50.0));
+    /// ```
+    #[must_use]
+    pub fn with_linear_damping(mut self, damping: Real) -> Self {
+        self.linear_damping = damping;
+        self
+    }
+
+    /// Sets the angular damping, 1/s (builder style).
+    #[must_use]
+    pub fn with_angular_damping(mut self, damping: Real) -> Self {
+        self.angular_damping = damping;
+        self
+    }
+
+    /// Sets the gravity scale (builder style).
+    #[must_use]
+    pub fn with_gravity_scale(mut self, scale: Real) -> Self {
+        self.gravity_scale = scale;
+        self
+    }
+
+    /// Starts the body awake or asleep (builder style; see [`BodyDef::awake`]).
+    #[must_use]
+    pub fn with_awake(mut self, awake: bool) -> Self {
+        self.awake = awake;
+        self
+    }
+
+    /// Lets the body fall asleep or not (builder style).
+    #[must_use]
+    pub fn with_enable_sleep(mut self, on: bool) -> Self {
+        self.enable_sleep = on;
+        self
+    }
+
+    /// Sets the body's own rest speed, m/s, or `None` for the world's
+    /// (builder style).
+    #[must_use]
+    pub fn with_sleep_threshold(mut self, threshold: Option<Real>) -> Self {
+        self.sleep_threshold = threshold;
+        self
+    }
+
+    /// Sets the maximum linear speed, m/s (builder style).
+    #[must_use]
+    pub fn with_max_linear_speed(mut self, speed: Real) -> Self {
+        self.max_linear_speed = speed;
+        self
+    }
+
+    /// Sets the maximum rotation per substep, rad (builder style).
+    #[must_use]
+    pub fn with_max_rotation(mut self, rotation: Real) -> Self {
+        self.max_rotation = rotation;
+        self
+    }
+
     /// Makes the body a bullet (builder style; see [`BodyDef::bullet`]).
     #[must_use]
     pub fn as_bullet(mut self) -> Self {
@@ -1067,11 +1146,19 @@ impl BodySet {
                 && sim.max_rotation >= 0.0
                 && sim.linear_damping >= 0.0
                 && sim.angular_damping >= 0.0
+                && sim.gravity_scale.abs() <= crate::limits::MAX_GRAVITY_SCALE
                 && sim
                     .sleep_threshold
                     .is_none_or(|t| t.is_finite() && t >= 0.0))
             {
                 return Err(format!("body {:?}: a setting out of its range", sim.handle));
+            }
+            let fixed = self.record(sim.handle).is_some_and(|r| r.fixed_rotation);
+            if sim.body_type == BodyType::Dynamic && fixed && sim.inv_inertia != 0.0 {
+                return Err(format!(
+                    "dynamic body {:?}: fixed rotation with inverse inertia {}",
+                    sim.handle, sim.inv_inertia
+                ));
             }
             if sim.body_type == BodyType::Dynamic && !(sim.mass > 0.0 && sim.inv_mass > 0.0) {
                 return Err(format!(

@@ -101,12 +101,13 @@ fn query_filter(
     category_bits: u64,
     exclude: Option<Body>,
     through_portals: bool,
-) -> QueryFilter {
+) -> QueryFilter<'static> {
     QueryFilter {
         category_bits,
         mask_bits,
         exclude_body: exclude.map(|b| b.raw()),
         through_portals,
+        predicate: None,
     }
 }
 

@@ -487,7 +487,7 @@ struct Mover<'a> {
     cc: &'a CharacterController,
     world: &'a World,
     capsule: Capsule,
-    filter: &'a QueryFilter,
+    filter: &'a QueryFilter<'a>,
     cos_slope: Real,
 }
 

@@ -157,6 +157,8 @@ pub enum QueryProblem {
     /// farther than [`UNIT_ROTATION_TOLERANCE`](janus2d_core::limits::UNIT_ROTATION_TOLERANCE)
     /// from 1 (a rotation within it is normalised).
     NotUnitRotation,
+    /// A distance or radius below zero.
+    Negative,
 }
 
 impl std::fmt::Display for QueryProblem {
@@ -167,6 +169,7 @@ impl std::fmt::Display for QueryProblem {
             QueryProblem::Inverted => write!(f, "has its lower corner above its upper corner"),
             QueryProblem::Shape(e) => write!(f, "is an invalid shape: {e}"),
             QueryProblem::NotUnitRotation => write!(f, "has a rotation that is not unit length"),
+            QueryProblem::Negative => write!(f, "is negative"),
         }
     }
 }

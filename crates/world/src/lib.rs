@@ -75,10 +75,12 @@ pub use portal::{
     PortalSide,
 };
 pub use profile::{CollisionCounters, StepCounters, StepProfile};
-pub use query::{PortalHop, QueryFilter, QueryProblem, RayHit, ShapeOverlap};
+pub use query::{
+    PointProjection, PortalHop, QueryFilter, QueryPredicate, QueryProblem, RayHit, ShapeOverlap,
+};
 pub use shapes::{Filter, ShapeData, ShapeDef, ShapeHandle};
 pub use snapshot::Snapshot;
 #[cfg(feature = "serde")]
 pub use snapshot::bytes::{SNAPSHOT_MAGIC, SNAPSHOT_VERSION, SnapshotError};
 pub use validate::{Invariant, InvariantError};
-pub use world::{StepEvents, World, WorldDef};
+pub use world::{ExplosionDef, StepEvents, World, WorldDef};

@@ -11,11 +11,16 @@
 //! | `overlap_shape`                    | shapes that touch or overlap a shape          | [`shapes_overlap`] |
 //! | `overlap_point`                    | solid shapes that contain a point (picking)   | [`shapes_overlap`] |
 //! | `shape_distance`                   | distance and closest points of two shapes     | [`shape_distance`](janus2d_core::geometry::shape_distance) |
+//! | `project_point`                    | the nearest surface point of any shape (inside first), [`PointProjection`] | per shape kind, exact |
+//! | `shape_project_point`, `shape_ray_cast`, `shape_test_point` | the same queries on one named shape | as above |
+//! | `sensor_overlaps`                  | the shapes a sensor holds (or the sensors a shape is in), as its events say | the contacts |
 //!
 //! **Rules shared by every query.**
-//! - A shape is tested when [`QueryFilter::accepts`] it: category/mask as
+//! - A shape is tested when [`QueryFilter::accepts_shape`] it: category/mask as
 //!   Box2D (`shape.category & query.mask != 0` and `shape.mask &
-//!   query.category != 0`), not on the excluded body, not a sensor.
+//!   query.category != 0`), not on the excluded body, not a sensor, and
+//!   then the filter's [`predicate`](QueryFilter::predicate) closure, if
+//!   any, returns `true` for it.
 //! - Candidates come from both broadphase trees (fat boxes), then the exact
 //!   test decides: a fat box that the query meets is not a hit.
 //! - Order is deterministic: cast hits are delivered by increasing fraction
@@ -40,6 +45,9 @@
 //! the last one ([`RayHit::last_portal`]); fractions stay those of the
 //! original translation. At most [`MAX_PORTAL_HOPS`] apertures are crossed;
 //! after that the apertures are walls again (two facing portals end).
+//! Point queries (`overlap_point`, `project_point`, `shape_test_point`)
+//! and overlaps see each shape where it is, crossing copies included:
+//! `through_portals` applies to rays and casts (`shape_ray_cast` included).
 
 use janus2d_constraints::portal_map::PortalMap;
 use janus2d_core::body::{BodyHandle, BodySet};
@@ -57,9 +65,16 @@ use crate::shapes::{ShapeData, ShapeHandle, ShapeStore};
 /// Most portal apertures one ray or shape cast goes through (a count; usual 4).
 pub const MAX_PORTAL_HOPS: u32 = 4;
 
+/// A caller's test of each shape a query would otherwise see: `true`
+/// keeps it (see [`QueryFilter::with_predicate`]).
+pub type QueryPredicate<'a> = &'a dyn Fn(ShapeHandle) -> bool;
+
 /// Which shapes a query sees.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct QueryFilter {
+///
+/// The lifetime is that of the [`predicate`](Self::predicate) closure it
+/// may borrow; a filter without one is a `QueryFilter<'static>`.
+#[derive(Clone, Copy)]
+pub struct QueryFilter<'a> {
     /// The categories the query belongs to (usual 1).
     pub category_bits: u64,
     /// The categories the query sees (usual all).
@@ -69,24 +84,76 @@ pub struct QueryFilter {
     pub exclude_body: Option<BodyHandle>,
     /// Rays and shape casts continue through portal apertures (usual off).
     pub through_portals: bool,
+    /// A last test of each shape that passed the others (usual none):
+    /// `false` skips the shape. Called only for shapes the category, mask,
+    /// body and sensor tests accept, before the exact geometric test.
+    pub predicate: Option<QueryPredicate<'a>>,
 }
 
-impl Default for QueryFilter {
+impl Default for QueryFilter<'_> {
     fn default() -> Self {
         QueryFilter {
             category_bits: 1,
             mask_bits: u64::MAX,
             exclude_body: None,
             through_portals: false,
+            predicate: None,
         }
     }
 }
 
-impl QueryFilter {
+impl std::fmt::Debug for QueryFilter<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("QueryFilter")
+            .field("category_bits", &self.category_bits)
+            .field("mask_bits", &self.mask_bits)
+            .field("exclude_body", &self.exclude_body)
+            .field("through_portals", &self.through_portals)
+            .field(
+                "predicate",
+                &self.predicate.map(|_| "Fn(ShapeHandle) -> bool"),
+            )
+            .finish()
+    }
+}
+
+/// Two filters are equal when their fields are and their predicates are
+/// both absent or the same closure (by address).
+impl PartialEq for QueryFilter<'_> {
+    fn eq(&self, other: &Self) -> bool {
+        let same_predicate = match (self.predicate, other.predicate) {
+            (None, None) => true,
+            (Some(a), Some(b)) => std::ptr::addr_eq(a, b),
+            _ => false,
+        };
+        self.category_bits == other.category_bits
+            && self.mask_bits == other.mask_bits
+            && self.exclude_body == other.exclude_body
+            && self.through_portals == other.through_portals
+            && same_predicate
+    }
+}
+
+impl Eq for QueryFilter<'_> {}
+
+impl<'a> QueryFilter<'a> {
     /// Sees only the categories in `mask_bits` (builder style).
     #[must_use]
     pub fn with_mask(mut self, mask_bits: u64) -> Self {
         self.mask_bits = mask_bits;
+        self
+    }
+
+    /// Belongs to the categories in `category_bits` (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::QueryFilter;
+    /// let f = QueryFilter::default().with_category(0b100);
+    /// assert_eq!(f.category_bits, 4);
+    /// ```
+    #[must_use]
+    pub fn with_category(mut self, category_bits: u64) -> Self {
+        self.category_bits = category_bits;
         self
     }
 
@@ -104,7 +171,42 @@ impl QueryFilter {
         self
     }
 
-    /// Whether the query sees `shape`.
+    /// Asks `predicate` about each shape the other tests accept; the query
+    /// skips those it returns `false` for (builder style; as Rapier's
+    /// `QueryFilter::predicate`). The closure is `Fn`: one that counts or
+    /// records keeps its state in a `Cell` or `RefCell`.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef, QueryFilter};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Polygon;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let mut boxes = Vec::new();
+    /// for x in [2.0, 4.0] {
+    ///     let b = world.create_body(&BodyDef::fixed(Vec2::new(x, 0.0))).unwrap();
+    ///     boxes.push(world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap());
+    /// }
+    /// // Skip the first box: the ray hits the second, at x = 3.5.
+    /// let skip_first = |s| s != boxes[0];
+    /// let filter = QueryFilter::default().with_predicate(&skip_first);
+    /// let hit = world.cast_ray_closest(Vec2::ZERO, Vec2::new(10.0, 0.0), &filter).unwrap().unwrap();
+    /// assert_eq!(hit.shape, boxes[1]);
+    /// assert!((hit.point.x - 3.5).abs() < 1e-5);
+    /// ```
+    #[must_use]
+    pub fn with_predicate<'b>(self, predicate: QueryPredicate<'b>) -> QueryFilter<'b> {
+        QueryFilter {
+            category_bits: self.category_bits,
+            mask_bits: self.mask_bits,
+            exclude_body: self.exclude_body,
+            through_portals: self.through_portals,
+            predicate: Some(predicate),
+        }
+    }
+
+    /// Whether the query sees `shape` by category, mask, excluded body and
+    /// sensor flag (the [`predicate`](Self::predicate) is not asked: it
+    /// needs the handle, see [`accepts_shape`](Self::accepts_shape)).
     ///
     /// ```
     /// use janus2d_world::query::QueryFilter;
@@ -118,6 +220,13 @@ impl QueryFilter {
             && (f.category_bits & self.mask_bits) != 0
             && (f.mask_bits & self.category_bits) != 0
             && self.exclude_body != Some(shape.body)
+    }
+
+    /// Whether the query sees the shape `handle` with data `shape`: the
+    /// tests of [`accepts`](Self::accepts), then the predicate.
+    #[must_use]
+    pub fn accepts_shape(&self, handle: ShapeHandle, shape: &ShapeData) -> bool {
+        self.accepts(shape) && self.predicate.is_none_or(|p| p(handle))
     }
 }
 
@@ -260,6 +369,14 @@ impl Leg {
 }
 
 impl QueryContext<'_> {
+    /// Whether `filter` (with its predicate) sees the shape in `slot`.
+    fn admits(&self, filter: &QueryFilter, slot: u32) -> bool {
+        filter.accepts_shape(
+            self.shapes.handle_of(slot, self.owner),
+            self.shapes.at(slot),
+        )
+    }
+
     fn transform_of(&self, body: BodyHandle) -> Transform {
         self.bodies
             .sim(body)
@@ -326,7 +443,7 @@ impl QueryContext<'_> {
         let mut best: Option<(Real, u32)> = None;
         for &slot in self.shapes.of_body(body) {
             let data = self.shapes.at(slot);
-            if !filter.accepts(data) {
+            if !self.admits(filter, slot) {
                 continue;
             }
             let d = janus2d_core::geometry::shape_distance(
@@ -438,7 +555,7 @@ pub(crate) fn cast_ray<F: FnMut(&RayHit) -> Real>(
         ctx.broadphase
             .ray_query(leg.origin, leg.translation, max_u, |_, slot| {
                 let data = ctx.shapes.at(slot);
-                if filter.accepts(data)
+                if ctx.admits(filter, slot)
                     && let Some(h) = data.geometry.ray_cast(&ctx.transform_of(data.body), &ray)
                 {
                     out.push((h.fraction, slot, h));
@@ -488,7 +605,7 @@ pub(crate) fn cast_shape<F: FnMut(&RayHit) -> Real>(
         let centre = start.apply(caster.centroid());
         ctx.broadphase.query(&swept, |_, slot| {
             let data = ctx.shapes.at(slot);
-            if !filter.accepts(data) {
+            if !ctx.admits(filter, slot) {
                 return true;
             }
             let xf_a = ctx.transform_of(data.body);
@@ -549,7 +666,7 @@ fn report_overlaps<F: FnMut(ShapeOverlap) -> bool>(
     candidates.dedup();
     for slot in candidates {
         let data = ctx.shapes.at(slot);
-        if !filter.accepts(data) || !exact(data, &ctx.transform_of(data.body)) {
+        if !ctx.admits(filter, slot) || !exact(data, &ctx.transform_of(data.body)) {
             continue;
         }
         let overlap = ShapeOverlap {
@@ -644,6 +761,237 @@ pub(crate) fn distance_between(ctx: &QueryContext<'_>, a: u32, b: u32) -> Distan
         &ShapeProxy::from_shape(&db.geometry),
         &ctx.transform_of(db.body),
     )
+}
+
+/// The point on a shape's surface nearest to a query point
+/// ([`World::project_point`](crate::World::project_point)).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointProjection {
+    /// The shape.
+    pub shape: ShapeHandle,
+    /// Its body.
+    pub body: BodyHandle,
+    /// The nearest point of the shape's surface, world, m.
+    pub point: Vec2,
+    /// Unit outward surface normal at `point` (for a query point on a
+    /// segment's or a core's line itself, the shape's own side normal).
+    pub normal: Vec2,
+    /// Distance from the query point to `point`, m (≥ 0; the depth when
+    /// `inside`).
+    pub distance: Real,
+    /// The query point lies inside the (solid) shape: deeper than 0 under
+    /// its surface. Segments and chain segments never hold a point.
+    pub inside: bool,
+}
+
+/// Nearest point on the segment `a`–`b` to `p`.
+fn closest_on_segment(a: Vec2, b: Vec2, p: Vec2) -> Vec2 {
+    let d = b - a;
+    let dd = d.length_squared();
+    if dd <= 0.0 {
+        return a;
+    }
+    let t = ((p - a).dot(d) / dd).clamp(0.0, 1.0);
+    a + t * d
+}
+
+/// The unit right perpendicular of `b - a` (`(0, -1)` for a point).
+fn side_normal(a: Vec2, b: Vec2) -> Vec2 {
+    let d = b - a;
+    let len = d.length();
+    if len > 0.0 {
+        Vec2::new(d.y, -d.x) / len
+    } else {
+        Vec2::new(0.0, -1.0)
+    }
+}
+
+/// Surface point, outward normal and signed distance (negative inside) of
+/// a core `core` (the nearest core point to `p`) rounded by `radius`;
+/// `fallback` is the normal when `p` is on the core itself.
+fn rounded(core: Vec2, p: Vec2, radius: Real, fallback: Vec2) -> (Vec2, Vec2, Real) {
+    let d = p - core;
+    let len = d.length();
+    let n = if len > 0.0 { d / len } else { fallback };
+    (core + radius * n, n, len - radius)
+}
+
+/// `(surface point, outward normal, signed distance)` of `shape` from
+/// `p`, all in the shape's frame; the distance is negative inside.
+pub(crate) fn project_local(shape: &Shape, p: Vec2) -> (Vec2, Vec2, Real) {
+    match shape {
+        Shape::Circle(c) => rounded(c.center, p, c.radius, Vec2::Y),
+        Shape::Capsule(c) => {
+            let core = closest_on_segment(c.center1, c.center2, p);
+            rounded(core, p, c.radius, side_normal(c.center1, c.center2))
+        }
+        Shape::Segment(s) => {
+            let core = closest_on_segment(s.point1, s.point2, p);
+            let (q, n, d) = rounded(core, p, 0.0, side_normal(s.point1, s.point2));
+            (q, n, d.max(0.0))
+        }
+        Shape::ChainSegment(c) => {
+            let s = &c.segment;
+            let core = closest_on_segment(s.point1, s.point2, p);
+            let (q, n, d) = rounded(core, p, 0.0, side_normal(s.point1, s.point2));
+            (q, n, d.max(0.0))
+        }
+        Shape::Polygon(poly) => {
+            let n = poly.count;
+            if n < 3 {
+                let (a, b) = (poly.vertices[0], poly.vertices[1.min(n - 1)]);
+                let core = closest_on_segment(a, b, p);
+                return rounded(core, p, poly.radius, poly.normals[0]);
+            }
+            // The face the point is farthest out of.
+            let mut best = (Real::NEG_INFINITY, 0);
+            for i in 0..n {
+                let s = poly.normals[i].dot(p - poly.vertices[i]);
+                if s > best.0 {
+                    best = (s, i);
+                }
+            }
+            let (s, face) = best;
+            if s <= 0.0 {
+                // Inside the core: straight out through the nearest face.
+                let normal = poly.normals[face];
+                return (p + (poly.radius - s) * normal, normal, s - poly.radius);
+            }
+            // Outside the core: the nearest point of its boundary.
+            let mut nearest = (Real::INFINITY, Vec2::ZERO, 0);
+            for i in 0..n {
+                let q = closest_on_segment(poly.vertices[i], poly.vertices[(i + 1) % n], p);
+                let d2 = (p - q).length_squared();
+                if d2 < nearest.0 {
+                    nearest = (d2, q, i);
+                }
+            }
+            rounded(nearest.1, p, poly.radius, poly.normals[nearest.2])
+        }
+    }
+}
+
+/// The projection of `p` (world) on the shape in `slot` at its body's pose.
+fn project_slot(ctx: &QueryContext<'_>, slot: u32, p: Vec2) -> PointProjection {
+    let data = ctx.shapes.at(slot);
+    let xf = ctx.transform_of(data.body);
+    let (q, n, signed) = project_local(&data.geometry, xf.apply_inv(p));
+    PointProjection {
+        shape: ctx.shapes.handle_of(slot, ctx.owner),
+        body: data.body,
+        point: xf.apply(q),
+        normal: xf.q.rotate(n),
+        distance: signed.abs(),
+        inside: signed < 0.0,
+    }
+}
+
+/// The accepted shape whose surface is nearest to `point` within
+/// `max_distance` (shapes holding the point first, the deepest first).
+pub(crate) fn project_point(
+    ctx: &QueryContext<'_>,
+    point: Vec2,
+    max_distance: Real,
+    filter: &QueryFilter,
+) -> Result<Option<PointProjection>, WorldError> {
+    check_vec(point, "point")?;
+    if max_distance.is_nan() {
+        return Err(bad("max_distance", QueryProblem::NonFinite));
+    }
+    if max_distance < 0.0 {
+        return Err(bad("max_distance", QueryProblem::Negative));
+    }
+    let reach = Vec2::new(max_distance, max_distance);
+    let aabb = Aabb::new(point - reach, point + reach);
+    let mut candidates = candidates_in(ctx, &aabb);
+    candidates.sort_unstable();
+    candidates.dedup();
+    let mut best: Option<(Real, PointProjection)> = None;
+    for slot in candidates {
+        if !ctx.admits(filter, slot) {
+            continue;
+        }
+        let proj = project_slot(ctx, slot, point);
+        let signed = if proj.inside {
+            -proj.distance
+        } else {
+            proj.distance
+        };
+        if signed > max_distance {
+            continue;
+        }
+        if best.is_none_or(|(b, _)| signed < b) {
+            best = Some((signed, proj));
+        }
+    }
+    Ok(best.map(|(_, p)| p))
+}
+
+/// The projection of `point` on one live shape (slot), unfiltered.
+pub(crate) fn project_on_shape(
+    ctx: &QueryContext<'_>,
+    slot: u32,
+    point: Vec2,
+) -> Result<PointProjection, WorldError> {
+    check_vec(point, "point")?;
+    Ok(project_slot(ctx, slot, point))
+}
+
+/// The first hit of the ray on the shape in `slot` only (when `filter`
+/// accepts it), through apertures when the filter says so.
+pub(crate) fn shape_ray_cast(
+    ctx: &QueryContext<'_>,
+    slot: u32,
+    origin: Vec2,
+    translation: Vec2,
+    filter: &QueryFilter,
+) -> Result<Option<RayHit>, WorldError> {
+    check_vec(origin, "origin")?;
+    check_translation(translation)?;
+    if !ctx.admits(filter, slot) {
+        return Ok(None);
+    }
+    let data = ctx.shapes.at(slot);
+    let gather = |leg: &Leg, max_u: Real, may_cross: bool, out: &mut Vec<(Real, u32, CastHit)>| {
+        let ray = RayInput {
+            origin: leg.origin,
+            translation: leg.translation,
+            max_fraction: max_u,
+        };
+        if let Some(h) = data.geometry.ray_cast(&ctx.transform_of(data.body), &ray) {
+            out.push((h.fraction, slot, h));
+        }
+        if may_cross {
+            ctx.drop_hole_hits(out);
+        }
+    };
+    let mut best = None;
+    ctx.run_cast(origin, translation, filter, gather, |hit| {
+        best = Some(*hit);
+        0.0
+    });
+    Ok(best)
+}
+
+/// Whether the solid shape in `slot` holds `point` (as `overlap_point`'s
+/// exact test; segments never do).
+pub(crate) fn shape_test_point(
+    ctx: &QueryContext<'_>,
+    slot: u32,
+    point: Vec2,
+) -> Result<bool, WorldError> {
+    check_vec(point, "point")?;
+    let data = ctx.shapes.at(slot);
+    if matches!(data.geometry, Shape::Segment(_) | Shape::ChainSegment(_)) {
+        return Ok(false);
+    }
+    let p = ShapeProxy::from_shape(&data.geometry);
+    Ok(shapes_overlap(
+        &p,
+        &ctx.transform_of(data.body),
+        &ShapeProxy::point(point),
+        &Transform::IDENTITY,
+    ))
 }
 
 #[cfg(test)]

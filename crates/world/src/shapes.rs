@@ -48,6 +48,30 @@ impl Default for Filter {
 }
 
 impl Filter {
+    /// A filter in the categories `category_bits` that collides with the
+    /// categories `mask_bits`, in no group.
+    ///
+    /// ```
+    /// use janus2d_world::Filter;
+    /// let f = Filter::new(0b10, 0b01).with_group(-3);
+    /// assert_eq!((f.category_bits, f.mask_bits, f.group_index), (2, 1, -3));
+    /// ```
+    #[must_use]
+    pub fn new(category_bits: u64, mask_bits: u64) -> Self {
+        Filter {
+            category_bits,
+            mask_bits,
+            group_index: 0,
+        }
+    }
+
+    /// Sets the group index (builder style; see [`Filter`]).
+    #[must_use]
+    pub fn with_group(mut self, group_index: i32) -> Self {
+        self.group_index = group_index;
+        self
+    }
+
     /// Whether two filters let their shapes collide.
     ///
     /// ```
@@ -127,6 +151,30 @@ impl ShapeDef {
     #[must_use]
     pub fn with_user_data(mut self, value: u64) -> Self {
         self.user_data = value;
+        self
+    }
+
+    /// Sets the collision filter (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::{Filter, ShapeDef};
+    /// let def = ShapeDef::default()
+    ///     .with_filter(Filter::new(0b10, !0b100))
+    ///     .with_sensor(true);
+    /// assert_eq!(def.filter.category_bits, 2);
+    /// assert!(def.is_sensor);
+    /// ```
+    #[must_use]
+    pub fn with_filter(mut self, filter: Filter) -> Self {
+        self.filter = filter;
+        self
+    }
+
+    /// Makes the shape a sensor or not (builder style; [`sensor`](Self::sensor)
+    /// is `with_sensor(true)`).
+    #[must_use]
+    pub fn with_sensor(mut self, on: bool) -> Self {
+        self.is_sensor = on;
         self
     }
 

@@ -322,15 +322,21 @@ pub struct Polygon {
 impl Polygon {
     /// An axis-aligned box centred on the body origin with half-widths `hx`, `hy`.
     ///
+    /// A convenience for sizes written in the code (a level's literals):
+    /// the checked constructor is [`try_make_box`](Self::try_make_box),
+    /// which returns a [`GeometryError`] instead of panicking; use it for
+    /// sizes computed or read at run time.
+    ///
     /// # Panics
-    /// If `hx` or `hy` is not finite and positive; [`try_make_box`](Self::try_make_box)
-    /// returns an error instead.
+    /// If `hx` or `hy` is not finite and positive.
     pub fn make_box(hx: Real, hy: Real) -> Polygon {
         Self::make_offset_rounded_box(hx, hy, Vec2::ZERO, Rot::IDENTITY, 0.0)
     }
 
     /// A box with half-widths `hx`, `hy`, centred on `center` and turned by
-    /// `angle` radians (all in the body frame).
+    /// `angle` radians (all in the body frame). A convenience for literals;
+    /// [`try_make_offset_box`](Self::try_make_offset_box) is the checked
+    /// constructor.
     ///
     /// # Panics
     /// If `hx` or `hy` is not finite and positive, or `center`/`angle` is not finite.
@@ -343,7 +349,9 @@ impl Polygon {
     }
 
     /// A box with core half-widths `hx`, `hy` rounded by `radius` (the outer
-    /// half-widths are `hx + radius`, `hy + radius`).
+    /// half-widths are `hx + radius`, `hy + radius`). A convenience for
+    /// literals; [`try_make_rounded_box`](Self::try_make_rounded_box) is the
+    /// checked constructor.
     ///
     /// # Panics
     /// If `hx` or `hy` is not finite and positive, or `radius` is negative or
@@ -422,7 +430,25 @@ impl Polygon {
         Self::try_make_offset_rounded_box(hx, hy, Vec2::ZERO, 0.0, radius)
     }
 
-    fn try_make_offset_rounded_box(
+    /// A box with core half-widths `hx`, `hy`, centred on `center`, turned
+    /// by `angle` radians (body frame) and rounded by `radius`: the general
+    /// checked box constructor. Errors: non-finite input
+    /// ([`GeometryError::NonFinite`]), a half-width ≤ 0
+    /// ([`GeometryError::DegeneratePolygon`]), a negative radius
+    /// ([`GeometryError::NegativeRadius`]).
+    ///
+    /// ```
+    /// use janus2d_core::geometry::{GeometryError, Polygon};
+    /// use janus2d_core::math::Vec2;
+    /// let p = Polygon::try_make_offset_rounded_box(1.0, 0.5, Vec2::new(2.0, 0.0), 0.0, 0.1).unwrap();
+    /// assert_eq!(p.centroid, Vec2::new(2.0, 0.0));
+    /// assert_eq!(p.radius, 0.1);
+    /// assert_eq!(
+    ///     Polygon::try_make_offset_rounded_box(1.0, 0.5, Vec2::ZERO, 0.0, -0.1),
+    ///     Err(GeometryError::NegativeRadius)
+    /// );
+    /// ```
+    pub fn try_make_offset_rounded_box(
         hx: Real,
         hy: Real,
         center: Vec2,

@@ -633,3 +633,463 @@ impl World {
         self.islands.island_id(body)
     }
 }
+
+/// An explosion ([`World::explode`], as Box2D's `b2ExplosionDef`): every
+/// dynamic body's shape within `radius + falloff` of `position` gets an
+/// outward impulse of `impulse_per_length` per metre of its width seen from
+/// the centre, full within `radius` and fading linearly to 0 across
+/// `falloff`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct ExplosionDef {
+    /// Centre of the explosion, world, m.
+    pub position: Vec2,
+    /// Radius of full strength, m (≥ 0).
+    pub radius: Real,
+    /// Width of the band beyond `radius` over which the impulse falls to 0,
+    /// m (≥ 0; usual 0).
+    pub falloff: Real,
+    /// Impulse per metre of projected width, N·s/m (negative: an implosion).
+    pub impulse_per_length: Real,
+    /// The shape categories it pushes (`shape.category & mask != 0`; usual all).
+    pub mask_bits: u64,
+}
+
+impl ExplosionDef {
+    /// An explosion at `position` of full strength within `radius`, pushing
+    /// `impulse_per_length` N·s per metre of width, no falloff, every
+    /// category.
+    ///
+    /// ```
+    /// use janus2d_world::ExplosionDef;
+    /// use janus2d_core::Vec2;
+    /// let e = ExplosionDef::new(Vec2::ZERO, 2.0, 5.0).with_falloff(1.0).with_mask(0b10);
+    /// assert_eq!((e.radius, e.falloff, e.impulse_per_length, e.mask_bits), (2.0, 1.0, 5.0, 2));
+    /// ```
+    #[must_use]
+    pub fn new(position: Vec2, radius: Real, impulse_per_length: Real) -> Self {
+        ExplosionDef {
+            position,
+            radius,
+            falloff: 0.0,
+            impulse_per_length,
+            mask_bits: u64::MAX,
+        }
+    }
+
+    /// Sets the falloff band, m (builder style).
+    #[must_use]
+    pub fn with_falloff(mut self, falloff: Real) -> Self {
+        self.falloff = falloff;
+        self
+    }
+
+    /// Pushes only the categories in `mask_bits` (builder style).
+    #[must_use]
+    pub fn with_mask(mut self, mask_bits: u64) -> Self {
+        self.mask_bits = mask_bits;
+        self
+    }
+
+    /// Checks the definition: a finite position within the world's extent,
+    /// finite non-negative radius and falloff, a finite impulse; the error
+    /// names the field.
+    pub fn validate(&self) -> Result<(), WorldError> {
+        janus2d_core::body::check_position(self.position, "position")?;
+        super::shapes::check_material(self.radius, "radius")?;
+        super::shapes::check_material(self.falloff, "falloff")?;
+        if !self.impulse_per_length.is_finite() {
+            return Err(WorldError::NonFinite("impulse_per_length"));
+        }
+        Ok(())
+    }
+}
+
+/// Width of `shape` (body frame) along the unit direction `line`, m.
+fn projected_width(shape: &Shape, line: Vec2) -> Real {
+    match shape {
+        Shape::Circle(c) => 2.0 * c.radius,
+        Shape::Capsule(c) => 2.0 * c.radius + (c.center2 - c.center1).dot(line).abs(),
+        Shape::Segment(s) => (s.point2 - s.point1).dot(line).abs(),
+        Shape::ChainSegment(c) => (c.segment.point2 - c.segment.point1).dot(line).abs(),
+        Shape::Polygon(p) => {
+            let (mut lo, mut hi) = (Real::INFINITY, Real::NEG_INFINITY);
+            for v in &p.vertices[..p.count] {
+                let s = v.dot(line);
+                lo = lo.min(s);
+                hi = hi.max(s);
+            }
+            hi - lo + 2.0 * p.radius
+        }
+    }
+}
+
+impl World {
+    // ----- motion settings after creation ------------------------------------
+
+    /// The body and, while it crosses a portal, its other copy: settings
+    /// that the crossing copies share are set on both.
+    fn with_crossing_copy(&self, body: BodyHandle) -> smallvec::SmallVec<[BodyHandle; 2]> {
+        #[cfg_attr(not(feature = "portals"), allow(unused_mut))]
+        let mut out = smallvec::smallvec![body];
+        #[cfg(feature = "portals")]
+        for c in &self.portals.crossings {
+            if c.original == body {
+                out.push(c.clone);
+            } else if c.clone == body {
+                out.push(c.original);
+            }
+        }
+        out
+    }
+
+    /// Sets the body's gravity scale (dimensionless; 0 floats, −1 falls up),
+    /// read by [`gravity_scale`](Self::gravity_scale); wakes the body. A
+    /// body crossing a portal and its copy get the same scale.
+    ///
+    /// Errors (the world unchanged): a stale or foreign handle, a
+    /// non-finite scale, a magnitude above
+    /// [`MAX_GRAVITY_SCALE`](janus2d_core::limits::MAX_GRAVITY_SCALE)
+    /// ([`WorldError::OutOfBounds`]).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO).with_velocity(Vec2::new(1.0, 2.0))).unwrap();
+    /// world.set_gravity_scale(b, 0.0).unwrap();
+    /// for _ in 0..60 { world.step(1.0 / 60.0).unwrap(); }
+    /// assert_eq!(world.linear_velocity(b).unwrap(), Vec2::new(1.0, 2.0));
+    /// assert_eq!(world.gravity_scale(b).unwrap(), 0.0);
+    /// ```
+    pub fn set_gravity_scale(&mut self, body: BodyHandle, scale: Real) -> Result<(), WorldError> {
+        self.check_body(body)?;
+        if !scale.is_finite() {
+            return Err(WorldError::NonFinite("gravity_scale"));
+        }
+        let max = janus2d_core::limits::MAX_GRAVITY_SCALE;
+        if scale.abs() > max {
+            return Err(WorldError::OutOfBounds {
+                field: "gravity_scale",
+                min: -max,
+                max,
+            });
+        }
+        for b in self.with_crossing_copy(body) {
+            self.wake_island(b);
+            if let Some(s) = self.bodies.sim_mut(b) {
+                s.gravity_scale = scale;
+            }
+        }
+        Ok(())
+    }
+
+    /// The body's linear damping, 1/s.
+    pub fn linear_damping(&self, body: BodyHandle) -> Result<Real, WorldError> {
+        self.bodies
+            .sim(body)
+            .map(|s| s.linear_damping)
+            .ok_or_else(|| self.body_error(body))
+    }
+
+    /// The body's angular damping, 1/s.
+    pub fn angular_damping(&self, body: BodyHandle) -> Result<Real, WorldError> {
+        self.bodies
+            .sim(body)
+            .map(|s| s.angular_damping)
+            .ok_or_else(|| self.body_error(body))
+    }
+
+    /// Sets the body's linear damping, 1/s (as
+    /// [`BodyDef::linear_damping`](janus2d_core::BodyDef::linear_damping):
+    /// each step scales the velocity by `1 / (1 + h c)`); wakes the body. A
+    /// body crossing a portal and its copy get the same damping.
+    ///
+    /// Errors (the world unchanged): a stale or foreign handle, a non-finite
+    /// (`NonFinite("linear_damping")`) or negative
+    /// (`OutOfRange("linear_damping")`) value.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, WorldError};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let mut world = World::new(WorldDef { gravity: Vec2::ZERO, ..WorldDef::default() }).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO).with_velocity(Vec2::new(4.0, 0.0))).unwrap();
+    /// world.set_linear_damping(b, 1.0).unwrap();
+    /// world.step(1.0 / 60.0).unwrap();
+    /// assert!(world.linear_velocity(b).unwrap().x < 4.0);
+    /// assert_eq!(world.set_linear_damping(b, -1.0), Err(WorldError::OutOfRange("linear_damping")));
+    /// assert_eq!(world.linear_damping(b).unwrap(), 1.0);
+    /// ```
+    pub fn set_linear_damping(
+        &mut self,
+        body: BodyHandle,
+        damping: Real,
+    ) -> Result<(), WorldError> {
+        self.check_body(body)?;
+        super::shapes::check_material(damping, "linear_damping")?;
+        for b in self.with_crossing_copy(body) {
+            self.wake_island(b);
+            if let Some(s) = self.bodies.sim_mut(b) {
+                s.linear_damping = damping;
+            }
+        }
+        Ok(())
+    }
+
+    /// Sets the body's angular damping, 1/s (as
+    /// [`set_linear_damping`](Self::set_linear_damping), for the spin).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO).with_angular_velocity(3.0)).unwrap();
+    /// world.set_angular_damping(b, 2.0).unwrap();
+    /// world.step(1.0 / 60.0).unwrap();
+    /// assert!(world.angular_velocity(b).unwrap() < 3.0);
+    /// ```
+    pub fn set_angular_damping(
+        &mut self,
+        body: BodyHandle,
+        damping: Real,
+    ) -> Result<(), WorldError> {
+        self.check_body(body)?;
+        super::shapes::check_material(damping, "angular_damping")?;
+        for b in self.with_crossing_copy(body) {
+            self.wake_island(b);
+            if let Some(s) = self.bodies.sim_mut(b) {
+                s.angular_damping = damping;
+            }
+        }
+        Ok(())
+    }
+
+    /// True when the body's rotation is fixed ([`BodyDef::fixed_rotation`](janus2d_core::BodyDef::fixed_rotation)).
+    pub fn is_fixed_rotation(&self, body: BodyHandle) -> Result<bool, WorldError> {
+        self.bodies
+            .record(body)
+            .map(|r| r.fixed_rotation)
+            .ok_or_else(|| self.body_error(body))
+    }
+
+    /// Fixes or frees a body's rotation (as Box2D's
+    /// `b2Body_SetFixedRotation`): fixing zeroes its rotational inertia's
+    /// inverse and its angular velocity; freeing gives back the inertia of
+    /// its shapes. A body whose mass was set directly keeps its mass and
+    /// centre; freed, it gets its shapes' inertia about that centre scaled by
+    /// its mass over theirs. Wakes a dynamic body.
+    ///
+    /// Errors (the world unchanged): a stale or foreign handle; a body that
+    /// carries or is crossing a portal ([`WorldError::PortalBody`]: the
+    /// crossing's mass split is fixed when it starts); freeing a body with
+    /// a directly set mass whose shapes have no rotational inertia
+    /// (`Body(NonPositiveInertia)`).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Polygon;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO).with_angular_velocity(2.0)).unwrap();
+    /// world.create_shape(b, &ShapeDef::default(), Polygon::make_box(1.0, 0.5)).unwrap();
+    /// let inertia = world.rotational_inertia(b).unwrap();
+    /// world.set_fixed_rotation(b, true).unwrap();
+    /// assert!(world.is_fixed_rotation(b).unwrap());
+    /// assert_eq!(world.angular_velocity(b).unwrap(), 0.0);
+    /// world.set_fixed_rotation(b, false).unwrap();
+    /// assert!((world.rotational_inertia(b).unwrap() - inertia).abs() < 1e-6);
+    /// ```
+    pub fn set_fixed_rotation(&mut self, body: BodyHandle, fixed: bool) -> Result<(), WorldError> {
+        self.check_body(body)?;
+        if self.is_fixed_rotation(body)? == fixed {
+            return Ok(());
+        }
+        if self.portals.involves(body) {
+            return Err(WorldError::PortalBody);
+        }
+        let dynamic = self.body_type(body)? == BodyType::Dynamic;
+        let overridden = self.has_mass_override(body)?;
+        // A directly set mass keeps its mass and centre; the inertia is
+        // worked out before anything changes.
+        let kept = if dynamic && overridden {
+            let sim = self.bodies.sim(body).ok_or(WorldError::StaleBody)?;
+            let inertia = if fixed {
+                0.0
+            } else {
+                let md = self.collision.shapes.mass_of(body);
+                if !(md.mass > 0.0 && md.rotational_inertia > 0.0) {
+                    return Err(WorldError::Body(
+                        janus2d_core::body::BodyError::NonPositiveInertia,
+                    ));
+                }
+                let shift = (md.center - sim.local_center).length_squared();
+                janus2d_core::limits::clamp_to(
+                    (md.rotational_inertia + md.mass * shift) * sim.mass / md.mass,
+                    janus2d_core::limits::INERTIA_RANGE,
+                )
+            };
+            Some(BodyMass {
+                mass: sim.mass,
+                rotational_inertia: inertia,
+                center: sim.local_center,
+            })
+        } else {
+            None
+        };
+        if let Some(r) = self.bodies.record_mut(body) {
+            r.fixed_rotation = fixed;
+        }
+        if !dynamic {
+            return Ok(());
+        }
+        self.wake_island(body);
+        match kept {
+            Some(mass) => self.bodies.apply_mass(body, mass, fixed),
+            None => self.update_mass_from_shapes(body),
+        }
+        if fixed && let Some(s) = self.bodies.state_mut(body) {
+            s.w = 0.0;
+        }
+        Ok(())
+    }
+
+    /// The velocity of the body's material point at world `point`, m/s:
+    /// `v + ω × (point − centre of mass)` (as Box2D's
+    /// `b2Body_GetWorldPointVelocity`; zero for a static body).
+    ///
+    /// Errors: a stale or foreign handle, a non-finite point
+    /// (`NonFinite("point")`).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let wheel = world
+    ///     .create_body(&BodyDef::dynamic(Vec2::ZERO).with_velocity(Vec2::new(1.0, 0.0)).with_angular_velocity(2.0))
+    ///     .unwrap();
+    /// // 0.5 m above the centre: 1 − 2 · 0.5 = 0 along x (rolling without slip).
+    /// let top = world.velocity_at_point(wheel, Vec2::new(0.0, 0.5)).unwrap();
+    /// assert!((top - Vec2::new(0.0, 0.0)).length() < 1e-6);
+    /// ```
+    pub fn velocity_at_point(&self, body: BodyHandle, point: Vec2) -> Result<Vec2, WorldError> {
+        self.check_body(body)?;
+        if !vec_is_finite(point) {
+            return Err(WorldError::NonFinite("point"));
+        }
+        let c = self.center_of_mass(body)?;
+        let v = self.linear_velocity(body)?;
+        let w = self.angular_velocity(body)?;
+        Ok(v + janus2d_core::math::cross_sv(w, point - c))
+    }
+
+    /// Applies an explosion (as Box2D's `b2World_Explode`): each shape of a
+    /// dynamic body whose surface is within `radius + falloff` of the centre
+    /// (sensors and shapes outside `mask_bits` excepted) gets the impulse
+    /// `impulse_per_length · w · s` along the direction from the centre to
+    /// its nearest point `p`, applied at `p`, where `w` is the shape's width
+    /// across that direction and `s` is 1 within `radius`, falling linearly
+    /// to 0 at `radius + falloff`. A shape holding the centre is pushed from
+    /// its centroid outward (along +x when the centroid is the centre). The
+    /// bodies pushed wake. Returns the number of shapes pushed. Acts on the
+    /// shapes where they are: both copies of a body crossing a portal may be
+    /// pushed, nothing goes through apertures.
+    ///
+    /// Errors (nothing pushed): an invalid definition
+    /// ([`ExplosionDef::validate`]); an impulse that would take a body past
+    /// [`MAX_SPEED`](janus2d_core::limits::MAX_SPEED) or
+    /// [`MAX_ANGULAR_SPEED`](janus2d_core::limits::MAX_ANGULAR_SPEED).
+    ///
+    /// ```
+    /// use janus2d_world::{ExplosionDef, World, WorldDef, ShapeDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Circle;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::new(3.0, 0.0))).unwrap();
+    /// world.create_shape(b, &ShapeDef::default(), Circle::new(Vec2::ZERO, 0.5).unwrap()).unwrap();
+    /// let pushed = world.explode(&ExplosionDef::new(Vec2::ZERO, 4.0, 2.0)).unwrap();
+    /// assert_eq!(pushed, 1);
+    /// // 2 N·s/m × 1 m of width = 2 N·s on m = π 0.5² kg, along +x.
+    /// let m = world.mass(b).unwrap();
+    /// assert!((world.linear_velocity(b).unwrap().x - 2.0 / m).abs() < 1e-4);
+    /// ```
+    pub fn explode(&mut self, def: &ExplosionDef) -> Result<usize, WorldError> {
+        def.validate()?;
+        let reach = def.radius + def.falloff;
+        let half = Vec2::new(reach, reach);
+        let aabb = janus2d_core::geometry::Aabb::new(def.position - half, def.position + half);
+        let mut slots = Vec::new();
+        self.collision.broadphase.query(&aabb, |_, slot| {
+            slots.push(slot);
+            true
+        });
+        slots.sort_unstable();
+        slots.dedup();
+        // Each body's new velocities, worked out before anything changes.
+        let mut pushes: Vec<(BodyHandle, Vec2, Real)> = Vec::new();
+        let mut count = 0;
+        for slot in slots {
+            let data = self.collision.shapes.at(slot);
+            if data.def.is_sensor || data.def.filter.category_bits & def.mask_bits == 0 {
+                continue;
+            }
+            if self.bodies.body_type(data.body) != Some(BodyType::Dynamic) {
+                continue;
+            }
+            let Some(sim) = self.bodies.sim(data.body) else {
+                continue;
+            };
+            let xf = sim.transform;
+            let (q, _, signed) =
+                crate::query::project_local(&data.geometry, xf.apply_inv(def.position));
+            let distance = signed.max(0.0);
+            if distance > reach {
+                continue;
+            }
+            let at = if signed > 0.0 {
+                xf.apply(q)
+            } else {
+                xf.apply(data.geometry.centroid())
+            };
+            let d = at - def.position;
+            let direction = if d.length_squared() > 1e-12 {
+                d.normalize()
+            } else {
+                Vec2::X
+            };
+            let scale = if distance <= def.radius {
+                1.0
+            } else {
+                ((reach - distance) / def.falloff).clamp(0.0, 1.0)
+            };
+            let across = xf.q.inv_rotate(Vec2::new(-direction.y, direction.x));
+            let magnitude =
+                def.impulse_per_length * projected_width(&data.geometry, across) * scale;
+            let impulse = magnitude * direction;
+            let (im, ii, c) = (sim.inv_mass, sim.inv_inertia, sim.center);
+            let (dv, dw) = (im * impulse, ii * cross(at - c, impulse));
+            match pushes.iter_mut().find(|p| p.0 == data.body) {
+                Some(p) => {
+                    p.1 += dv;
+                    p.2 += dw;
+                }
+                None => {
+                    let v = self.linear_velocity(data.body)?;
+                    let w = self.angular_velocity(data.body)?;
+                    pushes.push((data.body, v + dv, w + dw));
+                }
+            }
+            count += 1;
+        }
+        for &(_, v, w) in &pushes {
+            check_resulting_velocity(v, w)?;
+        }
+        for (body, v, w) in pushes {
+            self.wake_island(body);
+            if let Some(s) = self.bodies.state_mut(body) {
+                s.v = v;
+                s.w = w;
+            }
+        }
+        Ok(count)
+    }
+}

@@ -87,6 +87,55 @@ impl Default for WorldDef {
     }
 }
 
+impl WorldDef {
+    /// Sets the gravity, m/s² (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::WorldDef;
+    /// use janus2d_core::Vec2;
+    /// let def = WorldDef::default()
+    ///     .with_gravity(Vec2::new(0.0, -9.81))
+    ///     .with_continuous(false)
+    ///     .with_hit_event_threshold(2.0);
+    /// assert_eq!(def.gravity.y, -9.81);
+    /// assert!(!def.enable_continuous);
+    /// assert_eq!(def.hit_event_threshold, 2.0);
+    /// ```
+    #[must_use]
+    pub fn with_gravity(mut self, gravity: Vec2) -> Self {
+        self.gravity = gravity;
+        self
+    }
+
+    /// Sets the solver settings (builder style).
+    #[must_use]
+    pub fn with_solver(mut self, solver: SolverSettings) -> Self {
+        self.solver = solver;
+        self
+    }
+
+    /// Sets the sleep settings (builder style).
+    #[must_use]
+    pub fn with_sleep(mut self, sleep: SleepSettings) -> Self {
+        self.sleep = sleep;
+        self
+    }
+
+    /// Turns continuous collision on or off (builder style).
+    #[must_use]
+    pub fn with_continuous(mut self, on: bool) -> Self {
+        self.enable_continuous = on;
+        self
+    }
+
+    /// Sets the hit event approach speed threshold, m/s (builder style).
+    #[must_use]
+    pub fn with_hit_event_threshold(mut self, speed: Real) -> Self {
+        self.hit_event_threshold = speed;
+        self
+    }
+}
+
 /// Events of the last step, read after `step`.
 #[derive(Clone, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -340,6 +389,7 @@ impl World {
 }
 
 mod bodies;
+pub use bodies::ExplosionDef;
 mod events;
 mod internal;
 mod joints;

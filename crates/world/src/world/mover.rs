@@ -49,7 +49,7 @@ impl World {
         slots.dedup();
         slots.retain(|&slot| {
             let data = shapes.at(slot);
-            if !filter.accepts(data) {
+            if !filter.accepts_shape(shapes.handle_of(slot, self.bodies.owner()), data) {
                 return false;
             }
             if let Shape::ChainSegment(c) = &data.geometry {

@@ -233,4 +233,182 @@ impl World {
         let ctx = self.query_context(&crate::query::QueryFilter::default());
         Ok(crate::query::distance_between(&ctx, sa, sb))
     }
+
+    /// The point of the shapes' surfaces nearest to `point` within
+    /// `max_distance` m (`Real::INFINITY`: anywhere), with its shape, body,
+    /// outward normal and distance, or `None` when no shape the filter
+    /// accepts is that close. A shape that holds the point
+    /// ([`PointProjection::inside`](crate::query::PointProjection::inside);
+    /// the point is then `distance` under its surface) is nearer than any
+    /// other, the deepest first; ties go to the lower shape slot. As Rapier's
+    /// `project_point` with `solid = false`, Box2D has no such query.
+    ///
+    /// Point queries see each shape where it is, crossing copies included
+    /// (as [`overlap_point`](Self::overlap_point)); `through_portals` does
+    /// not apply to them.
+    ///
+    /// Errors: a non-finite point, a NaN or negative `max_distance`
+    /// ([`WorldError::BadQuery`]; the world is unchanged).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef, QueryFilter};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Polygon;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::fixed(Vec2::new(3.0, 0.0))).unwrap();
+    /// world.create_shape(b, &ShapeDef::default(), Polygon::make_box(1.0, 1.0)).unwrap();
+    /// let p = world
+    ///     .project_point(Vec2::new(0.0, 0.5), 10.0, &QueryFilter::default())
+    ///     .unwrap()
+    ///     .unwrap();
+    /// // The left face of the box is at x = 2.
+    /// assert!((p.point - Vec2::new(2.0, 0.5)).length() < 1e-5);
+    /// assert!((p.distance - 2.0).abs() < 1e-5 && !p.inside);
+    /// assert!((p.normal - Vec2::new(-1.0, 0.0)).length() < 1e-5);
+    /// ```
+    pub fn project_point(
+        &self,
+        point: Vec2,
+        max_distance: Real,
+        filter: &crate::query::QueryFilter,
+    ) -> Result<Option<crate::query::PointProjection>, WorldError> {
+        let ctx = self.query_context(filter);
+        crate::query::project_point(&ctx, point, max_distance, filter)
+    }
+
+    /// The point of one shape's surface nearest to `point` (as
+    /// [`project_point`](Self::project_point), on that shape alone, whatever
+    /// its filter or sensor flag).
+    ///
+    /// Errors: a stale or foreign shape handle, a non-finite point.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Circle;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    /// let s = world.create_shape(b, &ShapeDef::default(), Circle::new(Vec2::ZERO, 2.0).unwrap()).unwrap();
+    /// let p = world.shape_project_point(s, Vec2::new(0.5, 0.0)).unwrap();
+    /// assert!(p.inside && (p.distance - 1.5).abs() < 1e-6);
+    /// assert!((p.point - Vec2::new(2.0, 0.0)).length() < 1e-6);
+    /// ```
+    pub fn shape_project_point(
+        &self,
+        shape: ShapeHandle,
+        point: Vec2,
+    ) -> Result<crate::query::PointProjection, WorldError> {
+        let slot = self.collision.shapes.slot(shape, self.bodies.owner())?;
+        let ctx = self.query_context(&crate::query::QueryFilter::default());
+        crate::query::project_on_shape(&ctx, slot, point)
+    }
+
+    /// The first hit of the ray `origin + s · translation`, `s ∈ [0, 1]`, on
+    /// `shape` alone: [`cast_ray_closest`](Self::cast_ray_closest) restricted
+    /// to one shape (as Box2D's `b2Shape_RayCast`). `filter` applies as
+    /// there: a shape it does not accept (a sensor, another category, the
+    /// excluded body, the predicate's `false`) is never hit, and with
+    /// `through_portals` the ray goes on through apertures and may hit the
+    /// shape beyond them (`portal_hops` says how many). A ray that starts
+    /// inside the shape does not hit it.
+    ///
+    /// Errors: a stale or foreign shape handle, a non-finite origin or
+    /// translation, a zero translation.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef, QueryFilter};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Polygon;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let near = world.create_body(&BodyDef::fixed(Vec2::new(2.0, 0.0))).unwrap();
+    /// world.create_shape(near, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    /// let far = world.create_body(&BodyDef::fixed(Vec2::new(5.0, 0.0))).unwrap();
+    /// let s = world.create_shape(far, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    /// // The nearer box does not hide the one asked about.
+    /// let hit = world
+    ///     .shape_ray_cast(s, Vec2::ZERO, Vec2::new(10.0, 0.0), &QueryFilter::default())
+    ///     .unwrap()
+    ///     .unwrap();
+    /// assert!((hit.point.x - 4.5).abs() < 1e-5 && (hit.fraction - 0.45).abs() < 1e-6);
+    /// ```
+    pub fn shape_ray_cast(
+        &self,
+        shape: ShapeHandle,
+        origin: Vec2,
+        translation: Vec2,
+        filter: &crate::query::QueryFilter,
+    ) -> Result<Option<crate::query::RayHit>, WorldError> {
+        let slot = self.collision.shapes.slot(shape, self.bodies.owner())?;
+        let ctx = self.query_context(filter);
+        crate::query::shape_ray_cast(&ctx, slot, origin, translation, filter)
+    }
+
+    /// True when the solid `shape` holds `point` (its surface included;
+    /// segments and chain segments never do): the exact test of
+    /// [`overlap_point`](Self::overlap_point) on one shape, whatever its
+    /// filter or sensor flag (as Box2D's `b2Shape_TestPoint`).
+    ///
+    /// Errors: a stale or foreign shape handle, a non-finite point.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Polygon;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::fixed(Vec2::new(1.0, 0.0))).unwrap();
+    /// let s = world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    /// assert!(world.shape_test_point(s, Vec2::new(1.4, 0.4)).unwrap());
+    /// assert!(!world.shape_test_point(s, Vec2::new(1.6, 0.0)).unwrap());
+    /// ```
+    pub fn shape_test_point(&self, shape: ShapeHandle, point: Vec2) -> Result<bool, WorldError> {
+        let slot = self.collision.shapes.slot(shape, self.bodies.owner())?;
+        let ctx = self.query_context(&crate::query::QueryFilter::default());
+        crate::query::shape_test_point(&ctx, slot, point)
+    }
+
+    /// The shapes overlapping `shape` through sensor contacts now, sorted
+    /// by handle: for a sensor, the shapes inside it (its visitors); for any
+    /// other shape, the sensors it is inside. This is the set the sensor
+    /// events describe: after each step it equals the set before it, plus
+    /// the step's `sensor_begin` pairs naming `shape`, minus its
+    /// `sensor_end` pairs (see [`CollisionEvents`]).
+    /// A crossing copy is a shape of its own, with its own overlaps.
+    ///
+    /// Errors: a stale or foreign shape handle.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::{Circle, Polygon};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let zone = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    /// let sensor = world
+    ///     .create_shape(zone, &ShapeDef::default().sensor(), Polygon::make_box(2.0, 2.0))
+    ///     .unwrap();
+    /// let ball = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 1.0))).unwrap();
+    /// let s = world.create_shape(ball, &ShapeDef::default(), Circle::new(Vec2::ZERO, 0.25).unwrap()).unwrap();
+    /// world.step(1.0 / 60.0).unwrap();
+    /// assert_eq!(world.sensor_overlaps(sensor).unwrap(), vec![s]);
+    /// assert_eq!(world.sensor_overlaps(s).unwrap(), vec![sensor]);
+    /// ```
+    pub fn sensor_overlaps(&self, shape: ShapeHandle) -> Result<Vec<ShapeHandle>, WorldError> {
+        let body = self.shape(shape)?.body;
+        let contacts = &self.collision.contacts;
+        let mut out: Vec<ShapeHandle> = contacts
+            .of_body(body)
+            .iter()
+            .filter_map(|&id| contacts.get(id))
+            .filter(|c| c.sensor && c.touching && c.shapes.contains(&shape))
+            .map(|c| {
+                if c.shapes[0] == shape {
+                    c.shapes[1]
+                } else {
+                    c.shapes[0]
+                }
+            })
+            .collect();
+        out.sort();
+        out.dedup();
+        Ok(out)
+    }
 }
