@@ -523,13 +523,21 @@ struct JointScratch {
     c_angle: Real,
     /// A copy of its accumulated angle impulse, N·m·s.
     angle_impulse: Real,
+    /// A `General` joint: solved by the general 3×3 path (its
+    /// [`WideScratch`]).
+    general: bool,
+}
+
+/// The part of a tree joint's scratch only 3-row and `General` joints
+/// use, kept apart so the 2-row joints' scratch stays compact (a
+/// point-only tree never touches it).
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+struct WideScratch {
     /// The pivot `D_k` while eliminating, then `D_k⁻¹` (3-row joints).
     d3: Matrix3,
     /// The right-hand side, then the solution `μ` (3-row joints).
     b3: DVec3,
-    /// A `General` joint: its rows below, solved by the general 3×3 path
-    /// (with `d3`, `b3`).
-    general: bool,
     /// Its rows on the parent body (rows past its count are zero), masked
     /// like the point Jacobians.
     g_parent: Matrix3,
@@ -563,9 +571,14 @@ impl JointScratch {
         three: false,
         c_angle: 0.0,
         angle_impulse: 0.0,
+        general: false,
+    };
+}
+
+impl WideScratch {
+    const ZERO: WideScratch = WideScratch {
         d3: Matrix3::ZERO,
         b3: DVec3::ZERO,
-        general: false,
         g_parent: Matrix3::ZERO,
         g_child: Matrix3::ZERO,
         g_k: Matrix3::ZERO,
@@ -577,6 +590,12 @@ impl JointScratch {
 }
 
 impl Default for JointScratch {
+    fn default() -> Self {
+        Self::ZERO
+    }
+}
+
+impl Default for WideScratch {
     fn default() -> Self {
         Self::ZERO
     }
@@ -601,6 +620,8 @@ pub struct JointForest {
     /// Per tree body and per tree joint: the solve's scratch.
     body_scratch: Vec<BodyScratch>,
     joint_scratch: Vec<JointScratch>,
+    /// Per tree joint: the 3-row and general rows' part of its scratch.
+    wide_scratch: Vec<WideScratch>,
     /// Per joint: its moving ends this step (see `moving_pair`).
     pairs: Vec<[u32; 3]>,
     /// The pairs and switch the forest was last built from.
@@ -805,6 +826,8 @@ impl JointForest {
             .resize(self.bodies.len(), BodyScratch::ZERO);
         self.joint_scratch
             .resize(self.joints.len(), JointScratch::ZERO);
+        self.wide_scratch
+            .resize(self.joints.len(), WideScratch::ZERO);
     }
 
     /// Breadth-first from `root`, appending the tree's bodies and joints.
@@ -899,6 +922,7 @@ impl JointForest {
             let (joints, states) = (&*joints, &*states);
             let mut rest_bodies = &mut self.body_scratch[..];
             let mut rest_joints = &mut self.joint_scratch[..];
+            let mut rest_wide = &mut self.wide_scratch[..];
             let starts = &self.trees;
             let split = starts.iter().enumerate().map(move |(t, &start)| {
                 let end = starts.get(t + 1).copied().unwrap_or(TreeStart {
@@ -913,11 +937,15 @@ impl JointForest {
                 let (joint_scratch, tail) =
                     std::mem::take(&mut rest_joints).split_at_mut(joint_range.len());
                 rest_joints = tail;
+                let (wide_scratch, tail) =
+                    std::mem::take(&mut rest_wide).split_at_mut(joint_range.len());
+                rest_wide = tail;
                 Tree {
                     states: &bodies[body_range],
                     joints: &tree_joints[joint_range],
                     bodies: body_scratch,
                     rows: joint_scratch,
+                    wide: wide_scratch,
                 }
             });
             if team.threads() == 1 {
@@ -940,9 +968,10 @@ impl JointForest {
             st.v = sc.state.v;
             st.w = sc.state.w;
         }
-        for (tj, row) in self.joints.iter().zip(&self.joint_scratch) {
+        let rows = self.joint_scratch.iter().zip(&self.wide_scratch);
+        for (tj, (row, wide)) in self.joints.iter().zip(rows) {
             let impulses = if row.general {
-                row.g_impulse
+                wide.g_impulse
             } else {
                 [row.impulse.x, row.impulse.y, row.angle_impulse]
             };
@@ -972,6 +1001,8 @@ struct Tree<'a> {
     /// Per body and per joint: the solve's scratch.
     bodies: &'a mut [BodyScratch],
     rows: &'a mut [JointScratch],
+    /// Per joint: the 3-row and general rows' scratch.
+    wide: &'a mut [WideScratch],
 }
 
 /// The state of tree joint `tj`'s other end: the tree's copy of its child
@@ -1008,8 +1039,9 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
         joints: topology,
         bodies,
         rows,
+        wide: extra,
     } = tree;
-    let (topology, bodies, rows) = (&**topology, &mut **bodies, &mut **rows);
+    let (topology, bodies, rows, extra) = (&**topology, &mut **bodies, &mut **rows, &mut **extra);
     for (sc, &s) in bodies.iter_mut().zip(indices.iter()) {
         sc.state = states[s as usize];
         sc.leaf = true;
@@ -1026,7 +1058,7 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
     }
     // Arms, separations, Jacobians and impulses of the joints, and the
     // geometric stiffness each body takes from its joints.
-    for (tj, row) in topology.iter().zip(rows.iter_mut()) {
+    for ((tj, row), w) in topology.iter().zip(rows.iter_mut()).zip(extra.iter_mut()) {
         let j = &joints[tj.index as usize];
         let tree_rows = j.tree_rows();
         let base = j.base();
@@ -1034,7 +1066,7 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
         row.masses = base.masses;
         row.general = matches!(tree_rows, Some(TreeRows::General { .. }));
         if row.general {
-            general_rows(tj, row, j, bodies, states);
+            general_rows(tj, row, w, j, bodies, states);
             continue;
         }
         let (point, tree_angle) = match tree_rows {
@@ -1107,13 +1139,13 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
     if use_bias {
         // The warm start applied the kept impulses through the bodies' own
         // inertia; re-weight their torque to the solve's inertia.
-        for (tj, row) in topology.iter().zip(rows.iter()) {
+        for ((tj, row), w) in topology.iter().zip(rows.iter()).zip(extra.iter()) {
             if row.general {
-                let lambda = wide_rows(row.g_impulse);
+                let lambda = wide_rows(w.g_impulse);
                 let torque = |j: &Matrix3| from_f64(j.col(2).dot(lambda));
-                bodies[tj.parent as usize].reweight_angle(1.0, torque(&row.g_parent));
+                bodies[tj.parent as usize].reweight_angle(1.0, torque(&w.g_parent));
                 if tj.child != NONE {
-                    bodies[tj.child as usize].reweight_angle(1.0, torque(&row.g_child));
+                    bodies[tj.child as usize].reweight_angle(1.0, torque(&w.g_child));
                 }
                 continue;
             }
@@ -1132,13 +1164,18 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
     // Leaves first: each joint's row and pivot, its child body's subtree
     // folded in (that body's pivot is complete: its other joints come
     // later), then the joint folded into its parent body.
-    for (tj, row) in topology.iter().zip(rows.iter_mut()).rev() {
+    for ((tj, row), w) in topology
+        .iter()
+        .zip(rows.iter_mut())
+        .zip(extra.iter_mut())
+        .rev()
+    {
         if row.three {
-            eliminate_three(tj, row, bodies, states, params);
+            eliminate_three(tj, row, w, bodies, states, params);
             continue;
         }
         if row.general {
-            eliminate_general(tj, row, bodies, states, params);
+            eliminate_general(tj, row, w, bodies, states, params);
             continue;
         }
         let side = tj.side;
@@ -1198,13 +1235,13 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
     let root = &mut bodies[0];
     root.d = pivot_inverse(&root.d);
     root.b = root.d * root.b;
-    for (tj, row) in topology.iter().zip(rows.iter_mut()) {
+    for ((tj, row), w) in topology.iter().zip(rows.iter_mut()).zip(extra.iter_mut()) {
         if row.three {
-            substitute_three(tj, row, bodies);
+            substitute_three(tj, row, w, bodies);
             continue;
         }
         if row.general {
-            substitute_general(tj, row, bodies);
+            substitute_general(tj, w, bodies);
             continue;
         }
         let side = tj.side;
@@ -1260,6 +1297,7 @@ fn three_row_k(m: &PairMass, r_a: Vec2, r_b: Vec2) -> Matrix3 {
 fn eliminate_three(
     tj: &TreeJoint,
     row: &mut JointScratch,
+    w: &mut WideScratch,
     bodies: &mut [BodyScratch],
     states: &[BodyState],
     params: &TreeParams,
@@ -1311,8 +1349,8 @@ fn eliminate_three(
         }
     }
     let t = pivot_inverse(&d);
-    row.d3 = t;
-    row.b3 = b;
+    w.d3 = t;
+    w.b3 = b;
     // D_p −= Jᵀ D_k⁻¹ J,  b_p −= Jᵀ D_k⁻¹ b_k.
     let parent = &mut bodies[tj.parent as usize];
     let j = row.jac_parent.full();
@@ -1325,12 +1363,17 @@ fn eliminate_three(
 /// `x_k = T b_k − T J_kp x_p`, its impulse `Δλ = −x_k` applied (point
 /// impulse at the arms, angle impulse as a torque), then its child's
 /// `x_c = D_c⁻¹ b_c − D_c⁻¹ J_kcᵀ x_k`.
-fn substitute_three(tj: &TreeJoint, row: &mut JointScratch, bodies: &mut [BodyScratch]) {
+fn substitute_three(
+    tj: &TreeJoint,
+    row: &mut JointScratch,
+    w: &mut WideScratch,
+    bodies: &mut [BodyScratch],
+) {
     let side = tj.side;
     let parent = &mut bodies[tj.parent as usize];
-    let t = row.d3;
-    let x = t * row.b3 - t * (row.jac_parent.full() * parent.b);
-    row.b3 = x;
+    let t = w.d3;
+    let x = t * w.b3 - t * (row.jac_parent.full() * parent.b);
+    w.b3 = x;
     let impulse = -Vec2::new(from_f64(x.x), from_f64(x.y));
     let angular = -from_f64(x.z);
     row.impulse += impulse;
@@ -1393,6 +1436,7 @@ fn block_k(jr: &[[Real; 3]; 3], count: usize, mass: &InvMass) -> Matrix3 {
 fn general_rows(
     tj: &TreeJoint,
     row: &mut JointScratch,
+    w: &mut WideScratch,
     j: &Joint,
     bodies: &mut [BodyScratch],
     states: &[BodyState],
@@ -1418,16 +1462,16 @@ fn general_rows(
     } else {
         (&rows.j_a, &rows.j_b, m.a, m.b)
     };
-    row.g_k = block_k(j_parent, count, &m_parent) + block_k(j_other, count, &m_other);
-    row.g_c = wide_rows(rows.c);
-    row.g_impulse = rows.impulse;
-    row.g_linear = rows.linear;
-    row.g_count = count;
+    w.g_k = block_k(j_parent, count, &m_parent) + block_k(j_other, count, &m_other);
+    w.g_c = wide_rows(rows.c);
+    w.g_impulse = rows.impulse;
+    w.g_linear = rows.linear;
+    w.g_count = count;
     row.three = false;
     let parent = &mut bodies[tj.parent as usize];
     parent.leaf = false;
-    row.g_parent = row_block(j_parent, count, parent.lin, parent.ang);
-    row.g_child = if tj.child != NONE {
+    w.g_parent = row_block(j_parent, count, parent.lin, parent.ang);
+    w.g_child = if tj.child != NONE {
         let child = &mut bodies[tj.child as usize];
         child.set_mass(m_other);
         row_block(j_other, count, child.lin, child.ang)
@@ -1449,21 +1493,22 @@ fn rows_times(j: &Matrix3, st: &BodyState) -> DVec3 {
 fn eliminate_general(
     tj: &TreeJoint,
     row: &mut JointScratch,
+    w: &mut WideScratch,
     bodies: &mut [BodyScratch],
     states: &[BodyState],
     params: &TreeParams,
 ) {
     let parent = &bodies[tj.parent as usize].state;
     let other = other_end(tj, row.fixed, bodies, states);
-    let c_dot = rows_times(&row.g_parent, parent) + rows_times(&row.g_child, other);
+    let c_dot = rows_times(&w.g_parent, parent) + rows_times(&w.g_child, other);
     let compliance = params.compliance;
     let mut rhs = if params.use_bias {
         // Linear rows at the correction speed (m/s), angle rows at its
         // angular counterpart (rad/s).
         let max = to_f64(params.max_correction_speed);
         let max_angular = to_f64(angular_correction_cap(params.max_correction_speed));
-        let mut bias = row.g_c * to_f64(params.softness.bias_rate);
-        for (i, linear) in row.g_linear.iter().enumerate() {
+        let mut bias = w.g_c * to_f64(params.softness.bias_rate);
+        for (i, linear) in w.g_linear.iter().enumerate() {
             let max = if *linear { max } else { max_angular };
             bias[i] = if bias[i] > max {
                 max
@@ -1473,13 +1518,13 @@ fn eliminate_general(
                 bias[i]
             };
         }
-        let held = (row.g_k * wide_rows(row.g_impulse)) * compliance;
+        let held = (w.g_k * wide_rows(w.g_impulse)) * compliance;
         -(c_dot + bias + held)
     } else {
         -c_dot
     };
-    let mut d = row.g_k * -compliance;
-    for i in row.g_count..3 {
+    let mut d = w.g_k * -compliance;
+    for i in w.g_count..3 {
         rhs[i] = 0.0;
         d.col_mut(i)[i] = -1.0;
     }
@@ -1487,40 +1532,40 @@ fn eliminate_general(
     if tj.child != NONE {
         let child = &mut bodies[tj.child as usize];
         child.d = pivot_inverse(&child.d);
-        let l = row.g_child * child.d;
-        d -= l * row.g_child.transpose();
+        let l = w.g_child * child.d;
+        d -= l * w.g_child.transpose();
         if !child.leaf {
             b -= l * child.b;
         }
     }
     let t = pivot_inverse(&d);
-    row.d3 = t;
-    row.b3 = b;
+    w.d3 = t;
+    w.b3 = b;
     let parent = &mut bodies[tj.parent as usize];
-    let l = row.g_parent.transpose() * t;
-    parent.d -= l * row.g_parent;
+    let l = w.g_parent.transpose() * t;
+    parent.d -= l * w.g_parent;
     parent.b -= l * b;
 }
 
 /// Back substitution of a `General` joint: `x_k = T b_k − T J_kp x_p`,
 /// `Δλ = −x_k` applied through each body's block, then the child's
 /// `x_c = D_c⁻¹ b_c − D_c⁻¹ J_kcᵀ x_k`.
-fn substitute_general(tj: &TreeJoint, row: &mut JointScratch, bodies: &mut [BodyScratch]) {
+fn substitute_general(tj: &TreeJoint, w: &mut WideScratch, bodies: &mut [BodyScratch]) {
     let parent = &mut bodies[tj.parent as usize];
-    let t = row.d3;
-    let x = t * row.b3 - t * (row.g_parent * parent.b);
-    row.b3 = x;
+    let t = w.d3;
+    let x = t * w.b3 - t * (w.g_parent * parent.b);
+    w.b3 = x;
     let delta = -x;
-    for (i, impulse) in row.g_impulse.iter_mut().enumerate().take(row.g_count) {
+    for (i, impulse) in w.g_impulse.iter_mut().enumerate().take(w.g_count) {
         *impulse += from_f64(delta[i]);
     }
-    parent.apply_rows(&row.g_parent, delta);
+    parent.apply_rows(&w.g_parent, delta);
     if tj.child != NONE {
         let child = &mut bodies[tj.child as usize];
         if !child.leaf {
             let s = child.d;
-            child.b = s * child.b - s * (row.g_child.transpose() * x);
+            child.b = s * child.b - s * (w.g_child.transpose() * x);
         }
-        child.apply_rows(&row.g_child, delta);
+        child.apply_rows(&w.g_child, delta);
     }
 }
