@@ -33,9 +33,9 @@
 //! `joint_kinds!` list below: the file holds the definition (with
 //! `validate`, and `KindDef`'s limits, motor and spring views when it has
 //! them) and the solver form, whose `prepare` loads the bodies, whose
-//! `solve_rows` hands its rows to [`crate::joint_rows::RowSolve`] in solve
+//! `solve_rows` hands its rows to `joint_rows::RowSolve` in solve
 //! order and whose `warm_rows` hands their kept impulses to
-//! [`crate::joint_rows::WarmSide`]; plus `rows` (the report) and the
+//! `joint_rows::WarmSide`; plus `rows` (the report) and the
 //! read-backs. The macro generates the enums, the conversions and every
 //! dispatch; the world, the colouring, the warm start, the solve and the
 //! tree never name a kind. A kind whose rows the tree cannot take returns

@@ -35,7 +35,10 @@ use janus2d_core::math::{Real, Vec2, cross, cross_sv, solve22};
 use janus2d_core::softness::Softness;
 
 use crate::lane::Lane;
-use crate::parts::{AxisRow, PairMass, PointPart, apply_pair, cap, clamp_length, soft_impulse};
+use crate::parts::{
+    AxisRow, PairMass, PointPart, apply_pair, bounded_sum, cap, clamp_length, row_bound,
+    row_bound_of_k, soft_impulse,
+};
 
 /// A row's soft terms: the velocity bias `b` (m/s or rad/s), the mass
 /// scale `s_m` and the impulse scale `s_i` of [`Softness`].
@@ -131,17 +134,15 @@ impl Bounds {
         Bounds::Clamp(-max, max)
     }
 
-    /// Accumulates `lambda` into `impulse`; returns the step to apply.
+    /// Accumulates `lambda` into `impulse`, its size held within `max`
+    /// ([`row_bound`](crate::parts::row_bound)); returns the step to apply.
     #[inline(always)]
-    fn accumulate(self, impulse: &mut Real, lambda: Real) -> Real {
+    fn accumulate(self, impulse: &mut Real, lambda: Real, max: Real) -> Real {
         match self {
-            Bounds::Free => {
-                *impulse += lambda;
-                lambda
-            }
+            Bounds::Free => bounded_sum(impulse, lambda, max),
             Bounds::Clamp(lower, upper) => {
                 let old = *impulse;
-                *impulse = (old + lambda).clamp_to(lower, upper);
+                *impulse = cap((old + lambda).clamp_to(lower, upper), max);
                 *impulse - old
             }
         }
@@ -170,7 +171,7 @@ impl RowSolve {
             t.impulse_scale,
             *impulse,
         );
-        let step = bounds.accumulate(impulse, lambda);
+        let step = bounds.accumulate(impulse, lambda, row_bound(row.mass));
         row.apply(&mut self.sa, &mut self.sb, &self.m, step);
     }
 
@@ -192,7 +193,7 @@ impl RowSolve {
             t.impulse_scale,
             *impulse,
         );
-        let step = sign * bounds.accumulate(impulse, lambda);
+        let step = sign * bounds.accumulate(impulse, lambda, row_bound(mass));
         self.sa.w -= self.m.a.inv_inertia * step;
         self.sb.w += self.m.b.inv_inertia * step;
     }
@@ -217,12 +218,14 @@ impl RowSolve {
             soft_impulse(t.mass_scale, x.x, t.impulse_scale, impulse.x),
             soft_impulse(t.mass_scale, x.y, t.impulse_scale, impulse.y),
         );
-        let step = if max_length == Real::INFINITY {
-            *impulse += lambda;
+        let bound = max_length.min(row_bound_of_k(self.m.a.inv_mass + self.m.b.inv_mass));
+        let sum = *impulse + lambda;
+        let step = if sum.length_squared() <= bound * bound {
+            *impulse = sum;
             lambda
         } else {
             let old = *impulse;
-            *impulse = clamp_length(old + lambda, max_length);
+            *impulse = clamp_length(sum, bound);
             *impulse - old
         };
         apply_pair(sa, sb, &self.m, r_a, r_b, step, 0.0);
@@ -263,8 +266,8 @@ impl RowSolve {
             t_angle.impulse_scale,
             *angle_impulse,
         );
-        *linear_impulse += d_linear;
-        *angle_impulse += d_angle;
+        let d_linear = Bounds::Free.accumulate(linear_impulse, d_linear, row_bound(row.mass));
+        let d_angle = Bounds::Free.accumulate(angle_impulse, d_angle, row_bound_of_k(k22));
         row.apply(&mut self.sa, &mut self.sb, &m, d_linear);
         self.sa.w -= i_a * d_angle;
         self.sb.w += i_b * d_angle;
@@ -296,7 +299,8 @@ impl RowSolve {
             soft_impulse(softness.mass_scale, x.y, softness.impulse_scale, impulse.y),
         );
         let old = *impulse;
-        *impulse = clamp_length(old + lambda, max_length);
+        let bound = max_length.min(row_bound_of_k(m_b.inv_mass));
+        *impulse = clamp_length(old + lambda, bound);
         let p = *impulse - old;
         sb.v += m_b.inv_mass * p;
         sb.w += m_b.inv_inertia * cross(r_b, p);
@@ -314,8 +318,8 @@ impl RowSolve {
                 softness.impulse_scale,
                 *impulse,
             );
-            *impulse += lambda;
-            self.sb.w += i_b * lambda;
+            let step = Bounds::Free.accumulate(impulse, lambda, row_bound_of_k(i_b));
+            self.sb.w += i_b * step;
         }
     }
 }

@@ -161,7 +161,9 @@ use janus2d_core::union_find::{find, union};
 use crate::joint::Joint;
 use crate::joint_base::is_moving;
 use crate::kind_rows::{GeneralRows, TreeRows};
-use crate::parts::{PairMass, PointPart, angular_correction_cap, cap, clamp_length};
+use crate::parts::{
+    PairMass, PointPart, angular_correction_cap, bounded_sum, cap, clamp_length, row_bound_of_k,
+};
 use janus2d_core::math::wrap_angle;
 
 const NONE: u32 = u32::MAX;
@@ -1249,7 +1251,8 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
         let x = row.jac_parent.joint_solution(&row.d, row.b, parent.b);
         row.b = x;
         let impulse = -Vec2::new(from_f64(x.x), from_f64(x.y));
-        row.impulse += impulse;
+        let k_linear = row.masses.a.inv_mass + row.masses.b.inv_mass;
+        let impulse = bounded_point(&mut row.impulse, impulse, k_linear);
         parent.apply(side, row.r_parent, impulse);
         if tj.child != NONE {
             let child = &mut bodies[tj.child as usize];
@@ -1374,10 +1377,17 @@ fn substitute_three(
     let t = w.d3;
     let x = t * w.b3 - t * (row.jac_parent.full() * parent.b);
     w.b3 = x;
-    let impulse = -Vec2::new(from_f64(x.x), from_f64(x.y));
-    let angular = -from_f64(x.z);
-    row.impulse += impulse;
-    row.angle_impulse += angular;
+    let m = &row.masses;
+    let impulse = bounded_point(
+        &mut row.impulse,
+        -Vec2::new(from_f64(x.x), from_f64(x.y)),
+        m.a.inv_mass + m.b.inv_mass,
+    );
+    let angular = bounded_sum(
+        &mut row.angle_impulse,
+        -from_f64(x.z),
+        row_bound_of_k(m.a.inv_inertia + m.b.inv_inertia),
+    );
     parent.apply(side, row.r_parent, impulse);
     parent.apply_angle(side, angular);
     if tj.child != NONE {
@@ -1388,6 +1398,26 @@ fn substitute_three(
         }
         child.apply(-side, row.r_other, impulse);
         child.apply_angle(-side, angular);
+    }
+}
+
+/// `λ += Δλ` for a tree joint's point impulse, its length held within
+/// the bound of every kept impulse ([`ROW_SPEED_BOUND`](crate::parts::ROW_SPEED_BOUND),
+/// `k_linear = m_a⁻¹ + m_b⁻¹`); returns the change to apply. Within the
+/// bound, the plain sum bit for bit: rows that cannot all hold (a body
+/// held by a tree joint and by kinematic bodies moving apart) stop growing
+/// there instead of overflowing.
+#[inline(always)]
+fn bounded_point(impulse: &mut Vec2, delta: Vec2, k_linear: Real) -> Vec2 {
+    let bound = row_bound_of_k(k_linear);
+    let sum = *impulse + delta;
+    if sum.length_squared() <= bound * bound {
+        *impulse = sum;
+        delta
+    } else {
+        let old = *impulse;
+        *impulse = clamp_length(sum, bound);
+        *impulse - old
     }
 }
 
@@ -1555,9 +1585,14 @@ fn substitute_general(tj: &TreeJoint, w: &mut WideScratch, bodies: &mut [BodyScr
     let t = w.d3;
     let x = t * w.b3 - t * (w.g_parent * parent.b);
     w.b3 = x;
-    let delta = -x;
+    let mut delta = -x;
     for (i, impulse) in w.g_impulse.iter_mut().enumerate().take(w.g_count) {
-        *impulse += from_f64(delta[i]);
+        let step = from_f64(delta[i]);
+        let bound = row_bound_of_k(from_f64(w.g_k.col(i)[i]));
+        let applied = bounded_sum(impulse, step, bound);
+        if applied != step {
+            delta[i] = to_f64(applied);
+        }
     }
     parent.apply_rows(&w.g_parent, delta);
     if tj.child != NONE {
