@@ -38,5 +38,6 @@ mod setters;
 mod snapshot;
 mod soak;
 mod stages;
+mod surface_materials;
 mod weld;
 mod wheel;

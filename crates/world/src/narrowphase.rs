@@ -153,6 +153,8 @@ fn empty_lane() -> ContactLane {
         point_count: 0,
         friction: 0.0,
         restitution: 0.0,
+        tangent_speed: 0.0,
+        rolling_resistance: 0.0,
         contact_index: 0,
         cluster: [NO_CLUSTER; 2],
     }
@@ -184,6 +186,8 @@ pub(crate) fn stage(c: &Contact) -> StagedContact {
             point_count: c.point_count,
             friction: c.friction,
             restitution: c.restitution,
+            tangent_speed: c.tangent_speed,
+            rolling_resistance: c.rolling_resistance,
             contact_index: 0,
             cluster: [NO_CLUSTER; 2],
         },
