@@ -10,6 +10,7 @@ mod bad_input;
 mod breakable_joint;
 mod collision_api;
 mod contact_data;
+mod contact_modification;
 mod contact_properties;
 mod continuous;
 mod continuous_joints;

@@ -26,15 +26,24 @@ impl World {
     }
 
     /// Sets (or with `None` removes) the pre-solve hook: called after the
-    /// narrowphase for every touching solid contact, in contact order; a
-    /// `false` leaves that contact out of this step's solve (one-way
-    /// platforms, conveyor rules). Without a hook the step makes no call.
+    /// narrowphase for every touching solid contact, in contact order, on
+    /// the stepping thread. Through its view ([`PreSolve`](crate::PreSolve))
+    /// it may change the contact's friction, restitution, tangent speed
+    /// and rolling resistance for this step (a conveyor, ice under one
+    /// body); a `false` leaves the contact out of this step's solve
+    /// (one-way platforms). Without a hook the step makes no call. Not
+    /// state: snapshots and scene files do not hold it, and
+    /// [`World::restore`] keeps the world's own.
     ///
     /// ```
     /// use janus2d_world::{World, WorldDef};
     /// let mut world = World::new(WorldDef::default()).unwrap();
-    /// // Contacts whose normal points down (from a to b) are ignored.
-    /// world.set_pre_solve(Some(Box::new(|c| c.normal.y >= 0.0)));
+    /// // Contacts whose normal points down (from a to b) are ignored, the
+    /// // others slide without friction this step.
+    /// world.set_pre_solve(Some(Box::new(|c| {
+    ///     c.friction = 0.0;
+    ///     c.normal.y >= 0.0
+    /// })));
     /// world.step(1.0 / 60.0).unwrap();
     /// ```
     pub fn set_pre_solve(&mut self, hook: Option<crate::narrowphase::PreSolveFn>) {
