@@ -44,7 +44,7 @@ pub fn run() -> Result<Report, WorldError> {
     })));
     let unit = Polygon::make_box(0.25, 0.25);
     let box1 = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 0.25)))?;
-    world.create_shape(box1, &ShapeDef::default(), unit.clone())?;
+    world.create_shape(box1, &ShapeDef::default(), unit)?;
     let box2 = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, -4.75)))?;
     world.create_shape(box2, &ShapeDef::default(), unit)?;
     // A ball on a plain stretch of the first belt's level, well apart.

@@ -395,7 +395,10 @@ fn apply(
             match which {
                 0 => w.set_shape_rolling_resistance(s, *v),
                 1 => w.set_shape_tangent_speed(s, *v),
-                _ => w.set_shape_user_material_id(s, v.to_bits().into()),
+                _ => w.set_shape_user_material_id(
+                    s,
+                    u64::from(v.is_sign_negative()) << 40 | (v.abs() as u64),
+                ),
             }
         }
         Op::Explode {

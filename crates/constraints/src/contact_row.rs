@@ -74,7 +74,7 @@
 //! faster than the threshold and pushed: drive `Ċ` to `−e · Ċ_before`,
 //! `e = max(e_a, e_b)`.
 //!
-//! **Surface rows** (only where a contact has them: [`SurfaceRows`]).
+//! **Surface rows** (only where a contact has them: `SurfaceRows`).
 //! *Tangent speed* `v_t` (a conveyor belt): each friction row drives
 //! `Ċ_t − v_t` to zero instead of `Ċ_t`, so the bodies slide relative to
 //! each other at `v_t` along `t` while friction holds (the impulse bound
