@@ -16,7 +16,8 @@
 //! | scene queries: rays, casts, overlaps  | [`query`], [`QueryFilter`], [`RayHit`], [`World::cast_ray_closest`] |
 //! | a character mover and controller      | [`CharacterController`], [`World::cast_mover`], [`World::collide_mover`], [`solve_planes`], [`clip_vector`] |
 //! | events after a step                   | [`StepEvents`] ([`World::events`]): [`CollisionEvents`], [`HitEvent`], [`JointEvent`]; [`PortalEvent`] ([`World::portal_events`]) |
-//! | changing contacts before the solve    | [`PreSolve`], [`World::set_pre_solve`]                      |
+//! | changing contacts before the solve    | [`PreSolve`], [`World::set_pre_solve`], [`World::set_pair_filter`] |
+//! | surface materials                     | [`ShapeDef`] (`rolling_resistance`, `tangent_speed`, `friction_combine`, `user_material_id`), [`CombineRule`], [`World::set_friction_callback`] |
 //! | portals (feature `portals`, default)  | [`portal`], [`PortalPairDef`], [`PortalDef`], [`World::create_portal_pair`] |
 //! | saving and restoring a world          | [`Snapshot`], [`World::snapshot`], [`World::restore`]       |
 //! | drawing a world                       | [`debug_draw`], [`DebugDraw`], [`DrawOptions`], [`World::debug_draw`] |
@@ -158,6 +159,8 @@ pub use janus2d_core::geometry::{
     Aabb, Capsule, ChainSegment, Circle, GeometryError, Polygon, Segment, Shape, make_chain,
 };
 #[doc(inline)]
+pub use janus2d_core::material::CombineRule;
+#[doc(inline)]
 pub use janus2d_core::solver::SolverProfile;
 #[doc(inline)]
 pub use janus2d_core::{
@@ -180,10 +183,10 @@ pub use janus2d_world::{
 pub use janus2d_world::{
     CollisionCounters, CollisionEvents, Color, Contact, ContactPointData, ContinuousCounters,
     DebugDraw, DrawOptions, ExplosionDef, Filter, HitEvent, Invariant, InvariantError, JointEvent,
-    JointHandle, JointSet, Palette, PointProjection, PortalHop, PreSolve, PreSolveFn, QueryFilter,
-    QueryPredicate, QueryProblem, RayHit, ShapeData, ShapeDef, ShapeHandle, ShapeOverlap,
-    ShapePairEvent, SleepSettings, Snapshot, StepCounters, StepEvents, StepProfile, World,
-    WorldDef, WorldError,
+    JointHandle, JointSet, MixFn, PairFilterFn, Palette, PointProjection, PortalHop, PreSolve,
+    PreSolveFn, QueryFilter, QueryPredicate, QueryProblem, RayHit, ShapeData, ShapeDef,
+    ShapeHandle, ShapeOverlap, ShapePairEvent, SleepSettings, Snapshot, StepCounters, StepEvents,
+    StepProfile, World, WorldDef, WorldError,
 };
 #[cfg(feature = "portals")]
 #[doc(inline)]
@@ -206,6 +209,7 @@ pub mod prelude {
     pub use janus2d_core::geometry::{
         Capsule, ChainSegment, Circle, Polygon, Segment, Shape, make_chain,
     };
+    pub use janus2d_core::material::CombineRule;
     pub use janus2d_core::math::{Real, Rot, Transform, Vec2};
     pub use janus2d_core::solver::SolverSettings;
     pub use janus2d_world::{Autostep, CharacterController, MoveResult};

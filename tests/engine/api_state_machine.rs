@@ -121,6 +121,9 @@ enum Op {
     LinearDamping(usize, Real),
     AngularDamping(usize, Real),
     FixedRotation(usize, bool),
+    /// A shape's surface material: rolling resistance (0), tangent speed
+    /// (1) or user material id (2).
+    SurfaceMaterial(usize, u8, Real),
     Explode {
         position: Vec2,
         radius: Real,
@@ -176,6 +179,7 @@ fn op() -> impl Strategy<Value = Op> {
         1 => (pick(), real()).prop_map(|(b, c)| Op::LinearDamping(b, c)),
         1 => (pick(), real()).prop_map(|(b, c)| Op::AngularDamping(b, c)),
         1 => (pick(), any::<bool>()).prop_map(|(b, f)| Op::FixedRotation(b, f)),
+        1 => (pick(), 0u8..3, real()).prop_map(|(s, which, v)| Op::SurfaceMaterial(s, which, v)),
         1 => (place(), size(), size(), real())
             .prop_map(|(position, radius, falloff, impulse)| Op::Explode { position, radius, falloff, impulse }),
         1 => (pick(), place(), real()).prop_map(|(s, p, d)| Op::Query(s, p, d)),
@@ -386,6 +390,17 @@ fn apply(
         Op::LinearDamping(k, c) => w.set_linear_damping(body(*k, issued), *c),
         Op::AngularDamping(k, c) => w.set_angular_damping(body(*k, issued), *c),
         Op::FixedRotation(k, f) => w.set_fixed_rotation(body(*k, issued), *f),
+        Op::SurfaceMaterial(k, which, v) => {
+            let s = pick(&issued.shapes, *k, issued.foreign_shape);
+            match which {
+                0 => w.set_shape_rolling_resistance(s, *v),
+                1 => w.set_shape_tangent_speed(s, *v),
+                _ => w.set_shape_user_material_id(
+                    s,
+                    u64::from(v.is_sign_negative()) << 40 | (v.abs() as u64),
+                ),
+            }
+        }
         Op::Explode {
             position,
             radius,

@@ -1,5 +1,6 @@
 //! The collision API: mass from shapes, filters, sensors, contact events,
 //! `collide_connected`, and bad shape input (typed error, world unchanged).
+//! (The one-way platform through the pre-solve hook: `contact_modification`.)
 
 use janus2d::base::geometry::GeometryError;
 use janus2d::prelude::*;
@@ -285,22 +286,4 @@ fn hit_events_report_the_approach_speed_of_a_hard_landing_only() {
         );
         assert!(h.normal.y.abs() > 0.99 && h.point.y.abs() < 0.6);
     }
-}
-
-#[allow(dead_code)]
-#[path = "../../examples/one_way_platform.rs"]
-mod one_way_platform;
-
-/// The one-way platform example: the box passes up through the platform
-/// (its peak is above the top) and then rests on it (half its height above
-/// the top, within 2 cm), held by the contact the hook lets through.
-#[test]
-fn pre_solve_hook_makes_a_one_way_platform() {
-    let r = one_way_platform::run().unwrap();
-    assert!(r.peak > r.platform_top + 0.5, "rose through: {}", r.peak);
-    assert!(
-        (r.end - (r.platform_top + 0.25)).abs() < 0.02,
-        "rests on the platform: {}",
-        r.end
-    );
 }

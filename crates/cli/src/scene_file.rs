@@ -28,7 +28,7 @@
 //! | `name`, `steps`, `probe` | label; steps `janus2d run` takes; the body the summary reports | file name, 600, none |
 //! | `settings` | `gravity` [x, y] m/s², `dt` s, `substeps`, `relax_iterations`, `sleep`, `contact_hertz`, `contact_damping_ratio`, `contact_push_max_velocity` m/s, `joint_hertz`, `joint_damping_ratio`, `restitution_threshold` m/s, `warm_starting` | the world's defaults, dt 1/60 |
 //! | body | `id`, `type` (`static`, `kinematic`, `dynamic`), `position`, `angle`, `linear_velocity`, `angular_velocity`, `linear_damping`, `angular_damping`, `gravity_scale`, `fixed_rotation`, `awake`, `mass` {`mass`, `inertia`, `center`}, `shapes` | dynamic at the origin, mass from the shapes |
-//! | shape | `geometry` (one of below), `density`, `friction`, `restitution`, `sensor`, `filter` {`category`, `mask`, `group`} | 1, 0.6, 0, false, collides with all |
+//! | shape | `geometry` (one of below), `density`, `friction`, `restitution`, `sensor`, `filter` {`category`, `mask`, `group`}, `rolling_resistance`, `tangent_speed` m/s, `friction_combine` and `restitution_combine` (`default`, `average`, `min`, `multiply`, `max`), `material` (user material id) | 1, 0.6, 0, false, collides with all, 0, 0, `default`, `default`, 0 |
 //! | geometry | `circle` {`center`, `radius`}, `capsule` {`a`, `b`, `radius`}, `box` {`half`, `center`, `angle`, `radius`}, `polygon` {`points`, `radius`} (convex hull), `segment` {`a`, `b`}, `chain` {`points`, `closed`} (one-sided) | |
 //! | joint | `type` (below), `body_a`, `body_b` (index or id), `anchor` (a world point at creation) or `anchor_a`/`anchor_b` (body frames; motor and filter joints may leave both out: the bodies' origins), `angle_a`/`angle_b` (the frames' angles in the body frames, rad), `collide_connected`, `force_threshold` N and `torque_threshold` N·m (joint events), `constraint_hertz`/`constraint_damping_ratio` (softness of the rigid rows), `user_data`, `draw_scale` | `revolute`; frames at angle 0; not colliding; thresholds ∞; the world's joint softness; 0; 1 |
 //! | `revolute` | `reference_angle` (rad: θ_b − θ_a at angle 0), `limit` [lower, upper] rad, `motor` {`speed` rad/s, `max_torque` N·m}, `spring` {`hertz`, `damping_ratio`}, `target_angle` rad | a plain hinge |
@@ -315,6 +315,56 @@ pub struct ShapeFile {
     /// Collision filter.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub filter: Option<FilterFile>,
+    /// Rolling resistance (`ShapeDef::rolling_resistance`).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub rolling_resistance: f64,
+    /// Surface tangent speed, m/s (`ShapeDef::tangent_speed`).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub tangent_speed: f64,
+    /// Friction combine rule.
+    #[serde(default, skip_serializing_if = "is_default_rule")]
+    pub friction_combine: CombineFile,
+    /// Restitution combine rule.
+    #[serde(default, skip_serializing_if = "is_default_rule")]
+    pub restitution_combine: CombineFile,
+    /// The user's material id (`ShapeDef::user_material_id`).
+    #[serde(default, skip_serializing_if = "is_zero_u64")]
+    pub material: u64,
+}
+
+/// A combine rule by name (`janus2d_core::material::CombineRule`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CombineFile {
+    /// The property's default rule (friction `√(a b)`, restitution `max`).
+    #[default]
+    Default,
+    /// `(a + b) / 2`.
+    Average,
+    /// `min(a, b)`.
+    Min,
+    /// `a · b`.
+    Multiply,
+    /// `max(a, b)`.
+    Max,
+}
+
+impl CombineFile {
+    /// The engine's rule.
+    fn rule(self) -> janus2d_core::material::CombineRule {
+        use janus2d_core::material::CombineRule as R;
+        match self {
+            CombineFile::Default => R::Default,
+            CombineFile::Average => R::Average,
+            CombineFile::Min => R::Min,
+            CombineFile::Multiply => R::Multiply,
+            CombineFile::Max => R::Max,
+        }
+    }
+}
+
+fn is_default_rule(x: &CombineFile) -> bool {
+    *x == CombineFile::Default
 }
 
 /// A body named by its index in `bodies` or by its `id`.
@@ -981,6 +1031,11 @@ impl SceneFile {
                         mask_bits: f.mask,
                         group_index: f.group,
                     }),
+                    rolling_resistance: from_f64(s.rolling_resistance),
+                    tangent_speed: from_f64(s.tangent_speed),
+                    friction_combine: s.friction_combine.rule(),
+                    restitution_combine: s.restitution_combine.rule(),
+                    user_material_id: s.material,
                     ..ShapeDef::default()
                 };
                 let shapes = s
@@ -1475,6 +1530,11 @@ impl SceneFile {
                             mask: s.filter.mask,
                             group: s.filter.group,
                         }),
+                        rolling_resistance: 0.0,
+                        tangent_speed: 0.0,
+                        friction_combine: CombineFile::Default,
+                        restitution_combine: CombineFile::Default,
+                        material: 0,
                     })
                     .collect(),
             })

@@ -190,13 +190,50 @@ impl ContactConstraint {
             let (ja, jb) = (self.rows.ja[row], self.rows.jb[row]);
             let (sa, sb) = (&states[ia], &states[ib]);
             let c_dot = (sb.v - sa.v).dot(t) + (sb.w * jb - sa.w * ja);
-            let d = self.rows.friction_row(row, c_dot);
+            let d = self
+                .rows
+                .friction_row(row, self.rows.friction_target(c_dot));
             let p = d * t;
             states[ia].v -= m_a * p;
             states[ia].w -= i_a * d * ja;
             states[ib].v += m_b * p;
             states[ib].w += i_b * d * jb;
         }
+        if self.rows.surface.is_some() {
+            let d = self.rows.rolling_row(states[ib].w - states[ia].w);
+            states[ia].w -= i_a * d;
+            states[ib].w += i_b * d;
+        }
+    }
+
+    /// Sets the contact's surface terms (see
+    /// [`ContactLane`](janus2d_core::contact_input::ContactLane)): the
+    /// friction rows' target relative tangent speed, m/s, and the rolling
+    /// row's bound per unit normal impulse (rolling resistance × rolling
+    /// radius), m. Zero for both (the default) adds no row.
+    ///
+    /// ```
+    /// use janus2d_constraints::contact::{ContactConstraint, ContactPointInput};
+    /// use janus2d_core::{BodyHandle, Vec2};
+    /// let h = BodyHandle::new(0, 0, 0);
+    /// let point = ContactPointInput::default();
+    /// let mut c = ContactConstraint::new(h, h, Vec2::Y, &[point], 0.6, 0.0, 0);
+    /// assert_eq!(c.surface(), (0.0, 0.0));
+    /// c.set_surface(2.0, 0.05);
+    /// assert_eq!(c.surface(), (2.0, 0.05));
+    /// ```
+    pub fn set_surface(&mut self, tangent_speed: Real, rolling_resistance: Real) {
+        self.rows.set_surface(0, tangent_speed, rolling_resistance);
+    }
+
+    /// The surface terms `(tangent speed, rolling bound)` (see
+    /// [`ContactConstraint::set_surface`]).
+    #[must_use]
+    pub fn surface(&self) -> (Real, Real) {
+        self.rows
+            .surface
+            .as_deref()
+            .map_or((0.0, 0.0), |s| (s.tangent_speed, s.rolling_resistance))
     }
 
     /// Stiffens the normal rows of a contact of a light cluster's group:

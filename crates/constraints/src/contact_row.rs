@@ -74,6 +74,21 @@
 //! faster than the threshold and pushed: drive `Ċ` to `−e · Ċ_before`,
 //! `e = max(e_a, e_b)`.
 //!
+//! **Surface rows** (only where a contact has them: `SurfaceRows`).
+//! *Tangent speed* `v_t` (a conveyor belt): each friction row drives
+//! `Ċ_t − v_t` to zero instead of `Ċ_t`, so the bodies slide relative to
+//! each other at `v_t` along `t` while friction holds (the impulse bound
+//! is Coulomb's as before). *Rolling resistance*: one angular row per
+//! contact, `J = [0  −1  0  1]` (`Ċ = ω_b − ω_a`),
+//! `k = i_a⁻¹ + i_b⁻¹`, its accumulated impulse clamped to
+//! `±c r (λ_n0 + λ_n1)` with `c r` the mixed rolling resistance times the
+//! rolling radius (Box2D v3.1's `rollingResistance`). On flat ground the
+//! row's torque `c r N` (`N = m g`) slows a ball of radius `r` rolling
+//! without slipping at `a = c g r² / (r² + I/m)` (friction slows its
+//! centre with it), `⅔ c g` for a disc, so it stops within
+//! `v₀² / (2 a)`. It is solved after the friction rows and warm started
+//! within the step (its impulse starts from zero at each step).
+//!
 //! # Evaluation
 //!
 //! The anchors are kept only through the Jacobian's angular parts
@@ -266,6 +281,39 @@ pub(crate) struct ContactRows<L: Lane> {
     /// impulse of the whole step, N·s (see
     /// [`PointImpulse`](crate::contact_solver::PointImpulse)).
     pub(crate) step_base: [L; ROWS],
+    /// The surface rows (tangent speed, rolling resistance) when some lane
+    /// has them; `None` otherwise, and the solve then runs exactly the rows
+    /// above (a scene without surface materials pays one test per chunk).
+    pub(crate) surface: Option<Box<SurfaceRows<L>>>,
+}
+
+/// The surface terms of the lanes' contacts (module docs, Surface rows):
+/// kept apart from [`ContactRows`] and only where some lane has them, so
+/// that contacts without them carry none of it.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct SurfaceRows<L: Lane> {
+    /// Target relative tangent speed of the friction rows, m/s.
+    pub(crate) tangent_speed: L,
+    /// Bound of the rolling row per unit normal impulse (rolling
+    /// resistance × rolling radius), m.
+    pub(crate) rolling_resistance: L,
+    /// Effective mass of the rolling row `1 / (i_a⁻¹ + i_b⁻¹)`, kg·m².
+    pub(crate) rolling_mass: L,
+    /// Accumulated rolling impulse, N·m·s.
+    pub(crate) rolling_impulse: L,
+}
+
+impl<L: Lane> SurfaceRows<L> {
+    /// Every lane without surface terms.
+    fn empty() -> Self {
+        let z = L::splat(0.0);
+        SurfaceRows {
+            tangent_speed: z,
+            rolling_resistance: z,
+            rolling_mass: z,
+            rolling_impulse: z,
+        }
+    }
 }
 
 /// Impulses summed over a contact's rows, as they act on its bodies:
@@ -310,7 +358,22 @@ impl<L: Lane> ContactRows<L> {
             relative_velocity: [z; MAX_MANIFOLD_POINTS],
             restitution: z,
             step_base: [z; ROWS],
+            surface: None,
         }
+    }
+
+    /// Writes lane `k`'s surface terms: the friction rows' target tangent
+    /// speed (m/s) and the rolling row's bound per unit normal impulse
+    /// (m). Nothing is written (nor allocated) when both are zero.
+    pub(crate) fn set_surface(&mut self, k: usize, tangent_speed: Real, rolling_resistance: Real) {
+        if tangent_speed == 0.0 && rolling_resistance == 0.0 {
+            return;
+        }
+        let s = self
+            .surface
+            .get_or_insert_with(|| Box::new(SurfaceRows::empty()));
+        s.tangent_speed.set_lane(k, tangent_speed);
+        s.rolling_resistance.set_lane(k, rolling_resistance);
     }
 
     /// Writes a manifold into lane `k`: the Jacobian's angular parts from
@@ -432,6 +495,12 @@ impl<L: Lane> ContactRows<L> {
             self.impulse = [zero; ROWS];
         }
         self.step_base = self.impulse.map(|l| -l);
+        if let Some(s) = self.surface.as_deref_mut() {
+            // The rolling row: J = [0 −1 0 1], k = i_a⁻¹ + i_b⁻¹.
+            let k = inv_inertia_a + inv_inertia_b;
+            s.rolling_mass = L::select(k.gt(zero), one / k, zero);
+            s.rolling_impulse = zero;
+        }
     }
 
     /// The warm start: adds the kept impulses to the step totals and
@@ -447,12 +516,18 @@ impl<L: Lane> ContactRows<L> {
         }
         let (pn, pt) = (lambda[0] + lambda[1], lambda[2] + lambda[3]);
         // p = pn n + pt t with t = (n_y, −n_x).
-        Push {
+        let mut push = Push {
             p_x: pn * n_x + pt * n_y,
             p_y: pn * n_y - pt * n_x,
             l_a: dot_rows(lambda, &self.ja),
             l_b: dot_rows(lambda, &self.jb),
+        };
+        if let Some(s) = self.surface.as_deref() {
+            // The rolling row turns both bodies, J = [0 −1 0 1].
+            push.l_a += s.rolling_impulse;
+            push.l_b += s.rolling_impulse;
         }
+        push
     }
 
     /// Body a's share of a push: `v_a −= m_a⁻¹ p`, `ω_a −= i_a⁻¹ l_a`.
@@ -537,10 +612,10 @@ impl<L: Lane> ContactRows<L> {
         self.max_normal_impulse[0] = d0.at_least(self.max_normal_impulse[0]);
         self.max_normal_impulse[1] = d1.at_least(self.max_normal_impulse[1]);
 
-        // Friction rows.
-        let c_dot2 = (c_dot2 + k02 * d0) + k12 * d1;
+        // Friction rows (towards the surface's tangent speed, if any).
+        let c_dot2 = self.friction_target((c_dot2 + k02 * d0) + k12 * d1);
         let d2 = self.friction_row(2, c_dot2);
-        let c_dot3 = ((c_dot3 + k03 * d0) + k13 * d1) + k23 * d2;
+        let c_dot3 = self.friction_target(((c_dot3 + k03 * d0) + k13 * d1) + k23 * d2);
         let d3 = self.friction_row(3, c_dot3);
 
         // The velocities, once: Δv = M⁻¹ Jᵀ Δλ summed over the rows.
@@ -548,8 +623,18 @@ impl<L: Lane> ContactRows<L> {
         let (pn, pt) = (d0 + d1, d2 + d3);
         let p_x = pn * n_x + pt * n_y;
         let p_y = pn * n_y - pt * n_x;
-        let l_a = dot_rows(&d, &ja);
-        let l_b = dot_rows(&d, &jb);
+        let mut l_a = dot_rows(&d, &ja);
+        let mut l_b = dot_rows(&d, &jb);
+        if self.surface.is_some() {
+            // The rolling row last: its Ċ = ω_b − ω_a advanced by the
+            // rows above, K_ir = i_a⁻¹ (r_a × ·)_i + i_b⁻¹ (r_b × ·)_i.
+            let (ka3, kb3) = (i_a * ja[3], i_b * jb[3]);
+            let c_dot_r = (b.w - a.w)
+                + (((ka0 + kb0) * d0 + (ka1 + kb1) * d1) + ((ka2 + kb2) * d2 + (ka3 + kb3) * d3));
+            let d_r = self.rolling_row(c_dot_r);
+            l_a += d_r;
+            l_b += d_r;
+        }
         a.v_x -= self.inv_mass_a * p_x;
         a.v_y -= self.inv_mass_a * p_y;
         a.w -= i_a * l_a;
@@ -607,6 +692,34 @@ impl<L: Lane> ContactRows<L> {
         let d = (-(self.mass[i] * c_dot)).clamp_to(min_friction - old, max_friction - old);
         self.impulse[i] = (old + d).clamp_to(min_friction, max_friction);
         d
+    }
+
+    /// A friction row's `Ċ` measured against the surface's tangent speed:
+    /// `Ċ − v_t` (the row then drives the relative tangent speed to `v_t`);
+    /// `Ċ` itself without surface rows.
+    #[inline(always)]
+    pub(crate) fn friction_target(&self, c_dot: L) -> L {
+        match self.surface.as_deref() {
+            Some(s) => c_dot - s.tangent_speed,
+            None => c_dot,
+        }
+    }
+
+    /// The rolling row given its `Ċ = ω_b − ω_a`: accumulates the impulse,
+    /// bounded by `±c r (λ_n0 + λ_n1)` (the rolling resistance times the
+    /// rolling radius times the contact's normal impulse), and returns the
+    /// increment (0 without surface rows).
+    #[inline(always)]
+    pub(crate) fn rolling_row(&mut self, c_dot: L) -> L {
+        let total_normal = self.impulse[0] + self.impulse[1];
+        let Some(s) = self.surface.as_deref_mut() else {
+            return L::splat(0.0);
+        };
+        let old = s.rolling_impulse;
+        let max = s.rolling_resistance * total_normal;
+        let new = (old - s.rolling_mass * c_dot).clamp_to(-max, max);
+        s.rolling_impulse = new;
+        new - old
     }
 
     /// Whether some lane has restitution.

@@ -221,6 +221,7 @@ impl ContactSolver {
                 lane.restitution,
                 lane.contact_index,
             );
+            c.set_surface(lane.tangent_speed, lane.rolling_resistance);
             c.state_a = lane.state_a;
             c.state_b = lane.state_b;
             self.overflow.push(c);
@@ -892,6 +893,8 @@ impl WideContact {
             lane.restitution,
             lane.inv_masses,
         );
+        self.rows
+            .set_surface(k, lane.tangent_speed, lane.rolling_resistance);
     }
 
     /// [`ContactRows::prepare`] on the lanes, with the masses the impulses

@@ -330,6 +330,8 @@ mod tests {
                     point_count: 1,
                     friction: 0.6,
                     restitution: 0.0,
+                    tangent_speed: 0.0,
+                    rolling_resistance: 0.0,
                     contact_index: index,
                     cluster: [crate::contact_group::NO_CLUSTER; 2],
                 };

@@ -7,7 +7,7 @@
 //! | type | holds |
 //! |------|-------|
 //! | [`ContactPointInput`] | one manifold point: anchors, separation, kept impulses |
-//! | [`ContactLane`] | the bodies (handles, state indices, inverse masses), normal, points, material, the contact's index and light clusters |
+//! | [`ContactLane`] | the bodies (handles, state indices, inverse masses), normal, points, material (friction, restitution, tangent speed, rolling resistance), the contact's index and light clusters |
 
 use crate::body::BodyHandle;
 use crate::math::{Real, Vec2};
@@ -58,6 +58,14 @@ pub struct ContactLane {
     pub friction: Real,
     /// Mixed restitution.
     pub restitution: Real,
+    /// Target relative tangent speed of the friction rows, m/s (a
+    /// conveyor belt; 0: none). See
+    /// [`mix_tangent_speed`](crate::material::mix_tangent_speed).
+    pub tangent_speed: Real,
+    /// Bound of the rolling row per unit normal impulse, m (rolling
+    /// resistance × rolling radius; 0: no rolling row). See
+    /// [`mix_rolling_resistance`](crate::material::mix_rolling_resistance).
+    pub rolling_resistance: Real,
     /// The pipeline's index of the contact (impulses are stored back by it).
     pub contact_index: u32,
     /// The light cluster of each side (the light clusters of `janus2d_constraints::contact_group`,

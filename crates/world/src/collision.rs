@@ -25,13 +25,13 @@
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::geometry::Shape;
-use janus2d_core::material::{mix_friction, mix_restitution};
 use janus2d_core::math::{Real, Transform, Vec2};
 use janus2d_core::parallel::Team;
 
 use crate::broadphase::BroadPhase;
 pub use crate::contacts::CollisionEvents;
 use crate::contacts::{Contact, ContactPointData, ContactSet};
+use crate::hooks::Hooks;
 use crate::joints::NoCollide;
 use crate::shapes::{ShapeData, ShapeDef, ShapeHandle, ShapeStore};
 
@@ -313,7 +313,16 @@ impl Collision {
     }
 
     /// Finds new pairs among moved proxies and creates their contacts.
-    pub(crate) fn update_pairs(&mut self, bodies: &BodySet, no_collide: &NoCollide, team: &Team) {
+    /// The pair filter of `hooks` (if any) is asked about each new pair
+    /// that passed the shapes' filters, in pair order; the material
+    /// callbacks mix the new contacts' materials.
+    pub(crate) fn update_pairs(
+        &mut self,
+        bodies: &BodySet,
+        no_collide: &NoCollide,
+        hooks: &mut Hooks,
+        team: &Team,
+    ) {
         let mut candidates = std::mem::take(&mut self.candidates);
         candidates.clear();
         // Only new pairs are kept, as the broadphase finds them (on the
@@ -330,21 +339,31 @@ impl Collision {
         for &(a, b) in &candidates {
             let (a, b) = crate::contacts::pair_key(a, b);
             let (sa, sb) = (self.shapes.at(a), self.shapes.at(b));
+            let shapes = [
+                self.shapes.handle_of(a, self.owner),
+                self.shapes.handle_of(b, self.owner),
+            ];
+            if let Some(filter) = hooks.pair_filter.as_mut()
+                && !filter(shapes[0], shapes[1])
+            {
+                continue;
+            }
+            let mixed = hooks.mix(sa, sb);
             let contact = Contact {
                 id: 0,
                 shape_a: a,
                 shape_b: b,
-                shapes: [
-                    self.shapes.handle_of(a, self.owner),
-                    self.shapes.handle_of(b, self.owner),
-                ],
+                shapes,
                 body_a: sa.body,
                 body_b: sb.body,
                 normal: Vec2::ZERO,
                 points: [ContactPointData::default(); 2],
                 point_count: 0,
-                friction: mix_friction(sa.def.friction, sb.def.friction),
-                restitution: mix_restitution(sa.def.restitution, sb.def.restitution),
+                friction: mixed.friction,
+                restitution: mixed.restitution,
+                tangent_speed: mixed.tangent_speed,
+                rolling_resistance: mixed.rolling_resistance,
+                user_material_ids: [sa.def.user_material_id, sb.def.user_material_id],
                 touching: false,
                 sensor: sa.def.is_sensor || sb.def.is_sensor,
                 hit_events: sa.def.enable_hit_events || sb.def.enable_hit_events,

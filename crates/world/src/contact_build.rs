@@ -270,24 +270,39 @@ impl ContactBuilder {
                     let c = &awake[k];
                     let velocity = |b| bodies.state(b).map_or(Vec2::ZERO, |s| s.v);
                     let mut separations = [0.0; 2];
-                    for (s, p) in separations.iter_mut().zip(&c.points[..c.point_count]) {
+                    let mut points = [Vec2::ZERO; 2];
+                    for ((s, x), p) in separations
+                        .iter_mut()
+                        .zip(points.iter_mut())
+                        .zip(&c.points[..c.point_count])
+                    {
                         *s = p.separation;
+                        *x = p.point;
                     }
-                    let view = PreSolve {
+                    let lane = &record.lane;
+                    let mut view = PreSolve {
                         shape_a: c.shapes[0],
                         shape_b: c.shapes[1],
                         body_a: c.body_a,
                         body_b: c.body_b,
+                        user_material_ids: c.user_material_ids,
                         normal: c.normal,
+                        points,
                         separations,
                         point_count: c.point_count,
                         velocity_a: velocity(c.body_a),
                         velocity_b: velocity(c.body_b),
+                        friction: lane.friction,
+                        restitution: lane.restitution,
+                        tangent_speed: lane.tangent_speed,
+                        rolling_resistance: lane.rolling_resistance,
                     };
-                    if !hook(&view) {
+                    if !hook(&mut view) {
                         continue;
                     }
+                    view.apply_to(&mut staged[k].lane);
                 }
+                let record = &staged[k];
                 solved.push(entry(k, record));
             }
         }

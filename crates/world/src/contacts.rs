@@ -81,6 +81,16 @@ pub struct Contact {
     pub friction: Real,
     /// Mixed restitution.
     pub restitution: Real,
+    /// Mixed tangent speed, m/s: the friction rows drive the bodies'
+    /// relative tangent speed at the points to it (a conveyor belt; see
+    /// `ShapeDef::tangent_speed`).
+    pub tangent_speed: Real,
+    /// The rolling row's bound per unit normal impulse, m (the larger
+    /// rolling resistance times the larger rolling radius; 0: none).
+    pub rolling_resistance: Real,
+    /// The shapes' user material ids (`ShapeDef::user_material_id`), a's
+    /// then b's.
+    pub user_material_ids: [u64; 2],
     /// True when the manifold has points.
     pub touching: bool,
     /// True when either shape is a sensor (events only).
@@ -599,6 +609,9 @@ impl ContactSet {
                 let finite = janus2d_core::math::vec_is_finite(c.normal)
                     && c.friction.is_finite()
                     && c.restitution.is_finite()
+                    && c.tangent_speed.is_finite()
+                    && c.rolling_resistance.is_finite()
+                    && c.rolling_resistance >= 0.0
                     && c.point_count <= 2
                     // Both slots, the unused one too: recycling copies it
                     // (a decoded NaN there reached the recycling cache).

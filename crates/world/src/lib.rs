@@ -45,6 +45,7 @@ pub mod debug_draw;
 pub mod dynamic_tree;
 pub(crate) mod error;
 pub(crate) mod hash;
+pub(crate) mod hooks;
 pub(crate) mod islands;
 pub(crate) mod joints;
 pub mod mover;
@@ -65,6 +66,7 @@ pub use contacts::{CollisionEvents, Contact, ContactPointData, HitEvent, ShapePa
 pub use continuous::ContinuousCounters;
 pub use debug_draw::{Color, DebugDraw, DrawOptions, Palette};
 pub use error::WorldError;
+pub use hooks::{MixFn, PairFilterFn};
 pub use islands::SleepSettings;
 pub use joints::{JointEvent, JointHandle, JointKind, JointSet};
 pub use mover::{CollisionPlane, MoverCast, PlaneResult, PlaneSolution, clip_vector, solve_planes};

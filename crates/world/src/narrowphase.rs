@@ -35,8 +35,19 @@ use crate::profile::CollisionCounters;
 use crate::shapes::ShapeStore;
 use janus2d_core::geometry::SPECULATIVE_DISTANCE;
 
-/// What a pre-solve hook sees of a touching contact before it is solved
-/// (see `World::set_pre_solve`).
+/// What a pre-solve hook sees of a touching contact before it is solved,
+/// and what it may change for this step (see `World::set_pre_solve`; in
+/// the spirit of Box2D's `b2PreSolveFcn` and Rapier's
+/// `modify_solver_contacts`).
+///
+/// The geometry and bodies are read only (changing them changes
+/// nothing). The material fields start at the contact's mixed values and
+/// what the hook leaves in them is what this step's solve uses: the
+/// contact keeps its own for the next step, when the hook is asked again.
+/// A changed value that is not finite is ignored; friction, restitution
+/// and rolling resistance are clamped to `[0, MAX_FRICTION]`,
+/// `[0, MAX_RESTITUTION]` and `[0, ∞)`, the tangent speed to
+/// `±MAX_SPEED`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PreSolve {
     /// Shape a.
@@ -47,8 +58,13 @@ pub struct PreSolve {
     pub body_a: BodyHandle,
     /// Body of shape b.
     pub body_b: BodyHandle,
+    /// The shapes' user material ids (`ShapeDef::user_material_id`), a's
+    /// then b's.
+    pub user_material_ids: [u64; 2],
     /// Unit normal from a to b.
     pub normal: Vec2,
+    /// World point of each point (the first `point_count`), m.
+    pub points: [Vec2; 2],
     /// Separation of each point (the first `point_count`), m.
     pub separations: [Real; 2],
     /// Number of points.
@@ -57,11 +73,53 @@ pub struct PreSolve {
     pub velocity_a: Vec2,
     /// Linear velocity of body b, m/s.
     pub velocity_b: Vec2,
+    /// Friction coefficient this step (settable).
+    pub friction: Real,
+    /// Restitution this step (settable).
+    pub restitution: Real,
+    /// Target relative tangent speed of the friction rows this step, m/s
+    /// (settable: a conveyor; along `t = (n.y, −n.x)`, the speed of b's
+    /// points relative to a's the friction drives towards).
+    pub tangent_speed: Real,
+    /// Rolling row's bound per unit normal impulse this step, m
+    /// (settable; rolling resistance × rolling radius).
+    pub rolling_resistance: Real,
 }
 
-/// A pre-solve hook: `false` leaves the contact out of this step's solve
-/// (a one-way platform lets a body through from below).
-pub type PreSolveFn = Box<dyn FnMut(&PreSolve) -> bool + Send>;
+/// A pre-solve hook: it may change the contact's material for this step
+/// through the view ([`PreSolve`]), and returns `false` to leave the
+/// contact out of this step's solve (a one-way platform lets a body
+/// through from below).
+pub type PreSolveFn = Box<dyn FnMut(&mut PreSolve) -> bool + Send>;
+
+impl PreSolve {
+    /// Writes the view's material (as the type docs say: non-finite
+    /// changes ignored, values clamped) into a staged lane.
+    pub(crate) fn apply_to(&self, lane: &mut ContactLane) {
+        use janus2d_core::limits::{MAX_FRICTION, MAX_RESTITUTION, MAX_SPEED};
+        let keep = |new: Real, old: Real, lo: Real, hi: Real| {
+            if new.is_finite() {
+                new.clamp(lo, hi)
+            } else {
+                old
+            }
+        };
+        lane.friction = keep(self.friction, lane.friction, 0.0, MAX_FRICTION);
+        lane.restitution = keep(self.restitution, lane.restitution, 0.0, MAX_RESTITUTION);
+        lane.tangent_speed = keep(
+            self.tangent_speed,
+            lane.tangent_speed,
+            -MAX_SPEED,
+            MAX_SPEED,
+        );
+        lane.rolling_resistance = keep(
+            self.rolling_resistance,
+            lane.rolling_resistance,
+            0.0,
+            Real::MAX,
+        );
+    }
+}
 
 /// Phase-1 outcome of the narrowphase for one contact (its manifold is
 /// already updated in place).
@@ -153,6 +211,8 @@ fn empty_lane() -> ContactLane {
         point_count: 0,
         friction: 0.0,
         restitution: 0.0,
+        tangent_speed: 0.0,
+        rolling_resistance: 0.0,
         contact_index: 0,
         cluster: [NO_CLUSTER; 2],
     }
@@ -184,6 +244,8 @@ pub(crate) fn stage(c: &Contact) -> StagedContact {
             point_count: c.point_count,
             friction: c.friction,
             restitution: c.restitution,
+            tangent_speed: c.tangent_speed,
+            rolling_resistance: c.rolling_resistance,
             contact_index: 0,
             cluster: [NO_CLUSTER; 2],
         },

@@ -14,6 +14,7 @@
 use janus2d_core::body::BodyHandle;
 use janus2d_core::geometry::{Aabb, MassData, Shape};
 use janus2d_core::handle::{Handle, ShapeTag};
+use janus2d_core::material::CombineRule;
 use janus2d_core::math::{Real, Vec2};
 use janus2d_core::slots::Slots;
 use smallvec::SmallVec;
@@ -109,6 +110,36 @@ pub struct ShapeDef {
     pub enable_hit_events: bool,
     /// Opaque user value.
     pub user_data: u64,
+    /// Rolling resistance (usual 0: none; Box2D v3.1's
+    /// `rollingResistance`): a contact of a circle or capsule (or rounded
+    /// polygon) gets an angular row that resists rolling, its torque
+    /// bounded by `c · r · N` with `c` the larger of the two shapes'
+    /// resistances, `r` the larger rolling radius and `N` the contact's
+    /// normal force. On flat ground a disc rolling at `v₀` stops within
+    /// `v₀² / (2 · ⅔ c g)`. Finite, ≥ 0.
+    pub rolling_resistance: Real,
+    /// Tangent speed of the surface, m/s (usual 0; a conveyor belt): the
+    /// surface moves at this speed clockwise around the shape (on the top
+    /// face of a box, towards +x), and friction drags what touches it
+    /// along. Two shapes' speeds add up
+    /// ([`mix_tangent_speed`](janus2d_core::material::mix_tangent_speed)).
+    /// Finite, at most [`MAX_SPEED`](janus2d_core::limits::MAX_SPEED) in
+    /// size.
+    pub tangent_speed: Real,
+    /// How this shape's friction combines with the other shape's (usual
+    /// [`CombineRule::Default`], `√(μ_a μ_b)`; the stronger rule of the
+    /// two applies). A world's friction callback
+    /// ([`World::set_friction_callback`](crate::World::set_friction_callback))
+    /// replaces the rules.
+    pub friction_combine: CombineRule,
+    /// How this shape's restitution combines with the other shape's
+    /// (usual [`CombineRule::Default`], `max(e_a, e_b)`).
+    pub restitution_combine: CombineRule,
+    /// The user's material id (usual 0): not used by the engine, passed to
+    /// the friction and restitution callbacks and reported with the
+    /// shape's contacts ([`Contact::user_material_ids`](crate::Contact),
+    /// the pre-solve view) — a sound or particle effect per surface pair.
+    pub user_material_id: u64,
 }
 
 impl Default for ShapeDef {
@@ -121,6 +152,11 @@ impl Default for ShapeDef {
             is_sensor: false,
             enable_hit_events: false,
             user_data: 0,
+            rolling_resistance: 0.0,
+            tangent_speed: 0.0,
+            friction_combine: CombineRule::Default,
+            restitution_combine: CombineRule::Default,
+            user_material_id: 0,
         }
     }
 }
@@ -199,19 +235,80 @@ impl ShapeDef {
         self
     }
 
-    /// Checks the material: density, friction and restitution finite and
-    /// not negative; the error names the field.
+    /// Sets the rolling resistance (builder style; see
+    /// [`ShapeDef::rolling_resistance`]).
+    ///
+    /// ```
+    /// use janus2d_world::ShapeDef;
+    /// use janus2d_core::material::CombineRule;
+    /// let def = ShapeDef::default()
+    ///     .with_rolling_resistance(0.05)
+    ///     .with_tangent_speed(2.0)
+    ///     .with_friction_combine(CombineRule::Max)
+    ///     .with_restitution_combine(CombineRule::Min)
+    ///     .with_material_id(7);
+    /// assert_eq!((def.rolling_resistance, def.tangent_speed), (0.05, 2.0));
+    /// assert_eq!(def.friction_combine, CombineRule::Max);
+    /// assert_eq!(def.restitution_combine, CombineRule::Min);
+    /// assert_eq!(def.user_material_id, 7);
+    /// assert!(def.validate().is_ok());
+    /// ```
+    #[must_use]
+    pub fn with_rolling_resistance(mut self, rolling_resistance: Real) -> Self {
+        self.rolling_resistance = rolling_resistance;
+        self
+    }
+
+    /// Sets the surface's tangent speed, m/s (builder style; see
+    /// [`ShapeDef::tangent_speed`]).
+    #[must_use]
+    pub fn with_tangent_speed(mut self, tangent_speed: Real) -> Self {
+        self.tangent_speed = tangent_speed;
+        self
+    }
+
+    /// Sets the friction combine rule (builder style).
+    #[must_use]
+    pub fn with_friction_combine(mut self, rule: CombineRule) -> Self {
+        self.friction_combine = rule;
+        self
+    }
+
+    /// Sets the restitution combine rule (builder style).
+    #[must_use]
+    pub fn with_restitution_combine(mut self, rule: CombineRule) -> Self {
+        self.restitution_combine = rule;
+        self
+    }
+
+    /// Sets the user's material id (builder style; see
+    /// [`ShapeDef::user_material_id`]).
+    #[must_use]
+    pub fn with_material_id(mut self, id: u64) -> Self {
+        self.user_material_id = id;
+        self
+    }
+
+    /// Checks the material: density, friction, restitution and rolling
+    /// resistance finite and not negative, the tangent speed finite and
+    /// within [`MAX_SPEED`](janus2d_core::limits::MAX_SPEED); the error
+    /// names the field.
     ///
     /// ```
     /// use janus2d_world::{ShapeDef, WorldError};
     /// let bad = ShapeDef::default().with_friction(-1.0);
     /// assert_eq!(bad.validate(), Err(WorldError::OutOfRange("friction")));
+    /// let bad = ShapeDef::default().with_rolling_resistance(-0.1);
+    /// assert_eq!(bad.validate(), Err(WorldError::OutOfRange("rolling_resistance")));
+    /// let bad = ShapeDef::default().with_tangent_speed(janus2d_core::math::Real::NAN);
+    /// assert_eq!(bad.validate(), Err(WorldError::NonFinite("tangent_speed")));
     /// ```
     pub fn validate(&self) -> Result<(), WorldError> {
         for (v, name) in [
             (self.density, "density"),
             (self.friction, "friction"),
             (self.restitution, "restitution"),
+            (self.rolling_resistance, "rolling_resistance"),
         ] {
             if !v.is_finite() {
                 return Err(WorldError::NonFinite(name));
@@ -221,8 +318,26 @@ impl ShapeDef {
             }
         }
         check_material_limit(self.friction, "friction")?;
-        check_material_limit(self.restitution, "restitution")
+        check_material_limit(self.restitution, "restitution")?;
+        check_tangent_speed(self.tangent_speed)
     }
+}
+
+/// A tangent speed: finite, at most
+/// [`MAX_SPEED`](janus2d_core::limits::MAX_SPEED) in size.
+pub(crate) fn check_tangent_speed(v: Real) -> Result<(), WorldError> {
+    if !v.is_finite() {
+        return Err(WorldError::NonFinite("tangent_speed"));
+    }
+    let max = janus2d_core::limits::MAX_SPEED;
+    if v.abs() > max {
+        return Err(WorldError::OutOfBounds {
+            field: "tangent_speed",
+            min: -max,
+            max,
+        });
+    }
+    Ok(())
 }
 
 /// Friction and restitution within

@@ -79,11 +79,13 @@ impl World {
     }
 
     /// Puts the world back to `snapshot` (every stage, the step count and
-    /// the last events); the pre-solve hook stays as it is.
+    /// the last events); the callbacks (pre-solve hook, pair filter,
+    /// friction and restitution callbacks) stay as they are: they are not
+    /// state, and a snapshot holds none.
     pub fn restore(&mut self, snapshot: &Snapshot) {
-        let hook = self.take_pre_solve();
+        let hooks = std::mem::take(&mut self.hooks);
         *self = snapshot.world.copy_state();
-        self.set_pre_solve(hook);
+        self.hooks = hooks;
     }
 }
 
@@ -123,7 +125,7 @@ pub mod bytes {
     /// solved list belong to constraint building, not the narrowphase; 9:
     /// the portal stage keeps the events pushed between steps apart from
     /// the last step's).
-    pub const SNAPSHOT_VERSION: u16 = 10;
+    pub const SNAPSHOT_VERSION: u16 = 11;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.

@@ -175,9 +175,10 @@ pub struct World {
     continuous: crate::continuous::ContinuousStage,
     /// Approach speed above which hit events are reported, m/s.
     hit_event_threshold: Real,
-    /// The user's pre-solve hook, if any (called per touching contact).
+    /// The user's callbacks: pre-solve hook, pair filter, material mixing
+    /// (not state: neither serialized nor copied into snapshots).
     #[cfg_attr(feature = "serde", serde(skip))]
-    pre_solve: Option<crate::narrowphase::PreSolveFn>,
+    pub(crate) hooks: crate::hooks::Hooks,
     pub(crate) sleep_settings: SleepSettings,
     wake_list: Vec<BodyHandle>,
     events: StepEvents,
@@ -218,7 +219,7 @@ impl World {
             islands: Islands::default(),
             continuous: crate::continuous::ContinuousStage::new(def.enable_continuous),
             hit_event_threshold: def.hit_event_threshold,
-            pre_solve: None,
+            hooks: crate::hooks::Hooks::default(),
             sleep_settings: def.sleep,
             wake_list: Vec::new(),
             joints: JointSet::new(bodies.owner()),
@@ -362,7 +363,7 @@ impl World {
         self.continuous.enabled = on;
     }
 
-    /// Every field copied but the pre-solve hook (a snapshot's world).
+    /// Every field copied but the callbacks (a snapshot's world).
     pub(crate) fn copy_state(&self) -> World {
         World {
             gravity: self.gravity,
@@ -377,7 +378,7 @@ impl World {
             islands: self.islands.clone(),
             continuous: self.continuous.clone(),
             hit_event_threshold: self.hit_event_threshold,
-            pre_solve: None,
+            hooks: crate::hooks::Hooks::default(),
             sleep_settings: self.sleep_settings,
             wake_list: self.wake_list.clone(),
             events: self.events.clone(),

@@ -5,7 +5,6 @@ use super::*;
 use crate::error::WorldError;
 use crate::shapes::{Filter, ShapeHandle};
 use janus2d_core::body::{BodyHandle, BodyType};
-use janus2d_core::material::{mix_friction, mix_restitution};
 use janus2d_core::math::Real;
 
 impl World {
@@ -250,6 +249,26 @@ impl World {
         Ok(())
     }
 
+    /// Re-mixes the material of every contact (a material callback was
+    /// set or removed).
+    pub(super) fn refresh_all_contact_materials(&mut self) {
+        let ids: Vec<u32> = self.collision.contacts.iter().map(|c| c.id).collect();
+        for id in ids {
+            let Some(c) = self.collision.contacts.get(id) else {
+                continue;
+            };
+            let (sa, sb) = (
+                self.collision.shapes.at(c.shape_a),
+                self.collision.shapes.at(c.shape_b),
+            );
+            let mixed = self.hooks.mix(sa, sb);
+            if let Some(c) = self.collision.contacts.get_mut(id) {
+                c.friction = mixed.friction;
+                c.restitution = mixed.restitution;
+            }
+        }
+    }
+
     /// Re-mixes the material of the shape's existing contacts.
     pub(super) fn refresh_contact_materials(&mut self, slot: u32) {
         let body = self.collision.shapes.at(slot).body;
@@ -268,13 +287,15 @@ impl World {
                 continue;
             }
             let (a, b) = (c.shape_a, c.shape_b);
-            let da = &self.collision.shapes.at(a).def;
-            let db = &self.collision.shapes.at(b).def;
-            let friction = mix_friction(da.friction, db.friction);
-            let restitution = mix_restitution(da.restitution, db.restitution);
+            let (sa, sb) = (self.collision.shapes.at(a), self.collision.shapes.at(b));
+            let mixed = self.hooks.mix(sa, sb);
+            let ids = [sa.def.user_material_id, sb.def.user_material_id];
             if let Some(c) = self.collision.contacts.get_mut(id) {
-                c.friction = friction;
-                c.restitution = restitution;
+                c.friction = mixed.friction;
+                c.restitution = mixed.restitution;
+                c.tangent_speed = mixed.tangent_speed;
+                c.rolling_resistance = mixed.rolling_resistance;
+                c.user_material_ids = ids;
             }
         }
     }
@@ -305,6 +326,109 @@ impl World {
         self.collision.shapes.at_mut(slot).def.restitution = restitution;
         self.refresh_contact_materials(slot);
         Ok(())
+    }
+
+    /// Sets the shape's rolling resistance (finite, ≥ 0; see
+    /// [`ShapeDef::rolling_resistance`](crate::ShapeDef)); its contacts
+    /// use it from the next step. A bad value is a typed error and
+    /// changes nothing.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef, WorldError};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Circle;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    /// let s = world.create_shape(b, &ShapeDef::default(), Circle::new(Vec2::ZERO, 0.5).unwrap()).unwrap();
+    /// world.set_shape_rolling_resistance(s, 0.1).unwrap();
+    /// assert_eq!(world.shape(s).unwrap().def.rolling_resistance, 0.1);
+    /// assert_eq!(
+    ///     world.set_shape_rolling_resistance(s, -1.0),
+    ///     Err(WorldError::OutOfRange("rolling_resistance"))
+    /// );
+    /// ```
+    pub fn set_shape_rolling_resistance(
+        &mut self,
+        shape: ShapeHandle,
+        rolling_resistance: Real,
+    ) -> Result<(), WorldError> {
+        let slot = self.shape_slot(shape)?;
+        check_material(rolling_resistance, "rolling_resistance")?;
+        self.collision.shapes.at_mut(slot).def.rolling_resistance = rolling_resistance;
+        self.refresh_contact_materials(slot);
+        Ok(())
+    }
+
+    /// Sets the shape's surface tangent speed, m/s (a conveyor belt; see
+    /// [`ShapeDef::tangent_speed`](crate::ShapeDef)); its contacts use it
+    /// from the next step and the shape's body wakes (so that what rests
+    /// on a sleeping belt moves). Finite, at most
+    /// [`MAX_SPEED`](janus2d_core::limits::MAX_SPEED) in size.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Polygon;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let g = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    /// let belt = world.create_shape(g, &ShapeDef::default(), Polygon::make_box(5.0, 0.5)).unwrap();
+    /// world.set_shape_tangent_speed(belt, -1.5).unwrap();
+    /// assert_eq!(world.shape(belt).unwrap().def.tangent_speed, -1.5);
+    /// ```
+    pub fn set_shape_tangent_speed(
+        &mut self,
+        shape: ShapeHandle,
+        tangent_speed: Real,
+    ) -> Result<(), WorldError> {
+        let slot = self.shape_slot(shape)?;
+        crate::shapes::check_tangent_speed(tangent_speed)?;
+        self.collision.shapes.at_mut(slot).def.tangent_speed = tangent_speed;
+        self.refresh_contact_materials(slot);
+        self.wake_shape_contacts(slot);
+        Ok(())
+    }
+
+    /// Sets the shape's user material id (see
+    /// [`ShapeDef::user_material_id`](crate::ShapeDef)); its contacts
+    /// report it (and the material callbacks see it) from now on.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Polygon;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let g = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    /// let s = world.create_shape(g, &ShapeDef::default(), Polygon::make_box(5.0, 0.5)).unwrap();
+    /// world.set_shape_user_material_id(s, 42).unwrap();
+    /// assert_eq!(world.shape(s).unwrap().def.user_material_id, 42);
+    /// ```
+    pub fn set_shape_user_material_id(
+        &mut self,
+        shape: ShapeHandle,
+        id: u64,
+    ) -> Result<(), WorldError> {
+        let slot = self.shape_slot(shape)?;
+        self.collision.shapes.at_mut(slot).def.user_material_id = id;
+        self.refresh_contact_materials(slot);
+        Ok(())
+    }
+
+    /// Wakes the bodies touching shape `slot` (and its own).
+    fn wake_shape_contacts(&mut self, slot: u32) {
+        let body = self.collision.shapes.at(slot).body;
+        let others: smallvec::SmallVec<[BodyHandle; 8]> = self
+            .collision
+            .contacts
+            .of_body(body)
+            .iter()
+            .filter_map(|&id| self.collision.contacts.get(id))
+            .filter(|c| c.shape_a == slot || c.shape_b == slot)
+            .map(|c| c.other(body))
+            .collect();
+        for b in others {
+            self.wake_island(b);
+        }
+        self.wake_island(body);
     }
 
     /// Sets the shape's density, kg/m² (finite, ≥ 0); a dynamic body whose

@@ -120,8 +120,12 @@ impl World {
             // Clones answer for their originals in the joints' no-collide
             // pairs (set every step: crossings come and go).
             self.joints.set_clone_aliases(self.portals.clone_aliases());
-            self.collision
-                .update_pairs(&self.bodies, self.joints.no_collide(), team);
+            self.collision.update_pairs(
+                &self.bodies,
+                self.joints.no_collide(),
+                &mut self.hooks,
+                team,
+            );
             sp.broadphase += lap();
             let mut wake = std::mem::take(&mut self.wake_list);
             wake.clear();
@@ -146,7 +150,7 @@ impl World {
                 woke,
                 &self.object_masses,
                 self.joints.driven_bodies(),
-                self.pre_solve.as_mut(),
+                self.hooks.pre_solve.as_mut(),
                 self.joints.reserved(),
                 &mut self.contact_solver,
                 team,
