@@ -212,20 +212,23 @@ pub fn cap(v: Real, max: Real) -> Real {
     }
 }
 
-/// The speed change, m/s (rad/s for an angle row), beyond which no joint
-/// or portal row's accumulated impulse grows: a row holds `|λ| ≤ m_eff ·
-/// ROW_SPEED_BOUND`, with `m_eff` the row's effective mass (for a point
-/// block, the bound of its linear part, `1 / (m_a⁻¹ + m_b⁻¹)`).
+/// The speed change, m/s (rad/s for an angle row), beyond which no
+/// joint row's accumulated impulse grows (Gauss–Seidel and tree rows): a
+/// row holds `|λ| ≤ m_eff · ROW_SPEED_BOUND`, with `m_eff` the row's
+/// effective mass (for a point block, the bound of its linear part,
+/// `1 / (m_a⁻¹ + m_b⁻¹)`; for a coupled block, its smallest eigenvalue's).
 ///
 /// Rows that cannot all hold (a body jointed rigidly to two kinematic
-/// bodies moving apart, a crossing copy's joint far from satisfied, the
-/// portal rows of such a copy) make the kept impulses grow step after
-/// step, without bound, until they overflow and the body is reset for a
-/// non-finite state, again and again. The bound stops that growth at an
-/// impulse no consistent row set needs: it changes a body's speed by a
-/// thousand times the default speed limit (400 m/s), far beyond what any
-/// step of a scene the limits allow asks of one row (the benchmark scenes'
-/// states are bit-identical with it).
+/// bodies moving apart, a crossing copy's joint far from satisfied) make
+/// the kept impulses grow step after step, without bound, until they
+/// overflow and the body is reset for a non-finite state, again and
+/// again. The bound stops that growth at an impulse no consistent row set
+/// needs: it changes a body's speed by a thousand times the default speed
+/// limit (400 m/s), far beyond what any step of a scene the limits allow
+/// asks of one row (the benchmark scenes' states are bit-identical with
+/// it). A tree joint is bounded by its own bodies' masses, so a tree whose
+/// exact solve needs more (a light link carrying some 5 million times its
+/// mass) would be held there.
 pub const ROW_SPEED_BOUND: Real = 4.0e5;
 
 /// `m_eff · ROW_SPEED_BOUND`, or no bound for a row no body moves along

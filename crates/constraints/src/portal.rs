@@ -149,7 +149,7 @@ use janus2d_core::math::{Mat3, PI, Real, Vec2, cross, cross_sv, wrap_angle};
 use janus2d_core::softness::Softness;
 use smallvec::SmallVec;
 
-use crate::parts::{bounded_sum, clamp_length, row_bound_of_k, soft_impulse};
+use crate::parts::{clamp_length, soft_impulse};
 use crate::portal_map::{Portal, PortalError, PortalFrame, PortalMap, validate_eta};
 
 /// Everything needed to create a portal constraint.
@@ -559,24 +559,20 @@ impl PortalPart {
             ([0.0; 3], 1.0, 0.0)
         };
         let rhs = [c_dot[0] + bias[0], c_dot[1] + bias[1], c_dot[2] + bias[2]];
-        // `diagonal`: each row's own K, for the bound on its impulse.
-        let (x, diagonal) = if fast {
+        let x = if fast {
             let eta = self.eta;
             let k = eta * eta * m.body.inv_mass + m.clone.inv_mass;
             let k_angle = m.body.inv_inertia + m.clone.inv_inertia;
             let inv = |k: Real| if k > 0.0 { 1.0 / k } else { 0.0 };
-            (
-                [rhs[0] * inv(k), rhs[1] * inv(k), rhs[2] * inv(k_angle)],
-                [k, k, k_angle],
-            )
+            [rhs[0] * inv(k), rhs[1] * inv(k), rhs[2] * inv(k_angle)]
         } else {
             let k = g.effective_mass(m, merged_ab);
-            (solve_block(&k, rhs), [k[0][0], k[1][1], k[2][2]])
+            solve_block(&k, rhs)
         };
         let mut lambda = [0.0; 3];
         for i in 0..3 {
-            let step = soft_impulse(mass_scale, x[i], impulse_scale, self.impulse[i]);
-            lambda[i] = bounded_sum(&mut self.impulse[i], step, row_bound_of_k(diagonal[i]));
+            lambda[i] = soft_impulse(mass_scale, x[i], impulse_scale, self.impulse[i]);
+            self.impulse[i] += lambda[i];
         }
         g.apply(states, ix, m, lambda);
     }
