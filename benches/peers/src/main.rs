@@ -45,6 +45,7 @@ use rapier::Rapier;
 /// Box2D first: the others are compared with its figures of the same run.
 const ENGINES: [&str; 3] = ["Box2D", "janus2d", "Rapier"];
 
+#[derive(Clone)]
 struct Args {
     command: String,
     names: Vec<String>,
@@ -104,7 +105,7 @@ fn parse_args() -> Args {
             cmd if first
                 && matches!(
                     cmd,
-                    "all" | "profile" | "hard" | "sweep" | "chart" | "joints"
+                    "all" | "profile" | "hard" | "sweep" | "chart" | "joints" | "scaling"
                 ) =>
             {
                 args.command = cmd.into()
@@ -524,6 +525,179 @@ fn cmd_chart(args: &Args) {
     println!("wrote {svg}");
 }
 
+/// The scenes of the scaling run: the large pyramid at 10, 20, 50, 100
+/// and 200 rows, and many_pyramids at 1/4, 1/2, 1 and 2 times its count
+/// (5, 10, 20 and 40 rows of 20 pyramids).
+fn scaling_scenes() -> Vec<(&'static str, usize, janus2d_testbed::desc::SceneDesc)> {
+    let mut out = Vec::new();
+    for rows in [10, 20, 50, 100, 200] {
+        out.push(("large_pyramid", rows, benchmarks::pyramid(rows)));
+    }
+    for rows in [5, 10, 20, 40] {
+        out.push((
+            "many_pyramids",
+            rows,
+            benchmarks::many_pyramids_of(rows, 20),
+        ));
+    }
+    out
+}
+
+/// `scaling`: ms per step and µs per body per step of each engine (one
+/// thread) on the scaling scenes, in one run; prints a table, writes
+/// `--csv` (default `docs/performance/scaling.csv`) and `--svg` (default
+/// `docs/performance/scaling.svg`). `--steps` (default 120) timed steps
+/// each, best of `--repeats`.
+fn cmd_scaling(args: &Args) {
+    let steps = args.steps.unwrap_or(120);
+    let scenes = scaling_scenes();
+    println!(
+        "scaling: {} | {} steps, best of {} | one thread",
+        args.engines.join(", "),
+        steps,
+        args.repeats
+    );
+    println!(
+        "{:<14} {:>5} {:>7} {}",
+        "family",
+        "size",
+        "bodies",
+        args.engines
+            .iter()
+            .map(|e| format!("{:>10} {:>8}", format!("{e} ms"), "µs/body"))
+            .collect::<Vec<_>>()
+            .join(" ")
+            + "  janus2d ÷ Box2D"
+    );
+    // (family, size, bodies, engine, ms per step)
+    let mut points: Vec<(&str, usize, usize, String, f64)> = Vec::new();
+    let mut csv = String::from("family,size,bodies,engine,ms_per_step,us_per_body\n");
+    for (family, size, desc) in &scenes {
+        let bodies = desc
+            .bodies
+            .iter()
+            .filter(|b| b.kind == janus2d_testbed::desc::BodyKind::Dynamic)
+            .count();
+        let mut line = format!("{family:<14} {size:>5} {bodies:>7}");
+        let mut ms_of = std::collections::BTreeMap::new();
+        for engine in &args.engines {
+            let ms = match time_on(
+                engine,
+                desc,
+                1,
+                &Args {
+                    steps: Some(steps),
+                    ..args.clone()
+                },
+            ) {
+                Ok(t) => t.ms_per_step(),
+                Err(e) => {
+                    eprintln!("{engine} {family} {size}: {e}");
+                    f64::NAN
+                }
+            };
+            let per_body = 1e3 * ms / bodies.max(1) as f64;
+            let _ = write!(line, " {ms:>10.3} {per_body:>8.3}");
+            let _ = writeln!(
+                csv,
+                "{family},{size},{bodies},{engine},{ms:.4},{per_body:.4}"
+            );
+            ms_of.insert(engine.clone(), ms);
+            points.push((family, *size, bodies, engine.clone(), ms));
+        }
+        if let (Some(j), Some(b)) = (ms_of.get("janus2d"), ms_of.get("Box2D")) {
+            let _ = write!(line, "  {:.2}", j / b);
+        }
+        println!("{line}");
+    }
+    let csv_path = args
+        .csv
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("docs/performance/scaling.csv"));
+    let svg_path = args
+        .svg
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("docs/performance/scaling.svg"));
+    if let Err(e) = std::fs::write(&csv_path, csv) {
+        eprintln!("write {}: {e}", csv_path.display());
+    }
+    match scaling_chart(&points, &svg_path) {
+        Ok(()) => println!("wrote {} and {}", csv_path.display(), svg_path.display()),
+        Err(e) => eprintln!("chart: {e}"),
+    }
+}
+
+/// µs per body per step against bodies (log scale), one line per family
+/// and engine.
+fn scaling_chart(
+    points: &[(&str, usize, usize, String, f64)],
+    path: &PathBuf,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let root = SVGBackend::new(path, (960, 480)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let per_body = |p: &(&str, usize, usize, String, f64)| 1e3 * p.4 / p.2.max(1) as f64;
+    let max_y = points
+        .iter()
+        .map(per_body)
+        .filter(|v| v.is_finite())
+        .fold(0.1f64, f64::max);
+    let (min_x, max_x) = points.iter().fold((f64::MAX, 1.0f64), |(lo, hi), p| {
+        (lo.min(p.2 as f64), hi.max(p.2 as f64))
+    });
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "cost per body as the scene grows (one thread; flat or falling: the cost grows no faster than the scene)",
+            ("sans-serif", 16),
+        )
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(50)
+        .build_cartesian_2d((min_x * 0.8..max_x * 1.25).log_scale(), 0.0..max_y * 1.15)?;
+    chart
+        .configure_mesh()
+        .x_desc("dynamic bodies")
+        .y_desc("µs per body per step")
+        .draw()?;
+    let colour = |engine: &str| match engine {
+        "Box2D" => RGBColor(31, 119, 180),
+        "janus2d" => RGBColor(44, 160, 44),
+        _ => RGBColor(214, 39, 40),
+    };
+    for family in ["large_pyramid", "many_pyramids"] {
+        for engine in ENGINES {
+            let line: Vec<(f64, f64)> = points
+                .iter()
+                .filter(|p| p.0 == family && p.3 == engine && p.4.is_finite())
+                .map(|p| (p.2 as f64, per_body(p)))
+                .collect();
+            if line.is_empty() {
+                continue;
+            }
+            let c = colour(engine);
+            let style = if family == "large_pyramid" {
+                ShapeStyle::from(&c).stroke_width(2)
+            } else {
+                ShapeStyle::from(&c.mix(0.5)).stroke_width(2)
+            };
+            chart
+                .draw_series(LineSeries::new(line.clone(), style))?
+                .label(format!("{engine}, {family}"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            chart.draw_series(
+                line.iter()
+                    .map(|&(x, y)| Circle::new((x, y), 3, c.filled())),
+            )?;
+        }
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
+
 fn cmd_profile(args: &Args) {
     let names: Vec<String> = if args.names.is_empty() {
         ["large_pyramid", "many_pyramids", "tumbler"]
@@ -937,6 +1111,7 @@ fn main() {
         "sweep" => cmd_sweep(&args),
         "chart" => cmd_chart(&args),
         "joints" => cmd_joints(&args),
+        "scaling" => cmd_scaling(&args),
         _ => cmd_all(&args),
     }
 }

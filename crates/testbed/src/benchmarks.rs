@@ -111,7 +111,15 @@ pub fn pyramid(base: usize) -> SceneDesc {
 /// top box of the first pyramid.
 #[must_use]
 pub fn many_pyramids() -> SceneDesc {
-    let (rows, cols, base) = (20, 20, 10);
+    many_pyramids_of(20, 20)
+}
+
+/// `many_pyramids` with `rows` × `cols` pyramids of base 10 (the
+/// benchmark is 20 × 20), for the scaling run: the same layout, more or
+/// fewer rows.
+#[must_use]
+pub fn many_pyramids_of(rows: usize, cols: usize) -> SceneDesc {
+    let base = 10;
     let mut d = SceneDesc::new("many_pyramids", 200);
     let mut ground = BodyDesc::fixed(DVec2::ZERO);
     for r in 0..rows {
@@ -138,7 +146,9 @@ pub fn many_pyramids() -> SceneDesc {
         }
     }
     d.probe_label = "top box of the first pyramid";
-    d.reference.touching = Some(58_000.0);
+    if (rows, cols) == (20, 20) {
+        d.reference.touching = Some(58_000.0);
+    }
     d
 }
 
