@@ -141,8 +141,9 @@ impl Bounds {
         match self {
             Bounds::Free => bounded_sum(impulse, lambda, max),
             Bounds::Clamp(lower, upper) => {
+                // The bound folded into the clamp: one clamp per row.
                 let old = *impulse;
-                *impulse = cap((old + lambda).clamp_to(lower, upper), max);
+                *impulse = (old + lambda).clamp_to(lower.at_least(-max), upper.at_most(max));
                 *impulse - old
             }
         }
