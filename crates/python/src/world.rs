@@ -1253,8 +1253,14 @@ impl PyWorld {
                 .map(|s| (Shape::from(s.sensor_shape), Shape::from(s.visitor_shape)))
                 .collect()
         };
-        d.set_item("sensor_begin", PyList::new(py, sensors(&e.collision.sensor_begin))?)?;
-        d.set_item("sensor_end", PyList::new(py, sensors(&e.collision.sensor_end))?)?;
+        d.set_item(
+            "sensor_begin",
+            PyList::new(py, sensors(&e.collision.sensor_begin))?,
+        )?;
+        d.set_item(
+            "sensor_end",
+            PyList::new(py, sensors(&e.collision.sensor_end))?,
+        )?;
         let forces = PyList::empty(py);
         for f in &e.collision.forces {
             let fd = PyDict::new(py);
