@@ -66,7 +66,7 @@ fn main() -> Result<(), WorldError> {
         for step in 1..=90 {
             let v_before = s.world.linear_velocity(s.probe)?;
             s.world.step(DT)?;
-            for e in s.world.portal_events() {
+            for e in &s.world.events().portals {
                 let t = step as Real * DT;
                 match e {
                     PortalEvent::CrossingStarted { .. } => {

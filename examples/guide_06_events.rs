@@ -1,7 +1,7 @@
 //! Guide step 6 (docs/guide.md): events. After each step the world lists
 //! what began and ended: contacts, sensor overlaps (coins the player
 //! collects), hits above a speed (a crate landing hard) and joints past a
-//! force threshold. Events describe the last step only; read them before
+//! force threshold, all in one `StepEvents`. Events describe the last step only; read them before
 //! the next one. Shape user data tells the game what a shape is. Run with
 //! `cargo run --example guide_06_events`.
 
@@ -48,13 +48,8 @@ fn main() -> Result<(), WorldError> {
         let t = step as Real * DT;
         let events = world.events();
         for e in &events.collision.sensor_begin {
-            // A pair of shapes, in no particular order: a coin and the player?
-            let [a, b] = [e.shape_a, e.shape_b];
-            let (coin, other) = if world.shape_user_data(a)? == COIN {
-                (a, b)
-            } else {
-                (b, a)
-            };
+            // The sensor is the coin, the visitor the player?
+            let (coin, other) = (e.sensor_shape, e.visitor_shape);
             if world.shape_user_data(coin)? == COIN && world.shape_body(other)? == player {
                 score += 1;
                 println!("t = {t:.2} s: coin collected (score {score})");
@@ -63,13 +58,17 @@ fn main() -> Result<(), WorldError> {
         for hit in &events.collision.hits {
             println!(
                 "t = {t:.2} s: hit at ({:.2}, {:.2}), {:.1} m/s",
-                hit.point.x, hit.point.y, hit.approach_speed
+                hit.point_b.x, hit.point_b.y, hit.approach_speed
             );
         }
         for e in &events.collision.contact_begin {
             let bodies = [world.shape_body(e.shape_a)?, world.shape_body(e.shape_b)?];
             if bodies.contains(&crate_) {
-                println!("t = {t:.2} s: the crate touches the ground");
+                let n = e.manifold.normal;
+                println!(
+                    "t = {t:.2} s: the crate touches the ground ({} points, normal ({:.2}, {:.2}))",
+                    e.manifold.point_count, n.x, n.y
+                );
             }
         }
     }

@@ -43,7 +43,7 @@ fn main() -> Result<(), WorldError> {
 
     for step in 1..=90 {
         world.step(1.0 / 60.0)?;
-        for event in world.portal_events() {
+        for event in &world.events().portals {
             match event {
                 PortalEvent::CrossingStarted { body, clone, .. } => {
                     let who = if *body == crate_ {

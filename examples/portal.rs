@@ -28,7 +28,8 @@ fn main() -> Result<(), WorldError> {
             .filter(|h| world.body_type(*h) == Ok(BodyType::Dynamic))
             .count();
         let events: Vec<String> = world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .map(|e| match e {
                 PortalEvent::CrossingStarted { .. } => {

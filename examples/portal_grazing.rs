@@ -54,7 +54,8 @@ pub fn run() -> Result<Report, WorldError> {
     for step in 0..60 {
         world.step(1.0 / 60.0)?;
         if world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .any(|e| matches!(e, PortalEvent::CrossingCompleted { .. }))
         {

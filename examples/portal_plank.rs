@@ -61,7 +61,7 @@ pub fn run() -> Result<Report, WorldError> {
     let (mut plank_sink, mut plank_crossed, mut box_through) = (0.0 as Real, false, false);
     for step in 0..180 {
         world.step(1.0 / 60.0)?;
-        for e in world.portal_events() {
+        for e in &world.events().portals {
             match *e {
                 PortalEvent::CrossingStarted { body, .. } if body == plank => plank_crossed = true,
                 PortalEvent::CrossingCompleted { body, .. } if body == b => box_through = true,

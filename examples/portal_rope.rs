@@ -126,7 +126,7 @@ pub fn run(eta: Real) -> Result<Report, WorldError> {
     let mut through: Vec<BodyHandle> = Vec::new();
     for step in 0..300 {
         world.step(1.0 / 60.0)?;
-        for e in world.portal_events() {
+        for e in &world.events().portals {
             match *e {
                 PortalEvent::JointDisabled { .. } => disabled += 1,
                 PortalEvent::CrossingCompleted { body, .. } if !through.contains(&body) => {

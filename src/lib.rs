@@ -15,7 +15,7 @@
 //! | joints (eight kinds)                  | [`JointDef`], [`World::create_joint`], [`RevoluteJointDef`] and the other `…JointDef`s |
 //! | scene queries: rays, casts, overlaps  | [`query`], [`QueryFilter`], [`RayHit`], [`World::cast_ray_closest`] |
 //! | a character mover and controller      | [`CharacterController`], [`World::cast_mover`], [`World::collide_mover`], [`solve_planes`], [`clip_vector`] |
-//! | events after a step                   | [`StepEvents`] ([`World::events`]): [`CollisionEvents`], [`HitEvent`], [`JointEvent`]; [`PortalEvent`] ([`World::portal_events`]) |
+//! | events after a step                   | [`StepEvents`] ([`World::events`]): [`CollisionEvents`] (contact begin with manifold, end, sensor, [`HitEvent`], contact force), [`JointEvent`], [`PortalEvent`], body move events |
 //! | changing contacts before the solve    | [`PreSolve`], [`World::set_pre_solve`], [`World::set_pair_filter`] |
 //! | surface materials                     | [`ShapeDef`] (`rolling_resistance`, `tangent_speed`, `friction_combine`, `user_material_id`), [`CombineRule`], [`World::set_friction_callback`] |
 //! | portals (feature `portals`, default)  | [`portal`], [`PortalPairDef`], [`PortalDef`], [`World::create_portal_pair`] |

@@ -340,7 +340,8 @@ fn fast_ball_into_a_floor_portal_crosses_it() {
         for _ in 0..20 {
             world.step(1.0 / 60.0).unwrap();
             completed += world
-                .portal_events()
+                .events()
+                .portals
                 .iter()
                 .filter(|e| matches!(e, PortalEvent::CrossingCompleted { .. }))
                 .count();

@@ -39,6 +39,7 @@ mod setters;
 mod snapshot;
 mod soak;
 mod stages;
+mod step_events;
 mod surface_materials;
 mod weld;
 mod wheel;

@@ -293,23 +293,15 @@ fn sensor_overlaps_equal_the_set_the_sensor_events_build_over_a_run() {
         w.step(1.0 / 60.0).unwrap();
         let ev = &w.events().collision;
         for e in &ev.sensor_end {
-            if e.shape_a == sensor || e.shape_b == sensor {
-                let other = if e.shape_a == sensor {
-                    e.shape_b
-                } else {
-                    e.shape_a
-                };
+            if e.sensor_shape == sensor {
+                let other = e.visitor_shape;
                 assert!(from_events.remove(&other), "step {step}: end without begin");
                 ends += 1;
             }
         }
         for e in &ev.sensor_begin {
-            if e.shape_a == sensor || e.shape_b == sensor {
-                let other = if e.shape_a == sensor {
-                    e.shape_b
-                } else {
-                    e.shape_a
-                };
+            if e.sensor_shape == sensor {
+                let other = e.visitor_shape;
                 assert!(from_events.insert(other), "step {step}: begin twice");
                 begins += 1;
             }

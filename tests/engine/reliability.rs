@@ -1425,7 +1425,7 @@ fn portal_events_of_calls_between_steps_are_reported_with_the_next_step() {
         let world = &mut scene.world;
         let mut open: i64 = 0;
         let mut count = |world: &World| {
-            for e in world.portal_events() {
+            for e in &world.events().portals {
                 match e {
                     PortalEvent::CrossingStarted { .. } => open += 1,
                     PortalEvent::CrossingCompleted { .. }
@@ -1456,18 +1456,19 @@ fn portal_events_of_calls_between_steps_are_reported_with_the_next_step() {
         assert_eq!(world.crossing_count(), 0);
         world.step(DT).unwrap();
         let cancelled = world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .filter(|e| matches!(e, PortalEvent::CrossingCancelled { pair: p, .. } if *p == pair))
             .count();
-        assert!(cancelled >= 1, "case {what}: {:?}", world.portal_events());
+        assert!(cancelled >= 1, "case {what}: {:?}", world.events().portals);
         assert!(
             matches!(
-                world.portal_events()[0],
+                world.events().portals[0],
                 PortalEvent::CrossingCancelled { .. }
             ),
             "case {what}: the call's events come first: {:?}",
-            world.portal_events()
+            world.events().portals
         );
         count(world);
         for _ in 0..120 {

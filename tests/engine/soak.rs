@@ -541,7 +541,8 @@ impl Soak {
         {
             self.report.crossings_completed += self
                 .world
-                .portal_events()
+                .events()
+                .portals
                 .iter()
                 .filter(|e| matches!(e, janus2d::portal::PortalEvent::CrossingCompleted { .. }))
                 .count() as u64;

@@ -63,7 +63,8 @@ fn settle(world: &mut World, body: BodyHandle, steps: usize) -> (Real, Real, boo
     for k in 0..steps {
         world.step(DT).unwrap();
         started |= world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .any(|e| matches!(e, PortalEvent::CrossingStarted { .. }));
         if k >= steps / 2 {
@@ -143,7 +144,8 @@ fn box_within_an_aperture_enters() {
     for _ in 0..120 {
         world.step(DT).unwrap();
         completed |= world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .any(|e| matches!(e, PortalEvent::CrossingCompleted { .. }));
         if completed {
@@ -212,7 +214,7 @@ fn body_at_two_portals_is_held_by_the_second_wall() {
     let (mut worst, mut over_second, mut completed) = (0.0 as Real, 0, false);
     for _ in 0..240 {
         world.step(DT).unwrap();
-        for e in world.portal_events() {
+        for e in &world.events().portals {
             match e {
                 PortalEvent::CrossingStarted { pair, .. } => {
                     assert_ne!(*pair, second, "a second crossing started")
@@ -347,7 +349,8 @@ fn ball_within_the_aperture_enters() {
     for _ in 0..120 {
         world.step(DT).unwrap();
         completed |= world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .any(|e| matches!(e, PortalEvent::CrossingCompleted { .. }));
         if completed {

@@ -59,7 +59,8 @@ fn rod_through(eta: Real) -> Run {
         world.step(DT).unwrap();
         world.validate().unwrap();
         r.disabled += world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .filter(|e| matches!(e, PortalEvent::JointDisabled { .. }))
             .count();

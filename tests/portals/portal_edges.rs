@@ -79,7 +79,7 @@ fn crossing_ends_when_the_original_shape_is_destroyed_mid_crossing() {
         assert!(
             world.position(clone).is_err(),
             "the old clone is left (add {add_another}): {:?}",
-            world.portal_events()
+            world.events().portals
         );
         if add_another {
             // It crosses again with its new shape; the new clone is a circle.
@@ -117,7 +117,8 @@ fn crossing_ends_when_original_and_clone_are_jointed() {
     for step in 0..240 {
         world.step(DT).unwrap();
         disabled |= world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .any(|e| matches!(e, PortalEvent::JointDisabled { joint: j, .. } if *j == joint));
         if world.crossing_count() == 0 {

@@ -74,7 +74,8 @@ fn cross(steps: usize) -> Crossed {
         world.validate().unwrap();
         most_contacts = most_contacts.max(contacts_between(&world, a, b));
         disabled += world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .filter(|e| matches!(e, PortalEvent::JointDisabled { .. }))
             .count();

@@ -66,7 +66,8 @@ fn throw(angle_deg: Real, speed: Real, x_c: Real) -> Throw {
     for _ in 0..40 {
         world.step(DT).unwrap();
         if world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .any(|e| matches!(e, PortalEvent::CrossingCompleted { .. }))
         {

@@ -37,7 +37,8 @@ fn run(
         world.step(DT).unwrap();
         world.validate().unwrap();
         r.disabled += world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .filter(|e| matches!(e, PortalEvent::JointDisabled { .. }))
             .count();
@@ -174,7 +175,7 @@ fn jointed_pair_backs_out_whole() {
     for _ in 0..240 {
         world.step(DT).unwrap();
         world.validate().unwrap();
-        for e in world.portal_events() {
+        for e in &world.events().portals {
             match e {
                 PortalEvent::JointDisabled { .. } => r.disabled += 1,
                 PortalEvent::CrossingStarted { body, .. } if reversed && *body == a => {
@@ -246,7 +247,8 @@ fn destroying_the_pair_under_a_crossing_rope_disables_only_what_cannot_follow() 
     // Events of a call between steps come with the next step's.
     world.step(DT).unwrap();
     let reported = world
-        .portal_events()
+        .events()
+        .portals
         .iter()
         .filter(|e| matches!(e, PortalEvent::JointDisabled { .. }))
         .count();
@@ -359,7 +361,7 @@ fn jointed_pair_through_dynamic_portal_bodies_conserves_momentum() {
     for _ in 0..150 {
         world.step(DT).unwrap();
         world.validate().unwrap();
-        for e in world.portal_events() {
+        for e in &world.events().portals {
             match e {
                 PortalEvent::JointDisabled { .. } => r.disabled += 1,
                 PortalEvent::CrossingCompleted { .. } => completed += 1,

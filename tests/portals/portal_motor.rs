@@ -125,7 +125,8 @@ fn motor_joined_pair_keeps_its_offset_through_a_portal() {
         world.step(DT).unwrap();
         world.validate().unwrap();
         disabled += world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .filter(|e| matches!(e, PortalEvent::JointDisabled { .. }))
             .count();

@@ -66,7 +66,7 @@ pub(super) fn run(
     for _ in 0..150 {
         world.step(DT).unwrap();
         world.validate().unwrap();
-        for e in world.portal_events() {
+        for e in &world.events().portals {
             match e {
                 PortalEvent::JointDisabled { .. } => r.disabled += 1,
                 PortalEvent::CrossingCompleted { .. } => r.completed += 1,

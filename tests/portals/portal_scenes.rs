@@ -45,7 +45,8 @@ fn launched_box(world: &mut World, pos: Vec2, velocity: Vec2, half: Real) -> Bod
 
 fn completed(world: &World) -> bool {
     world
-        .portal_events()
+        .events()
+        .portals
         .iter()
         .any(|e| matches!(e, PortalEvent::CrossingCompleted { .. }))
 }
@@ -64,7 +65,8 @@ fn portal_drop_exits_sideways_at_impact_speed() {
         let v_before = world.linear_velocity(body).unwrap();
         world.step(DT).unwrap();
         if world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .any(|e| matches!(e, PortalEvent::CrossingStarted { .. }))
         {
@@ -266,7 +268,8 @@ fn portal_loop_speed_grows_only_by_gravity() {
         // Free fall from rest gains g t; the box is never faster than that.
         max_excess = max_excess.max(speed - 10.0 * t);
         passes += world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .filter(|e| matches!(e, PortalEvent::CrossingCompleted { .. }))
             .count();
@@ -461,7 +464,8 @@ fn portal_stream_conserves_bodies() {
     for _ in 0..1800 {
         world.step(DT).unwrap();
         passes += world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .filter(|e| matches!(e, PortalEvent::CrossingCompleted { .. }))
             .count();
@@ -550,7 +554,7 @@ fn joint_on_a_body_that_goes_through_follows_it() {
     let mut worst_gap: Real = 0.0;
     for _ in 0..150 {
         world.step(DT).unwrap();
-        for e in world.portal_events() {
+        for e in &world.events().portals {
             match e {
                 PortalEvent::JointDisabled { .. } => disabled = true,
                 PortalEvent::CrossingCompleted { body, .. } if *body == scene.probe => {
@@ -603,7 +607,8 @@ fn fast_body_crosses_without_tunnelling() {
     for _ in 0..30 {
         world.step(DT).unwrap();
         completions += world
-            .portal_events()
+            .events()
+            .portals
             .iter()
             .filter(|e| matches!(e, PortalEvent::CrossingCompleted { .. }))
             .count();

@@ -33,7 +33,7 @@ fn weld_through(direct_joints: bool) -> (Real, Real, usize, usize) {
     for _ in 0..150 {
         world.step(1.0 / 60.0).unwrap();
         world.validate().unwrap();
-        for e in world.portal_events() {
+        for e in &world.events().portals {
             match e {
                 PortalEvent::JointDisabled { .. } => disabled += 1,
                 PortalEvent::CrossingCompleted { .. } => completed += 1,

@@ -694,7 +694,7 @@ fn run_here<W: Write>(
             ));
         }
         #[cfg(feature = "portals")]
-        for e in world.portal_events() {
+        for e in &world.events().portals {
             use janus2d_world::PortalEvent;
             events.push(match e {
                 PortalEvent::CrossingStarted { body, clone, .. } => {

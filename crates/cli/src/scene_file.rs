@@ -27,8 +27,8 @@
 //! |-----|------|---------|
 //! | `name`, `steps`, `probe` | label; steps `janus2d run` takes; the body the summary reports | file name, 600, none |
 //! | `settings` | `gravity` [x, y] m/s², `dt` s, `substeps`, `relax_iterations`, `sleep`, `contact_hertz`, `contact_damping_ratio`, `contact_push_max_velocity` m/s, `joint_hertz`, `joint_damping_ratio`, `restitution_threshold` m/s, `warm_starting` | the world's defaults, dt 1/60 |
-//! | body | `id`, `type` (`static`, `kinematic`, `dynamic`), `position`, `angle`, `linear_velocity`, `angular_velocity`, `linear_damping`, `angular_damping`, `gravity_scale`, `fixed_rotation`, `awake`, `mass` {`mass`, `inertia`, `center`}, `shapes` | dynamic at the origin, mass from the shapes |
-//! | shape | `geometry` (one of below), `density`, `friction`, `restitution`, `sensor`, `filter` {`category`, `mask`, `group`}, `rolling_resistance`, `tangent_speed` m/s, `friction_combine` and `restitution_combine` (`default`, `average`, `min`, `multiply`, `max`), `material` (user material id) | 1, 0.6, 0, false, collides with all, 0, 0, `default`, `default`, 0 |
+//! | body | `id`, `type` (`static`, `kinematic`, `dynamic`), `position`, `angle`, `linear_velocity`, `angular_velocity`, `linear_damping`, `angular_damping`, `gravity_scale`, `fixed_rotation`, `awake`, `move_events`, `mass` {`mass`, `inertia`, `center`}, `shapes` | dynamic at the origin, mass from the shapes, move events on |
+//! | shape | `geometry` (one of below), `density`, `friction`, `restitution`, `sensor`, `filter` {`category`, `mask`, `group`}, `rolling_resistance`, `tangent_speed` m/s, `friction_combine` and `restitution_combine` (`default`, `average`, `min`, `multiply`, `max`), `material` (user material id), `hit_events`, `contact_events`, `sensor_events`, `force_event_threshold` N | 1, 0.6, 0, false, collides with all, 0, 0, `default`, `default`, 0, false, true, true, none (never) |
 //! | geometry | `circle` {`center`, `radius`}, `capsule` {`a`, `b`, `radius`}, `box` {`half`, `center`, `angle`, `radius`}, `polygon` {`points`, `radius`} (convex hull), `segment` {`a`, `b`}, `chain` {`points`, `closed`} (one-sided) | |
 //! | joint | `type` (below), `body_a`, `body_b` (index or id), `anchor` (a world point at creation) or `anchor_a`/`anchor_b` (body frames; motor and filter joints may leave both out: the bodies' origins), `angle_a`/`angle_b` (the frames' angles in the body frames, rad), `collide_connected`, `force_threshold` N and `torque_threshold` N·m (joint events), `constraint_hertz`/`constraint_damping_ratio` (softness of the rigid rows), `user_data`, `draw_scale` | `revolute`; frames at angle 0; not colliding; thresholds ∞; the world's joint softness; 0; 1 |
 //! | `revolute` | `reference_angle` (rad: θ_b − θ_a at angle 0), `limit` [lower, upper] rad, `motor` {`speed` rad/s, `max_torque` N·m}, `spring` {`hertz`, `damping_ratio`}, `target_angle` rad | a plain hinge |
@@ -202,6 +202,9 @@ pub struct BodyFile {
     /// Created awake.
     #[serde(default = "yes", skip_serializing_if = "is_true")]
     pub awake: bool,
+    /// Reports move events (`BodyDef::enable_move_events`).
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub move_events: bool,
     /// Mass set directly (otherwise from the shapes).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mass: Option<MassFile>,
@@ -330,6 +333,19 @@ pub struct ShapeFile {
     /// The user's material id (`ShapeDef::user_material_id`).
     #[serde(default, skip_serializing_if = "is_zero_u64")]
     pub material: u64,
+    /// Hit events (`ShapeDef::enable_hit_events`).
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub hit_events: bool,
+    /// Contact begin/end events (`ShapeDef::enable_contact_events`).
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub contact_events: bool,
+    /// Sensor events (`ShapeDef::enable_sensor_events`).
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub sensor_events: bool,
+    /// Contact force event threshold, N (`ShapeDef::force_event_threshold`;
+    /// absent: never).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub force_event_threshold: Option<f64>,
 }
 
 /// A combine rule by name (`janus2d_core::material::CombineRule`).
@@ -1007,6 +1023,7 @@ impl SceneFile {
                 gravity_scale: from_f64(b.gravity_scale),
                 fixed_rotation: b.fixed_rotation,
                 awake: b.awake,
+                enable_move_events: b.move_events,
                 ..BodyDef::default()
             };
             if let Some(m) = &b.mass {
@@ -1036,6 +1053,10 @@ impl SceneFile {
                     friction_combine: s.friction_combine.rule(),
                     restitution_combine: s.restitution_combine.rule(),
                     user_material_id: s.material,
+                    enable_hit_events: s.hit_events,
+                    enable_contact_events: s.contact_events,
+                    enable_sensor_events: s.sensor_events,
+                    force_event_threshold: s.force_event_threshold.map_or(Real::INFINITY, from_f64),
                     ..ShapeDef::default()
                 };
                 let shapes = s
@@ -1478,6 +1499,7 @@ impl SceneFile {
                 gravity_scale: 1.0,
                 fixed_rotation: false,
                 awake: b.awake,
+                move_events: true,
                 mass: b.mass.map(|(mass, inertia)| MassFile {
                     mass,
                     inertia,
@@ -1535,6 +1557,10 @@ impl SceneFile {
                         friction_combine: CombineFile::Default,
                         restitution_combine: CombineFile::Default,
                         material: 0,
+                        hit_events: s.hit_events,
+                        contact_events: true,
+                        sensor_events: true,
+                        force_event_threshold: None,
                     })
                     .collect(),
             })

@@ -131,6 +131,10 @@ pub struct BodyDef {
     pub sleep_threshold: Option<Real>,
     /// Opaque user value.
     pub user_data: u64,
+    /// Report a body move event for this body after each step it moves
+    /// (usual true, as Box2D's; the world gathers them only when its own
+    /// switch is on: `WorldDef::enable_move_events` in `janus2d-world`).
+    pub enable_move_events: bool,
 }
 
 impl Default for BodyDef {
@@ -153,6 +157,7 @@ impl Default for BodyDef {
             enable_sleep: true,
             sleep_threshold: None,
             user_data: 0,
+            enable_move_events: true,
         }
     }
 }
@@ -211,6 +216,20 @@ impl BodyDef {
     #[must_use]
     pub fn with_user_data(mut self, value: u64) -> Self {
         self.user_data = value;
+        self
+    }
+
+    /// Turns the body's move events on or off (builder style; see
+    /// [`BodyDef::enable_move_events`]).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let def = BodyDef::dynamic(Vec2::ZERO).with_move_events(false);
+    /// assert!(!def.enable_move_events);
+    /// ```
+    #[must_use]
+    pub fn with_move_events(mut self, on: bool) -> Self {
+        self.enable_move_events = on;
         self
     }
 
@@ -598,6 +617,8 @@ pub struct BodyRecord {
     pub mass_override: bool,
     /// True when rotation is locked.
     pub fixed_rotation: bool,
+    /// Reports move events ([`BodyDef::enable_move_events`]).
+    pub enable_move_events: bool,
 }
 
 /// A body as the solver sees it during prepare: its state slot and its data.
@@ -893,6 +914,7 @@ impl BodySet {
             user_data: def.user_data,
             mass_override: def.mass.is_some(),
             fixed_rotation: def.fixed_rotation,
+            enable_move_events: def.enable_move_events,
         });
         let handle = BodyHandle::new(index, generation, self.owner);
         let transform = Transform::new(def.position, def.angle);

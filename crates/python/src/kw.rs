@@ -176,7 +176,7 @@ macro_rules! fields {
 /// `WorldDef`: gravity, continuous, hit threshold, the solver and sleep
 /// settings (flattened: `substeps`, `sleep_enabled`, …).
 pub fn world_def<V: Visitor>(d: &mut WorldDef, v: &mut V) -> PyResult<()> {
-    fields!(v, d; gravity, enable_continuous, hit_event_threshold)?;
+    fields!(v, d; gravity, enable_continuous, hit_event_threshold, enable_move_events)?;
     let s = &mut d.solver;
     fields!(v, s; substeps, relax_iterations, velocity_iterations, baumgarte, contact_hertz,
         contact_hertz_fraction, contact_damping_ratio, contact_push_max_velocity, joint_hertz,
@@ -192,13 +192,14 @@ pub fn world_def<V: Visitor>(d: &mut WorldDef, v: &mut V) -> PyResult<()> {
 pub fn body_def<V: Visitor>(d: &mut BodyDef, v: &mut V) -> PyResult<()> {
     fields!(v, d; angle, linear_velocity, angular_velocity, linear_damping, angular_damping,
         gravity_scale, max_linear_speed, max_rotation, fixed_rotation, awake, bullet,
-        enable_sleep, sleep_threshold, user_data)
+        enable_sleep, sleep_threshold, user_data, enable_move_events)
 }
 
 /// `ShapeDef` with its filter flattened (`category_bits`, `mask_bits`,
 /// `group_index`).
 pub fn shape_def<V: Visitor>(d: &mut ShapeDef, v: &mut V) -> PyResult<()> {
-    fields!(v, d; density, friction, restitution, is_sensor, enable_hit_events, user_data)?;
+    fields!(v, d; density, friction, restitution, is_sensor, enable_hit_events,
+        enable_contact_events, enable_sensor_events, force_event_threshold, user_data)?;
     let f = &mut d.filter;
     fields!(v, f; category_bits, mask_bits, group_index)
 }

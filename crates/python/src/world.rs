@@ -1103,7 +1103,7 @@ impl PyWorld {
     fn portal_events<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         let w = self.inner.lock();
         let list = PyList::empty(py);
-        for e in w.portal_events() {
+        for e in &w.events().portals {
             let d = PyDict::new(py);
             match *e {
                 PortalEvent::CrossingStarted { body, clone, pair } => {
@@ -1216,28 +1216,80 @@ impl PyWorld {
 
     // ---- events ---------------------------------------------------------
 
-    /// The last step's events: a dict of `contact_begin`, `contact_end`,
-    /// `sensor_begin`, `sensor_end` (lists of shape pairs), `hits` (dicts
-    /// with `shape_a`, `shape_b`, `point`, `normal`, `approach_speed`),
+    /// The last step's events: a dict of `contact_begin`, `contact_end`
+    /// (lists of shape pairs), `contact_begin_manifolds` (dicts with
+    /// `normal`, `points`, `user_material_ids`, one per begin),
+    /// `sensor_begin`, `sensor_end` (lists of (sensor, visitor) pairs),
+    /// `hits` (dicts with `shape_a`, `shape_b`, `point`, `point_a`,
+    /// `point_b`, `normal`, `approach_speed`), `forces` (dicts with
+    /// `shape_a`, `shape_b`, `total_force`, `max_force`), `moves` (dicts
+    /// with `body`, `position`, `angle`, `user_data`, `fell_asleep`),
     /// `joints` (dicts with `joint`, `force`, `torque`) and
-    /// `non_finite_bodies`.
+    /// `non_finite_bodies`. Portal events: `portal_events()`.
     fn events<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let w = self.inner.lock();
         let e = w.events();
         let d = PyDict::new(py);
-        d.set_item(
-            "contact_begin",
-            shape_pairs(py, &e.collision.contact_begin)?,
-        )?;
+        let begins: Vec<(Shape, Shape)> = e
+            .collision
+            .contact_begin
+            .iter()
+            .map(|b| (Shape::from(b.shape_a), Shape::from(b.shape_b)))
+            .collect();
+        d.set_item("contact_begin", PyList::new(py, begins)?)?;
+        let manifolds = PyList::empty(py);
+        for b in &e.collision.contact_begin {
+            let md = PyDict::new(py);
+            md.set_item("normal", pair(b.manifold.normal))?;
+            let points: Vec<(f64, f64)> = b.manifold.points().iter().map(|&p| pair(p)).collect();
+            md.set_item("points", points)?;
+            md.set_item("user_material_ids", b.manifold.user_material_ids.to_vec())?;
+            manifolds.append(md)?;
+        }
+        d.set_item("contact_begin_manifolds", manifolds)?;
         d.set_item("contact_end", shape_pairs(py, &e.collision.contact_end)?)?;
-        d.set_item("sensor_begin", shape_pairs(py, &e.collision.sensor_begin)?)?;
-        d.set_item("sensor_end", shape_pairs(py, &e.collision.sensor_end)?)?;
+        let sensors = |list: &[janus2d::world::SensorEvent]| -> Vec<(Shape, Shape)> {
+            list.iter()
+                .map(|s| (Shape::from(s.sensor_shape), Shape::from(s.visitor_shape)))
+                .collect()
+        };
+        d.set_item(
+            "sensor_begin",
+            PyList::new(py, sensors(&e.collision.sensor_begin))?,
+        )?;
+        d.set_item(
+            "sensor_end",
+            PyList::new(py, sensors(&e.collision.sensor_end))?,
+        )?;
+        let forces = PyList::empty(py);
+        for f in &e.collision.forces {
+            let fd = PyDict::new(py);
+            fd.set_item("shape_a", Shape::from(f.shape_a))?;
+            fd.set_item("shape_b", Shape::from(f.shape_b))?;
+            fd.set_item("total_force", pair(f.total_force))?;
+            fd.set_item("max_force", f64::from(f.max_force_magnitude))?;
+            forces.append(fd)?;
+        }
+        d.set_item("forces", forces)?;
+        let moves = PyList::empty(py);
+        for m in &e.moves {
+            let md = PyDict::new(py);
+            md.set_item("body", Body::from(m.body))?;
+            md.set_item("position", pair(m.transform.p))?;
+            md.set_item("angle", f64::from(m.transform.q.angle()))?;
+            md.set_item("user_data", m.user_data)?;
+            md.set_item("fell_asleep", m.fell_asleep)?;
+            moves.append(md)?;
+        }
+        d.set_item("moves", moves)?;
         let hits = PyList::empty(py);
         for h in &e.collision.hits {
             let hd = PyDict::new(py);
             hd.set_item("shape_a", Shape::from(h.shape_a))?;
             hd.set_item("shape_b", Shape::from(h.shape_b))?;
             hd.set_item("point", pair(h.point))?;
+            hd.set_item("point_a", pair(h.point_a))?;
+            hd.set_item("point_b", pair(h.point_b))?;
             hd.set_item("normal", pair(h.normal))?;
             hd.set_item("approach_speed", f64::from(h.approach_speed))?;
             hits.append(hd)?;

@@ -367,6 +367,7 @@ impl Collision {
                 touching: false,
                 sensor: sa.def.is_sensor || sb.def.is_sensor,
                 hit_events: sa.def.enable_hit_events || sb.def.enable_hit_events,
+                event_flags: crate::contacts::event_flags::of(&sa.def, &sb.def),
                 enabled: true,
                 still: [false, false],
                 solve_bodies: [(0, [0.0; 2]); 2],
@@ -406,13 +407,65 @@ impl Collision {
         best.sort_unstable_by_key(|b| b.0);
         for (index, point, speed) in best {
             let c = &self.contacts.awake()[index as usize];
+            let p = &c.points[point];
+            let half = 0.5 * p.separation * c.normal;
             self.events.hits.push(crate::contacts::HitEvent {
                 shape_a: c.shapes[0],
                 shape_b: c.shapes[1],
-                point: c.points[point].point,
+                point: p.point,
+                point_a: p.point - half,
+                point_b: p.point + half,
                 normal: c.normal,
                 approach_speed: speed,
             });
+        }
+    }
+
+    /// Whether some shape has a finite force event threshold.
+    #[inline]
+    pub(crate) fn has_force_events(&self) -> bool {
+        self.shapes.force_event_shapes() > 0
+    }
+
+    /// Contact force events of the step (the impulses stored): each awake
+    /// solid touching contact whose total normal force, its points' step
+    /// impulses over `dt`, exceeds the smaller of its shapes' thresholds,
+    /// in contact order. Run only when some shape has a threshold.
+    pub(crate) fn collect_forces(&mut self, dt: Real) {
+        let inv_dt = 1.0 / dt;
+        for c in self.contacts.awake() {
+            if !c.is_solid_touching() {
+                continue;
+            }
+            let threshold = self
+                .shapes
+                .at(c.shape_a)
+                .def
+                .force_event_threshold
+                .min(self.shapes.at(c.shape_b).def.force_event_threshold);
+            if !threshold.is_finite() {
+                continue;
+            }
+            let (mut total, mut max) = (0.0, 0.0);
+            for p in c.points() {
+                let f = p.total_normal_impulse * inv_dt;
+                total += f;
+                if f > max {
+                    max = f;
+                }
+            }
+            let total_force = total * c.normal;
+            let magnitude = total_force.length();
+            if magnitude > threshold {
+                self.events.forces.push(crate::contacts::ContactForceEvent {
+                    shape_a: c.shapes[0],
+                    shape_b: c.shapes[1],
+                    total_force,
+                    total_force_magnitude: magnitude,
+                    max_force_magnitude: max,
+                    max_force_direction: c.normal,
+                });
+            }
         }
     }
 

@@ -97,6 +97,10 @@ pub struct Contact {
     pub sensor: bool,
     /// True when either shape asked for hit events.
     pub hit_events: bool,
+    /// Event switches of the pair (`event_flags` bits): whether both
+    /// shapes report this contact's begin/end (or sensor) events, and
+    /// which shape is the sensor.
+    pub(crate) event_flags: u8,
     /// False when a filter (portal clipping, a disabled pair) suppresses it.
     pub enabled: bool,
     /// Whether each body read as static (static or asleep) at the last
@@ -163,7 +167,7 @@ impl Contact {
     }
 }
 
-/// Two shapes that began or stopped touching.
+/// Two shapes that stopped touching.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ShapePairEvent {
@@ -173,10 +177,160 @@ pub struct ShapePairEvent {
     pub shape_b: ShapeHandle,
 }
 
+/// The manifold of a contact when it began touching (what a
+/// [`ContactBeginEvent`] carries): Box2D's `b2ContactBeginTouchEvent`
+/// manifold.
+///
+/// ```
+/// use janus2d_world::EventManifold;
+/// let m = EventManifold::default();
+/// assert!(m.points().is_empty());
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct EventManifold {
+    /// Unit normal from shape a to shape b.
+    pub normal: Vec2,
+    /// World points (the first `point_count` are valid), m: each the
+    /// mid-point between the two surfaces, as the solver uses it.
+    pub points: [Vec2; 2],
+    /// Separation at each point (negative: penetration), m.
+    pub separations: [Real; 2],
+    /// Number of valid points (1 or 2).
+    pub point_count: usize,
+    /// The two shapes' user material ids (`ShapeDef::user_material_id`),
+    /// a's then b's, as [`Contact::user_material_ids`].
+    pub user_material_ids: [u64; 2],
+}
+
+impl EventManifold {
+    /// The valid points.
+    #[must_use]
+    pub fn points(&self) -> &[Vec2] {
+        &self.points[..self.point_count.min(2)]
+    }
+
+    /// The manifold of a contact as it is now.
+    pub(crate) fn of(c: &Contact) -> Self {
+        let mut m = EventManifold {
+            normal: c.normal,
+            point_count: c.point_count.min(2),
+            user_material_ids: c.user_material_ids,
+            ..EventManifold::default()
+        };
+        for (k, p) in c.points().iter().enumerate().take(2) {
+            m.points[k] = p.point;
+            m.separations[k] = p.separation;
+        }
+        m
+    }
+}
+
+/// Two solid shapes that began touching, with the manifold they began
+/// with.
+///
+/// ```
+/// use janus2d_world::{ShapeDef, World, WorldDef};
+/// use janus2d_core::{BodyDef, Vec2};
+/// use janus2d_core::geometry::Polygon;
+/// let mut world = World::new(WorldDef::default()).unwrap();
+/// let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+/// world.create_shape(ground, &ShapeDef::default(), Polygon::make_box(5.0, 0.5)).unwrap();
+/// let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 1.0))).unwrap();
+/// world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+/// world.step(1.0 / 60.0).unwrap();
+/// let begin = world.events().collision.contact_begin[0];
+/// assert_eq!(begin.manifold.points().len(), 2);
+/// assert!((begin.manifold.normal.y.abs() - 1.0).abs() < 1e-5);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct ContactBeginEvent {
+    /// Shape a of the contact.
+    pub shape_a: ShapeHandle,
+    /// Shape b of the contact.
+    pub shape_b: ShapeHandle,
+    /// The manifold when the contact began touching.
+    pub manifold: EventManifold,
+}
+
+/// A sensor overlap that began or ended, with the roles of its shapes.
+/// (When both shapes are sensors, `sensor_shape` is the contact's shape
+/// a.)
+///
+/// ```
+/// use janus2d_world::{ShapeDef, World, WorldDef};
+/// use janus2d_core::{BodyDef, Vec2};
+/// use janus2d_core::geometry::{Circle, Polygon};
+/// let mut world = World::new(WorldDef::default()).unwrap();
+/// let zone = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+/// let sensor = world.create_shape(zone, &ShapeDef::default().sensor(), Polygon::make_box(2.0, 2.0)).unwrap();
+/// let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+/// let ball = world.create_shape(b, &ShapeDef::default(), Circle::new(Vec2::ZERO, 0.25).unwrap()).unwrap();
+/// world.step(1.0 / 60.0).unwrap();
+/// let e = world.events().collision.sensor_begin[0];
+/// assert_eq!((e.sensor_shape, e.visitor_shape), (sensor, ball));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct SensorEvent {
+    /// The sensor shape.
+    pub sensor_shape: ShapeHandle,
+    /// The shape that entered or left it.
+    pub visitor_shape: ShapeHandle,
+}
+
+/// A contact that pushed harder than its shapes' force threshold this
+/// step (Rapier's `ContactForceEvent`; see
+/// `ShapeDef::force_event_threshold`). Forces are the step's normal
+/// impulses over the step's `dt`.
+///
+/// ```
+/// use janus2d_world::{ShapeDef, World, WorldDef};
+/// use janus2d_core::{BodyDef, Vec2};
+/// use janus2d_core::geometry::Polygon;
+/// let mut world = World::new(WorldDef::default()).unwrap();
+/// let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+/// world.create_shape(ground, &ShapeDef::default(), Polygon::make_box(5.0, 0.5)).unwrap();
+/// let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 1.0))).unwrap();
+/// let def = ShapeDef::default().with_force_event_threshold(1.0);
+/// world.create_shape(b, &def, Polygon::make_box(0.5, 0.5)).unwrap();
+/// for _ in 0..30 {
+///     world.step(1.0 / 60.0).unwrap();
+/// }
+/// // Resting: the ground carries the box's weight, m·g ≈ 9.8 N.
+/// let f = world.events().collision.forces[0];
+/// assert!((f.total_force_magnitude - 9.81).abs() < 0.5);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct ContactForceEvent {
+    /// Shape a of the contact.
+    pub shape_a: ShapeHandle,
+    /// Shape b of the contact.
+    pub shape_b: ShapeHandle,
+    /// Sum of the points' normal forces (on b, along the normal from a to
+    /// b), N.
+    pub total_force: Vec2,
+    /// Its length, N (what the threshold is compared with).
+    pub total_force_magnitude: Real,
+    /// The largest force at one point, N.
+    pub max_force_magnitude: Real,
+    /// The unit normal of that point's force (the contact normal).
+    pub max_force_direction: Vec2,
+}
+
 /// Contact and sensor events, read after the step.
 ///
 /// Events of contacts that end because a body or shape was destroyed
 /// between steps are kept and reported with the next step's.
+///
+/// **Switches.** A solid contact reports begin and end events only when
+/// both shapes have `ShapeDef::enable_contact_events` (usual true), a
+/// sensor overlap only when both have `ShapeDef::enable_sensor_events`
+/// (usual true): a shape that turns them off hears nothing of its pairs.
+/// A switch changed while a pair touches takes effect for the pair's next
+/// change.
 ///
 /// **The net change.** Each list holds every pair at most once: a pair
 /// that began and ended touching between two reports (a contact found by
@@ -191,17 +345,20 @@ pub struct ShapePairEvent {
 #[derive(Clone, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct CollisionEvents {
-    /// Solid contacts that began touching.
-    pub contact_begin: Vec<ShapePairEvent>,
+    /// Solid contacts that began touching, with their manifolds.
+    pub contact_begin: Vec<ContactBeginEvent>,
     /// Solid contacts that stopped touching (or whose shapes were destroyed).
     pub contact_end: Vec<ShapePairEvent>,
     /// Sensor overlaps that began.
-    pub sensor_begin: Vec<ShapePairEvent>,
+    pub sensor_begin: Vec<SensorEvent>,
     /// Sensor overlaps that ended.
-    pub sensor_end: Vec<ShapePairEvent>,
+    pub sensor_end: Vec<SensorEvent>,
     /// Contacts of shapes with hit events on that pushed this step with an
     /// approach speed above the world's threshold, in contact order.
     pub hits: Vec<HitEvent>,
+    /// Contacts of shapes with a finite `force_event_threshold` that
+    /// pushed harder than it this step, in contact order.
+    pub forces: Vec<ContactForceEvent>,
     /// Where each pair's begin or end event sits (not part of the value:
     /// not compared, not stored in snapshots, rebuilt when it does not
     /// cover the lists).
@@ -238,6 +395,12 @@ impl std::fmt::Debug for EventIndex {
 
 /// A contact that hit hard enough (see `ShapeDef::enable_hit_events` and
 /// `WorldDef::hit_event_threshold`): its fastest-approaching point.
+///
+/// The contact was found before the step's solve, possibly while the
+/// shapes were still apart (a speculative contact): `point` is the
+/// manifold's point, the mid-point between the two surfaces then, which
+/// for a fast body can lie well in front of the surface it hits.
+/// `point_a` and `point_b` are the points on each shape's surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct HitEvent {
@@ -245,8 +408,15 @@ pub struct HitEvent {
     pub shape_a: ShapeHandle,
     /// Shape b of the contact.
     pub shape_b: ShapeHandle,
-    /// World point of the contact point, m.
+    /// World point of the contact point, m: the mid-point between the
+    /// two surfaces when the contact was found (see the type docs).
     pub point: Vec2,
+    /// The point on shape a's surface, m (`point − ½ s n`, `s` the
+    /// point's separation then).
+    pub point_a: Vec2,
+    /// The point on shape b's surface, m (`point + ½ s n`): for a body
+    /// hitting a wall that is b, where the wall's face is.
+    pub point_b: Vec2,
     /// Unit normal from a to b.
     pub normal: Vec2,
     /// Speed at which the point approached along the normal before the
@@ -254,56 +424,119 @@ pub struct HitEvent {
     pub approach_speed: Real,
 }
 
+/// Bits of [`Contact::event_flags`].
+pub(crate) mod event_flags {
+    /// Both shapes report contact (or, for a sensor pair, sensor) events.
+    pub(crate) const REPORT: u8 = 1;
+    /// The sensor of a sensor pair is shape b (else shape a).
+    pub(crate) const SENSOR_IS_B: u8 = 2;
+
+    /// The flags of a contact between shapes with these definitions.
+    pub(crate) fn of(a: &crate::shapes::ShapeDef, b: &crate::shapes::ShapeDef) -> u8 {
+        let report = if a.is_sensor || b.is_sensor {
+            a.enable_sensor_events && b.enable_sensor_events
+        } else {
+            a.enable_contact_events && b.enable_contact_events
+        };
+        let mut flags = if report { REPORT } else { 0 };
+        if b.is_sensor && !a.is_sensor {
+            flags |= SENSOR_IS_B;
+        }
+        flags
+    }
+}
+
 impl CollisionEvents {
     /// Records a begin (`touching`) or end event of a contact, as the net
     /// change (type docs): an event that undoes the pair's pending opposite
-    /// event removes it instead of being added.
+    /// event removes it instead of being added. Contacts whose shapes turned
+    /// the events off record nothing.
     pub(crate) fn push(&mut self, c: &Contact, touching: bool) {
-        let ev = ShapePairEvent {
-            shape_a: c.shapes[0],
-            shape_b: c.shapes[1],
-        };
+        if c.event_flags & event_flags::REPORT == 0 {
+            return;
+        }
         let (this, opposite) = match (touching, c.sensor) {
             (true, false) => (CONTACT_BEGIN, CONTACT_END),
             (false, false) => (CONTACT_END, CONTACT_BEGIN),
             (true, true) => (SENSOR_BEGIN, SENSOR_END),
             (false, true) => (SENSOR_END, SENSOR_BEGIN),
         };
-        let key = pair_of_shapes(&ev, c.sensor);
+        let key = pair_of_shapes(c.shapes[0], c.shapes[1], c.sensor);
         self.sync_index();
         match self.index.0.get(&key).copied() {
             Some((list, pos)) if list == opposite => {
                 // The pair is back where it was at the last report.
                 self.index.0.remove(&key);
-                let events = self.list_mut(list);
                 let pos = pos as usize;
-                if pos < events.len() {
-                    events.swap_remove(pos);
-                    if let Some(moved) = events.get(pos).copied() {
-                        let moved = pair_of_shapes(&moved, list >= SENSOR_BEGIN);
-                        self.index.0.insert(moved, (list, pos as u32));
-                    }
+                if let Some(moved) = self.swap_remove_at(list, pos) {
+                    self.index.0.insert(moved, (list, pos as u32));
                 }
             }
             // Already reported this way (touching alternates, so only
             // a decoded snapshot's lists could hold it): nothing to add.
             Some(_) => {}
             None => {
-                let events = self.list_mut(this);
-                events.push(ev);
-                let pos = (events.len() - 1) as u32;
-                self.index.0.insert(key, (this, pos));
+                let len = match this {
+                    CONTACT_BEGIN => {
+                        self.contact_begin.push(ContactBeginEvent {
+                            shape_a: c.shapes[0],
+                            shape_b: c.shapes[1],
+                            manifold: EventManifold::of(c),
+                        });
+                        self.contact_begin.len()
+                    }
+                    CONTACT_END => {
+                        self.contact_end.push(ShapePairEvent {
+                            shape_a: c.shapes[0],
+                            shape_b: c.shapes[1],
+                        });
+                        self.contact_end.len()
+                    }
+                    _ => {
+                        let b_is_sensor = c.event_flags & event_flags::SENSOR_IS_B != 0;
+                        let ev = SensorEvent {
+                            sensor_shape: c.shapes[usize::from(b_is_sensor)],
+                            visitor_shape: c.shapes[usize::from(!b_is_sensor)],
+                        };
+                        let list = if this == SENSOR_BEGIN {
+                            &mut self.sensor_begin
+                        } else {
+                            &mut self.sensor_end
+                        };
+                        list.push(ev);
+                        list.len()
+                    }
+                };
+                self.index.0.insert(key, (this, (len - 1) as u32));
             }
         }
     }
 
-    /// The begin/end list numbered `list`.
-    fn list_mut(&mut self, list: u8) -> &mut Vec<ShapePairEvent> {
+    /// Swap-removes the event at `pos` of list `list`; returns the pair
+    /// of the event that moved into `pos`, if any.
+    fn swap_remove_at(&mut self, list: u8, pos: usize) -> Option<PairOfShapes> {
+        fn take<T: Copy>(
+            v: &mut Vec<T>,
+            pos: usize,
+            key: impl Fn(&T) -> PairOfShapes,
+        ) -> Option<PairOfShapes> {
+            if pos >= v.len() {
+                return None;
+            }
+            v.swap_remove(pos);
+            v.get(pos).map(key)
+        }
         match list {
-            CONTACT_BEGIN => &mut self.contact_begin,
-            CONTACT_END => &mut self.contact_end,
-            SENSOR_BEGIN => &mut self.sensor_begin,
-            _ => &mut self.sensor_end,
+            CONTACT_BEGIN => take(&mut self.contact_begin, pos, begin_key),
+            CONTACT_END => take(&mut self.contact_end, pos, end_key),
+            _ => {
+                let v = if list == SENSOR_BEGIN {
+                    &mut self.sensor_begin
+                } else {
+                    &mut self.sensor_end
+                };
+                take(v, pos, sensor_key)
+            }
         }
     }
 
@@ -318,22 +551,49 @@ impl CollisionEvents {
             return;
         }
         let mut index = std::collections::HashMap::with_capacity(total);
-        for list in [CONTACT_BEGIN, CONTACT_END, SENSOR_BEGIN, SENSOR_END] {
-            for (pos, ev) in self.list_mut(list).iter().enumerate() {
-                index.insert(pair_of_shapes(ev, list >= SENSOR_BEGIN), (list, pos as u32));
+        let keyed = [
+            (
+                CONTACT_BEGIN,
+                self.contact_begin.iter().map(begin_key).collect::<Vec<_>>(),
+            ),
+            (CONTACT_END, self.contact_end.iter().map(end_key).collect()),
+            (
+                SENSOR_BEGIN,
+                self.sensor_begin.iter().map(sensor_key).collect(),
+            ),
+            (SENSOR_END, self.sensor_end.iter().map(sensor_key).collect()),
+        ];
+        for (list, keys) in keyed {
+            for (pos, key) in keys.into_iter().enumerate() {
+                index.insert(key, (list, pos as u32));
             }
         }
         self.index.0 = index;
     }
 }
 
-/// The pair of an event in a fixed order (the lower handle first), with
-/// its kind.
-fn pair_of_shapes(ev: &ShapePairEvent, sensor: bool) -> PairOfShapes {
-    if ev.shape_a <= ev.shape_b {
-        (ev.shape_a, ev.shape_b, sensor)
+/// The pair key of a begin event.
+fn begin_key(e: &ContactBeginEvent) -> PairOfShapes {
+    pair_of_shapes(e.shape_a, e.shape_b, false)
+}
+
+/// The pair key of an end event.
+fn end_key(e: &ShapePairEvent) -> PairOfShapes {
+    pair_of_shapes(e.shape_a, e.shape_b, false)
+}
+
+/// The pair key of a sensor event.
+fn sensor_key(e: &SensorEvent) -> PairOfShapes {
+    pair_of_shapes(e.sensor_shape, e.visitor_shape, true)
+}
+
+/// A pair of shapes in a fixed order (the lower handle first), with its
+/// kind.
+fn pair_of_shapes(a: ShapeHandle, b: ShapeHandle, sensor: bool) -> PairOfShapes {
+    if a <= b {
+        (a, b, sensor)
     } else {
-        (ev.shape_b, ev.shape_a, sensor)
+        (b, a, sensor)
     }
 }
 

@@ -62,7 +62,10 @@ pub(crate) mod validate;
 pub mod world;
 
 pub use character::{Autostep, CharacterController, Ground, MoveResult};
-pub use contacts::{CollisionEvents, Contact, ContactPointData, HitEvent, ShapePairEvent};
+pub use contacts::{
+    CollisionEvents, Contact, ContactBeginEvent, ContactForceEvent, ContactPointData,
+    EventManifold, HitEvent, SensorEvent, ShapePairEvent,
+};
 pub use continuous::ContinuousCounters;
 pub use debug_draw::{Color, DebugDraw, DrawOptions, Palette};
 pub use error::WorldError;
@@ -85,4 +88,4 @@ pub use snapshot::Snapshot;
 #[cfg(feature = "serde")]
 pub use snapshot::bytes::{SNAPSHOT_MAGIC, SNAPSHOT_VERSION, SnapshotError};
 pub use validate::{Invariant, InvariantError};
-pub use world::{ExplosionDef, StepEvents, World, WorldDef};
+pub use world::{BodyMoveEvent, ExplosionDef, StepEvents, World, WorldDef};

@@ -108,6 +108,20 @@ pub struct ShapeDef {
     /// step, each contact that pushed with an approach speed above the
     /// world's `hit_event_threshold` gives a [`HitEvent`](crate::HitEvent).
     pub enable_hit_events: bool,
+    /// Report contact begin and end events for this shape's solid
+    /// contacts (usual true; Box2D's `enableContactEvents`): a pair
+    /// reports them when both its shapes have them on.
+    pub enable_contact_events: bool,
+    /// Report sensor begin and end events for this shape (usual true;
+    /// Box2D's `enableSensorEvents`), as the sensor or as the visitor: an
+    /// overlap reports them when both its shapes have them on.
+    pub enable_sensor_events: bool,
+    /// Contact force above which this shape's contacts give a
+    /// [`ContactForceEvent`](crate::ContactForceEvent), N (usual
+    /// `Real::INFINITY`: never; Rapier's `contact_force_event_threshold`).
+    /// A contact uses the smaller of its two shapes' thresholds. Not NaN,
+    /// ≥ 0.
+    pub force_event_threshold: Real,
     /// Opaque user value.
     pub user_data: u64,
     /// Rolling resistance (usual 0: none; Box2D v3.1's
@@ -151,6 +165,9 @@ impl Default for ShapeDef {
             filter: Filter::default(),
             is_sensor: false,
             enable_hit_events: false,
+            enable_contact_events: true,
+            enable_sensor_events: true,
+            force_event_threshold: Real::INFINITY,
             user_data: 0,
             rolling_resistance: 0.0,
             tangent_speed: 0.0,
@@ -180,6 +197,40 @@ impl ShapeDef {
     #[must_use]
     pub fn with_hit_events(mut self, on: bool) -> Self {
         self.enable_hit_events = on;
+        self
+    }
+
+    /// Turns the shape's contact begin/end events on or off (builder
+    /// style; see [`ShapeDef::enable_contact_events`]).
+    ///
+    /// ```
+    /// use janus2d_world::ShapeDef;
+    /// let def = ShapeDef::default()
+    ///     .with_contact_events(false)
+    ///     .with_sensor_events(false)
+    ///     .with_force_event_threshold(50.0);
+    /// assert!(!def.enable_contact_events && !def.enable_sensor_events);
+    /// assert_eq!(def.force_event_threshold, 50.0);
+    /// ```
+    #[must_use]
+    pub fn with_contact_events(mut self, on: bool) -> Self {
+        self.enable_contact_events = on;
+        self
+    }
+
+    /// Turns the shape's sensor events on or off (builder style; see
+    /// [`ShapeDef::enable_sensor_events`]).
+    #[must_use]
+    pub fn with_sensor_events(mut self, on: bool) -> Self {
+        self.enable_sensor_events = on;
+        self
+    }
+
+    /// Sets the contact force event threshold, N (builder style; see
+    /// [`ShapeDef::force_event_threshold`]).
+    #[must_use]
+    pub fn with_force_event_threshold(mut self, force: Real) -> Self {
+        self.force_event_threshold = force;
         self
     }
 
@@ -319,8 +370,20 @@ impl ShapeDef {
         }
         check_material_limit(self.friction, "friction")?;
         check_material_limit(self.restitution, "restitution")?;
+        check_force_threshold(self.force_event_threshold)?;
         check_tangent_speed(self.tangent_speed)
     }
+}
+
+/// A force event threshold: not NaN, ≥ 0 (infinity: off).
+pub(crate) fn check_force_threshold(v: Real) -> Result<(), WorldError> {
+    if v.is_nan() {
+        return Err(WorldError::NonFinite("force_event_threshold"));
+    }
+    if v < 0.0 {
+        return Err(WorldError::OutOfRange("force_event_threshold"));
+    }
+    Ok(())
 }
 
 /// A tangent speed: finite, at most
@@ -414,6 +477,9 @@ pub struct ShapeStore {
     /// Number of live shapes with hit events on (the hit pass runs only
     /// when some shape asks for it).
     hit_event_shapes: usize,
+    /// Number of live shapes with a finite force event threshold (the
+    /// force pass runs only when some shape has one).
+    force_event_shapes: usize,
 }
 
 impl ShapeStore {
@@ -421,6 +487,29 @@ impl ShapeStore {
     #[must_use]
     pub fn hit_event_shapes(&self) -> usize {
         self.hit_event_shapes
+    }
+
+    /// Number of live shapes with a finite force event threshold.
+    #[must_use]
+    pub fn force_event_shapes(&self) -> usize {
+        self.force_event_shapes
+    }
+
+    /// Turns a live shape's hit events on or off, keeping the count.
+    pub(crate) fn set_hit_events(&mut self, index: u32, on: bool) {
+        let def = &mut self.slots.live_mut(index).def;
+        self.hit_event_shapes -= usize::from(def.enable_hit_events);
+        def.enable_hit_events = on;
+        self.hit_event_shapes += usize::from(on);
+    }
+
+    /// Sets a live shape's force event threshold (checked), keeping the
+    /// count.
+    pub(crate) fn set_force_event_threshold(&mut self, index: u32, force: Real) {
+        let def = &mut self.slots.live_mut(index).def;
+        self.force_event_shapes -= usize::from(def.force_event_threshold.is_finite());
+        def.force_event_threshold = force;
+        self.force_event_shapes += usize::from(force.is_finite());
     }
 
     /// Number of live shapes.
@@ -510,9 +599,10 @@ impl ShapeStore {
         self.slots
             .check()
             .map_err(|e| format!("shape slots: {e}"))?;
-        let mut hits = 0;
+        let (mut hits, mut forces) = (0, 0);
         for (index, shape) in self.slots.iter() {
             hits += usize::from(shape.def.enable_hit_events);
+            forces += usize::from(shape.def.force_event_threshold.is_finite());
             if !bodies.contains(shape.body) {
                 return Err(format!("shape {index}: body {:?} is not live", shape.body));
             }
@@ -545,6 +635,12 @@ impl ShapeStore {
                 self.hit_event_shapes
             ));
         }
+        if forces != self.force_event_shapes {
+            return Err(format!(
+                "{forces} force-event shapes, counted {}",
+                self.force_event_shapes
+            ));
+        }
         for (b, list) in self.body_shapes.iter().enumerate() {
             for &s in list {
                 match self.slots.at(s) {
@@ -560,6 +656,7 @@ impl ShapeStore {
     pub fn insert(&mut self, data: ShapeData) -> u32 {
         let b = data.body.index as usize;
         self.hit_event_shapes += usize::from(data.def.enable_hit_events);
+        self.force_event_shapes += usize::from(data.def.force_event_threshold.is_finite());
         let (index, _) = self.slots.insert(data);
         if self.body_shapes.len() <= b {
             self.body_shapes.resize(b + 1, SmallVec::new());
@@ -577,6 +674,7 @@ impl ShapeStore {
             .remove(index, generation)
             .expect("slot index handed out by this store");
         self.hit_event_shapes -= usize::from(data.def.enable_hit_events);
+        self.force_event_shapes -= usize::from(data.def.force_event_threshold.is_finite());
         if let Some(list) = self.body_shapes.get_mut(data.body.index as usize) {
             list.retain(|i| *i != index);
         }

@@ -27,7 +27,6 @@ impl PortalStage {
     pub(crate) fn constraints_mut(&mut self) -> &mut Vec<PortalConstraint> {
         &mut self.constraints
     }
-    pub(crate) fn publish_events(&mut self) {}
     pub(crate) fn clone_aliases(&self) -> std::iter::Empty<(u32, u32)> {
         std::iter::empty()
     }

@@ -367,8 +367,6 @@ pub(crate) struct PortalStage {
     pub(crate) crossings: Vec<Crossing>,
     /// One constraint per crossing, same order.
     pub(crate) constraints: Vec<PortalConstraint>,
-    /// The events of the last step (what `World::portal_events` reads).
-    pub(crate) events: Vec<PortalEvent>,
     /// Events pushed since the last step ended, by calls between steps
     /// (`destroy_portal_pair`, destroying a copy or a portal body) and by
     /// the step under way: reported with the next step's, as collision
@@ -395,9 +393,10 @@ impl PortalStage {
     }
 
     /// Ends a step's events: those pushed since the last step (between
-    /// steps, then by this step) become the step's, in order.
-    pub(crate) fn publish_events(&mut self) {
-        self.events = std::mem::take(&mut self.pending_events);
+    /// steps, then by this step) become the step's, in order (what
+    /// `StepEvents::portals` holds).
+    pub(crate) fn take_events(&mut self) -> Vec<PortalEvent> {
+        std::mem::take(&mut self.pending_events)
     }
 
     /// Portal rows, bodies tested and crossings of the step.

@@ -4,10 +4,224 @@
 
 use super::*;
 
+/// A body that moved in the last step (Box2D's `b2BodyMoveEvent`): see
+/// [`WorldDef::enable_move_events`] and [`StepEvents::moves`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct BodyMoveEvent {
+    /// The body.
+    pub body: BodyHandle,
+    /// Its transform after the step.
+    pub transform: Transform,
+    /// Its user value (`BodyDef::user_data`).
+    pub user_data: u64,
+    /// True when it fell asleep at the end of this step (reported once:
+    /// a sleeping body does not move, so the next steps list it no more).
+    pub fell_asleep: bool,
+}
+
 impl World {
-    /// Events of the last step.
+    /// Every event of the last step (see [`StepEvents`]).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// world.step(1.0 / 60.0).unwrap();
+    /// assert!(world.events().collision.contact_begin.is_empty());
+    /// ```
     pub fn events(&self) -> &StepEvents {
         &self.events
+    }
+
+    /// The move events of the step just solved: every awake dynamic or
+    /// kinematic body that reports them, in body slot order (their
+    /// `fell_asleep` is set after the sleep stage).
+    pub(super) fn gather_moves(&self) -> Vec<BodyMoveEvent> {
+        let mut out: Vec<BodyMoveEvent> = self
+            .bodies
+            .sims
+            .iter()
+            .skip(1)
+            .filter_map(|sim| {
+                let record = self.bodies.record(sim.handle)?;
+                record.enable_move_events.then_some(BodyMoveEvent {
+                    body: sim.handle,
+                    transform: sim.transform,
+                    user_data: record.user_data,
+                    fell_asleep: false,
+                })
+            })
+            .collect();
+        out.sort_unstable_by_key(|m| m.body.index);
+        out
+    }
+
+    /// Whether the world gathers body move events
+    /// ([`WorldDef::enable_move_events`]).
+    pub fn move_events_enabled(&self) -> bool {
+        self.move_events
+    }
+
+    /// Turns the gathering of body move events on or off (see
+    /// [`WorldDef::enable_move_events`]); from the next step.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let a = world.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    /// world.set_move_events(true);
+    /// world.set_body_move_events(a, false).unwrap();
+    /// world.step(1.0 / 60.0).unwrap();
+    /// let moved: Vec<_> = world.events().moves.iter().map(|m| m.body).collect();
+    /// assert_eq!(moved, vec![b]);
+    /// assert!(world.move_events_enabled() && !world.body_move_events(a).unwrap());
+    /// ```
+    pub fn set_move_events(&mut self, on: bool) {
+        self.move_events = on;
+    }
+
+    /// Whether the body reports move events (`BodyDef::enable_move_events`).
+    /// Errors: a stale handle.
+    pub fn body_move_events(&self, body: BodyHandle) -> Result<bool, WorldError> {
+        self.check_body(body)?;
+        Ok(self
+            .bodies
+            .record(body)
+            .is_some_and(|r| r.enable_move_events))
+    }
+
+    /// Turns the body's move events on or off (`BodyDef::enable_move_events`;
+    /// example at [`World::set_move_events`]). Errors: a stale handle.
+    pub fn set_body_move_events(&mut self, body: BodyHandle, on: bool) -> Result<(), WorldError> {
+        self.check_body(body)?;
+        if let Some(r) = self.bodies.record_mut(body) {
+            r.enable_move_events = on;
+        }
+        Ok(())
+    }
+
+    /// Turns the shape's contact begin/end events on or off
+    /// ([`ShapeDef::enable_contact_events`]); its existing contacts
+    /// follow for their next change. Errors: a stale handle.
+    ///
+    /// ```
+    /// use janus2d_world::{ShapeDef, World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Polygon;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    /// world.create_shape(ground, &ShapeDef::default(), Polygon::make_box(5.0, 0.5)).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 1.0))).unwrap();
+    /// let s = world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+    /// world.set_shape_contact_events(s, false).unwrap();
+    /// world.set_shape_sensor_events(s, false).unwrap();
+    /// world.set_shape_hit_events(s, true).unwrap();
+    /// world.set_shape_force_event_threshold(s, 100.0).unwrap();
+    /// world.step(1.0 / 60.0).unwrap();
+    /// assert!(world.events().collision.contact_begin.is_empty());
+    /// let def = &world.shape(s).unwrap().def;
+    /// assert!(!def.enable_contact_events && def.enable_hit_events);
+    /// assert_eq!(def.force_event_threshold, 100.0);
+    /// ```
+    pub fn set_shape_contact_events(
+        &mut self,
+        shape: ShapeHandle,
+        on: bool,
+    ) -> Result<(), WorldError> {
+        let slot = self.shape_slot(shape)?;
+        self.collision.shapes.at_mut(slot).def.enable_contact_events = on;
+        self.refresh_event_flags(slot);
+        Ok(())
+    }
+
+    /// Turns the shape's sensor events on or off
+    /// ([`ShapeDef::enable_sensor_events`]; example at
+    /// [`World::set_shape_contact_events`]). Errors: a stale handle.
+    pub fn set_shape_sensor_events(
+        &mut self,
+        shape: ShapeHandle,
+        on: bool,
+    ) -> Result<(), WorldError> {
+        let slot = self.shape_slot(shape)?;
+        self.collision.shapes.at_mut(slot).def.enable_sensor_events = on;
+        self.refresh_event_flags(slot);
+        Ok(())
+    }
+
+    /// Turns the shape's hit events on or off
+    /// ([`ShapeDef::enable_hit_events`]; example at
+    /// [`World::set_shape_contact_events`]). Errors: a stale handle.
+    pub fn set_shape_hit_events(&mut self, shape: ShapeHandle, on: bool) -> Result<(), WorldError> {
+        let slot = self.shape_slot(shape)?;
+        self.collision.shapes.set_hit_events(slot, on);
+        let body = self.collision.shapes.at(slot).body;
+        let ids: smallvec::SmallVec<[u32; 8]> = self
+            .collision
+            .contacts
+            .of_body(body)
+            .iter()
+            .copied()
+            .collect();
+        for id in ids {
+            let Some(c) = self.collision.contacts.get(id) else {
+                continue;
+            };
+            if c.shape_a != slot && c.shape_b != slot {
+                continue;
+            }
+            let (a, b) = (c.shape_a, c.shape_b);
+            let hits = self.collision.shapes.at(a).def.enable_hit_events
+                || self.collision.shapes.at(b).def.enable_hit_events;
+            if let Some(c) = self.collision.contacts.get_mut(id) {
+                c.hit_events = hits;
+            }
+        }
+        Ok(())
+    }
+
+    /// Sets the shape's contact force event threshold, N
+    /// ([`ShapeDef::force_event_threshold`]; infinity turns them off;
+    /// example at [`World::set_shape_contact_events`]). Errors: a stale
+    /// handle, a NaN or negative threshold (the world unchanged).
+    pub fn set_shape_force_event_threshold(
+        &mut self,
+        shape: ShapeHandle,
+        force: Real,
+    ) -> Result<(), WorldError> {
+        let slot = self.shape_slot(shape)?;
+        crate::shapes::check_force_threshold(force)?;
+        self.collision.shapes.set_force_event_threshold(slot, force);
+        Ok(())
+    }
+
+    /// Recomputes the event switches of the shape's existing contacts.
+    fn refresh_event_flags(&mut self, slot: u32) {
+        let body = self.collision.shapes.at(slot).body;
+        let ids: smallvec::SmallVec<[u32; 8]> = self
+            .collision
+            .contacts
+            .of_body(body)
+            .iter()
+            .copied()
+            .collect();
+        for id in ids {
+            let Some(c) = self.collision.contacts.get(id) else {
+                continue;
+            };
+            if c.shape_a != slot && c.shape_b != slot {
+                continue;
+            }
+            let (a, b) = (c.shape_a, c.shape_b);
+            let flags = crate::contacts::event_flags::of(
+                &self.collision.shapes.at(a).def,
+                &self.collision.shapes.at(b).def,
+            );
+            if let Some(c) = self.collision.contacts.get_mut(id) {
+                c.event_flags = flags;
+            }
+        }
     }
 
     /// Stage timings of the solver in the last step.

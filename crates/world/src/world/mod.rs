@@ -52,6 +52,7 @@ use crate::islands::{Islands, SleepInput, SleepSettings};
 use crate::joints::{JointHandle, JointSet};
 use crate::portal::PortalStage;
 use crate::shapes::{ShapeData, ShapeDef, ShapeHandle};
+pub use events::BodyMoveEvent;
 
 /// Default gravity, m/s² (usual (0, −10)).
 pub const DEFAULT_GRAVITY: Vec2 = Vec2::new(0.0, -10.0);
@@ -73,6 +74,11 @@ pub struct WorldDef {
     /// reports a [`HitEvent`](crate::HitEvent), m/s (usual 1, as
     /// Box2D's `hitEventThreshold`).
     pub hit_event_threshold: Real,
+    /// Gather body move events after each step (usual false): every body
+    /// that moved and has `BodyDef::enable_move_events` gets a
+    /// [`BodyMoveEvent`] in [`StepEvents::moves`]. Off by default, unlike
+    /// Box2D's: a world that reads no move events pays nothing for them.
+    pub enable_move_events: bool,
 }
 
 impl Default for WorldDef {
@@ -83,6 +89,7 @@ impl Default for WorldDef {
             sleep: SleepSettings::default(),
             enable_continuous: true,
             hit_event_threshold: 1.0,
+            enable_move_events: false,
         }
     }
 }
@@ -134,19 +141,83 @@ impl WorldDef {
         self.hit_event_threshold = speed;
         self
     }
+
+    /// Turns the gathering of body move events on or off (builder style;
+    /// see [`WorldDef::enable_move_events`]).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let mut world = World::new(WorldDef::default().with_move_events(true)).unwrap();
+    /// let body = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 4.0))).unwrap();
+    /// world.step(1.0 / 60.0).unwrap();
+    /// let moves = &world.events().moves;
+    /// assert_eq!(moves.len(), 1);
+    /// assert_eq!(moves[0].body, body);
+    /// assert!(moves[0].transform.p.y < 4.0 && !moves[0].fell_asleep);
+    /// ```
+    #[must_use]
+    pub fn with_move_events(mut self, on: bool) -> Self {
+        self.enable_move_events = on;
+        self
+    }
 }
 
-/// Events of the last step, read after `step`.
+/// Every event of the last step, in one place, read after `step`
+/// ([`World::events`]).
+///
+/// | field | what | switch |
+/// |---|---|---|
+/// | `collision.contact_begin` | solid contacts that began touching, with their manifold | `ShapeDef::enable_contact_events` (both shapes, usual on) |
+/// | `collision.contact_end` | solid contacts that stopped touching | same |
+/// | `collision.sensor_begin`, `sensor_end` | sensor overlaps, sensor and visitor shapes | `ShapeDef::enable_sensor_events` (both shapes, usual on) |
+/// | `collision.hits` | contacts that hit faster than `WorldDef::hit_event_threshold` | `ShapeDef::enable_hit_events` (either shape, usual off) |
+/// | `collision.forces` | contacts that pushed harder than a threshold | `ShapeDef::force_event_threshold` (usual ∞: off) |
+/// | `moves` | bodies that moved, in body order | `WorldDef::enable_move_events` (usual off) and `BodyDef::enable_move_events` (usual on) |
+/// | `portals` | portal crossings begun, completed, cancelled; joints disabled | always |
+/// | `joints` | joints whose force or torque passed their thresholds | the joint's thresholds |
+/// | `non_finite_bodies` | bodies reset from a non-finite state | always |
+///
+/// ```
+/// use janus2d_world::{ShapeDef, World, WorldDef};
+/// use janus2d_core::{BodyDef, Vec2};
+/// use janus2d_core::geometry::Polygon;
+/// let mut world = World::new(WorldDef::default()).unwrap();
+/// let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+/// world.create_shape(ground, &ShapeDef::default(), Polygon::make_box(5.0, 0.5)).unwrap();
+/// let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 1.2))).unwrap();
+/// world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+/// let mut begins = 0;
+/// for _ in 0..60 {
+///     world.step(1.0 / 60.0).unwrap();
+///     let events = world.events();
+///     begins += events.collision.contact_begin.len();
+///     assert!(events.moves.is_empty());
+/// }
+/// assert_eq!(begins, 1);
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct StepEvents {
     /// Bodies whose state went non-finite during the step. Each was put back
     /// at its start-of-step pose, at rest, instead of spreading NaN.
     pub non_finite_bodies: Vec<BodyHandle>,
-    /// Contact and sensor begin/end events.
+    /// Contact, sensor, hit and contact force events.
     pub collision: CollisionEvents,
     /// Joints whose force or torque passed their thresholds.
     pub joints: Vec<crate::joints::JointEvent>,
+    /// Portal events: crossings begun, completed or cancelled, joints
+    /// disabled. Events of calls between steps (`CrossingCancelled` and
+    /// `JointDisabled` from `destroy_portal_pair` or from destroying a
+    /// crossing's copy or a portal body) are reported with the next
+    /// step's, first, as collision events are.
+    #[cfg(feature = "portals")]
+    pub portals: Vec<crate::PortalEvent>,
+    /// Bodies that moved in the step (awake dynamic and kinematic bodies),
+    /// in body (handle slot) order, when the world gathers them
+    /// ([`WorldDef::enable_move_events`]) and the body reports them
+    /// (`BodyDef::enable_move_events`).
+    pub moves: Vec<BodyMoveEvent>,
 }
 
 /// The simulation world: it owns one value of each stage and calls them
@@ -175,6 +246,8 @@ pub struct World {
     continuous: crate::continuous::ContinuousStage,
     /// Approach speed above which hit events are reported, m/s.
     hit_event_threshold: Real,
+    /// Body move events are gathered ([`WorldDef::enable_move_events`]).
+    move_events: bool,
     /// The user's callbacks: pre-solve hook, pair filter, material mixing
     /// (not state: neither serialized nor copied into snapshots).
     #[cfg_attr(feature = "serde", serde(skip))]
@@ -219,6 +292,7 @@ impl World {
             islands: Islands::default(),
             continuous: crate::continuous::ContinuousStage::new(def.enable_continuous),
             hit_event_threshold: def.hit_event_threshold,
+            move_events: def.enable_move_events,
             hooks: crate::hooks::Hooks::default(),
             sleep_settings: def.sleep,
             wake_list: Vec::new(),
@@ -378,6 +452,7 @@ impl World {
             islands: self.islands.clone(),
             continuous: self.continuous.clone(),
             hit_event_threshold: self.hit_event_threshold,
+            move_events: self.move_events,
             hooks: crate::hooks::Hooks::default(),
             sleep_settings: self.sleep_settings,
             wake_list: self.wake_list.clone(),

@@ -42,13 +42,20 @@ impl World {
         self.portals.crossings.len()
     }
 
-    /// Portal events of the last step. Events of calls between steps
-    /// (`CrossingCancelled` and `JointDisabled` from
-    /// [`destroy_portal_pair`](Self::destroy_portal_pair) or from
-    /// destroying a crossing's copy or a portal body) are kept and reported
-    /// with the next step's, first, as collision events are.
+    /// Portal events of the last step: the same list as
+    /// [`StepEvents::portals`](crate::StepEvents::portals), kept for the
+    /// callers written before every event moved into
+    /// [`World::events`].
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// world.step(1.0 / 60.0).unwrap();
+    /// assert!(world.events().portals.is_empty());
+    /// ```
+    #[deprecated(since = "0.2.0", note = "read `world.events().portals`")]
     pub fn portal_events(&self) -> &[PortalEvent] {
-        &self.portals.events
+        &self.events.portals
     }
 
     /// Portal counters of the last step.

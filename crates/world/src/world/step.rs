@@ -227,6 +227,10 @@ impl World {
                 self.collision
                     .collect_hits(|hit| solver.for_each_approach(threshold, hit));
             }
+            // Only when some shape has a finite force threshold.
+            if self.collision.has_force_events() {
+                self.collision.collect_forces(dt);
+            }
             let both = lap();
             sp.continuous += continuous_time;
             sp.broadphase += both - continuous_time;
@@ -244,6 +248,12 @@ impl World {
             portals.cross(&mut stores);
             sp.portals += lap();
         }
+        // The bodies that moved: the awake ones before the sleep stage.
+        let mut moves = if self.move_events {
+            self.gather_moves()
+        } else {
+            Vec::new()
+        };
         if self.sleep_settings.enabled {
             let keep_awake = self.portals.keep_awake();
             let (shapes, contacts) = self.collision.sleep_parts();
@@ -272,11 +282,16 @@ impl World {
             continuous: self.continuous.counters(),
         });
         self.step_profile = sp;
-        self.portals.publish_events();
+        for m in &mut moves {
+            m.fell_asleep = self.bodies.is_sleeping(m.body);
+        }
         self.events = StepEvents {
             non_finite_bodies: report.non_finite,
             collision: self.collision.take_events(),
             joints: self.joints.threshold_events(),
+            #[cfg(feature = "portals")]
+            portals: self.portals.take_events(),
+            moves,
         };
         self.step_count += 1;
     }
