@@ -637,9 +637,11 @@ impl LanderEnv {
                 self.world.apply_linear_impulse(hull, imp, at)?;
             }
             // Side engine: a sideways push high on the hull, so it also
-            // turns it (action 1 pushes right from right of the centre).
+            // turns it. As in Gymnasium, action 1 (the left engine) pushes
+            // left from right of the centre: the lander turns
+            // counterclockwise; action 3 is the mirror image.
             let offset = -side_dir * (SIDE_OUT / PX) + 3.0 * j1;
-            let gain = SIDE_POWER * s_power;
+            let gain = -SIDE_POWER * s_power;
             let imp = v2(
                 (right.0 * offset + j0 * up.0) * gain,
                 (right.1 * offset + j0 * up.1) * gain,
@@ -969,3 +971,7 @@ where
         }
     }
 }
+
+#[cfg(test)]
+#[path = "lander_tests.rs"]
+mod tests;

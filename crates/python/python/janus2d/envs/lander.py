@@ -176,11 +176,12 @@ def engine_impulses(actions: np.ndarray, angles: np.ndarray, centres: np.ndarray
     main[:, 0, 2:4] = centres - lever
 
     # Side engine: a sideways push high on the hull, so it also turns it:
-    # action 1 (the left engine) pushes right from the right of the centre
-    # (turning the lander clockwise), action 3 the mirror image.
+    # as in Gymnasium, action 1 (the left engine) pushes left from the
+    # right of the centre (turning the lander counterclockwise), action 3
+    # the mirror image.
     offset = -side_dir * (SIDE_OUT / PX) + 3.0 * jitter[:, 1]
     side = np.zeros((n, 1, 4))
-    side[:, 0, 0:2] = (right * offset[:, None] + jitter[:, :1] * up) * (SIDE_POWER * s_power)[:, None]
+    side[:, 0, 0:2] = (right * offset[:, None] + jitter[:, :1] * up) * (-SIDE_POWER * s_power)[:, None]
     side[:, 0, 2:4] = centres + right * offset[:, None] + up * (SIDE_UP / PX)
     return main, side, m_power, s_power
 
