@@ -27,6 +27,7 @@
 //! ```
 
 use crate::BatchError;
+use janus2d::base::math::to_f64;
 use janus2d::{BodyDef, BodyHandle, Polygon, Real, RevoluteJointDef, Segment, ShapeDef, Vec2};
 use janus2d::{World, WorldDef, WorldError};
 use rayon::prelude::*;
@@ -620,9 +621,9 @@ impl LanderEnv {
             }
         };
         if m_power > 0.0 || s_power > 0.0 {
-            let angle = f64::from(self.world.angle(hull)?);
+            let angle = to_f64(self.world.angle(hull)?);
             let p = self.world.position(hull)?;
-            let (cx, cy) = (f64::from(p.x), f64::from(p.y));
+            let (cx, cy) = (to_f64(p.x), to_f64(p.y));
             let (s, c) = angle.sin_cos();
             let up = (-s, c);
             let right = (c, s);
@@ -706,8 +707,8 @@ impl LanderEnv {
         let hull = self.bodies.hull;
         let p = w.position(hull)?;
         let v = w.linear_velocity(hull)?;
-        let (x, y) = (f64::from(p.x), f64::from(p.y));
-        let (vx, vy) = (f64::from(v.x), f64::from(v.y));
+        let (x, y) = (to_f64(p.x), to_f64(p.y));
+        let (vx, vy) = (to_f64(v.x), to_f64(v.y));
         let leg = |k: usize| -> Result<f32, WorldError> {
             let touching = w.body_contacts(self.bodies.legs[k])?.next().is_some();
             Ok(if touching { 1.0 } else { 0.0 })
@@ -717,8 +718,8 @@ impl LanderEnv {
             ((y - (PAD_Y + LEG_DROP / PX)) / (VIEW_H / 2.0)) as f32,
             (vx * (VIEW_W / 2.0) / FPS) as f32,
             (vy * (VIEW_H / 2.0) / FPS) as f32,
-            w.angle(hull)?,
-            (20.0 * f64::from(w.angular_velocity(hull)?) / FPS) as f32,
+            to_f64(w.angle(hull)?) as f32,
+            (20.0 * to_f64(w.angular_velocity(hull)?) / FPS) as f32,
             leg(0)?,
             leg(1)?,
         ])

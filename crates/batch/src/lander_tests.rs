@@ -3,6 +3,7 @@
 //! lander flown through the portal variant's portal.
 
 use super::*;
+use janus2d::base::math::to_f64;
 
 /// A fixed pseudo-random table of discrete actions, `steps × n`.
 fn action_table(n: usize, steps: usize, seed: u64) -> Vec<i64> {
@@ -281,7 +282,7 @@ fn a_piloted_lander_goes_through_the_portal_into_the_pad_chamber() {
             .unwrap();
         let env = batch.env(0).unwrap();
         let p = env.world().position(env.bodies().hull).unwrap();
-        let (x, y) = (f64::from(p.x), f64::from(p.y));
+        let (x, y) = (to_f64(p.x), to_f64(p.y));
         if env.portal_crossings() > 0 && x > left && x < right && y < roof_y {
             inside_at = Some(k);
             break;
