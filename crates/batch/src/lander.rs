@@ -27,10 +27,10 @@
 //! ```
 
 use crate::BatchError;
+use crate::crew::{Crew, Task};
 use janus2d::base::math::to_f64;
 use janus2d::{BodyDef, BodyHandle, Polygon, Real, RevoluteJointDef, Segment, ShapeDef, Vec2};
 use janus2d::{World, WorldDef, WorldError};
-use rayon::prelude::*;
 
 /// Steps per second (the step is `1 / FPS` s).
 pub const FPS: f64 = 50.0;
@@ -727,12 +727,20 @@ impl LanderEnv {
 }
 
 /// N landers stepped together: one call steps every lander (its action,
-/// the world's step, its observation and reward), on the calling thread
-/// (one thread) or one parallel pass over contiguous runs of landers.
+/// the world's step, its observation and reward). On one thread the
+/// landers step on the calling thread; on `t` threads they are cut into
+/// `t` contiguous runs, the caller steps the first and `t − 1` helper
+/// threads of the batch's own crew the others (see the `crew` module:
+/// a few microseconds of hand-off per call, where a rayon pool's was some
+/// 50 µs on the 2-core machine here).
 pub struct LanderBatch {
     config: LanderConfig,
-    envs: Vec<LanderEnv>,
-    pool: Option<rayon::ThreadPool>,
+    /// The landers in runs, one per thread, in order.
+    runs: Vec<Vec<LanderEnv>>,
+    /// Landers per run (the last may hold fewer).
+    run_len: usize,
+    count: usize,
+    crew: Option<Crew<LanderEnv>>,
     threads: usize,
 }
 
@@ -740,9 +748,60 @@ impl std::fmt::Debug for LanderBatch {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("LanderBatch")
             .field("config", &self.config)
-            .field("landers", &self.envs.len())
+            .field("landers", &self.count)
             .field("threads", &self.threads)
             .finish()
+    }
+}
+
+/// The operation of one call, for every lander of a run.
+#[derive(Clone)]
+enum Op {
+    Step(OwnedActions),
+    Reseed(u64),
+}
+
+#[derive(Clone)]
+enum OwnedActions {
+    Discrete(Vec<i64>),
+    Continuous(Vec<f64>),
+}
+
+impl Op {
+    /// The part of the operation for landers `from..to`.
+    fn part(&self, from: usize, to: usize) -> Op {
+        match self {
+            Op::Step(OwnedActions::Discrete(a)) => {
+                Op::Step(OwnedActions::Discrete(a[from..to].to_vec()))
+            }
+            Op::Step(OwnedActions::Continuous(a)) => {
+                Op::Step(OwnedActions::Continuous(a[2 * from..2 * to].to_vec()))
+            }
+            Op::Reseed(seed) => Op::Reseed(*seed),
+        }
+    }
+
+    /// Applies the operation to a run whose first lander is lander
+    /// `offset` of the batch (its part of the actions starts at 0).
+    fn apply(
+        &self,
+        config: &LanderConfig,
+        offset: usize,
+        run: &mut [LanderEnv],
+    ) -> Option<(usize, WorldError)> {
+        for (k, env) in run.iter_mut().enumerate() {
+            let result = match self {
+                Op::Step(OwnedActions::Discrete(a)) => env.act(config, Action::Discrete(a[k])),
+                Op::Step(OwnedActions::Continuous(a)) => {
+                    env.act(config, Action::Continuous(a[2 * k], a[2 * k + 1]))
+                }
+                Op::Reseed(seed) => env.reseed(config, lander_seed(*seed, offset + k)),
+            };
+            if let Err(e) = result {
+                return Some((offset + k, e));
+            }
+        }
+        None
     }
 }
 
@@ -768,8 +827,10 @@ impl LanderBatch {
         }
         let mut batch = LanderBatch {
             config,
-            envs,
-            pool: None,
+            runs: vec![envs],
+            run_len: count,
+            count,
+            crew: None,
             threads: 1,
         };
         batch.set_threads(threads)?;
@@ -779,13 +840,13 @@ impl LanderBatch {
     /// Landers in the batch.
     #[must_use]
     pub fn len(&self) -> usize {
-        self.envs.len()
+        self.count
     }
 
     /// Always false: a batch holds at least one lander.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.envs.is_empty()
+        self.count == 0
     }
 
     /// The configuration.
@@ -801,26 +862,48 @@ impl LanderBatch {
     }
 
     /// Steps on `threads` threads from now on (one: on the calling
-    /// thread, no pool). The landers' trajectories do not depend on it.
+    /// thread alone). The landers' trajectories do not depend on it.
     pub fn set_threads(&mut self, threads: usize) -> Result<(), BatchError> {
-        self.pool = match threads {
-            0 => {
-                return Err(BatchError::Threads(
-                    "the thread count must be at least 1".into(),
-                ));
-            }
-            1 => None,
-            n => Some(crate::build_pool(n)?),
+        if threads == 0 {
+            return Err(BatchError::Threads(
+                "the thread count must be at least 1".into(),
+            ));
+        }
+        self.check_whole()?;
+        let crew = if threads > 1 {
+            Some(Crew::new(threads - 1).map_err(|e| BatchError::Threads(e.to_string()))?)
+        } else {
+            None
         };
+        let all: Vec<LanderEnv> = self.runs.drain(..).flatten().collect();
+        self.run_len = self.count.div_ceil(threads);
+        let mut rest = all.into_iter();
+        self.runs = (0..threads)
+            .map(|_| rest.by_ref().take(self.run_len).collect())
+            .collect();
+        self.crew = crew;
         self.threads = threads;
         Ok(())
     }
 
+    /// A helper's panic loses its run of landers: refuse to go on.
+    fn check_whole(&self) -> Result<(), BatchError> {
+        let held: usize = self.runs.iter().map(Vec::len).sum();
+        if held == self.count {
+            Ok(())
+        } else {
+            Err(BatchError::Threads(
+                "a helper thread panicked and its landers are lost".into(),
+            ))
+        }
+    }
+
     /// Lander `index`.
     pub fn env(&self, index: usize) -> Result<&LanderEnv, BatchError> {
-        let len = self.envs.len();
-        self.envs
-            .get(index)
+        let len = self.count;
+        self.runs
+            .get(index / self.run_len)
+            .and_then(|run| run.get(index % self.run_len))
             .ok_or(BatchError::WorldIndex { index, len })
     }
 
@@ -830,16 +913,14 @@ impl LanderBatch {
     }
 
     /// Every lander's last outcome, in order.
-    pub fn outcomes(&self) -> impl ExactSizeIterator<Item = LanderOutcome> + '_ {
-        self.envs.iter().map(LanderEnv::last)
+    pub fn outcomes(&self) -> impl Iterator<Item = LanderOutcome> + '_ {
+        self.runs.iter().flatten().map(LanderEnv::last)
     }
 
     /// Reseeds every lander from `seed` (lander `i` gets its own stream)
     /// and starts new episodes.
     pub fn reset_all(&mut self, seed: u64) -> Result<(), BatchError> {
-        let config = &self.config;
-        let job = |i: usize, env: &mut LanderEnv| env.reseed(config, lander_seed(seed, i));
-        run(&mut self.envs, self.pool.as_ref(), job)
+        self.run(Op::Reseed(seed))
     }
 
     /// Starts a new episode of lander `index` on the terrain of `draws`
@@ -851,10 +932,12 @@ impl LanderBatch {
         draws: &[f64; TERRAIN_DRAWS],
         push: [f64; 2],
     ) -> Result<(), BatchError> {
-        let len = self.envs.len();
+        let len = self.count;
+        let run_len = self.run_len;
         let env = self
-            .envs
-            .get_mut(index)
+            .runs
+            .get_mut(index / run_len)
+            .and_then(|run| run.get_mut(index % run_len))
             .ok_or(BatchError::WorldIndex { index, len })?;
         env.reset_with(&self.config, draws, push)
             .map_err(|error| BatchError::World { index, error })
@@ -864,8 +947,8 @@ impl LanderBatch {
     /// episode ended when the configuration says so). Actions are checked
     /// first: a bad one changes nothing.
     pub fn step(&mut self, actions: LanderActions<'_>) -> Result<(), BatchError> {
-        let n = self.envs.len();
-        match actions {
+        let n = self.count;
+        let owned = match actions {
             LanderActions::Discrete(a) => {
                 if self.config.continuous {
                     return Err(BatchError::Action {
@@ -880,9 +963,7 @@ impl LanderBatch {
                         why: format!("action {} is not in Discrete(4)", a[i]),
                     });
                 }
-                let config = &self.config;
-                let job = |i: usize, env: &mut LanderEnv| env.act(config, Action::Discrete(a[i]));
-                run(&mut self.envs, self.pool.as_ref(), job)
+                OwnedActions::Discrete(a.to_vec())
             }
             LanderActions::Continuous(a) => {
                 if !self.config.continuous {
@@ -901,12 +982,65 @@ impl LanderBatch {
                         why: format!("action value {} is not in [-1, 1]", a[i]),
                     });
                 }
-                let config = &self.config;
-                let job = |i: usize, env: &mut LanderEnv| {
-                    env.act(config, Action::Continuous(a[2 * i], a[2 * i + 1]))
-                };
-                run(&mut self.envs, self.pool.as_ref(), job)
+                OwnedActions::Continuous(a.to_vec())
             }
+        };
+        self.run(Op::Step(owned))
+    }
+
+    /// Runs `op` on every lander: the helpers take runs 1.., the caller
+    /// run 0; the error is the lowest-index lander's.
+    fn run(&mut self, op: Op) -> Result<(), BatchError> {
+        self.check_whole()?;
+        let mut first: Option<(usize, WorldError)> = None;
+        let mut keep = |e: Option<(usize, WorldError)>| {
+            if let Some((i, error)) = e
+                && first.as_ref().is_none_or(|(j, _)| i < *j)
+            {
+                first = Some((i, error));
+            }
+        };
+        match &self.crew {
+            None => {
+                for (r, run) in self.runs.iter_mut().enumerate() {
+                    keep(op.apply(&self.config, r * self.run_len, run));
+                }
+            }
+            Some(crew) => {
+                let mut posted = Vec::with_capacity(crew.len());
+                for k in 0..crew.len() {
+                    let run = std::mem::take(&mut self.runs[k + 1]);
+                    if run.is_empty() {
+                        continue;
+                    }
+                    let offset = (k + 1) * self.run_len;
+                    let part = op.part(offset, offset + run.len());
+                    let config = self.config.clone();
+                    let task: Task<LanderEnv> =
+                        Box::new(move |run: &mut [LanderEnv]| part.apply(&config, offset, run));
+                    crew.post(k, run, task);
+                    posted.push(k);
+                }
+                let own = self.runs[0].len();
+                keep(op.part(0, own).apply(&self.config, 0, &mut self.runs[0]));
+                let mut panic = None;
+                for k in posted {
+                    match crew.collect(k) {
+                        Ok((run, e)) => {
+                            self.runs[k + 1] = run;
+                            keep(e);
+                        }
+                        Err(payload) => panic = panic.or(Some(payload)),
+                    }
+                }
+                if let Some(payload) = panic {
+                    std::panic::resume_unwind(payload);
+                }
+            }
+        }
+        match first {
+            Some((index, error)) => Err(BatchError::World { index, error }),
+            None => Ok(()),
         }
     }
 }
@@ -920,56 +1054,6 @@ fn check_len(what: &'static str, found: usize, expected: usize) -> Result<(), Ba
             expected,
             found,
         })
-    }
-}
-
-/// Runs `job(i, env)` for every lander: inline without a pool, else one
-/// parallel pass whose pieces are contiguous runs of landers (at least 8
-/// per piece, so a step is a few jobs per thread, not one per lander).
-/// The error is the lowest-index lander's.
-fn run<F>(
-    envs: &mut [LanderEnv],
-    pool: Option<&rayon::ThreadPool>,
-    job: F,
-) -> Result<(), BatchError>
-where
-    F: Fn(usize, &mut LanderEnv) -> Result<(), WorldError> + Sync,
-{
-    let first = |errors: Vec<Option<(usize, WorldError)>>| {
-        errors
-            .into_iter()
-            .flatten()
-            .min_by_key(|(i, _)| *i)
-            .map_or(Ok(()), |(index, error)| {
-                Err(BatchError::World { index, error })
-            })
-    };
-    match pool {
-        None => {
-            for (i, env) in envs.iter_mut().enumerate() {
-                job(i, env).map_err(|error| BatchError::World { index: i, error })?;
-            }
-            Ok(())
-        }
-        Some(pool) => {
-            let threads = pool.current_num_threads().max(1);
-            let piece = envs.len().div_ceil(threads * 4).max(8);
-            let errors: Vec<Option<(usize, WorldError)>> = pool.install(|| {
-                envs.par_chunks_mut(piece)
-                    .enumerate()
-                    .map(|(c, chunk)| {
-                        for (k, env) in chunk.iter_mut().enumerate() {
-                            let i = c * piece + k;
-                            if let Err(e) = job(i, env) {
-                                return Some((i, e));
-                            }
-                        }
-                        None
-                    })
-                    .collect()
-            });
-            first(errors)
-        }
     }
 }
 

@@ -3,6 +3,7 @@
 //! lander flown through the portal variant's portal.
 
 use super::*;
+use crate::crew::Crew;
 use janus2d::base::math::to_f64;
 
 /// A fixed pseudo-random table of discrete actions, `steps × n`.
@@ -295,4 +296,60 @@ fn a_piloted_lander_goes_through_the_portal_into_the_pad_chamber() {
     let k = inside_at.expect("the hull crossed and came out in the pad chamber");
     // It flew there: the crossing is no accident of the first steps.
     assert!(k > 100, "inside at step {k}");
+}
+
+#[test]
+fn changing_threads_mid_run_and_more_threads_than_landers_change_nothing() {
+    let run = |switch: &[usize]| {
+        let mut batch = LanderBatch::new(5, LanderConfig::vector(1000), 2, switch[0]).unwrap();
+        let actions = action_table(5, 90, 3);
+        for k in 0..90 {
+            if k % 30 == 0 {
+                batch.set_threads(switch[k / 30]).unwrap();
+            }
+            batch
+                .step(LanderActions::Discrete(&actions[k * 5..(k + 1) * 5]))
+                .unwrap();
+        }
+        assert_eq!(batch.threads(), switch[2]);
+        (0..5)
+            .map(|i| batch.env(i).unwrap().world().state_hash())
+            .collect::<Vec<_>>()
+    };
+    let one = run(&[1, 1, 1]);
+    assert_eq!(one, run(&[2, 4, 1]));
+    assert_eq!(one, run(&[8, 3, 6]));
+    let batch = LanderBatch::new(3, LanderConfig::default(), 0, 8).unwrap();
+    assert_eq!(batch.outcomes().count(), 3);
+    assert!(batch.env(3).is_err());
+    assert!(batch.env(2).is_ok());
+}
+
+#[test]
+fn a_helpers_panic_reaches_the_caller_and_the_crew_stops_cleanly() {
+    let crew: Crew<u32> = Crew::new(2).unwrap();
+    crew.post(
+        0,
+        vec![1, 2],
+        Box::new(|v: &mut [u32]| {
+            v[0] += 10;
+            None
+        }),
+    );
+    crew.post(1, vec![3], Box::new(|_: &mut [u32]| panic!("helper fails")));
+    let (items, error) = crew.collect(0).unwrap();
+    assert_eq!(items, vec![11, 2]);
+    assert!(error.is_none());
+    assert!(crew.collect(1).is_err());
+    // The helper that panicked takes work again.
+    crew.post(
+        1,
+        vec![5],
+        Box::new(|v: &mut [u32]| {
+            v[0] *= 2;
+            None
+        }),
+    );
+    assert_eq!(crew.collect(1).unwrap().0, vec![10]);
+    drop(crew); // joins both helpers
 }

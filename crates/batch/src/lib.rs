@@ -40,6 +40,7 @@
 //! [`WorldBatch::set_world`]): the handle's world id is replaced by the id
 //! of the world it is used in.
 
+mod crew;
 pub mod lander;
 
 use janus2d::{BodyHandle, JointHandle, QueryFilter, Real, Snapshot, Vec2, World, WorldError};
