@@ -8,7 +8,9 @@ use crate::handles::Body;
 use crate::world::PyWorld;
 use janus2d_batch::BatchError;
 use janus2d_batch::lander::{LanderActions, LanderBatch, LanderConfig, OBS_WIDTH, TERRAIN_DRAWS};
-use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLikeDyn, PyArrayMethods};
+use numpy::{
+    AllowTypeChange, PyArray1, PyArray2, PyArrayLikeDyn, PyArrayMethods, PyReadonlyArrayDyn,
+};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
@@ -36,6 +38,11 @@ fn action_error(index: usize, why: String) -> PyErr {
 }
 
 fn actions_of(obj: &Bound<'_, PyAny>, continuous: bool) -> PyResult<Owned> {
+    // The usual case first, without a conversion: an int64 array of
+    // discrete actions.
+    if !continuous && let Ok(ints) = obj.extract::<PyReadonlyArrayDyn<'_, i64>>() {
+        return Ok(Owned::Discrete(ints.as_array().iter().copied().collect()));
+    }
     let array: PyArrayLikeDyn<'_, f64, AllowTypeChange> = obj.extract().map_err(|_| {
         action_error(
             0,
