@@ -186,7 +186,7 @@ def main():
                 steps,
             )
         line(n, j, j1, g)
-    print(f"   ({load()})")
+        print(f"       ({load()})")
 
     print()
     print(f"== random policy returns over {episodes} episodes ({load()})")
