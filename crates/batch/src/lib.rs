@@ -40,6 +40,9 @@
 //! [`WorldBatch::set_world`]): the handle's world id is replaced by the id
 //! of the world it is used in.
 
+mod crew;
+pub mod lander;
+
 use janus2d::{BodyHandle, JointHandle, QueryFilter, Real, Snapshot, Vec2, World, WorldError};
 use rayon::prelude::*;
 
@@ -81,6 +84,16 @@ pub enum BatchError {
     },
     /// A thread count of zero, or a pool the system would not start.
     Threads(String),
+    /// An environment configuration the batch cannot build (see
+    /// [`lander::LanderConfig`]).
+    Config(String),
+    /// An action outside the environment's action space.
+    Action {
+        /// The index of the environment whose action it is.
+        index: usize,
+        /// What is wrong with it.
+        why: String,
+    },
     /// A world refused the call (the first world, by index, that did).
     World {
         /// The world's index in the batch.
@@ -103,6 +116,8 @@ impl std::fmt::Display for BatchError {
                 found,
             } => write!(f, "`{what}` has {found} values, {expected} needed"),
             BatchError::Threads(why) => write!(f, "thread pool: {why}"),
+            BatchError::Config(why) => write!(f, "configuration: {why}"),
+            BatchError::Action { index, why } => write!(f, "environment {index}: {why}"),
             BatchError::World { index, error } => write!(f, "world {index}: {error}"),
         }
     }

@@ -1,17 +1,21 @@
-"""janus2d's Python side, measured: the batch's thread scaling, and
-LunarLander steps per second beside Gymnasium's Box2D one (when
-``gymnasium[box2d]`` is installed), single and vectorised, with the random
-policy's returns.
+"""janus2d's Python side, measured in one run: the batches' thread
+scaling (WorldBatch stepping lander worlds; LanderBatch, the lander's
+whole environment step in Rust), and LunarLander environment steps per
+second beside Gymnasium's Box2D one (when ``gymnasium[box2d]`` is
+installed), single and vectorised (8, 64, 256), with the random policy's
+returns. Each section prints the load average (1 minute) before it.
 
     python crates/python/bench/bench.py            # everything
     python crates/python/bench/bench.py --quick    # fewer repeats
 
-Run it on an idle machine: nothing else compiling.
+Run it on an idle machine (nothing else compiling): on 2 cores, one busy
+process elsewhere halves the 2-thread figures.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import numpy as np
@@ -46,6 +50,31 @@ def batch_scaling(worlds=256, steps=100, repeats=5):
     return rows
 
 
+def lander_batch_scaling(landers=256, steps=200, repeats=5):
+    """Env-steps/s of a LanderBatch (random discrete actions, autoreset)
+    on 1 and 2 threads: the Rust environment step without Python."""
+    rng = np.random.default_rng(0)
+    actions = rng.integers(0, 4, size=(steps, landers))
+    rows = []
+    for threads in (1, 2):
+        batch = janus2d.LanderBatch(landers, threads=threads, autoreset=True,
+                                    max_episode_steps=1000)
+
+        def run():
+            batch.reset(1)
+            for a in actions:
+                batch.step(a)
+
+        reset = best_of(repeats, lambda: batch.reset(1))
+        t = best_of(repeats, run) - reset
+        rows.append((threads, landers * steps / t))
+    return rows
+
+
+def load():
+    return f"load average {os.getloadavg()[0]:.2f}"
+
+
 def lander_returns(make_env, episodes, seed):
     env = make_env()
     out = []
@@ -61,29 +90,38 @@ def lander_returns(make_env, episodes, seed):
     return np.array(out)
 
 
-def env_rate(make_env, steps, seed=0):
+def env_rate(make_env, steps, seed=0, repeats=3):
+    """Best of `repeats` runs of `steps` random steps (a busy neighbour
+    only ever slows a run down)."""
     env = make_env()
     env.reset(seed=seed)
     rng = np.random.default_rng(seed)
-    actions = rng.integers(0, 4, size=steps)
-    t0 = time.perf_counter()
-    for a in actions:
-        _, _, term, trunc, _ = env.step(int(a))
-        if term or trunc:
-            env.reset()
-    return steps / (time.perf_counter() - t0)
+    actions = [int(a) for a in rng.integers(0, 4, size=steps)]
+    best = 0.0
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        for a in actions:
+            _, _, term, trunc, _ = env.step(a)
+            if term or trunc:
+                env.reset()
+        best = max(best, steps / (time.perf_counter() - t0))
+    return best
 
 
-def vector_rate(make_vec, n, steps, seed=0):
+def vector_rate(make_vec, n, steps, seed=0, repeats=3):
+    """Best of `repeats` runs of `steps` random vector steps."""
     envs = make_vec(n)
     envs.reset(seed=seed)
     rng = np.random.default_rng(seed)
-    t0 = time.perf_counter()
-    for _ in range(steps):
-        envs.step(rng.integers(0, 4, size=n))
-    dt = time.perf_counter() - t0
+    actions = [rng.integers(0, 4, size=n) for _ in range(steps)]
+    best = 0.0
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        for a in actions:
+            envs.step(a)
+        best = max(best, n * steps / (time.perf_counter() - t0))
     envs.close()
-    return n * steps / dt
+    return best
 
 
 def main():
@@ -94,9 +132,16 @@ def main():
     repeats = 2 if args.quick else 5
     episodes = 20 if args.quick else 100
 
-    print("== WorldBatch: 256 lander worlds, 100 steps, best of", repeats)
+    print(f"== WorldBatch: 256 lander worlds, 100 steps, best of {repeats} ({load()})")
     rows = batch_scaling(repeats=repeats)
     print(f"{'threads':>8} {'world-steps/s':>14} {'speed-up':>9}")
+    for threads, rate in rows:
+        print(f"{threads:>8} {rate:>14.0f} {rate / rows[0][1]:>9.2f}")
+
+    print()
+    print(f"== LanderBatch: 256 landers, random actions, 200 steps, best of {repeats} ({load()})")
+    rows = lander_batch_scaling(repeats=repeats)
+    print(f"{'threads':>8} {'env-steps/s':>14} {'speed-up':>9}")
     for threads, rate in rows:
         print(f"{threads:>8} {rate:>14.0f} {rate / rows[0][1]:>9.2f}")
 
@@ -113,23 +158,26 @@ def main():
         have_box2d = False
 
     print()
-    print("== LunarLander, random actions: environment steps per second")
+    print(f"== LunarLander, random actions: environment steps per second ({load()})")
+    print(f"   janus2d's vector envs on {args.threads} threads; Gymnasium's: sync vector env")
     single_steps = 5000 if args.quick else 20000
     j_single = env_rate(lambda: gym.make("janus2d/LunarLander-v0"), single_steps)
     g_single = (
         env_rate(lambda: gym.make("LunarLander-v3"), single_steps) if have_box2d else None
     )
-    print(f"{'envs':>6} {'janus2d':>12} {'gymnasium+Box2D':>16} {'ratio':>7}")
+    print(f"{'envs':>6} {'janus2d':>12} {'(1 thread)':>12} {'gymnasium+Box2D':>16} {'ratio':>7}")
 
-    def line(n, j, g):
+    def line(n, j, j1, g):
         gs = f"{g:>16.0f}" if g else f"{'n/a':>16}"
         ratio = f"{j / g:>7.2f}" if g else f"{'':>7}"
-        print(f"{n:>6} {j:>12.0f} {gs} {ratio}")
+        j1s = f"{j1:>12.0f}" if j1 else f"{'':>12}"
+        print(f"{n:>6} {j:>12.0f} {j1s} {gs} {ratio}", flush=True)
 
-    line(1, j_single, g_single)
+    line(1, j_single, None, g_single)
     for n in (8, 64, 256):
-        steps = max(20, (2000 if args.quick else 8000) // n)
+        steps = max(50, (5000 if args.quick else 20000) // n)
         j = vector_rate(lambda k: LunarLanderVector(k, threads=args.threads), n, steps)
+        j1 = vector_rate(lambda k: LunarLanderVector(k, threads=1), n, steps)
         g = None
         if have_box2d:
             g = vector_rate(
@@ -137,10 +185,11 @@ def main():
                 n,
                 steps,
             )
-        line(n, j, g)
+        line(n, j, j1, g)
+        print(f"       ({load()})")
 
     print()
-    print(f"== random policy returns over {episodes} episodes")
+    print(f"== random policy returns over {episodes} episodes ({load()})")
     for name, make in [("janus2d", lambda: gym.make("janus2d/LunarLander-v0"))] + (
         [("gymnasium+Box2D", lambda: gym.make("LunarLander-v3"))] if have_box2d else []
     ):

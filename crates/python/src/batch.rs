@@ -8,7 +8,9 @@ use janus2d_batch::{BatchError, WorldBatch};
 use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArray3, PyArrayLikeDyn, PyArrayMethods};
 use pyo3::prelude::*;
 
-fn batch_error(e: BatchError) -> PyErr {
+/// The Python exception of a batch error (a world's error carries the
+/// world's index as `world`).
+pub(crate) fn batch_error(e: BatchError) -> PyErr {
     match e {
         BatchError::World { index, error } => {
             let err = crate::world_error(error);
@@ -22,10 +24,20 @@ fn batch_error(e: BatchError) -> PyErr {
         BatchError::WorldIndex { .. } => raise("BatchError", "WorldIndex", e.to_string()),
         BatchError::Length { .. } => raise("BatchError", "Length", e.to_string()),
         BatchError::Threads(_) => raise("BatchError", "Threads", e.to_string()),
+        BatchError::Config(_) => raise("BatchError", "Config", e.to_string()),
+        BatchError::Action { index, .. } => {
+            let err = raise("InvalidInputError", "Action", e.to_string());
+            Python::attach(|py| {
+                let _ = err.value(py).setattr("world", index);
+            });
+            err
+        }
     }
 }
 
-trait OrBatch<T> {
+/// Converts `Result<T, BatchError>` into a Python result.
+pub(crate) trait OrBatch<T> {
+    /// The Python exception of the error.
     fn pyb(self) -> PyResult<T>;
 }
 

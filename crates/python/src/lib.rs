@@ -14,6 +14,7 @@ use std::sync::{Mutex, MutexGuard, PoisonError};
 mod batch;
 mod handles;
 mod kw;
+mod lander;
 mod world;
 
 pub use handles::{Body, Joint, PortalPair, Shape};
@@ -128,6 +129,7 @@ fn real_bytes() -> usize {
 fn _janus2d(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<world::PyWorld>()?;
     m.add_class::<batch::PyWorldBatch>()?;
+    m.add_class::<lander::PyLanderBatch>()?;
     m.add_class::<Body>()?;
     m.add_class::<Shape>()?;
     m.add_class::<Joint>()?;

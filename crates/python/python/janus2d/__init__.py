@@ -25,6 +25,7 @@ from ._janus2d import (
     PortalPair,
     Shape,
     World,
+    LanderBatch,
     WorldBatch,
     defaults,
     real_bytes,
@@ -46,6 +47,7 @@ __version__ = "0.1.0"
 __all__ = [
     "World",
     "WorldBatch",
+    "LanderBatch",
     "Body",
     "Shape",
     "Joint",

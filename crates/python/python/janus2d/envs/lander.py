@@ -1,14 +1,17 @@
 """LunarLander on janus2d: the rules of Gymnasium's ``LunarLander-v3``
 (observation and action spaces, reward terms, termination) on janus2d
-bodies, a revolute joint per leg with a motor as its spring, and a
-:class:`janus2d.WorldBatch` that steps one or many landers.
+bodies, a revolute joint per leg with a motor as its spring.
 
 Units follow the Gymnasium environment: a 20 x 13.3 m viewport (600 x 400
 pixels at 30 px/m), 50 steps per second, gravity -10 m/s^2.
 
-``LanderSim`` holds the physics of N landers and the reward; the single
-environment is ``LanderSim`` with N = 1, the vector environment
-(:mod:`janus2d.envs.vector`) is the same with N > 1.
+The environment's step runs in Rust (:class:`janus2d.LanderBatch`, crate
+``janus2d-batch``'s ``lander`` module): :class:`LunarLander` is a thin
+Gymnasium wrapper around a one-lander batch, one Rust call per step.
+
+``LanderSim`` is the same rules written with NumPy over a
+:class:`janus2d.WorldBatch`, the implementation before the Rust one; it
+stays as the reference the tests compare the Rust step with.
 """
 
 from __future__ import annotations
@@ -173,17 +176,19 @@ def engine_impulses(actions: np.ndarray, angles: np.ndarray, centres: np.ndarray
     main[:, 0, 2:4] = centres - lever
 
     # Side engine: a sideways push high on the hull, so it also turns it:
-    # action 1 (the left engine) pushes right from the right of the centre
-    # (turning the lander clockwise), action 3 the mirror image.
+    # as in Gymnasium, action 1 (the left engine) pushes left from the
+    # right of the centre (turning the lander counterclockwise), action 3
+    # the mirror image.
     offset = -side_dir * (SIDE_OUT / PX) + 3.0 * jitter[:, 1]
     side = np.zeros((n, 1, 4))
-    side[:, 0, 0:2] = (right * offset[:, None] + jitter[:, :1] * up) * (SIDE_POWER * s_power)[:, None]
+    side[:, 0, 0:2] = (right * offset[:, None] + jitter[:, :1] * up) * (-SIDE_POWER * s_power)[:, None]
     side[:, 0, 2:4] = centres + right * offset[:, None] + up * (SIDE_UP / PX)
     return main, side, m_power, s_power
 
 
 class LanderSim:
-    """N landers in a WorldBatch, with Gymnasium's observation and reward."""
+    """N landers in a WorldBatch, with Gymnasium's observation and reward,
+    in NumPy (the reference for :class:`janus2d.LanderBatch`)."""
 
     def __init__(self, n: int, rng: np.random.Generator, continuous=False, gravity=-10.0,
                  threads=1, portal=False):
@@ -304,6 +309,9 @@ if gym is not None:
         engine, right engine); ``True``: ``Box(-1, 1, (2,))`` (main
         throttle, side throttle). Observation: the 8 values of Gymnasium's
         environment, in its bounds. ``portal=True`` is the portal variant.
+        Each step is one call into Rust (:class:`janus2d.LanderBatch` of
+        one lander); an action outside the space raises
+        :class:`janus2d.errors.InvalidInputError` (a ``ValueError``).
         """
 
         metadata = {"render_modes": ["rgb_array"], "render_fps": FPS}
@@ -322,37 +330,37 @@ if gym is not None:
                 self.action_space = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
             else:
                 self.action_space = spaces.Discrete(4)
-            self.sim = None
+            self.core = None
 
         def reset(self, *, seed=None, options=None):
             super().reset(seed=seed)
-            if self.sim is None or seed is not None:
-                self.sim = LanderSim(1, self.np_random, self.continuous, self.gravity,
-                                     portal=self.portal)
-            self.sim.rng = self.np_random
-            fresh = np.ones(1, dtype=bool)
-            self.sim.reset(fresh)
-            noop = np.zeros((1, 2)) if self.continuous else np.zeros(1, dtype=np.int64)
-            obs, _, _ = self.sim.step(noop, fresh)
+            # The lander's own generator (terrain, push, engine dispersion)
+            # is seeded from the environment's, so `seed` decides it all.
+            core_seed = int(self.np_random.integers(0, 2**63))
+            if self.core is None:
+                self.core = janus2d.LanderBatch(
+                    1, continuous=self.continuous, gravity=self.gravity,
+                    portal=self.portal, seed=core_seed,
+                )
+            obs = self.core.reset(core_seed)
             return obs[0], {}
 
         def step(self, action):
-            if self.sim is None:
+            core = self.core
+            if core is None:
                 raise RuntimeError("call reset() before step()")
-            if not self.action_space.contains(
-                np.asarray(action, dtype=np.float32) if self.continuous else action
-            ):
-                raise ValueError(f"action {action!r} is not in {self.action_space}")
-            obs, reward, done = self.sim.step(np.asarray([action]))
-            return obs[0], float(reward[0]), bool(done[0]), False, {}
+            obs, reward, terminated = core.step_one(action)
+            return obs, reward, terminated, False, {}
 
         def render(self):
             if self.render_mode is None:
                 gym.logger.warn("render() without render_mode: pass render_mode='rgb_array'")
                 return None
-            if self.sim is None:
+            if self.core is None:
                 raise RuntimeError("call reset() before render()")
-            return self.sim.render(0)
+            return self.core.world(0).render(
+                600, 400, center=(VIEW_W / 2, VIEW_H / 2), scale=PX
+            )
 
         def close(self):
-            self.sim = None
+            self.core = None

@@ -1,5 +1,7 @@
-"""A vector LunarLander over one :class:`janus2d.WorldBatch`: N landers
-stepped in one call on rayon threads, observations and rewards as arrays.
+"""A vector LunarLander over one :class:`janus2d.LanderBatch`: N landers
+stepped in one Rust call on rayon threads (engines, world steps,
+observations, rewards, autoresets), the GIL released, the results as
+arrays.
 
 It follows Gymnasium's ``VectorEnv`` interface with next-step autoreset:
 the step after an episode ends resets that lander (its action is ignored,
@@ -13,11 +15,13 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from .lander import FPS, OBS_HIGH, OBS_LOW, LanderSim
+import janus2d
+
+from .lander import FPS, OBS_HIGH, OBS_LOW, PX, VIEW_H, VIEW_W
 
 
 class LunarLanderVector(VectorEnv):
-    """``num_envs`` landers in a WorldBatch of ``threads`` threads."""
+    """``num_envs`` landers in a LanderBatch of ``threads`` threads."""
 
     metadata = {
         "render_modes": ["rgb_array"],
@@ -42,45 +46,34 @@ class LunarLanderVector(VectorEnv):
             self.single_action_space = spaces.Discrete(4)
         self.observation_space = batch_space(self.single_observation_space, num_envs)
         self.action_space = batch_space(self.single_action_space, num_envs)
-        self.sim = None
+        self.core = None
         self._rng = np.random.default_rng()
-        self._autoreset = np.zeros(num_envs, dtype=bool)
-        self._steps = np.zeros(num_envs, dtype=np.int64)
-
-    def _noop(self):
-        if self.continuous:
-            return np.tile(np.array([-1.0, 0.0]), (self.num_envs, 1))
-        return np.zeros(self.num_envs, dtype=np.int64)
 
     def reset(self, *, seed=None, options=None):
         if seed is not None:
             self._rng = np.random.default_rng(seed)
-        if self.sim is None or seed is not None:
-            self.sim = LanderSim(self.num_envs, self._rng, self.continuous, self.gravity,
-                                 threads=self.threads, portal=self.portal)
-        mask = np.ones(self.num_envs, dtype=bool)
-        self.sim.reset(mask, self._rng)
-        obs, _, _ = self.sim.step(self._noop(), mask)
-        self._autoreset[:] = False
-        self._steps[:] = 0
-        return obs, {}
+        core_seed = int(self._rng.integers(0, 2**63))
+        if self.core is None:
+            self.core = janus2d.LanderBatch(
+                self.num_envs, threads=self.threads, continuous=self.continuous,
+                gravity=self.gravity, portal=self.portal,
+                max_episode_steps=self.max_episode_steps, autoreset=True, seed=core_seed,
+            )
+        return self.core.reset(core_seed), {}
 
     def step(self, actions):
-        fresh = self._autoreset.copy()
-        if fresh.any():
-            self.sim.reset(fresh, self._rng)
-            self._steps[fresh] = 0
-        obs, reward, terminated = self.sim.step(actions, fresh)
-        self._steps += 1
-        self._steps[fresh] = 0
-        truncated = (self._steps >= self.max_episode_steps) & ~terminated
-        self._autoreset = terminated | truncated
-        return obs, reward.astype(np.float64), terminated, truncated, {}
+        if self.core is None:
+            raise RuntimeError("call reset() before step()")
+        obs, reward, terminated, truncated = self.core.step(actions)
+        return obs, reward, terminated, truncated, {}
 
     def render(self):
-        if self.render_mode != "rgb_array" or self.sim is None:
+        if self.render_mode != "rgb_array" or self.core is None:
             return None
-        return tuple(self.sim.render(i) for i in range(self.num_envs))
+        return tuple(
+            self.core.world(i).render(600, 400, center=(VIEW_W / 2, VIEW_H / 2), scale=PX)
+            for i in range(self.num_envs)
+        )
 
     def close_extras(self, **kwargs):
-        self.sim = None
+        self.core = None
