@@ -658,7 +658,7 @@ impl LanderEnv {
         self.world.step_serial((1.0 / FPS) as Real)?;
         #[cfg(feature = "portals")]
         if config.portal {
-            for e in self.world.portal_events() {
+            for e in &self.world.events().portals {
                 if let janus2d::PortalEvent::CrossingCompleted { body, .. } = e
                     && *body == hull
                 {
