@@ -124,8 +124,9 @@ pub mod bytes {
     /// common solver data in `JointBase`, and the constraint graph and
     /// solved list belong to constraint building, not the narrowphase; 9:
     /// the portal stage keeps the events pushed between steps apart from
-    /// the last step's).
-    pub const SNAPSHOT_VERSION: u16 = 11;
+    /// the last step's; 12: shape definitions carry an offset, bodies
+    /// their motion locks and enabled flag, and the world its chains).
+    pub const SNAPSHOT_VERSION: u16 = 12;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.

@@ -398,6 +398,7 @@ mod mover;
 #[cfg(feature = "portals")]
 mod portals;
 mod queries;
+mod shape_edit;
 mod shapes;
 mod step;
 /// Gravity: finite, its length at most

@@ -1,0 +1,269 @@
+//! Shapes and bodies changed after creation: geometry setters and scaling,
+//! shape offsets, motion locks, body enable/disable and chains. Each test
+//! checks a number against what the change should give.
+
+use janus2d::prelude::*;
+
+const DT: Real = 1.0 / 60.0;
+
+fn v(x: Real, y: Real) -> Vec2 {
+    Vec2::new(x, y)
+}
+
+fn world() -> World {
+    World::new(WorldDef::default()).unwrap()
+}
+
+/// A static ground box whose top face is at y = 0.
+fn ground(w: &mut World) -> (BodyHandle, ShapeHandle) {
+    let g = w.create_body(&BodyDef::fixed(v(0.0, -0.5))).unwrap();
+    let s = w
+        .create_shape(g, &ShapeDef::default(), Polygon::make_box(20.0, 0.5))
+        .unwrap();
+    (g, s)
+}
+
+fn ball(w: &mut World, at: Vec2, r: Real) -> (BodyHandle, ShapeHandle) {
+    let b = w.create_body(&BodyDef::dynamic(at)).unwrap();
+    let s = w
+        .create_shape(b, &ShapeDef::default(), Circle::new(Vec2::ZERO, r).unwrap())
+        .unwrap();
+    (b, s)
+}
+
+fn run(w: &mut World, steps: usize) {
+    for _ in 0..steps {
+        w.step(DT).unwrap();
+    }
+}
+
+// ----- geometry setters ------------------------------------------------------
+
+#[test]
+fn set_circle_grows_a_resting_ball_and_it_rises_by_the_radius_change() {
+    let mut w = world();
+    ground(&mut w);
+    let (b, s) = ball(&mut w, v(0.0, 0.5), 0.5);
+    run(&mut w, 60);
+    let y0 = w.position(b).unwrap().y;
+    assert!((y0 - 0.5).abs() < 0.02, "rests on its radius: {y0}");
+    let m0 = w.mass(b).unwrap();
+    w.set_circle(s, Circle::new(Vec2::ZERO, 1.0).unwrap())
+        .unwrap();
+    assert!(!w.is_sleeping(b).unwrap());
+    // Mass from density: π r², ×4.
+    assert!((w.mass(b).unwrap() / m0 - 4.0).abs() < 1e-4);
+    run(&mut w, 60);
+    let y1 = w.position(b).unwrap().y;
+    assert!(((y1 - y0) - 0.5).abs() < 1e-3, "rose by {}", y1 - y0);
+    w.validate().unwrap();
+}
+
+#[test]
+fn set_polygon_on_the_static_ground_lifts_what_rests_on_it() {
+    let mut w = world();
+    let (_, gs) = ground(&mut w);
+    let (b, _) = ball(&mut w, v(0.0, 0.5), 0.5);
+    run(&mut w, 90);
+    let y0 = w.position(b).unwrap().y;
+    // The ground's top face goes from 0 to 0.25 (the body is at y = −0.5).
+    w.set_polygon(gs, Polygon::make_offset_box(20.0, 0.5, v(0.0, 0.25), 0.0))
+        .unwrap();
+    run(&mut w, 60);
+    let y1 = w.position(b).unwrap().y;
+    assert!(((y1 - y0) - 0.25).abs() < 1e-3, "rose by {}", y1 - y0);
+    w.validate().unwrap();
+}
+
+#[test]
+fn degenerate_geometry_is_a_typed_error_and_changes_nothing() {
+    let mut w = world();
+    ground(&mut w);
+    let b = w.create_body(&BodyDef::dynamic(v(0.0, 2.0))).unwrap();
+    let s = w
+        .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    run(&mut w, 10);
+    let hash = w.state_hash();
+    let mass = w.mass(b).unwrap();
+    // A flat "polygon": three points on a line.
+    let mut flat = Polygon::make_box(0.5, 0.5);
+    flat.vertices[2] = flat.vertices[1];
+    assert!(matches!(
+        w.set_polygon(s, flat),
+        Err(WorldError::Geometry(_))
+    ));
+    assert!(matches!(
+        w.set_circle(s, Circle { center: Vec2::ZERO, radius: -1.0 }),
+        Err(WorldError::Geometry(_))
+    ));
+    assert_eq!(
+        w.scale_shape(s, 0.0),
+        Err(WorldError::OutOfRange("factor"))
+    );
+    assert_eq!(
+        w.scale_shape(s, Real::NAN),
+        Err(WorldError::NonFinite("factor"))
+    );
+    assert_eq!(w.state_hash(), hash);
+    assert_eq!(w.mass(b).unwrap(), mass);
+    assert_eq!(w.shape(s).unwrap().geometry, Shape::Polygon(Polygon::make_box(0.5, 0.5)));
+    w.validate().unwrap();
+}
+
+#[test]
+fn a_directly_set_mass_stays_when_the_geometry_changes() {
+    let mut w = world();
+    let b = w.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    let s = w
+        .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    w.set_mass(b, BodyMass::new(7.0, 2.0)).unwrap();
+    w.set_polygon(s, Polygon::make_box(2.0, 2.0)).unwrap();
+    assert_eq!(w.mass(b).unwrap(), 7.0);
+    assert_eq!(w.rotational_inertia(b).unwrap(), 2.0);
+    // Back to the shapes: 16 kg.
+    w.reset_mass_from_shapes(b).unwrap();
+    assert!((w.mass(b).unwrap() - 16.0).abs() < 1e-3);
+}
+
+#[test]
+fn changing_the_kind_moves_the_centre_of_mass() {
+    let mut w = world();
+    let b = w.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    let s = w
+        .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    // A capsule from (1, 0) to (3, 0): centre of mass at x = 2.
+    w.set_capsule(s, Capsule::new(v(1.0, 0.0), v(3.0, 0.0), 0.25).unwrap())
+        .unwrap();
+    assert!((w.center_of_mass(b).unwrap() - v(2.0, 0.0)).length() < 1e-5);
+    let area = 2.0 * 0.5 + janus2d::base::math::PI * 0.25 * 0.25;
+    assert!((w.mass(b).unwrap() - area).abs() < 1e-4);
+    // A segment has no mass: the body gets the unit fallback mass.
+    w.set_segment(s, Segment::new(v(-1.0, 0.0), v(1.0, 0.0)).unwrap())
+        .unwrap();
+    assert!((w.mass(b).unwrap() - 1.0).abs() < 1e-6);
+    w.validate().unwrap();
+}
+
+#[test]
+fn scale_shape_scales_mass_by_the_square_and_the_rest_height() {
+    let mut w = world();
+    ground(&mut w);
+    let (b, s) = ball(&mut w, v(0.0, 0.3), 0.3);
+    run(&mut w, 60);
+    let m0 = w.mass(b).unwrap();
+    let y0 = w.position(b).unwrap().y;
+    w.scale_shape(s, 2.0).unwrap();
+    assert!((w.mass(b).unwrap() / m0 - 4.0).abs() < 1e-4);
+    run(&mut w, 60);
+    let y1 = w.position(b).unwrap().y;
+    assert!(((y1 - y0) - 0.3).abs() < 1e-3, "rose by {}", y1 - y0);
+    w.validate().unwrap();
+}
+
+#[test]
+fn geometry_changes_round_trip_snapshots() {
+    let mut w = world();
+    ground(&mut w);
+    let (b, s) = ball(&mut w, v(0.0, 2.0), 0.5);
+    run(&mut w, 5);
+    w.set_circle(s, Circle::new(v(0.1, 0.0), 0.7).unwrap())
+        .unwrap();
+    let snap = w.snapshot();
+    run(&mut w, 60);
+    let after = w.state_hash();
+    w.restore(&snap);
+    assert_eq!(
+        w.shape(s).unwrap().geometry,
+        Shape::Circle(Circle::new(v(0.1, 0.0), 0.7).unwrap())
+    );
+    run(&mut w, 60);
+    assert_eq!(w.state_hash(), after);
+    assert!(w.position(b).unwrap().y < 1.0);
+}
+
+// ----- shape offsets -----------------------------------------------------
+
+#[test]
+fn shape_offsets_move_every_kind_in_the_body_frame() {
+    let mut w = world();
+    let b = w.create_body(&BodyDef::dynamic(v(10.0, 0.0))).unwrap();
+    let half_turn = janus2d::base::math::PI / 2.0;
+    let def = ShapeDef::default().with_offset(v(0.0, 3.0), half_turn);
+    let circle = w
+        .create_shape(b, &def, Circle::new(v(1.0, 0.0), 0.5).unwrap())
+        .unwrap();
+    let capsule = w
+        .create_shape(b, &def, Capsule::new(v(-1.0, 0.0), v(1.0, 0.0), 0.2).unwrap())
+        .unwrap();
+    let segment = w
+        .create_shape(b, &def, Segment::new(v(-1.0, 0.0), v(1.0, 0.0)).unwrap())
+        .unwrap();
+    let polygon = w
+        .create_shape(b, &def, Polygon::make_box(2.0, 0.5))
+        .unwrap();
+    // The circle centre (1, 0) turned a quarter and moved up 3: (0, 4).
+    let Shape::Circle(c) = w.shape(circle).unwrap().geometry else {
+        panic!("circle")
+    };
+    assert!((c.center - v(0.0, 4.0)).length() < 1e-5);
+    // The capsule and segment stand upright from y = 2 to y = 4.
+    let Shape::Capsule(k) = w.shape(capsule).unwrap().geometry else {
+        panic!("capsule")
+    };
+    assert!((k.center1 - v(0.0, 2.0)).length() < 1e-5);
+    assert!((k.center2 - v(0.0, 4.0)).length() < 1e-5);
+    let seg_box = w.shape(segment).unwrap().aabb;
+    assert!((seg_box.lower.y - 2.0).abs() < 1e-5 && (seg_box.upper.y - 4.0).abs() < 1e-5);
+    // The 4 × 1 box turned upright: 1 wide, 4 tall, centred on (10, 3).
+    let pb = w.shape(polygon).unwrap().aabb;
+    assert!(((pb.upper.x - pb.lower.x) - 1.0).abs() < 1e-4);
+    assert!(((pb.upper.y - pb.lower.y) - 4.0).abs() < 1e-4);
+    assert!(((pb.lower.y + pb.upper.y) / 2.0 - 3.0).abs() < 1e-4);
+    // Baked: the stored definitions are back at the identity.
+    assert_eq!(w.shape(polygon).unwrap().def.offset, Transform::IDENTITY);
+    w.validate().unwrap();
+}
+
+#[test]
+fn an_offset_circle_swings_the_centre_of_mass() {
+    let mut w = world();
+    let b = w.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    let def = ShapeDef::default().with_offset(v(1.5, -0.5), 0.3);
+    w.create_shape(b, &def, Circle::new(Vec2::ZERO, 0.5).unwrap())
+        .unwrap();
+    assert!((w.center_of_mass(b).unwrap() - v(1.5, -0.5)).length() < 1e-6);
+    // Inertia about the centre of mass: ½ m r², the offset adds nothing.
+    let m = w.mass(b).unwrap();
+    assert!((w.rotational_inertia(b).unwrap() - 0.5 * m * 0.25).abs() < 1e-5);
+}
+
+#[test]
+fn a_bad_offset_is_a_typed_error_and_creates_nothing() {
+    let mut w = world();
+    let b = w.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    let nan = ShapeDef::default().with_offset(v(Real::NAN, 0.0), 0.0);
+    assert_eq!(
+        w.create_shape(b, &nan, Polygon::make_box(0.5, 0.5)),
+        Err(WorldError::NonFinite("offset"))
+    );
+    let far = ShapeDef::default().with_offset(v(1e9, 0.0), 0.0);
+    assert!(matches!(
+        w.create_shape(b, &far, Polygon::make_box(0.5, 0.5)),
+        Err(WorldError::OutOfBounds { field: "offset", .. })
+    ));
+    let skew = ShapeDef {
+        offset: Transform {
+            p: Vec2::ZERO,
+            q: Rot { c: 2.0, s: 0.0 },
+        },
+        ..ShapeDef::default()
+    };
+    assert_eq!(
+        w.create_shape(b, &skew, Polygon::make_box(0.5, 0.5)),
+        Err(WorldError::OutOfRange("offset"))
+    );
+    assert_eq!(w.shape_count(), 0);
+}
