@@ -267,3 +267,112 @@ fn a_bad_offset_is_a_typed_error_and_creates_nothing() {
     );
     assert_eq!(w.shape_count(), 0);
 }
+
+// ----- motion locks ----------------------------------------------------------
+
+/// A 1 × 1 box at `at` under gravity with `locks`, and a heavy ball coming
+/// at it from the left at 12 m/s, level with its centre.
+fn box_hit_sideways(locks: MotionLocks) -> (World, BodyHandle, BodyHandle) {
+    let mut w = world();
+    let b = w
+        .create_body(&BodyDef::dynamic(v(0.0, 10.0)).with_motion_locks(locks))
+        .unwrap();
+    w.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    let bullet = w
+        .create_body(&BodyDef::dynamic(v(-3.0, 10.0)).with_velocity(v(12.0, 0.0)))
+        .unwrap();
+    w.create_shape(
+        bullet,
+        &ShapeDef::default().with_density(5.0),
+        Circle::new(Vec2::ZERO, 0.3).unwrap(),
+    )
+    .unwrap();
+    (w, b, bullet)
+}
+
+#[test]
+fn an_x_locked_box_hit_sideways_falls_straight_down() {
+    let (mut w, b, bullet) = box_hit_sideways(MotionLocks::X);
+    let x0 = w.position(b).unwrap().x;
+    let mut hit = false;
+    for _ in 0..60 {
+        w.step(DT).unwrap();
+        hit |= w.body_contacts(b).unwrap().count() > 0;
+        assert!((w.position(b).unwrap().x - x0).abs() < 1e-6);
+        assert_eq!(w.linear_velocity(b).unwrap().x, 0.0);
+    }
+    assert!(hit, "the ball reached the box");
+    // Free fall along y all the while: 10 m/s after 1 s.
+    assert!((w.linear_velocity(b).unwrap().y + 10.0).abs() < 0.05);
+    // The ball bounced back off the box as off a wall.
+    assert!(w.linear_velocity(bullet).unwrap().x < 1.0);
+    w.validate().unwrap();
+}
+
+#[test]
+fn without_locks_the_same_hit_pushes_the_box_sideways() {
+    let (mut w, b, _) = box_hit_sideways(MotionLocks::NONE);
+    run(&mut w, 60);
+    assert!(w.position(b).unwrap().x > 1.0, "{}", w.position(b).unwrap().x);
+}
+
+#[test]
+fn a_y_locked_box_slides_on_without_falling() {
+    let mut w = world();
+    let b = w
+        .create_body(
+            &BodyDef::dynamic(v(0.0, 3.0))
+                .with_velocity(v(2.0, 0.0))
+                .with_motion_locks(MotionLocks::Y),
+        )
+        .unwrap();
+    w.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    // A ball dropped on it does not push it down.
+    let (ball_b, _) = ball(&mut w, v(1.0, 5.0), 0.25);
+    run(&mut w, 60);
+    assert_eq!(w.position(b).unwrap().y, 3.0);
+    assert!((w.position(b).unwrap().x - 2.0).abs() < 0.05);
+    assert!(w.position(ball_b).unwrap().y > 3.0, "the ball rests on top");
+    w.validate().unwrap();
+}
+
+#[test]
+fn a_rotation_lock_is_fixed_rotation_and_locks_set_later_take_hold() {
+    let mut w = world();
+    let b = w
+        .create_body(&BodyDef::dynamic(v(0.0, 3.0)).with_angular_velocity(2.0))
+        .unwrap();
+    w.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    w.set_motion_locks(b, MotionLocks::ROTATION).unwrap();
+    assert!(w.is_fixed_rotation(b).unwrap());
+    assert_eq!(w.angular_velocity(b).unwrap(), 0.0);
+    run(&mut w, 30);
+    assert_eq!(w.angle(b).unwrap(), 0.0);
+    // Lock y too: the fall stops where it is.
+    let locks = MotionLocks {
+        linear_y: true,
+        ..MotionLocks::ROTATION
+    };
+    w.set_motion_locks(b, locks).unwrap();
+    assert_eq!(w.motion_locks(b).unwrap(), locks);
+    let y = w.position(b).unwrap().y;
+    run(&mut w, 30);
+    assert_eq!(w.position(b).unwrap().y, y);
+    // Freed: it falls again.
+    w.set_motion_locks(b, MotionLocks::NONE).unwrap();
+    assert!(!w.is_fixed_rotation(b).unwrap());
+    run(&mut w, 30);
+    assert!(w.position(b).unwrap().y < y - 1.0);
+    // Locks survive a snapshot.
+    w.set_motion_locks(b, MotionLocks::X).unwrap();
+    let snap = w.snapshot();
+    let mut copy = snap.to_world();
+    assert_eq!(copy.motion_locks(b).unwrap(), MotionLocks::X);
+    copy.step(DT).unwrap();
+    w.step(DT).unwrap();
+    assert_eq!(copy.state_hash(), w.state_hash());
+    w.validate().unwrap();
+}

@@ -84,6 +84,66 @@ impl BodyMass {
     }
 }
 
+/// Which of a body's three motions are locked (Box2D v3.1's
+/// `b2MotionLocks`): a locked axis behaves as if the body had infinite
+/// mass along it. The rotation lock is the body's fixed rotation (its
+/// inverse inertia is zero in every constraint); a linear lock zeroes that
+/// component of the body's velocity wherever the solver integrates it, so
+/// that the body never moves along the axis (constraints see its whole
+/// mass, as Box2D's do).
+///
+/// ```
+/// use janus2d_core::{BodyDef, MotionLocks, Vec2};
+/// let def = BodyDef::dynamic(Vec2::ZERO).with_motion_locks(MotionLocks::X);
+/// assert!(def.motion_locks.linear_x && !def.motion_locks.linear_y);
+/// assert_eq!(MotionLocks::default(), MotionLocks::NONE);
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct MotionLocks {
+    /// No motion along world x.
+    pub linear_x: bool,
+    /// No motion along world y.
+    pub linear_y: bool,
+    /// No rotation (the same as [`BodyDef::fixed_rotation`]).
+    pub angular: bool,
+}
+
+impl MotionLocks {
+    /// Nothing locked.
+    pub const NONE: MotionLocks = MotionLocks {
+        linear_x: false,
+        linear_y: false,
+        angular: false,
+    };
+    /// Only x translation locked.
+    pub const X: MotionLocks = MotionLocks {
+        linear_x: true,
+        linear_y: false,
+        angular: false,
+    };
+    /// Only y translation locked.
+    pub const Y: MotionLocks = MotionLocks {
+        linear_x: false,
+        linear_y: true,
+        angular: false,
+    };
+    /// Only the rotation locked.
+    pub const ROTATION: MotionLocks = MotionLocks {
+        linear_x: false,
+        linear_y: false,
+        angular: true,
+    };
+
+    /// The [`BodyState`] flag bits of the linear locks.
+    #[inline]
+    #[must_use]
+    pub fn linear_flags(self) -> u32 {
+        (if self.linear_x { BodyState::LOCK_X } else { 0 })
+            | (if self.linear_y { BodyState::LOCK_Y } else { 0 })
+    }
+}
+
 /// Everything needed to create a body. Start from `BodyDef::default()` or a
 /// constructor and change fields.
 #[derive(Clone, Debug, PartialEq)]
@@ -113,6 +173,10 @@ pub struct BodyDef {
     pub mass: Option<BodyMass>,
     /// Prevents rotation (infinite rotational inertia).
     pub fixed_rotation: bool,
+    /// Locks x translation, y translation or rotation separately (usual
+    /// none; see [`MotionLocks`]). A rotation lock here or
+    /// `fixed_rotation` locks the rotation.
+    pub motion_locks: MotionLocks,
     /// Starts awake (usual true); `false` creates the body asleep, as Box2D's
     /// `isAwake = false`: the world puts it to sleep before its next step
     /// (after its shapes are attached), and it costs nothing until something
@@ -148,6 +212,7 @@ impl Default for BodyDef {
             max_rotation: DEFAULT_MAX_ROTATION,
             mass: None,
             fixed_rotation: false,
+            motion_locks: MotionLocks::NONE,
             awake: true,
             bullet: false,
             enable_sleep: true,
@@ -204,6 +269,24 @@ impl BodyDef {
     #[must_use]
     pub fn with_fixed_rotation(mut self, fixed: bool) -> Self {
         self.fixed_rotation = fixed;
+        self
+    }
+
+    /// Locks x translation, y translation or rotation (builder style; see
+    /// [`MotionLocks`]).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, MotionLocks, Vec2};
+    /// let def = BodyDef::dynamic(Vec2::ZERO).with_motion_locks(MotionLocks {
+    ///     linear_x: true,
+    ///     linear_y: false,
+    ///     angular: true,
+    /// });
+    /// assert!(def.motion_locks.angular && def.motion_locks.linear_x);
+    /// ```
+    #[must_use]
+    pub fn with_motion_locks(mut self, locks: MotionLocks) -> Self {
+        self.motion_locks = locks;
         self
     }
 
@@ -425,6 +508,26 @@ impl BodyState {
     /// inverse mass or inverse inertia).
     pub const MOVES: u32 = 1;
 
+    /// Flag: the body never moves along world x ([`MotionLocks::linear_x`]).
+    pub const LOCK_X: u32 = 2;
+
+    /// Flag: the body never moves along world y ([`MotionLocks::linear_y`]).
+    pub const LOCK_Y: u32 = 4;
+
+    /// Zeroes the velocity components the state's lock flags forbid (no
+    /// effect without locks).
+    #[inline(always)]
+    pub fn apply_locks(&mut self) {
+        if self.flags & (Self::LOCK_X | Self::LOCK_Y) != 0 {
+            if self.flags & Self::LOCK_X != 0 {
+                self.v.x = 0.0;
+            }
+            if self.flags & Self::LOCK_Y != 0 {
+                self.v.y = 0.0;
+            }
+        }
+    }
+
     /// True when constraint impulses move the body ([`BodyState::MOVES`]).
     #[inline(always)]
     #[must_use]
@@ -508,6 +611,10 @@ pub struct BodySim {
     pub enable_sleep: bool,
     /// Own rest speed, m/s ([`BodyDef::sleep_threshold`]).
     pub sleep_threshold: Option<Real>,
+    /// The linear motion locks (the rotation lock is the record's
+    /// `fixed_rotation`): [`BodyState::LOCK_X`] and
+    /// [`BodyState::LOCK_Y`] bits, 0 without locks.
+    pub linear_locks: u32,
 }
 
 impl BodySim {
@@ -530,7 +637,12 @@ impl BodySim {
         // Only a dynamic body has a positive inverse mass or inertia.
         let moves =
             self.body_type == BodyType::Dynamic && (self.inv_mass > 0.0 || self.inv_inertia > 0.0);
-        if moves { BodyState::MOVES } else { 0 }
+        let locks = if self.body_type == BodyType::Dynamic {
+            self.linear_locks
+        } else {
+            0
+        };
+        locks | if moves { BodyState::MOVES } else { 0 }
     }
 
     /// The inverse mass and inertia of this body.
@@ -567,6 +679,7 @@ impl BodySim {
             bullet: false,
             enable_sleep: true,
             sleep_threshold: None,
+            linear_locks: 0,
         }
     }
 }
@@ -748,7 +861,11 @@ pub fn validate_body_def(def: &BodyDef) -> Result<(), BodyError> {
         }
     }
     if let Some(m) = def.mass {
-        validate_mass(def.body_type, &m, def.fixed_rotation)?;
+        validate_mass(
+            def.body_type,
+            &m,
+            def.fixed_rotation || def.motion_locks.angular,
+        )?;
     }
     Ok(())
 }
@@ -892,7 +1009,7 @@ impl BodySet {
             location: BodyLocation::Static(u32::MAX),
             user_data: def.user_data,
             mass_override: def.mass.is_some(),
-            fixed_rotation: def.fixed_rotation,
+            fixed_rotation: def.fixed_rotation || def.motion_locks.angular,
         });
         let handle = BodyHandle::new(index, generation, self.owner);
         let transform = Transform::new(def.position, def.angle);
@@ -920,6 +1037,7 @@ impl BodySet {
             bullet: def.bullet,
             enable_sleep: def.enable_sleep,
             sleep_threshold: def.sleep_threshold,
+            linear_locks: def.motion_locks.linear_flags(),
         };
         let location = if def.body_type == BodyType::Static {
             self.static_sims.push(sim);
@@ -938,7 +1056,7 @@ impl BodySet {
         };
         self.records.live_mut(index).location = location;
         if def.body_type == BodyType::Dynamic {
-            self.apply_mass(handle, mass, def.fixed_rotation);
+            self.apply_mass(handle, mass, def.fixed_rotation || def.motion_locks.angular);
             // Velocity given for the origin: keep it for the centre (same when
             // the centre is at the origin; otherwise add ω × r).
             if let BodyLocation::Moving(i) = self.records.live(index).location {
@@ -1152,6 +1270,12 @@ impl BodySet {
                     .is_none_or(|t| t.is_finite() && t >= 0.0))
             {
                 return Err(format!("body {:?}: a setting out of its range", sim.handle));
+            }
+            if sim.linear_locks & !(BodyState::LOCK_X | BodyState::LOCK_Y) != 0 {
+                return Err(format!(
+                    "body {:?}: linear lock bits {:#x}",
+                    sim.handle, sim.linear_locks
+                ));
             }
             let fixed = self.record(sim.handle).is_some_and(|r| r.fixed_rotation);
             if sim.body_type == BodyType::Dynamic && fixed && sim.inv_inertia != 0.0 {

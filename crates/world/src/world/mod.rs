@@ -390,6 +390,7 @@ impl World {
 }
 
 mod bodies;
+mod body_state;
 pub use bodies::ExplosionDef;
 mod events;
 mod internal;
