@@ -376,3 +376,121 @@ fn a_rotation_lock_is_fixed_rotation_and_locks_set_later_take_hold() {
     assert_eq!(copy.state_hash(), w.state_hash());
     w.validate().unwrap();
 }
+
+// ----- enable / disable ----------------------------------------------------
+
+#[test]
+fn a_disabled_box_does_not_fall_and_resumes_from_its_kept_state() {
+    let mut w = world();
+    ground(&mut w);
+    let b = w
+        .create_body(&BodyDef::dynamic(v(0.0, 5.0)).with_velocity(v(1.0, 0.0)))
+        .unwrap();
+    w.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    run(&mut w, 30);
+    let (p, vel) = (w.position(b).unwrap(), w.linear_velocity(b).unwrap());
+    assert!((vel.y + 5.0).abs() < 0.01, "half a second of fall: {vel:?}");
+    w.set_body_enabled(b, false).unwrap();
+    assert!(!w.is_body_enabled(b).unwrap());
+    run(&mut w, 60);
+    assert_eq!(w.position(b).unwrap(), p);
+    assert_eq!(w.linear_velocity(b).unwrap(), vel);
+    // Out of the broadphase: a query finds nothing there.
+    let probe = janus2d::geometry::Aabb::new(p - v(1.0, 1.0), p + v(1.0, 1.0));
+    assert!(w.bodies_in_box(&probe).is_empty());
+    w.validate().unwrap();
+    // Enabled: one step on from the kept velocity (−5 − g·dt).
+    w.set_body_enabled(b, true).unwrap();
+    w.step(DT).unwrap();
+    let v1 = w.linear_velocity(b).unwrap();
+    assert!((v1.x - 1.0).abs() < 1e-5 && (v1.y - (vel.y - 10.0 * DT)).abs() < 1e-4, "{v1:?}");
+    assert!(w.position(b).unwrap().y < p.y);
+    assert_eq!(w.bodies_in_box(&probe), vec![b]);
+    w.validate().unwrap();
+}
+
+#[test]
+fn a_box_resting_on_a_disabled_ground_falls() {
+    let mut w = world();
+    let (g, _) = ground(&mut w);
+    let b = w.create_body(&BodyDef::dynamic(v(0.0, 0.5))).unwrap();
+    w.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    run(&mut w, 120);
+    assert!(w.is_sleeping(b).unwrap(), "asleep on the ground");
+    let y0 = w.position(b).unwrap().y;
+    assert!((y0 - 0.5).abs() < 0.02);
+    w.set_body_enabled(g, false).unwrap();
+    assert_eq!(w.contact_count(), 0);
+    // The contact's end is reported with the next step's events.
+    w.step(DT).unwrap();
+    assert_eq!(w.events().collision.contact_end.len(), 1);
+    // One second of free fall from rest: 5 m.
+    run(&mut w, 59);
+    let fall = y0 - w.position(b).unwrap().y;
+    assert!((fall - 5.0).abs() < 0.1, "fell {fall}");
+    // The ground back: it catches nothing above it now, and is hit again
+    // by what falls on it.
+    w.set_body_enabled(g, true).unwrap();
+    let c = w.create_body(&BodyDef::dynamic(v(3.0, 0.6))).unwrap();
+    w.create_shape(c, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    run(&mut w, 60);
+    assert!((w.position(c).unwrap().y - 0.5).abs() < 0.02);
+    w.validate().unwrap();
+}
+
+#[test]
+fn joints_to_a_disabled_body_stop_acting_until_it_is_enabled() {
+    let mut w = world();
+    let anchor = w.create_body(&BodyDef::fixed(v(0.0, 10.0))).unwrap();
+    let bob = w.create_body(&BodyDef::dynamic(v(0.0, 8.0))).unwrap();
+    w.create_shape(bob, &ShapeDef::default(), Circle::new(Vec2::ZERO, 0.25).unwrap())
+        .unwrap();
+    let j = w
+        .create_joint(&DistanceJointDef::new(anchor, bob, Vec2::ZERO, Vec2::ZERO, 2.0).into())
+        .unwrap();
+    run(&mut w, 30);
+    assert!((w.position(bob).unwrap().y - 8.0).abs() < 0.01, "hangs");
+    w.set_body_enabled(anchor, false).unwrap();
+    assert!(!w.joint(j).unwrap().is_enabled());
+    run(&mut w, 30);
+    // Half a second of free fall: 1.25 m.
+    let y = w.position(bob).unwrap().y;
+    assert!((8.0 - y - 1.25).abs() < 0.05, "{y}");
+    w.set_body_enabled(anchor, true).unwrap();
+    assert!(w.joint(j).unwrap().is_enabled());
+    run(&mut w, 120);
+    // The joint holds it again near 2 m below the anchor (free, it would
+    // be 20 m lower by now).
+    let d = (w.position(bob).unwrap() - v(0.0, 10.0)).length();
+    assert!((d - 2.0).abs() < 0.3, "{d}");
+    w.validate().unwrap();
+}
+
+#[test]
+fn disabled_state_round_trips_snapshots_and_blocks_type_changes() {
+    let mut w = world();
+    ground(&mut w);
+    let (b, _) = ball(&mut w, v(0.0, 3.0), 0.5);
+    w.set_body_enabled(b, false).unwrap();
+    assert_eq!(
+        w.set_body_type(b, BodyType::Kinematic),
+        Err(WorldError::DisabledBody)
+    );
+    let snap = w.snapshot();
+    let mut copy = snap.to_world();
+    assert!(!copy.is_body_enabled(b).unwrap());
+    copy.validate().unwrap();
+    copy.set_body_enabled(b, true).unwrap();
+    w.set_body_enabled(b, true).unwrap();
+    run(&mut w, 30);
+    run(&mut copy, 30);
+    assert_eq!(w.state_hash(), copy.state_hash());
+    assert!(w.position(b).unwrap().y < 3.0);
+    // Destroying a disabled body leaves a valid world.
+    w.set_body_enabled(b, false).unwrap();
+    w.destroy_body(b).unwrap();
+    w.validate().unwrap();
+}

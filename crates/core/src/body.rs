@@ -711,6 +711,10 @@ pub struct BodyRecord {
     pub mass_override: bool,
     /// True when rotation is locked.
     pub fixed_rotation: bool,
+    /// True while the body is disabled (`World::set_body_enabled`): it is
+    /// kept with the sleeping bodies, with its velocities, and
+    /// [`BodySet::wake`] leaves it there.
+    pub disabled: bool,
 }
 
 /// A body as the solver sees it during prepare: its state slot and its data.
@@ -972,6 +976,9 @@ impl BodySet {
         let Some(BodyLocation::Sleeping(j)) = self.location(handle) else {
             return;
         };
+        if self.records.live(handle.index).disabled {
+            return;
+        }
         let j = j as usize;
         let mut sim = self.sleeping_sims.swap_remove(j);
         let state = self.sleeping_states.swap_remove(j);
@@ -984,6 +991,43 @@ impl BodySet {
         self.states.push(state);
         self.records.live_mut(handle.index).location =
             BodyLocation::Moving((self.sims.len() - 1) as u32);
+    }
+
+    /// Disables a live body (or enables it again): a disabled moving body
+    /// leaves the solver's arrays for the sleeping ones with its
+    /// velocities kept (unlike [`BodySet::sleep`]), and stays there until
+    /// enabled; a static body only records the flag. Enabling brings a
+    /// moving body back into the solver.
+    pub fn set_disabled(&mut self, handle: BodyHandle, disabled: bool) {
+        let Some(loc) = self.location(handle) else {
+            return;
+        };
+        if disabled {
+            if let BodyLocation::Moving(i) = loc {
+                let i = i as usize;
+                let sim = self.sims.swap_remove(i);
+                let mut state = self.states.swap_remove(i);
+                if i < self.sims.len() {
+                    let moved = self.sims[i].handle;
+                    self.records.live_mut(moved.index).location = BodyLocation::Moving(i as u32);
+                }
+                state.dp = Vec2::ZERO;
+                state.dq = Rot::IDENTITY;
+                self.sleeping_sims.push(sim);
+                self.sleeping_states.push(state);
+                self.records.live_mut(handle.index).location =
+                    BodyLocation::Sleeping((self.sleeping_sims.len() - 1) as u32);
+            }
+            self.records.live_mut(handle.index).disabled = true;
+        } else {
+            self.records.live_mut(handle.index).disabled = false;
+            self.wake(handle);
+        }
+    }
+
+    /// True when the body is disabled ([`BodySet::set_disabled`]).
+    pub fn is_disabled(&self, handle: BodyHandle) -> bool {
+        self.record(handle).is_some_and(|r| r.disabled)
     }
 
     /// True when the body sleeps.
@@ -1010,6 +1054,7 @@ impl BodySet {
             user_data: def.user_data,
             mass_override: def.mass.is_some(),
             fixed_rotation: def.fixed_rotation || def.motion_locks.angular,
+            disabled: false,
         });
         let handle = BodyHandle::new(index, generation, self.owner);
         let transform = Transform::new(def.position, def.angle);

@@ -180,6 +180,10 @@ pub struct World {
     #[cfg_attr(feature = "serde", serde(skip))]
     pub(crate) hooks: crate::hooks::Hooks,
     pub(crate) sleep_settings: SleepSettings,
+    /// Joints switched off because a body they hold was disabled, with
+    /// the disabled body (switched back on when it is enabled and the
+    /// joint's other body is enabled).
+    pub(crate) disabled_joints: Vec<(BodyHandle, JointHandle)>,
     wake_list: Vec<BodyHandle>,
     events: StepEvents,
     /// Timings of the last step (not state: not serialized).
@@ -221,6 +225,7 @@ impl World {
             hit_event_threshold: def.hit_event_threshold,
             hooks: crate::hooks::Hooks::default(),
             sleep_settings: def.sleep,
+            disabled_joints: Vec::new(),
             wake_list: Vec::new(),
             joints: JointSet::new(bodies.owner()),
             bodies,
@@ -380,6 +385,7 @@ impl World {
             hit_event_threshold: self.hit_event_threshold,
             hooks: crate::hooks::Hooks::default(),
             sleep_settings: self.sleep_settings,
+            disabled_joints: self.disabled_joints.clone(),
             wake_list: self.wake_list.clone(),
             events: self.events.clone(),
             step_profile: self.step_profile.clone(),

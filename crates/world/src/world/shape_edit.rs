@@ -28,13 +28,18 @@ impl crate::collision::Collision {
         let old = self.shapes.at(slot).proxy;
         self.broadphase.destroy_proxy(old);
         let aabb = geometry.compute_aabb(xf);
-        let margin = crate::broadphase::proxy_margin(&geometry, self.broadphase.margin());
-        let proxy = self.broadphase.create_proxy_with_margin(
-            crate::broadphase::bounded(aabb),
-            slot,
-            is_static,
-            margin,
-        );
+        let proxy = if old == crate::broadphase::NO_PROXY {
+            // A disabled body's shape: still no proxy.
+            old
+        } else {
+            let margin = crate::broadphase::proxy_margin(&geometry, self.broadphase.margin());
+            self.broadphase.create_proxy_with_margin(
+                crate::broadphase::bounded(aabb),
+                slot,
+                is_static,
+                margin,
+            )
+        };
         let shape = self.shapes.at_mut(slot);
         shape.geometry = geometry;
         shape.aabb = aabb;
