@@ -94,20 +94,26 @@ fn degenerate_geometry_is_a_typed_error_and_changes_nothing() {
         Err(WorldError::Geometry(_))
     ));
     assert!(matches!(
-        w.set_circle(s, Circle { center: Vec2::ZERO, radius: -1.0 }),
+        w.set_circle(
+            s,
+            Circle {
+                center: Vec2::ZERO,
+                radius: -1.0
+            }
+        ),
         Err(WorldError::Geometry(_))
     ));
-    assert_eq!(
-        w.scale_shape(s, 0.0),
-        Err(WorldError::OutOfRange("factor"))
-    );
+    assert_eq!(w.scale_shape(s, 0.0), Err(WorldError::OutOfRange("factor")));
     assert_eq!(
         w.scale_shape(s, Real::NAN),
         Err(WorldError::NonFinite("factor"))
     );
     assert_eq!(w.state_hash(), hash);
     assert_eq!(w.mass(b).unwrap(), mass);
-    assert_eq!(w.shape(s).unwrap().geometry, Shape::Polygon(Polygon::make_box(0.5, 0.5)));
+    assert_eq!(
+        w.shape(s).unwrap().geometry,
+        Shape::Polygon(Polygon::make_box(0.5, 0.5))
+    );
     w.validate().unwrap();
 }
 
@@ -196,7 +202,11 @@ fn shape_offsets_move_every_kind_in_the_body_frame() {
         .create_shape(b, &def, Circle::new(v(1.0, 0.0), 0.5).unwrap())
         .unwrap();
     let capsule = w
-        .create_shape(b, &def, Capsule::new(v(-1.0, 0.0), v(1.0, 0.0), 0.2).unwrap())
+        .create_shape(
+            b,
+            &def,
+            Capsule::new(v(-1.0, 0.0), v(1.0, 0.0), 0.2).unwrap(),
+        )
         .unwrap();
     let segment = w
         .create_shape(b, &def, Segment::new(v(-1.0, 0.0), v(1.0, 0.0)).unwrap())
@@ -252,7 +262,10 @@ fn a_bad_offset_is_a_typed_error_and_creates_nothing() {
     let far = ShapeDef::default().with_offset(v(1e9, 0.0), 0.0);
     assert!(matches!(
         w.create_shape(b, &far, Polygon::make_box(0.5, 0.5)),
-        Err(WorldError::OutOfBounds { field: "offset", .. })
+        Err(WorldError::OutOfBounds {
+            field: "offset",
+            ..
+        })
     ));
     let skew = ShapeDef {
         offset: Transform {
@@ -314,7 +327,11 @@ fn an_x_locked_box_hit_sideways_falls_straight_down() {
 fn without_locks_the_same_hit_pushes_the_box_sideways() {
     let (mut w, b, _) = box_hit_sideways(MotionLocks::NONE);
     run(&mut w, 60);
-    assert!(w.position(b).unwrap().x > 1.0, "{}", w.position(b).unwrap().x);
+    assert!(
+        w.position(b).unwrap().x > 1.0,
+        "{}",
+        w.position(b).unwrap().x
+    );
 }
 
 #[test]
@@ -404,7 +421,10 @@ fn a_disabled_box_does_not_fall_and_resumes_from_its_kept_state() {
     w.set_body_enabled(b, true).unwrap();
     w.step(DT).unwrap();
     let v1 = w.linear_velocity(b).unwrap();
-    assert!((v1.x - 1.0).abs() < 1e-5 && (v1.y - (vel.y - 10.0 * DT)).abs() < 1e-4, "{v1:?}");
+    assert!(
+        (v1.x - 1.0).abs() < 1e-5 && (v1.y - (vel.y - 10.0 * DT)).abs() < 1e-4,
+        "{v1:?}"
+    );
     assert!(w.position(b).unwrap().y < p.y);
     assert_eq!(w.bodies_in_box(&probe), vec![b]);
     w.validate().unwrap();
@@ -446,8 +466,12 @@ fn joints_to_a_disabled_body_stop_acting_until_it_is_enabled() {
     let mut w = world();
     let anchor = w.create_body(&BodyDef::fixed(v(0.0, 10.0))).unwrap();
     let bob = w.create_body(&BodyDef::dynamic(v(0.0, 8.0))).unwrap();
-    w.create_shape(bob, &ShapeDef::default(), Circle::new(Vec2::ZERO, 0.25).unwrap())
-        .unwrap();
+    w.create_shape(
+        bob,
+        &ShapeDef::default(),
+        Circle::new(Vec2::ZERO, 0.25).unwrap(),
+    )
+    .unwrap();
     let j = w
         .create_joint(&DistanceJointDef::new(anchor, bob, Vec2::ZERO, Vec2::ZERO, 2.0).into())
         .unwrap();

@@ -1120,10 +1120,16 @@ impl BodySet {
         let Some(loc) = self.location(handle) else {
             return;
         };
-        let BodyLocation::Moving(i) = loc else {
-            return;
+        // A disabled body is kept with the sleeping ones: its mass follows
+        // too.
+        let (sim, state) = match loc {
+            BodyLocation::Moving(i) => (&mut self.sims[i as usize], &mut self.states[i as usize]),
+            BodyLocation::Sleeping(j) => (
+                &mut self.sleeping_sims[j as usize],
+                &mut self.sleeping_states[j as usize],
+            ),
+            BodyLocation::Static(_) => return,
         };
-        let sim = &mut self.sims[i as usize];
         if sim.body_type != BodyType::Dynamic {
             return;
         }
@@ -1142,7 +1148,7 @@ impl BodySet {
         sim.local_center = m.center;
         sim.center = sim.transform.apply(m.center);
         sim.center0 = sim.center;
-        self.states[i as usize].flags = sim.state_flags();
+        state.flags = sim.state_flags();
     }
 
     /// Removes a body's data from the array `loc` names (the last entry

@@ -3,8 +3,8 @@
 
 use super::*;
 use crate::error::WorldError;
-use janus2d_core::MotionLocks;
 use crate::joints::JointHandle;
+use janus2d_core::MotionLocks;
 use janus2d_core::body::{BodyHandle, BodyState, BodyType};
 
 impl World {
