@@ -164,7 +164,8 @@ pub use janus2d_core::material::CombineRule;
 pub use janus2d_core::solver::SolverProfile;
 #[doc(inline)]
 pub use janus2d_core::{
-    BodyDef, BodyHandle, BodyMass, BodyType, Real, Rot, SolverMode, SolverSettings, Transform, Vec2,
+    BodyDef, BodyHandle, BodyMass, BodyType, MotionLocks, Real, Rot, SolverMode, SolverSettings,
+    Transform, Vec2,
 };
 #[cfg(feature = "serde")]
 #[doc(inline)]
@@ -204,7 +205,7 @@ pub mod prelude {
         PrismaticJointDef, RevoluteJoint, RevoluteJointDef, WeldJoint, WeldJointDef, WheelJoint,
         WheelJointDef,
     };
-    pub use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
+    pub use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType, MotionLocks};
     pub use janus2d_core::constraint::SolverMode;
     pub use janus2d_core::geometry::{
         Capsule, ChainSegment, Circle, Polygon, Segment, Shape, make_chain,

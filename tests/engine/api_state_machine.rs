@@ -121,6 +121,10 @@ enum Op {
     LinearDamping(usize, Real),
     AngularDamping(usize, Real),
     FixedRotation(usize, bool),
+    MotionLocks(usize, u8),
+    BodyEnabled(usize, bool),
+    SetGeometry(usize, Geometry),
+    ScaleShape(usize, Real),
     /// A shape's surface material: rolling resistance (0), tangent speed
     /// (1) or user material id (2).
     SurfaceMaterial(usize, u8, Real),
@@ -179,6 +183,10 @@ fn op() -> impl Strategy<Value = Op> {
         1 => (pick(), real()).prop_map(|(b, c)| Op::LinearDamping(b, c)),
         1 => (pick(), real()).prop_map(|(b, c)| Op::AngularDamping(b, c)),
         1 => (pick(), any::<bool>()).prop_map(|(b, f)| Op::FixedRotation(b, f)),
+        1 => (pick(), 0u8..8).prop_map(|(b, l)| Op::MotionLocks(b, l)),
+        1 => (pick(), any::<bool>()).prop_map(|(b, e)| Op::BodyEnabled(b, e)),
+        1 => (pick(), geometry()).prop_map(|(s, g)| Op::SetGeometry(s, g)),
+        1 => (pick(), prop_oneof![3 => Just(1.5 as Real), 1 => real()]).prop_map(|(s, f)| Op::ScaleShape(s, f)),
         1 => (pick(), 0u8..3, real()).prop_map(|(s, which, v)| Op::SurfaceMaterial(s, which, v)),
         1 => (place(), size(), size(), real())
             .prop_map(|(position, radius, falloff, impulse)| Op::Explode { position, radius, falloff, impulse }),
@@ -390,6 +398,22 @@ fn apply(
         Op::LinearDamping(k, c) => w.set_linear_damping(body(*k, issued), *c),
         Op::AngularDamping(k, c) => w.set_angular_damping(body(*k, issued), *c),
         Op::FixedRotation(k, f) => w.set_fixed_rotation(body(*k, issued), *f),
+        Op::MotionLocks(k, l) => w.set_motion_locks(
+            body(*k, issued),
+            MotionLocks {
+                linear_x: l & 1 != 0,
+                linear_y: l & 2 != 0,
+                angular: l & 4 != 0,
+            },
+        ),
+        Op::BodyEnabled(k, e) => w.set_body_enabled(body(*k, issued), *e),
+        Op::SetGeometry(k, g) => {
+            let Some(shape) = shape_of(g) else {
+                return Err(WorldError::OutOfRange("constructor refused"));
+            };
+            w.set_shape_geometry(pick(&issued.shapes, *k, issued.foreign_shape), shape)
+        }
+        Op::ScaleShape(k, f) => w.scale_shape(pick(&issued.shapes, *k, issued.foreign_shape), *f),
         Op::SurfaceMaterial(k, which, v) => {
             let s = pick(&issued.shapes, *k, issued.foreign_shape);
             match which {

@@ -36,6 +36,7 @@ mod queries;
 mod reliability;
 mod revolute_properties;
 mod setters;
+mod shape_body_setters;
 mod snapshot;
 mod soak;
 mod stages;

@@ -84,6 +84,66 @@ impl BodyMass {
     }
 }
 
+/// Which of a body's three motions are locked (Box2D v3.1's
+/// `b2MotionLocks`): a locked axis behaves as if the body had infinite
+/// mass along it. The rotation lock is the body's fixed rotation (its
+/// inverse inertia is zero in every constraint); a linear lock zeroes that
+/// component of the body's velocity wherever the solver integrates it, so
+/// that the body never moves along the axis (constraints see its whole
+/// mass, as Box2D's do).
+///
+/// ```
+/// use janus2d_core::{BodyDef, MotionLocks, Vec2};
+/// let def = BodyDef::dynamic(Vec2::ZERO).with_motion_locks(MotionLocks::X);
+/// assert!(def.motion_locks.linear_x && !def.motion_locks.linear_y);
+/// assert_eq!(MotionLocks::default(), MotionLocks::NONE);
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct MotionLocks {
+    /// No motion along world x.
+    pub linear_x: bool,
+    /// No motion along world y.
+    pub linear_y: bool,
+    /// No rotation (the same as [`BodyDef::fixed_rotation`]).
+    pub angular: bool,
+}
+
+impl MotionLocks {
+    /// Nothing locked.
+    pub const NONE: MotionLocks = MotionLocks {
+        linear_x: false,
+        linear_y: false,
+        angular: false,
+    };
+    /// Only x translation locked.
+    pub const X: MotionLocks = MotionLocks {
+        linear_x: true,
+        linear_y: false,
+        angular: false,
+    };
+    /// Only y translation locked.
+    pub const Y: MotionLocks = MotionLocks {
+        linear_x: false,
+        linear_y: true,
+        angular: false,
+    };
+    /// Only the rotation locked.
+    pub const ROTATION: MotionLocks = MotionLocks {
+        linear_x: false,
+        linear_y: false,
+        angular: true,
+    };
+
+    /// The [`BodyState`] flag bits of the linear locks.
+    #[inline]
+    #[must_use]
+    pub fn linear_flags(self) -> u32 {
+        (if self.linear_x { BodyState::LOCK_X } else { 0 })
+            | (if self.linear_y { BodyState::LOCK_Y } else { 0 })
+    }
+}
+
 /// Everything needed to create a body. Start from `BodyDef::default()` or a
 /// constructor and change fields.
 #[derive(Clone, Debug, PartialEq)]
@@ -113,6 +173,10 @@ pub struct BodyDef {
     pub mass: Option<BodyMass>,
     /// Prevents rotation (infinite rotational inertia).
     pub fixed_rotation: bool,
+    /// Locks x translation, y translation or rotation separately (usual
+    /// none; see [`MotionLocks`]). A rotation lock here or
+    /// `fixed_rotation` locks the rotation.
+    pub motion_locks: MotionLocks,
     /// Starts awake (usual true); `false` creates the body asleep, as Box2D's
     /// `isAwake = false`: the world puts it to sleep before its next step
     /// (after its shapes are attached), and it costs nothing until something
@@ -152,6 +216,7 @@ impl Default for BodyDef {
             max_rotation: DEFAULT_MAX_ROTATION,
             mass: None,
             fixed_rotation: false,
+            motion_locks: MotionLocks::NONE,
             awake: true,
             bullet: false,
             enable_sleep: true,
@@ -209,6 +274,24 @@ impl BodyDef {
     #[must_use]
     pub fn with_fixed_rotation(mut self, fixed: bool) -> Self {
         self.fixed_rotation = fixed;
+        self
+    }
+
+    /// Locks x translation, y translation or rotation (builder style; see
+    /// [`MotionLocks`]).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, MotionLocks, Vec2};
+    /// let def = BodyDef::dynamic(Vec2::ZERO).with_motion_locks(MotionLocks {
+    ///     linear_x: true,
+    ///     linear_y: false,
+    ///     angular: true,
+    /// });
+    /// assert!(def.motion_locks.angular && def.motion_locks.linear_x);
+    /// ```
+    #[must_use]
+    pub fn with_motion_locks(mut self, locks: MotionLocks) -> Self {
+        self.motion_locks = locks;
         self
     }
 
@@ -444,6 +527,26 @@ impl BodyState {
     /// inverse mass or inverse inertia).
     pub const MOVES: u32 = 1;
 
+    /// Flag: the body never moves along world x ([`MotionLocks::linear_x`]).
+    pub const LOCK_X: u32 = 2;
+
+    /// Flag: the body never moves along world y ([`MotionLocks::linear_y`]).
+    pub const LOCK_Y: u32 = 4;
+
+    /// Zeroes the velocity components the state's lock flags forbid (no
+    /// effect without locks).
+    #[inline(always)]
+    pub fn apply_locks(&mut self) {
+        if self.flags & (Self::LOCK_X | Self::LOCK_Y) != 0 {
+            if self.flags & Self::LOCK_X != 0 {
+                self.v.x = 0.0;
+            }
+            if self.flags & Self::LOCK_Y != 0 {
+                self.v.y = 0.0;
+            }
+        }
+    }
+
     /// True when constraint impulses move the body ([`BodyState::MOVES`]).
     #[inline(always)]
     #[must_use]
@@ -527,6 +630,10 @@ pub struct BodySim {
     pub enable_sleep: bool,
     /// Own rest speed, m/s ([`BodyDef::sleep_threshold`]).
     pub sleep_threshold: Option<Real>,
+    /// The linear motion locks (the rotation lock is the record's
+    /// `fixed_rotation`): [`BodyState::LOCK_X`] and
+    /// [`BodyState::LOCK_Y`] bits, 0 without locks.
+    pub linear_locks: u32,
 }
 
 impl BodySim {
@@ -549,7 +656,12 @@ impl BodySim {
         // Only a dynamic body has a positive inverse mass or inertia.
         let moves =
             self.body_type == BodyType::Dynamic && (self.inv_mass > 0.0 || self.inv_inertia > 0.0);
-        if moves { BodyState::MOVES } else { 0 }
+        let locks = if self.body_type == BodyType::Dynamic {
+            self.linear_locks
+        } else {
+            0
+        };
+        locks | if moves { BodyState::MOVES } else { 0 }
     }
 
     /// The inverse mass and inertia of this body.
@@ -586,6 +698,7 @@ impl BodySim {
             bullet: false,
             enable_sleep: true,
             sleep_threshold: None,
+            linear_locks: 0,
         }
     }
 }
@@ -619,6 +732,10 @@ pub struct BodyRecord {
     pub fixed_rotation: bool,
     /// Reports move events ([`BodyDef::enable_move_events`]).
     pub enable_move_events: bool,
+    /// True while the body is disabled (`World::set_body_enabled`): it is
+    /// kept with the sleeping bodies, with its velocities, and
+    /// [`BodySet::wake`] leaves it there.
+    pub disabled: bool,
 }
 
 /// A body as the solver sees it during prepare: its state slot and its data.
@@ -769,7 +886,11 @@ pub fn validate_body_def(def: &BodyDef) -> Result<(), BodyError> {
         }
     }
     if let Some(m) = def.mass {
-        validate_mass(def.body_type, &m, def.fixed_rotation)?;
+        validate_mass(
+            def.body_type,
+            &m,
+            def.fixed_rotation || def.motion_locks.angular,
+        )?;
     }
     Ok(())
 }
@@ -876,6 +997,9 @@ impl BodySet {
         let Some(BodyLocation::Sleeping(j)) = self.location(handle) else {
             return;
         };
+        if self.records.live(handle.index).disabled {
+            return;
+        }
         let j = j as usize;
         let mut sim = self.sleeping_sims.swap_remove(j);
         let state = self.sleeping_states.swap_remove(j);
@@ -888,6 +1012,43 @@ impl BodySet {
         self.states.push(state);
         self.records.live_mut(handle.index).location =
             BodyLocation::Moving((self.sims.len() - 1) as u32);
+    }
+
+    /// Disables a live body (or enables it again): a disabled moving body
+    /// leaves the solver's arrays for the sleeping ones with its
+    /// velocities kept (unlike [`BodySet::sleep`]), and stays there until
+    /// enabled; a static body only records the flag. Enabling brings a
+    /// moving body back into the solver.
+    pub fn set_disabled(&mut self, handle: BodyHandle, disabled: bool) {
+        let Some(loc) = self.location(handle) else {
+            return;
+        };
+        if disabled {
+            if let BodyLocation::Moving(i) = loc {
+                let i = i as usize;
+                let sim = self.sims.swap_remove(i);
+                let mut state = self.states.swap_remove(i);
+                if i < self.sims.len() {
+                    let moved = self.sims[i].handle;
+                    self.records.live_mut(moved.index).location = BodyLocation::Moving(i as u32);
+                }
+                state.dp = Vec2::ZERO;
+                state.dq = Rot::IDENTITY;
+                self.sleeping_sims.push(sim);
+                self.sleeping_states.push(state);
+                self.records.live_mut(handle.index).location =
+                    BodyLocation::Sleeping((self.sleeping_sims.len() - 1) as u32);
+            }
+            self.records.live_mut(handle.index).disabled = true;
+        } else {
+            self.records.live_mut(handle.index).disabled = false;
+            self.wake(handle);
+        }
+    }
+
+    /// True when the body is disabled ([`BodySet::set_disabled`]).
+    pub fn is_disabled(&self, handle: BodyHandle) -> bool {
+        self.record(handle).is_some_and(|r| r.disabled)
     }
 
     /// True when the body sleeps.
@@ -913,8 +1074,9 @@ impl BodySet {
             location: BodyLocation::Static(u32::MAX),
             user_data: def.user_data,
             mass_override: def.mass.is_some(),
-            fixed_rotation: def.fixed_rotation,
+            fixed_rotation: def.fixed_rotation || def.motion_locks.angular,
             enable_move_events: def.enable_move_events,
+            disabled: false,
         });
         let handle = BodyHandle::new(index, generation, self.owner);
         let transform = Transform::new(def.position, def.angle);
@@ -942,6 +1104,7 @@ impl BodySet {
             bullet: def.bullet,
             enable_sleep: def.enable_sleep,
             sleep_threshold: def.sleep_threshold,
+            linear_locks: def.motion_locks.linear_flags(),
         };
         let location = if def.body_type == BodyType::Static {
             self.static_sims.push(sim);
@@ -960,7 +1123,7 @@ impl BodySet {
         };
         self.records.live_mut(index).location = location;
         if def.body_type == BodyType::Dynamic {
-            self.apply_mass(handle, mass, def.fixed_rotation);
+            self.apply_mass(handle, mass, def.fixed_rotation || def.motion_locks.angular);
             // Velocity given for the origin: keep it for the centre (same when
             // the centre is at the origin; otherwise add ω × r).
             if let BodyLocation::Moving(i) = self.records.live(index).location {
@@ -979,10 +1142,16 @@ impl BodySet {
         let Some(loc) = self.location(handle) else {
             return;
         };
-        let BodyLocation::Moving(i) = loc else {
-            return;
+        // A disabled body is kept with the sleeping ones: its mass follows
+        // too.
+        let (sim, state) = match loc {
+            BodyLocation::Moving(i) => (&mut self.sims[i as usize], &mut self.states[i as usize]),
+            BodyLocation::Sleeping(j) => (
+                &mut self.sleeping_sims[j as usize],
+                &mut self.sleeping_states[j as usize],
+            ),
+            BodyLocation::Static(_) => return,
         };
-        let sim = &mut self.sims[i as usize];
         if sim.body_type != BodyType::Dynamic {
             return;
         }
@@ -1001,7 +1170,7 @@ impl BodySet {
         sim.local_center = m.center;
         sim.center = sim.transform.apply(m.center);
         sim.center0 = sim.center;
-        self.states[i as usize].flags = sim.state_flags();
+        state.flags = sim.state_flags();
     }
 
     /// Removes a body's data from the array `loc` names (the last entry
@@ -1174,6 +1343,12 @@ impl BodySet {
                     .is_none_or(|t| t.is_finite() && t >= 0.0))
             {
                 return Err(format!("body {:?}: a setting out of its range", sim.handle));
+            }
+            if sim.linear_locks & !(BodyState::LOCK_X | BodyState::LOCK_Y) != 0 {
+                return Err(format!(
+                    "body {:?}: linear lock bits {:#x}",
+                    sim.handle, sim.linear_locks
+                ));
             }
             let fixed = self.record(sim.handle).is_some_and(|r| r.fixed_rotation);
             if sim.body_type == BodyType::Dynamic && fixed && sim.inv_inertia != 0.0 {

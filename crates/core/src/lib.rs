@@ -34,7 +34,7 @@ pub mod softness;
 pub mod solver;
 pub mod union_find;
 
-pub use body::{BodyDef, BodyHandle, BodyMass, BodySet, BodyState, BodyType, InvMass};
+pub use body::{BodyDef, BodyHandle, BodyMass, BodySet, BodyState, BodyType, InvMass, MotionLocks};
 pub use constraint::{Constraint, ConstraintBatch, ConstraintRows, SolverMode, StepContext};
 pub use handle::{Handle, HandleError};
 pub use math::{Real, Rot, Transform, Vec2};

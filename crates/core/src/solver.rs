@@ -524,6 +524,7 @@ pub fn integrate_velocities(ctx: &StepContext, bodies: &mut BodySet) {
         }
         state.v = v;
         state.w = w;
+        state.apply_locks();
     }
 }
 
@@ -604,6 +605,8 @@ fn integrate_terms(terms: &[VelocityTerms], states: &mut [BodyState]) {
         }
         state.v = v;
         state.w = w;
+        // Motion locks: the locked components are zero before the solve.
+        state.apply_locks();
     }
 }
 
@@ -642,6 +645,7 @@ fn clamp_velocity_terms(terms: &[VelocityTerms], states: &mut [BodyState], team:
                 continue;
             }
             state.v = clamp_speed(state.v, t.max_v);
+            state.apply_locks();
         }
     });
 }
@@ -650,6 +654,7 @@ fn clamp_velocity_terms(terms: &[VelocityTerms], states: &mut [BodyState], team:
 pub fn integrate_positions(ctx: &StepContext, bodies: &mut BodySet) {
     let h = ctx.h;
     for state in bodies.states.iter_mut().skip(1) {
+        state.apply_locks();
         state.dq = state.dq.integrate(h * state.w);
         state.dp += h * state.v;
     }
@@ -674,6 +679,9 @@ fn integrate_positions_on(
         for (t, state) in terms.iter().zip(block.iter_mut()).skip(skip) {
             if t.dynamic {
                 state.v = clamp_speed(state.v, t.max_v);
+                // Motion locks: what the solve gave a locked axis does
+                // not move the body (a constraint that comes last).
+                state.apply_locks();
             }
             state.dq = state.dq.integrate(h * state.w);
             state.dp += h * state.v;

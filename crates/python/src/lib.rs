@@ -78,6 +78,7 @@ pub fn world_error(e: WorldError) -> PyErr {
         WorldError::NotDynamic => ("BodyTypeError", "NotDynamic"),
         WorldError::NotMovable => ("BodyTypeError", "NotMovable"),
         WorldError::PortalBody => ("PortalBodyError", "PortalBody"),
+        WorldError::DisabledBody => ("BodyTypeError", "DisabledBody"),
         WorldError::Body(_) => ("InvalidInputError", "Body"),
         WorldError::Joint(_) => ("InvalidInputError", "Joint"),
         WorldError::Geometry(_) => ("InvalidInputError", "Geometry"),

@@ -247,6 +247,9 @@ impl BroadPhase {
     /// Removes a proxy. Its pairs are not reported any more; contacts that
     /// the caller holds for it must be destroyed by the caller.
     pub fn destroy_proxy(&mut self, proxy: u32) {
+        if proxy == NO_PROXY {
+            return;
+        }
         let slot = self.slot(proxy);
         self.tree_mut(slot.is_static).destroy_proxy(slot.leaf);
         let s = &mut self.proxies[proxy as usize];
@@ -261,6 +264,9 @@ impl BroadPhase {
     /// had to be re-inserted; the proxy is then marked as moved and its new
     /// pairs are reported by the next [`update_pairs`](Self::update_pairs).
     pub fn move_proxy(&mut self, proxy: u32, aabb: Aabb) -> bool {
+        if proxy == NO_PROXY {
+            return false;
+        }
         let slot = self.slot(proxy);
         if slot.fat.contains(&aabb) {
             // Still inside its fat box: the tree is not touched.
@@ -379,6 +385,9 @@ impl BroadPhase {
     /// [`update_pairs`](Self::update_pairs) reports all its pairs again (for
     /// instance after its collision filter changed).
     pub fn touch_proxy(&mut self, proxy: u32) {
+        if proxy == NO_PROXY {
+            return;
+        }
         self.slot(proxy);
         self.mark_moved(proxy);
     }
@@ -833,6 +842,11 @@ pub fn proxy_margin(geometry: &janus2d_core::geometry::Shape, max: Real) -> Real
     (janus2d_core::geometry::SPECULATIVE_DISTANCE + AABB_MARGIN_FRACTION * geometry.extent())
         .min(max)
 }
+
+/// The proxy id of a shape that has none (its body is disabled):
+/// [`BroadPhase::destroy_proxy`], [`BroadPhase::move_proxy`] and
+/// [`BroadPhase::touch_proxy`] do nothing with it.
+pub const NO_PROXY: u32 = u32::MAX;
 
 /// Largest coordinate of a box handed to the broadphase, m: four times
 /// [`MAX_COORDINATE`](janus2d_core::limits::MAX_COORDINATE), beyond any

@@ -206,10 +206,14 @@ impl Collision {
             proxy: 0,
             aabb,
         });
-        let margin = proxy_margin(&geometry, self.broadphase.margin());
-        let proxy =
+        // A disabled body's shapes stay out of the broadphase.
+        let proxy = if bodies.is_disabled(body) {
+            crate::broadphase::NO_PROXY
+        } else {
+            let margin = proxy_margin(&geometry, self.broadphase.margin());
             self.broadphase
-                .create_proxy_with_margin(bounded(aabb), index, is_static, margin);
+                .create_proxy_with_margin(bounded(aabb), index, is_static, margin)
+        };
         self.shapes.at_mut(index).proxy = proxy;
         self.shapes.handle_of(index, self.owner)
     }
@@ -234,13 +238,22 @@ impl Collision {
     pub(crate) fn check_proxies(&self, bodies: &BodySet) -> Result<(), String> {
         self.broadphase.check()?;
         let mut count = 0usize;
+        let mut disabled_shapes = 0usize;
         for body in bodies.handles() {
             let Some(sim) = bodies.sim(body) else {
                 continue;
             };
+            let disabled = bodies.is_disabled(body);
             for &s in self.shapes.of_body(body) {
-                count += 1;
                 let shape = self.shapes.at(s);
+                if disabled {
+                    if shape.proxy != crate::broadphase::NO_PROXY {
+                        return Err(format!("shape {s} of a disabled body has a proxy"));
+                    }
+                    disabled_shapes += 1;
+                    continue;
+                }
+                count += 1;
                 if !self.broadphase.is_live(shape.proxy) {
                     return Err(format!("shape {s}: proxy {} is not live", shape.proxy));
                 }
@@ -261,7 +274,7 @@ impl Collision {
                 }
             }
         }
-        if count != self.shapes.len() || self.broadphase.proxy_count() != count {
+        if count + disabled_shapes != self.shapes.len() || self.broadphase.proxy_count() != count {
             return Err(format!(
                 "{} shapes, {count} on live bodies, {} proxies",
                 self.shapes.len(),
@@ -574,6 +587,10 @@ impl Collision {
         for k in 0..n {
             let s = self.shapes.of_body(body)[k];
             let old = self.shapes.at(s).proxy;
+            if old == crate::broadphase::NO_PROXY {
+                // A disabled body's shape: no proxy until it is enabled.
+                continue;
+            }
             self.broadphase.destroy_proxy(old);
             let geometry = &self.shapes.at(s).geometry;
             let aabb = geometry.compute_aabb(xf);

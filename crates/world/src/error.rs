@@ -55,6 +55,9 @@ pub enum WorldError {
     /// The body carries a portal or is crossing one: the operation would
     /// break the portal stage's bookkeeping.
     PortalBody,
+    /// The body is disabled ([`World::set_body_enabled`](crate::World::set_body_enabled)):
+    /// enable it first.
+    DisabledBody,
     /// A scene query input that is non-finite or degenerate: names the
     /// field (`origin`, `translation`, `point`, `aabb`, `transform`,
     /// `shape`) and what is wrong with it.
@@ -88,6 +91,7 @@ impl std::fmt::Display for WorldError {
             WorldError::NotDynamic => write!(f, "operation needs a dynamic body"),
             WorldError::NotMovable => write!(f, "operation needs a kinematic or dynamic body"),
             WorldError::PortalBody => write!(f, "the body carries or is crossing a portal"),
+            WorldError::DisabledBody => write!(f, "the body is disabled"),
             WorldError::BadQuery { field, problem } => write!(f, "query `{field}` {problem}"),
         }
     }

@@ -266,7 +266,7 @@ impl Islands {
         }
         let dynamic = bodies
             .handles()
-            .filter(|&h| bodies.body_type(h) == Some(BodyType::Dynamic))
+            .filter(|&h| bodies.body_type(h) == Some(BodyType::Dynamic) && !bodies.is_disabled(h))
             .count();
         if dynamic != members {
             return Err(format!(

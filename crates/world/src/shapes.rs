@@ -15,7 +15,7 @@ use janus2d_core::body::BodyHandle;
 use janus2d_core::geometry::{Aabb, MassData, Shape};
 use janus2d_core::handle::{Handle, ShapeTag};
 use janus2d_core::material::CombineRule;
-use janus2d_core::math::{Real, Vec2};
+use janus2d_core::math::{Real, Transform, Vec2};
 use janus2d_core::slots::Slots;
 use smallvec::SmallVec;
 
@@ -154,6 +154,15 @@ pub struct ShapeDef {
     /// shape's contacts ([`Contact::user_material_ids`](crate::Contact),
     /// the pre-solve view) — a sound or particle effect per surface pair.
     pub user_material_id: u64,
+    /// Where the geometry sits in the body frame (usual identity): the
+    /// geometry given to [`World::create_shape`](crate::World::create_shape)
+    /// is moved by this offset and turned by its angle before it is
+    /// attached, for every kind (a circle's centre, a capsule's or
+    /// segment's points, a polygon's vertices and normals). It is baked
+    /// into the stored geometry: the shape's stored definition
+    /// ([`ShapeData::def`]) has it back at the identity, and geometry
+    /// setters take body-frame geometry as they are given.
+    pub offset: Transform,
 }
 
 impl Default for ShapeDef {
@@ -174,6 +183,7 @@ impl Default for ShapeDef {
             friction_combine: CombineRule::Default,
             restitution_combine: CombineRule::Default,
             user_material_id: 0,
+            offset: Transform::IDENTITY,
         }
     }
 }
@@ -340,6 +350,27 @@ impl ShapeDef {
         self
     }
 
+    /// Places the geometry at `position`, turned by `angle` (rad), in the
+    /// body frame (builder style; see [`ShapeDef::offset`]).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, ShapeDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::{Circle, Shape};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    /// let def = ShapeDef::default().with_offset(Vec2::new(2.0, 0.0), 0.0);
+    /// let s = world.create_shape(b, &def, Circle::new(Vec2::ZERO, 0.5).unwrap()).unwrap();
+    /// assert!(matches!(world.shape(s).unwrap().geometry, Shape::Circle(c) if c.center == Vec2::new(2.0, 0.0)));
+    /// // The body's centre of mass follows the offset geometry.
+    /// assert!((world.center_of_mass(b).unwrap().x - 2.0).abs() < 1e-6);
+    /// ```
+    #[must_use]
+    pub fn with_offset(mut self, position: Vec2, angle: Real) -> Self {
+        self.offset = Transform::new(position, angle);
+        self
+    }
+
     /// Checks the material: density, friction, restitution and rolling
     /// resistance finite and not negative, the tangent speed finite and
     /// within [`MAX_SPEED`](janus2d_core::limits::MAX_SPEED); the error
@@ -371,7 +402,8 @@ impl ShapeDef {
         check_material_limit(self.friction, "friction")?;
         check_material_limit(self.restitution, "restitution")?;
         check_force_threshold(self.force_event_threshold)?;
-        check_tangent_speed(self.tangent_speed)
+        check_tangent_speed(self.tangent_speed)?;
+        check_offset(&self.offset)
     }
 }
 
@@ -382,6 +414,28 @@ pub(crate) fn check_force_threshold(v: Real) -> Result<(), WorldError> {
     }
     if v < 0.0 {
         return Err(WorldError::OutOfRange("force_event_threshold"));
+    }
+    Ok(())
+}
+
+/// A shape offset: finite, its position within
+/// [`MAX_EXTENT`](janus2d_core::limits::MAX_EXTENT) of the body origin,
+/// its rotation of unit length (within
+/// [`UNIT_ROTATION_TOLERANCE`](janus2d_core::limits::UNIT_ROTATION_TOLERANCE)).
+pub(crate) fn check_offset(xf: &Transform) -> Result<(), WorldError> {
+    if !(janus2d_core::math::vec_is_finite(xf.p) && xf.q.is_finite()) {
+        return Err(WorldError::NonFinite("offset"));
+    }
+    let max = janus2d_core::limits::MAX_EXTENT;
+    if xf.p.x.abs() > max || xf.p.y.abs() > max {
+        return Err(WorldError::OutOfBounds {
+            field: "offset",
+            min: -max,
+            max,
+        });
+    }
+    if xf.q.to_unit().is_none() {
+        return Err(WorldError::OutOfRange("offset"));
     }
     Ok(())
 }

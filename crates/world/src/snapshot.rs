@@ -126,8 +126,10 @@ pub mod bytes {
     /// the portal stage keeps the events pushed between steps apart from
     /// the last step's; 12: events in one place — contacts keep their
     /// event switches, shapes their event fields, bodies their move-event
-    /// switch, the portal stage no longer keeps the last step's events).
-    pub const SNAPSHOT_VERSION: u16 = 12;
+    /// switch, the portal stage no longer keeps the last step's events;
+    /// 13: shape definitions carry an offset, bodies their motion locks
+    /// and enabled flag, and the world its disabled joints).
+    pub const SNAPSHOT_VERSION: u16 = 13;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.

@@ -95,6 +95,7 @@ impl World {
         self.joints.check(bodies).map_err(tag(I::Joints))?;
         self.islands.check(bodies).map_err(tag(I::Islands))?;
         self.portals.check(bodies).map_err(tag(I::Portals))?;
+        self.check_disabled().map_err(tag(I::Bodies))?;
         self.check_world_values().map_err(tag(I::World))
     }
 }

@@ -123,6 +123,56 @@ impl Shape {
         }
     }
 
+    /// The shape moved by the rigid transform `xf` (every point `x` maps to
+    /// `xf.apply(x)`, normals turn with `xf.q`): a shape placed at an
+    /// offset and angle in its body's frame. Sizes and areas are kept.
+    ///
+    /// ```
+    /// use janus2d_core::geometry::{Capsule, Shape};
+    /// use janus2d_core::{Transform, Vec2};
+    /// let c = Shape::Capsule(Capsule::new(Vec2::new(-1.0, 0.0), Vec2::new(1.0, 0.0), 0.2).unwrap());
+    /// let moved = c.transformed(&Transform::new(Vec2::new(0.0, 3.0), std::f32::consts::FRAC_PI_2 as _));
+    /// let Shape::Capsule(m) = moved else { unreachable!() };
+    /// assert!((m.center1 - Vec2::new(0.0, 2.0)).length() < 1e-5);
+    /// assert!((moved.area() - c.area()).abs() < 1e-5);
+    /// ```
+    #[must_use]
+    pub fn transformed(&self, xf: &Transform) -> Shape {
+        let map = |x: Vec2| xf.apply(x);
+        match self {
+            Shape::Circle(c) => Shape::Circle(Circle {
+                center: map(c.center),
+                radius: c.radius,
+            }),
+            Shape::Capsule(c) => Shape::Capsule(Capsule {
+                center1: map(c.center1),
+                center2: map(c.center2),
+                radius: c.radius,
+            }),
+            Shape::Polygon(p) => {
+                let mut q = *p;
+                for i in 0..p.count {
+                    q.vertices[i] = map(p.vertices[i]);
+                    q.normals[i] = xf.q.rotate(p.normals[i]);
+                }
+                q.centroid = map(p.centroid);
+                Shape::Polygon(q)
+            }
+            Shape::Segment(s) => Shape::Segment(Segment {
+                point1: map(s.point1),
+                point2: map(s.point2),
+            }),
+            Shape::ChainSegment(c) => Shape::ChainSegment(ChainSegment {
+                ghost1: map(c.ghost1),
+                segment: Segment {
+                    point1: map(c.segment.point1),
+                    point2: map(c.segment.point2),
+                },
+                ghost2: map(c.ghost2),
+            }),
+        }
+    }
+
     /// Area (m²) of the part of the shape, placed in the world by `xf`, that
     /// lies on the side of the line through `plane_point` that `plane_normal`
     /// points to (`dot(x - plane_point, plane_normal) > 0`).

@@ -1166,6 +1166,11 @@ impl PortalStage {
             max_rotation: sim.max_rotation,
             mass: Some(mass_clone),
             fixed_rotation: record.fixed_rotation,
+            motion_locks: janus2d_core::MotionLocks {
+                linear_x: sim.linear_locks & janus2d_core::BodyState::LOCK_X != 0,
+                linear_y: sim.linear_locks & janus2d_core::BodyState::LOCK_Y != 0,
+                angular: record.fixed_rotation,
+            },
             // Speeds scale by η through the portal.
             sleep_threshold: sim.sleep_threshold.map(|t| eta * t),
             bullet: sim.bullet,

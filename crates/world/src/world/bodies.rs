@@ -58,6 +58,7 @@ impl World {
         if self.bodies.contains(body) {
             self.destroy_body_unchecked(body);
         }
+        self.disabled_joints.retain(|&(b, _)| b != body);
         Ok(())
     }
 
@@ -588,6 +589,9 @@ impl World {
         }
         if self.portals.involves(body) {
             return Err(WorldError::PortalBody);
+        }
+        if self.bodies.is_disabled(body) {
+            return Err(WorldError::DisabledBody);
         }
         self.wake_island(body);
         self.wake_touching(body);

@@ -253,6 +253,10 @@ pub struct World {
     #[cfg_attr(feature = "serde", serde(skip))]
     pub(crate) hooks: crate::hooks::Hooks,
     pub(crate) sleep_settings: SleepSettings,
+    /// Joints switched off because a body they hold was disabled, with
+    /// the disabled body (switched back on when it is enabled and the
+    /// joint's other body is enabled).
+    pub(crate) disabled_joints: Vec<(BodyHandle, JointHandle)>,
     wake_list: Vec<BodyHandle>,
     events: StepEvents,
     /// Timings of the last step (not state: not serialized).
@@ -295,6 +299,7 @@ impl World {
             move_events: def.enable_move_events,
             hooks: crate::hooks::Hooks::default(),
             sleep_settings: def.sleep,
+            disabled_joints: Vec::new(),
             wake_list: Vec::new(),
             joints: JointSet::new(bodies.owner()),
             bodies,
@@ -455,6 +460,7 @@ impl World {
             move_events: self.move_events,
             hooks: crate::hooks::Hooks::default(),
             sleep_settings: self.sleep_settings,
+            disabled_joints: self.disabled_joints.clone(),
             wake_list: self.wake_list.clone(),
             events: self.events.clone(),
             step_profile: self.step_profile.clone(),
@@ -465,6 +471,7 @@ impl World {
 }
 
 mod bodies;
+mod body_state;
 pub use bodies::ExplosionDef;
 mod events;
 mod internal;
@@ -473,6 +480,7 @@ mod mover;
 #[cfg(feature = "portals")]
 mod portals;
 mod queries;
+mod shape_edit;
 mod shapes;
 mod step;
 /// Gravity: finite, its length at most

@@ -33,6 +33,19 @@ impl World {
         let ty = self.bodies.body_type(body).unwrap_or(BodyType::Static);
         def.validate()?;
         geometry.validate()?;
+        // The offset is baked into the geometry (and the stored definition
+        // keeps the identity).
+        let (geometry, def) = if def.offset == Transform::IDENTITY {
+            (geometry, std::borrow::Cow::Borrowed(def))
+        } else {
+            let q = def.offset.q.to_unit().unwrap_or(Rot::IDENTITY);
+            let moved = geometry.transformed(&Transform { p: def.offset.p, q });
+            moved.validate()?;
+            let mut stored = def.clone();
+            stored.offset = Transform::IDENTITY;
+            (moved, std::borrow::Cow::Owned(stored))
+        };
+        let def = def.as_ref();
         check_shape_mass(&geometry, def.density)?;
         let mass_override = self
             .bodies
