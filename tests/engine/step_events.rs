@@ -82,7 +82,10 @@ fn a_landing_box_begins_one_contact_with_its_manifold() {
         );
     }
     for k in 0..2 {
-        assert!((0.0..0.05).contains(&m.separations[k]), "{m:?}");
+        // Found within the speculative distance: ahead of the ground in
+        // the f32 build (2.2 cm), 8 mm into it in the f64 build, whose
+        // first manifold comes one step later.
+        assert!(m.separations[k].abs() < 0.05, "{m:?}");
         assert!(
             (m.points[k].y - 0.5 * m.separations[k]).abs() < 1e-4,
             "{m:?}"
