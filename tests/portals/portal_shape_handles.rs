@@ -117,7 +117,11 @@ fn drop_scene() -> (World, BodyHandle, ShapeHandle, ShapeHandle, ShapeHandle) {
         .create_body(&BodyDef::fixed(Vec2::new(-10.0, 5.0)))
         .unwrap();
     let sensor = world
-        .create_shape(zone, &ShapeDef::default().sensor(), Polygon::make_box(5.0, 1.4))
+        .create_shape(
+            zone,
+            &ShapeDef::default().sensor(),
+            Polygon::make_box(5.0, 1.4),
+        )
         .unwrap();
     let body = world
         .create_body(&BodyDef::dynamic(Vec2::new(0.0, 4.0)))
