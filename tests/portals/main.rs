@@ -24,6 +24,8 @@ mod portal_prismatic;
 mod portal_properties;
 #[cfg(feature = "portals")]
 mod portal_scenes;
+#[cfg(feature = "portals")]
+mod portal_shape_handles;
 mod portal_sim;
 #[cfg(feature = "portals")]
 mod portal_stiff;

@@ -445,6 +445,17 @@ impl BroadPhase {
         self.slot(proxy).payload
     }
 
+    /// Gives a live proxy a new payload (its boxes and trees unchanged):
+    /// the shape store moved the proxy's shape to another slot.
+    #[cfg_attr(not(feature = "portals"), allow(dead_code))]
+    pub(crate) fn set_payload(&mut self, proxy: u32, payload: u32) {
+        if let Some(slot) = self.proxies.get_mut(proxy as usize)
+            && slot.alive
+        {
+            slot.payload = payload;
+        }
+    }
+
     /// True for a proxy created as static.
     pub fn is_static(&self, proxy: u32) -> bool {
         self.slot(proxy).is_static

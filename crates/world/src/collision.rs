@@ -315,11 +315,29 @@ impl Collision {
         }
     }
 
-    /// Exchanges the shape lists of two bodies whose identities were swapped
-    /// (their contacts must be gone already).
+    /// Moves the shapes of two bodies whose identities were swapped (their
+    /// contacts must be gone already) to their new owners. When the bodies
+    /// have as many shapes (a portal crossing's two copies, the clone's
+    /// shapes made in the order of the original's), each slot keeps its
+    /// body, handle, material, filter, flags and user data, and takes its
+    /// counterpart's geometry, box, proxy and density: the handles follow
+    /// the object as the body handles do. Otherwise the lists are
+    /// exchanged whole (the shapes keep their handles and change body).
     #[cfg_attr(not(feature = "portals"), allow(dead_code))]
     pub(crate) fn swap_body_shapes(&mut self, a: BodyHandle, b: BodyHandle) {
-        self.shapes.swap_bodies(a, b);
+        let (la, lb) = (
+            smallvec::SmallVec::<[u32; 4]>::from_slice(self.shapes.of_body(a)),
+            smallvec::SmallVec::<[u32; 4]>::from_slice(self.shapes.of_body(b)),
+        );
+        if la.len() == lb.len() {
+            for (&i, &j) in la.iter().zip(&lb) {
+                self.shapes.exchange_copies(i, j);
+                self.broadphase.set_payload(self.shapes.at(i).proxy, i);
+                self.broadphase.set_payload(self.shapes.at(j).proxy, j);
+            }
+        } else {
+            self.shapes.swap_bodies(a, b);
+        }
         // Proxies must report their pairs again under the new owners.
         self.refind_pairs_of(a);
         self.refind_pairs_of(b);

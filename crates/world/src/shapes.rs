@@ -756,6 +756,32 @@ impl ShapeStore {
         self.refresh_extent(ib);
     }
 
+    /// Exchanges what two live slots hold of their copies of one shape
+    /// (geometry, world box, broadphase proxy and density), leaving each
+    /// slot its body, its handle and the rest of its definition (material,
+    /// filter, flags, user data): after a portal crossing the user's
+    /// handle names the shape of the copy that goes on. The caller gives
+    /// the proxies their new payloads.
+    #[cfg_attr(not(feature = "portals"), allow(dead_code))]
+    pub(crate) fn exchange_copies(&mut self, i: u32, j: u32) {
+        if i == j {
+            return;
+        }
+        let a = self.slots.live(i).clone();
+        let b = self.slots.live_mut(j);
+        let b_old = (
+            std::mem::replace(&mut b.geometry, a.geometry),
+            std::mem::replace(&mut b.aabb, a.aabb),
+            std::mem::replace(&mut b.proxy, a.proxy),
+            std::mem::replace(&mut b.def.density, a.def.density),
+        );
+        let a = self.slots.live_mut(i);
+        (a.geometry, a.aabb, a.proxy, a.def.density) = b_old;
+        let (bi, bj) = (self.slots.live(i).body, self.slots.live(j).body);
+        self.refresh_extent(bi.index as usize);
+        self.refresh_extent(bj.index as usize);
+    }
+
     /// The mass, centre (body frame) and inertia about the centre of a
     /// body's shapes with positive density.
     #[must_use]

@@ -93,7 +93,8 @@ pub(crate) enum PortalCommand {
         /// The new local anchor on `to`.
         anchor: Vec2,
     },
-    /// Exchange two bodies' identities (handles, shapes, islands).
+    /// Exchange two bodies' identities (handles, islands; each shape
+    /// handle moves to the matching shape of the other body).
     SwapIdentity(BodyHandle, BodyHandle),
     /// Destroy a live body, its shapes and joints.
     DestroyBody(BodyHandle),

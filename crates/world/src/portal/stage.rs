@@ -20,7 +20,7 @@
 //! |-----------|-------------------------------------------------------------|--------|
 //! | start     | a body's shapes straddle an aperture and fit its width, or its centre swept through the aperture during the step | clone created, constraint linked, [`PortalEvent::CrossingStarted`] |
 //! | straddle  | every step                                                  | masses and inertias weighted by `f₁`, `f₂` (clamped to `[F_MIN, 1 − F_MIN]`) |
-//! | handover  | the original is entirely behind the entry plane (and its joints can follow) | the handle moves to the clone's body, the original's body is removed, joints re-pointed, [`PortalEvent::CrossingCompleted`] |
+//! | handover  | the original is entirely behind the entry plane (and its joints can follow) | the handle moves to the clone's body and each shape handle to the clone's matching shape, the original's body is removed, joints re-pointed, [`PortalEvent::CrossingCompleted`] |
 //! | cancel    | the clone is entirely behind the exit plane (backed out; its joints can follow) | clone removed, joints re-pointed, [`PortalEvent::CrossingCancelled`] |
 //! | restart   | a copy's shapes changed (one destroyed or added)            | clone removed; the original may start again at once with its shapes |
 //!
@@ -291,7 +291,12 @@ pub enum PortalEvent {
         /// The pair.
         pair: PortalPairHandle,
     },
-    /// A body went through: `body` now refers to the object on the exit side.
+    /// A body went through: `body` now refers to the object on the exit
+    /// side, and each of its shape handles to the matching shape there
+    /// (material, filter, flags and user data kept; the clone's handles are
+    /// stale). Every contact of both copies ended at the handover; those of
+    /// the object on the exit side begin again at the next step, under the
+    /// user's shape handles.
     CrossingCompleted {
         /// The object (its handle followed it).
         body: BodyHandle,

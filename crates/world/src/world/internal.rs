@@ -206,7 +206,8 @@ impl Stores<'_> {
     }
 
     /// Exchanges two bodies' identities (see `BodySet::swap_identity`),
-    /// moving their shapes along and dropping their contacts.
+    /// moving their shapes' handles along (see
+    /// `Collision::swap_body_shapes`) and dropping their contacts.
     #[cfg_attr(not(feature = "portals"), allow(dead_code))]
     pub(crate) fn swap_body_identity(&mut self, a: BodyHandle, b: BodyHandle) {
         self.collision.remove_contacts_of(a);
