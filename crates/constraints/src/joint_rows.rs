@@ -24,7 +24,11 @@
 //! limit's `[0, ∞)`, a force-bounded row), or for a point block a bound on
 //! the accumulated impulse's length. The bias terms come from one of the
 //! constructors of [`Terms`] (an equality that relaxes without feedback,
-//! a spring, a speculative limit, a motor's target speed).
+//! a spring, a speculative limit, a motor's target speed). Every kept
+//! impulse is also held within
+//! [`ROW_SPEED_BOUND`](crate::parts::ROW_SPEED_BOUND) of its row's
+//! effective mass (bit for bit the plain sum below it), so rows that cannot
+//! all hold stop growing instead of overflowing.
 //!
 //! **Order.** A kind calls its rows in the order it wants them solved
 //! (Box2D's: spring, motor, limits, then the rigid point), so the sequence
