@@ -128,8 +128,9 @@ pub mod bytes {
     /// event switches, shapes their event fields, bodies their move-event
     /// switch, the portal stage no longer keeps the last step's events;
     /// 13: shape definitions carry an offset, bodies their motion locks
-    /// and enabled flag, and the world its disabled joints).
-    pub const SNAPSHOT_VERSION: u16 = 13;
+    /// and enabled flag, and the world its disabled joints; 14: the
+    /// collision stage keeps the chains).
+    pub const SNAPSHOT_VERSION: u16 = 14;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.
