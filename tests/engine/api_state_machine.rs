@@ -176,7 +176,8 @@ fn op() -> impl Strategy<Value = Op> {
         4 => (pick(), geometry(), prop_oneof![3 => Just(1.0 as Real), 1 => real()], prop_oneof![3 => Just(0.6 as Real), 1 => real()], proptest::bool::weighted(0.1))
             .prop_map(|(body, geometry, density, friction, sensor)| Op::CreateShape { body, geometry, density, friction, sensor }),
         1 => pick().prop_map(Op::DestroyShape),
-        1 => (pick(), proptest::collection::vec(place(), 0..7), any::<bool>(), 0usize..8, prop_oneof![3 => Just(0.6 as Real), 1 => real()])
+        2 => (pick(), prop_oneof![4 => proptest::collection::vec((-4.0 as Real..4.0, -1.0 as Real..6.0).prop_map(|(x, y)| Vec2::new(x, y)), 2..7), 1 => proptest::collection::vec(place(), 0..7)],
+              any::<bool>(), prop_oneof![4 => Just(1usize), 1 => 0usize..8], prop_oneof![3 => Just(0.6 as Real), 1 => real()])
             .prop_map(|(body, points, is_loop, materials, friction)| Op::CreateChain { body, points, is_loop, materials, friction }),
         1 => pick().prop_map(Op::DestroyChain),
         2 => (any::<usize>(), pick(), pick(), place(), proptest::option::weighted(0.3, (real(), real())), any::<bool>())
@@ -528,6 +529,7 @@ fn cases() -> u32 {
 static RAN: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 static ACCEPTED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 static STEPS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+static CHAINS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 /// The world a case starts from: a ground box, the portal drop scene, or
 /// a small pyramid (with their bodies among the issued handles).
@@ -597,6 +599,9 @@ fn run(scene: u8, ops: &[Op]) -> Result<(), TestCaseError> {
             if matches!(op, Op::Step(_)) {
                 STEPS.fetch_add(1, Relaxed);
             }
+            if matches!(op, Op::CreateChain { .. }) {
+                CHAINS.fetch_add(1, Relaxed);
+            }
         }
         if let Err(e) = &result {
             prop_assert_eq!(
@@ -641,9 +646,10 @@ proptest! {
 fn z_report_counts() {
     use std::sync::atomic::Ordering::Relaxed;
     eprintln!(
-        "state machine: {} operations, {} accepted, {} steps",
+        "state machine: {} operations, {} accepted, {} steps, {} chains created",
         RAN.load(Relaxed),
         ACCEPTED.load(Relaxed),
-        STEPS.load(Relaxed)
+        STEPS.load(Relaxed),
+        CHAINS.load(Relaxed)
     );
 }
