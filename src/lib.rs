@@ -181,9 +181,7 @@ pub use janus2d_world::{
     PlaneSolution, clip_vector, solve_planes,
 };
 #[doc(inline)]
-pub use janus2d_world::{
-    ChainDef, ChainHandle, SurfaceMaterial,
-};
+pub use janus2d_world::{ChainDef, ChainHandle, SurfaceMaterial};
 #[doc(inline)]
 pub use janus2d_world::{
     CollisionCounters, CollisionEvents, Color, Contact, ContactPointData, ContinuousCounters,

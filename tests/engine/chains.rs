@@ -258,7 +258,9 @@ fn a_snapshot_with_chains_continues_bit_identically() {
     #[cfg(feature = "serde")]
     {
         let bytes = saved.to_bytes();
-        let mut back = janus2d::world::Snapshot::from_bytes(&bytes).unwrap().to_world();
+        let mut back = janus2d::world::Snapshot::from_bytes(&bytes)
+            .unwrap()
+            .to_world();
         assert_eq!(back.chain_count(), 1);
         for _ in 0..60 {
             back.step(DT).unwrap();

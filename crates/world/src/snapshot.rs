@@ -4,6 +4,7 @@
 //! |-----------------------------------------------|------------------------------------------------|
 //! | bodies (poses, velocities, masses, sleep timers, slots and generations) | the state itself, and which handles are live |
 //! | shapes, broadphase trees and proxies, move buffer | pairs found next step, in the same order    |
+//! | chains and their segment shapes               | chain handles resolve after a restore          |
 //! | contacts with their warm-start impulses and feature ids, pair index | warm starting, begin/end events |
 //! | joints, their accumulated impulses, the joint forest | warm starting, the direct solve          |
 //! | islands, pending sleepers, sleep settings     | who sleeps when                                |
