@@ -11,7 +11,7 @@
 //! |---------------------------------------|------------------------------------------------------------|
 //! | the world: create, step, read back    | [`World`], [`WorldDef`], [`WorldError`]                     |
 //! | bodies                                | [`BodyDef`], [`BodyHandle`], [`BodyType`], [`BodyMass`]     |
-//! | shapes and their material             | [`Polygon`], [`Circle`], [`Capsule`], [`Segment`], [`make_chain`], [`ShapeDef`], [`Filter`] |
+//! | shapes and their material             | [`Polygon`], [`Circle`], [`Capsule`], [`Segment`], [`make_chain`], [`ShapeDef`], [`Filter`]; chains: [`ChainDef`], [`ChainHandle`], [`SurfaceMaterial`], [`World::create_chain`] |
 //! | joints (eight kinds)                  | [`JointDef`], [`World::create_joint`], [`RevoluteJointDef`] and the other `…JointDef`s |
 //! | scene queries: rays, casts, overlaps  | [`query`], [`QueryFilter`], [`RayHit`], [`World::cast_ray_closest`] |
 //! | a character mover and controller      | [`CharacterController`], [`World::cast_mover`], [`World::collide_mover`], [`solve_planes`], [`clip_vector`] |
@@ -181,6 +181,8 @@ pub use janus2d_world::{
     PlaneSolution, clip_vector, solve_planes,
 };
 #[doc(inline)]
+pub use janus2d_world::{ChainDef, ChainHandle, SurfaceMaterial};
+#[doc(inline)]
 pub use janus2d_world::{
     CollisionCounters, CollisionEvents, Color, Contact, ContactPointData, ContinuousCounters,
     DebugDraw, DrawOptions, ExplosionDef, Filter, HitEvent, Invariant, InvariantError, JointEvent,
@@ -214,6 +216,7 @@ pub mod prelude {
     pub use janus2d_core::math::{Real, Rot, Transform, Vec2};
     pub use janus2d_core::solver::SolverSettings;
     pub use janus2d_world::{Autostep, CharacterController, MoveResult};
+    pub use janus2d_world::{ChainDef, ChainHandle, SurfaceMaterial};
     pub use janus2d_world::{
         ExplosionDef, Filter, JointEvent, JointHandle, PointProjection, QueryFilter, RayHit,
         ShapeDef, ShapeHandle, ShapeOverlap, StepEvents, World, WorldDef, WorldError,

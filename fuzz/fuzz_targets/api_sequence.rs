@@ -1,5 +1,5 @@
 //! The API as a byte-coded sequence of calls (bodies, shapes, joints,
-//! portal pairs, velocities, transforms, masses, types, forces, settings,
+//! portal pairs, chains, velocities, transforms, masses, types, forces, settings,
 //! steps, snapshot and restore), valid and invalid values mixed. After each
 //! call: no panic, an `Err` left the world unchanged, `World::validate`
 //! passes.
@@ -43,6 +43,7 @@ struct Issued {
     shapes: Vec<ShapeHandle>,
     joints: Vec<JointHandle>,
     pairs: Vec<PortalPairHandle>,
+    chains: Vec<ChainHandle>,
     foreign: BodyHandle,
 }
 
@@ -88,8 +89,9 @@ fn shape(b: &mut Bytes) -> Option<Shape> {
     })
 }
 
-fn fingerprint(w: &World) -> [u64; 7] {
+fn fingerprint(w: &World) -> [u64; 8] {
     [
+        w.chain_count() as u64,
         w.state_hash(),
         w.body_count() as u64,
         w.shape_count() as u64,
@@ -107,7 +109,7 @@ fn call(
     b: &mut Bytes,
 ) -> Result<(), WorldError> {
     let f = i.foreign;
-    match b.byte() % 20 {
+    match b.byte() % 22 {
         0 | 1 => {
             let ty = body_type(b.byte());
             let def = BodyDef {
@@ -157,7 +159,9 @@ fn call(
                 2 => WeldJointDef::new(ba, bb, anchor, -anchor).into(),
                 3 => DistanceJointDef::new(ba, bb, anchor, -anchor, b.real()).into(),
                 4 => WheelJointDef::new(ba, bb, anchor, -anchor, b.vec()).into(),
-                5 => MotorJointDef::new(ba, bb).with_offset(anchor, b.real()).into(),
+                5 => MotorJointDef::new(ba, bb)
+                    .with_offset(anchor, b.real())
+                    .into(),
                 6 => MouseJointDef::new(ba, bb, anchor, b.real()).into(),
                 _ => FilterJointDef::new(ba, bb).into(),
             };
@@ -235,6 +239,29 @@ fn call(
             *saved = Some(w.snapshot());
             Ok(())
         }
+        20 => {
+            let body = pick(&i.bodies, b.byte(), f);
+            let n = (b.byte() % 7) as usize;
+            let points: Vec<Vec2> = (0..n).map(|_| b.vec()).collect();
+            let per_segment = b.byte() % 3;
+            let material = SurfaceMaterial::default().with_friction(b.real());
+            let count = match per_segment {
+                0 => 1,
+                1 => n.saturating_sub(1),
+                _ => n,
+            };
+            let def = ChainDef::new(points)
+                .with_loop(b.byte().is_multiple_of(2))
+                .with_segment_materials(vec![material; count]);
+            let chain = w.create_chain(body, &def)?;
+            i.chains.push(chain);
+            i.shapes.extend_from_slice(w.chain_segments(chain)?);
+            Ok(())
+        }
+        21 => match i.chains.get(b.byte() as usize % i.chains.len().max(1)) {
+            Some(c) => w.destroy_chain(*c),
+            None => Err(WorldError::StaleChain),
+        },
         18 => {
             if let Some(s) = saved {
                 w.restore(s);
@@ -265,6 +292,7 @@ fuzz_target!(|data: &[u8]| {
         shapes: Vec::new(),
         joints: Vec::new(),
         pairs: Vec::new(),
+        chains: Vec::new(),
         foreign,
     };
     let mut saved = None;

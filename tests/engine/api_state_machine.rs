@@ -92,6 +92,16 @@ enum Op {
         sensor: bool,
     },
     DestroyShape(usize),
+    /// A chain on a body: its points, loop flag, and 1 material or one
+    /// per segment (`per_segment`, sometimes a wrong count).
+    CreateChain {
+        body: usize,
+        points: Vec<Vec2>,
+        is_loop: bool,
+        materials: usize,
+        friction: Real,
+    },
+    DestroyChain(usize),
     CreateJoint {
         kind: usize,
         a: usize,
@@ -166,6 +176,10 @@ fn op() -> impl Strategy<Value = Op> {
         4 => (pick(), geometry(), prop_oneof![3 => Just(1.0 as Real), 1 => real()], prop_oneof![3 => Just(0.6 as Real), 1 => real()], proptest::bool::weighted(0.1))
             .prop_map(|(body, geometry, density, friction, sensor)| Op::CreateShape { body, geometry, density, friction, sensor }),
         1 => pick().prop_map(Op::DestroyShape),
+        2 => (pick(), prop_oneof![4 => proptest::collection::vec((-4.0 as Real..4.0, -1.0 as Real..6.0).prop_map(|(x, y)| Vec2::new(x, y)), 2..7), 1 => proptest::collection::vec(place(), 0..7)],
+              any::<bool>(), prop_oneof![4 => Just(1usize), 1 => 0usize..8], prop_oneof![3 => Just(0.6 as Real), 1 => real()])
+            .prop_map(|(body, points, is_loop, materials, friction)| Op::CreateChain { body, points, is_loop, materials, friction }),
+        1 => pick().prop_map(Op::DestroyChain),
         2 => (any::<usize>(), pick(), pick(), place(), proptest::option::weighted(0.3, (real(), real())), any::<bool>())
             .prop_map(|(kind, a, b, anchor, limits, collide)| Op::CreateJoint { kind, a, b, anchor, limits, collide }),
         1 => pick().prop_map(Op::DestroyJoint),
@@ -210,6 +224,8 @@ struct Issued {
     shapes: Vec<ShapeHandle>,
     joints: Vec<JointHandle>,
     pairs: Vec<PortalPairHandle>,
+    chains: Vec<ChainHandle>,
+    foreign_chain: ChainHandle,
     foreign_body: BodyHandle,
     foreign_shape: ShapeHandle,
     foreign_joint: JointHandle,
@@ -223,9 +239,10 @@ fn pick<T: Copy>(list: &[T], k: usize, foreign: T) -> T {
     }
 }
 
-fn fingerprint(w: &World) -> (u64, usize, usize, usize, usize, usize, usize) {
+fn fingerprint(w: &World) -> (u64, usize, usize, usize, usize, usize, usize, usize) {
     (
         w.state_hash(),
+        w.chain_count(),
         w.body_count(),
         w.shape_count(),
         w.joint_count(),
@@ -324,6 +341,23 @@ fn apply(
             Ok(())
         }
         Op::DestroyShape(k) => w.destroy_shape(pick(&issued.shapes, *k, issued.foreign_shape)),
+        Op::CreateChain {
+            body: k,
+            points,
+            is_loop,
+            materials,
+            friction,
+        } => {
+            let material = SurfaceMaterial::default().with_friction(*friction);
+            let def = ChainDef::new(points.clone())
+                .with_loop(*is_loop)
+                .with_segment_materials(vec![material; *materials]);
+            let h = w.create_chain(body(*k, issued), &def)?;
+            issued.chains.push(h);
+            issued.shapes.extend_from_slice(w.chain_segments(h)?);
+            Ok(())
+        }
+        Op::DestroyChain(k) => w.destroy_chain(pick(&issued.chains, *k, issued.foreign_chain)),
         Op::CreateJoint {
             kind,
             a,
@@ -495,6 +529,7 @@ fn cases() -> u32 {
 static RAN: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 static ACCEPTED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 static STEPS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+static CHAINS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 /// The world a case starts from: a ground box, the portal drop scene, or
 /// a small pyramid (with their bodies among the issued handles).
@@ -529,7 +564,16 @@ fn run(scene: u8, ops: &[Op]) -> Result<(), TestCaseError> {
     let fj = other
         .create_revolute_joint(&RevoluteJointDef::new(fb, fb2, Vec2::ZERO, Vec2::ZERO))
         .unwrap();
+    let ground = other.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    let fc = other
+        .create_chain(
+            ground,
+            &ChainDef::new(vec![Vec2::ZERO, Vec2::new(1.0, 0.0)]),
+        )
+        .unwrap();
     let mut issued = Issued {
+        chains: Vec::new(),
+        foreign_chain: fc,
         bodies: Vec::new(),
         shapes: Vec::new(),
         joints: Vec::new(),
@@ -554,6 +598,9 @@ fn run(scene: u8, ops: &[Op]) -> Result<(), TestCaseError> {
             ACCEPTED.fetch_add(1, Relaxed);
             if matches!(op, Op::Step(_)) {
                 STEPS.fetch_add(1, Relaxed);
+            }
+            if matches!(op, Op::CreateChain { .. }) {
+                CHAINS.fetch_add(1, Relaxed);
             }
         }
         if let Err(e) = &result {
@@ -599,9 +646,10 @@ proptest! {
 fn z_report_counts() {
     use std::sync::atomic::Ordering::Relaxed;
     eprintln!(
-        "state machine: {} operations, {} accepted, {} steps",
+        "state machine: {} operations, {} accepted, {} steps, {} chains created",
         RAN.load(Relaxed),
         ACCEPTED.load(Relaxed),
-        STEPS.load(Relaxed)
+        STEPS.load(Relaxed),
+        CHAINS.load(Relaxed)
     );
 }

@@ -8,6 +8,7 @@ mod api_consistency;
 mod api_state_machine;
 mod bad_input;
 mod breakable_joint;
+mod chains;
 mod collision_api;
 mod contact_data;
 mod contact_modification;

@@ -14,6 +14,7 @@
 //! | `ShapeHandle` | [`ShapeTag`] | `World::create_shape` |
 //! | `JointHandle` | [`JointTag`] | `World::create_revolute_joint` |
 //! | `PortalPairHandle` | [`PortalPairTag`] | `World::create_portal_pair` |
+//! | `ChainHandle` | [`ChainTag`] | `World::create_chain` |
 //!
 //! Handles of different kinds are different types, so a shape handle can
 //! never be passed where a body is expected.
@@ -71,6 +72,9 @@ pub enum JointTag {}
 /// Marker of portal pair handles.
 #[derive(Clone, Copy, Debug)]
 pub enum PortalPairTag {}
+/// Marker of chain handles.
+#[derive(Clone, Copy, Debug)]
+pub enum ChainTag {}
 
 impl<K> Clone for Handle<K> {
     fn clone(&self) -> Self {

@@ -56,6 +56,8 @@ pub(crate) struct Collision {
     pub(crate) counters: CollisionCounters,
     pub(crate) narrowphase: crate::narrowphase::Narrowphase,
     candidates: Vec<(u32, u32)>,
+    /// The chains: which shapes are segments of one chain.
+    pub(crate) chains: crate::chains::ChainSet,
 }
 
 /// What the collision stage hands to contact building after the
@@ -185,6 +187,7 @@ impl Collision {
             counters: CollisionCounters::default(),
             narrowphase: Default::default(),
             candidates: Vec::new(),
+            chains: crate::chains::ChainSet::default(),
         }
     }
 

@@ -27,6 +27,11 @@ pub enum WorldError {
     StaleShape,
     /// A portal pair handle that is stale.
     StalePortal,
+    /// A chain handle that is stale (the chain or its body was destroyed).
+    StaleChain,
+    /// The shape is a segment of a chain: it goes with its chain
+    /// ([`World::destroy_chain`](crate::World::destroy_chain)), not alone.
+    ChainSegmentShape,
     /// A handle (of any kind) that another world issued.
     ForeignHandle,
     /// Invalid portal input (η ≤ 0, zero direction, non-positive half-width).
@@ -80,6 +85,10 @@ impl std::fmt::Display for WorldError {
             WorldError::WrongJointKind => write!(f, "the joint is of another kind"),
             WorldError::StaleShape => write!(f, "stale shape handle"),
             WorldError::StalePortal => write!(f, "stale portal pair handle"),
+            WorldError::StaleChain => write!(f, "stale chain handle"),
+            WorldError::ChainSegmentShape => {
+                write!(f, "the shape is a chain segment: destroy its chain")
+            }
             WorldError::ForeignHandle => write!(f, "handle issued by another world"),
             WorldError::Portal(e) => write!(f, "portal: {e}"),
             WorldError::InvalidTimeStep => write!(f, "time step must be finite and > 0"),

@@ -36,6 +36,7 @@
 
 pub mod aperture;
 pub(crate) mod broadphase;
+pub mod chains;
 pub mod character;
 pub(crate) mod collision;
 pub(crate) mod contact_build;
@@ -61,6 +62,7 @@ mod stores;
 pub(crate) mod validate;
 pub mod world;
 
+pub use chains::{ChainDef, ChainHandle, SurfaceMaterial};
 pub use character::{Autostep, CharacterController, Ground, MoveResult};
 pub use contacts::{
     CollisionEvents, Contact, ContactBeginEvent, ContactForceEvent, ContactPointData,

@@ -4,6 +4,7 @@
 //! |-----------------------------------------------|------------------------------------------------|
 //! | bodies (poses, velocities, masses, sleep timers, slots and generations) | the state itself, and which handles are live |
 //! | shapes, broadphase trees and proxies, move buffer | pairs found next step, in the same order    |
+//! | chains and their segment shapes               | chain handles resolve after a restore          |
 //! | contacts with their warm-start impulses and feature ids, pair index | warm starting, begin/end events |
 //! | joints, their accumulated impulses, the joint forest | warm starting, the direct solve          |
 //! | islands, pending sleepers, sleep settings     | who sleeps when                                |
@@ -128,8 +129,9 @@ pub mod bytes {
     /// event switches, shapes their event fields, bodies their move-event
     /// switch, the portal stage no longer keeps the last step's events;
     /// 13: shape definitions carry an offset, bodies their motion locks
-    /// and enabled flag, and the world its disabled joints).
-    pub const SNAPSHOT_VERSION: u16 = 13;
+    /// and enabled flag, and the world its disabled joints; 14: the
+    /// collision stage keeps the chains).
+    pub const SNAPSHOT_VERSION: u16 = 14;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.

@@ -8,7 +8,7 @@
 //! | [`Invariant`]    | checked by                 | what                                                              |
 //! |------------------|----------------------------|-------------------------------------------------------------------|
 //! | `Bodies`         | `BodySet::check_invariants`| handles ↔ slots ↔ arrays, sentinel, finite numbers, dynamic mass   |
-//! | `Shapes`         | `ShapeStore::check`        | shapes ↔ bodies ↔ body lists, valid geometry, finite boxes        |
+//! | `Shapes`         | `ShapeStore::check`, `World::check_chains` | shapes ↔ bodies ↔ body lists, valid geometry, finite boxes; chains ↔ live segment shapes of one body |
 //! | `Proxies`        | `Collision::check_proxies` | shapes ↔ broadphase proxies, tree by type, fat box ⊇ shape box    |
 //! | `Contacts`       | `ContactSet::check`        | contacts ↔ pair index ↔ per-body lists, sleep lists, finite data  |
 //! | `Joints`         | `JointSet::check`          | joint handles ↔ slots ↔ bodies ↔ body lists, definitions valid, no-collide pairs |
@@ -85,6 +85,7 @@ impl World {
         bodies.check_invariants().map_err(tag(I::Bodies))?;
         let c = &self.collision;
         c.shapes.check(bodies).map_err(tag(I::Shapes))?;
+        self.check_chains().map_err(tag(I::Shapes))?;
         c.check_proxies(bodies).map_err(tag(I::Proxies))?;
         c.contacts
             .check(bodies, &c.shapes)

@@ -123,6 +123,7 @@ impl Stores<'_> {
         for h in attached {
             self.remove_joint(h);
         }
+        self.forget_chains_of(body);
         let shapes: smallvec::SmallVec<[u32; 4]> = self
             .collision
             .shapes
@@ -136,6 +137,32 @@ impl Stores<'_> {
         self.islands.remove_body(body);
         let destroyed = self.bodies.destroy(body);
         debug_assert!(destroyed.is_ok(), "checked by the caller");
+    }
+
+    /// Drops the chains whose segments are on `body` (their shapes go
+    /// with the body's).
+    pub(crate) fn forget_chains_of(&mut self, body: BodyHandle) {
+        let c = &mut *self.collision;
+        if c.chains.slots.is_empty() {
+            return;
+        }
+        let owner = c.owner;
+        let doomed: Vec<(u32, u32)> = c
+            .chains
+            .slots
+            .iter()
+            .filter(|(_, chain)| {
+                chain.segments.iter().any(|&s| {
+                    c.shapes
+                        .slot(s, owner)
+                        .is_ok_and(|slot| c.shapes.at(slot).body == body)
+                })
+            })
+            .map(|(i, _)| (i, c.chains.slots.generation(i)))
+            .collect();
+        for (i, g) in doomed {
+            c.chains.slots.remove(i, g);
+        }
     }
 
     /// Removes a live joint, waking its bodies.

@@ -472,6 +472,7 @@ impl World {
 
 mod bodies;
 mod body_state;
+mod chains;
 pub use bodies::ExplosionDef;
 mod events;
 mod internal;

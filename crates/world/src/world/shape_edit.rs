@@ -85,6 +85,12 @@ impl World {
         let geometry = geometry.into();
         let slot = self.shape_slot(shape)?;
         geometry.validate()?;
+        // A chain's segment stays a chain segment.
+        if !matches!(geometry, Shape::ChainSegment(_))
+            && self.collision.chains.chain_of_shape(shape).is_some()
+        {
+            return Err(WorldError::ChainSegmentShape);
+        }
         let data = self.collision.shapes.at(slot);
         let body = data.body;
         check_shape_mass(&geometry, data.def.density)?;

@@ -75,8 +75,15 @@ impl World {
     }
 
     /// Removes a shape (its contacts end; the body's mass is recomputed).
+    ///
+    /// A chain's segment shape is refused with
+    /// [`WorldError::ChainSegmentShape`]: it goes with its chain
+    /// ([`World::destroy_chain`]).
     pub fn destroy_shape(&mut self, shape: ShapeHandle) -> Result<(), WorldError> {
         let slot = self.collision.shapes.slot(shape, self.bodies.owner())?;
+        if self.collision.chains.chain_of_shape(shape).is_some() {
+            return Err(WorldError::ChainSegmentShape);
+        }
         let body = self.collision.shapes.at(slot).body;
         self.wake_island(body);
         self.collision.remove_shape(slot);
