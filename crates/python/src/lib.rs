@@ -73,6 +73,8 @@ pub fn world_error(e: WorldError) -> PyErr {
         WorldError::StaleJoint => ("StaleHandleError", "StaleJoint"),
         WorldError::StaleShape => ("StaleHandleError", "StaleShape"),
         WorldError::StalePortal => ("StaleHandleError", "StalePortal"),
+        WorldError::StaleChain => ("StaleHandleError", "StaleChain"),
+        WorldError::ChainSegmentShape => ("InvalidInputError", "ChainSegmentShape"),
         WorldError::ForeignHandle => ("ForeignHandleError", "ForeignHandle"),
         WorldError::WrongJointKind => ("WrongJointKindError", "WrongJointKind"),
         WorldError::NotDynamic => ("BodyTypeError", "NotDynamic"),
