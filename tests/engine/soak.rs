@@ -86,6 +86,9 @@ pub struct SoakReport {
     pub validate_failures: u64,
     /// Bodies the steps reset for a non-finite state.
     pub non_finite_resets: u64,
+    /// Resets of a body already reset within the last 60 steps: a reset
+    /// body that did not recover (issue 35, "reset once").
+    pub repeated_resets: u64,
     /// Joints and portal pairs created.
     pub joints_created: u64,
     pub portal_pairs_created: u64,
@@ -104,6 +107,7 @@ impl SoakReport {
         self.worst_speed_ratio = self.worst_speed_ratio.max(other.worst_speed_ratio);
         self.validate_failures += other.validate_failures;
         self.non_finite_resets += other.non_finite_resets;
+        self.repeated_resets += other.repeated_resets;
         self.joints_created += other.joints_created;
         self.portal_pairs_created += other.portal_pairs_created;
         self.crossings_completed += other.crossings_completed;
@@ -133,6 +137,8 @@ struct Soak {
     #[cfg(feature = "portals")]
     pairs: Vec<janus2d::world::PortalPairHandle>,
     report: SoakReport,
+    /// Bodies reset for a non-finite state, with the step of their reset.
+    reset_at: Vec<(BodyHandle, u64)>,
 }
 
 /// A random shape of size up to `size` m and its area, m².
@@ -204,6 +210,7 @@ impl Soak {
             #[cfg(feature = "portals")]
             pairs: Vec::new(),
             report: SoakReport::default(),
+            reset_at: Vec::new(),
         }
     }
 
@@ -537,6 +544,14 @@ impl Soak {
         self.report.steps += 1;
         let events = self.world.events();
         self.report.non_finite_resets += events.non_finite_bodies.len() as u64;
+        let step = self.report.steps;
+        self.reset_at.retain(|&(_, at)| step - at < 60);
+        for &b in &events.non_finite_bodies {
+            if self.reset_at.iter().any(|&(r, _)| r == b) {
+                self.report.repeated_resets += 1;
+            }
+            self.reset_at.push((b, step));
+        }
         #[cfg(feature = "portals")]
         {
             self.report.crossings_completed += self
@@ -691,7 +706,8 @@ fn random_operation_soak_of_a_million_operations() {
     let report = soak(seed, operations, 20_000);
     println!(
         "soak of {} operations: {} steps, {} refused, worst speed {:.2} m/s ({:.4} of the limit), \
-         {} validate failures, {} non-finite resets, {} joints and {} portal pairs created, \
+         {} validate failures, {} non-finite resets ({} of a body reset within 60 steps), \
+         {} joints and {} portal pairs created, \
          {} crossings completed, at most {} bodies, {:.1} s",
         report.operations,
         report.steps,
@@ -700,6 +716,7 @@ fn random_operation_soak_of_a_million_operations() {
         report.worst_speed_ratio,
         report.validate_failures,
         report.non_finite_resets,
+        report.repeated_resets,
         report.joints_created,
         report.portal_pairs_created,
         report.crossings_completed,
@@ -708,5 +725,8 @@ fn random_operation_soak_of_a_million_operations() {
     );
     assert_eq!(report.validate_failures, 0);
     assert!(report.worst_speed_ratio <= 1.0 + 1e-5, "{report:?}");
-    assert_eq!(report.non_finite_resets, 0, "{report:?}");
+    // Reset once: a body reset for a non-finite state recovers (issue 35).
+    // A reset is rare (none or one in a million operations); a body reset
+    // again soon after is what must never happen.
+    assert_eq!(report.repeated_resets, 0, "{report:?}");
 }
