@@ -117,6 +117,11 @@ impl World {
     /// awake, moving on from the kept pose and velocities. Setting the
     /// current value does nothing.
     ///
+    /// A joint created, or switched on, while one of its bodies is
+    /// disabled acts on the other body as if the disabled one were static
+    /// (it is not switched off for the disabled body's sake): switch such
+    /// a joint on after enabling the body.
+    ///
     /// Errors (the world unchanged): a stale or foreign handle; a body
     /// that carries or is crossing a portal ([`WorldError::PortalBody`]).
     ///
