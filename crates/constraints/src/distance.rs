@@ -859,24 +859,6 @@ mod tests {
     }
 
     #[test]
-    fn warm_start_side_is_the_warm_start_body_by_body() {
-        let (set, mut joint, ctx) = prepared();
-        let mut whole = set.states.clone();
-        joint.warm_start(&ctx, &mut whole);
-        let mut sides = set.states.clone();
-        for (s, side_b) in [(joint.base.state_a, false), (joint.base.state_b, true)] {
-            crate::kind_rows::warm_start_side(&joint, &mut sides[s as usize], side_b);
-        }
-        for (w, s) in whole.iter().zip(&sides) {
-            assert_eq!((w.v, w.w), (s.v, s.w));
-        }
-        assert_ne!(
-            whole[joint.base.state_b as usize].v,
-            set.states[joint.base.state_b as usize].v
-        );
-    }
-
-    #[test]
     fn rows_follow_the_switches() {
         let (set, joint, ctx) = prepared();
         assert_eq!(joint.rows(&ctx, &set).rows.len(), 4);

@@ -994,22 +994,4 @@ mod tests {
         // The prepare's rows are the report's at the same poses.
         assert!((joint.perp_row.s_a - rows.rows[0].jacobian[0].angular.abs()).abs() < 1e-5);
     }
-
-    #[test]
-    fn the_warm_start_by_body_is_the_pair_warm_start() {
-        let (mut set, a, b) = pair();
-        let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
-        let def = PrismaticJointDef::new(a, b, Vec2::new(0.5, 0.2), Vec2::ZERO, Vec2::X)
-            .with_motor(1.0, 10.0);
-        let mut joint = PrismaticJoint::new(def);
-        joint.prepare(&ctx, &set);
-        joint.solve(&ctx, &mut set.states, true);
-        let mut whole = set.states.clone();
-        joint.warm_start(&ctx, &mut whole);
-        let (sa, sb) = (joint.base.state_a as usize, joint.base.state_b as usize);
-        let mut by_body = set.states.clone();
-        crate::kind_rows::warm_start_side(&joint, &mut by_body[sa], false);
-        crate::kind_rows::warm_start_side(&joint, &mut by_body[sb], true);
-        assert_eq!(whole, by_body);
-    }
 }

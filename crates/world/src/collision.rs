@@ -86,6 +86,27 @@ impl Collision {
         &self.shapes
     }
 
+    /// Updates each existing contact of shape `slot` from its two shapes
+    /// (`f(shape a, shape b, contact)`): what a shape setter does to the
+    /// contacts it already has (event switches, mixed materials).
+    pub(crate) fn update_contacts_of_shape(
+        &mut self,
+        slot: u32,
+        mut f: impl FnMut(&ShapeData, &ShapeData, &mut Contact),
+    ) {
+        let body = self.shapes.at(slot).body;
+        let ids: smallvec::SmallVec<[u32; 8]> =
+            self.contacts.of_body(body).iter().copied().collect();
+        for id in ids {
+            let Some(c) = self.contacts.get_mut(id) else {
+                continue;
+            };
+            if c.shape_a == slot || c.shape_b == slot {
+                f(self.shapes.at(c.shape_a), self.shapes.at(c.shape_b), c);
+            }
+        }
+    }
+
     /// The narrowphase over the pairs the broadphase holds: manifolds,
     /// impulses carried by feature, begin/end events, and in `wake` the
     /// sleeping bodies a new touch wakes.
@@ -613,16 +634,42 @@ impl Collision {
                 continue;
             }
             self.broadphase.destroy_proxy(old);
-            let geometry = &self.shapes.at(s).geometry;
-            let aabb = geometry.compute_aabb(xf);
-            let margin = proxy_margin(geometry, self.broadphase.margin());
-            let proxy =
-                self.broadphase
-                    .create_proxy_with_margin(bounded(aabb), s, is_static, margin);
-            let shape = self.shapes.at_mut(s);
-            shape.aabb = aabb;
-            shape.proxy = proxy;
+            self.make_proxy(s, xf, is_static);
         }
+    }
+
+    /// Takes a body's shapes out of the broadphase (a disabled body):
+    /// their proxies become `NO_PROXY`.
+    pub(crate) fn drop_body_proxies(&mut self, body: BodyHandle) {
+        let n = self.shapes.of_body(body).len();
+        for k in 0..n {
+            let s = self.shapes.of_body(body)[k];
+            self.broadphase.destroy_proxy(self.shapes.at(s).proxy);
+            self.shapes.at_mut(s).proxy = crate::broadphase::NO_PROXY;
+        }
+    }
+
+    /// Puts a body's shapes (without proxies) back into the broadphase at
+    /// `xf` (an enabled body).
+    pub(crate) fn add_body_proxies(&mut self, body: BodyHandle, xf: &Transform, is_static: bool) {
+        let n = self.shapes.of_body(body).len();
+        for k in 0..n {
+            let s = self.shapes.of_body(body)[k];
+            self.make_proxy(s, xf, is_static);
+        }
+    }
+
+    /// Shape `s`'s box at `xf` and a new proxy for it.
+    fn make_proxy(&mut self, s: u32, xf: &Transform, is_static: bool) {
+        let geometry = &self.shapes.at(s).geometry;
+        let aabb = geometry.compute_aabb(xf);
+        let margin = proxy_margin(geometry, self.broadphase.margin());
+        let proxy = self
+            .broadphase
+            .create_proxy_with_margin(bounded(aabb), s, is_static, margin);
+        let shape = self.shapes.at_mut(s);
+        shape.aabb = aabb;
+        shape.proxy = proxy;
     }
 
     /// Recomputes one body's shape boxes now (after a teleport).

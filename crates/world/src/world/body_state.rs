@@ -177,18 +177,7 @@ impl World {
                 }
             }
         }
-        let shapes: smallvec::SmallVec<[u32; 4]> = self
-            .collision
-            .shapes
-            .of_body(body)
-            .iter()
-            .copied()
-            .collect();
-        for s in shapes {
-            let proxy = self.collision.shapes.at(s).proxy;
-            self.collision.broadphase.destroy_proxy(proxy);
-            self.collision.shapes.at_mut(s).proxy = crate::broadphase::NO_PROXY;
-        }
+        self.collision.drop_body_proxies(body);
         self.islands.remove_body(body);
         self.bodies.set_disabled(body, true);
     }
@@ -204,28 +193,8 @@ impl World {
         if ty == BodyType::Dynamic {
             self.islands.add_body(body);
         }
-        let shapes: smallvec::SmallVec<[u32; 4]> = self
-            .collision
-            .shapes
-            .of_body(body)
-            .iter()
-            .copied()
-            .collect();
-        for s in shapes {
-            let c = &mut self.collision;
-            let geometry = c.shapes.at(s).geometry;
-            let aabb = geometry.compute_aabb(&xf);
-            let margin = crate::broadphase::proxy_margin(&geometry, c.broadphase.margin());
-            let proxy = c.broadphase.create_proxy_with_margin(
-                crate::broadphase::bounded(aabb),
-                s,
-                ty == BodyType::Static,
-                margin,
-            );
-            let shape = c.shapes.at_mut(s);
-            shape.aabb = aabb;
-            shape.proxy = proxy;
-        }
+        self.collision
+            .add_body_proxies(body, &xf, ty == BodyType::Static);
         let mine: Vec<JointHandle> = self
             .disabled_joints
             .iter()

@@ -156,28 +156,9 @@ impl World {
     pub fn set_shape_hit_events(&mut self, shape: ShapeHandle, on: bool) -> Result<(), WorldError> {
         let slot = self.shape_slot(shape)?;
         self.collision.shapes.set_hit_events(slot, on);
-        let body = self.collision.shapes.at(slot).body;
-        let ids: smallvec::SmallVec<[u32; 8]> = self
-            .collision
-            .contacts
-            .of_body(body)
-            .iter()
-            .copied()
-            .collect();
-        for id in ids {
-            let Some(c) = self.collision.contacts.get(id) else {
-                continue;
-            };
-            if c.shape_a != slot && c.shape_b != slot {
-                continue;
-            }
-            let (a, b) = (c.shape_a, c.shape_b);
-            let hits = self.collision.shapes.at(a).def.enable_hit_events
-                || self.collision.shapes.at(b).def.enable_hit_events;
-            if let Some(c) = self.collision.contacts.get_mut(id) {
-                c.hit_events = hits;
-            }
-        }
+        self.collision.update_contacts_of_shape(slot, |a, b, c| {
+            c.hit_events = a.def.enable_hit_events || b.def.enable_hit_events;
+        });
         Ok(())
     }
 
@@ -198,30 +179,9 @@ impl World {
 
     /// Recomputes the event switches of the shape's existing contacts.
     fn refresh_event_flags(&mut self, slot: u32) {
-        let body = self.collision.shapes.at(slot).body;
-        let ids: smallvec::SmallVec<[u32; 8]> = self
-            .collision
-            .contacts
-            .of_body(body)
-            .iter()
-            .copied()
-            .collect();
-        for id in ids {
-            let Some(c) = self.collision.contacts.get(id) else {
-                continue;
-            };
-            if c.shape_a != slot && c.shape_b != slot {
-                continue;
-            }
-            let (a, b) = (c.shape_a, c.shape_b);
-            let flags = crate::contacts::event_flags::of(
-                &self.collision.shapes.at(a).def,
-                &self.collision.shapes.at(b).def,
-            );
-            if let Some(c) = self.collision.contacts.get_mut(id) {
-                c.event_flags = flags;
-            }
-        }
+        self.collision.update_contacts_of_shape(slot, |a, b, c| {
+            c.event_flags = crate::contacts::event_flags::of(&a.def, &b.def);
+        });
     }
 
     /// Stage timings of the solver in the last step.

@@ -291,33 +291,15 @@ impl World {
 
     /// Re-mixes the material of the shape's existing contacts.
     pub(super) fn refresh_contact_materials(&mut self, slot: u32) {
-        let body = self.collision.shapes.at(slot).body;
-        let ids: smallvec::SmallVec<[u32; 8]> = self
-            .collision
-            .contacts
-            .of_body(body)
-            .iter()
-            .copied()
-            .collect();
-        for id in ids {
-            let Some(c) = self.collision.contacts.get(id) else {
-                continue;
-            };
-            if c.shape_a != slot && c.shape_b != slot {
-                continue;
-            }
-            let (a, b) = (c.shape_a, c.shape_b);
-            let (sa, sb) = (self.collision.shapes.at(a), self.collision.shapes.at(b));
-            let mixed = self.hooks.mix(sa, sb);
-            let ids = [sa.def.user_material_id, sb.def.user_material_id];
-            if let Some(c) = self.collision.contacts.get_mut(id) {
-                c.friction = mixed.friction;
-                c.restitution = mixed.restitution;
-                c.tangent_speed = mixed.tangent_speed;
-                c.rolling_resistance = mixed.rolling_resistance;
-                c.user_material_ids = ids;
-            }
-        }
+        let hooks = &self.hooks;
+        self.collision.update_contacts_of_shape(slot, |sa, sb, c| {
+            let mixed = hooks.mix(sa, sb);
+            c.friction = mixed.friction;
+            c.restitution = mixed.restitution;
+            c.tangent_speed = mixed.tangent_speed;
+            c.rolling_resistance = mixed.rolling_resistance;
+            c.user_material_ids = [sa.def.user_material_id, sb.def.user_material_id];
+        });
     }
 
     /// Sets the shape's friction (finite, ≥ 0); its contacts use it from
