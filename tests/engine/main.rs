@@ -43,5 +43,6 @@ mod soak;
 mod stages;
 mod step_events;
 mod surface_materials;
+mod tree_momentum;
 mod weld;
 mod wheel;

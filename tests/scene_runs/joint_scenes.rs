@@ -2,6 +2,7 @@
 //! and the 160-plank bridge (planks need no collision here).
 
 use janus2d::prelude::*;
+use janus2d_testbed::janus::Janus;
 use janus2d_testbed::{hard, scenes};
 
 const DT: Real = 1.0 / 60.0;
@@ -154,5 +155,61 @@ fn joint_read_back_is_the_force_over_the_step_and_holds_after_sleep() {
         let f = world.joint_force(joint).unwrap();
         assert!((f.y - 100.0).abs() < 1.0, "asleep: {f}");
         assert!(world.joint_torque(joint).unwrap().abs() < 1e-3);
+    }
+}
+
+/// One member of the stretched-chain family at `substeps`: (its peak
+/// speed, its unstretched twin's, its late joint gap).
+fn family_figures(case: &hard::ChainFamilyCase, substeps: u32) -> (f64, f64, f64) {
+    let run = |desc: &janus2d_testbed::desc::SceneDesc| {
+        let mut desc = desc.clone();
+        desc.settings.substeps = substeps;
+        let case = hard::HardCase {
+            name: "stretched_chain_family",
+            desc,
+            steps: 600,
+            bounds: vec![],
+            rest: None,
+            box2d: "",
+        };
+        case.run::<Janus>().unwrap().figures
+    };
+    let stretched = run(&case.stretched);
+    let unstretched = run(&case.unstretched);
+    (
+        stretched.get(hard::Figure::PeakSpeed),
+        unstretched.get(hard::Figure::PeakSpeed),
+        stretched.get(hard::Figure::LateJointGap),
+    )
+}
+
+/// The stretched-chain family (`hard::stretched_chain_family`: lying,
+/// hanging, 45°; 1.5×, 2×, 3×; 20 and 40 links; circles and capsules) at
+/// 1, 2, 4 and 8 substeps (`JANUS2D_SUBSTEPS=a,b` picks): each member's
+/// peak speed beside its bound (the unstretched twin's peak + 5%, at least
+/// 3 m/s hanging) and its late joint gap (bound 1 cm). A report:
+/// `cargo test --release --test scene_runs -- --ignored --nocapture stretched_chain_family_report`.
+#[test]
+#[ignore = "report: the stretched-chain family at 1, 2, 4, 8 substeps"]
+fn stretched_chain_family_report() {
+    let substeps: Vec<u32> = std::env::var("JANUS2D_SUBSTEPS")
+        .ok()
+        .map(|v| v.split(',').filter_map(|s| s.parse().ok()).collect())
+        .unwrap_or_else(|| vec![1, 2, 4, 8]);
+    for &n in &substeps {
+        let mut passed = 0;
+        let family = hard::stretched_chain_family();
+        for case in &family {
+            let (peak, twin, late_gap) = family_figures(case, n);
+            let bound = case.speed_bound(twin);
+            let pass = peak <= bound && late_gap <= 0.01;
+            passed += usize::from(pass);
+            eprintln!(
+                "{n} substeps {:<26} {} peak {peak:8.2} m/s (bound {bound:7.2}, twin {twin:7.2}) late gap {late_gap:.4} m",
+                case.name,
+                if pass { "pass" } else { "FAIL" },
+            );
+        }
+        eprintln!("{n} substeps: {passed} of {} pass", family.len());
     }
 }

@@ -717,6 +717,110 @@ pub fn stretched_chain() -> HardCase {
     }
 }
 
+/// One member of the stretched-chain family: a chain of `links`
+/// non-colliding links (anchors ±0.5 on each, rest spacing 1 m) hinged to
+/// a static pin at the origin, laid out along the direction `angle`
+/// (rad; 0 lying to the right, −π/2 hanging, −π/4 at 45° below), its
+/// bodies placed `stretch` m apart (1: unstretched; 2: a 1 m error at every
+/// joint), turned to the direction so every error is along the chain.
+/// Links are circles of r 0.25 or capsules of half-length 0.3 and r 0.125
+/// (density 1). Released from rest under gravity for 10 s.
+#[must_use]
+pub fn posed_chain(angle: f64, stretch: f64, links: usize, capsules: bool) -> SceneDesc {
+    let mut d = SceneDesc::new("stretched_chain_family", 600);
+    let ground = d.add(BodyDesc::fixed(DVec2::ZERO));
+    let mut link = ShapeDesc::new(if capsules {
+        Geometry::Capsule {
+            a: v(-0.3, 0.0),
+            b: v(0.3, 0.0),
+            radius: 0.125,
+        }
+    } else {
+        Geometry::Circle {
+            center: DVec2::ZERO,
+            radius: 0.25,
+        }
+    });
+    link.filter.mask = 0;
+    let axis = DVec2::from_angle(angle);
+    let mut prev = ground;
+    for i in 0..links {
+        let mut body = BodyDesc::dynamic(axis * (stretch * (i as f64 + 0.5))).with(link.clone());
+        body.angle = angle;
+        let b = d.add(body);
+        let anchor_a = if i == 0 { DVec2::ZERO } else { v(0.5, 0.0) };
+        d.join(RevoluteDesc::new(prev, b, anchor_a, v(-0.5, 0.0)));
+        prev = b;
+    }
+    d.probe = Some(prev);
+    d.probe_label = "free end";
+    d
+}
+
+/// A member of the stretched-chain family with its unstretched twin.
+#[derive(Clone, Debug)]
+pub struct ChainFamilyCase {
+    /// `pose/stretch/links/shape`, e.g. `hanging x2 40 capsules`.
+    pub name: String,
+    /// The chain released stretched.
+    pub stretched: SceneDesc,
+    /// The same chain built unstretched and released the same way.
+    pub unstretched: SceneDesc,
+    /// The pose is hanging (an unstretched hanging chain does not swing).
+    pub hanging: bool,
+}
+
+/// Speed a hanging chain may reach while its stretch is corrected, m/s
+/// (it would not move at all unstretched).
+pub const HANGING_RECOVERY_SPEED: f64 = 3.0;
+
+impl ChainFamilyCase {
+    /// The bound on the stretched chain's peak speed, m/s: its
+    /// unstretched twin's peak + 5%, at least [`HANGING_RECOVERY_SPEED`]
+    /// for a hanging chain.
+    #[must_use]
+    pub fn speed_bound(&self, unstretched_peak: f64) -> f64 {
+        let bound = unstretched_peak * 1.05;
+        if self.hanging {
+            bound.max(HANGING_RECOVERY_SPEED)
+        } else {
+            bound
+        }
+    }
+}
+
+/// The stretched-chain family: lying, hanging and at 45°; stretched 1.5×,
+/// 2× and 3×; 20 and 40 links; circles and capsules (36 members). Each is
+/// bounded by its unstretched twin ([`ChainFamilyCase::speed_bound`]) and
+/// every joint back within 1 cm over the last second.
+#[must_use]
+pub fn stretched_chain_family() -> Vec<ChainFamilyCase> {
+    let poses = [
+        ("lying", 0.0, false),
+        ("hanging", -std::f64::consts::FRAC_PI_2, true),
+        ("45deg", -std::f64::consts::FRAC_PI_4, false),
+    ];
+    let mut out = Vec::new();
+    for (pose, angle, hanging) in poses {
+        for stretch in [1.5, 2.0, 3.0] {
+            for links in [20, 40] {
+                for capsules in [false, true] {
+                    out.push(ChainFamilyCase {
+                        name: format!(
+                            "{pose} x{stretch} {links} {}",
+                            if capsules { "capsules" } else { "circles" }
+                        ),
+                        stretched: posed_chain(angle, stretch, links, capsules),
+                        unstretched: posed_chain(angle, 1.0, links, capsules),
+                        hanging,
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
 /// `joint_grid` with N = 40 and doubled gravity: peak gap ≤ 0.2 m.
 #[must_use]
 pub fn joint_grid_40() -> HardCase {
