@@ -4,8 +4,10 @@
 //! some also pinned a second time; masses and inertias in [0.1, 1e3]) one
 //! solve
 //!
-//! - satisfies every joint's soft row exactly: `J v' + β C + Γ Δλ = 0`
-//!   (with bias) or `J v' + Γ Δλ = 0` (relax), `Γ = K / a2`;
+//! - satisfies every joint's soft row exactly: `J v' + b_v + Γ Δλ = 0`
+//!   (with bias: `b_v` the velocity solve's share of `β C`, see
+//!   `joint_tree::VELOCITY_CORRECTION_SPEED`) or `J v' + Γ Δλ = 0`
+//!   (relax), `Γ = K / a2`;
 //! - changes the bodies' total linear momentum by exactly the impulses the
 //!   static pin takes.
 //!
@@ -19,6 +21,7 @@
 //! through its joint. `JANUS2D_REPORT=1` prints the
 //! worst error as a fraction of its bound.
 
+use janus2d_constraints::joint_tree::VELOCITY_CORRECTION_SPEED;
 use janus2d_constraints::revolute::{RevoluteJoint, RevoluteJointDef};
 use janus2d_constraints::{Joint, JointForest};
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
@@ -173,12 +176,17 @@ fn tree_solve_satisfies_every_soft_row() {
             for i in 0..2 {
                 let c_dot = d(after.row_velocity(i, |h| velocity(&b.set, h)));
                 let bias = if case.use_bias {
+                    // The velocity solve's share of the capped feedback
+                    // (`joint_tree::VELOCITY_CORRECTION_SPEED`; the
+                    // joints start with no impulse, so nothing is held);
+                    // the rest moves the bodies in the correction pass.
                     let c = Vec2::new(rows.rows[0].c, rows.rows[1].c);
-                    let bias = soft.bias_rate * c;
-                    let len = bias.length();
-                    let cap = ctx.direct_joint_max_correction_speed;
-                    let bias = if len > cap { bias * (cap / len) } else { bias };
-                    d(bias[i])
+                    let clamp = |b: Vec2, cap: Real| {
+                        let len = b.length();
+                        if len > cap { b * (cap / len) } else { b }
+                    };
+                    let full = clamp(soft.bias_rate * c, ctx.direct_joint_max_correction_speed);
+                    d(clamp(full, VELOCITY_CORRECTION_SPEED)[i])
                 } else {
                     0.0
                 };

@@ -346,8 +346,8 @@ fn weld(j: &Joint) -> &WeldJoint {
 }
 
 /// One solve satisfies every weld's three soft rows exactly:
-/// `J v' + β C + Γ λ' = 0` (bias) or `J v' + Γ Δλ = 0` (relax), with the
-/// full 3×3 `K` in `Γ = K / a2`.
+/// `J v' + b + Γ λ' = 0` (bias: `b` the velocity solve's share of `β C`)
+/// or `J v' + Γ Δλ = 0` (relax), with the full 3×3 `K` in `Γ = K / a2`.
 #[test]
 fn weld_tree_solve_satisfies_every_soft_row() {
     check("weld tree residual", weld_case(), |case| {
@@ -418,12 +418,22 @@ fn weld_tree_residual(case: &WeldCase) -> Result<(f64, f64), TestCaseError> {
         ];
         let k = &rows.blocks[0].k;
         let bias = if case.use_bias {
+            // The point rows: the velocity solve's share of the feedback
+            // (the tree hangs from the pin, the welds start with no
+            // impulse: `joint_tree::VELOCITY_CORRECTION_SPEED`); the rest
+            // moves the bodies in the correction pass.
             let c = Vec2::new(rows.rows[0].c, rows.rows[1].c);
             let bias = soft.bias_rate * c;
             let len = bias.length();
+            let share = janus2d_constraints::joint_tree::VELOCITY_CORRECTION_SPEED;
+            let bias = if len > share {
+                bias * (share / len)
+            } else {
+                bias
+            };
+            // The angle row's feedback stays whole, capped at the
+            // correction speed in rad/s.
             let cap = ctx.direct_joint_max_correction_speed;
-            let bias = if len > cap { bias * (cap / len) } else { bias };
-            // The angle row's feedback is capped at the same number in rad/s.
             let angle_cap = janus2d_constraints::parts::angular_correction_cap(cap);
             let angle = (soft.bias_rate * rows.rows[2].c).clamp(-angle_cap, angle_cap);
             [d(bias.x), d(bias.y), d(angle)]

@@ -23,10 +23,13 @@ fn determinism_hash_matches_golden_value() {
     let hash = build_and_run();
     // Issue 12: the joints' Gauss–Seidel rows (here the chains' limits,
     // springs and motors) are solved colour by colour, not in storage order.
+    // Issue 33: the chains hang from pins, so the large errors their
+    // limits and motors open are corrected on pseudo-velocities
+    // (`joint_tree::VELOCITY_CORRECTION_SPEED`).
     #[cfg(not(feature = "f64"))]
-    let golden: u64 = 0x44dd_3561_bdfb_08a9;
+    let golden: u64 = 0x2a67_3270_1968_c9aa;
     #[cfg(feature = "f64")]
-    let golden: u64 = 0x6416_4074_5836_e0dc;
+    let golden: u64 = 0x29e3_04c0_0c68_24a6;
     assert_eq!(
         hash, golden,
         "state hash {hash:#018x} differs from the golden value"

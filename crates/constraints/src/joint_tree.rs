@@ -528,6 +528,12 @@ struct JointScratch {
     /// A `General` joint: solved by the general 3×3 path (its
     /// [`WideScratch`]).
     general: bool,
+    /// The bias pass left part of its feedback to the correction pass
+    /// (see [`VELOCITY_CORRECTION_SPEED`]).
+    split: bool,
+    /// That part: the point rows' (m/s) and the angle row's (rad/s).
+    rest: Vec2,
+    rest_angle: Real,
 }
 
 /// The part of a tree joint's scratch only 3-row and `General` joints
@@ -554,6 +560,8 @@ struct WideScratch {
     g_impulse: [Real; 3],
     /// Which of its rows have their correction speed capped.
     g_linear: [bool; 3],
+    /// The part of its rows' feedback left to the correction pass.
+    g_rest: DVec3,
     /// Its number of rows.
     g_count: usize,
 }
@@ -574,6 +582,9 @@ impl JointScratch {
         c_angle: 0.0,
         angle_impulse: 0.0,
         general: false,
+        split: false,
+        rest: Vec2::ZERO,
+        rest_angle: 0.0,
     };
 }
 
@@ -587,6 +598,7 @@ impl WideScratch {
         g_c: DVec3::ZERO,
         g_impulse: [0.0; 3],
         g_linear: [false; 3],
+        g_rest: DVec3::ZERO,
         g_count: 0,
     };
 }
@@ -624,6 +636,8 @@ pub struct JointForest {
     joint_scratch: Vec<JointScratch>,
     /// Per tree joint: the 3-row and general rows' part of its scratch.
     wide_scratch: Vec<WideScratch>,
+    /// Per tree: the last bias pass left it a position correction.
+    correct: Vec<bool>,
     /// Per joint: its moving ends this step (see `moving_pair`).
     pairs: Vec<[u32; 3]>,
     /// The pairs and switch the forest was last built from.
@@ -908,7 +922,7 @@ impl JointForest {
             return;
         }
         let softness = ctx.direct_joint_softness;
-        let params = TreeParams {
+        let mut params = TreeParams {
             softness,
             compliance: if softness.mass_scale > 0.0 {
                 to_f64(softness.impulse_scale) / to_f64(softness.mass_scale)
@@ -918,53 +932,10 @@ impl JointForest {
             h: to_f64(ctx.h),
             max_correction_speed: ctx.direct_joint_max_correction_speed,
             use_bias,
+            correct: false,
+            anchored: false,
         };
-        {
-            let (bodies, tree_joints) = (&self.bodies[..], &self.joints[..]);
-            let (joints, states) = (&*joints, &*states);
-            let mut rest_bodies = &mut self.body_scratch[..];
-            let mut rest_joints = &mut self.joint_scratch[..];
-            let mut rest_wide = &mut self.wide_scratch[..];
-            let starts = &self.trees;
-            let split = starts.iter().enumerate().map(move |(t, &start)| {
-                let end = starts.get(t + 1).copied().unwrap_or(TreeStart {
-                    bodies: bodies.len() as u32,
-                    joints: tree_joints.len() as u32,
-                });
-                let body_range = start.bodies as usize..end.bodies as usize;
-                let joint_range = start.joints as usize..end.joints as usize;
-                let (body_scratch, tail) =
-                    std::mem::take(&mut rest_bodies).split_at_mut(body_range.len());
-                rest_bodies = tail;
-                let (joint_scratch, tail) =
-                    std::mem::take(&mut rest_joints).split_at_mut(joint_range.len());
-                rest_joints = tail;
-                let (wide_scratch, tail) =
-                    std::mem::take(&mut rest_wide).split_at_mut(joint_range.len());
-                rest_wide = tail;
-                Tree {
-                    states: &bodies[body_range],
-                    joints: &tree_joints[joint_range],
-                    bodies: body_scratch,
-                    rows: joint_scratch,
-                    wide: wide_scratch,
-                }
-            });
-            if team.threads() == 1 {
-                // Tree by tree, without collecting the split.
-                for mut tree in split {
-                    solve_tree(&mut tree, joints, states, &params);
-                }
-            } else {
-                let mut trees: Vec<_> = split.collect();
-                let per_block = trees.len().div_ceil(4 * team.threads()).max(1);
-                team.for_each_chunk_mut(&mut trees, per_block, |_, block| {
-                    for tree in block.iter_mut() {
-                        solve_tree(tree, joints, states, &params);
-                    }
-                });
-            }
-        }
+        self.solve_trees(joints, states, &params, team, false);
         for (&s, sc) in self.bodies.iter().zip(&self.body_scratch) {
             let st = &mut states[s as usize];
             st.v = sc.state.v;
@@ -979,10 +950,125 @@ impl JointForest {
             };
             joints[tj.index as usize].set_tree_impulses(impulses);
         }
+        if !use_bias {
+            return;
+        }
+        // The trees whose feedback the bias pass split: their position
+        // correction, on pseudo-velocities (see VELOCITY_CORRECTION_SPEED).
+        self.correct.clear();
+        let mut any = false;
+        for (t, start) in self.trees.iter().enumerate() {
+            let end = self
+                .trees
+                .get(t + 1)
+                .map_or(self.joints.len(), |n| n.joints as usize);
+            let split = self.joint_scratch[start.joints as usize..end]
+                .iter()
+                .any(|row| row.split);
+            any |= split;
+            self.correct.push(split);
+        }
+        if !any {
+            return;
+        }
+        params.use_bias = false;
+        params.correct = true;
+        params.compliance *= CORRECTION_COMPLIANCE;
+        self.solve_trees(joints, states, &params, team, true);
+        let h = ctx.h;
+        for (t, start) in self.trees.iter().enumerate() {
+            if !self.correct[t] {
+                continue;
+            }
+            let end = self
+                .trees
+                .get(t + 1)
+                .map_or(self.bodies.len(), |n| n.bodies as usize);
+            let range = start.bodies as usize..end;
+            for (&s, sc) in self.bodies[range.clone()]
+                .iter()
+                .zip(&self.body_scratch[range])
+            {
+                let st = &mut states[s as usize];
+                st.dp += h * sc.state.v;
+                st.dq = st.dq.integrate(h * sc.state.w);
+            }
+        }
+    }
+
+    /// One pass of [`solve_tree`] over every tree (with `only_marked`,
+    /// over the trees marked in `correct`), on the team.
+    fn solve_trees(
+        &mut self,
+        joints: &[Joint],
+        states: &[BodyState],
+        params: &TreeParams,
+        team: &Team,
+        only_marked: bool,
+    ) {
+        let (bodies, tree_joints) = (&self.bodies[..], &self.joints[..]);
+        let mut rest_bodies = &mut self.body_scratch[..];
+        let mut rest_joints = &mut self.joint_scratch[..];
+        let mut rest_wide = &mut self.wide_scratch[..];
+        let starts = &self.trees;
+        let marked = &self.correct;
+        let split = starts.iter().enumerate().filter_map(move |(t, &start)| {
+            let end = starts.get(t + 1).copied().unwrap_or(TreeStart {
+                bodies: bodies.len() as u32,
+                joints: tree_joints.len() as u32,
+            });
+            let body_range = start.bodies as usize..end.bodies as usize;
+            let joint_range = start.joints as usize..end.joints as usize;
+            let (body_scratch, tail) =
+                std::mem::take(&mut rest_bodies).split_at_mut(body_range.len());
+            rest_bodies = tail;
+            let (joint_scratch, tail) =
+                std::mem::take(&mut rest_joints).split_at_mut(joint_range.len());
+            rest_joints = tail;
+            let (wide_scratch, tail) =
+                std::mem::take(&mut rest_wide).split_at_mut(joint_range.len());
+            rest_wide = tail;
+            (!only_marked || marked[t]).then_some(Tree {
+                states: &bodies[body_range],
+                joints: &tree_joints[joint_range],
+                bodies: body_scratch,
+                rows: joint_scratch,
+                wide: wide_scratch,
+            })
+        });
+        if team.threads() == 1 {
+            // Tree by tree, without collecting the split.
+            for mut tree in split {
+                solve_tree(&mut tree, joints, states, params);
+            }
+        } else {
+            let mut trees: Vec<_> = split.collect();
+            let per_block = trees.len().div_ceil(4 * team.threads()).max(1);
+            team.for_each_chunk_mut(&mut trees, per_block, |_, block| {
+                for tree in block.iter_mut() {
+                    solve_tree(tree, joints, states, params);
+                }
+            });
+        }
+    }
+}
+
+impl TreeParams {
+    /// The cap of a linear row's feedback, m/s: an anchored tree's
+    /// correction reaches CORRECTION_SPEED_FACTOR times the setting (only
+    /// [`VELOCITY_CORRECTION_SPEED`] of it in the velocities).
+    #[inline(always)]
+    fn linear_cap(&self) -> Real {
+        if self.anchored {
+            self.max_correction_speed * CORRECTION_SPEED_FACTOR
+        } else {
+            self.max_correction_speed
+        }
     }
 }
 
 /// The step constants of one tree solve.
+#[derive(Clone, Copy)]
 struct TreeParams {
     softness: janus2d_core::softness::Softness,
     /// `Γ / K = impulse_scale / mass_scale`.
@@ -992,6 +1078,82 @@ struct TreeParams {
     /// Largest correction speed, m/s.
     max_correction_speed: Real,
     use_bias: bool,
+    /// The position correction pass (see [`VELOCITY_CORRECTION_SPEED`]):
+    /// only the feedback above that speed, on pseudo-velocities.
+    correct: bool,
+    /// The tree is held by a fixed end, so its feedback is split between
+    /// the velocity solve and the correction pass (set per tree).
+    anchored: bool,
+}
+
+/// Largest position-feedback speed of one tree joint that goes into the
+/// bodies' velocities, m/s (rad/s for angle rows, through
+/// [`angular_correction_cap`]), beyond what its softness holds (see
+/// `velocity_share`). A larger error's feedback (up to
+/// `direct_joint_max_correction_speed`) is split: this much in the
+/// velocity solve, the rest in a second, position-only solve of the same
+/// tree on pseudo-velocities (Catto's split impulses), which moves the
+/// bodies and adds no speed:
+///
+/// ```text
+/// bias pass:        J Δv + Γ Δλ = −(Ċ + b_v + Γ λ)     b_v = β C capped at v_vel + |Γ λ|
+/// correction pass:  J Δv_b + ε Γ Δλ_b = −(b − b_v)      b   = β C capped at v_max
+///                   dp += h Δv_b,  dq ← dq ⊕ h Δω_b      (Δv_b, Δλ_b then dropped)
+/// ```
+///
+/// With the whole feedback in the velocities, a chain hung 2× stretched
+/// (40 circles) reached 48 m/s where the same chain unstretched does not
+/// move, and the stretched-chain family (`janus2d_testbed::hard`) passed
+/// 4 of 36 at 4 substeps: the relax pass that removes the correction's
+/// speed is soft, and its compliance acts on the impulse that stops the
+/// whole subtree below a joint, so part of the speed stays; made rigid,
+/// its impulses compress the closing chain and it buckles (links spinning
+/// at 40 rad/s). The correction solve is nearly rigid
+/// ([`CORRECTION_COMPLIANCE`]: with the joints' own softness a 40-link
+/// chain's root joints closed at 2% of the asked speed) and moves the
+/// bodies rather than turning them ([`CORRECTION_INERTIA`]). Its metric
+/// does not touch momentum: the pseudo-velocities are not kept. A joint
+/// whose feedback stays below its share (every joint of the benchmark
+/// scenes' ragdolls at rest) never reaches the second solve, which then
+/// costs nothing.
+pub const VELOCITY_CORRECTION_SPEED: Real = 0.1;
+
+/// The correction solve's compliance as a fraction of the joints' own
+/// (dimensionless): nearly rigid, so a long chain's joints near its root
+/// close at the asked speed (with the joints' own, 0.04 of 1.9 m/s at the
+/// sixth of 40 links). Kept above zero so that a joint to a fixed end
+/// keeps a definite pivot.
+const CORRECTION_COMPLIANCE: f64 = 1.0e-4;
+
+/// The correction solve's rotational inertia, as a multiple of `m r²`
+/// for a body's longest joint arm `r` (dimensionless): a gap is closed by
+/// moving the bodies rather than by turning light links through large
+/// angles, whose linearisation zig-zagged a lying 40-link chain (late gap
+/// 0.54 m at `m r²`; 10: 25 of the 36 family members, 100: 36).
+const CORRECTION_INERTIA: f64 = 100.0;
+
+/// How far above `direct_joint_max_correction_speed` an anchored tree's
+/// correction may go (dimensionless): the velocity solve keeps at most
+/// [`VELOCITY_CORRECTION_SPEED`] of it, so the cap no longer bounds speed
+/// added, only how far the bodies move in a substep (at 2 m/s × 5 a
+/// joint closes 4 cm per substep at 240 Hz). The stretched-chain family
+/// passed 17 of 36 at the cap itself, 30 at 2.5×, 36 at 5×.
+const CORRECTION_SPEED_FACTOR: Real = 5.0;
+
+/// The largest feedback speed a tree joint's row keeps in the velocity
+/// solve, m/s, given the speed `held` (m/s) its softness term `Γ λ` asks
+/// for: [`VELOCITY_CORRECTION_SPEED`] plus that, so a joint holding a load
+/// keeps the feedback that balances its softness (its static stretch,
+/// where `β C = Γ λ`) where it was, and only an error beyond it is moved
+/// by the correction pass. (With all of it above 0.1 m/s moved, the
+/// 670:1 ball and chain opened to 4.2 m and the bridge to 0.54 m.)
+#[inline(always)]
+fn velocity_share(held: Real, params: &TreeParams) -> Real {
+    if params.anchored {
+        VELOCITY_CORRECTION_SPEED + held
+    } else {
+        Real::MAX
+    }
 }
 
 /// One tree's share of the forest: its topology and its scratch.
@@ -1029,12 +1191,22 @@ fn other_end<'s>(
 /// are `side ((x_p + r_p) − (x_o + r_o))`, with `o` its other end (child or
 /// fixed) and `side` +1 where the parent is the joint's body b.
 fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], params: &TreeParams) {
+    // A tree held by a fixed end splits its feedback (see
+    // VELOCITY_CORRECTION_SPEED) up to CORRECTION_SPEED_FACTOR times the
+    // cap; a free tree keeps all of it, at the cap, in its velocities.
+    let anchored = tree.joints.iter().any(|tj| tj.child == NONE);
+    let params = &TreeParams {
+        anchored,
+        ..*params
+    };
     let TreeParams {
         softness,
         compliance,
         h,
-        max_correction_speed,
+        max_correction_speed: _,
         use_bias,
+        correct,
+        anchored: _,
     } = *params;
     let Tree {
         states: indices,
@@ -1046,6 +1218,11 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
     let (topology, bodies, rows, extra) = (&**topology, &mut **bodies, &mut **rows, &mut **extra);
     for (sc, &s) in bodies.iter_mut().zip(indices.iter()) {
         sc.state = states[s as usize];
+        if correct {
+            // The correction solves for pseudo-velocities from zero.
+            sc.state.v = Vec2::ZERO;
+            sc.state.w = 0.0;
+        }
         sc.leaf = true;
         sc.geometric = 0.0;
         sc.geometric_up = 0.0;
@@ -1067,8 +1244,12 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
         let side = tj.side;
         row.masses = base.masses;
         row.general = matches!(tree_rows, Some(TreeRows::General { .. }));
+        row.split = false;
         if row.general {
             general_rows(tj, row, w, j, bodies, states);
+            if correct {
+                w.g_impulse = [0.0; 3];
+            }
             continue;
         }
         let (point, tree_angle) = match tree_rows {
@@ -1104,10 +1285,20 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
             row.c_angle = wrap_angle(angle.delta_angle + q_a.relative_angle(q_b));
             row.angle_impulse = angle.impulse;
         }
+        if correct {
+            // Pseudo-impulses start from zero and are not kept.
+            row.impulse = Vec2::ZERO;
+            row.angle_impulse = 0.0;
+        }
         let lambda = wide(row.impulse);
         let parent = &mut bodies[tj.parent as usize];
         parent.leaf = false;
-        parent.geometric += geometric_stiffness(h, lambda, r_parent, side);
+        if correct {
+            // The correction's metric: the longest arm (see below).
+            parent.geometric = parent.geometric.max(to_f64(r_parent.length_squared()));
+        } else {
+            parent.geometric += geometric_stiffness(h, lambda, r_parent, side);
+        }
         if tj.child != NONE {
             let child = &mut bodies[tj.child as usize];
             child.set_mass(if side > 0.0 {
@@ -1116,7 +1307,11 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
                 base.masses.b
             });
             row.jac_child = Jacobian::new(-side, r_other, child);
-            child.geometric_up = geometric_stiffness(h, lambda, r_other, -side);
+            child.geometric_up = if correct {
+                to_f64(r_other.length_squared())
+            } else {
+                geometric_stiffness(h, lambda, r_other, -side)
+            };
         }
     }
     // Ĩ = max(I, K_g / GEOMETRIC_RATIO): only the inertia the limit needs
@@ -1127,7 +1322,18 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
         let (mut added, mut inv_i_tilde) = (0.0, inv_i);
         // Its child joints' terms first, then its parent joint's.
         let geometric = sc.geometric + sc.geometric_up;
-        if sc.ang > 0.0 && geometric > 0.0 {
+        if correct {
+            // The correction's inertia: at least m r² for the longest arm
+            // r (see VELOCITY_CORRECTION_SPEED).
+            let arm_squared = CORRECTION_INERTIA * sc.geometric.max(sc.geometric_up);
+            let inv_m = to_f64(sc.mass.inv_mass);
+            if sc.ang > 0.0 && inv_m > 0.0 {
+                added = (arm_squared / inv_m - 1.0 / inv_i).max(0.0);
+            }
+            if added > 0.0 {
+                inv_i_tilde = 1.0 / (1.0 / inv_i + added);
+            }
+        } else if sc.ang > 0.0 && geometric > 0.0 {
             added = (geometric / GEOMETRIC_RATIO - 1.0 / inv_i).max(0.0);
             if added > 0.0 {
                 inv_i_tilde = 1.0 / (1.0 / inv_i + added);
@@ -1193,13 +1399,18 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
             PointPart::effective_mass(&row.masses, r_parent, r_other)
         };
         let (k11, k12, k22) = (to_f64(k11), to_f64(k12), to_f64(k22));
-        let rhs = if use_bias {
-            let bias = clamp_length(softness.bias_rate * row.c, max_correction_speed);
+        let rhs = if correct {
+            -wide(row.rest)
+        } else if use_bias {
             let lambda = wide(row.impulse);
             let held = DVec2::new(
                 k11 * lambda.x + k12 * lambda.y,
                 k12 * lambda.x + k22 * lambda.y,
             ) * compliance;
+            let full = clamp_length(softness.bias_rate * row.c, params.linear_cap());
+            let bias = clamp_length(full, velocity_share(from_f64(held.length()), params));
+            row.rest = full - bias;
+            row.split = bias != full;
             -(wide(c_dot + bias) + held)
         } else {
             -wide(c_dot)
@@ -1318,19 +1529,33 @@ fn eliminate_three(
         three_row_k(&row.masses, r_parent, r_other)
     };
     let compliance = params.compliance;
-    let rhs = if params.use_bias {
-        let softness = params.softness;
-        let bias = clamp_length(softness.bias_rate * row.c, params.max_correction_speed);
-        let bias_angle = cap(
-            softness.bias_rate * row.c_angle,
-            angular_correction_cap(params.max_correction_speed),
-        );
+    let softness = params.softness;
+    let full = clamp_length(softness.bias_rate * row.c, params.linear_cap());
+    let full_angle = cap(
+        softness.bias_rate * row.c_angle,
+        angular_correction_cap(params.max_correction_speed),
+    );
+    let rhs = if params.correct {
+        let rest = wide(row.rest);
+        -DVec3::new(rest.x, rest.y, to_f64(row.rest_angle))
+    } else if params.use_bias {
         let lambda = DVec3::new(
             to_f64(row.impulse.x),
             to_f64(row.impulse.y),
             to_f64(row.angle_impulse),
         );
         let held = (k * lambda) * compliance;
+        let bias = clamp_length(
+            full,
+            velocity_share(from_f64(held.truncate().length()), params),
+        );
+        // Angle rows keep their whole feedback in the velocities: turned
+        // on pseudo-velocities, a chain of welds started 3 rad from its
+        // reference angles flung its boxes at 87 m/s.
+        let bias_angle = full_angle;
+        row.rest = full - bias;
+        row.rest_angle = 0.0;
+        row.split = bias != full;
         let v = wide(c_dot + bias);
         -(DVec3::new(v.x, v.y, to_f64(c_dot_angle + bias_angle)) + held)
     } else {
@@ -1532,23 +1757,41 @@ fn eliminate_general(
     let other = other_end(tj, row.fixed, bodies, states);
     let c_dot = rows_times(&w.g_parent, parent) + rows_times(&w.g_child, other);
     let compliance = params.compliance;
-    let mut rhs = if params.use_bias {
+    let mut rhs = if params.correct {
+        -w.g_rest
+    } else if params.use_bias {
         // Linear rows at the correction speed (m/s), angle rows at its
-        // angular counterpart (rad/s).
-        let max = to_f64(params.max_correction_speed);
+        // angular counterpart (rad/s); split between the velocity solve
+        // and the correction as VELOCITY_CORRECTION_SPEED says.
+        let max = to_f64(params.linear_cap());
         let max_angular = to_f64(angular_correction_cap(params.max_correction_speed));
-        let mut bias = w.g_c * to_f64(params.softness.bias_rate);
-        for (i, linear) in w.g_linear.iter().enumerate() {
-            let max = if *linear { max } else { max_angular };
-            bias[i] = if bias[i] > max {
-                max
-            } else if bias[i] < -max {
-                -max
-            } else {
-                bias[i]
-            };
-        }
         let held = (w.g_k * wide_rows(w.g_impulse)) * compliance;
+        let mut bias = w.g_c * to_f64(params.softness.bias_rate);
+        let clamp = |x: f64, m: f64| {
+            if x > m {
+                m
+            } else if x < -m {
+                -m
+            } else {
+                x
+            }
+        };
+        for (i, linear) in w.g_linear.iter().enumerate() {
+            // Angle rows keep their whole feedback in the velocities (see
+            // eliminate_three).
+            let (max, velocity) = if *linear {
+                (max, to_f64(velocity_share(from_f64(held[i].abs()), params)))
+            } else {
+                (max_angular, f64::MAX)
+            };
+            let full = clamp(bias[i], max);
+            let part = clamp(full, velocity);
+            if i < w.g_count && part != full {
+                row.split = true;
+            }
+            w.g_rest[i] = full - part;
+            bias[i] = part;
+        }
         -(c_dot + bias + held)
     } else {
         -c_dot
