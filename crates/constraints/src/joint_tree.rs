@@ -1109,9 +1109,9 @@ struct TreeParams {
 /// whole subtree below a joint, so part of the speed stays; made rigid,
 /// its impulses compress the closing chain and it buckles (links spinning
 /// at 40 rad/s). The correction solve is nearly rigid
-/// ([`CORRECTION_COMPLIANCE`]: with the joints' own softness a 40-link
+/// (`CORRECTION_COMPLIANCE`: with the joints' own softness a 40-link
 /// chain's root joints closed at 2% of the asked speed) and moves the
-/// bodies rather than turning them ([`CORRECTION_INERTIA`]). Its metric
+/// bodies rather than turning them (`CORRECTION_INERTIA`). Its metric
 /// does not touch momentum: the pseudo-velocities are not kept. A joint
 /// whose feedback stays below its share (every joint of the benchmark
 /// scenes' ragdolls at rest) never reaches the second solve, which then
