@@ -297,7 +297,10 @@ fn call(
         }
         23 => w.set_body_enabled(pick(&i.bodies, b.byte(), f), b.byte().is_multiple_of(2)),
         24 => {
-            let s = i.shapes.get(b.byte() as usize % i.shapes.len().max(1)).copied();
+            let s = i
+                .shapes
+                .get(b.byte() as usize % i.shapes.len().max(1))
+                .copied();
             let Some(s) = s else {
                 return Err(WorldError::StaleShape);
             };
@@ -315,7 +318,10 @@ fn call(
             }
         }
         25 | 26 => {
-            let s = i.shapes.get(b.byte() as usize % i.shapes.len().max(1)).copied();
+            let s = i
+                .shapes
+                .get(b.byte() as usize % i.shapes.len().max(1))
+                .copied();
             let Some(s) = s else {
                 return Err(WorldError::StaleShape);
             };
@@ -329,14 +335,19 @@ fn call(
                 6 => w.set_shape_sensor_events(s, b.byte().is_multiple_of(2)),
                 7 => w.set_shape_hit_events(s, b.byte().is_multiple_of(2)),
                 8 => w.set_shape_force_event_threshold(s, b.real()),
-                _ => w.set_body_move_events(pick(&i.bodies, b.byte(), f), b.byte().is_multiple_of(2)),
+                _ => {
+                    w.set_body_move_events(pick(&i.bodies, b.byte(), f), b.byte().is_multiple_of(2))
+                }
             }
         }
         27 => w
             .explode(&ExplosionDef::new(b.vec(), b.real(), b.real()).with_falloff(b.real()))
             .map(|_| ()),
         28 => {
-            let s = i.shapes.get(b.byte() as usize % i.shapes.len().max(1)).copied();
+            let s = i
+                .shapes
+                .get(b.byte() as usize % i.shapes.len().max(1))
+                .copied();
             let p = b.vec();
             let odd = |h: ShapeHandle| h.index % 2 == 1;
             let filter = QueryFilter::default().with_predicate(&odd);

@@ -147,7 +147,12 @@ fn issue32_calls(world: &mut World, bodies: &[BodyHandle], seed: u8) {
             let _ = world.set_shape_user_material_id(sh, k as u64);
             let _ = world.shape_test_point(sh, Vec2::ZERO);
             let _ = world.shape_project_point(sh, Vec2::new(0.5, 2.0));
-            let _ = world.shape_ray_cast(sh, Vec2::new(-5.0, 1.0), Vec2::new(10.0, 0.0), &QueryFilter::default());
+            let _ = world.shape_ray_cast(
+                sh,
+                Vec2::new(-5.0, 1.0),
+                Vec2::new(10.0, 0.0),
+                &QueryFilter::default(),
+            );
             let _ = world.sensor_overlaps(sh);
             valid(world, "after a shape call");
         }
@@ -158,7 +163,11 @@ fn issue32_calls(world: &mut World, bodies: &[BodyHandle], seed: u8) {
         valid(world, "after destroying a chain");
     }
     if let Some(&b) = bodies.first() {
-        let points = vec![Vec2::new(3.0, -1.0), Vec2::new(0.0, -1.2), Vec2::new(-3.0, -1.0)];
+        let points = vec![
+            Vec2::new(3.0, -1.0),
+            Vec2::new(0.0, -1.2),
+            Vec2::new(-3.0, -1.0),
+        ];
         let material = SurfaceMaterial::default().with_rolling_resistance(0.1);
         let _ = world.create_chain(b, &ChainDef::new(points).with_material(material));
         valid(world, "after creating a chain");
@@ -168,12 +177,28 @@ fn issue32_calls(world: &mut World, bodies: &[BodyHandle], seed: u8) {
     let _ = world.project_point(Vec2::new(0.0, 5.0), 10.0, &QueryFilter::default());
     let mover = Capsule::new(Vec2::new(0.0, 2.75), Vec2::new(0.0, 3.25), 0.25).expect("a capsule");
     if let Ok(cast) = world.cast_mover(&mover, Vec2::new(3.0, -6.0), &QueryFilter::default()) {
-        assert!(cast.fraction.is_finite(), "mover fraction {}", cast.fraction);
+        assert!(
+            cast.fraction.is_finite(),
+            "mover fraction {}",
+            cast.fraction
+        );
     }
-    let _ = world.collide_mover(&mover, 0.05, &QueryFilter::default(), |p| p.separation.is_finite());
+    let _ = world.collide_mover(&mover, 0.05, &QueryFilter::default(), |p| {
+        p.separation.is_finite()
+    });
     let mut cc = CharacterController::new().with_snap_to_ground(Some(0.1));
-    if let Ok(m) = cc.move_and_slide(world, &mover, Vec2::ZERO, Vec2::new(2.0, -1.0), DT, &QueryFilter::default()) {
-        assert!(m.position.is_finite() && m.velocity.is_finite(), "controller {m:?}");
+    if let Ok(m) = cc.move_and_slide(
+        world,
+        &mover,
+        Vec2::ZERO,
+        Vec2::new(2.0, -1.0),
+        DT,
+        &QueryFilter::default(),
+    ) {
+        assert!(
+            m.position.is_finite() && m.velocity.is_finite(),
+            "controller {m:?}"
+        );
     }
 }
 

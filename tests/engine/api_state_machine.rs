@@ -535,7 +535,12 @@ fn apply(
             if let Ok(data) = w.shape(s)
                 && let Shape::ChainSegment(mut c) = data.geometry
             {
-                for p in [&mut c.ghost1, &mut c.segment.point1, &mut c.segment.point2, &mut c.ghost2] {
+                for p in [
+                    &mut c.ghost1,
+                    &mut c.segment.point1,
+                    &mut c.segment.point2,
+                    &mut c.ghost2,
+                ] {
                     *p += *d;
                 }
                 return w.set_chain_segment(s, c);
@@ -608,9 +613,11 @@ fn apply(
                 1 => w.set_pair_filter(Some(Box::new(|a, b| (a.index ^ b.index) % 4 != 1))),
                 2 => {
                     w.set_friction_callback(Some(Box::new(move |a, _, b, _| v * (a + b))));
-                    w.set_restitution_callback(Some(Box::new(move |_, ma, _, mb| {
-                        if ma == mb { v } else { -v }
-                    })));
+                    w.set_restitution_callback(Some(Box::new(
+                        move |_, ma, _, mb| {
+                            if ma == mb { v } else { -v }
+                        },
+                    )));
                 }
                 _ => {
                     w.set_pre_solve(None);

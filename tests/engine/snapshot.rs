@@ -183,7 +183,10 @@ fn issue_32_state_continues_bit_exactly() {
         assert_eq!(restored.body_shapes(b), world.body_shapes(b));
         for s in world.body_shapes(b).unwrap() {
             assert_eq!(restored.shape(s).unwrap().def, world.shape(s).unwrap().def);
-            assert_eq!(restored.shape(s).unwrap().geometry, world.shape(s).unwrap().geometry);
+            assert_eq!(
+                restored.shape(s).unwrap().geometry,
+                world.shape(s).unwrap().geometry
+            );
         }
     }
     let mut events = [0usize; 4];

@@ -360,7 +360,9 @@ impl ChainFile {
             .with_loop(self.is_loop)
             .with_user_data(self.user_data);
         if !self.materials.is_empty() {
-            def = def.with_segment_materials(self.materials.iter().map(MaterialFile::material).collect());
+            def = def.with_segment_materials(
+                self.materials.iter().map(MaterialFile::material).collect(),
+            );
         }
         if let Some(f) = &self.filter {
             def = def.with_filter(f.filter());
@@ -1222,7 +1224,10 @@ impl SceneFile {
                     friction: from_f64(s.friction),
                     restitution: from_f64(s.restitution),
                     is_sensor: s.sensor,
-                    filter: s.filter.as_ref().map_or_else(Filter::default, FilterFile::filter),
+                    filter: s
+                        .filter
+                        .as_ref()
+                        .map_or_else(Filter::default, FilterFile::filter),
                     rolling_resistance: from_f64(s.rolling_resistance),
                     tangent_speed: from_f64(s.tangent_speed),
                     friction_combine: s.friction_combine.rule(),
@@ -1234,7 +1239,10 @@ impl SceneFile {
                     force_event_threshold: s.force_event_threshold.map_or(Real::INFINITY, from_f64),
                     ..ShapeDef::default()
                 };
-                finite(&format!("{field}.offset"), &[s.offset.position[0], s.offset.position[1], s.offset.angle])?;
+                finite(
+                    &format!("{field}.offset"),
+                    &[s.offset.position[0], s.offset.position[1], s.offset.angle],
+                )?;
                 let sd = sd.with_offset(v2(s.offset.position), from_f64(s.offset.angle));
                 let shapes = s
                     .geometry

@@ -626,13 +626,20 @@ pub fn issue32_world(steps: usize) -> janus2d_world::World {
     use janus2d_core::material::CombineRule;
     use janus2d_world::{ChainDef, ShapeDef, SurfaceMaterial, World, WorldDef};
     let v = Vec2::new;
-    let mut world = World::new(WorldDef::default().with_move_events(true)).expect("the default world");
-    let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).expect("ground");
+    let mut world =
+        World::new(WorldDef::default().with_move_events(true)).expect("the default world");
+    let ground = world
+        .create_body(&BodyDef::fixed(Vec2::ZERO))
+        .expect("ground");
     let materials = vec![
-        SurfaceMaterial::default().with_friction(0.2).with_material_id(7),
+        SurfaceMaterial::default()
+            .with_friction(0.2)
+            .with_material_id(7),
         SurfaceMaterial {
             friction_combine: CombineRule::Max,
-            ..SurfaceMaterial::default().with_friction(0.9).with_rolling_resistance(0.3)
+            ..SurfaceMaterial::default()
+                .with_friction(0.9)
+                .with_rolling_resistance(0.3)
         },
         SurfaceMaterial {
             restitution_combine: CombineRule::Min,
@@ -644,10 +651,16 @@ pub fn issue32_world(steps: usize) -> janus2d_world::World {
     ];
     let points = vec![v(12.0, 0.0), v(4.0, 0.0), v(-2.0, 0.0), v(-12.0, 0.0)];
     world
-        .create_chain(ground, &ChainDef::new(points).with_segment_materials(materials))
+        .create_chain(
+            ground,
+            &ChainDef::new(points).with_segment_materials(materials),
+        )
         .expect("the ground chain");
     let ball = world
-        .create_body(&BodyDef { linear_velocity: v(-4.0, 0.0), ..BodyDef::dynamic(v(8.0, 0.6)) })
+        .create_body(&BodyDef {
+            linear_velocity: v(-4.0, 0.0),
+            ..BodyDef::dynamic(v(8.0, 0.6))
+        })
         .expect("ball");
     let def = ShapeDef::default()
         .with_rolling_resistance(0.1)
@@ -658,12 +671,20 @@ pub fn issue32_world(steps: usize) -> janus2d_world::World {
     world
         .create_shape(ball, &def, Circle::new(Vec2::ZERO, 0.5).expect("a circle"))
         .expect("ball shape");
-    let locks = MotionLocks { linear_x: true, linear_y: false, angular: true };
+    let locks = MotionLocks {
+        linear_x: true,
+        linear_y: false,
+        angular: true,
+    };
     let slider = world
         .create_body(&BodyDef::dynamic(v(-6.0, 3.0)).with_motion_locks(locks))
         .expect("slider");
     world
-        .create_shape(slider, &ShapeDef::default().with_offset(v(0.3, 0.0), 0.4), Polygon::make_box(0.4, 0.3))
+        .create_shape(
+            slider,
+            &ShapeDef::default().with_offset(v(0.3, 0.0), 0.4),
+            Polygon::make_box(0.4, 0.3),
+        )
         .expect("slider shape");
     let hover = world
         .create_body(&BodyDef {
@@ -672,32 +693,69 @@ pub fn issue32_world(steps: usize) -> janus2d_world::World {
         })
         .expect("hover");
     world
-        .create_shape(hover, &ShapeDef::default().with_tangent_speed(0.5), Polygon::make_box(0.25, 0.25))
+        .create_shape(
+            hover,
+            &ShapeDef::default().with_tangent_speed(0.5),
+            Polygon::make_box(0.25, 0.25),
+        )
         .expect("hover shape");
-    let held = world.create_body(&BodyDef::dynamic(v(2.0, 4.0))).expect("held");
+    let held = world
+        .create_body(&BodyDef::dynamic(v(2.0, 4.0)))
+        .expect("held");
     world
         .create_shape(held, &ShapeDef::default(), Polygon::make_box(0.3, 0.3))
         .expect("held shape");
-    let off = world.create_body(&BodyDef::dynamic(v(3.0, 4.0))).expect("off");
+    let off = world
+        .create_body(&BodyDef::dynamic(v(3.0, 4.0)))
+        .expect("off");
     let capsule = Capsule::new(v(-0.4, 0.0), v(0.4, 0.0), 0.2).expect("a capsule");
     world
-        .create_shape(off, &ShapeDef::default().with_offset(v(0.0, 0.3), 0.2), capsule)
+        .create_shape(
+            off,
+            &ShapeDef::default().with_offset(v(0.0, 0.3), 0.2),
+            capsule,
+        )
         .expect("off shape");
     world
-        .create_revolute_joint(&RevoluteJointDef::new(held, off, v(0.5, 0.0), v(-0.5, -0.3)))
+        .create_revolute_joint(&RevoluteJointDef::new(
+            held,
+            off,
+            v(0.5, 0.0),
+            v(-0.5, -0.3),
+        ))
         .expect("a hinge");
     world.set_body_enabled(off, false).expect("disable");
-    let sensor = world.create_body(&BodyDef::fixed(v(-3.0, 1.0))).expect("sensor body");
+    let sensor = world
+        .create_body(&BodyDef::fixed(v(-3.0, 1.0)))
+        .expect("sensor body");
     world
-        .create_shape(sensor, &ShapeDef::default().sensor(), Polygon::make_box(1.0, 1.0))
+        .create_shape(
+            sensor,
+            &ShapeDef::default().sensor(),
+            Polygon::make_box(1.0, 1.0),
+        )
         .expect("sensor");
-    let visitor = world.create_body(&BodyDef::dynamic(v(-3.0, 8.0))).expect("visitor");
+    let visitor = world
+        .create_body(&BodyDef::dynamic(v(-3.0, 8.0)))
+        .expect("visitor");
     world
-        .create_shape(visitor, &ShapeDef::default().with_sensor_events(true), Circle::new(Vec2::ZERO, 0.2).expect("a circle"))
+        .create_shape(
+            visitor,
+            &ShapeDef::default().with_sensor_events(true),
+            Circle::new(Vec2::ZERO, 0.2).expect("a circle"),
+        )
         .expect("visitor shape");
-    let quiet = world.create_body(&BodyDef::dynamic(v(-2.5, 8.0))).expect("quiet visitor");
+    let quiet = world
+        .create_body(&BodyDef::dynamic(v(-2.5, 8.0)))
+        .expect("quiet visitor");
     world
-        .create_shape(quiet, &ShapeDef::default().with_sensor_events(false).with_contact_events(false), Circle::new(Vec2::ZERO, 0.2).expect("a circle"))
+        .create_shape(
+            quiet,
+            &ShapeDef::default()
+                .with_sensor_events(false)
+                .with_contact_events(false),
+            Circle::new(Vec2::ZERO, 0.2).expect("a circle"),
+        )
         .expect("quiet shape");
     for _ in 0..steps {
         world.step(1.0 / 60.0).expect("a step");

@@ -1016,11 +1016,7 @@ mod tests {
         world.debug_draw(&mut r, &DrawOptions::default());
         // Two chain segments, each with its tick: 4 segments.
         assert_eq!(r.segments.len(), 4);
-        let ticks: Vec<_> = r
-            .segments
-            .iter()
-            .filter(|(a, b, _)| a.y != b.y)
-            .collect();
+        let ticks: Vec<_> = r.segments.iter().filter(|(a, b, _)| a.y != b.y).collect();
         assert_eq!(ticks.len(), 2, "one tick per chain segment");
         for (a, b, c) in &ticks {
             assert_eq!(*c, palette.static_body);
@@ -1039,7 +1035,13 @@ mod tests {
         assert_eq!(r.polygons, vec![palette.disabled]);
         assert_ne!(palette.disabled, palette.sleeping);
         let mut r = Lines::default();
-        world.debug_draw(&mut r, &DrawOptions { sleep: false, ..DrawOptions::default() });
+        world.debug_draw(
+            &mut r,
+            &DrawOptions {
+                sleep: false,
+                ..DrawOptions::default()
+            },
+        );
         assert_eq!(r.polygons, vec![palette.disabled]);
         world.set_body_enabled(off, true).unwrap();
         let mut r = Lines::default();

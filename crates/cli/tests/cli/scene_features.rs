@@ -197,9 +197,16 @@ fn every_issue_32_field_round_trips_and_builds_the_api_world() {
     // the ball rolled along the chain.
     let slider_now = from_file.position(slider).unwrap();
     assert_eq!(slider_now.x, start_slider.x, "x lock");
-    assert!(slider_now.y < start_slider.y - 1.0, "it fell: {slider_now:?}");
+    assert!(
+        slider_now.y < start_slider.y - 1.0,
+        "it fell: {slider_now:?}"
+    );
     assert_eq!(from_file.angle(slider), Ok(0.0), "rotation lock");
-    assert_eq!(from_file.position(hover).unwrap().y, start_hover.y, "y lock");
+    assert_eq!(
+        from_file.position(hover).unwrap().y,
+        start_hover.y,
+        "y lock"
+    );
     assert_eq!(from_file.position(off), Ok(start_off), "disabled");
     let ball_now = from_file.position(ball).unwrap();
     assert!(
@@ -210,21 +217,18 @@ fn every_issue_32_field_round_trips_and_builds_the_api_world() {
 
 #[test]
 fn bad_chains_and_offsets_name_their_field() {
-    let one_point = FILE.replace(
-        "[[8, 0], [2, 0], [-2, 0], [-8, 0]]",
-        "[[8, 0]]",
-    );
+    let one_point = FILE.replace("[[8, 0], [2, 0], [-2, 0], [-8, 0]]", "[[8, 0]]");
     let e = scene_file::load(&one_point, "bad.json").err().unwrap();
     assert_eq!(e.kind, ErrorKind::Invalid);
     assert_eq!(e.field, "bodies[0].chains[0]");
-    let two_materials = FILE.replace(
-        "{ \"friction\": 0.2, \"material\": 7 },",
-        "",
-    );
+    let two_materials = FILE.replace("{ \"friction\": 0.2, \"material\": 7 },", "");
     let e = scene_file::load(&two_materials, "bad.json").err().unwrap();
     assert_eq!(e.field, "bodies[0].chains[0]");
     assert!(e.message.contains("materials"), "{}", e.message);
-    let far = FILE.replace("\"offset\": { \"position\": [0, 0.5] }", "\"offset\": { \"position\": [0, 1e9] }");
+    let far = FILE.replace(
+        "\"offset\": { \"position\": [0, 0.5] }",
+        "\"offset\": { \"position\": [0, 1e9] }",
+    );
     let e = scene_file::load(&far, "bad.json").err().unwrap();
     assert_eq!(e.field, "bodies[3].shapes[0]");
     let typo = FILE.replace("\"rotation\": true", "\"spin\": true");
