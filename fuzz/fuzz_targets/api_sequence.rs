@@ -1,13 +1,20 @@
 //! The API as a byte-coded sequence of calls (bodies, shapes, joints,
 //! portal pairs, chains, velocities, transforms, masses, types, forces, settings,
-//! steps, snapshot and restore), valid and invalid values mixed. After each
+//! steps, snapshot and restore; issue 32's motion locks, fixed rotation,
+//! gravity scale, damping, enable/disable, geometry setters and scaling,
+//! surface materials, event switches, explosions, point/shape/sensor
+//! queries with a predicate, mover casts and collisions, the character
+//! controller, callbacks), valid and invalid values mixed. After each
 //! call: no panic, an `Err` left the world unchanged, `World::validate`
 //! passes.
 #![no_main]
 
 use janus2d::base::geometry::{Capsule, Circle, Polygon, Segment, Shape};
 use janus2d::prelude::*;
-use janus2d::world::{PortalDef, PortalPairDef, PortalPairHandle, SleepSettings, Snapshot};
+use janus2d::world::{
+    CharacterController, CollisionPlane, ExplosionDef, PortalDef, PortalPairDef, PortalPairHandle,
+    SleepSettings, Snapshot, clip_vector, solve_planes,
+};
 use libfuzzer_sys::fuzz_target;
 
 struct Bytes<'a>(&'a [u8]);
@@ -109,7 +116,7 @@ fn call(
     b: &mut Bytes,
 ) -> Result<(), WorldError> {
     let f = i.foreign;
-    match b.byte() % 22 {
+    match b.byte() % 31 {
         0 | 1 => {
             let ty = body_type(b.byte());
             let def = BodyDef {
@@ -265,6 +272,142 @@ fn call(
         18 => {
             if let Some(s) = saved {
                 w.restore(s);
+            }
+            Ok(())
+        }
+        22 => {
+            let body = pick(&i.bodies, b.byte(), f);
+            match b.byte() % 5 {
+                0 => {
+                    let l = b.byte();
+                    w.set_motion_locks(
+                        body,
+                        MotionLocks {
+                            linear_x: l & 1 != 0,
+                            linear_y: l & 2 != 0,
+                            angular: l & 4 != 0,
+                        },
+                    )
+                }
+                1 => w.set_fixed_rotation(body, b.byte().is_multiple_of(2)),
+                2 => w.set_gravity_scale(body, b.real()),
+                3 => w.set_linear_damping(body, b.real()),
+                _ => w.set_angular_damping(body, b.real()),
+            }
+        }
+        23 => w.set_body_enabled(pick(&i.bodies, b.byte(), f), b.byte().is_multiple_of(2)),
+        24 => {
+            let s = i
+                .shapes
+                .get(b.byte() as usize % i.shapes.len().max(1))
+                .copied();
+            let Some(s) = s else {
+                return Err(WorldError::StaleShape);
+            };
+            if b.byte().is_multiple_of(2) {
+                w.scale_shape(s, b.real())
+            } else {
+                match shape(b) {
+                    Some(Shape::Circle(c)) => w.set_circle(s, c),
+                    Some(Shape::Capsule(c)) => w.set_capsule(s, c),
+                    Some(Shape::Polygon(p)) => w.set_polygon(s, p),
+                    Some(Shape::Segment(x)) => w.set_segment(s, x),
+                    Some(other) => w.set_shape_geometry(s, other),
+                    None => Err(WorldError::OutOfRange("constructor refused")),
+                }
+            }
+        }
+        25 | 26 => {
+            let s = i
+                .shapes
+                .get(b.byte() as usize % i.shapes.len().max(1))
+                .copied();
+            let Some(s) = s else {
+                return Err(WorldError::StaleShape);
+            };
+            match b.byte() % 10 {
+                0 => w.set_shape_rolling_resistance(s, b.real()),
+                1 => w.set_shape_tangent_speed(s, b.real()),
+                2 => w.set_shape_user_material_id(s, u64::from(b.byte())),
+                3 => w.set_shape_friction(s, b.real()),
+                4 => w.set_shape_restitution(s, b.real()),
+                5 => w.set_shape_contact_events(s, b.byte().is_multiple_of(2)),
+                6 => w.set_shape_sensor_events(s, b.byte().is_multiple_of(2)),
+                7 => w.set_shape_hit_events(s, b.byte().is_multiple_of(2)),
+                8 => w.set_shape_force_event_threshold(s, b.real()),
+                _ => {
+                    w.set_body_move_events(pick(&i.bodies, b.byte(), f), b.byte().is_multiple_of(2))
+                }
+            }
+        }
+        27 => w
+            .explode(&ExplosionDef::new(b.vec(), b.real(), b.real()).with_falloff(b.real()))
+            .map(|_| ()),
+        28 => {
+            let s = i
+                .shapes
+                .get(b.byte() as usize % i.shapes.len().max(1))
+                .copied();
+            let p = b.vec();
+            let odd = |h: ShapeHandle| h.index % 2 == 1;
+            let filter = QueryFilter::default().with_predicate(&odd);
+            let _ = w.project_point(p, b.real(), &filter);
+            let _ = w.velocity_at_point(pick(&i.bodies, b.byte(), f), p);
+            if let Some(s) = s {
+                let _ = w.shape_project_point(s, p);
+                let _ = w.shape_test_point(s, p);
+                let _ = w.shape_ray_cast(s, p, b.vec(), &filter);
+                let _ = w.sensor_overlaps(s);
+            }
+            Ok(())
+        }
+        29 => {
+            let at = b.vec();
+            let mover = Capsule {
+                center1: at - Vec2::new(0.0, 0.25),
+                center2: at + Vec2::new(0.0, 0.25),
+                radius: b.real(),
+            };
+            let translation = b.vec();
+            let filter = QueryFilter::default();
+            if let Ok(c) = w.cast_mover(&mover, translation, &filter) {
+                assert!(c.fraction.is_finite(), "mover fraction {}", c.fraction);
+            }
+            let mut planes = Vec::new();
+            let _ = w.collide_mover(&mover, b.real(), &filter, |p| {
+                planes.push(CollisionPlane::new(p.normal, p.separation));
+                planes.len() < 8
+            });
+            let solved = solve_planes(translation, &mut planes);
+            let clipped = clip_vector(translation, &planes);
+            let _ = (solved, clipped);
+            let mut cc = CharacterController::new().with_snap_to_ground(Some(0.1));
+            if let Ok(m) = cc.move_and_slide(w, &mover, at, translation, b.real(), &filter) {
+                assert!(m.position.is_finite(), "controller {m:?}");
+            }
+            Ok(())
+        }
+        30 => {
+            let v = b.real();
+            match b.byte() % 4 {
+                0 => w.set_pre_solve(Some(Box::new(move |c| {
+                    c.friction = v;
+                    c.restitution = v;
+                    c.tangent_speed = v;
+                    c.rolling_resistance = v;
+                    (c.shape_a.index + c.shape_b.index) % 3 != 0
+                }))),
+                1 => w.set_pair_filter(Some(Box::new(|a, b| (a.index ^ b.index) % 4 != 1))),
+                2 => {
+                    w.set_friction_callback(Some(Box::new(move |a, _, b, _| v * (a + b))));
+                    w.set_restitution_callback(Some(Box::new(move |_, _, _, _| v)));
+                }
+                _ => {
+                    w.set_pre_solve(None);
+                    w.set_pair_filter(None);
+                    w.set_friction_callback(None);
+                    w.set_restitution_callback(None);
+                }
             }
             Ok(())
         }

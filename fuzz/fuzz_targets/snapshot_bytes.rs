@@ -1,8 +1,12 @@
 //! Snapshot bytes: `Snapshot::from_bytes` on any bytes never panics; a
 //! world it accepts validates, and keeps validating through steps and API
 //! calls (reads, wakes, velocities, impulses, joint read-back and
-//! destruction, body destruction and creation, a ray cast); its own bytes
-//! decode again.
+//! destruction, body destruction and creation, a ray cast; and issue 32's:
+//! motion locks, fixed rotation, gravity scale, damping, enable/disable,
+//! velocity at a point, geometry scaling, surface materials, friction and
+//! restitution, event switches, a chain created and one destroyed, an
+//! explosion, the point, shape and sensor queries, the mover casts and
+//! collisions and the character controller); its own bytes decode again.
 //!
 //! Input: a mode byte, then bytes. Mode even: the bytes are a payload and
 //! the target writes a correct header in front of it (magic, version,
@@ -13,7 +17,7 @@
 #![no_main]
 
 use janus2d::prelude::*;
-use janus2d::world::Snapshot;
+use janus2d::world::{CharacterController, ExplosionDef, Snapshot};
 use libfuzzer_sys::fuzz_target;
 
 const DT: Real = 1.0 / 60.0;
@@ -75,6 +79,8 @@ fn exercise(mut world: World, seed: u8) {
         }
     }
     valid(&world, "after the calls");
+    issue32_calls(&mut world, &bodies, seed);
+    valid(&world, "after issue 32's calls");
     let _ = world.step(DT);
     valid(&world, "after a step");
     if let Some(&j) = world.joint_handles().first() {
@@ -98,6 +104,101 @@ fn exercise(mut world: World, seed: u8) {
     let again = world.snapshot().to_bytes();
     if let Err(e) = Snapshot::from_bytes(&again) {
         panic!("a world's own bytes do not decode: {e}");
+    }
+}
+
+/// Issue 32's setters and queries on a decoded world, each followed by
+/// the validator.
+fn issue32_calls(world: &mut World, bodies: &[BodyHandle], seed: u8) {
+    let s = usize::from(seed);
+    for (k, &b) in bodies.iter().enumerate() {
+        let locks = MotionLocks {
+            linear_x: (k + s) % 3 == 0,
+            linear_y: (k + s) % 5 == 0,
+            angular: (k + s) % 2 == 0,
+        };
+        let _ = world.set_motion_locks(b, locks);
+        let _ = world.set_gravity_scale(b, 0.5 + (k % 3) as Real);
+        let _ = world.set_linear_damping(b, 0.1);
+        let _ = world.set_fixed_rotation(b, k % 4 == 1);
+        let _ = world.set_body_move_events(b, k % 2 == 0);
+        if let Ok(v) = world.velocity_at_point(b, Vec2::new(1.0, 1.0)) {
+            assert!(v.is_finite(), "velocity at a point {v:?}");
+        }
+        if (k + s) % 4 == 0 {
+            let _ = world.set_body_enabled(b, false);
+            valid(world, "after disabling a body");
+            if k % 8 == 0 {
+                let _ = world.set_body_enabled(b, true);
+                valid(world, "after enabling a body");
+            }
+        }
+        let shapes = world.body_shapes(b).unwrap_or_default();
+        for (j, &sh) in shapes.iter().take(4).enumerate() {
+            match (j + s + k) % 6 {
+                0 => drop(world.scale_shape(sh, 1.25)),
+                1 => drop(world.set_shape_rolling_resistance(sh, 0.2)),
+                2 => drop(world.set_shape_tangent_speed(sh, 1.0)),
+                3 => drop(world.set_shape_friction(sh, 0.1)),
+                4 => drop(world.set_shape_hit_events(sh, true)),
+                _ => drop(world.set_shape_force_event_threshold(sh, 1.0)),
+            }
+            let _ = world.set_shape_contact_events(sh, j % 2 == 0);
+            let _ = world.set_shape_user_material_id(sh, k as u64);
+            let _ = world.shape_test_point(sh, Vec2::ZERO);
+            let _ = world.shape_project_point(sh, Vec2::new(0.5, 2.0));
+            let _ = world.shape_ray_cast(
+                sh,
+                Vec2::new(-5.0, 1.0),
+                Vec2::new(10.0, 0.0),
+                &QueryFilter::default(),
+            );
+            let _ = world.sensor_overlaps(sh);
+            valid(world, "after a shape call");
+        }
+    }
+    world.set_move_events(seed % 2 == 0);
+    if let Some(&c) = world.chain_handles().first() {
+        let _ = world.destroy_chain(c);
+        valid(world, "after destroying a chain");
+    }
+    if let Some(&b) = bodies.first() {
+        let points = vec![
+            Vec2::new(3.0, -1.0),
+            Vec2::new(0.0, -1.2),
+            Vec2::new(-3.0, -1.0),
+        ];
+        let material = SurfaceMaterial::default().with_rolling_resistance(0.1);
+        let _ = world.create_chain(b, &ChainDef::new(points).with_material(material));
+        valid(world, "after creating a chain");
+    }
+    let _ = world.explode(&ExplosionDef::new(Vec2::new(0.0, 1.0), 3.0, 2.0).with_falloff(1.0));
+    valid(world, "after an explosion");
+    let _ = world.project_point(Vec2::new(0.0, 5.0), 10.0, &QueryFilter::default());
+    let mover = Capsule::new(Vec2::new(0.0, 2.75), Vec2::new(0.0, 3.25), 0.25).expect("a capsule");
+    if let Ok(cast) = world.cast_mover(&mover, Vec2::new(3.0, -6.0), &QueryFilter::default()) {
+        assert!(
+            cast.fraction.is_finite(),
+            "mover fraction {}",
+            cast.fraction
+        );
+    }
+    let _ = world.collide_mover(&mover, 0.05, &QueryFilter::default(), |p| {
+        p.separation.is_finite()
+    });
+    let mut cc = CharacterController::new().with_snap_to_ground(Some(0.1));
+    if let Ok(m) = cc.move_and_slide(
+        world,
+        &mover,
+        Vec2::ZERO,
+        Vec2::new(2.0, -1.0),
+        DT,
+        &QueryFilter::default(),
+    ) {
+        assert!(
+            m.position.is_finite() && m.velocity.is_finite(),
+            "controller {m:?}"
+        );
     }
 }
 

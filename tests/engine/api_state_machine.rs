@@ -5,8 +5,18 @@
 //! unchanged (state hash and counts); [`World::validate`] passes (which
 //! includes every stored number being finite).
 //!
-//! CI runs 48 cases of up to 48 operations, each from one of three
-//! starting worlds (a ground box, the portal drop, a small pyramid). A longer run:
+//! The calls include issue 32's: chains, geometry setters (generic, per
+//! kind, scaling), motion locks, enable/disable, gravity scale, damping
+//! and fixed rotation, surface materials, friction and restitution, the
+//! per-shape and per-body event switches, explosions, the point, shape and
+//! sensor queries with a predicate filter, the mover casts and collisions,
+//! the character controller, and the callbacks (a pre-solve hook writing
+//! any value into the contact material, a pair filter, friction and
+//! restitution callbacks).
+//!
+//! CI runs 48 cases of up to 48 operations, each from one of four
+//! starting worlds (a ground box, the portal drop, a small pyramid, the
+//! issue-32 world of every new per-body and per-shape state). A longer run:
 //!
 //! ```text
 //! JANUS_STATE_MACHINE_CASES=5000 cargo test --release --test engine api_state_machine
@@ -144,6 +154,30 @@ enum Op {
         falloff: Real,
         impulse: Real,
     },
+    /// A shape's event switch: contact (0), sensor (1), hit (2), force
+    /// threshold (3, the value); a body's move events (4); the world's (5).
+    EventSwitch(usize, u8, bool, Real),
+    /// A shape's friction (0) or restitution (1).
+    ShapeMixing(usize, u8, Real),
+    /// The setter of the geometry's own kind (`set_circle`, `set_capsule`,
+    /// `set_polygon`, `set_segment`); on a chain segment,
+    /// `set_chain_segment` with its points moved by the vector.
+    SetKindGeometry(usize, Geometry, Vec2),
+    /// The mover: a capsule of `radius` at `at` cast by `translation`
+    /// (all shapes, or a one-way predicate), collided with `margin`, and a
+    /// character controller moving it for `dt`.
+    Mover {
+        at: Vec2,
+        radius: Real,
+        translation: Vec2,
+        margin: Real,
+        dt: Real,
+        one_way: bool,
+    },
+    /// Callbacks: a pre-solve hook writing `value` into every material
+    /// field and dropping every third contact (0), a pair filter (1),
+    /// friction and restitution callbacks returning `value` (2), none (3).
+    Hooks(u8, Real),
     /// Queries (they change nothing, errors included).
     Query(usize, Vec2, Real),
     Settings {
@@ -205,6 +239,13 @@ fn op() -> impl Strategy<Value = Op> {
         1 => (place(), size(), size(), real())
             .prop_map(|(position, radius, falloff, impulse)| Op::Explode { position, radius, falloff, impulse }),
         1 => (pick(), place(), real()).prop_map(|(s, p, d)| Op::Query(s, p, d)),
+        2 => (pick(), 0u8..6, any::<bool>(), real()).prop_map(|(s, w, on, v)| Op::EventSwitch(s, w, on, v)),
+        1 => (pick(), 0u8..2, real()).prop_map(|(s, w, v)| Op::ShapeMixing(s, w, v)),
+        1 => (pick(), geometry(), vec2()).prop_map(|(s, g, d)| Op::SetKindGeometry(s, g, d * 0.1)),
+        2 => (place(), prop_oneof![3 => Just(0.25 as Real), 1 => size()], vec2(), prop_oneof![3 => Just(0.01 as Real), 1 => real()],
+              prop_oneof![3 => Just(1.0 as Real / 60.0), 1 => real()], any::<bool>())
+            .prop_map(|(at, radius, translation, margin, dt, one_way)| Op::Mover { at, radius, translation, margin, dt, one_way }),
+        1 => (0u8..4, prop_oneof![2 => Just(0.3 as Real), 1 => real()]).prop_map(|(k, v)| Op::Hooks(k, v)),
         1 => (prop_oneof![3 => Just(30.0 as Real), 1 => real()], prop_oneof![3 => Just(10.0 as Real), 1 => real()], prop_oneof![3 => Just(4u32), 1 => 0u32..12])
             .prop_map(|(hertz, damping, substeps)| Op::Settings { hertz, damping, substeps }),
         1 => prop_oneof![3 => Just(Vec2::new(0.0, -10.0)), 1 => vec2()].prop_map(Op::Gravity),
@@ -467,6 +508,126 @@ fn apply(
         } => w
             .explode(&ExplosionDef::new(*position, *radius, *impulse).with_falloff(*falloff))
             .map(|_| ()),
+        Op::EventSwitch(k, which, on, v) => {
+            let s = pick(&issued.shapes, *k, issued.foreign_shape);
+            match which {
+                0 => w.set_shape_contact_events(s, *on),
+                1 => w.set_shape_sensor_events(s, *on),
+                2 => w.set_shape_hit_events(s, *on),
+                3 => w.set_shape_force_event_threshold(s, *v),
+                4 => w.set_body_move_events(body(*k, issued), *on),
+                _ => {
+                    w.set_move_events(*on);
+                    Ok(())
+                }
+            }
+        }
+        Op::ShapeMixing(k, which, v) => {
+            let s = pick(&issued.shapes, *k, issued.foreign_shape);
+            if *which == 0 {
+                w.set_shape_friction(s, *v)
+            } else {
+                w.set_shape_restitution(s, *v)
+            }
+        }
+        Op::SetKindGeometry(k, g, d) => {
+            let s = pick(&issued.shapes, *k, issued.foreign_shape);
+            if let Ok(data) = w.shape(s)
+                && let Shape::ChainSegment(mut c) = data.geometry
+            {
+                for p in [
+                    &mut c.ghost1,
+                    &mut c.segment.point1,
+                    &mut c.segment.point2,
+                    &mut c.ghost2,
+                ] {
+                    *p += *d;
+                }
+                return w.set_chain_segment(s, c);
+            }
+            match shape_of(g) {
+                Some(Shape::Circle(c)) => w.set_circle(s, c),
+                Some(Shape::Capsule(c)) => w.set_capsule(s, c),
+                Some(Shape::Polygon(p)) => w.set_polygon(s, p),
+                Some(Shape::Segment(x)) => w.set_segment(s, x),
+                _ => Err(WorldError::OutOfRange("constructor refused")),
+            }
+        }
+        Op::Mover {
+            at,
+            radius,
+            translation,
+            margin,
+            dt,
+            one_way,
+        } => {
+            let mover = Capsule {
+                center1: *at - Vec2::new(0.0, 0.25),
+                center2: *at + Vec2::new(0.0, 0.25),
+                radius: *radius,
+            };
+            let up = |h: &janus2d::world::RayHit| h.normal.y > 0.5;
+            let odd = |s: ShapeHandle| s.index % 2 == 1;
+            let f = if *one_way {
+                QueryFilter::default().with_predicate(&odd)
+            } else {
+                QueryFilter::default()
+            };
+            let cast = if *one_way {
+                w.cast_mover_with(&mover, *translation, &f, up)
+            } else {
+                w.cast_mover(&mover, *translation, &f)
+            };
+            if let Ok(c) = &cast {
+                prop_assert_real(c.fraction)?;
+            }
+            let mut planes = Vec::new();
+            let collided = w.collide_mover(&mover, *margin, &f, |p| {
+                planes.push(janus2d::world::CollisionPlane::new(p.normal, p.separation));
+                planes.len() < 8
+            });
+            if collided.is_ok() {
+                let solved = janus2d::world::solve_planes(*translation, &mut planes);
+                let clipped = janus2d::world::clip_vector(*translation, &planes);
+                let _ = (solved, clipped);
+            }
+            let mut cc = janus2d::world::CharacterController::new()
+                .with_snap_to_ground(Some(0.1))
+                .with_autostep(Some(janus2d::world::Autostep::default()));
+            let moved = cc.move_and_slide(w, &mover, *at, *translation, *dt, &f);
+            if let Ok(m) = &moved {
+                prop_assert_real(m.position.x + m.position.y)?;
+            }
+            cast.and(collided).and(moved).map(|_| ())
+        }
+        Op::Hooks(which, v) => {
+            let v = *v;
+            match which {
+                0 => w.set_pre_solve(Some(Box::new(move |c| {
+                    c.friction = v;
+                    c.restitution = v;
+                    c.tangent_speed = v;
+                    c.rolling_resistance = v;
+                    (c.shape_a.index + c.shape_b.index) % 3 != 0
+                }))),
+                1 => w.set_pair_filter(Some(Box::new(|a, b| (a.index ^ b.index) % 4 != 1))),
+                2 => {
+                    w.set_friction_callback(Some(Box::new(move |a, _, b, _| v * (a + b))));
+                    w.set_restitution_callback(Some(Box::new(
+                        move |_, ma, _, mb| {
+                            if ma == mb { v } else { -v }
+                        },
+                    )));
+                }
+                _ => {
+                    w.set_pre_solve(None);
+                    w.set_pair_filter(None);
+                    w.set_friction_callback(None);
+                    w.set_restitution_callback(None);
+                }
+            }
+            Ok(())
+        }
         Op::Query(k, p, d) => {
             let shape = pick(&issued.shapes, *k, issued.foreign_shape);
             let f = QueryFilter::default();
@@ -518,6 +679,16 @@ fn apply(
     }
 }
 
+/// A mover or controller result that is not finite is an error of the
+/// engine (its inputs were accepted).
+fn prop_assert_real(x: Real) -> Result<(), WorldError> {
+    if x.is_finite() {
+        Ok(())
+    } else {
+        panic!("an accepted mover query gave {x}")
+    }
+}
+
 fn cases() -> u32 {
     std::env::var("JANUS_STATE_MACHINE_CASES")
         .ok()
@@ -530,12 +701,20 @@ static RAN: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new
 static ACCEPTED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 static STEPS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 static CHAINS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+/// Accepted event switches, friction/restitution setters, per-kind
+/// geometry setters and mover/controller queries (hooks are always
+/// accepted).
+static SWITCHES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+static MIXING: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+static KIND_GEOMETRY: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+static MOVERS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
-/// The world a case starts from: a ground box, the portal drop scene, or
-/// a small pyramid (with their bodies among the issued handles).
+/// The world a case starts from: a ground box, the portal drop scene, a
+/// small pyramid, or the issue-32 world (with their bodies among the
+/// issued handles).
 fn start(scene: u8) -> World {
     let def = janus2d_testbed::scenes::shared_settings();
-    match scene % 3 {
+    match scene % 4 {
         0 => {
             let mut world = World::new(WorldDef::default()).unwrap();
             let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
@@ -545,7 +724,8 @@ fn start(scene: u8) -> World {
             world
         }
         1 => janus2d_testbed::scenes::portal_drop(&def).0.world,
-        _ => janus2d_testbed::scenes::large_pyramid(&def, 4).world,
+        2 => janus2d_testbed::scenes::large_pyramid(&def, 4).world,
+        _ => janus2d_testbed::support::issue32_world(0),
     }
 }
 
@@ -588,6 +768,7 @@ fn run(scene: u8, ops: &[Op]) -> Result<(), TestCaseError> {
         issued.shapes.extend(world.body_shapes(b).unwrap());
     }
     issued.joints.extend(world.joint_handles().iter().copied());
+    issued.chains.extend(world.chain_handles());
     issued.pairs.extend(world.portal_pairs().map(|(h, _)| h));
     let mut saved = None;
     for (i, op) in ops.iter().enumerate() {
@@ -599,8 +780,16 @@ fn run(scene: u8, ops: &[Op]) -> Result<(), TestCaseError> {
             if matches!(op, Op::Step(_)) {
                 STEPS.fetch_add(1, Relaxed);
             }
-            if matches!(op, Op::CreateChain { .. }) {
-                CHAINS.fetch_add(1, Relaxed);
+            let counter = match op {
+                Op::CreateChain { .. } => Some(&CHAINS),
+                Op::EventSwitch(..) => Some(&SWITCHES),
+                Op::ShapeMixing(..) => Some(&MIXING),
+                Op::SetKindGeometry(..) => Some(&KIND_GEOMETRY),
+                Op::Mover { .. } => Some(&MOVERS),
+                _ => None,
+            };
+            if let Some(c) = counter {
+                c.fetch_add(1, Relaxed);
             }
         }
         if let Err(e) = &result {
@@ -633,7 +822,7 @@ proptest! {
     /// error, and always leave a valid world.
     #[test]
     fn api_sequences_keep_the_world_valid(
-        scene in 0u8..3,
+        scene in 0u8..4,
         ops in proptest::collection::vec(op(), 1..48),
     ) {
         run(scene, &ops)?;
@@ -646,10 +835,15 @@ proptest! {
 fn z_report_counts() {
     use std::sync::atomic::Ordering::Relaxed;
     eprintln!(
-        "state machine: {} operations, {} accepted, {} steps, {} chains created",
+        "state machine: {} operations, {} accepted, {} steps, {} chains created, \
+         {} event switches, {} friction/restitution, {} per-kind geometry, {} mover queries accepted",
         RAN.load(Relaxed),
         ACCEPTED.load(Relaxed),
         STEPS.load(Relaxed),
-        CHAINS.load(Relaxed)
+        CHAINS.load(Relaxed),
+        SWITCHES.load(Relaxed),
+        MIXING.load(Relaxed),
+        KIND_GEOMETRY.load(Relaxed),
+        MOVERS.load(Relaxed)
     );
 }

@@ -150,6 +150,69 @@ fn restore_keeps_the_pre_solve_hook_of_the_world() {
 
 /// With the `serde` feature: a snapshot through bytes continues bit-exactly;
 /// truncated, corrupted and wrong-version bytes are typed errors.
+/// Issue 32's state — motion locks, a disabled body and the joint it
+/// keeps off, a chain object with segment materials, shape offsets, event
+/// switches, move events — is in a snapshot: taken mid-run, restored into
+/// a new world and in place, both continue with the same state hash and
+/// the same events at every step, and the restored world reads back the
+/// same locks, enabled flags, chain and materials.
+#[test]
+fn issue_32_state_continues_bit_exactly() {
+    use janus2d::world::ChainHandle;
+    let mut world = janus2d_testbed::support::issue32_world(45);
+    let bodies: Vec<BodyHandle> = world.body_handles().collect();
+    let disabled: Vec<BodyHandle> = bodies
+        .iter()
+        .copied()
+        .filter(|&b| world.is_body_enabled(b) == Ok(false))
+        .collect();
+    assert_eq!(disabled.len(), 1, "one disabled body");
+    let locked = bodies
+        .iter()
+        .filter(|&&b| world.motion_locks(b).unwrap() != MotionLocks::NONE)
+        .count();
+    assert_eq!(locked, 2, "two locked bodies");
+    let chain: ChainHandle = world.chain_handles()[0];
+    assert!(!world.joint(world.joint_handles()[0]).unwrap().is_enabled());
+    let saved = world.snapshot();
+    let mut restored = saved.to_world();
+    assert_eq!(restored.chain_segments(chain), world.chain_segments(chain));
+    for &b in &bodies {
+        assert_eq!(restored.is_body_enabled(b), world.is_body_enabled(b));
+        assert_eq!(restored.motion_locks(b), world.motion_locks(b));
+        assert_eq!(restored.body_shapes(b), world.body_shapes(b));
+        for s in world.body_shapes(b).unwrap() {
+            assert_eq!(restored.shape(s).unwrap().def, world.shape(s).unwrap().def);
+            assert_eq!(
+                restored.shape(s).unwrap().geometry,
+                world.shape(s).unwrap().geometry
+            );
+        }
+    }
+    let mut events = [0usize; 4];
+    for step in 0..90 {
+        world.step(DT).unwrap();
+        restored.step(DT).unwrap();
+        assert_eq!(restored.state_hash(), world.state_hash(), "step {step}");
+        assert_eq!(restored.events(), world.events(), "step {step}: events");
+        let e = world.events();
+        events[0] += e.collision.contact_begin.len();
+        events[1] += e.collision.hits.len() + e.collision.forces.len();
+        events[2] += e.collision.sensor_begin.len();
+        events[3] += e.moves.len();
+    }
+    restored.validate().unwrap();
+    // The run had events of each kind to compare.
+    assert!(events.iter().all(|&n| n > 0), "events seen: {events:?}");
+    // Restoring in place continues the same way.
+    let after = world.state_hash();
+    world.restore(&saved);
+    for _ in 0..90 {
+        world.step(DT).unwrap();
+    }
+    assert_eq!(world.state_hash(), after, "in place");
+}
+
 #[cfg(feature = "serde")]
 mod bytes {
     use super::*;
@@ -172,6 +235,10 @@ mod bytes {
             (
                 "every joint kind",
                 janus2d_testbed::support::every_joint_kind_world(),
+            ),
+            (
+                "issue 32 features",
+                janus2d_testbed::support::issue32_world(10),
             ),
         ];
         #[cfg(feature = "portals")]
@@ -362,6 +429,7 @@ mod bytes {
             mixed.step(DT).unwrap();
         }
         worlds.push(("mixed", mixed));
+        worlds.push(("issue32", janus2d_testbed::support::issue32_world(60)));
         #[cfg(feature = "portals")]
         {
             let mut drop = scenes::portal_drop(&scenes::shared_settings()).0.world;

@@ -27,8 +27,9 @@
 //! |-----|------|---------|
 //! | `name`, `steps`, `probe` | label; steps `janus2d run` takes; the body the summary reports | file name, 600, none |
 //! | `settings` | `gravity` [x, y] m/s², `dt` s, `substeps`, `relax_iterations`, `sleep`, `contact_hertz`, `contact_damping_ratio`, `contact_push_max_velocity` m/s, `joint_hertz`, `joint_damping_ratio`, `restitution_threshold` m/s, `warm_starting` | the world's defaults, dt 1/60 |
-//! | body | `id`, `type` (`static`, `kinematic`, `dynamic`), `position`, `angle`, `linear_velocity`, `angular_velocity`, `linear_damping`, `angular_damping`, `gravity_scale`, `fixed_rotation`, `awake`, `move_events`, `mass` {`mass`, `inertia`, `center`}, `shapes` | dynamic at the origin, mass from the shapes, move events on |
-//! | shape | `geometry` (one of below), `density`, `friction`, `restitution`, `sensor`, `filter` {`category`, `mask`, `group`}, `rolling_resistance`, `tangent_speed` m/s, `friction_combine` and `restitution_combine` (`default`, `average`, `min`, `multiply`, `max`), `material` (user material id), `hit_events`, `contact_events`, `sensor_events`, `force_event_threshold` N | 1, 0.6, 0, false, collides with all, 0, 0, `default`, `default`, 0, false, true, true, none (never) |
+//! | body | `id`, `type` (`static`, `kinematic`, `dynamic`), `position`, `angle`, `linear_velocity`, `angular_velocity`, `linear_damping`, `angular_damping`, `gravity_scale`, `fixed_rotation`, `motion_locks` {`x`, `y`, `rotation`}, `enabled`, `awake`, `move_events`, `mass` {`mass`, `inertia`, `center`}, `shapes`, `chains` | dynamic at the origin, nothing locked, enabled, mass from the shapes, move events on, no chains |
+//! | shape | `geometry` (one of below), `offset` {`position`, `angle`} (where the geometry sits in the body frame), `density`, `friction`, `restitution`, `sensor`, `filter` {`category`, `mask`, `group`}, `rolling_resistance`, `tangent_speed` m/s, `friction_combine` and `restitution_combine` (`default`, `average`, `min`, `multiply`, `max`), `material` (user material id), `hit_events`, `contact_events`, `sensor_events`, `force_event_threshold` N | no offset, 1, 0.6, 0, false, collides with all, 0, 0, `default`, `default`, 0, false, true, true, none (never) |
+//! | chain | a chain object on its body (`World::create_chain`): `points` (body frame), `loop`, `materials` (one for every segment, or one per segment: {`friction`, `restitution`, `rolling_resistance`, `tangent_speed`, `friction_combine`, `restitution_combine`, `material`}), `filter`, `user_data`, `hit_events`, `contact_events`, `sensor_events` | open, one default material, collides with all, 0, false, true, true |
 //! | geometry | `circle` {`center`, `radius`}, `capsule` {`a`, `b`, `radius`}, `box` {`half`, `center`, `angle`, `radius`}, `polygon` {`points`, `radius`} (convex hull), `segment` {`a`, `b`}, `chain` {`points`, `closed`} (one-sided) | |
 //! | joint | `type` (below), `body_a`, `body_b` (index or id), `anchor` (a world point at creation) or `anchor_a`/`anchor_b` (body frames; motor and filter joints may leave both out: the bodies' origins), `angle_a`/`angle_b` (the frames' angles in the body frames, rad), `collide_connected`, `force_threshold` N and `torque_threshold` N·m (joint events), `constraint_hertz`/`constraint_damping_ratio` (softness of the rigid rows), `user_data`, `draw_scale` | `revolute`; frames at angle 0; not colliding; thresholds ∞; the world's joint softness; 0; 1 |
 //! | `revolute` | `reference_angle` (rad: θ_b − θ_a at angle 0), `limit` [lower, upper] rad, `motor` {`speed` rad/s, `max_torque` N·m}, `spring` {`hertz`, `damping_ratio`}, `target_angle` rad | a plain hinge |
@@ -53,11 +54,11 @@ use janus2d_constraints::{
     DistanceJointDef, FilterJointDef, JointDef, JointDefBase, JointFrame, MotorJointDef,
     MouseJointDef, PrismaticJointDef, RevoluteJointDef, WeldJointDef, WheelJointDef,
 };
-use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType};
+use janus2d_core::body::{BodyDef, BodyHandle, BodyMass, BodyType, MotionLocks};
 use janus2d_core::geometry::{Shape, make_chain};
 use janus2d_core::math::{Real, Vec2, from_f64, to_f64};
 use janus2d_testbed::desc::{self, Geometry, SceneDesc};
-use janus2d_world::{Filter, ShapeDef, World, WorldDef};
+use janus2d_world::{ChainDef, Filter, ShapeDef, SurfaceMaterial, World, WorldDef};
 use serde::{Deserialize, Serialize};
 
 /// A whole scene file.
@@ -205,12 +206,172 @@ pub struct BodyFile {
     /// Reports move events (`BodyDef::enable_move_events`).
     #[serde(default = "yes", skip_serializing_if = "is_true")]
     pub move_events: bool,
+    /// Motion locks (`BodyDef::motion_locks`; default none).
+    #[serde(default, skip_serializing_if = "LocksFile::is_none")]
+    pub motion_locks: LocksFile,
+    /// Enabled (default); `false` builds the body with its shapes and
+    /// chains, then disables it (`World::set_body_enabled`).
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub enabled: bool,
     /// Mass set directly (otherwise from the shapes).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mass: Option<MassFile>,
     /// Shapes.
     #[serde(default)]
     pub shapes: Vec<ShapeFile>,
+    /// Chain objects (`World::create_chain`), created after the shapes.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub chains: Vec<ChainFile>,
+}
+
+/// Motion locks by axis (`janus2d_core::body::MotionLocks`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LocksFile {
+    /// No motion along world x.
+    #[serde(skip_serializing_if = "is_false")]
+    pub x: bool,
+    /// No motion along world y.
+    #[serde(skip_serializing_if = "is_false")]
+    pub y: bool,
+    /// No rotation.
+    #[serde(skip_serializing_if = "is_false")]
+    pub rotation: bool,
+}
+
+impl LocksFile {
+    /// Nothing locked.
+    fn is_none(&self) -> bool {
+        *self == LocksFile::default()
+    }
+}
+
+/// Where a shape's geometry sits in its body's frame (`ShapeDef::offset`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct OffsetFile {
+    /// Translation, m.
+    #[serde(skip_serializing_if = "is_zero2")]
+    pub position: [f64; 2],
+    /// Turn, rad.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub angle: f64,
+}
+
+impl OffsetFile {
+    /// The identity.
+    fn is_identity(&self) -> bool {
+        *self == OffsetFile::default()
+    }
+}
+
+/// A surface material of a chain segment (`janus2d_world::SurfaceMaterial`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialFile {
+    /// Friction.
+    #[serde(default = "friction", skip_serializing_if = "is_friction")]
+    pub friction: f64,
+    /// Restitution.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub restitution: f64,
+    /// Rolling resistance.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub rolling_resistance: f64,
+    /// Surface tangent speed, m/s.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub tangent_speed: f64,
+    /// Friction combine rule.
+    #[serde(default, skip_serializing_if = "is_default_rule")]
+    pub friction_combine: CombineFile,
+    /// Restitution combine rule.
+    #[serde(default, skip_serializing_if = "is_default_rule")]
+    pub restitution_combine: CombineFile,
+    /// The user's material id.
+    #[serde(default, skip_serializing_if = "is_zero_u64")]
+    pub material: u64,
+}
+
+impl Default for MaterialFile {
+    /// `SurfaceMaterial::default()`'s values.
+    fn default() -> Self {
+        MaterialFile {
+            friction: 0.6,
+            restitution: 0.0,
+            rolling_resistance: 0.0,
+            tangent_speed: 0.0,
+            friction_combine: CombineFile::Default,
+            restitution_combine: CombineFile::Default,
+            material: 0,
+        }
+    }
+}
+
+impl MaterialFile {
+    /// The engine's material.
+    fn material(&self) -> SurfaceMaterial {
+        SurfaceMaterial {
+            friction: from_f64(self.friction),
+            restitution: from_f64(self.restitution),
+            rolling_resistance: from_f64(self.rolling_resistance),
+            tangent_speed: from_f64(self.tangent_speed),
+            friction_combine: self.friction_combine.rule(),
+            restitution_combine: self.restitution_combine.rule(),
+            user_material_id: self.material,
+        }
+    }
+}
+
+/// A chain object on a body (`janus2d_world::ChainDef`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChainFile {
+    /// Points in the body frame, m.
+    pub points: Vec<[f64; 2]>,
+    /// A closed loop (the last point joins the first).
+    #[serde(rename = "loop", default, skip_serializing_if = "is_false")]
+    pub is_loop: bool,
+    /// One material for every segment, or one per segment (default: one
+    /// default material).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub materials: Vec<MaterialFile>,
+    /// Collision filter of every segment.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub filter: Option<FilterFile>,
+    /// The chain's opaque user value.
+    #[serde(default, skip_serializing_if = "is_zero_u64")]
+    pub user_data: u64,
+    /// Hit events on the segments.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub hit_events: bool,
+    /// Contact begin/end events on the segments.
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub contact_events: bool,
+    /// Sensor events on the segments.
+    #[serde(default = "yes", skip_serializing_if = "is_true")]
+    pub sensor_events: bool,
+}
+
+impl ChainFile {
+    /// The engine's chain definition.
+    #[must_use]
+    pub fn chain_def(&self) -> ChainDef {
+        let mut def = ChainDef::new(self.points.iter().map(|p| v2(*p)).collect())
+            .with_loop(self.is_loop)
+            .with_user_data(self.user_data);
+        if !self.materials.is_empty() {
+            def = def.with_segment_materials(
+                self.materials.iter().map(MaterialFile::material).collect(),
+            );
+        }
+        if let Some(f) = &self.filter {
+            def = def.with_filter(f.filter());
+        }
+        def.enable_hit_events = self.hit_events;
+        def.enable_contact_events = self.contact_events;
+        def.enable_sensor_events = self.sensor_events;
+        def
+    }
 }
 
 /// A collision filter.
@@ -223,6 +384,17 @@ pub struct FilterFile {
     pub mask: u64,
     /// Group (positive: always collide, negative: never, 0: none).
     pub group: i32,
+}
+
+impl FilterFile {
+    /// The engine's filter.
+    fn filter(&self) -> Filter {
+        Filter {
+            category_bits: self.category,
+            mask_bits: self.mask,
+            group_index: self.group,
+        }
+    }
 }
 
 impl Default for FilterFile {
@@ -303,6 +475,10 @@ pub enum GeometryFile {
 pub struct ShapeFile {
     /// Geometry.
     pub geometry: GeometryFile,
+    /// Where the geometry sits in the body frame (`ShapeDef::offset`;
+    /// default none).
+    #[serde(default, skip_serializing_if = "OffsetFile::is_identity")]
+    pub offset: OffsetFile,
     /// Density, kg/m².
     #[serde(default = "one", skip_serializing_if = "is_one")]
     pub density: f64,
@@ -1022,6 +1198,11 @@ impl SceneFile {
                 angular_damping: from_f64(b.angular_damping),
                 gravity_scale: from_f64(b.gravity_scale),
                 fixed_rotation: b.fixed_rotation,
+                motion_locks: MotionLocks {
+                    linear_x: b.motion_locks.x,
+                    linear_y: b.motion_locks.y,
+                    angular: b.motion_locks.rotation,
+                },
                 awake: b.awake,
                 enable_move_events: b.move_events,
                 ..BodyDef::default()
@@ -1043,11 +1224,10 @@ impl SceneFile {
                     friction: from_f64(s.friction),
                     restitution: from_f64(s.restitution),
                     is_sensor: s.sensor,
-                    filter: s.filter.as_ref().map_or_else(Filter::default, |f| Filter {
-                        category_bits: f.category,
-                        mask_bits: f.mask,
-                        group_index: f.group,
-                    }),
+                    filter: s
+                        .filter
+                        .as_ref()
+                        .map_or_else(Filter::default, FilterFile::filter),
                     rolling_resistance: from_f64(s.rolling_resistance),
                     tangent_speed: from_f64(s.tangent_speed),
                     friction_combine: s.friction_combine.rule(),
@@ -1059,6 +1239,11 @@ impl SceneFile {
                     force_event_threshold: s.force_event_threshold.map_or(Real::INFINITY, from_f64),
                     ..ShapeDef::default()
                 };
+                finite(
+                    &format!("{field}.offset"),
+                    &[s.offset.position[0], s.offset.position[1], s.offset.angle],
+                )?;
+                let sd = sd.with_offset(v2(s.offset.position), from_f64(s.offset.angle));
                 let shapes = s
                     .geometry
                     .shapes()
@@ -1068,6 +1253,18 @@ impl SceneFile {
                         .create_shape(h, &sd, shape)
                         .map_err(|e| invalid(field.clone(), e))?;
                 }
+            }
+            for (k, c) in b.chains.iter().enumerate() {
+                let field = format!("bodies[{i}].chains[{k}]");
+                finite(&format!("{field}.points"), &c.points.concat())?;
+                world
+                    .create_chain(h, &c.chain_def())
+                    .map_err(|e| invalid(field, e))?;
+            }
+            if !b.enabled {
+                world
+                    .set_body_enabled(h, false)
+                    .map_err(|e| invalid(f("enabled"), e))?;
             }
             bodies.push(h);
         }
@@ -1498,6 +1695,8 @@ impl SceneFile {
                 angular_damping: 0.0,
                 gravity_scale: 1.0,
                 fixed_rotation: false,
+                motion_locks: LocksFile::default(),
+                enabled: true,
                 awake: b.awake,
                 move_events: true,
                 mass: b.mass.map(|(mass, inertia)| MassFile {
@@ -1543,6 +1742,7 @@ impl SceneFile {
                                 closed: true,
                             },
                         },
+                        offset: OffsetFile::default(),
                         density: s.density,
                         friction: s.friction,
                         restitution: s.restitution,
@@ -1563,6 +1763,7 @@ impl SceneFile {
                         force_event_threshold: None,
                     })
                     .collect(),
+                chains: Vec::new(),
             })
             .collect();
         let joints = d.all_joints().map(|j| joint_file(&j)).collect();

@@ -111,24 +111,44 @@ pub struct MotionLocks {
 
 impl MotionLocks {
     /// Nothing locked.
+    ///
+    /// ```
+    /// use janus2d_core::body::MotionLocks;
+    /// assert_eq!(MotionLocks::NONE, MotionLocks::default());
+    /// ```
     pub const NONE: MotionLocks = MotionLocks {
         linear_x: false,
         linear_y: false,
         angular: false,
     };
     /// Only x translation locked.
+    ///
+    /// ```
+    /// use janus2d_core::body::MotionLocks;
+    /// assert!(MotionLocks::X.linear_x && !MotionLocks::X.linear_y && !MotionLocks::X.angular);
+    /// ```
     pub const X: MotionLocks = MotionLocks {
         linear_x: true,
         linear_y: false,
         angular: false,
     };
     /// Only y translation locked.
+    ///
+    /// ```
+    /// use janus2d_core::body::MotionLocks;
+    /// assert!(MotionLocks::Y.linear_y && !MotionLocks::Y.linear_x);
+    /// ```
     pub const Y: MotionLocks = MotionLocks {
         linear_x: false,
         linear_y: true,
         angular: false,
     };
     /// Only the rotation locked.
+    ///
+    /// ```
+    /// use janus2d_core::body::MotionLocks;
+    /// assert!(MotionLocks::ROTATION.angular && !MotionLocks::ROTATION.linear_x);
+    /// ```
     pub const ROTATION: MotionLocks = MotionLocks {
         linear_x: false,
         linear_y: false,
@@ -136,6 +156,12 @@ impl MotionLocks {
     };
 
     /// The [`BodyState`] flag bits of the linear locks.
+    ///
+    /// ```
+    /// use janus2d_core::body::{BodyState, MotionLocks};
+    /// assert_eq!(MotionLocks::X.linear_flags(), BodyState::LOCK_X);
+    /// assert_eq!(MotionLocks::ROTATION.linear_flags(), 0);
+    /// ```
     #[inline]
     #[must_use]
     pub fn linear_flags(self) -> u32 {
@@ -296,6 +322,11 @@ impl BodyDef {
     }
 
     /// Sets the opaque user value (builder style).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// assert_eq!(BodyDef::dynamic(Vec2::ZERO).with_user_data(9).user_data, 9);
+    /// ```
     #[must_use]
     pub fn with_user_data(mut self, value: u64) -> Self {
         self.user_data = value;
@@ -317,6 +348,11 @@ impl BodyDef {
     }
 
     /// Sets the angle (builder style).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// assert_eq!(BodyDef::dynamic(Vec2::ZERO).with_angle(0.5).angle, 0.5);
+    /// ```
     #[must_use]
     pub fn with_angle(mut self, angle: Real) -> Self {
         self.angle = angle;
@@ -324,6 +360,11 @@ impl BodyDef {
     }
 
     /// Sets the linear velocity (builder style).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// assert_eq!(BodyDef::dynamic(Vec2::ZERO).with_velocity(Vec2::Y).linear_velocity, Vec2::Y);
+    /// ```
     #[must_use]
     pub fn with_velocity(mut self, v: Vec2) -> Self {
         self.linear_velocity = v;
@@ -331,6 +372,11 @@ impl BodyDef {
     }
 
     /// Sets the angular velocity (builder style).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// assert_eq!(BodyDef::dynamic(Vec2::ZERO).with_angular_velocity(2.0).angular_velocity, 2.0);
+    /// ```
     #[must_use]
     pub fn with_angular_velocity(mut self, w: Real) -> Self {
         self.angular_velocity = w;
@@ -338,6 +384,11 @@ impl BodyDef {
     }
 
     /// Sets the position (builder style).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// assert_eq!(BodyDef::dynamic(Vec2::ZERO).with_position(Vec2::X).position, Vec2::X);
+    /// ```
     #[must_use]
     pub fn with_position(mut self, position: Vec2) -> Self {
         self.position = position;
@@ -367,6 +418,11 @@ impl BodyDef {
     }
 
     /// Sets the angular damping, 1/s (builder style).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// assert_eq!(BodyDef::dynamic(Vec2::ZERO).with_angular_damping(0.4).angular_damping, 0.4);
+    /// ```
     #[must_use]
     pub fn with_angular_damping(mut self, damping: Real) -> Self {
         self.angular_damping = damping;
@@ -374,6 +430,11 @@ impl BodyDef {
     }
 
     /// Sets the gravity scale (builder style).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// assert_eq!(BodyDef::dynamic(Vec2::ZERO).with_gravity_scale(-1.0).gravity_scale, -1.0);
+    /// ```
     #[must_use]
     pub fn with_gravity_scale(mut self, scale: Real) -> Self {
         self.gravity_scale = scale;
@@ -381,6 +442,11 @@ impl BodyDef {
     }
 
     /// Starts the body awake or asleep (builder style; see [`BodyDef::awake`]).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// assert!(!BodyDef::dynamic(Vec2::ZERO).with_awake(false).awake);
+    /// ```
     #[must_use]
     pub fn with_awake(mut self, awake: bool) -> Self {
         self.awake = awake;
@@ -388,6 +454,11 @@ impl BodyDef {
     }
 
     /// Lets the body fall asleep or not (builder style).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// assert!(!BodyDef::dynamic(Vec2::ZERO).with_enable_sleep(false).enable_sleep);
+    /// ```
     #[must_use]
     pub fn with_enable_sleep(mut self, on: bool) -> Self {
         self.enable_sleep = on;
@@ -396,6 +467,11 @@ impl BodyDef {
 
     /// Sets the body's own rest speed, m/s, or `None` for the world's
     /// (builder style).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// assert_eq!(BodyDef::dynamic(Vec2::ZERO).with_sleep_threshold(Some(0.1)).sleep_threshold, Some(0.1));
+    /// ```
     #[must_use]
     pub fn with_sleep_threshold(mut self, threshold: Option<Real>) -> Self {
         self.sleep_threshold = threshold;
@@ -403,6 +479,11 @@ impl BodyDef {
     }
 
     /// Sets the maximum linear speed, m/s (builder style).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// assert_eq!(BodyDef::dynamic(Vec2::ZERO).with_max_linear_speed(30.0).max_linear_speed, 30.0);
+    /// ```
     #[must_use]
     pub fn with_max_linear_speed(mut self, speed: Real) -> Self {
         self.max_linear_speed = speed;
@@ -410,6 +491,11 @@ impl BodyDef {
     }
 
     /// Sets the maximum rotation per substep, rad (builder style).
+    ///
+    /// ```
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// assert_eq!(BodyDef::dynamic(Vec2::ZERO).with_max_rotation(0.1).max_rotation, 0.1);
+    /// ```
     #[must_use]
     pub fn with_max_rotation(mut self, rotation: Real) -> Self {
         self.max_rotation = rotation;

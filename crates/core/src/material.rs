@@ -67,6 +67,14 @@ pub enum CombineRule {
 }
 
 /// Which coefficient [`combine`] mixes (it names the default rule).
+///
+/// ```
+/// use janus2d_core::material::{CombineRule, Property, combine};
+/// // The same rules, the property's default: friction √(a b), restitution max.
+/// let (r, d) = (CombineRule::Default, CombineRule::Default);
+/// assert_eq!(combine(Property::Friction, 0.25, r, 1.0, d), 0.5);
+/// assert_eq!(combine(Property::Restitution, 0.25, r, 1.0, d), 1.0);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Property {
     /// Friction: default `√(a b)`.

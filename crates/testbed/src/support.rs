@@ -609,6 +609,160 @@ pub fn hinged_chains() -> janus2d_world::World {
     world
 }
 
+/// A world using every per-body and per-shape state issue 32 added, for
+/// the snapshot, fuzz-seed and state-machine tests: a chain object with
+/// three segment materials (friction, rolling resistance, tangent speed,
+/// combine rules, material ids) on the ground; a rolling ball (rolling
+/// resistance, hit events, a contact force threshold); an x- and
+/// rotation-locked box with an offset turned geometry; a y-locked box
+/// sliding; a disabled body (offset capsule) hinged to an enabled one (the
+/// joint kept off); a sensor with sensor events off on one visitor; move
+/// events on. Returned after `steps` steps of 1/60 s.
+#[must_use]
+pub fn issue32_world(steps: usize) -> janus2d_world::World {
+    use janus2d_constraints::RevoluteJointDef;
+    use janus2d_core::body::MotionLocks;
+    use janus2d_core::geometry::{Capsule, Circle, Polygon};
+    use janus2d_core::material::CombineRule;
+    use janus2d_world::{ChainDef, ShapeDef, SurfaceMaterial, World, WorldDef};
+    let v = Vec2::new;
+    let mut world =
+        World::new(WorldDef::default().with_move_events(true)).expect("the default world");
+    let ground = world
+        .create_body(&BodyDef::fixed(Vec2::ZERO))
+        .expect("ground");
+    let materials = vec![
+        SurfaceMaterial::default()
+            .with_friction(0.2)
+            .with_material_id(7),
+        SurfaceMaterial {
+            friction_combine: CombineRule::Max,
+            ..SurfaceMaterial::default()
+                .with_friction(0.9)
+                .with_rolling_resistance(0.3)
+        },
+        SurfaceMaterial {
+            restitution_combine: CombineRule::Min,
+            ..SurfaceMaterial::default()
+                .with_tangent_speed(1.5)
+                .with_restitution(0.2)
+                .with_material_id(9)
+        },
+    ];
+    let points = vec![v(12.0, 0.0), v(4.0, 0.0), v(-2.0, 0.0), v(-12.0, 0.0)];
+    world
+        .create_chain(
+            ground,
+            &ChainDef::new(points).with_segment_materials(materials),
+        )
+        .expect("the ground chain");
+    let ball = world
+        .create_body(&BodyDef {
+            linear_velocity: v(-4.0, 0.0),
+            ..BodyDef::dynamic(v(8.0, 0.6))
+        })
+        .expect("ball");
+    let def = ShapeDef::default()
+        .with_rolling_resistance(0.1)
+        .with_friction_combine(CombineRule::Average)
+        .with_hit_events(true)
+        .with_force_event_threshold(5.0)
+        .with_material_id(3);
+    world
+        .create_shape(ball, &def, Circle::new(Vec2::ZERO, 0.5).expect("a circle"))
+        .expect("ball shape");
+    let locks = MotionLocks {
+        linear_x: true,
+        linear_y: false,
+        angular: true,
+    };
+    let slider = world
+        .create_body(&BodyDef::dynamic(v(-6.0, 3.0)).with_motion_locks(locks))
+        .expect("slider");
+    world
+        .create_shape(
+            slider,
+            &ShapeDef::default().with_offset(v(0.3, 0.0), 0.4),
+            Polygon::make_box(0.4, 0.3),
+        )
+        .expect("slider shape");
+    let hover = world
+        .create_body(&BodyDef {
+            linear_velocity: v(2.0, 0.0),
+            ..BodyDef::dynamic(v(-1.0, 1.5)).with_motion_locks(MotionLocks::Y)
+        })
+        .expect("hover");
+    world
+        .create_shape(
+            hover,
+            &ShapeDef::default().with_tangent_speed(0.5),
+            Polygon::make_box(0.25, 0.25),
+        )
+        .expect("hover shape");
+    let held = world
+        .create_body(&BodyDef::dynamic(v(2.0, 4.0)))
+        .expect("held");
+    world
+        .create_shape(held, &ShapeDef::default(), Polygon::make_box(0.3, 0.3))
+        .expect("held shape");
+    let off = world
+        .create_body(&BodyDef::dynamic(v(3.0, 4.0)))
+        .expect("off");
+    let capsule = Capsule::new(v(-0.4, 0.0), v(0.4, 0.0), 0.2).expect("a capsule");
+    world
+        .create_shape(
+            off,
+            &ShapeDef::default().with_offset(v(0.0, 0.3), 0.2),
+            capsule,
+        )
+        .expect("off shape");
+    world
+        .create_revolute_joint(&RevoluteJointDef::new(
+            held,
+            off,
+            v(0.5, 0.0),
+            v(-0.5, -0.3),
+        ))
+        .expect("a hinge");
+    world.set_body_enabled(off, false).expect("disable");
+    let sensor = world
+        .create_body(&BodyDef::fixed(v(-3.0, 1.0)))
+        .expect("sensor body");
+    world
+        .create_shape(
+            sensor,
+            &ShapeDef::default().sensor(),
+            Polygon::make_box(1.0, 1.0),
+        )
+        .expect("sensor");
+    let visitor = world
+        .create_body(&BodyDef::dynamic(v(-3.0, 8.0)))
+        .expect("visitor");
+    world
+        .create_shape(
+            visitor,
+            &ShapeDef::default().with_sensor_events(true),
+            Circle::new(Vec2::ZERO, 0.2).expect("a circle"),
+        )
+        .expect("visitor shape");
+    let quiet = world
+        .create_body(&BodyDef::dynamic(v(-2.5, 8.0)))
+        .expect("quiet visitor");
+    world
+        .create_shape(
+            quiet,
+            &ShapeDef::default()
+                .with_sensor_events(false)
+                .with_contact_events(false),
+            Circle::new(Vec2::ZERO, 0.2).expect("a circle"),
+        )
+        .expect("quiet shape");
+    for _ in 0..steps {
+        world.step(1.0 / 60.0).expect("a step");
+    }
+    world
+}
+
 /// Whether `JANUS2D_REPORT` is set: the tests then print their measured
 /// worst figures.
 pub fn report() -> bool {

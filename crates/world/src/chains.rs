@@ -23,6 +23,15 @@ use crate::error::WorldError;
 use crate::shapes::{Filter, ShapeDef, ShapeHandle};
 
 /// A generational handle to a chain ([`World::create_chain`](crate::World::create_chain)).
+///
+/// ```
+/// use janus2d_world::{ChainDef, ChainHandle, World, WorldDef};
+/// use janus2d_core::{BodyDef, Vec2};
+/// let mut world = World::new(WorldDef::default()).unwrap();
+/// let g = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+/// let chain: ChainHandle = world.create_chain(g, &ChainDef::new(vec![Vec2::ZERO, Vec2::X])).unwrap();
+/// assert_eq!(world.chain_handles(), vec![chain]);
+/// ```
 pub type ChainHandle = Handle<ChainTag>;
 
 /// The surface fields of a shape, one per chain segment (Box2D's

@@ -51,17 +51,40 @@ use crate::shapes::ShapeHandle;
 
 /// Extra distance beyond `skin` within which a shape counts as touched,
 /// m (usual 0.01 = 2 · [`LINEAR_SLOP`]).
+///
+/// ```
+/// use janus2d_world::character::{CONTACT_MARGIN, ONE_WAY_DEPTH};
+/// assert!(CONTACT_MARGIN > 0.0 && CONTACT_MARGIN < ONE_WAY_DEPTH);
+/// ```
 pub const CONTACT_MARGIN: Real = 2.0 * LINEAR_SLOP;
 
 /// How deep (m) the capsule may be in a one-way shape and still stand on it
 /// (usual 0.02 = 4 · [`LINEAR_SLOP`]): deeper, it is passing through.
+///
+/// ```
+/// use janus2d_core::geometry::LINEAR_SLOP;
+/// assert_eq!(janus2d_world::character::ONE_WAY_DEPTH, 4.0 * LINEAR_SLOP);
+/// ```
 pub const ONE_WAY_DEPTH: Real = 4.0 * LINEAR_SLOP;
 
 /// A slide stops when the plane solver moves it less than this, m (usual
 /// 5e-5 = [`LINEAR_SLOP`] / 100).
+///
+/// ```
+/// use janus2d_core::geometry::LINEAR_SLOP;
+/// assert!(janus2d_world::character::SLIDE_TOLERANCE < LINEAR_SLOP);
+/// ```
 pub const SLIDE_TOLERANCE: Real = 0.01 * LINEAR_SLOP;
 
 /// Stepping up ledges (Rapier's autostep).
+///
+/// ```
+/// use janus2d_world::character::{Autostep, CharacterController};
+/// let a = Autostep::default();
+/// assert_eq!((a.max_height, a.min_width), (0.3, 0.1));
+/// let cc = CharacterController::new().with_autostep(Some(Autostep { max_height: 0.25, ..a }));
+/// assert_eq!(cc.autostep.unwrap().max_height, 0.25);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Autostep {
     /// Highest ledge stepped up, m, measured from the ground point the
@@ -82,6 +105,23 @@ impl Default for Autostep {
 }
 
 /// The ground a character stands on.
+///
+/// ```
+/// use janus2d_world::{ShapeDef, World, WorldDef, QueryFilter};
+/// use janus2d_world::character::CharacterController;
+/// use janus2d_core::{BodyDef, Vec2};
+/// use janus2d_core::geometry::{Capsule, Polygon};
+/// let mut world = World::new(WorldDef::default()).unwrap();
+/// let floor = world.create_body(&BodyDef::fixed(Vec2::new(0.0, -0.5))).unwrap();
+/// world.create_shape(floor, &ShapeDef::default(), Polygon::make_box(10.0, 0.5)).unwrap();
+/// let capsule = Capsule::new(Vec2::new(0.0, 0.25), Vec2::new(0.0, 0.75), 0.25).unwrap();
+/// let mut cc = CharacterController::new();
+/// let r = cc.move_and_slide(&world, &capsule, Vec2::new(0.0, 0.01), Vec2::new(1.0, -1.0), 1.0 / 60.0, &QueryFilter::default()).unwrap();
+/// let ground = r.ground.unwrap();
+/// assert_eq!(ground.body, floor);
+/// assert!((ground.normal - Vec2::Y).length() < 1e-3 && ground.point.y.abs() < 1e-3);
+/// assert_eq!(ground.velocity, Vec2::ZERO);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ground {
     /// The shape.
@@ -97,6 +137,23 @@ pub struct Ground {
 }
 
 /// What one [`CharacterController::move_and_slide`] did.
+///
+/// ```
+/// use janus2d_world::{ShapeDef, World, WorldDef, QueryFilter};
+/// use janus2d_world::character::CharacterController;
+/// use janus2d_core::{BodyDef, Vec2};
+/// use janus2d_core::geometry::{Capsule, Polygon};
+/// let mut world = World::new(WorldDef::default()).unwrap();
+/// let floor = world.create_body(&BodyDef::fixed(Vec2::new(0.0, -0.5))).unwrap();
+/// world.create_shape(floor, &ShapeDef::default(), Polygon::make_box(10.0, 0.5)).unwrap();
+/// let capsule = Capsule::new(Vec2::new(0.0, 0.25), Vec2::new(0.0, 0.75), 0.25).unwrap();
+/// let mut cc = CharacterController::new();
+/// let r = cc.move_and_slide(&world, &capsule, Vec2::new(0.0, 0.01), Vec2::new(3.0, -1.0), 0.5, &QueryFilter::default()).unwrap();
+/// assert!(r.grounded && !r.stepped);
+/// assert!((r.position.x - 1.5).abs() < 1e-3, "walked 3 m/s for 0.5 s: {:?}", r.position);
+/// assert!(r.velocity.y.abs() < 1e-3, "the floor absorbed the downward part");
+/// assert_eq!(r.carried, Vec2::ZERO);
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct MoveResult {
     /// Where the character is now (the capsule's reference point), m.

@@ -12,8 +12,8 @@
 //!
 //! | flag               | default | primitives                                                        |
 //! |--------------------|---------|-------------------------------------------------------------------|
-//! | `shapes`           | on      | circles ([`DebugDraw::solid_circle`], with a radius line showing the turn), capsules ([`DebugDraw::solid_capsule`]), polygons ([`DebugDraw::solid_polygon`], rounded by their radius), segments and chain segments ([`DebugDraw::segment`]); coloured by body type |
-//! | `sleep`            | on      | shapes of sleeping bodies in [`Palette::sleeping`]                |
+//! | `shapes`           | on      | circles ([`DebugDraw::solid_circle`], with a radius line showing the turn), capsules ([`DebugDraw::solid_capsule`]), polygons ([`DebugDraw::solid_polygon`], rounded by their radius), segments ([`DebugDraw::segment`]), chain segments as a segment with a short tick from its middle along its front normal (the side that collides; a fifth of its length, at most 0.25 m); coloured by body type; shapes of disabled bodies ([`World::set_body_enabled`]) always in [`Palette::disabled`]. A shape offset ([`ShapeDef::offset`](crate::ShapeDef::offset)) is in the stored geometry, so offset shapes draw where they are |
+//! | `sleep`            | on      | shapes of sleeping (enabled) bodies in [`Palette::sleeping`]      |
 //! | `islands`          | off     | shapes coloured by island; one outline box ([`DebugDraw::polygon`]) per island around its members' boxes, with its id as [`DebugDraw::text`] |
 //! | `joints`           | on      | per joint (every kind): body origin → anchor a → anchor b ← body origin ([`DebugDraw::segment`]), both anchors as [`DebugDraw::point`]; a prismatic or wheel joint's axis through anchor a (`draw_scale` m long) with its limits as points; a mouse joint's target and pull; a motor joint's target point; a filter joint only as a line between its bodies; disabled joints in [`Palette::joint_disabled`] |
 //! | `contacts`         | off     | one [`DebugDraw::point`] per manifold point of a solid contact: touching in [`Palette::contact_touching`], speculative (separation > 0) in [`Palette::contact_speculative`] |
@@ -144,6 +144,8 @@ pub struct Palette {
     pub dynamic_body: Color,
     /// Shapes of sleeping bodies (with the `sleep` flag).
     pub sleeping: Color,
+    /// Shapes of disabled bodies (whatever the flags).
+    pub disabled: Color,
     /// Sensor shapes (alpha applied to the body colour).
     pub sensor_alpha: f32,
     /// Joints.
@@ -181,6 +183,7 @@ impl Default for Palette {
             kinematic_body: Color::rgb(0.5, 0.5, 0.9),
             dynamic_body: Color::rgb(0.9, 0.7, 0.7),
             sleeping: Color::rgb(0.6, 0.6, 0.6),
+            disabled: Color::rgb(0.35, 0.3, 0.3).with_alpha(0.5),
             sensor_alpha: 0.35,
             joint: Color::rgb(0.5, 0.8, 0.8),
             joint_disabled: Color::rgb(0.4, 0.4, 0.4),
@@ -342,6 +345,9 @@ pub fn box_corners(b: &Aabb) -> [Vec2; 4] {
 fn shape_color(world: &World, body: BodyHandle, island: Option<u32>, o: &DrawOptions) -> Color {
     let p = &o.palette;
     let ty = world.body_type(body).unwrap_or(BodyType::Static);
+    if world.is_body_enabled(body) == Ok(false) {
+        return p.disabled;
+    }
     if o.sleep && world.is_sleeping(body) == Ok(true) {
         return p.sleeping;
     }
@@ -372,11 +378,17 @@ fn draw_geometry<D: DebugDraw + ?Sized>(draw: &mut D, xf: &Transform, shape: &Sh
         }
         Shape::Segment(s) => draw.segment(xf.apply(s.point1), xf.apply(s.point2), color),
         Shape::ChainSegment(c) => {
-            draw.segment(
-                xf.apply(c.segment.point1),
-                xf.apply(c.segment.point2),
-                color,
-            );
+            let (p1, p2) = (xf.apply(c.segment.point1), xf.apply(c.segment.point2));
+            draw.segment(p1, p2, color);
+            // The front normal (d.y, −d.x)/|d|: the side that collides.
+            let d = p2 - p1;
+            let length = d.length();
+            if length > 0.0 {
+                let normal = Vec2::new(d.y, -d.x) / length;
+                let tick = (0.2 * length).min(0.25);
+                let mid = 0.5 * (p1 + p2);
+                draw.segment(mid, mid + tick * normal, color);
+            }
         }
     }
 }
@@ -942,5 +954,98 @@ mod tests {
         // Two holes, and the two copies of the crossing in progress.
         assert_eq!(a.polygons, world.portal_clipping().clips.len());
         assert!(a.polygons >= 4, "{}", a.polygons);
+    }
+
+    /// Every segment and circle with its colour.
+    #[derive(Default)]
+    struct Lines {
+        segments: Vec<(Vec2, Vec2, Color)>,
+        circles: Vec<(Vec2, Color)>,
+        polygons: Vec<Color>,
+    }
+
+    impl DebugDraw for Lines {
+        fn polygon(&mut self, _: &[Vec2], _: Color) {}
+        fn solid_polygon(&mut self, _: &[Vec2], _: Real, c: Color) {
+            self.polygons.push(c);
+        }
+        fn circle(&mut self, _: Vec2, _: Real, _: Color) {}
+        fn solid_circle(&mut self, p: Vec2, _: Real, _: Vec2, c: Color) {
+            self.circles.push((p, c));
+        }
+        fn solid_capsule(&mut self, _: Vec2, _: Vec2, _: Real, _: Color) {}
+        fn segment(&mut self, a: Vec2, b: Vec2, c: Color) {
+            self.segments.push((a, b, c));
+        }
+        fn point(&mut self, _: Vec2, _: f32, _: Color) {}
+    }
+
+    /// A chain draws each segment and a tick on its colliding side; an
+    /// offset circle draws at its offset; a disabled body's shapes draw in
+    /// the disabled colour, asleep or not, and again in the body colour once
+    /// enabled.
+    #[test]
+    fn chains_offsets_and_disabled_bodies() {
+        use crate::ChainDef;
+        let mut world = World::new(WorldDef::default()).unwrap();
+        let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+        // Walked on from above: right to left; segments 4 m and 1 m long.
+        let points = vec![
+            Vec2::new(4.0, 0.0),
+            Vec2::new(0.0, 0.0),
+            Vec2::new(-1.0, 0.0),
+        ];
+        world.create_chain(ground, &ChainDef::new(points)).unwrap();
+        let ball = world
+            .create_body(&BodyDef::dynamic(Vec2::new(0.0, 3.0)))
+            .unwrap();
+        let def = ShapeDef::default().with_offset(Vec2::new(1.5, 0.0), 0.0);
+        world
+            .create_shape(ball, &def, Circle::new(Vec2::ZERO, 0.25).unwrap())
+            .unwrap();
+        let off = world
+            .create_body(&BodyDef::dynamic(Vec2::new(-3.0, 3.0)))
+            .unwrap();
+        world
+            .create_shape(off, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+            .unwrap();
+        world.set_body_enabled(off, false).unwrap();
+
+        let palette = Palette::default();
+        let mut r = Lines::default();
+        world.debug_draw(&mut r, &DrawOptions::default());
+        // Two chain segments, each with its tick: 4 segments.
+        assert_eq!(r.segments.len(), 4);
+        let ticks: Vec<_> = r.segments.iter().filter(|(a, b, _)| a.y != b.y).collect();
+        assert_eq!(ticks.len(), 2, "one tick per chain segment");
+        for (a, b, c) in &ticks {
+            assert_eq!(*c, palette.static_body);
+            assert_eq!(a.y, 0.0);
+            // Up (the colliding side of right-to-left ground), a fifth of
+            // the segment's length capped at 0.25 m.
+            let expected = if a.x == 2.0 { 0.25 } else { 0.2 };
+            assert!(a.x == 2.0 || a.x == -0.5, "{a:?}");
+            assert!((b.y - expected).abs() < 1e-6, "tick {a:?} → {b:?}");
+        }
+        // The circle is drawn at body origin + offset.
+        assert_eq!(r.circles.len(), 1);
+        assert_eq!(r.circles[0].0, Vec2::new(1.5, 3.0));
+        // The disabled box: drawn, in the disabled colour (the sleeping
+        // colour would be the same with and without the `sleep` flag).
+        assert_eq!(r.polygons, vec![palette.disabled]);
+        assert_ne!(palette.disabled, palette.sleeping);
+        let mut r = Lines::default();
+        world.debug_draw(
+            &mut r,
+            &DrawOptions {
+                sleep: false,
+                ..DrawOptions::default()
+            },
+        );
+        assert_eq!(r.polygons, vec![palette.disabled]);
+        world.set_body_enabled(off, true).unwrap();
+        let mut r = Lines::default();
+        world.debug_draw(&mut r, &DrawOptions::default());
+        assert_eq!(r.polygons, vec![palette.dynamic_body]);
     }
 }

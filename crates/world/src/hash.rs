@@ -1,15 +1,21 @@
 //! The state hash: equal hashes mean bit-identical body states.
 //!
 //! FNV-1a (64 bit) over every live body in handle order: the slot index,
-//! then the bits of `x, y, cos θ, sin θ, v_x, v_y, ω`. Small, stable across
+//! then the bits of `x, y, cos θ, sin θ, v_x, v_y, ω`; then, when the world
+//! has chains, every chain in slot order: its slot index and generation,
+//! its loop flag and its segment shapes' slot indices (a world without
+//! chains hashes as before chains existed). Small, stable across
 //! platforms and releases, and cheap enough to run every step in a test.
 
 use janus2d_core::body::BodySet;
 use janus2d_core::math::Real;
 
-/// The hash of every body's transform and velocity bits, in handle order.
+use crate::chains::ChainSet;
+
+/// The hash of every body's transform and velocity bits, in handle order,
+/// then of the chains (none: nothing added).
 #[must_use]
-pub fn state_hash(bodies: &BodySet) -> u64 {
+pub(crate) fn state_hash(bodies: &BodySet, chains: &ChainSet) -> u64 {
     let mut h = Fnv::new();
     for handle in bodies.handles() {
         let (Some(sim), Some(st)) = (bodies.sim(handle), bodies.state(handle)) else {
@@ -26,6 +32,15 @@ pub fn state_hash(bodies: &BodySet) -> u64 {
             st.w,
         ] {
             h.write_real(x);
+        }
+    }
+    for (index, chain) in chains.slots.iter() {
+        h.write_u32(index);
+        h.write_u32(chains.slots.generation(index));
+        h.write_u32(u32::from(chain.is_loop));
+        h.write_u32(chain.segments.len() as u32);
+        for s in &chain.segments {
+            h.write_u32(s.index);
         }
     }
     h.finish()

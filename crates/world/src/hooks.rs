@@ -24,6 +24,23 @@ use crate::shapes::{ShapeData, ShapeHandle};
 /// `false` makes no contact between them. A pair it turned down is asked
 /// again when the broadphase reports it again (a shape moved out of its
 /// fattened box); existing contacts are not asked again.
+///
+/// ```
+/// use janus2d_world::{PairFilterFn, ShapeDef, World, WorldDef};
+/// use janus2d_core::{BodyDef, Vec2};
+/// use janus2d_core::geometry::Polygon;
+/// let mut world = World::new(WorldDef::default()).unwrap();
+/// let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+/// world.create_shape(ground, &ShapeDef::default(), Polygon::make_box(5.0, 0.5)).unwrap();
+/// let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 1.0))).unwrap();
+/// world.create_shape(b, &ShapeDef::default().with_user_data(1), Polygon::make_box(0.5, 0.5)).unwrap();
+/// // Nothing collides: the box falls through the ground.
+/// let never: PairFilterFn = Box::new(|_, _| false);
+/// world.set_pair_filter(Some(never));
+/// for _ in 0..60 { world.step(1.0 / 60.0).unwrap(); }
+/// assert_eq!(world.contact_count(), 0);
+/// assert!(world.position(b).unwrap().y < -1.0);
+/// ```
 pub type PairFilterFn = Box<dyn FnMut(ShapeHandle, ShapeHandle) -> bool + Send>;
 
 /// A friction or restitution callback (Box2D's `b2FrictionCallback`,
@@ -31,6 +48,22 @@ pub type PairFilterFn = Box<dyn FnMut(ShapeHandle, ShapeHandle) -> bool + Send>;
 /// user_material_id_b) → mixed`, in place of the shapes' combine rules.
 /// A result that is not finite falls back to the combine rules; it is
 /// clamped to `[0, MAX_FRICTION]` (or `[0, MAX_RESTITUTION]`).
+///
+/// ```
+/// use janus2d_world::{MixFn, ShapeDef, World, WorldDef};
+/// use janus2d_core::{BodyDef, Vec2};
+/// use janus2d_core::geometry::Polygon;
+/// let mut world = World::new(WorldDef::default()).unwrap();
+/// let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+/// world.create_shape(ground, &ShapeDef::default().with_material_id(1), Polygon::make_box(5.0, 0.5)).unwrap();
+/// let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 1.0))).unwrap();
+/// world.create_shape(b, &ShapeDef::default().with_material_id(2), Polygon::make_box(0.5, 0.5)).unwrap();
+/// // Material pair (1, 2) is ice, whatever the shapes' frictions.
+/// let ice: MixFn = Box::new(|fa, ma, fb, mb| if ma.min(mb) == 1 && ma.max(mb) == 2 { 0.01 } else { (fa * fb).sqrt() });
+/// world.set_friction_callback(Some(ice));
+/// world.step(1.0 / 60.0).unwrap();
+/// assert_eq!(world.contacts().next().unwrap().friction, 0.01);
+/// ```
 pub type MixFn = Box<dyn Fn(Real, u64, Real, u64) -> Real + Send>;
 
 /// The world's callbacks (none by default).

@@ -33,14 +33,41 @@ use crate::query::RayHit;
 use crate::shapes::ShapeHandle;
 
 /// Most Gauss–Seidel sweeps of [`solve_planes`] (a count; usual 20).
+///
+/// ```
+/// use janus2d_world::mover::{CollisionPlane, PLANE_SOLVER_ITERATIONS, solve_planes};
+/// use janus2d_core::Vec2;
+/// let mut planes = [CollisionPlane::new(Vec2::Y, 0.0), CollisionPlane::new(Vec2::X, 0.0)];
+/// assert!(solve_planes(Vec2::new(-1.0, -1.0), &mut planes).iterations <= PLANE_SOLVER_ITERATIONS);
+/// ```
 pub const PLANE_SOLVER_ITERATIONS: usize = 20;
 
 /// [`solve_planes`] stops when a sweep pushes less than this in all, m
 /// (usual 1e-5 = [`LINEAR_SLOP`] / 500).
+///
+/// ```
+/// use janus2d_core::geometry::LINEAR_SLOP;
+/// assert!(janus2d_world::mover::PLANE_SOLVER_TOLERANCE < 0.01 * LINEAR_SLOP);
+/// ```
 pub const PLANE_SOLVER_TOLERANCE: Real = 0.002 * LINEAR_SLOP;
 
 /// A shape the mover touches or nearly touches, from
 /// [`World::collide_mover`](crate::World::collide_mover).
+///
+/// ```
+/// use janus2d_world::{World, WorldDef, ShapeDef, QueryFilter};
+/// use janus2d_core::{BodyDef, Vec2};
+/// use janus2d_core::geometry::{Capsule, Polygon};
+/// let mut world = World::new(WorldDef::default()).unwrap();
+/// let wall = world.create_body(&BodyDef::fixed(Vec2::new(1.0, 0.0))).unwrap();
+/// world.create_shape(wall, &ShapeDef::default(), Polygon::make_box(0.5, 2.0)).unwrap();
+/// // The capsule's right side is 5 cm from the wall's face (x = 0.5).
+/// let mover = Capsule::new(Vec2::new(0.2, -0.25), Vec2::new(0.2, 0.25), 0.25).unwrap();
+/// let mut found = Vec::new();
+/// world.collide_mover(&mover, 0.1, &QueryFilter::default(), |p| { found.push(*p); true }).unwrap();
+/// assert_eq!(found[0].body, wall);
+/// assert!((found[0].separation - 0.05).abs() < 1e-4 && (found[0].normal + Vec2::X).length() < 1e-4);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlaneResult {
     /// The shape.
@@ -82,6 +109,15 @@ impl PlaneResult {
 
 /// One constraint of [`solve_planes`]: the displacement `δ` must satisfy
 /// `normal · δ ≥ offset`, with at most `push_limit` of push along `normal`.
+///
+/// ```
+/// use janus2d_world::mover::{CollisionPlane, solve_planes};
+/// use janus2d_core::Vec2;
+/// // A soft plane: it pushes at most 1 cm.
+/// let mut planes = [CollisionPlane { push_limit: 0.01, ..CollisionPlane::new(Vec2::Y, 0.05) }];
+/// let s = solve_planes(Vec2::ZERO, &mut planes);
+/// assert!((s.translation.y - 0.01).abs() < 1e-6 && (planes[0].push - 0.01).abs() < 1e-6);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CollisionPlane {
     /// Unit normal, pointing where the mover may go.
@@ -120,6 +156,15 @@ impl CollisionPlane {
 }
 
 /// What [`solve_planes`] found.
+///
+/// ```
+/// use janus2d_world::mover::{CollisionPlane, solve_planes};
+/// use janus2d_core::Vec2;
+/// // Into a floor: the downward part of the move is taken out.
+/// let mut planes = [CollisionPlane::new(Vec2::Y, 0.0)];
+/// let s = solve_planes(Vec2::new(1.0, -1.0), &mut planes);
+/// assert!((s.translation - Vec2::new(1.0, 0.0)).length() < 1e-6);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlaneSolution {
     /// The displacement that satisfies the planes, m.
@@ -297,6 +342,16 @@ pub fn clip_vector(vector: Vec2, planes: &[CollisionPlane]) -> Vec2 {
 
 /// Where a mover cast stopped, from
 /// [`World::cast_mover`](crate::World::cast_mover).
+///
+/// ```
+/// use janus2d_world::{World, WorldDef, QueryFilter};
+/// use janus2d_core::Vec2;
+/// use janus2d_core::geometry::Capsule;
+/// let world = World::new(WorldDef::default()).unwrap();
+/// let mover = Capsule::new(Vec2::ZERO, Vec2::Y, 0.25).unwrap();
+/// let cast = world.cast_mover(&mover, Vec2::new(5.0, 0.0), &QueryFilter::default()).unwrap();
+/// assert_eq!((cast.fraction, cast.hit), (1.0, None), "nothing in the way");
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MoverCast {
     /// Fraction of the translation the mover can travel, in `[0, 1]` (1:

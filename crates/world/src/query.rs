@@ -67,6 +67,21 @@ pub const MAX_PORTAL_HOPS: u32 = 4;
 
 /// A caller's test of each shape a query would otherwise see: `true`
 /// keeps it (see [`QueryFilter::with_predicate`]).
+///
+/// ```
+/// use janus2d_world::{QueryFilter, ShapeDef, ShapeHandle, World, WorldDef};
+/// use janus2d_core::{BodyDef, Vec2};
+/// use janus2d_core::geometry::Circle;
+/// let mut world = World::new(WorldDef::default()).unwrap();
+/// let b = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+/// let keep = world.create_shape(b, &ShapeDef::default(), Circle::new(Vec2::ZERO, 1.0).unwrap()).unwrap();
+/// let skip = world.create_shape(b, &ShapeDef::default(), Circle::new(Vec2::ZERO, 0.5).unwrap()).unwrap();
+/// let only_keep = |s: ShapeHandle| s == keep;
+/// let mut seen = Vec::new();
+/// world.overlap_point(Vec2::ZERO, &QueryFilter::default().with_predicate(&only_keep), |o| { seen.push(o.shape); true });
+/// assert_eq!(seen, vec![keep]);
+/// assert_ne!(keep, skip);
+/// ```
 pub type QueryPredicate<'a> = &'a dyn Fn(ShapeHandle) -> bool;
 
 /// Which shapes a query sees.
@@ -765,6 +780,17 @@ pub(crate) fn distance_between(ctx: &QueryContext<'_>, a: u32, b: u32) -> Distan
 
 /// The point on a shape's surface nearest to a query point
 /// ([`World::project_point`](crate::World::project_point)).
+///
+/// ```
+/// use janus2d_world::{QueryFilter, ShapeDef, World, WorldDef};
+/// use janus2d_core::{BodyDef, Vec2};
+/// use janus2d_core::geometry::Polygon;
+/// let mut world = World::new(WorldDef::default()).unwrap();
+/// let b = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+/// world.create_shape(b, &ShapeDef::default(), Polygon::make_box(1.0, 1.0)).unwrap();
+/// let p = world.project_point(Vec2::new(3.0, 0.5), 10.0, &QueryFilter::default()).unwrap().unwrap();
+/// assert_eq!((p.point, p.normal, p.distance, p.inside), (Vec2::new(1.0, 0.5), Vec2::X, 2.0, false));
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PointProjection {
     /// The shape.

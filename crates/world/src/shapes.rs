@@ -67,6 +67,12 @@ impl Filter {
     }
 
     /// Sets the group index (builder style; see [`Filter`]).
+    ///
+    /// ```
+    /// use janus2d_world::Filter;
+    /// // Group −1: shapes of this group never collide with each other.
+    /// assert_eq!(Filter::new(1, u64::MAX).with_group(-1).group_index, -1);
+    /// ```
     #[must_use]
     pub fn with_group(mut self, group_index: i32) -> Self {
         self.group_index = group_index;
@@ -204,6 +210,11 @@ impl ShapeDef {
     }
 
     /// Turns the shape's hit events on or off (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::ShapeDef;
+    /// assert!(ShapeDef::default().with_hit_events(true).enable_hit_events);
+    /// ```
     #[must_use]
     pub fn with_hit_events(mut self, on: bool) -> Self {
         self.enable_hit_events = on;
@@ -230,6 +241,11 @@ impl ShapeDef {
 
     /// Turns the shape's sensor events on or off (builder style; see
     /// [`ShapeDef::enable_sensor_events`]).
+    ///
+    /// ```
+    /// use janus2d_world::ShapeDef;
+    /// assert!(!ShapeDef::default().with_sensor_events(false).enable_sensor_events);
+    /// ```
     #[must_use]
     pub fn with_sensor_events(mut self, on: bool) -> Self {
         self.enable_sensor_events = on;
@@ -238,6 +254,11 @@ impl ShapeDef {
 
     /// Sets the contact force event threshold, N (builder style; see
     /// [`ShapeDef::force_event_threshold`]).
+    ///
+    /// ```
+    /// use janus2d_world::ShapeDef;
+    /// assert_eq!(ShapeDef::default().with_force_event_threshold(20.0).force_event_threshold, 20.0);
+    /// ```
     #[must_use]
     pub fn with_force_event_threshold(mut self, force: Real) -> Self {
         self.force_event_threshold = force;
@@ -245,6 +266,11 @@ impl ShapeDef {
     }
 
     /// Sets the opaque user value (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::ShapeDef;
+    /// assert_eq!(ShapeDef::default().with_user_data(11).user_data, 11);
+    /// ```
     #[must_use]
     pub fn with_user_data(mut self, value: u64) -> Self {
         self.user_data = value;
@@ -269,6 +295,11 @@ impl ShapeDef {
 
     /// Makes the shape a sensor or not (builder style; [`sensor`](Self::sensor)
     /// is `with_sensor(true)`).
+    ///
+    /// ```
+    /// use janus2d_world::ShapeDef;
+    /// assert!(ShapeDef::default().with_sensor(true).is_sensor);
+    /// ```
     #[must_use]
     pub fn with_sensor(mut self, on: bool) -> Self {
         self.is_sensor = on;
@@ -276,6 +307,11 @@ impl ShapeDef {
     }
 
     /// Sets the friction (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::ShapeDef;
+    /// assert_eq!(ShapeDef::default().with_friction(0.2).friction, 0.2);
+    /// ```
     #[must_use]
     pub fn with_friction(mut self, friction: Real) -> Self {
         self.friction = friction;
@@ -283,6 +319,11 @@ impl ShapeDef {
     }
 
     /// Sets the density (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::ShapeDef;
+    /// assert_eq!(ShapeDef::default().with_density(3.0).density, 3.0);
+    /// ```
     #[must_use]
     pub fn with_density(mut self, density: Real) -> Self {
         self.density = density;
@@ -290,6 +331,11 @@ impl ShapeDef {
     }
 
     /// Sets the restitution (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::ShapeDef;
+    /// assert_eq!(ShapeDef::default().with_restitution(0.5).restitution, 0.5);
+    /// ```
     #[must_use]
     pub fn with_restitution(mut self, restitution: Real) -> Self {
         self.restitution = restitution;
@@ -322,6 +368,12 @@ impl ShapeDef {
 
     /// Sets the surface's tangent speed, m/s (builder style; see
     /// [`ShapeDef::tangent_speed`]).
+    ///
+    /// ```
+    /// use janus2d_world::ShapeDef;
+    /// // A conveyor belt moving its surface at 2 m/s.
+    /// assert_eq!(ShapeDef::default().with_tangent_speed(2.0).tangent_speed, 2.0);
+    /// ```
     #[must_use]
     pub fn with_tangent_speed(mut self, tangent_speed: Real) -> Self {
         self.tangent_speed = tangent_speed;
@@ -329,6 +381,12 @@ impl ShapeDef {
     }
 
     /// Sets the friction combine rule (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::ShapeDef;
+    /// use janus2d_core::material::CombineRule;
+    /// assert_eq!(ShapeDef::default().with_friction_combine(CombineRule::Min).friction_combine, CombineRule::Min);
+    /// ```
     #[must_use]
     pub fn with_friction_combine(mut self, rule: CombineRule) -> Self {
         self.friction_combine = rule;
@@ -336,6 +394,12 @@ impl ShapeDef {
     }
 
     /// Sets the restitution combine rule (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::ShapeDef;
+    /// use janus2d_core::material::CombineRule;
+    /// assert_eq!(ShapeDef::default().with_restitution_combine(CombineRule::Multiply).restitution_combine, CombineRule::Multiply);
+    /// ```
     #[must_use]
     pub fn with_restitution_combine(mut self, rule: CombineRule) -> Self {
         self.restitution_combine = rule;
@@ -344,6 +408,11 @@ impl ShapeDef {
 
     /// Sets the user's material id (builder style; see
     /// [`ShapeDef::user_material_id`]).
+    ///
+    /// ```
+    /// use janus2d_world::ShapeDef;
+    /// assert_eq!(ShapeDef::default().with_material_id(42).user_material_id, 42);
+    /// ```
     #[must_use]
     pub fn with_material_id(mut self, id: u64) -> Self {
         self.user_material_id = id;

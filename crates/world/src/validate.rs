@@ -7,7 +7,7 @@
 //!
 //! | [`Invariant`]    | checked by                 | what                                                              |
 //! |------------------|----------------------------|-------------------------------------------------------------------|
-//! | `Bodies`         | `BodySet::check_invariants`| handles ↔ slots ↔ arrays, sentinel, finite numbers, dynamic mass   |
+//! | `Bodies`         | `BodySet::check_invariants`, `World::check_disabled` | handles ↔ slots ↔ arrays, sentinel, finite numbers, settings in range, lock bits, fixed rotation ⇒ no inverse inertia, dynamic mass; disabled bodies out of the solver, the islands and the contacts, the joints kept off for them off |
 //! | `Shapes`         | `ShapeStore::check`, `World::check_chains` | shapes ↔ bodies ↔ body lists, valid geometry, finite boxes; chains ↔ live segment shapes of one body |
 //! | `Proxies`        | `Collision::check_proxies` | shapes ↔ broadphase proxies, tree by type, fat box ⊇ shape box    |
 //! | `Contacts`       | `ContactSet::check`        | contacts ↔ pair index ↔ per-body lists, sleep lists, finite data  |

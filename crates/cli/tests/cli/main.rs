@@ -4,4 +4,5 @@
 
 mod cli;
 mod joints;
+mod scene_features;
 mod serve;

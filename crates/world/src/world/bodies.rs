@@ -643,6 +643,18 @@ impl World {
 /// outward impulse of `impulse_per_length` per metre of its width seen from
 /// the centre, full within `radius` and fading linearly to 0 across
 /// `falloff`.
+///
+/// ```
+/// use janus2d_world::{ExplosionDef, ShapeDef, World, WorldDef};
+/// use janus2d_core::{BodyDef, Vec2};
+/// use janus2d_core::geometry::Polygon;
+/// let mut world = World::new(WorldDef::default().with_gravity(Vec2::ZERO)).unwrap();
+/// let b = world.create_body(&BodyDef::dynamic(Vec2::new(2.0, 0.0))).unwrap();
+/// world.create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5)).unwrap();
+/// let pushed = world.explode(&ExplosionDef::new(Vec2::ZERO, 3.0, 1.0)).unwrap();
+/// assert_eq!(pushed, 1);
+/// assert!(world.linear_velocity(b).unwrap().x > 0.0, "pushed away from the centre");
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ExplosionDef {
@@ -682,6 +694,14 @@ impl ExplosionDef {
     }
 
     /// Sets the falloff band, m (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::ExplosionDef;
+    /// use janus2d_core::Vec2;
+    /// let e = ExplosionDef::new(Vec2::ZERO, 1.0, 2.0).with_falloff(0.5);
+    /// assert_eq!(e.falloff, 0.5);
+    /// assert!(ExplosionDef::new(Vec2::ZERO, 1.0, 2.0).with_falloff(-1.0).validate().is_err());
+    /// ```
     #[must_use]
     pub fn with_falloff(mut self, falloff: Real) -> Self {
         self.falloff = falloff;
@@ -789,6 +809,16 @@ impl World {
     }
 
     /// The body's linear damping, 1/s.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO).with_linear_damping(0.5)).unwrap();
+    /// assert_eq!(world.linear_damping(b), Ok(0.5));
+    /// world.set_linear_damping(b, 2.0).unwrap();
+    /// assert_eq!(world.linear_damping(b), Ok(2.0));
+    /// ```
     pub fn linear_damping(&self, body: BodyHandle) -> Result<Real, WorldError> {
         self.bodies
             .sim(body)
@@ -797,6 +827,14 @@ impl World {
     }
 
     /// The body's angular damping, 1/s.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO).with_angular_damping(0.3)).unwrap();
+    /// assert_eq!(world.angular_damping(b), Ok(0.3));
+    /// ```
     pub fn angular_damping(&self, body: BodyHandle) -> Result<Real, WorldError> {
         self.bodies
             .sim(body)
@@ -869,6 +907,16 @@ impl World {
     }
 
     /// True when the body's rotation is fixed ([`BodyDef::fixed_rotation`](janus2d_core::BodyDef::fixed_rotation)).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO).with_fixed_rotation(true)).unwrap();
+    /// assert_eq!(world.is_fixed_rotation(b), Ok(true));
+    /// world.set_fixed_rotation(b, false).unwrap();
+    /// assert_eq!(world.is_fixed_rotation(b), Ok(false));
+    /// ```
     pub fn is_fixed_rotation(&self, body: BodyHandle) -> Result<bool, WorldError> {
         self.bodies
             .record(body)

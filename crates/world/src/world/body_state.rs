@@ -242,6 +242,9 @@ impl World {
             if self.bodies.is_disabled(h) && self.islands.island_id(h).is_some() {
                 return Err(format!("disabled body {h:?} is in an island"));
             }
+            if self.bodies.is_disabled(h) && !self.collision.contacts.of_body(h).is_empty() {
+                return Err(format!("disabled body {h:?} has contacts"));
+            }
         }
         Ok(())
     }

@@ -6,6 +6,17 @@ use super::*;
 
 /// A body that moved in the last step (Box2D's `b2BodyMoveEvent`): see
 /// [`WorldDef::enable_move_events`] and [`StepEvents::moves`].
+///
+/// ```
+/// use janus2d_world::{World, WorldDef};
+/// use janus2d_core::{BodyDef, Vec2};
+/// let mut world = World::new(WorldDef::default().with_move_events(true)).unwrap();
+/// let b = world.create_body(&BodyDef::dynamic(Vec2::ZERO).with_user_data(7)).unwrap();
+/// world.step(1.0 / 60.0).unwrap();
+/// let m = world.events().moves[0];
+/// assert_eq!((m.body, m.user_data, m.fell_asleep), (b, 7, false));
+/// assert!(m.transform.p.y < 0.0, "it fell");
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BodyMoveEvent {
@@ -58,6 +69,12 @@ impl World {
 
     /// Whether the world gathers body move events
     /// ([`WorldDef::enable_move_events`]).
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// assert!(!World::new(WorldDef::default()).unwrap().move_events_enabled());
+    /// assert!(World::new(WorldDef::default().with_move_events(true)).unwrap().move_events_enabled());
+    /// ```
     pub fn move_events_enabled(&self) -> bool {
         self.move_events
     }
@@ -84,6 +101,16 @@ impl World {
 
     /// Whether the body reports move events (`BodyDef::enable_move_events`).
     /// Errors: a stale handle.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let quiet = world.create_body(&BodyDef::dynamic(Vec2::ZERO).with_move_events(false)).unwrap();
+    /// assert_eq!(world.body_move_events(quiet), Ok(false));
+    /// world.set_body_move_events(quiet, true).unwrap();
+    /// assert_eq!(world.body_move_events(quiet), Ok(true));
+    /// ```
     pub fn body_move_events(&self, body: BodyHandle) -> Result<bool, WorldError> {
         self.check_body(body)?;
         Ok(self

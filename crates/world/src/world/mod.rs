@@ -115,6 +115,13 @@ impl WorldDef {
     }
 
     /// Sets the solver settings (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::WorldDef;
+    /// use janus2d_core::SolverSettings;
+    /// let def = WorldDef::default().with_solver(SolverSettings { substeps: 8, ..SolverSettings::default() });
+    /// assert_eq!(def.solver.substeps, 8);
+    /// ```
     #[must_use]
     pub fn with_solver(mut self, solver: SolverSettings) -> Self {
         self.solver = solver;
@@ -122,6 +129,12 @@ impl WorldDef {
     }
 
     /// Sets the sleep settings (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::{SleepSettings, WorldDef};
+    /// let def = WorldDef::default().with_sleep(SleepSettings { enabled: false, ..SleepSettings::default() });
+    /// assert!(!def.sleep.enabled);
+    /// ```
     #[must_use]
     pub fn with_sleep(mut self, sleep: SleepSettings) -> Self {
         self.sleep = sleep;
@@ -129,6 +142,11 @@ impl WorldDef {
     }
 
     /// Turns continuous collision on or off (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::WorldDef;
+    /// assert!(!WorldDef::default().with_continuous(false).enable_continuous);
+    /// ```
     #[must_use]
     pub fn with_continuous(mut self, on: bool) -> Self {
         self.enable_continuous = on;
@@ -136,6 +154,11 @@ impl WorldDef {
     }
 
     /// Sets the hit event approach speed threshold, m/s (builder style).
+    ///
+    /// ```
+    /// use janus2d_world::WorldDef;
+    /// assert_eq!(WorldDef::default().with_hit_event_threshold(0.5).hit_event_threshold, 0.5);
+    /// ```
     #[must_use]
     pub fn with_hit_event_threshold(mut self, speed: Real) -> Self {
         self.hit_event_threshold = speed;

@@ -315,9 +315,23 @@ impl World {
         Ok(())
     }
 
-    /// A hash of every body's transform and velocity bits, in handle order
-    /// (FNV-1a, 64 bit): equal hashes mean bit-identical states.
+    /// A hash of every body's transform and velocity bits, in handle order,
+    /// then of the chains (slot, generation, loop flag, segment shapes;
+    /// a world without chains adds nothing) (FNV-1a, 64 bit): equal hashes
+    /// mean bit-identical states.
+    ///
+    /// ```
+    /// use janus2d_world::{ChainDef, World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    /// let before = world.state_hash();
+    /// let chain = world.create_chain(ground, &ChainDef::new(vec![Vec2::ZERO, Vec2::new(1.0, 0.0)])).unwrap();
+    /// assert_ne!(world.state_hash(), before);
+    /// world.destroy_chain(chain).unwrap();
+    /// assert_eq!(world.state_hash(), before);
+    /// ```
     pub fn state_hash(&self) -> u64 {
-        crate::hash::state_hash(&self.bodies)
+        crate::hash::state_hash(&self.bodies, &self.collision.chains)
     }
 }
