@@ -8,6 +8,7 @@
 //! spinning free chain in zero gravity.
 
 use janus2d::prelude::*;
+use janus2d_testbed::support::d;
 
 /// A free chain of `links` circles (r 0.25, density 1; the last `ratio`
 /// times denser) hinged end to end 1 m apart, spun as a rigid body at
@@ -62,15 +63,14 @@ fn totals(world: &World, bodies: &[BodyHandle]) -> (Vec2, Real) {
 fn momentum(world: &World, bodies: &[BodyHandle]) -> ([f64; 2], f64) {
     let (mut p, mut l) = ([0.0f64; 2], 0.0f64);
     for &b in bodies {
-        let m = world.mass(b).unwrap() as f64;
+        let m = d(world.mass(b).unwrap());
         let c = world.center_of_mass(b).unwrap();
         let v = world.linear_velocity(b).unwrap();
-        let (vx, vy) = (v.x as f64, v.y as f64);
+        let (vx, vy) = (d(v.x), d(v.y));
         p[0] += m * vx;
         p[1] += m * vy;
-        l += m * (c.x as f64 * vy - c.y as f64 * vx)
-            + world.rotational_inertia(b).unwrap() as f64
-                * world.angular_velocity(b).unwrap() as f64;
+        l += m * (d(c.x) * vy - d(c.y) * vx)
+            + d(world.rotational_inertia(b).unwrap()) * d(world.angular_velocity(b).unwrap());
     }
     (p, l)
 }
@@ -79,12 +79,12 @@ fn momentum(world: &World, bodies: &[BodyHandle]) -> ([f64; 2], f64) {
 fn drift(links: usize, ratio: Real, spin: Real, steps: usize) -> (f64, f64) {
     let (mut world, bodies) = spinning_chain(links, ratio, spin);
     let (p0, l0) = momentum(&world, &bodies);
-    let m = totals(&world, &bodies).1 as f64;
+    let m = d(totals(&world, &bodies).1);
     // Linear momentum is zero at the start: compare with the total mass
     // times the fastest body's speed.
     let v_scale = bodies
         .iter()
-        .map(|&b| world.linear_velocity(b).unwrap().length() as f64)
+        .map(|&b| d(world.linear_velocity(b).unwrap().length()))
         .fold(0.0, f64::max);
     let (mut dp, mut dl) = (0.0f64, 0.0f64);
     for _ in 0..steps {
