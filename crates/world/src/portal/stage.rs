@@ -392,6 +392,11 @@ impl PortalStage {
         &self.clipping
     }
 
+    /// The portal rows, one per crossing (same order).
+    pub(crate) fn constraints(&self) -> &[PortalConstraint] {
+        &self.constraints
+    }
+
     /// The portal constraints, as the solver's third batch.
     pub(crate) fn constraints_mut(&mut self) -> &mut Vec<PortalConstraint> {
         &mut self.constraints
