@@ -36,8 +36,9 @@
 //! its plane are dropped beside the span too (that part is on the other
 //! side), and the lips act as the sides of the aperture: where the copy's
 //! cross-section at the plane reaches past `|t| = w`, a lip corner pushes
-//! it back into the span (normal `∓t`, touching points only: a fast
-//! grazing entry is through before its section would reach the far lip);
+//! it back into the span (normal `∓t`, with a speculative margin of a few
+//! linear slops only: a fast grazing entry is through before its section
+//! would reach the far lip);
 //! a copy wholly behind its plane (held there for its joints) is kept in
 //! the slot `|t| < w` as between two side walls. The deeper of this side
 //! contact and the clipped manifold is kept. Without it the two copies of
@@ -553,6 +554,10 @@ impl ContactClipping {
     }
 }
 
+/// Linear slops within which a copy's cross-section at its plane meets a
+/// lip corner before it touches (its speculative margin there).
+const SECTION_MARGIN_SLOPS: Real = 4.0;
+
 /// The contact of a crossing copy (pair side `copy`) with the sides of
 /// the aperture `clip` it passes through. Where the copy crosses the
 /// plane, its cross-section there must lie within the span `|t| < w`: the
@@ -602,14 +607,16 @@ fn side_wall(clip: &ApertureClip, copy: usize, shapes: &PairShapes<'_>) -> Optio
             }
         }
     }
-    // A cross-section point acts when it touches: the section moves with
-    // the copy only while it straddles (a fast grazing entry is through
-    // before its section would reach the far lip), so no speculative
-    // point for it.
+    // A cross-section point acts when it is about to touch: the section
+    // moves with the copy only while it straddles (a fast grazing entry is
+    // through before its section would reach the far lip), so its
+    // speculative margin is a few slops, not the step's travel.
     let near_enough = if wholly {
         shapes.speculative
     } else {
-        shapes.speculative.min(janus2d_core::geometry::LINEAR_SLOP)
+        shapes
+            .speculative
+            .min(SECTION_MARGIN_SLOPS * janus2d_core::geometry::LINEAR_SLOP)
     };
     let mut best: Option<Manifold> = None;
     for (side, id) in [(-1.0, LIP_ID_LOW), (1.0, LIP_ID_HIGH)] {
