@@ -293,12 +293,15 @@ fn turning_dynamic_portal_bodies_stay_bounded_and_conserve_momentum() {
 /// under 1 cm/s for half a second), no step has a sideways speed above
 /// 5 mm/s over the next 4 s.
 ///
-/// Ignored: the bound is not met. Measured: every placement settles
-/// (2.3–2.7 s) and about half a second later rocks again at 7.5 mm/s in
-/// f32 (6.9–7.7 mm/s in f64), x and y speeds equal and opposite with a
-/// small turn (the clone's top on the slab carries almost no load), and
-/// decays to under 0.1 mm/s by 5 s. The lips acting as the aperture's
-/// sides do not change it (these boxes never reach a lip).
+/// Ignored: the bound is not met. Measured: every placement comes under
+/// 1 cm/s at 2.3–2.7 s still tilted by about 5 mrad, resting on one
+/// corner of its clone's top against the slab (a contact that carries
+/// almost no load: the two halves' weights cancel). It then turns flat
+/// about that corner, slowly gathering speed, and its centre, 0.5 m from
+/// the corner, moves sideways at up to 7.5 mm/s in f32 (6.9–7.7 mm/s in
+/// f64) until the other corner lands (half a second later); after that
+/// it stays under 0.1 mm/s. The lips acting as the aperture's sides do
+/// not change it (these boxes never reach a lip).
 #[test]
 #[ignore = "rocks at 7.5 mm/s half a second after settling (see the doc comment)"]
 fn body_resting_across_a_blocked_aperture_does_not_jitter() {
