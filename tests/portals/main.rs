@@ -6,6 +6,8 @@
 #[cfg(feature = "portals")]
 mod portal_apertures;
 #[cfg(feature = "portals")]
+mod portal_continuous;
+#[cfg(feature = "portals")]
 mod portal_distance;
 #[cfg(feature = "portals")]
 mod portal_edges;

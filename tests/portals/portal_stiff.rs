@@ -286,3 +286,72 @@ fn turning_dynamic_portal_bodies_stay_bounded_and_conserve_momentum() {
     assert!(worst_p <= tol, "linear momentum error {worst_p}");
     assert!(worst_l <= tol, "angular momentum error {worst_l}");
 }
+
+/// A body resting across a floor aperture whose exit is blocked (the
+/// scene of `blocked_body_does_not_drift_sideways`, the box dropped at
+/// several places across the aperture): once it has settled (its speed
+/// under 1 cm/s for half a second), no step has a sideways speed above
+/// 5 mm/s over the next 4 s.
+///
+/// Ignored: the bound is not met. Measured: every placement comes under
+/// 1 cm/s at 2.3–2.7 s still tilted by about 5 mrad, resting on one
+/// corner of its clone's top against the slab (a contact that carries
+/// almost no load: the two halves' weights cancel). It then turns flat
+/// about that corner, slowly gathering speed, and its centre, 0.5 m from
+/// the corner, moves sideways at up to 7.5 mm/s in f32 (6.9–7.7 mm/s in
+/// f64) until the other corner lands (half a second later); after that
+/// it stays under 0.1 mm/s. The lips acting as the aperture's sides do
+/// not change it (these boxes never reach a lip).
+#[test]
+#[ignore = "rocks at 7.5 mm/s half a second after settling (see the doc comment)"]
+fn body_resting_across_a_blocked_aperture_does_not_jitter() {
+    let mut report_line = String::new();
+    let mut failures = Vec::new();
+    for (x, half) in [(0.0, 0.5), (0.3, 0.5), (-0.45, 0.5), (0.2, 0.4)] {
+        let mut world = World::new(WorldDef::default()).unwrap();
+        let entry_floor = wall(&mut world, Vec2::new(0.0, -0.5), 5.0, 0.5);
+        let exit_floor = wall(&mut world, Vec2::new(30.0, -0.5), 5.0, 0.5);
+        // Lower face a box's half height above the exit: the clone's top
+        // rests against it with the object half through.
+        wall(&mut world, Vec2::new(30.0, half + 0.5), 3.0, 0.5);
+        world
+            .create_portal_pair(&PortalPairDef::new(
+                portal(entry_floor, Vec2::new(0.0, 0.5), Vec2::Y, 1.0),
+                portal(exit_floor, Vec2::new(0.0, 0.5), Vec2::Y, 1.0),
+            ))
+            .unwrap();
+        let body = body_box(&mut world, &BodyDef::dynamic(Vec2::new(x, 3.5)), half, half);
+        let mut still = 0;
+        let mut settled_at = None;
+        for step in 0..600 {
+            world.step(DT).unwrap();
+            let v = world.linear_velocity(body).unwrap().length();
+            still = if v < 0.01 { still + 1 } else { 0 };
+            if still >= 30 {
+                settled_at = Some(step);
+                break;
+            }
+        }
+        let settled_at = settled_at.expect("the body never settled");
+        let mut worst: Real = 0.0;
+        for _ in 0..240 {
+            world.step(DT).unwrap();
+            worst = worst.max(world.linear_velocity(body).unwrap().x.abs());
+        }
+        assert!(world.clone_of(body).is_some(), "no longer straddling");
+        report_line += &format!(
+            " x {x}: settled at {:.2} s, then {:.5} m/s;",
+            settled_at as Real * DT,
+            worst
+        );
+        if worst > 0.005 {
+            failures.push(format!(
+                "x = {x}: sideways {worst} m/s after settling at step {settled_at}"
+            ));
+        }
+    }
+    if report() {
+        eprintln!("resting across a blocked aperture:{report_line}");
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

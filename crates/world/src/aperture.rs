@@ -31,6 +31,27 @@
 //!
 //! A one-point manifold keeps its point unless a region covers it.
 //!
+//! **A copy against its own wall.** Between a crossing copy and the wall
+//! that carries the aperture it passes through, the copy's points behind
+//! its plane are dropped beside the span too (that part is on the other
+//! side), and the lips act as the sides of the aperture: where the copy's
+//! cross-section at the plane reaches past `|t| = w`, a lip corner pushes
+//! it back into the span (normal `∓t`, with a speculative margin of a few
+//! linear slops only: a fast grazing entry is through before its section
+//! would reach the far lip);
+//! a copy wholly behind its plane (held there for its joints) is kept in
+//! the slot `|t| < w` as between two side walls. The deeper of this side
+//! contact and the clipped manifold is kept. Without it the two copies of
+//! a link pushed past a lip were each pushed out of their own wall, in
+//! opposite directions through the map.
+//!
+//! ```text
+//!            span |t| < w
+//!   ────────●               ●────────   wall surface (normal n)
+//!        ▶ ┃│  copy crossing  │┃ ◀       the lips hold its section at the
+//!          ┃│                 │┃         plane within the span
+//! ```
+//!
 //! **Speculative points land where the body will arrive.** A speculative
 //! point (separation > 0) acts for the whole step, so what matters is where
 //! the body's point meets the wall, not where it is at the start of the
@@ -294,6 +315,26 @@ impl ContactClipping {
         }
     }
 
+    /// The hole clip of the aperture a crossing copy passes through when
+    /// the pair is that copy and the wall carrying the aperture, and which
+    /// of the two the copy is (0: a, 1: b).
+    fn own_wall(&self, body_a: BodyHandle, body_b: BodyHandle) -> Option<(&ApertureClip, usize)> {
+        self.copies.iter().find_map(|&(c, aperture)| {
+            let (wall, copy) = if c == body_a {
+                (body_b, 0)
+            } else if c == body_b {
+                (body_a, 1)
+            } else {
+                return None;
+            };
+            let clip = self
+                .clips
+                .iter()
+                .find(|k| k.hole && k.body == wall && k.aperture == aperture)?;
+            Some((clip, copy))
+        })
+    }
+
     /// True when the pair `(a, b)` never touches (a crossing copy and its twin).
     pub(crate) fn ignores(&self, a: BodyHandle, b: BodyHandle) -> bool {
         self.ignored_pairs
@@ -372,6 +413,37 @@ impl ContactClipping {
         };
         if !self.clips.iter().any(|c| involved(&c)) {
             return;
+        }
+        if let Some(shapes) = shapes
+            && let Some((clip, copy)) = self.own_wall(body_a, body_b)
+        {
+            let side = side_wall(clip, copy, shapes);
+            // The copy's part behind its plane is on the other side,
+            // beside the span too: against its own wall only the side
+            // walls hold it there.
+            let (p0, p1) = (m.points[0], m.points[1]);
+            let front: Vec<ManifoldPoint> = [p0, p1][..m.point_count]
+                .iter()
+                .copied()
+                .filter(|p| (p.point - clip.point).dot(clip.normal) >= 0.0)
+                .collect();
+            m.point_count = front.len();
+            m.points[..front.len()].copy_from_slice(&front);
+            if let Some(side) = side {
+                let deepest = |m: &Manifold| {
+                    m.points[..m.point_count]
+                        .iter()
+                        .map(|p| p.separation)
+                        .fold(Real::MAX, Real::min)
+                };
+                if m.point_count == 0 || deepest(&side) < deepest(m) {
+                    *m = side;
+                    return;
+                }
+            }
+            if m.point_count == 0 {
+                return;
+            }
         }
         // Where each point meets a hole's wall (its own place when it
         // touches already or does not approach).
@@ -480,6 +552,103 @@ impl ContactClipping {
             m.points = [low, high];
         }
     }
+}
+
+/// Linear slops within which a copy's cross-section at its plane meets a
+/// lip corner before it touches (its speculative margin there).
+const SECTION_MARGIN_SLOPS: Real = 4.0;
+
+/// The contact of a crossing copy (pair side `copy`) with the sides of
+/// the aperture `clip` it passes through. Where the copy crosses the
+/// plane, its cross-section there must lie within the span `|t| < w`: the
+/// lip corners `P ± w t` hold it (a part behind the plane is on the other
+/// side, where it may reach past the span; a fast grazing entry does).
+/// A copy wholly behind its plane (held there for its joints) is held in
+/// the slot `|t| < w` behind the lips, as between two side walls. Normal
+/// `∓t` into the span; the deeper side, up to two points. `None` when
+/// neither side is near, or for a shape without an area.
+fn side_wall(clip: &ApertureClip, copy: usize, shapes: &PairShapes<'_>) -> Option<Manifold> {
+    let xf = &shapes.transforms[copy];
+    let capsule;
+    let (core, radius): (&[Vec2], Real) = match shapes.shapes[copy] {
+        Shape::Polygon(p) => (&p.vertices[..p.count], p.radius),
+        Shape::Capsule(c) => {
+            capsule = [c.center1, c.center2];
+            (&capsule[..], c.radius)
+        }
+        Shape::Circle(c) => (std::slice::from_ref(&c.center), c.radius),
+        _ => return None,
+    };
+    let n = clip.normal;
+    let tangent = n.perp();
+    let coords = |v: Vec2| {
+        let d = xf.apply(v) - clip.point;
+        (d.dot(n), d.dot(tangent))
+    };
+    // Candidate points (s, t, reach along t beyond the point).
+    let mut reach: Vec<(Real, Real, Real)> = Vec::with_capacity(2 * core.len());
+    let wholly = core.iter().all(|&v| coords(v).0 + radius <= 0.0);
+    for (k, &v) in core.iter().enumerate() {
+        let (s0, t0) = coords(v);
+        if wholly {
+            reach.push((s0, t0, radius));
+            continue;
+        }
+        // The cross-section at the plane: the core's edges crossing it,
+        // and a rounded vertex within its radius of it.
+        if s0.abs() < radius {
+            reach.push((0.0, t0, (radius * radius - s0 * s0).sqrt()));
+        }
+        if core.len() > 1 {
+            let (s1, t1) = coords(core[(k + 1) % core.len()]);
+            if (s0 < 0.0) != (s1 < 0.0) {
+                let u = s0 / (s0 - s1);
+                reach.push((0.0, t0 + u * (t1 - t0), radius));
+            }
+        }
+    }
+    // A cross-section point acts when it is about to touch: the section
+    // moves with the copy only while it straddles (a fast grazing entry is
+    // through before its section would reach the far lip), so its
+    // speculative margin is a few slops, not the step's travel.
+    let near_enough = if wholly {
+        shapes.speculative
+    } else {
+        shapes
+            .speculative
+            .min(SECTION_MARGIN_SLOPS * janus2d_core::geometry::LINEAR_SLOP)
+    };
+    let mut best: Option<Manifold> = None;
+    for (side, id) in [(-1.0, LIP_ID_LOW), (1.0, LIP_ID_HIGH)] {
+        let mut m = Manifold::default();
+        // Into the span from this side, as the pair's normal (a to b).
+        let into_span = -side * tangent;
+        m.normal = if copy == 1 { into_span } else { -into_span };
+        let mut near: Vec<(Real, Real)> = reach
+            .iter()
+            .map(|&(s, t, r)| (clip.half_width - (side * t + r), s))
+            .filter(|&(separation, _)| separation < near_enough)
+            .collect();
+        near.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (k, &(separation, s)) in near.iter().take(2).enumerate() {
+            let point = clip.point + side * clip.half_width * tangent + s * n
+                - 0.5 * separation * into_span;
+            m.points[k] = ManifoldPoint {
+                point,
+                anchor_a: point - shapes.transforms[0].p,
+                anchor_b: point - shapes.transforms[1].p,
+                separation,
+                id: id + 2 * k as u16,
+            };
+            m.point_count = k + 1;
+        }
+        if m.point_count > 0
+            && best.is_none_or(|b: Manifold| m.points[0].separation < b.points[0].separation)
+        {
+            best = Some(m);
+        }
+    }
+    best
 }
 
 #[cfg(test)]

@@ -22,9 +22,36 @@
 //!       behind the aperture plane, so the crossing stage sees it straddle
 //!   move back  (first fraction t < 1): pose at t; velocity kept, so the
 //!     next step's speculative contact stops the body; a jointed body
-//!     moves back with every moving body its enabled joints reach, all to
-//!     the group's smallest t (its joints stay as the solve left them)
+//!     moves back with every moving body its enabled joints reach, and a
+//!     crossing copy with its twin, all to the group's smallest t
+//!   close the joints (a group of more than one body): each revolute and
+//!     weld point, opened by the move (below), is closed again
 //! ```
+//!
+//! ## Closing the joints
+//!
+//! Each body moves back along its own sweep: its centre on the chord,
+//! its angle interpolated. A link that turns fast about a hinge moves its
+//! centre on an arc, so at a fraction between the ends its hinge points
+//! part by about the arc's sagitta, `r Δθ² / 8` (a link of a landing rope
+//! turning 1–2 rad in a step: centimetres). After the move, each revolute
+//! or weld joint `j` of the group has the separation of its world anchors
+//! `C = (c_b + r_b) − (c_a + r_a) − d`, with the target `d` zero for a
+//! hinge and, for a weld (its point may be soft), the separation at the
+//! step's start and end interpolated to the fraction. [`CLOSING_PASSES`]
+//! Gauss–Seidel passes over the group's joints (slot order) each apply
+//! the position impulse `P = −K⁻¹ C`,
+//!
+//! ```text
+//!   K = (m_a⁻¹ + m_b⁻¹) 1 + I_a⁻¹ perp(r_a) perp(r_a)ᵀ + I_b⁻¹ perp(r_b) perp(r_b)ᵀ
+//!   c_b += m_b⁻¹ P    θ_b += I_b⁻¹ (r_b × P)      (a: the same with −P)
+//! ```
+//!
+//! which closes `C` to first order. The body that hit (and its twin) does
+//! not move: it touches what it hit. A crossing copy's shift `(Δc, Δθ)`
+//! is carried to its twin through the map (`x₂ = T(x₁)` moves by
+//! `η Q Δc`, `θ₂ = θ₁ + const` by `Δθ`), so the portal rows stay as they
+//! were. Velocities are not touched: the closing adds no speed.
 //!
 //! A scene where nothing is fast does one cheap test per awake dynamic body
 //! and nothing else: [`ContinuousCounters::toi_bodies`] stays 0.
@@ -33,13 +60,14 @@ use janus2d_core::body::{BodyLocation, BodySet, BodyType};
 use janus2d_core::geometry::{
     LINEAR_SLOP, Shape, ShapeProxy, Sweep, ToiState, shape_distance, shape_extent, time_of_impact,
 };
-use janus2d_core::math::{Real, Vec2, cross};
+use janus2d_core::math::{Real, Rot, Transform, Vec2, cross};
 use janus2d_core::parallel::Team;
 
 use crate::aperture::ContactClipping;
 use crate::broadphase::BroadPhase;
 use crate::joints::{JointSet, NoCollide};
 use crate::shapes::ShapeStore;
+use janus2d_constraints::JointKind;
 
 /// Fraction of a body's smallest extent it may travel in one step before it
 /// counts as fast (dimensionless; usual 0.5, Box2D's safety factor).
@@ -65,8 +93,11 @@ pub(crate) struct ContinuousInput<'a> {
     /// The portal stage's aperture clipping (empty without portals).
     pub(crate) clipping: &'a ContactClipping,
     /// The joints: a jointed body is moved back with the bodies its
-    /// enabled joints join it to.
+    /// enabled joints join it to, and its joints closed after.
     pub(crate) joints: &'a JointSet,
+    /// The portal rows (one per crossing): a crossing copy's twin moves
+    /// with it.
+    pub(crate) portal_rows: &'a [janus2d_constraints::PortalConstraint],
 }
 
 /// The continuous stage: the switch, its scratch lists and its counters.
@@ -86,6 +117,16 @@ pub(crate) struct ContinuousStage {
     moved: Vec<bool>,
     #[cfg_attr(feature = "serde", serde(skip))]
     fractions: Vec<Real>,
+    /// Scratch of the joint closing: the group's revolute and weld joints
+    /// (slot index, handle) and each one's target separation.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    closing: Vec<(u32, crate::joints::JointHandle)>,
+    #[cfg_attr(feature = "serde", serde(skip))]
+    targets: Vec<Vec2>,
+    /// Scratch of the joint closing: the group's crossings (original's
+    /// slot, clone's slot, the map's rotation Q and scale η).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    twin_maps: Vec<(usize, usize, Rot, Real)>,
 }
 
 /// How far behind a one-sided chain segment's line a fast shape's centroid
@@ -105,6 +146,9 @@ impl ContinuousStage {
             group: Vec::new(),
             moved: Vec::new(),
             fractions: Vec::new(),
+            closing: Vec::new(),
+            targets: Vec::new(),
+            twin_maps: Vec::new(),
         }
     }
 
@@ -210,7 +254,7 @@ impl ContinuousStage {
         self.moved.clear();
         self.moved.resize(bodies.sims.len(), false);
         for &i in &fast {
-            self.move_back(i as usize, bodies, input.joints);
+            self.move_back(i as usize, bodies, input);
         }
         self.fast = fast;
         let bullets = std::mem::take(&mut self.bullets);
@@ -227,18 +271,22 @@ impl ContinuousStage {
                 &mut self.counters.toi_calls,
             );
             self.fractions[i as usize] = fraction;
-            self.move_back(i as usize, bodies, input.joints);
+            self.move_back(i as usize, bodies, input);
         }
         self.bullets = bullets;
     }
 
     /// Moves body `i` back to its fraction of the step's sweep (nothing
-    /// at 1), and with it every moving body its enabled joints join it to,
-    /// directly or through others, all to the smallest fraction among
-    /// them: a jointed body rewound alone would open its joints by what
-    /// its neighbours travelled after the impact (a link landing at
-    /// 30 m/s, 50 cm a step). Each body moves once per pass.
-    fn move_back(&mut self, i: usize, bodies: &mut BodySet, joints: &JointSet) {
+    /// at 1), and with it every moving body its enabled joints join it to
+    /// and every crossing copy's twin, directly or through others, all to
+    /// the smallest fraction among them: a jointed body rewound alone
+    /// would open its joints by what its neighbours travelled after the
+    /// impact (a link landing at 30 m/s, 50 cm a step), a copy rewound
+    /// without its twin its portal rows. Then closes the group's joints
+    /// (module docs). Each body moves once per pass.
+    fn move_back(&mut self, i: usize, bodies: &mut BodySet, input: &ContinuousInput<'_>) {
+        let joints = input.joints;
+        let twins = &input.clipping.ignored_pairs;
         if self.moved[i] || self.fractions[i] >= 1.0 {
             return;
         }
@@ -246,18 +294,29 @@ impl ContinuousStage {
         self.group.push(i as u32);
         self.moved[i] = true;
         let mut fraction = self.fractions[i];
+        // The body at the group's fraction: it touches what it hit there.
+        let mut hit = i;
         let mut next = 0;
-        while next < self.group.len() && !joints.is_empty() {
+        while next < self.group.len() && !(joints.is_empty() && twins.is_empty()) {
             let handle = bodies.sims[self.group[next] as usize].handle;
             next += 1;
-            for &jh in joints.of_body(handle) {
-                let Ok(joint) = joints.get(jh) else { continue };
+            let joined = joints.of_body(handle).iter().filter_map(|&jh| {
+                let joint = joints.get(jh).ok()?;
                 if !joint.is_enabled() {
-                    continue;
+                    return None;
                 }
-                let Some(other) = joint.other_body(handle) else {
-                    continue;
-                };
+                joint.other_body(handle)
+            });
+            let twinned = twins.iter().filter_map(|&(x, y)| {
+                if x == handle {
+                    Some(y)
+                } else if y == handle {
+                    Some(x)
+                } else {
+                    None
+                }
+            });
+            for other in joined.chain(twinned) {
                 let Some(BodyLocation::Moving(k)) = bodies.location(other) else {
                     continue;
                 };
@@ -266,10 +325,14 @@ impl ContinuousStage {
                     continue;
                 }
                 self.moved[k] = true;
-                fraction = fraction.min(self.fractions[k]);
+                if self.fractions[k] < fraction {
+                    fraction = self.fractions[k];
+                    hit = k;
+                }
                 self.group.push(k as u32);
             }
         }
+        let close = self.group.len() > 1 && self.gather_joints(fraction, bodies, input);
         for &k in &self.group {
             let sweep = sweep_of(bodies, k as usize);
             let sim = &mut bodies.sims[k as usize];
@@ -277,8 +340,189 @@ impl ContinuousStage {
             sim.center = sweep.center_at(fraction);
             self.counters.toi_hits += 1;
         }
+        if close {
+            self.close_joints(hit, bodies, input);
+        }
+    }
+
+    /// Lists the revolute and weld joints of the group about to move back
+    /// to `fraction`, each with its target separation of the two anchors:
+    /// zero for a hinge, a weld's start and end values interpolated to the
+    /// fraction (what the solve left, carried back). False when there are
+    /// none.
+    fn gather_joints(
+        &mut self,
+        fraction: Real,
+        bodies: &BodySet,
+        input: &ContinuousInput<'_>,
+    ) -> bool {
+        let joints = input.joints;
+        self.closing.clear();
+        for &k in &self.group {
+            let handle = bodies.sims[k as usize].handle;
+            for &jh in joints.of_body(handle) {
+                let Ok(joint) = joints.get(jh) else { continue };
+                if joint.is_enabled()
+                    && matches!(joint.kind(), JointKind::Revolute | JointKind::Weld)
+                {
+                    self.closing.push((jh.index, jh));
+                }
+            }
+        }
+        // Each joint once, in slot order (the walk meets most twice).
+        self.closing.sort_unstable_by_key(|&(index, _)| index);
+        self.closing.dedup_by_key(|&mut (index, _)| index);
+        self.targets.clear();
+        for &(_, jh) in &self.closing {
+            let Ok(joint) = joints.get(jh) else { continue };
+            let (a, b) = joint.bodies();
+            let (la, lb) = joint.local_anchors();
+            let at = |body, local, t: Real| match bodies.location(body) {
+                Some(BodyLocation::Moving(k)) => {
+                    sweep_of(bodies, k as usize).transform_at(t).apply(local)
+                }
+                _ => bodies.solver_body(body).sim.transform.apply(local),
+            };
+            // As the solve left it, carried back.
+            let d0 = at(b, lb, 0.0) - at(a, la, 0.0);
+            let d1 = at(b, lb, 1.0) - at(a, la, 1.0);
+            let left = d0 + fraction * (d1 - d0);
+            if joint.kind() != JointKind::Revolute {
+                // A weld's point may be soft (its linear spring).
+                self.targets.push(left);
+                continue;
+            }
+            // A hinge's point is rigid: closed, by no more than the
+            // distance a body may travel unswept in a step (a joint made
+            // far from satisfied is left to the solve's capped correction).
+            let reach = FAST_FRACTION
+                * input
+                    .shapes
+                    .extent_of(a)
+                    .min_extent
+                    .min(input.shapes.extent_of(b).min_extent);
+            let open = left.length();
+            self.targets.push(if open <= reach {
+                Vec2::ZERO
+            } else {
+                left * (1.0 - reach / open)
+            });
+        }
+        !self.closing.is_empty()
+    }
+
+    /// Closes the joints [`Self::gather_joints`] listed, now that their
+    /// group has moved back (module docs, "closing the joints"): each
+    /// point is brought to its target separation by [`CLOSING_PASSES`]
+    /// Gauss–Seidel position passes. The body that hit (`hit`, and its
+    /// twin when it is a crossing copy) does not move; a crossing copy's
+    /// correction is carried to its twin through the portal map.
+    fn close_joints(&mut self, hit: usize, bodies: &mut BodySet, input: &ContinuousInput<'_>) {
+        let joints = input.joints;
+        // The group's crossings: (original, clone, Q, η), slots in `sims`.
+        self.twin_maps.clear();
+        for pc in input.portal_rows {
+            let d = pc.def();
+            let (Some(BodyLocation::Moving(k1)), Some(BodyLocation::Moving(k2))) =
+                (bodies.location(d.body), bodies.location(d.clone))
+            else {
+                continue;
+            };
+            let map = pc.map(bodies);
+            self.twin_maps
+                .push((k1 as usize, k2 as usize, map.rotation(), map.eta));
+        }
+        let twin_maps = &self.twin_maps;
+        let twin_of = |k: usize| {
+            twin_maps.iter().find_map(|&(k1, k2, q, eta)| {
+                if k1 == k {
+                    Some((k2, q, eta))
+                } else if k2 == k {
+                    // The inverse map: Q⁻¹ and 1/η.
+                    Some((k1, Rot { c: q.c, s: -q.s }, 1.0 / eta))
+                } else {
+                    None
+                }
+            })
+        };
+        let pinned = twin_of(hit).map(|(t, _, _)| t);
+        // A body the pass may move: a moving dynamic body of the group
+        // (every such joint partner is in it), neither the one that hit
+        // nor its twin.
+        let movable = |bodies: &BodySet, handle: janus2d_core::body::BodyHandle| -> Option<usize> {
+            let Some(BodyLocation::Moving(k)) = bodies.location(handle) else {
+                return None;
+            };
+            let k = k as usize;
+            (k != hit && Some(k) != pinned && bodies.sims[k].body_type == BodyType::Dynamic)
+                .then_some(k)
+        };
+        // Moves body k by (Δc, Δθ) about its centre.
+        let shift = |bodies: &mut BodySet, k: usize, dc: Vec2, da: Real| {
+            let sim = &mut bodies.sims[k];
+            sim.center += dc;
+            let q = sim.transform.q.integrate(da);
+            sim.transform = Transform {
+                p: sim.center - q.rotate(sim.local_center),
+                q,
+            };
+        };
+        for _ in 0..CLOSING_PASSES {
+            for (n, &(_, jh)) in self.closing.iter().enumerate() {
+                let Ok(joint) = joints.get(jh) else { continue };
+                let (a, b) = joint.bodies();
+                let (la, lb) = joint.local_anchors();
+                let (ka, kb) = (movable(bodies, a), movable(bodies, b));
+                if ka.is_none() && kb.is_none() {
+                    continue;
+                }
+                let arm = |k: Option<usize>, body, local: Vec2| -> (Vec2, Vec2, Real, Real) {
+                    let sim = match k {
+                        Some(k) => &bodies.sims[k],
+                        None => bodies.solver_body(body).sim,
+                    };
+                    let r = sim.transform.q.rotate(local - sim.local_center);
+                    let (im, ii) = if k.is_some() {
+                        (sim.inv_mass, sim.inv_inertia)
+                    } else {
+                        (0.0, 0.0)
+                    };
+                    (sim.center, r, im, ii)
+                };
+                let (ca, ra, ma, ia) = arm(ka, a, la);
+                let (cb, rb, mb, ib) = arm(kb, b, lb);
+                let c = (cb + rb) - (ca + ra) - self.targets[n];
+                // K = (ma + mb) 1 + ia perp(ra) perp(ra)ᵀ + ib perp(rb) perp(rb)ᵀ
+                let k11 = ma + mb + ia * ra.y * ra.y + ib * rb.y * rb.y;
+                let k12 = -ia * ra.x * ra.y - ib * rb.x * rb.y;
+                let k22 = ma + mb + ia * ra.x * ra.x + ib * rb.x * rb.x;
+                let det = k11 * k22 - k12 * k12;
+                if det <= Real::EPSILON * (k11 * k22).max(Real::MIN_POSITIVE) {
+                    continue;
+                }
+                // P = −K⁻¹ C: b moves by +P, a by −P.
+                let p = Vec2::new(
+                    -(k22 * c.x - k12 * c.y) / det,
+                    -(k11 * c.y - k12 * c.x) / det,
+                );
+                for (k, sign, r, m, i) in [(ka, -1.0, ra, ma, ia), (kb, 1.0, rb, mb, ib)] {
+                    let Some(k) = k else { continue };
+                    let (dc, da) = (sign * m * p, sign * i * cross(r, p));
+                    shift(bodies, k, dc, da);
+                    // The twin follows through the map: x₂ = T(x₁) moves
+                    // by η Q Δx₁, θ₂ = θ₁ + const by Δθ₁.
+                    if let Some((t, q, eta)) = twin_of(k) {
+                        shift(bodies, t, eta * q.rotate(dc), da);
+                    }
+                }
+            }
+        }
     }
 }
+
+/// Gauss–Seidel passes that close a moved-back group's joints (8: a
+/// 20-link rope's hinges end within 1 mm, where 4 passes leave 2 mm).
+pub const CLOSING_PASSES: usize = 8;
 
 /// Fast bodies from which the non-bullet sweeps run on threads.
 const PARALLEL_FAST: usize = 32;

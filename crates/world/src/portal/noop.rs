@@ -24,6 +24,9 @@ impl PortalStage {
     pub(crate) fn clipping(&self) -> &ContactClipping {
         &NO_CLIPPING
     }
+    pub(crate) fn constraints(&self) -> &[PortalConstraint] {
+        &self.constraints
+    }
     pub(crate) fn constraints_mut(&mut self) -> &mut Vec<PortalConstraint> {
         &mut self.constraints
     }

@@ -95,6 +95,11 @@ pub const F_MIN: Real = 0.1;
 /// with the coupled passes of the joint and portal solves 0.8 and 7.7 mm).
 pub const F_JOINTED: Real = 0.5;
 
+/// How far past its span a copy held for its joints may press into the
+/// aperture's side wall and still count as within it, m (two linear
+/// slops).
+const SPAN_SLACK: Real = 2.0 * janus2d_core::geometry::LINEAR_SLOP;
+
 /// Half-width of the region behind a copy's plane that the clipping drops
 /// for a copy wholly behind it (m): beyond any coordinate a body can have.
 const HELD_HALF_WIDTH: Real = 4.0 * janus2d_core::limits::MAX_COORDINATE;
@@ -390,6 +395,11 @@ impl PortalStage {
     /// The clipping the narrowphase applies.
     pub(crate) fn clipping(&self) -> &ContactClipping {
         &self.clipping
+    }
+
+    /// The portal rows, one per crossing (same order).
+    pub(crate) fn constraints(&self) -> &[PortalConstraint] {
+        &self.constraints
     }
 
     /// The portal constraints, as the solver's third batch.
@@ -1414,6 +1424,9 @@ impl PortalStage {
         };
         let f = frame_in(stores.bodies, &d.portals[side], &d.local[side]);
         let w = d.local[side].half_width;
+        // Held against a side wall, it may press into it by the contacts'
+        // slop.
+        let w = w + SPAN_SLACK;
         extents_in(stores.bodies, &stores.collision.shapes, body, &f)
             .is_some_and(|(_, _, t0, t1)| t0 >= -w && t1 <= w)
     }

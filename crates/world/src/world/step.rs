@@ -202,6 +202,7 @@ impl World {
             // collision and the proxy update (`Collision::end_step`).
             let continuous = &mut self.continuous;
             let (no_collide, clipping) = (self.joints.no_collide(), self.portals.clipping());
+            let portal_rows = self.portals.constraints();
             let joints = &self.joints;
             let (builder, solver) = (&self.contact_builder, &self.contact_solver);
             let continuous_time = self.collision.end_step(
@@ -216,6 +217,7 @@ impl World {
                         no_collide,
                         clipping,
                         joints,
+                        portal_rows,
                     };
                     continuous.run(bodies, &input, team);
                     start.elapsed().as_secs_f64()
