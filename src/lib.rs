@@ -177,7 +177,7 @@ pub use janus2d_world::aperture::ContactClipping;
 pub use janus2d_world::portal::PortalCounters;
 #[doc(inline)]
 pub use janus2d_world::{
-    Autostep, CharacterController, CollisionPlane, Ground, MoveResult, MoverCast, PlaneResult,
+    Autostep, CharacterController, CollisionPlane, Ground, MoveResult, MoverCast, MoverCrossing, PlaneResult,
     PlaneSolution, clip_vector, solve_planes,
 };
 #[doc(inline)]
