@@ -209,7 +209,12 @@ pub fn run() -> Result<Report, WorldError> {
 pub fn portal_run() -> Result<(Real, Real), WorldError> {
     let mut world = World::new(WorldDef::default())?;
     let solid = ShapeDef::default();
-    fixed(&mut world, Vec2::new(0.0, -0.5), Polygon::make_box(30.0, 0.5), &solid)?;
+    fixed(
+        &mut world,
+        Vec2::new(0.0, -0.5),
+        Polygon::make_box(30.0, 0.5),
+        &solid,
+    )?;
     let mut wall = |x: Real| -> Result<BodyHandle, WorldError> {
         let b = world.create_body(&BodyDef::fixed(Vec2::new(x, 2.5)))?;
         world.create_shape(b, &solid, Polygon::make_box(0.5, 3.5))?;
@@ -228,7 +233,14 @@ pub fn portal_run() -> Result<(Real, Real), WorldError> {
     let mut out = (1.0, WALK);
     for k in 0..180 {
         let t = k as Real * DT;
-        let r = cc.move_and_slide(&world, &capsule, p, v - Vec2::new(0.0, GRAVITY * DT), DT, &filter)?;
+        let r = cc.move_and_slide(
+            &world,
+            &capsule,
+            p,
+            v - Vec2::new(0.0, GRAVITY * DT),
+            DT,
+            &filter,
+        )?;
         if let Some(c) = r.crossings.first() {
             println!(
                 "t = {t:5.2} s  through the portal at ({:.2}, {:.2}): out at ({:.2}, {:.2}), \

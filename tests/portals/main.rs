@@ -18,9 +18,9 @@ mod portal_joints;
 #[cfg(feature = "portals")]
 mod portal_motor;
 #[cfg(feature = "portals")]
-mod portal_mover;
-#[cfg(feature = "portals")]
 mod portal_mouse;
+#[cfg(feature = "portals")]
+mod portal_mover;
 #[cfg(feature = "portals")]
 mod portal_prismatic;
 mod portal_properties;

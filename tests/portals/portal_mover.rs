@@ -78,7 +78,10 @@ fn walking_into_a_wall_portal_comes_out_of_the_other_scaled_by_eta() {
             crossed = Some((i, p, r));
             break;
         }
-        assert!(r.grounded, "walking on the floor before the portal (step {i})");
+        assert!(
+            r.grounded,
+            "walking on the floor before the portal (step {i})"
+        );
         (cap, p, vel) = (r.capsule, r.position, r.velocity);
     }
     let (i, before, r) = crossed.expect("the character crossed the portal");
@@ -99,7 +102,10 @@ fn walking_into_a_wall_portal_comes_out_of_the_other_scaled_by_eta() {
         r.scale
     );
     assert_eq!(r.crossings.len(), 1);
-    assert_eq!((r.crossings[0].entered, r.crossings[0].bodies.len()), (0, 2));
+    assert_eq!(
+        (r.crossings[0].entered, r.crossings[0].bodies.len()),
+        (0, 2)
+    );
     assert!(err < 0.01, "{err}");
     assert!(speed_err < 0.01, "{speed_err}");
     assert!((r.scale - 2.0).abs() < 1e-5 && (r.capsule.radius - 0.5).abs() < 1e-5);
@@ -149,7 +155,10 @@ fn falling_through_a_floor_portal_comes_out_of_a_wall_portal() {
             crossed = Some((i, p, vel - v(0.0, G * DT), r));
             break;
         }
-        assert!(!r.grounded, "the floor is open over the aperture (step {i})");
+        assert!(
+            !r.grounded,
+            "the floor is open over the aperture (step {i})"
+        );
         (cap, p, vel) = (r.capsule, r.position, r.velocity);
     }
     let (i, before, fall, r) = crossed.expect("the character fell through");
@@ -160,7 +169,8 @@ fn falling_through_a_floor_portal_comes_out_of_a_wall_portal() {
     let u = (before.y + 0.5) / -d;
     let centre = before + v(0.0, 0.5 + u * d);
     let q = |x: Vec2| v(-x.y, x.x);
-    let expected = v(-20.0, 2.0) + q(centre - v(10.0, 0.0)) - v(0.0, 0.5) + q(v(0.0, (1.0 - u) * d));
+    let expected =
+        v(-20.0, 2.0) + q(centre - v(10.0, 0.0)) - v(0.0, 0.5) + q(v(0.0, (1.0 - u) * d));
     let err = (r.position - expected).length();
     let speed = -fall.y;
     let speed_err = (r.velocity - v(speed, 0.0)).length() / speed;
@@ -183,7 +193,10 @@ fn falling_through_a_floor_portal_comes_out_of_a_wall_portal() {
         (cap, p, vel) = (r.capsule, r.position, r.velocity);
     }
     println!("two seconds later at {p}");
-    assert!(p.x > -20.0 + 1.0 && p.y.abs() < 0.03, "landed in front of the wall: {p}");
+    assert!(
+        p.x > -20.0 + 1.0 && p.y.abs() < 0.03,
+        "landed in front of the wall: {p}"
+    );
 }
 
 #[test]
@@ -214,7 +227,14 @@ fn the_wall_around_an_aperture_and_its_lips_stop_the_character() {
     let mut p = v(3.0, 0.01);
     for _ in 0..60 {
         let r = cc
-            .move_and_slide(&w, &capsule(), p, v(3.0, -G * DT), DT, &QueryFilter::default())
+            .move_and_slide(
+                &w,
+                &capsule(),
+                p,
+                v(3.0, -G * DT),
+                DT,
+                &QueryFilter::default(),
+            )
             .unwrap();
         assert!(r.crossings.is_empty());
         p = r.position;
@@ -251,9 +271,15 @@ fn what_stands_in_front_of_the_partner_stops_the_part_that_went_in() {
     );
     assert!((p.x - expected).abs() < 2e-3, "{}", p.x);
     assert!(
-        r.contacts.iter().any(|c| c.body == block && c.normal.x < -0.99),
+        r.contacts
+            .iter()
+            .any(|c| c.body == block && c.normal.x < -0.99),
         "the block is among what it touches, its normal mapped back: {:?}",
         r.contacts
     );
-    assert!(r.velocity.x.abs() < 1e-3, "the walk is clipped: {}", r.velocity);
+    assert!(
+        r.velocity.x.abs() < 1e-3,
+        "the walk is clipped: {}",
+        r.velocity
+    );
 }

@@ -83,7 +83,7 @@ pub use portal::{
     CrossingRole, MassModel, PlaneSide, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle,
     PortalSide,
 };
-pub use profile::{CollisionCounters, StepCounters, StepProfile};
+pub use profile::{CollisionCounters, EventWork, StepCounters, StepProfile};
 pub use query::{
     PointProjection, PortalHop, QueryFilter, QueryPredicate, QueryProblem, RayHit, ShapeOverlap,
 };

@@ -27,8 +27,8 @@
 
 use janus2d_constraints::portal_map::PortalMap;
 use janus2d_core::body::BodyHandle;
-use janus2d_core::handle::{Handle, PortalPairTag};
 use janus2d_core::geometry::LINEAR_SLOP;
+use janus2d_core::handle::{Handle, PortalPairTag};
 use janus2d_core::math::{Real, Vec2};
 
 use crate::query::RayHit;

@@ -100,7 +100,12 @@ fn lips(a: &QueryAperture) -> [Vec2; 2] {
 /// The first hit of the mover (proxy `m`) swept along `translation` against
 /// `a` placed by `xf_a`, a shape the mover already touches or overlaps
 /// stopping it only [`LINEAR_SLOP`] deeper (none when the cores cross).
-fn sweep_one(a: &ShapeProxy, xf_a: &Transform, m: &ShapeProxy, translation: Vec2) -> Option<CastHit> {
+fn sweep_one(
+    a: &ShapeProxy,
+    xf_a: &Transform,
+    m: &ShapeProxy,
+    translation: Vec2,
+) -> Option<CastHit> {
     let (gap, _, _) = separation(a, xf_a, m);
     let mut caster = *m;
     if gap < CAST_TOLERANCE {
@@ -494,7 +499,8 @@ impl World {
     /// `filter.through_portals`).
     fn mover_apertures(&self, filter: &QueryFilter) -> Vec<QueryAperture> {
         if filter.through_portals {
-            self.portals.query_apertures(&self.bodies, self.bodies.owner())
+            self.portals
+                .query_apertures(&self.bodies, self.bodies.owner())
         } else {
             Vec::new()
         }
