@@ -204,7 +204,7 @@ pub fn run() -> Result<Report, WorldError> {
 }
 
 /// The portal room: walls at x = 5 (an aperture 2.4 m wide, from y = −0.2)
-/// and x = −20 (its partner, 4.8 m wide: η = 2). The character walks right
+/// and x = −20 (its partner, 4.8 m wide, from y = 0.1: η = 2). The character walks right
 /// at 2 m/s into the first; returns its scale and speed as it comes out.
 pub fn portal_run() -> Result<(Real, Real), WorldError> {
     let mut world = World::new(WorldDef::default())?;
@@ -223,7 +223,7 @@ pub fn portal_run() -> Result<(Real, Real), WorldError> {
     let (a, b) = (wall(5.5)?, wall(-20.5)?);
     world.create_portal_pair(&PortalPairDef::new(
         PortalDef::new(a, Vec2::new(-0.5, -1.5), -Vec2::X, 1.2),
-        PortalDef::new(b, Vec2::new(0.5, -0.3), Vec2::X, 2.4),
+        PortalDef::new(b, Vec2::new(0.5, 0.0), Vec2::X, 2.4),
     ))?;
     // Through portals: the filter says so.
     let filter = QueryFilter::default().through_portals();

@@ -11,6 +11,7 @@ use janus2d_core::geometry::CastHit;
 
 use crate::mover::{MOVER_PLANE_TOLERANCE, MoverCast, MoverCrossing, PlaneResult};
 use crate::query::{PortalHop, QueryAperture, QueryFilter, QueryProblem, RayHit};
+use janus2d_constraints::portal_map::PortalFrame;
 
 fn bad(field: &'static str, problem: QueryProblem) -> WorldError {
     WorldError::BadQuery { field, problem }
@@ -152,6 +153,27 @@ fn far_side_keeps(
     !apertures
         .iter()
         .any(|b| b.body == body && (in_hole(b, point) || cores_cross))
+}
+
+/// The capsule's cross-section with the line of the frame's plane: its two
+/// ends (`None` when the capsule does not reach the plane). The core is
+/// sampled at 33 points (the ends' error is second order in the spacing).
+fn cross_section(mover: &Capsule, f: &PortalFrame) -> Option<(Vec2, Vec2)> {
+    const SAMPLES: usize = 32;
+    let (mut lo, mut hi) = (Real::INFINITY, Real::NEG_INFINITY);
+    for i in 0..=SAMPLES {
+        let u = i as Real / SAMPLES as Real;
+        let c = mover.center1 + u * (mover.center2 - mover.center1);
+        let d = c - f.point;
+        let (s, t) = (d.dot(f.normal), d.dot(f.tangent));
+        let h2 = mover.radius * mover.radius - s * s;
+        if h2 >= 0.0 {
+            let h = h2.sqrt();
+            lo = lo.min(t - h);
+            hi = hi.max(t + h);
+        }
+    }
+    (lo <= hi).then(|| (f.point + lo * f.tangent, f.point + hi * f.tangent))
 }
 
 /// A plane the mover query found: the slot, the plane, and whether the
@@ -424,7 +446,7 @@ impl World {
         let apertures = self.mover_apertures(filter);
         let going: Vec<bool> = apertures.iter().map(|a| passes(a, mover)).collect();
         let mut out: Vec<PlaneResult> = Vec::new();
-        for f in self.mover_touches(mover, margin, filter) {
+        for f in self.mover_touches(mover, margin, filter, None) {
             let body = shapes.at(f.slot).body;
             if Self::mover_drops(&apertures, &going, body, f.point, f.cores_cross) {
                 continue;
@@ -473,7 +495,8 @@ impl World {
                 .iter()
                 .find(|b| b.pair == a.pair && b.side != a.side);
             let far = image(a, mover);
-            for f in self.mover_touches(&far, a.map.eta * margin, filter) {
+            let front = partner.map(|b| &b.map.frame1);
+            for f in self.mover_touches(&far, a.map.eta * margin, filter, front) {
                 let body = shapes.at(f.slot).body;
                 if !far_side_keeps(&apertures, partner, body, f.point, f.cores_cross) {
                     continue;
@@ -583,8 +606,19 @@ impl World {
     }
 
     /// Every shape `filter` accepts within `margin` of the capsule
-    /// `mover`, in slot order.
-    fn mover_touches(&self, mover: &Capsule, margin: Real, filter: &QueryFilter) -> Vec<Found> {
+    /// `mover`, in slot order. With `front` (a portal's frame: the mover is
+    /// an image there, only its part in front of that plane is real), a
+    /// shape nearest to the part behind the plane is measured to the
+    /// capsule's cross-section on the plane instead (the nearest point of
+    /// a convex part cut by a plane lies on the cut when the whole's does
+    /// not lie in the part), and left out when there is none.
+    fn mover_touches(
+        &self,
+        mover: &Capsule,
+        margin: Real,
+        filter: &QueryFilter,
+        front: Option<&PortalFrame>,
+    ) -> Vec<Found> {
         let shape = Shape::Capsule(*mover);
         let aabb = shape.compute_aabb(&Transform::IDENTITY).fattened(margin);
         let centre = 0.5 * (mover.center1 + mover.center2);
@@ -594,7 +628,26 @@ impl World {
             let data = self.collision.shapes.at(slot);
             let xf = self.mover_transform_of(data.body);
             let proxy_a = ShapeProxy::from_shape(&data.geometry);
-            let (gap, mut normal, mut point) = separation(&proxy_a, &xf, &proxy_m);
+            let (mut gap, mut normal, mut point) = separation(&proxy_a, &xf, &proxy_m);
+            if let Some(f) = front
+                && normal != Vec2::ZERO
+                && (point + gap * normal - f.point).dot(f.normal) < -MOVER_PLANE_TOLERANCE
+            {
+                let Some((p0, p1)) = cross_section(mover, f) else {
+                    continue;
+                };
+                let chord = ShapeProxy {
+                    points: {
+                        let mut pts = [Vec2::ZERO; janus2d_core::geometry::MAX_POLYGON_VERTICES];
+                        pts[0] = p0;
+                        pts[1] = p1;
+                        pts
+                    },
+                    count: 2,
+                    radius: 0.0,
+                };
+                (gap, normal, point) = separation(&proxy_a, &xf, &chord);
+            }
             if gap > margin {
                 continue;
             }
