@@ -1,10 +1,13 @@
 //! A platformer character, headless: a capsule moved by a
 //! `CharacterController` walks along the floor, steps up a 0.2 m stair,
 //! climbs a 30° slope, drops off a ledge, rides a platform moving at 3 m/s,
-//! then jumps up through a one-way ledge and lands on it. Prints what
-//! happened. Run with `cargo run --release --example platformer`.
+//! then jumps up through a one-way ledge and lands on it. In a second
+//! room it walks into a wall portal and comes out of its partner, twice
+//! as wide, twice as large and twice as fast. Prints what happened. Run
+//! with `cargo run --release --example platformer`.
 
 use janus2d::prelude::*;
+use janus2d::{PortalDef, PortalPairDef};
 
 const DT: Real = 1.0 / 60.0;
 const GRAVITY: Real = 10.0;
@@ -200,6 +203,67 @@ pub fn run() -> Result<Report, WorldError> {
     Ok(report)
 }
 
+/// The portal room: walls at x = 5 (an aperture 2.4 m wide, from y = −0.2)
+/// and x = −20 (its partner, 4.8 m wide, from y = 0.1: η = 2). The character walks right
+/// at 2 m/s into the first; returns its scale and speed as it comes out.
+pub fn portal_run() -> Result<(Real, Real), WorldError> {
+    let mut world = World::new(WorldDef::default())?;
+    let solid = ShapeDef::default();
+    fixed(
+        &mut world,
+        Vec2::new(0.0, -0.5),
+        Polygon::make_box(30.0, 0.5),
+        &solid,
+    )?;
+    let mut wall = |x: Real| -> Result<BodyHandle, WorldError> {
+        let b = world.create_body(&BodyDef::fixed(Vec2::new(x, 2.5)))?;
+        world.create_shape(b, &solid, Polygon::make_box(0.5, 3.5))?;
+        Ok(b)
+    };
+    let (a, b) = (wall(5.5)?, wall(-20.5)?);
+    world.create_portal_pair(&PortalPairDef::new(
+        PortalDef::new(a, Vec2::new(-0.5, -1.5), -Vec2::X, 1.2),
+        PortalDef::new(b, Vec2::new(0.5, 0.0), Vec2::X, 2.4),
+    ))?;
+    // Through portals: the filter says so.
+    let filter = QueryFilter::default().through_portals();
+    let mut capsule = Capsule::new(Vec2::new(0.0, 0.25), Vec2::new(0.0, 0.75), 0.25)?;
+    let mut cc = CharacterController::new();
+    let (mut p, mut v) = (Vec2::new(2.0, 0.01), Vec2::new(WALK, 0.0));
+    let mut out = (1.0, WALK);
+    for k in 0..180 {
+        let t = k as Real * DT;
+        let r = cc.move_and_slide(
+            &world,
+            &capsule,
+            p,
+            v - Vec2::new(0.0, GRAVITY * DT),
+            DT,
+            &filter,
+        )?;
+        if let Some(c) = r.crossings.first() {
+            println!(
+                "t = {t:5.2} s  through the portal at ({:.2}, {:.2}): out at ({:.2}, {:.2}), \
+                 capsule radius {:.2} (x{:.1}), moving at {:.2} m/s",
+                c.point.x,
+                c.point.y,
+                c.exit_point().x,
+                c.exit_point().y,
+                r.capsule.radius,
+                r.scale,
+                r.velocity.length()
+            );
+            out = (r.scale, r.velocity.length());
+        }
+        (capsule, p, v) = (r.capsule, r.position, r.velocity);
+    }
+    println!(
+        "after 3 s: x = {:.2}, y = {:.3}, walking at {:.2} m/s",
+        p.x, p.y, v.x
+    );
+    Ok(out)
+}
+
 fn main() -> Result<(), WorldError> {
     let r = run()?;
     println!(
@@ -215,5 +279,8 @@ fn main() -> Result<(), WorldError> {
             "not on the ledge"
         }
     );
+    println!("\nthe portal room:");
+    let (scale, speed) = portal_run()?;
+    println!("came out scaled by {scale:.2}, at {speed:.2} m/s (walked in at {WALK:.2})");
     Ok(())
 }

@@ -177,17 +177,17 @@ pub use janus2d_world::aperture::ContactClipping;
 pub use janus2d_world::portal::PortalCounters;
 #[doc(inline)]
 pub use janus2d_world::{
-    Autostep, CharacterController, CollisionPlane, Ground, MoveResult, MoverCast, PlaneResult,
-    PlaneSolution, clip_vector, solve_planes,
+    Autostep, CharacterController, CollisionPlane, Ground, MoveResult, MoverCast, MoverCrossing,
+    PlaneResult, PlaneSolution, clip_vector, solve_planes,
 };
 #[doc(inline)]
 pub use janus2d_world::{ChainDef, ChainHandle, SurfaceMaterial};
 #[doc(inline)]
 pub use janus2d_world::{
     CollisionCounters, CollisionEvents, Color, Contact, ContactPointData, ContinuousCounters,
-    DebugDraw, DrawOptions, ExplosionDef, Filter, HitEvent, Invariant, InvariantError, JointEvent,
-    JointHandle, JointSet, MixFn, PairFilterFn, Palette, PointProjection, PortalHop, PreSolve,
-    PreSolveFn, QueryFilter, QueryPredicate, QueryProblem, RayHit, ShapeData, ShapeDef,
+    DebugDraw, DrawOptions, EventWork, ExplosionDef, Filter, HitEvent, Invariant, InvariantError,
+    JointEvent, JointHandle, JointSet, MixFn, PairFilterFn, Palette, PointProjection, PortalHop,
+    PreSolve, PreSolveFn, QueryFilter, QueryPredicate, QueryProblem, RayHit, ShapeData, ShapeDef,
     ShapeHandle, ShapeOverlap, ShapePairEvent, SleepSettings, Snapshot, StepCounters, StepEvents,
     StepProfile, World, WorldDef, WorldError,
 };

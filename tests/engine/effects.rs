@@ -1,8 +1,9 @@
 //! Only the effects a scene calls for: a stage whose feature the scene
-//! lacks does no work, shown by the per-step counters; and sleeping.
+//! lacks does no work, shown by the per-step counters (and events switched
+//! off gather nothing, shown by `World::event_work`); and sleeping.
 
 use janus2d::prelude::*;
-use janus2d::world::SleepSettings;
+use janus2d::world::{EventWork, SleepSettings};
 use janus2d_testbed::scenes::DT;
 
 fn boxes_on_ground(def: WorldDef, restitution: Real) -> (World, Vec<BodyHandle>) {
@@ -307,4 +308,96 @@ fn bodies_created_asleep_cost_nothing_until_touched() {
         "the hit box is still asleep"
     );
     assert!(world.linear_velocity(asleep[0]).unwrap().x > 0.0);
+}
+
+/// Boxes dropped from 1 to 3 m onto the ground beside a sensor, every
+/// shape made with `sd`.
+fn dropped_boxes(def: WorldDef, sd: &ShapeDef) -> World {
+    let mut world = World::new(def).unwrap();
+    let g = world
+        .create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0)))
+        .unwrap();
+    world
+        .create_shape(g, sd, Polygon::make_box(20.0, 1.0))
+        .unwrap();
+    let zone = world
+        .create_body(&BodyDef::fixed(Vec2::new(0.0, 1.0)))
+        .unwrap();
+    world
+        .create_shape(zone, &sd.clone().sensor(), Polygon::make_box(3.0, 1.0))
+        .unwrap();
+    for i in 0..5 {
+        let b = world
+            .create_body(&BodyDef::dynamic(Vec2::new(
+                1.5 * i as Real - 3.0,
+                1.0 + 0.5 * i as Real,
+            )))
+            .unwrap();
+        world
+            .create_shape(b, sd, Polygon::make_box(0.5, 0.5))
+            .unwrap();
+    }
+    world
+}
+
+#[test]
+fn events_switched_off_everywhere_gather_nothing() {
+    let def = WorldDef {
+        sleep: SleepSettings {
+            enabled: false,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let off = ShapeDef::default()
+        .with_contact_events(false)
+        .with_sensor_events(false)
+        .with_hit_events(false);
+    let mut world = dropped_boxes(def.clone(), &off);
+    let mut contacts = 0;
+    for k in 0..90 {
+        world.step(DT).unwrap();
+        contacts += world.counters().contacts;
+        // No gathering read a point, a contact or a body.
+        assert_eq!(world.event_work(), EventWork::default(), "step {k}");
+        let e = &world.events().collision;
+        assert!(
+            e.contact_begin.is_empty()
+                && e.contact_end.is_empty()
+                && e.sensor_begin.is_empty()
+                && e.sensor_end.is_empty()
+                && e.hits.is_empty()
+                && e.forces.is_empty()
+                && world.events().moves.is_empty(),
+            "step {k}: {e:?}"
+        );
+    }
+    println!("all events off: {contacts} contact constraints over 90 steps, event work 0");
+    assert!(contacts > 0, "there were contacts to gather from");
+
+    // Each switch turned on makes its gathering read, and only its own.
+    let mut hits = dropped_boxes(def.clone(), &off.clone().with_hit_events(true));
+    let mut forces = dropped_boxes(def.clone(), &off.clone().with_force_event_threshold(1.0));
+    let mut moves = dropped_boxes(def.with_move_events(true), &off);
+    let (mut hit_points, mut hit_events) = (0, 0);
+    for _ in 0..90 {
+        hits.step(DT).unwrap();
+        forces.step(DT).unwrap();
+        moves.step(DT).unwrap();
+        let h = hits.event_work();
+        hit_points += h.hit_points_read;
+        hit_events += hits.events().collision.hits.len();
+        assert_eq!((h.force_contacts_read, h.move_bodies_read), (0, 0));
+        let f = forces.event_work();
+        assert_eq!(f.force_contacts_read, forces.contacts().count());
+        assert_eq!((f.hit_points_read, f.move_bodies_read), (0, 0));
+        let m = moves.event_work();
+        assert_eq!(m.move_bodies_read, 5, "the five awake boxes");
+        assert_eq!((m.hit_points_read, m.force_contacts_read), (0, 0));
+    }
+    println!("hit events on: {hit_points} approach points read, {hit_events} hit events");
+    assert!(
+        hit_points >= hit_events && hit_events >= 5,
+        "each box lands once"
+    );
 }

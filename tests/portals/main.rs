@@ -22,6 +22,8 @@ mod portal_motor;
 #[cfg(feature = "portals")]
 mod portal_mouse;
 #[cfg(feature = "portals")]
+mod portal_mover;
+#[cfg(feature = "portals")]
 mod portal_prismatic;
 mod portal_properties;
 #[cfg(feature = "portals")]

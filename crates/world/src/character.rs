@@ -33,8 +33,19 @@
 //!    edge slips past the corner onto the step below);
 //! 6. the velocity clipped against what it touches; the ground remembered.
 //!
-//! **Portals.** The controller does not cross portals yet: the wall that
-//! carries a portal is a wall to it (see [`World::cast_mover`]).
+//! **Portals** (when the filter has
+//! [`through_portals`](QueryFilter::through_portals)). A portal's wall is
+//! not solid inside its aperture, and its lips are; while part of the
+//! capsule is in an aperture, what that part meets on the far side stops
+//! it too ([`World::cast_mover`], [`World::collide_mover`]). When the
+//! capsule's centre crosses an aperture's plane within its span
+//! ([`World::mover_crossing`]), the character goes through: its centre is
+//! mapped to the partner portal (`T(x) = P₂ + η Q (x − P₁)`), its capsule
+//! scaled by `η` about the reference point (radius and core × η; it stays
+//! upright: the capsule is not turned by `Q`, the character keeps `up`),
+//! the rest of the move and the velocity mapped by `η Q` (relative to the
+//! portals' own motion). [`MoveResult::capsule`] is the capsule to use from
+//! then on, [`MoveResult::crossings`] lists the apertures crossed.
 //!
 //! **Bodies.** Static, kinematic and dynamic shapes are all obstacles; the
 //! character pushes nothing (it is not a body).
@@ -45,7 +56,9 @@ use janus2d_core::math::{PI, Real, Vec2, vec_is_finite};
 
 use crate::World;
 use crate::error::WorldError;
-use crate::mover::{CollisionPlane, MoverCast, PlaneResult, clip_vector, lateral, solve_planes};
+use crate::mover::{
+    CollisionPlane, MoverCast, MoverCrossing, PlaneResult, clip_vector, lateral, solve_planes,
+};
 use crate::query::{QueryFilter, QueryProblem, RayHit};
 use crate::shapes::ShapeHandle;
 
@@ -174,6 +187,15 @@ pub struct MoveResult {
     pub iterations: usize,
     /// What it touches at the end (within `skin` + [`CONTACT_MARGIN`]).
     pub contacts: Vec<PlaneResult>,
+    /// The character's capsule now, relative to `position`: the one given,
+    /// scaled by the `η` of every portal crossed (use it for the next move).
+    pub capsule: Capsule,
+    /// The portal apertures its centre went through, in order (empty
+    /// unless the filter has `through_portals`).
+    pub crossings: Vec<MoverCrossing>,
+    /// The product of the crossings' `η`: how much the character grew
+    /// (1 without a crossing).
+    pub scale: Real,
 }
 
 /// Where the character stood: a point fixed in the ground body.
@@ -410,12 +432,13 @@ impl CharacterController {
         if !dt.is_finite() || dt <= 0.0 {
             return Err(WorldError::InvalidTimeStep);
         }
-        let mv = Mover {
+        let mut mv = Mover {
             cc: self,
             world,
             capsule: *capsule,
             filter,
             cos_slope: self.max_slope.cos(),
+            crossings: Vec::new(),
         };
         let mut iterations = 0;
 
@@ -436,6 +459,13 @@ impl CharacterController {
             }
         }
 
+        // Carried through a portal: the velocity goes through too.
+        let mut velocity = velocity;
+        for c in &mv.crossings {
+            velocity = world.mover_velocity_through(c, velocity)?;
+        }
+        let carried_crossings = mv.crossings.len();
+
         // 2. The ground under it; the wanted displacement along it.
         let start_ground = mv.ground(&mv.touch(pos)?.contacts);
         let desired = velocity * dt;
@@ -453,14 +483,15 @@ impl CharacterController {
 
         // 3. Slide.
         let before = pos;
+        let crossed_before_walk = mv.crossings.len();
         let (mut p, n) = mv.slide(pos, delta)?;
         iterations += n;
 
-        // 4. Blocked on the ground: a step.
+        // 4. Blocked on the ground: a step (not after a portal).
         let mut stepped = false;
         let lat = lateral(delta, self.up);
         let lat_len = lat.length();
-        if on_ground && lat_len > 0.0 {
+        if on_ground && lat_len > 0.0 && mv.crossings.len() == crossed_before_walk {
             let dir = lat / lat_len;
             let progress = (p - before).dot(dir);
             if progress < lat_len - 0.1 * LINEAR_SLOP
@@ -503,7 +534,16 @@ impl CharacterController {
             .iter()
             .flat_map(|c| mv.planes_of(c))
             .collect();
+        for c in &mv.crossings[carried_crossings..] {
+            velocity = world.mover_velocity_through(c, velocity)?;
+        }
         let velocity = clip_vector(velocity, &planes);
+        let Mover {
+            capsule: now,
+            crossings,
+            ..
+        } = mv;
+        let scale = crossings.iter().map(|c| c.map.eta).product();
         let ground = match ground {
             Some(g) => Some(Ground {
                 shape: g.shape,
@@ -535,6 +575,9 @@ impl CharacterController {
             snapped,
             iterations,
             contacts: touch.contacts,
+            capsule: now,
+            crossings,
+            scale,
         })
     }
 }
@@ -546,6 +589,8 @@ struct Mover<'a> {
     capsule: Capsule,
     filter: &'a QueryFilter<'a>,
     cos_slope: Real,
+    /// The portals crossed so far (the capsule is scaled by each).
+    crossings: Vec<MoverCrossing>,
 }
 
 impl Mover<'_> {
@@ -637,9 +682,12 @@ impl Mover<'_> {
             .cast_mover_with(&self.placed(pos, self.cc.skin), delta, self.filter, accept)
     }
 
-    /// Collide, solve, cast until the capsule stops: `(end, rounds)`.
-    fn slide(&self, pos: Vec2, delta: Vec2) -> Result<(Vec2, usize), WorldError> {
-        let target = pos + delta;
+    /// Collide, solve, cast until the capsule stops: `(end, rounds)`. A
+    /// cast whose centre reaches a portal aperture stops there; the
+    /// character goes through (see [`Mover::cross`]) and the rest of the
+    /// move goes on from the far side.
+    fn slide(&mut self, pos: Vec2, delta: Vec2) -> Result<(Vec2, usize), WorldError> {
+        let mut target = pos + delta;
         let mut p = pos;
         let mut rounds = 0;
         for _ in 0..self.cc.max_iterations {
@@ -654,10 +702,40 @@ impl Mover<'_> {
             if !vec_is_finite(solution) || solution.length() < SLIDE_TOLERANCE {
                 break;
             }
-            let cast = self.cast(p, solution, &touch.passing)?;
-            p += cast.fraction * solution;
+            let crossing = if self.filter.through_portals {
+                self.world
+                    .mover_crossing(&self.placed(p, 0.0), solution, self.filter)?
+            } else {
+                None
+            };
+            let reach = crossing.map_or(1.0, |c| c.fraction) * solution;
+            let cast = self.cast(p, reach, &touch.passing)?;
+            p += cast.fraction * reach;
+            if let Some(c) = crossing
+                && cast.fraction >= 1.0
+            {
+                let rest = target - p;
+                p = self.cross(&c, p);
+                target = p + c.map.map_vector(rest);
+            }
         }
         Ok((p, rounds))
+    }
+
+    /// Takes the character at `pos`, its centre on the aperture of `c`,
+    /// through to the partner portal: the centre mapped, the capsule scaled
+    /// by `η` about the reference point. Returns the new reference point.
+    fn cross(&mut self, c: &MoverCrossing, pos: Vec2) -> Vec2 {
+        let eta = c.map.eta;
+        let centre = 0.5 * (self.capsule.center1 + self.capsule.center2);
+        let out = c.map.map_point(pos + centre) - eta * centre;
+        self.capsule = Capsule {
+            center1: eta * self.capsule.center1,
+            center2: eta * self.capsule.center2,
+            radius: eta * self.capsule.radius,
+        };
+        self.crossings.push(*c);
+        out
     }
 
     /// Whether the capsule at `pos` touches a face too steep to walk that

@@ -439,13 +439,16 @@ impl Collision {
     /// approached faster than the world's threshold and pushed (contact
     /// index, point, approach speed in m/s; the solver side's read-back);
     /// each contact with hit events on gets one event, at its fastest.
+    /// Returns the points it read.
     pub(crate) fn collect_hits(
         &mut self,
         approaches: impl FnOnce(&mut dyn FnMut(u32, usize, Real)),
-    ) {
+    ) -> usize {
         let mut best: Vec<(u32, usize, Real)> = Vec::new();
         let contacts = &self.contacts;
+        let mut read = 0;
         approaches(&mut |index, point, speed| {
+            read += 1;
             if !contacts.awake()[index as usize].hit_events {
                 return;
             }
@@ -474,6 +477,7 @@ impl Collision {
                 approach_speed: speed,
             });
         }
+        read
     }
 
     /// Whether some shape has a finite force event threshold.
@@ -485,10 +489,13 @@ impl Collision {
     /// Contact force events of the step (the impulses stored): each awake
     /// solid touching contact whose total normal force, its points' step
     /// impulses over `dt`, exceeds the smaller of its shapes' thresholds,
-    /// in contact order. Run only when some shape has a threshold.
-    pub(crate) fn collect_forces(&mut self, dt: Real) {
+    /// in contact order. Run only when some shape has a threshold. Returns
+    /// the contacts it read.
+    pub(crate) fn collect_forces(&mut self, dt: Real) -> usize {
         let inv_dt = 1.0 / dt;
+        let mut read = 0;
         for c in self.contacts.awake() {
+            read += 1;
             if !c.is_solid_touching() {
                 continue;
             }
@@ -522,6 +529,7 @@ impl Collision {
                 });
             }
         }
+        read
     }
 
     /// The step's end for the pipeline: the solved impulses go back into

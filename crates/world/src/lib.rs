@@ -74,14 +74,16 @@ pub use error::WorldError;
 pub use hooks::{MixFn, PairFilterFn};
 pub use islands::SleepSettings;
 pub use joints::{JointEvent, JointHandle, JointKind, JointSet};
-pub use mover::{CollisionPlane, MoverCast, PlaneResult, PlaneSolution, clip_vector, solve_planes};
+pub use mover::{
+    CollisionPlane, MoverCast, MoverCrossing, PlaneResult, PlaneSolution, clip_vector, solve_planes,
+};
 pub use narrowphase::{PreSolve, PreSolveFn};
 #[cfg(feature = "portals")]
 pub use portal::{
     CrossingRole, MassModel, PlaneSide, PortalDef, PortalEvent, PortalPairDef, PortalPairHandle,
     PortalSide,
 };
-pub use profile::{CollisionCounters, StepCounters, StepProfile};
+pub use profile::{CollisionCounters, EventWork, StepCounters, StepProfile};
 pub use query::{
     PointProjection, PortalHop, QueryFilter, QueryPredicate, QueryProblem, RayHit, ShapeOverlap,
 };

@@ -25,8 +25,10 @@
 //! mover `s` in front of an obstacle (separation `s`, positive when apart)
 //! that is to keep a gap `g` has `offset = g − s`.
 
+use janus2d_constraints::portal_map::PortalMap;
 use janus2d_core::body::BodyHandle;
 use janus2d_core::geometry::LINEAR_SLOP;
+use janus2d_core::handle::{Handle, PortalPairTag};
 use janus2d_core::math::{Real, Vec2};
 
 use crate::query::RayHit;
@@ -340,6 +342,72 @@ pub fn clip_vector(vector: Vec2, planes: &[CollisionPlane]) -> Vec2 {
     v
 }
 
+/// How far behind a portal plane (m) the centre of a mover may be and still
+/// count as in front of it (usual 5e-6 = [`LINEAR_SLOP`] / 100): a mover
+/// that has just come out lies on the exit plane up to rounding.
+///
+/// ```
+/// use janus2d_core::geometry::LINEAR_SLOP;
+/// assert!(janus2d_world::mover::MOVER_PLANE_TOLERANCE < LINEAR_SLOP);
+/// ```
+pub const MOVER_PLANE_TOLERANCE: Real = 0.01 * LINEAR_SLOP;
+
+/// A portal aperture a mover's centre goes through, from
+/// [`World::mover_crossing`](crate::World::mover_crossing) (and in
+/// [`MoveResult::crossings`](crate::character::MoveResult::crossings)).
+///
+/// The mover comes out of the partner portal: its centre at
+/// `map.map_point(point)`, its size times `map.eta`, its velocity relative
+/// to the portals mapped by `η Q` ([`PortalMap::map_vector`]).
+///
+/// ```
+/// use janus2d_world::mover::MoverCrossing;
+/// use janus2d_constraints::portal_map::{PortalFrame, PortalMap};
+/// use janus2d_core::{BodyHandle, Vec2};
+/// use janus2d_core::handle::Handle;
+/// // A floor portal at the origin, its partner on a wall at x = 10 facing +x, η = 2.
+/// let map = PortalMap::new(
+///     PortalFrame::from_point_normal(Vec2::ZERO, Vec2::Y),
+///     PortalFrame::from_point_normal(Vec2::new(10.0, 0.0), Vec2::X),
+///     2.0,
+/// ).unwrap();
+/// let c = MoverCrossing {
+///     pair: Handle::new(0, 1, 0),
+///     entered: 0,
+///     fraction: 0.5,
+///     point: Vec2::ZERO,
+///     map,
+///     bodies: [BodyHandle::new(0, 1, 0), BodyHandle::new(1, 1, 0)],
+/// };
+/// // Falling at 3 m/s, it leaves the wall at 6 m/s.
+/// assert!((c.map.map_vector(Vec2::new(0.0, -3.0)) - Vec2::new(6.0, 0.0)).length() < 1e-5);
+/// assert_eq!(c.exit_point(), Vec2::new(10.0, 0.0));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MoverCrossing {
+    /// The portal pair.
+    pub pair: Handle<PortalPairTag>,
+    /// The side entered: 0 for portal a, 1 for portal b.
+    pub entered: usize,
+    /// Fraction of the translation at which the centre meets the aperture,
+    /// in `[0, 1]`.
+    pub fraction: Real,
+    /// Where the centre meets the entered aperture, world, m.
+    pub point: Vec2,
+    /// The map from the entered portal to its partner.
+    pub map: PortalMap,
+    /// The bodies that carry the entered portal and its partner.
+    pub bodies: [BodyHandle; 2],
+}
+
+impl MoverCrossing {
+    /// Where the centre comes out of the partner portal, world, m.
+    #[must_use]
+    pub fn exit_point(&self) -> Vec2 {
+        self.map.map_point(self.point)
+    }
+}
+
 /// Where a mover cast stopped, from
 /// [`World::cast_mover`](crate::World::cast_mover).
 ///
@@ -358,7 +426,8 @@ pub struct MoverCast {
     /// nothing in the way).
     pub fraction: Real,
     /// The shape that stopped it: point and normal on that shape's surface
-    /// (`portal_hops` 0: the mover does not go through portals).
+    /// (`portal_hops` 1 when it was met through an aperture: the point and
+    /// normal are then mapped back to the mover's side).
     pub hit: Option<RayHit>,
 }
 

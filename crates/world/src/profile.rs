@@ -129,6 +129,37 @@ impl StepCounters {
     }
 }
 
+/// What the event gathering read in the last step: the per-point,
+/// per-contact and per-body work of hit, contact force and body move
+/// events. Each gathering runs only when something asks for it (a shape
+/// with hit events on, a shape with a finite force threshold, move events
+/// on), so a scene that turns them all off reads nothing (0 here). Contact
+/// and sensor begin/end events cost no gathering: the contact update that
+/// finds a pair's touching change tests the pair's flag and records it or
+/// not.
+///
+/// Not state, as the timings: not serialized (a restored world reads 0
+/// until it steps).
+///
+/// ```
+/// use janus2d_world::{EventWork, World, WorldDef};
+/// let mut world = World::new(WorldDef::default()).unwrap();
+/// world.step(1.0 / 60.0).unwrap();
+/// assert_eq!(world.event_work(), EventWork::default());
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct EventWork {
+    /// Solved contact points whose approach speed the hit-event gathering
+    /// read (0 unless some shape has hit events on).
+    pub hit_points_read: usize,
+    /// Awake contacts the contact-force gathering read (0 unless some shape
+    /// has a finite `force_event_threshold`).
+    pub force_contacts_read: usize,
+    /// Bodies the move-event gathering read (0 unless the world gathers
+    /// move events).
+    pub move_bodies_read: usize,
+}
+
 /// Counters of the last collision pass.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]

@@ -226,6 +226,29 @@ impl World {
         self.counters
     }
 
+    /// What the event gathering read in the last step (see
+    /// [`EventWork`](crate::EventWork)): all 0 in a scene that asks for no
+    /// hit, force or move events.
+    ///
+    /// ```
+    /// use janus2d_world::{ShapeDef, World, WorldDef};
+    /// use janus2d_core::{BodyDef, Vec2};
+    /// use janus2d_core::geometry::Polygon;
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// let floor = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    /// world.create_shape(floor, &ShapeDef::default(), Polygon::make_box(5.0, 0.5)).unwrap();
+    /// let b = world.create_body(&BodyDef::dynamic(Vec2::new(0.0, 1.0))).unwrap();
+    /// let forces = ShapeDef::default().with_force_event_threshold(1.0);
+    /// world.create_shape(b, &forces, Polygon::make_box(0.5, 0.5)).unwrap();
+    /// world.step(1.0 / 60.0).unwrap();
+    /// // One shape with a force threshold: the gathering reads the contact.
+    /// assert_eq!(world.event_work().force_contacts_read, 1);
+    /// assert_eq!(world.event_work().hit_points_read, 0);
+    /// ```
+    pub fn event_work(&self) -> crate::profile::EventWork {
+        self.event_work
+    }
+
     /// Sets (or with `None` removes) the pre-solve hook: called after the
     /// narrowphase for every touching solid contact, in contact order, on
     /// the stepping thread. Through its view ([`PreSolve`](crate::PreSolve))

@@ -286,6 +286,10 @@ pub struct World {
     #[cfg_attr(feature = "serde", serde(skip))]
     step_profile: crate::profile::StepProfile,
     counters: crate::profile::StepCounters,
+    /// What the event gathering read in the last step (a diagnostic, not
+    /// state: not serialized).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    event_work: crate::profile::EventWork,
     step_count: u64,
 }
 
@@ -329,6 +333,7 @@ impl World {
             events: StepEvents::default(),
             step_profile: crate::profile::StepProfile::default(),
             counters: crate::profile::StepCounters::default(),
+            event_work: crate::profile::EventWork::default(),
             step_count: 0,
         })
     }
@@ -488,6 +493,7 @@ impl World {
             events: self.events.clone(),
             step_profile: self.step_profile.clone(),
             counters: self.counters,
+            event_work: self.event_work,
             step_count: self.step_count,
         }
     }

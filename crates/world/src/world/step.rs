@@ -98,6 +98,7 @@ impl World {
     /// pool of more than one thread; serial otherwise).
     fn step_on(&mut self, dt: Real, team: &janus2d_core::parallel::Team) {
         let mut ctx = self.step_context(dt);
+        let mut event_work = crate::profile::EventWork::default();
         let start = std::time::Instant::now();
         let mut t = start;
         let mut lap = || {
@@ -226,12 +227,13 @@ impl World {
             );
             if self.collision.has_hit_events() {
                 let (solver, threshold) = (&self.contact_solver, self.hit_event_threshold);
-                self.collision
+                event_work.hit_points_read = self
+                    .collision
                     .collect_hits(|hit| solver.for_each_approach(threshold, hit));
             }
             // Only when some shape has a finite force threshold.
             if self.collision.has_force_events() {
-                self.collision.collect_forces(dt);
+                event_work.force_contacts_read = self.collision.collect_forces(dt);
             }
             let both = lap();
             sp.continuous += continuous_time;
@@ -252,6 +254,7 @@ impl World {
         }
         // The bodies that moved: the awake ones before the sleep stage.
         let mut moves = if self.move_events {
+            event_work.move_bodies_read = self.bodies.sims.len().saturating_sub(1);
             self.gather_moves()
         } else {
             Vec::new()
@@ -284,6 +287,7 @@ impl World {
             continuous: self.continuous.counters(),
         });
         self.step_profile = sp;
+        self.event_work = event_work;
         for m in &mut moves {
             m.fell_asleep = self.bodies.is_sleeping(m.body);
         }
