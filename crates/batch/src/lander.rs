@@ -27,10 +27,11 @@
 //! ```
 
 use crate::BatchError;
-use crate::crew::{Crew, Task};
+use crate::crew::{Crew, Job};
 use janus2d::base::math::to_f64;
 use janus2d::{BodyDef, BodyHandle, Polygon, Real, RevoluteJointDef, Segment, ShapeDef, Vec2};
 use janus2d::{World, WorldDef, WorldError};
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 /// Steps per second (the step is `1 / FPS` s).
 pub const FPS: f64 = 50.0;
@@ -105,6 +106,19 @@ pub struct LanderConfig {
     /// returned), as a Gymnasium vector environment's next-step autoreset.
     /// Off, it keeps stepping until [`LanderBatch::reset_all`].
     pub autoreset: bool,
+    /// Gymnasium's wind: while neither leg touches the ground, a
+    /// sideways force of `wind_power · tanh(sin(0.02 t) + sin(0.01 π t))`
+    /// N and a torque of `turbulence_power` times the same function of
+    /// another count (N·m) act on the hull, each count starting at a
+    /// random integer in `[-9999, 9999)` drawn at the reset and going up
+    /// by one a step. Off by default.
+    pub enable_wind: bool,
+    /// The wind's largest force, N (Gymnasium's default 15, recommended
+    /// range 0 to 20).
+    pub wind_power: f64,
+    /// The turbulence's largest torque, N·m (Gymnasium's default 1.5,
+    /// recommended range 0 to 2).
+    pub turbulence_power: f64,
 }
 
 impl Default for LanderConfig {
@@ -116,6 +130,9 @@ impl Default for LanderConfig {
             dispersion: true,
             max_episode_steps: 0,
             autoreset: false,
+            enable_wind: false,
+            wind_power: 15.0,
+            turbulence_power: 1.5,
         }
     }
 }
@@ -137,6 +154,12 @@ impl LanderConfig {
             return Err(BatchError::Config(format!(
                 "gravity {}: between -12 and 0 (exclusive)",
                 self.gravity
+            )));
+        }
+        if !(self.wind_power.is_finite() && self.turbulence_power.is_finite()) {
+            return Err(BatchError::Config(format!(
+                "wind_power {} and turbulence_power {} must be finite",
+                self.wind_power, self.turbulence_power
             )));
         }
         if self.portal && !cfg!(feature = "portals") {
@@ -464,6 +487,9 @@ pub struct LanderEnv {
     needs_reset: bool,
     portal_crossings: u32,
     last: LanderOutcome,
+    /// The wind's and the turbulence's step counts (with `enable_wind`).
+    wind_idx: i64,
+    torque_idx: i64,
 }
 
 impl std::fmt::Debug for LanderEnv {
@@ -474,6 +500,13 @@ impl std::fmt::Debug for LanderEnv {
             .field("last", &self.last)
             .finish()
     }
+}
+
+/// Gymnasium's wind function of a step count, between −1 and 1:
+/// `tanh(sin(2 k t) + sin(π k t))`, `k = 0.01` (never periodic).
+fn gust(t: i64) -> f64 {
+    let t = t as f64;
+    ((0.02 * t).sin() + (std::f64::consts::PI * 0.01 * t).sin()).tanh()
 }
 
 /// Gymnasium's potential: distance to the pad, speed and tilt cost, 10
@@ -502,6 +535,8 @@ impl LanderEnv {
             needs_reset: false,
             portal_crossings: 0,
             last: LanderOutcome::default(),
+            wind_idx: 0,
+            torque_idx: 0,
         };
         env.start(config, push)?;
         Ok(env)
@@ -553,6 +588,13 @@ impl LanderEnv {
     }
 
     fn start(&mut self, config: &LanderConfig, push: [f64; 2]) -> Result<(), WorldError> {
+        if config.enable_wind {
+            // Gymnasium draws the counts after the push, with the reset.
+            self.wind_idx = self.rng.uniform(-9999.0, 9999.0).floor() as i64;
+            self.torque_idx = self.rng.uniform(-9999.0, 9999.0).floor() as i64;
+        }
+        // No leg is down before the first step (the wind blows in it).
+        self.last = LanderOutcome::default();
         let f = v2(push[0], push[1]);
         if f != Vec2::ZERO {
             self.world.apply_force_to_center(self.bodies.hull, f)?;
@@ -610,6 +652,15 @@ impl LanderEnv {
         fresh: bool,
     ) -> Result<(), WorldError> {
         let hull = self.bodies.hull;
+        let legs_down = self.last.observation[6] > 0.0 || self.last.observation[7] > 0.0;
+        if config.enable_wind && !legs_down {
+            let wind = gust(self.wind_idx) * config.wind_power;
+            self.wind_idx += 1;
+            self.world.apply_force_to_center(hull, v2(wind, 0.0))?;
+            let torque = gust(self.torque_idx) * config.turbulence_power;
+            self.torque_idx += 1;
+            self.world.apply_torque(hull, torque as Real)?;
+        }
         let (m_power, side_dir, s_power) = action.throttles();
         let (j0, j1) = {
             let a = self.rng.uniform(-1.0, 1.0) / PX;
@@ -728,19 +779,27 @@ impl LanderEnv {
 
 /// N landers stepped together: one call steps every lander (its action,
 /// the world's step, its observation and reward). On one thread the
-/// landers step on the calling thread; on `t` threads they are cut into
-/// `t` contiguous runs, the caller steps the first and `t − 1` helper
-/// threads of the batch's own crew the others (see the `crew` module:
-/// a few microseconds of hand-off per call, where a rayon pool's was some
-/// 50 µs on the 2-core machine here).
+/// landers step on the calling thread; on `t` threads the caller and
+/// `t − 1` helper threads of the batch's own crew share them (see the
+/// `crew` module: a few microseconds of hand-off per call, where a rayon
+/// pool's was some 50 µs on the 2-core machine here).
+///
+/// The landers are kept in chunks, some 16 per thread. Each thread has a
+/// home run of contiguous chunks, the same from call to call (its landers
+/// stay in its core's cache), and steps them in order; a thread done with
+/// its run takes chunks from the end of the run with the most left (a
+/// lander that resets, or one in contact with the ground, costs more
+/// than one in flight). A lander's step never depends on which thread
+/// takes it, so every trajectory is the same on any thread count.
 pub struct LanderBatch {
     config: LanderConfig,
-    /// The landers in runs, one per thread, in order.
-    runs: Vec<Vec<LanderEnv>>,
-    /// Landers per run (the last may hold fewer).
-    run_len: usize,
+    /// The landers in chunks of `chunk_len` (the last may hold fewer), in
+    /// order.
+    chunks: Vec<Vec<LanderEnv>>,
+    /// Landers per chunk.
+    chunk_len: usize,
     count: usize,
-    crew: Option<Crew<LanderEnv>>,
+    crew: Option<Crew>,
     threads: usize,
 }
 
@@ -754,54 +813,103 @@ impl std::fmt::Debug for LanderBatch {
     }
 }
 
-/// The operation of one call, for every lander of a run.
-#[derive(Clone)]
+/// Chunks of landers per thread: enough that a thread done early finds
+/// work left, few enough that claiming one (a lock) costs nothing beside
+/// a lander's step (about 5 µs).
+const CHUNKS_PER_THREAD: usize = 16;
+
+/// The operation of one call, for every lander.
 enum Op {
     Step(OwnedActions),
     Reseed(u64),
 }
 
-#[derive(Clone)]
 enum OwnedActions {
     Discrete(Vec<i64>),
     Continuous(Vec<f64>),
 }
 
-impl Op {
-    /// The part of the operation for landers `from..to`.
-    fn part(&self, from: usize, to: usize) -> Op {
-        match self {
-            Op::Step(OwnedActions::Discrete(a)) => {
-                Op::Step(OwnedActions::Discrete(a[from..to].to_vec()))
-            }
-            Op::Step(OwnedActions::Continuous(a)) => {
-                Op::Step(OwnedActions::Continuous(a[2 * from..2 * to].to_vec()))
-            }
-            Op::Reseed(seed) => Op::Reseed(*seed),
-        }
-    }
+/// A lander's error, with its index in the batch.
+type Failure = Option<(usize, WorldError)>;
 
+/// Keeps the lowest-index error of `first` and `next`.
+fn keep_first(first: &mut Failure, next: Failure) {
+    if let Some((i, error)) = next
+        && first.as_ref().is_none_or(|(j, _)| i < *j)
+    {
+        *first = Some((i, error));
+    }
+}
+
+impl Op {
     /// Applies the operation to a run whose first lander is lander
-    /// `offset` of the batch (its part of the actions starts at 0).
-    fn apply(
-        &self,
-        config: &LanderConfig,
-        offset: usize,
-        run: &mut [LanderEnv],
-    ) -> Option<(usize, WorldError)> {
+    /// `offset` of the batch; the first error stops the run.
+    fn apply(&self, config: &LanderConfig, offset: usize, run: &mut [LanderEnv]) -> Failure {
         for (k, env) in run.iter_mut().enumerate() {
+            let i = offset + k;
             let result = match self {
-                Op::Step(OwnedActions::Discrete(a)) => env.act(config, Action::Discrete(a[k])),
+                Op::Step(OwnedActions::Discrete(a)) => env.act(config, Action::Discrete(a[i])),
                 Op::Step(OwnedActions::Continuous(a)) => {
-                    env.act(config, Action::Continuous(a[2 * k], a[2 * k + 1]))
+                    env.act(config, Action::Continuous(a[2 * i], a[2 * i + 1]))
                 }
-                Op::Reseed(seed) => env.reseed(config, lander_seed(*seed, offset + k)),
+                Op::Reseed(seed) => env.reseed(config, lander_seed(*seed, i)),
             };
             if let Err(e) = result {
-                return Some((offset + k, e));
+                return Some((i, e));
             }
         }
         None
+    }
+}
+
+/// One call's work shared by the threads: the chunks (each claimed by one
+/// thread at a time) and what is left of each thread's home run.
+struct Board {
+    op: Op,
+    config: LanderConfig,
+    chunk_len: usize,
+    chunks: Vec<Mutex<Vec<LanderEnv>>>,
+    /// Each thread's unclaimed chunks, `start..end` of its home run.
+    left: Mutex<Vec<(usize, usize)>>,
+    failure: Mutex<Failure>,
+}
+
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+impl Board {
+    /// The next chunk for `worker`: the next of its home run, or else the
+    /// last of the run with the most chunks left.
+    fn claim(&self, worker: usize) -> Option<usize> {
+        let mut left = lock(&self.left);
+        let own = &mut left[worker];
+        if own.0 < own.1 {
+            own.0 += 1;
+            return Some(own.0 - 1);
+        }
+        let most = left.iter_mut().max_by_key(|(start, end)| *end - *start)?;
+        if most.0 < most.1 {
+            most.1 -= 1;
+            Some(most.1)
+        } else {
+            None
+        }
+    }
+
+    /// Steps chunks until none is left.
+    fn work(&self, worker: usize) {
+        while let Some(c) = self.claim(worker) {
+            // A chunk whose lock is poisoned (a panic in a lander's step)
+            // is not touched again: the batch counts it lost.
+            let Ok(mut run) = self.chunks[c].lock() else {
+                continue;
+            };
+            let failure = self.op.apply(&self.config, c * self.chunk_len, &mut run);
+            if failure.is_some() {
+                keep_first(&mut lock(&self.failure), failure);
+            }
+        }
     }
 }
 
@@ -827,8 +935,8 @@ impl LanderBatch {
         }
         let mut batch = LanderBatch {
             config,
-            runs: vec![envs],
-            run_len: count,
+            chunks: vec![envs],
+            chunk_len: count,
             count,
             crew: None,
             threads: 1,
@@ -875,25 +983,31 @@ impl LanderBatch {
         } else {
             None
         };
-        let all: Vec<LanderEnv> = self.runs.drain(..).flatten().collect();
-        self.run_len = self.count.div_ceil(threads);
-        let mut rest = all.into_iter();
-        self.runs = (0..threads)
-            .map(|_| rest.by_ref().take(self.run_len).collect())
-            .collect();
+        let all: Vec<LanderEnv> = self.chunks.drain(..).flatten().collect();
+        self.chunk_len = if threads == 1 {
+            self.count
+        } else {
+            self.count.div_ceil(threads * CHUNKS_PER_THREAD)
+        };
+        let mut rest = all.into_iter().peekable();
+        while rest.peek().is_some() {
+            self.chunks
+                .push(rest.by_ref().take(self.chunk_len).collect());
+        }
         self.crew = crew;
         self.threads = threads;
         Ok(())
     }
 
-    /// A helper's panic loses its run of landers: refuse to go on.
+    /// A panic in a lander's step loses its chunk of landers: refuse to
+    /// go on.
     fn check_whole(&self) -> Result<(), BatchError> {
-        let held: usize = self.runs.iter().map(Vec::len).sum();
+        let held: usize = self.chunks.iter().map(Vec::len).sum();
         if held == self.count {
             Ok(())
         } else {
             Err(BatchError::Threads(
-                "a helper thread panicked and its landers are lost".into(),
+                "a lander's step panicked and its chunk of landers is lost".into(),
             ))
         }
     }
@@ -901,9 +1015,9 @@ impl LanderBatch {
     /// Lander `index`.
     pub fn env(&self, index: usize) -> Result<&LanderEnv, BatchError> {
         let len = self.count;
-        self.runs
-            .get(index / self.run_len)
-            .and_then(|run| run.get(index % self.run_len))
+        self.chunks
+            .get(index / self.chunk_len)
+            .and_then(|chunk| chunk.get(index % self.chunk_len))
             .ok_or(BatchError::WorldIndex { index, len })
     }
 
@@ -914,7 +1028,7 @@ impl LanderBatch {
 
     /// Every lander's last outcome, in order.
     pub fn outcomes(&self) -> impl Iterator<Item = LanderOutcome> + '_ {
-        self.runs.iter().flatten().map(LanderEnv::last)
+        self.chunks.iter().flatten().map(LanderEnv::last)
     }
 
     /// Reseeds every lander from `seed` (lander `i` gets its own stream)
@@ -933,11 +1047,11 @@ impl LanderBatch {
         push: [f64; 2],
     ) -> Result<(), BatchError> {
         let len = self.count;
-        let run_len = self.run_len;
+        let chunk_len = self.chunk_len;
         let env = self
-            .runs
-            .get_mut(index / run_len)
-            .and_then(|run| run.get_mut(index % run_len))
+            .chunks
+            .get_mut(index / chunk_len)
+            .and_then(|chunk| chunk.get_mut(index % chunk_len))
             .ok_or(BatchError::WorldIndex { index, len })?;
         env.reset_with(&self.config, draws, push)
             .map_err(|error| BatchError::World { index, error })
@@ -988,54 +1102,52 @@ impl LanderBatch {
         self.run(Op::Step(owned))
     }
 
-    /// Runs `op` on every lander: the helpers take runs 1.., the caller
-    /// run 0; the error is the lowest-index lander's.
+    /// Runs `op` on every lander, on the calling thread alone or shared
+    /// with the crew; the error is the lowest-index lander's.
     fn run(&mut self, op: Op) -> Result<(), BatchError> {
         self.check_whole()?;
-        let mut first: Option<(usize, WorldError)> = None;
-        let mut keep = |e: Option<(usize, WorldError)>| {
-            if let Some((i, error)) = e
-                && first.as_ref().is_none_or(|(j, _)| i < *j)
-            {
-                first = Some((i, error));
-            }
-        };
+        let mut first: Failure = None;
         match &self.crew {
             None => {
-                for (r, run) in self.runs.iter_mut().enumerate() {
-                    keep(op.apply(&self.config, r * self.run_len, run));
+                for (c, chunk) in self.chunks.iter_mut().enumerate() {
+                    let failure = op.apply(&self.config, c * self.chunk_len, chunk);
+                    keep_first(&mut first, failure);
                 }
             }
             Some(crew) => {
-                let mut posted = Vec::with_capacity(crew.len());
-                for k in 0..crew.len() {
-                    let run = std::mem::take(&mut self.runs[k + 1]);
-                    if run.is_empty() {
-                        continue;
-                    }
-                    let offset = (k + 1) * self.run_len;
-                    let part = op.part(offset, offset + run.len());
-                    let config = self.config.clone();
-                    let task: Task<LanderEnv> =
-                        Box::new(move |run: &mut [LanderEnv]| part.apply(&config, offset, run));
-                    crew.post(k, run, task);
-                    posted.push(k);
+                let workers = crew.len() + 1;
+                let count = self.chunks.len();
+                let board = Arc::new(Board {
+                    op,
+                    config: self.config.clone(),
+                    chunk_len: self.chunk_len,
+                    chunks: self.chunks.drain(..).map(Mutex::new).collect(),
+                    left: Mutex::new(
+                        (0..workers)
+                            .map(|w| (w * count / workers, (w + 1) * count / workers))
+                            .collect(),
+                    ),
+                    failure: Mutex::new(None),
+                });
+                let shared = Arc::clone(&board);
+                let job: Job = Arc::new(move |worker| shared.work(worker));
+                // A panic of the caller's own part unwinds from here once
+                // the helpers are done: the landers on the board are lost
+                // and the batch refuses further calls.
+                let helper_panic = crew.run(&job);
+                drop(job);
+                for chunk in &board.chunks {
+                    // A poisoned chunk (a step in it panicked) is lost:
+                    // an empty one keeps the others' places.
+                    self.chunks.push(match chunk.lock() {
+                        Ok(mut run) => std::mem::take(&mut *run),
+                        Err(_) => Vec::new(),
+                    });
                 }
-                let own = self.runs[0].len();
-                keep(op.part(0, own).apply(&self.config, 0, &mut self.runs[0]));
-                let mut panic = None;
-                for k in posted {
-                    match crew.collect(k) {
-                        Ok((run, e)) => {
-                            self.runs[k + 1] = run;
-                            keep(e);
-                        }
-                        Err(payload) => panic = panic.or(Some(payload)),
-                    }
-                }
-                if let Some(payload) = panic {
+                if let Err(payload) = helper_panic {
                     std::panic::resume_unwind(payload);
                 }
+                first = lock(&board.failure).take();
             }
         }
         match first {

@@ -3,7 +3,7 @@
 //! lander flown through the portal variant's portal.
 
 use super::*;
-use crate::crew::Crew;
+use crate::crew::{Crew, Job};
 use janus2d::base::math::to_f64;
 
 /// A fixed pseudo-random table of discrete actions, `steps × n`.
@@ -327,29 +327,146 @@ fn changing_threads_mid_run_and_more_threads_than_landers_change_nothing() {
 
 #[test]
 fn a_helpers_panic_reaches_the_caller_and_the_crew_stops_cleanly() {
-    let crew: Crew<u32> = Crew::new(2).unwrap();
-    crew.post(
-        0,
-        vec![1, 2],
-        Box::new(|v: &mut [u32]| {
-            v[0] += 10;
-            None
-        }),
-    );
-    crew.post(1, vec![3], Box::new(|_: &mut [u32]| panic!("helper fails")));
-    let (items, error) = crew.collect(0).unwrap();
-    assert_eq!(items, vec![11, 2]);
-    assert!(error.is_none());
-    assert!(crew.collect(1).is_err());
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let crew = Crew::new(2).unwrap();
+    // Every worker runs the job once, with its own number.
+    let seen = Arc::new(AtomicUsize::new(0));
+    let mine = Arc::clone(&seen);
+    let job: Job = Arc::new(move |w| {
+        mine.fetch_add(1 << (4 * w), Ordering::Relaxed);
+    });
+    crew.run(&job).unwrap();
+    assert_eq!(seen.load(Ordering::Relaxed), 0x111);
+    let failing: Job = Arc::new(|w| assert!(w != 2, "helper fails"));
+    assert!(crew.run(&failing).is_err());
     // The helper that panicked takes work again.
-    crew.post(
-        1,
-        vec![5],
-        Box::new(|v: &mut [u32]| {
-            v[0] *= 2;
-            None
-        }),
-    );
-    assert_eq!(crew.collect(1).unwrap().0, vec![10]);
+    crew.run(&job).unwrap();
+    assert_eq!(seen.load(Ordering::Relaxed), 0x222);
     drop(crew); // joins both helpers
+}
+
+#[test]
+fn a_panic_in_a_landers_step_loses_its_chunk_and_the_batch_refuses_to_go_on() {
+    let mut batch = LanderBatch::new(8, LanderConfig::vector(1000), 3, 2).unwrap();
+    batch.step(LanderActions::Discrete(&[0; 8])).unwrap();
+    let held: usize = batch.chunks.iter().map(Vec::len).sum();
+    assert_eq!(held, 8);
+    // A chunk taken out of the batch stands for one lost to a panic.
+    batch.chunks[1].clear();
+    assert!(matches!(
+        batch.step(LanderActions::Discrete(&[0; 8])),
+        Err(BatchError::Threads(_))
+    ));
+    assert!(batch.set_threads(1).is_err());
+}
+
+/// The hull's velocity after `steps` steps of doing nothing, for `config`
+/// (engine dispersion off), and the wind counts at the reset.
+fn calm_or_windy(config: &LanderConfig, steps: usize) -> (Vec2, i64, f64) {
+    let mut env = LanderEnv::new(config, 31).unwrap();
+    let start = env.wind_idx;
+    for _ in 0..steps {
+        env.act(config, Action::Discrete(0)).unwrap();
+    }
+    let w = env.world();
+    let hull = env.bodies().hull;
+    let mass: f64 = [hull, env.bodies().legs[0], env.bodies().legs[1]]
+        .iter()
+        .map(|&b| to_f64(w.mass(b).unwrap()))
+        .sum();
+    (w.linear_velocity(hull).unwrap(), start, mass)
+}
+
+#[test]
+fn the_wind_pushes_the_lander_sideways_by_gymnasiums_function() {
+    let calm = LanderConfig {
+        dispersion: false,
+        ..LanderConfig::default()
+    };
+    let windy = LanderConfig {
+        enable_wind: true,
+        turbulence_power: 0.0,
+        ..calm.clone()
+    };
+    // 20 steps: the lander is still high above the ground (no leg down).
+    let steps = 20;
+    let (v0, _, mass) = calm_or_windy(&calm, steps);
+    let (v1, start, _) = calm_or_windy(&windy, steps);
+    assert!((-9999..9999).contains(&start), "{start}");
+    // The reset's step blew too: steps + 1 gusts of 1/50 s each on the
+    // lander (hull and legs, joined).
+    let impulse: f64 = (0..=steps as i64)
+        .map(|k| gust(start + k) * windy.wind_power / FPS)
+        .sum();
+    let expected = impulse / mass;
+    let dvx = to_f64(v1.x - v0.x);
+    assert!(
+        expected.abs() > 0.05,
+        "a gust this small tests nothing: {expected}"
+    );
+    assert!(
+        (dvx - expected).abs() < 0.05 * expected.abs(),
+        "Δvx {dvx} m/s, expected {expected}"
+    );
+    // The wind is horizontal.
+    assert!(to_f64(v1.y - v0.y).abs() < 1e-3 * expected.abs().max(1.0));
+}
+
+#[test]
+fn turbulence_turns_the_lander_and_wind_off_changes_nothing() {
+    let run = |config: &LanderConfig| {
+        let mut batch = LanderBatch::new(4, config.clone(), 8, 1).unwrap();
+        for k in 0..120 {
+            batch
+                .step(LanderActions::Discrete(&[k % 4, 0, 2, (k + 1) % 4]))
+                .unwrap();
+        }
+        (0..4)
+            .map(|i| batch.env(i).unwrap().world().state_hash())
+            .collect::<Vec<_>>()
+    };
+    let default = run(&LanderConfig::default());
+    // Wind powers without enable_wind: the default bits.
+    let off = LanderConfig {
+        wind_power: 20.0,
+        turbulence_power: 2.0,
+        ..LanderConfig::default()
+    };
+    assert_eq!(run(&off), default);
+    let on = LanderConfig {
+        enable_wind: true,
+        ..LanderConfig::default()
+    };
+    let windy = run(&on);
+    assert!(windy.iter().zip(&default).all(|(a, b)| a != b));
+    // Turbulence alone (no sideways force) turns the hull.
+    let turn = |config: &LanderConfig| {
+        let mut env = LanderEnv::new(config, 12).unwrap();
+        for _ in 0..15 {
+            env.act(config, Action::Discrete(0)).unwrap();
+        }
+        to_f64(env.world().angular_velocity(env.bodies().hull).unwrap())
+    };
+    let still = LanderConfig {
+        dispersion: false,
+        ..LanderConfig::default()
+    };
+    let twisted = LanderConfig {
+        enable_wind: true,
+        wind_power: 0.0,
+        ..still.clone()
+    };
+    let w0 = turn(&still);
+    let w1 = turn(&twisted);
+    assert!((w1 - w0).abs() > 0.05, "ω {w0} calm, {w1} turbulent");
+    let bad = LanderConfig {
+        enable_wind: true,
+        wind_power: f64::NAN,
+        ..LanderConfig::default()
+    };
+    assert!(matches!(
+        LanderBatch::new(1, bad, 0, 1),
+        Err(BatchError::Config(_))
+    ));
 }

@@ -16,7 +16,7 @@ use pyo3::types::PyTuple;
 
 /// `LanderBatch(count, threads=1, continuous=False, gravity=-10.0,
 /// portal=False, dispersion=True, max_episode_steps=0, autoreset=False,
-/// seed=0)`: `count` landers with Gymnasium's LunarLander rules, each
+/// seed=0, enable_wind=False, wind_power=15.0, turbulence_power=1.5)`: `count` landers with Gymnasium's LunarLander rules, each
 /// step of every lander done in Rust. `step` takes the actions of all
 /// landers and returns `(obs, reward, terminated, truncated)` arrays;
 /// with `autoreset`, a lander whose episode ended is reset by its next
@@ -89,7 +89,8 @@ impl PyLanderBatch {
 impl PyLanderBatch {
     #[new]
     #[pyo3(signature = (count, threads = 1, continuous = false, gravity = -10.0,
-        portal = false, dispersion = true, max_episode_steps = 0, autoreset = false, seed = 0))]
+        portal = false, dispersion = true, max_episode_steps = 0, autoreset = false, seed = 0,
+        enable_wind = false, wind_power = 15.0, turbulence_power = 1.5))]
     fn py_new(
         py: Python<'_>,
         count: usize,
@@ -101,6 +102,9 @@ impl PyLanderBatch {
         max_episode_steps: u32,
         autoreset: bool,
         seed: u64,
+        enable_wind: bool,
+        wind_power: f64,
+        turbulence_power: f64,
     ) -> PyResult<Self> {
         let config = LanderConfig {
             continuous,
@@ -109,6 +113,9 @@ impl PyLanderBatch {
             dispersion,
             max_episode_steps,
             autoreset,
+            enable_wind,
+            wind_power,
+            turbulence_power,
         };
         let batch = py
             .detach(|| LanderBatch::new(count, config, seed, threads))
