@@ -8,9 +8,7 @@ use crate::handles::Body;
 use crate::world::PyWorld;
 use janus2d_batch::BatchError;
 use janus2d_batch::lander::{LanderActions, LanderBatch, LanderConfig, OBS_WIDTH, TERRAIN_DRAWS};
-use numpy::{
-    AllowTypeChange, PyArray1, PyArray2, PyArrayLikeDyn, PyArrayMethods, PyReadonlyArrayDyn,
-};
+use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLikeDyn, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
@@ -75,13 +73,20 @@ impl Owned {
     }
 }
 
+/// `(n, 8)` observations from their values in order, without a copy.
+fn obs_array(py: Python<'_>, obs: Vec<f32>, n: usize) -> PyResult<Bound<'_, PyArray2<f32>>> {
+    let array = numpy::ndarray::Array2::from_shape_vec((n, OBS_WIDTH), obs)
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+    Ok(PyArray2::from_owned_array(py, array))
+}
+
 impl PyLanderBatch {
     fn observations<'py>(
         py: Python<'py>,
         batch: &LanderBatch,
     ) -> PyResult<Bound<'py, PyArray2<f32>>> {
         let obs: Vec<f32> = batch.outcomes().flat_map(|o| o.observation).collect();
-        PyArray1::from_vec(py, obs).reshape([batch.len(), OBS_WIDTH])
+        obs_array(py, obs, batch.len())
     }
 }
 
@@ -206,7 +211,7 @@ impl PyLanderBatch {
             terminated.push(o.terminated);
             truncated.push(o.truncated);
         }
-        let obs = PyArray1::from_vec(py, obs).reshape([n, OBS_WIDTH])?;
+        let obs = obs_array(py, obs, n)?;
         PyTuple::new(
             py,
             [
