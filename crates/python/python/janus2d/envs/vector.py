@@ -1,5 +1,5 @@
 """A vector LunarLander over one :class:`janus2d.LanderBatch`: N landers
-stepped in one Rust call on rayon threads (engines, world steps,
+stepped in one Rust call on the batch's threads (engines, world steps,
 observations, rewards, autoresets), the GIL released, the results as
 arrays.
 
