@@ -27,11 +27,10 @@
 //! ```
 
 use crate::BatchError;
-use crate::crew::{Crew, Job};
+use crate::crew::{Crew, Task};
 use janus2d::base::math::to_f64;
 use janus2d::{BodyDef, BodyHandle, Polygon, Real, RevoluteJointDef, Segment, ShapeDef, Vec2};
 use janus2d::{World, WorldDef, WorldError};
-use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 /// Steps per second (the step is `1 / FPS` s).
 pub const FPS: f64 = 50.0;
@@ -779,27 +778,19 @@ impl LanderEnv {
 
 /// N landers stepped together: one call steps every lander (its action,
 /// the world's step, its observation and reward). On one thread the
-/// landers step on the calling thread; on `t` threads the caller and
-/// `t − 1` helper threads of the batch's own crew share them (see the
-/// `crew` module: a few microseconds of hand-off per call, where a rayon
-/// pool's was some 50 µs on the 2-core machine here).
-///
-/// The landers are kept in chunks, some 16 per thread. Each thread has a
-/// home run of contiguous chunks, the same from call to call (its landers
-/// stay in its core's cache), and steps them in order; a thread done with
-/// its run takes chunks from the end of the run with the most left (a
-/// lander that resets, or one in contact with the ground, costs more
-/// than one in flight). A lander's step never depends on which thread
-/// takes it, so every trajectory is the same on any thread count.
+/// landers step on the calling thread; on `t` threads they are cut into
+/// `t` contiguous runs, the caller steps the first and `t − 1` helper
+/// threads of the batch's own crew the others (see the `crew` module:
+/// a few microseconds of hand-off per call, where a rayon pool's was some
+/// 50 µs on the 2-core machine here).
 pub struct LanderBatch {
     config: LanderConfig,
-    /// The landers in chunks of `chunk_len` (the last may hold fewer), in
-    /// order.
-    chunks: Vec<Vec<LanderEnv>>,
-    /// Landers per chunk.
-    chunk_len: usize,
+    /// The landers in runs, one per thread, in order.
+    runs: Vec<Vec<LanderEnv>>,
+    /// Landers per run (the last may hold fewer).
+    run_len: usize,
     count: usize,
-    crew: Option<Crew>,
+    crew: Option<Crew<LanderEnv>>,
     threads: usize,
 }
 
@@ -813,103 +804,54 @@ impl std::fmt::Debug for LanderBatch {
     }
 }
 
-/// Chunks of landers per thread: enough that a thread done early finds
-/// work left, few enough that claiming one (a lock) costs nothing beside
-/// a lander's step (about 5 µs).
-const CHUNKS_PER_THREAD: usize = 16;
-
-/// The operation of one call, for every lander.
+/// The operation of one call, for every lander of a run.
+#[derive(Clone)]
 enum Op {
     Step(OwnedActions),
     Reseed(u64),
 }
 
+#[derive(Clone)]
 enum OwnedActions {
     Discrete(Vec<i64>),
     Continuous(Vec<f64>),
 }
 
-/// A lander's error, with its index in the batch.
-type Failure = Option<(usize, WorldError)>;
-
-/// Keeps the lowest-index error of `first` and `next`.
-fn keep_first(first: &mut Failure, next: Failure) {
-    if let Some((i, error)) = next
-        && first.as_ref().is_none_or(|(j, _)| i < *j)
-    {
-        *first = Some((i, error));
-    }
-}
-
 impl Op {
+    /// The part of the operation for landers `from..to`.
+    fn part(&self, from: usize, to: usize) -> Op {
+        match self {
+            Op::Step(OwnedActions::Discrete(a)) => {
+                Op::Step(OwnedActions::Discrete(a[from..to].to_vec()))
+            }
+            Op::Step(OwnedActions::Continuous(a)) => {
+                Op::Step(OwnedActions::Continuous(a[2 * from..2 * to].to_vec()))
+            }
+            Op::Reseed(seed) => Op::Reseed(*seed),
+        }
+    }
+
     /// Applies the operation to a run whose first lander is lander
-    /// `offset` of the batch; the first error stops the run.
-    fn apply(&self, config: &LanderConfig, offset: usize, run: &mut [LanderEnv]) -> Failure {
+    /// `offset` of the batch (its part of the actions starts at 0).
+    fn apply(
+        &self,
+        config: &LanderConfig,
+        offset: usize,
+        run: &mut [LanderEnv],
+    ) -> Option<(usize, WorldError)> {
         for (k, env) in run.iter_mut().enumerate() {
-            let i = offset + k;
             let result = match self {
-                Op::Step(OwnedActions::Discrete(a)) => env.act(config, Action::Discrete(a[i])),
+                Op::Step(OwnedActions::Discrete(a)) => env.act(config, Action::Discrete(a[k])),
                 Op::Step(OwnedActions::Continuous(a)) => {
-                    env.act(config, Action::Continuous(a[2 * i], a[2 * i + 1]))
+                    env.act(config, Action::Continuous(a[2 * k], a[2 * k + 1]))
                 }
-                Op::Reseed(seed) => env.reseed(config, lander_seed(*seed, i)),
+                Op::Reseed(seed) => env.reseed(config, lander_seed(*seed, offset + k)),
             };
             if let Err(e) = result {
-                return Some((i, e));
+                return Some((offset + k, e));
             }
         }
         None
-    }
-}
-
-/// One call's work shared by the threads: the chunks (each claimed by one
-/// thread at a time) and what is left of each thread's home run.
-struct Board {
-    op: Op,
-    config: LanderConfig,
-    chunk_len: usize,
-    chunks: Vec<Mutex<Vec<LanderEnv>>>,
-    /// Each thread's unclaimed chunks, `start..end` of its home run.
-    left: Mutex<Vec<(usize, usize)>>,
-    failure: Mutex<Failure>,
-}
-
-fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
-    m.lock().unwrap_or_else(PoisonError::into_inner)
-}
-
-impl Board {
-    /// The next chunk for `worker`: the next of its home run, or else the
-    /// last of the run with the most chunks left.
-    fn claim(&self, worker: usize) -> Option<usize> {
-        let mut left = lock(&self.left);
-        let own = &mut left[worker];
-        if own.0 < own.1 {
-            own.0 += 1;
-            return Some(own.0 - 1);
-        }
-        let most = left.iter_mut().max_by_key(|(start, end)| *end - *start)?;
-        if most.0 < most.1 {
-            most.1 -= 1;
-            Some(most.1)
-        } else {
-            None
-        }
-    }
-
-    /// Steps chunks until none is left.
-    fn work(&self, worker: usize) {
-        while let Some(c) = self.claim(worker) {
-            // A chunk whose lock is poisoned (a panic in a lander's step)
-            // is not touched again: the batch counts it lost.
-            let Ok(mut run) = self.chunks[c].lock() else {
-                continue;
-            };
-            let failure = self.op.apply(&self.config, c * self.chunk_len, &mut run);
-            if failure.is_some() {
-                keep_first(&mut lock(&self.failure), failure);
-            }
-        }
     }
 }
 
@@ -935,8 +877,8 @@ impl LanderBatch {
         }
         let mut batch = LanderBatch {
             config,
-            chunks: vec![envs],
-            chunk_len: count,
+            runs: vec![envs],
+            run_len: count,
             count,
             crew: None,
             threads: 1,
@@ -983,31 +925,25 @@ impl LanderBatch {
         } else {
             None
         };
-        let all: Vec<LanderEnv> = self.chunks.drain(..).flatten().collect();
-        self.chunk_len = if threads == 1 {
-            self.count
-        } else {
-            self.count.div_ceil(threads * CHUNKS_PER_THREAD)
-        };
-        let mut rest = all.into_iter().peekable();
-        while rest.peek().is_some() {
-            self.chunks
-                .push(rest.by_ref().take(self.chunk_len).collect());
-        }
+        let all: Vec<LanderEnv> = self.runs.drain(..).flatten().collect();
+        self.run_len = self.count.div_ceil(threads);
+        let mut rest = all.into_iter();
+        self.runs = (0..threads)
+            .map(|_| rest.by_ref().take(self.run_len).collect())
+            .collect();
         self.crew = crew;
         self.threads = threads;
         Ok(())
     }
 
-    /// A panic in a lander's step loses its chunk of landers: refuse to
-    /// go on.
+    /// A helper's panic loses its run of landers: refuse to go on.
     fn check_whole(&self) -> Result<(), BatchError> {
-        let held: usize = self.chunks.iter().map(Vec::len).sum();
+        let held: usize = self.runs.iter().map(Vec::len).sum();
         if held == self.count {
             Ok(())
         } else {
             Err(BatchError::Threads(
-                "a lander's step panicked and its chunk of landers is lost".into(),
+                "a helper thread panicked and its landers are lost".into(),
             ))
         }
     }
@@ -1015,9 +951,9 @@ impl LanderBatch {
     /// Lander `index`.
     pub fn env(&self, index: usize) -> Result<&LanderEnv, BatchError> {
         let len = self.count;
-        self.chunks
-            .get(index / self.chunk_len)
-            .and_then(|chunk| chunk.get(index % self.chunk_len))
+        self.runs
+            .get(index / self.run_len)
+            .and_then(|run| run.get(index % self.run_len))
             .ok_or(BatchError::WorldIndex { index, len })
     }
 
@@ -1028,7 +964,7 @@ impl LanderBatch {
 
     /// Every lander's last outcome, in order.
     pub fn outcomes(&self) -> impl Iterator<Item = LanderOutcome> + '_ {
-        self.chunks.iter().flatten().map(LanderEnv::last)
+        self.runs.iter().flatten().map(LanderEnv::last)
     }
 
     /// Reseeds every lander from `seed` (lander `i` gets its own stream)
@@ -1047,11 +983,11 @@ impl LanderBatch {
         push: [f64; 2],
     ) -> Result<(), BatchError> {
         let len = self.count;
-        let chunk_len = self.chunk_len;
+        let run_len = self.run_len;
         let env = self
-            .chunks
-            .get_mut(index / chunk_len)
-            .and_then(|chunk| chunk.get_mut(index % chunk_len))
+            .runs
+            .get_mut(index / run_len)
+            .and_then(|run| run.get_mut(index % run_len))
             .ok_or(BatchError::WorldIndex { index, len })?;
         env.reset_with(&self.config, draws, push)
             .map_err(|error| BatchError::World { index, error })
@@ -1102,52 +1038,54 @@ impl LanderBatch {
         self.run(Op::Step(owned))
     }
 
-    /// Runs `op` on every lander, on the calling thread alone or shared
-    /// with the crew; the error is the lowest-index lander's.
+    /// Runs `op` on every lander: the helpers take runs 1.., the caller
+    /// run 0; the error is the lowest-index lander's.
     fn run(&mut self, op: Op) -> Result<(), BatchError> {
         self.check_whole()?;
-        let mut first: Failure = None;
+        let mut first: Option<(usize, WorldError)> = None;
+        let mut keep = |e: Option<(usize, WorldError)>| {
+            if let Some((i, error)) = e
+                && first.as_ref().is_none_or(|(j, _)| i < *j)
+            {
+                first = Some((i, error));
+            }
+        };
         match &self.crew {
             None => {
-                for (c, chunk) in self.chunks.iter_mut().enumerate() {
-                    let failure = op.apply(&self.config, c * self.chunk_len, chunk);
-                    keep_first(&mut first, failure);
+                for (r, run) in self.runs.iter_mut().enumerate() {
+                    keep(op.apply(&self.config, r * self.run_len, run));
                 }
             }
             Some(crew) => {
-                let workers = crew.len() + 1;
-                let count = self.chunks.len();
-                let board = Arc::new(Board {
-                    op,
-                    config: self.config.clone(),
-                    chunk_len: self.chunk_len,
-                    chunks: self.chunks.drain(..).map(Mutex::new).collect(),
-                    left: Mutex::new(
-                        (0..workers)
-                            .map(|w| (w * count / workers, (w + 1) * count / workers))
-                            .collect(),
-                    ),
-                    failure: Mutex::new(None),
-                });
-                let shared = Arc::clone(&board);
-                let job: Job = Arc::new(move |worker| shared.work(worker));
-                // A panic of the caller's own part unwinds from here once
-                // the helpers are done: the landers on the board are lost
-                // and the batch refuses further calls.
-                let helper_panic = crew.run(&job);
-                drop(job);
-                for chunk in &board.chunks {
-                    // A poisoned chunk (a step in it panicked) is lost:
-                    // an empty one keeps the others' places.
-                    self.chunks.push(match chunk.lock() {
-                        Ok(mut run) => std::mem::take(&mut *run),
-                        Err(_) => Vec::new(),
-                    });
+                let mut posted = Vec::with_capacity(crew.len());
+                for k in 0..crew.len() {
+                    let run = std::mem::take(&mut self.runs[k + 1]);
+                    if run.is_empty() {
+                        continue;
+                    }
+                    let offset = (k + 1) * self.run_len;
+                    let part = op.part(offset, offset + run.len());
+                    let config = self.config.clone();
+                    let task: Task<LanderEnv> =
+                        Box::new(move |run: &mut [LanderEnv]| part.apply(&config, offset, run));
+                    crew.post(k, run, task);
+                    posted.push(k);
                 }
-                if let Err(payload) = helper_panic {
+                let own = self.runs[0].len();
+                keep(op.part(0, own).apply(&self.config, 0, &mut self.runs[0]));
+                let mut panic = None;
+                for k in posted {
+                    match crew.collect(k) {
+                        Ok((run, e)) => {
+                            self.runs[k + 1] = run;
+                            keep(e);
+                        }
+                        Err(payload) => panic = panic.or(Some(payload)),
+                    }
+                }
+                if let Some(payload) = panic {
                     std::panic::resume_unwind(payload);
                 }
-                first = lock(&board.failure).take();
             }
         }
         match first {

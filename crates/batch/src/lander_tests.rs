@@ -3,7 +3,7 @@
 //! lander flown through the portal variant's portal.
 
 use super::*;
-use crate::crew::{Crew, Job};
+use crate::crew::Crew;
 use janus2d::base::math::to_f64;
 
 /// A fixed pseudo-random table of discrete actions, `steps × n`.
@@ -327,33 +327,41 @@ fn changing_threads_mid_run_and_more_threads_than_landers_change_nothing() {
 
 #[test]
 fn a_helpers_panic_reaches_the_caller_and_the_crew_stops_cleanly() {
-    use std::sync::Arc;
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    let crew = Crew::new(2).unwrap();
-    // Every worker runs the job once, with its own number.
-    let seen = Arc::new(AtomicUsize::new(0));
-    let mine = Arc::clone(&seen);
-    let job: Job = Arc::new(move |w| {
-        mine.fetch_add(1 << (4 * w), Ordering::Relaxed);
-    });
-    crew.run(&job).unwrap();
-    assert_eq!(seen.load(Ordering::Relaxed), 0x111);
-    let failing: Job = Arc::new(|w| assert!(w != 2, "helper fails"));
-    assert!(crew.run(&failing).is_err());
+    let crew: Crew<u32> = Crew::new(2).unwrap();
+    crew.post(
+        0,
+        vec![1, 2],
+        Box::new(|v: &mut [u32]| {
+            v[0] += 10;
+            None
+        }),
+    );
+    crew.post(1, vec![3], Box::new(|_: &mut [u32]| panic!("helper fails")));
+    let (items, error) = crew.collect(0).unwrap();
+    assert_eq!(items, vec![11, 2]);
+    assert!(error.is_none());
+    assert!(crew.collect(1).is_err());
     // The helper that panicked takes work again.
-    crew.run(&job).unwrap();
-    assert_eq!(seen.load(Ordering::Relaxed), 0x222);
+    crew.post(
+        1,
+        vec![5],
+        Box::new(|v: &mut [u32]| {
+            v[0] *= 2;
+            None
+        }),
+    );
+    assert_eq!(crew.collect(1).unwrap().0, vec![10]);
     drop(crew); // joins both helpers
 }
 
 #[test]
-fn a_panic_in_a_landers_step_loses_its_chunk_and_the_batch_refuses_to_go_on() {
+fn a_lost_run_of_landers_makes_the_batch_refuse_to_go_on() {
     let mut batch = LanderBatch::new(8, LanderConfig::vector(1000), 3, 2).unwrap();
     batch.step(LanderActions::Discrete(&[0; 8])).unwrap();
-    let held: usize = batch.chunks.iter().map(Vec::len).sum();
+    let held: usize = batch.runs.iter().map(Vec::len).sum();
     assert_eq!(held, 8);
-    // A chunk taken out of the batch stands for one lost to a panic.
-    batch.chunks[1].clear();
+    // A run emptied stands for one lost to a helper's panic.
+    batch.runs[1].clear();
     assert!(matches!(
         batch.step(LanderActions::Discrete(&[0; 8])),
         Err(BatchError::Threads(_))
