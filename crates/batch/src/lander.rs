@@ -105,6 +105,19 @@ pub struct LanderConfig {
     /// returned), as a Gymnasium vector environment's next-step autoreset.
     /// Off, it keeps stepping until [`LanderBatch::reset_all`].
     pub autoreset: bool,
+    /// Gymnasium's wind: while neither leg touches the ground, a
+    /// sideways force of `wind_power · tanh(sin(0.02 t) + sin(0.01 π t))`
+    /// N and a torque of `turbulence_power` times the same function of
+    /// another count (N·m) act on the hull, each count starting at a
+    /// random integer in `[-9999, 9999)` drawn at the reset and going up
+    /// by one a step. Off by default.
+    pub enable_wind: bool,
+    /// The wind's largest force, N (Gymnasium's default 15, recommended
+    /// range 0 to 20).
+    pub wind_power: f64,
+    /// The turbulence's largest torque, N·m (Gymnasium's default 1.5,
+    /// recommended range 0 to 2).
+    pub turbulence_power: f64,
 }
 
 impl Default for LanderConfig {
@@ -116,6 +129,9 @@ impl Default for LanderConfig {
             dispersion: true,
             max_episode_steps: 0,
             autoreset: false,
+            enable_wind: false,
+            wind_power: 15.0,
+            turbulence_power: 1.5,
         }
     }
 }
@@ -137,6 +153,12 @@ impl LanderConfig {
             return Err(BatchError::Config(format!(
                 "gravity {}: between -12 and 0 (exclusive)",
                 self.gravity
+            )));
+        }
+        if !(self.wind_power.is_finite() && self.turbulence_power.is_finite()) {
+            return Err(BatchError::Config(format!(
+                "wind_power {} and turbulence_power {} must be finite",
+                self.wind_power, self.turbulence_power
             )));
         }
         if self.portal && !cfg!(feature = "portals") {
@@ -464,6 +486,9 @@ pub struct LanderEnv {
     needs_reset: bool,
     portal_crossings: u32,
     last: LanderOutcome,
+    /// The wind's and the turbulence's step counts (with `enable_wind`).
+    wind_idx: i64,
+    torque_idx: i64,
 }
 
 impl std::fmt::Debug for LanderEnv {
@@ -474,6 +499,13 @@ impl std::fmt::Debug for LanderEnv {
             .field("last", &self.last)
             .finish()
     }
+}
+
+/// Gymnasium's wind function of a step count, between −1 and 1:
+/// `tanh(sin(2 k t) + sin(π k t))`, `k = 0.01` (never periodic).
+fn gust(t: i64) -> f64 {
+    let t = t as f64;
+    ((0.02 * t).sin() + (std::f64::consts::PI * 0.01 * t).sin()).tanh()
 }
 
 /// Gymnasium's potential: distance to the pad, speed and tilt cost, 10
@@ -502,6 +534,8 @@ impl LanderEnv {
             needs_reset: false,
             portal_crossings: 0,
             last: LanderOutcome::default(),
+            wind_idx: 0,
+            torque_idx: 0,
         };
         env.start(config, push)?;
         Ok(env)
@@ -553,6 +587,13 @@ impl LanderEnv {
     }
 
     fn start(&mut self, config: &LanderConfig, push: [f64; 2]) -> Result<(), WorldError> {
+        if config.enable_wind {
+            // Gymnasium draws the counts after the push, with the reset.
+            self.wind_idx = self.rng.uniform(-9999.0, 9999.0).floor() as i64;
+            self.torque_idx = self.rng.uniform(-9999.0, 9999.0).floor() as i64;
+        }
+        // No leg is down before the first step (the wind blows in it).
+        self.last = LanderOutcome::default();
         let f = v2(push[0], push[1]);
         if f != Vec2::ZERO {
             self.world.apply_force_to_center(self.bodies.hull, f)?;
@@ -610,6 +651,15 @@ impl LanderEnv {
         fresh: bool,
     ) -> Result<(), WorldError> {
         let hull = self.bodies.hull;
+        let legs_down = self.last.observation[6] > 0.0 || self.last.observation[7] > 0.0;
+        if config.enable_wind && !legs_down {
+            let wind = gust(self.wind_idx) * config.wind_power;
+            self.wind_idx += 1;
+            self.world.apply_force_to_center(hull, v2(wind, 0.0))?;
+            let torque = gust(self.torque_idx) * config.turbulence_power;
+            self.torque_idx += 1;
+            self.world.apply_torque(hull, torque as Real)?;
+        }
         let (m_power, side_dir, s_power) = action.throttles();
         let (j0, j1) = {
             let a = self.rng.uniform(-1.0, 1.0) / PX;

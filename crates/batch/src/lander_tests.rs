@@ -353,3 +353,128 @@ fn a_helpers_panic_reaches_the_caller_and_the_crew_stops_cleanly() {
     assert_eq!(crew.collect(1).unwrap().0, vec![10]);
     drop(crew); // joins both helpers
 }
+
+#[test]
+fn a_lost_run_of_landers_makes_the_batch_refuse_to_go_on() {
+    let mut batch = LanderBatch::new(8, LanderConfig::vector(1000), 3, 2).unwrap();
+    batch.step(LanderActions::Discrete(&[0; 8])).unwrap();
+    let held: usize = batch.runs.iter().map(Vec::len).sum();
+    assert_eq!(held, 8);
+    // A run emptied stands for one lost to a helper's panic.
+    batch.runs[1].clear();
+    assert!(matches!(
+        batch.step(LanderActions::Discrete(&[0; 8])),
+        Err(BatchError::Threads(_))
+    ));
+    assert!(batch.set_threads(1).is_err());
+}
+
+/// The hull's velocity after `steps` steps of doing nothing, for `config`
+/// (engine dispersion off), and the wind counts at the reset.
+fn calm_or_windy(config: &LanderConfig, steps: usize) -> (Vec2, i64, f64) {
+    let mut env = LanderEnv::new(config, 31).unwrap();
+    let start = env.wind_idx;
+    for _ in 0..steps {
+        env.act(config, Action::Discrete(0)).unwrap();
+    }
+    let w = env.world();
+    let hull = env.bodies().hull;
+    let mass: f64 = [hull, env.bodies().legs[0], env.bodies().legs[1]]
+        .iter()
+        .map(|&b| to_f64(w.mass(b).unwrap()))
+        .sum();
+    (w.linear_velocity(hull).unwrap(), start, mass)
+}
+
+#[test]
+fn the_wind_pushes_the_lander_sideways_by_gymnasiums_function() {
+    let calm = LanderConfig {
+        dispersion: false,
+        ..LanderConfig::default()
+    };
+    let windy = LanderConfig {
+        enable_wind: true,
+        turbulence_power: 0.0,
+        ..calm.clone()
+    };
+    // 20 steps: the lander is still high above the ground (no leg down).
+    let steps = 20;
+    let (v0, _, mass) = calm_or_windy(&calm, steps);
+    let (v1, start, _) = calm_or_windy(&windy, steps);
+    assert!((-9999..9999).contains(&start), "{start}");
+    // The reset's step blew too: steps + 1 gusts of 1/50 s each on the
+    // lander (hull and legs, joined).
+    let impulse: f64 = (0..=steps as i64)
+        .map(|k| gust(start + k) * windy.wind_power / FPS)
+        .sum();
+    let expected = impulse / mass;
+    let dvx = to_f64(v1.x - v0.x);
+    assert!(
+        expected.abs() > 0.05,
+        "a gust this small tests nothing: {expected}"
+    );
+    assert!(
+        (dvx - expected).abs() < 0.05 * expected.abs(),
+        "Δvx {dvx} m/s, expected {expected}"
+    );
+    // The wind is horizontal.
+    assert!(to_f64(v1.y - v0.y).abs() < 1e-3 * expected.abs().max(1.0));
+}
+
+#[test]
+fn turbulence_turns_the_lander_and_wind_off_changes_nothing() {
+    let run = |config: &LanderConfig| {
+        let mut batch = LanderBatch::new(4, config.clone(), 8, 1).unwrap();
+        for k in 0..120 {
+            batch
+                .step(LanderActions::Discrete(&[k % 4, 0, 2, (k + 1) % 4]))
+                .unwrap();
+        }
+        (0..4)
+            .map(|i| batch.env(i).unwrap().world().state_hash())
+            .collect::<Vec<_>>()
+    };
+    let default = run(&LanderConfig::default());
+    // Wind powers without enable_wind: the default bits.
+    let off = LanderConfig {
+        wind_power: 20.0,
+        turbulence_power: 2.0,
+        ..LanderConfig::default()
+    };
+    assert_eq!(run(&off), default);
+    let on = LanderConfig {
+        enable_wind: true,
+        ..LanderConfig::default()
+    };
+    let windy = run(&on);
+    assert!(windy.iter().zip(&default).all(|(a, b)| a != b));
+    // Turbulence alone (no sideways force) turns the hull.
+    let turn = |config: &LanderConfig| {
+        let mut env = LanderEnv::new(config, 12).unwrap();
+        for _ in 0..15 {
+            env.act(config, Action::Discrete(0)).unwrap();
+        }
+        to_f64(env.world().angular_velocity(env.bodies().hull).unwrap())
+    };
+    let still = LanderConfig {
+        dispersion: false,
+        ..LanderConfig::default()
+    };
+    let twisted = LanderConfig {
+        enable_wind: true,
+        wind_power: 0.0,
+        ..still.clone()
+    };
+    let w0 = turn(&still);
+    let w1 = turn(&twisted);
+    assert!((w1 - w0).abs() > 0.05, "ω {w0} calm, {w1} turbulent");
+    let bad = LanderConfig {
+        enable_wind: true,
+        wind_power: f64::NAN,
+        ..LanderConfig::default()
+    };
+    assert!(matches!(
+        LanderBatch::new(1, bad, 0, 1),
+        Err(BatchError::Config(_))
+    ));
+}

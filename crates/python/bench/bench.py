@@ -9,7 +9,9 @@ returns. Each section prints the load average (1 minute) before it.
     python crates/python/bench/bench.py --quick    # fewer repeats
 
 Run it on an idle machine (nothing else compiling): on 2 cores, one busy
-process elsewhere halves the 2-thread figures.
+process elsewhere halves the 2-thread figures. Before each timed run it
+waits (up to ``--idle-wait`` seconds) for a moment with the CPUs idle
+(under 10 % busy over a second, from ``/proc/stat``), both engines alike.
 """
 
 from __future__ import annotations
@@ -24,9 +26,39 @@ import janus2d
 from janus2d.envs.lander import build_world
 
 
+IDLE_WAIT = 60.0
+
+
+def cpu_busy(interval=1.0):
+    """The fraction of CPU time busy over `interval` s (None off Linux)."""
+    def sample():
+        with open("/proc/stat") as f:
+            v = [int(x) for x in f.readline().split()[1:]]
+        return v[0] + v[1] + v[2] + v[5] + v[6], v[3] + v[4]
+
+    try:
+        b0, i0 = sample()
+        time.sleep(interval)
+        b1, i1 = sample()
+    except OSError:
+        return None
+    total = (b1 - b0) + (i1 - i0)
+    return (b1 - b0) / total if total else 0.0
+
+
+def wait_idle():
+    """Waits up to IDLE_WAIT s for a second with the CPUs under 10 % busy."""
+    start = time.monotonic()
+    while time.monotonic() - start < IDLE_WAIT:
+        busy = cpu_busy()
+        if busy is None or busy < 0.10:
+            return
+
+
 def best_of(repeats, fn):
     times = []
     for _ in range(repeats):
+        wait_idle()
         t0 = time.perf_counter()
         fn()
         times.append(time.perf_counter() - t0)
@@ -99,6 +131,7 @@ def env_rate(make_env, steps, seed=0, repeats=3):
     actions = [int(a) for a in rng.integers(0, 4, size=steps)]
     best = 0.0
     for _ in range(repeats):
+        wait_idle()
         t0 = time.perf_counter()
         for a in actions:
             _, _, term, trunc, _ = env.step(a)
@@ -116,6 +149,7 @@ def vector_rate(make_vec, n, steps, seed=0, repeats=3):
     actions = [rng.integers(0, 4, size=n) for _ in range(steps)]
     best = 0.0
     for _ in range(repeats):
+        wait_idle()
         t0 = time.perf_counter()
         for a in actions:
             envs.step(a)
@@ -128,7 +162,11 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--threads", type=int, default=2, help="threads of janus2d's vector envs")
+    ap.add_argument("--idle-wait", type=float, default=60.0,
+                    help="longest wait for an idle moment before each timed run, s")
     args = ap.parse_args()
+    global IDLE_WAIT
+    IDLE_WAIT = args.idle_wait
     repeats = 2 if args.quick else 5
     episodes = 20 if args.quick else 100
 

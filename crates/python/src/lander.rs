@@ -8,15 +8,13 @@ use crate::handles::Body;
 use crate::world::PyWorld;
 use janus2d_batch::BatchError;
 use janus2d_batch::lander::{LanderActions, LanderBatch, LanderConfig, OBS_WIDTH, TERRAIN_DRAWS};
-use numpy::{
-    AllowTypeChange, PyArray1, PyArray2, PyArrayLikeDyn, PyArrayMethods, PyReadonlyArrayDyn,
-};
+use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLikeDyn, PyReadonlyArrayDyn};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
 /// `LanderBatch(count, threads=1, continuous=False, gravity=-10.0,
 /// portal=False, dispersion=True, max_episode_steps=0, autoreset=False,
-/// seed=0)`: `count` landers with Gymnasium's LunarLander rules, each
+/// seed=0, enable_wind=False, wind_power=15.0, turbulence_power=1.5)`: `count` landers with Gymnasium's LunarLander rules, each
 /// step of every lander done in Rust. `step` takes the actions of all
 /// landers and returns `(obs, reward, terminated, truncated)` arrays;
 /// with `autoreset`, a lander whose episode ended is reset by its next
@@ -75,13 +73,20 @@ impl Owned {
     }
 }
 
+/// `(n, 8)` observations from their values in order, without a copy.
+fn obs_array(py: Python<'_>, obs: Vec<f32>, n: usize) -> PyResult<Bound<'_, PyArray2<f32>>> {
+    let array = numpy::ndarray::Array2::from_shape_vec((n, OBS_WIDTH), obs)
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+    Ok(PyArray2::from_owned_array(py, array))
+}
+
 impl PyLanderBatch {
     fn observations<'py>(
         py: Python<'py>,
         batch: &LanderBatch,
     ) -> PyResult<Bound<'py, PyArray2<f32>>> {
         let obs: Vec<f32> = batch.outcomes().flat_map(|o| o.observation).collect();
-        PyArray1::from_vec(py, obs).reshape([batch.len(), OBS_WIDTH])
+        obs_array(py, obs, batch.len())
     }
 }
 
@@ -89,7 +94,8 @@ impl PyLanderBatch {
 impl PyLanderBatch {
     #[new]
     #[pyo3(signature = (count, threads = 1, continuous = false, gravity = -10.0,
-        portal = false, dispersion = true, max_episode_steps = 0, autoreset = false, seed = 0))]
+        portal = false, dispersion = true, max_episode_steps = 0, autoreset = false, seed = 0,
+        enable_wind = false, wind_power = 15.0, turbulence_power = 1.5))]
     fn py_new(
         py: Python<'_>,
         count: usize,
@@ -101,6 +107,9 @@ impl PyLanderBatch {
         max_episode_steps: u32,
         autoreset: bool,
         seed: u64,
+        enable_wind: bool,
+        wind_power: f64,
+        turbulence_power: f64,
     ) -> PyResult<Self> {
         let config = LanderConfig {
             continuous,
@@ -109,6 +118,9 @@ impl PyLanderBatch {
             dispersion,
             max_episode_steps,
             autoreset,
+            enable_wind,
+            wind_power,
+            turbulence_power,
         };
         let batch = py
             .detach(|| LanderBatch::new(count, config, seed, threads))
@@ -199,7 +211,7 @@ impl PyLanderBatch {
             terminated.push(o.terminated);
             truncated.push(o.truncated);
         }
-        let obs = PyArray1::from_vec(py, obs).reshape([n, OBS_WIDTH])?;
+        let obs = obs_array(py, obs, n)?;
         PyTuple::new(
             py,
             [

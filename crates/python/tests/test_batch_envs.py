@@ -1,6 +1,8 @@
 """WorldBatch (determinism across thread counts, arrays, errors) and the
 Gymnasium environments (the checker, episodes, a vectorised rollout)."""
 
+import hashlib
+
 import numpy as np
 import pytest
 
@@ -105,6 +107,7 @@ def test_batch_errors():
         ("janus2d/LunarLander-v0", {"continuous": True}),
         ("janus2d/LunarLanderPortal-v0", {}),
         ("janus2d/BipedalWalker-v0", {}),
+        ("janus2d/BipedalWalkerHardcore-v0", {}),
     ],
 )
 def test_env_checker_passes(env_id, kwargs):
@@ -214,3 +217,51 @@ def test_vector_walker_steps():
     for _ in range(20):
         obs, rew, term, trunc, _ = envs.step(np.zeros((4, 4)))
     assert rew.shape == (4,) and np.all(np.isfinite(rew))
+
+
+def test_hardcore_walker_course_has_obstacles_and_the_default_is_unchanged():
+    from janus2d.envs.walker import STEP, TERRAIN_STEPS, build_world, hardcore_terrain, terrain
+
+    kinds = set()
+    for seed in range(4):
+        ys, polys = hardcore_terrain(np.random.default_rng(seed))
+        assert len(ys) == TERRAIN_STEPS
+        # The ground drops 4 steps into a pit (and climbs out of it).
+        assert np.isclose(np.diff(ys).min(), -4 * STEP)
+        for p in polys:
+            size = (round((p[1][0] - p[0][0]) / STEP, 6), round((p[2][1] - p[1][1]) / STEP, 6))
+            # A stair (4 wide, 1 high), a pit wall (1 by 4), a stump (1 or 2 square).
+            assert size in {(4, 1), (1, 4), (1, 1), (2, 2)}, size
+            kinds.add({(4, 1): "stair", (1, 4): "pit", (1, 1): "stump", (2, 2): "stump"}[size])
+    assert kinds == {"stair", "pit", "stump"}
+    normal = terrain(np.random.default_rng(4))
+    assert np.abs(np.diff(normal)).max() < 4 * STEP  # no pit in the normal course
+    # The build before the hardcore option (f32): the same world, the same
+    # walk below.
+    pinned = janus2d.real_bytes() == 4
+    world, _ = build_world(np.random.default_rng(4))
+    if pinned:
+        assert world.state_hash() == 0xB201134B968E3ADE
+
+    def walk(env_id):
+        env = gym.make(env_id)
+        env.reset(seed=9)
+        xs = []
+        for _ in range(60):
+            obs, *_ = env.step(np.array([0.5, -0.5, -0.5, 0.5], dtype=np.float32))
+            xs.append(obs.copy())
+        return np.array(xs)
+
+    normal_run = walk("janus2d/BipedalWalker-v0")
+    if pinned:
+        digest = hashlib.sha256(normal_run.tobytes()).hexdigest()
+        assert digest.startswith("9d3aa907e2365929")
+    hard = walk("janus2d/BipedalWalkerHardcore-v0")
+    assert hard.tobytes() != normal_run.tobytes()
+    assert gym.spec("janus2d/BipedalWalkerHardcore-v0").max_episode_steps == 2000
+    vec = BipedalWalkerVector(2, hardcore=True)
+    assert vec.max_episode_steps == 2000
+    obs, _ = vec.reset(seed=1)
+    for _ in range(10):
+        obs, rew, *_ = vec.step(np.zeros((2, 4)))
+    assert np.all(np.isfinite(rew))

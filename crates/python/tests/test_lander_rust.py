@@ -217,3 +217,61 @@ def test_portal_lander_rollouts_cross_sometimes_under_the_pilot():
             if term:
                 break
     assert crossed >= 1
+
+
+def pinned_run(**kwargs):
+    """Six landers, 200 steps of fixed actions: their world hashes."""
+    core = janus2d.LanderBatch(6, autoreset=True, max_episode_steps=1000, seed=11, **kwargs)
+    for k in range(200):
+        core.step(np.array([(k + i) % 4 for i in range(6)], dtype=np.int64))
+    return [int(h) for h in core.state_hashes()]
+
+
+# The hashes of `pinned_run()` from the build before the wind options were
+# added (f32): the default lander is the same bit for bit.
+DEFAULT_HASHES = [0x8FF872F7C16BE21A, 0x2865EC39BFB1BFCB, 0xA42927F40C4BAB12,
+                  0xF6B27CEACBB0EB14, 0x8AA7E1C3767FCE18, 0xB3928314023794E0]
+
+
+def test_wind_options_default_off_and_the_default_lander_unchanged():
+    if janus2d.real_bytes() != 4:
+        pytest.skip("the pinned hashes are of the f32 build")
+    assert pinned_run() == DEFAULT_HASHES
+    # The powers alone change nothing; enable_wind changes every lander.
+    assert pinned_run(wind_power=20.0, turbulence_power=2.0) == DEFAULT_HASHES
+    windy = pinned_run(enable_wind=True)
+    assert all(a != b for a, b in zip(windy, DEFAULT_HASHES))
+
+
+def test_wind_changes_the_trajectory_in_the_gymnasium_envs():
+    def xs(env_id, **kwargs):
+        env = gym.make(env_id, **kwargs)
+        obs, _ = env.reset(seed=3)
+        out = [obs[0]]
+        for _ in range(30):
+            obs, *_ = env.step(0)
+            out.append(obs[0])
+        return np.array(out)
+
+    calm = xs("janus2d/LunarLander-v0")
+    assert calm.tobytes() == xs("janus2d/LunarLander-v0", enable_wind=False).tobytes()
+    windy = xs("janus2d/LunarLander-v0", enable_wind=True)
+    # The same seed: the same terrain and push, then the wind moves the
+    # lander sideways (x is scaled to the view: 0.01 is 10 cm).
+    assert windy[0] != calm[0]  # the reset's step blows too
+    assert np.abs(windy - calm).max() > 0.01
+    windy_vec = LunarLanderVector(3, enable_wind=True, wind_power=10.0)
+    obs, _ = windy_vec.reset(seed=2)
+    calm_vec = LunarLanderVector(3)
+    obs0, _ = calm_vec.reset(seed=2)
+    for _ in range(20):
+        obs, *_ = windy_vec.step(np.zeros(3, dtype=np.int64))
+        obs0, *_ = calm_vec.step(np.zeros(3, dtype=np.int64))
+    # Every lander's flight changed; a gust can be weak for a while (the
+    # function crosses zero), so the size is asserted for the largest.
+    assert (obs[:, 0] != obs0[:, 0]).all()
+    assert np.abs(obs[:, 0] - obs0[:, 0]).max() > 1e-3
+    with pytest.warns(UserWarning, match="wind_power"):
+        gym.make("janus2d/LunarLander-v0", wind_power=25.0)
+    with pytest.raises(errors.BatchError), pytest.warns(UserWarning, match="turbulence_power"):
+        gym.make("janus2d/LunarLander-v0", enable_wind=True, turbulence_power=float("inf")).reset()

@@ -3,8 +3,9 @@
 - ``janus2d/LunarLander-v0`` (``continuous=True`` for the Box action space),
 - ``janus2d/LunarLanderPortal-v0`` (the pad is reached through a portal),
 - ``janus2d/BipedalWalker-v0``,
+- ``janus2d/BipedalWalkerHardcore-v0`` (``hardcore=True``: pits, stumps, stairs),
 
-with Gymnasium's time limits (1000 and 1600 steps). The vector
+with Gymnasium's time limits (1000, 1600 and 2000 steps). The vector
 environments over a :class:`janus2d.WorldBatch` are
 :class:`LunarLanderVector` and :class:`BipedalWalkerVector`.
 
@@ -26,6 +27,8 @@ def register_envs() -> None:
         ("janus2d/LunarLanderPortal-v0", "janus2d.envs.lander:LunarLander",
          {"portal": True}, 1000, 200),
         ("janus2d/BipedalWalker-v0", "janus2d.envs.walker:BipedalWalker", {}, 1600, 300),
+        ("janus2d/BipedalWalkerHardcore-v0", "janus2d.envs.walker:BipedalWalker",
+         {"hardcore": True}, 2000, 300),
     ]
     for env_id, entry, kwargs, steps, threshold in specs:
         if env_id not in registry:

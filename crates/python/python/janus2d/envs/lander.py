@@ -294,6 +294,21 @@ class LunarLander:
     """Placeholder replaced below once gymnasium is imported."""
 
 
+def wind_warnings(wind_power: float, turbulence_power: float) -> None:
+    """Gymnasium's warnings for wind powers outside the recommended
+    ranges (0 to 20 N, 0 to 2 N·m); non-finite ones are refused by Rust."""
+    import warnings
+
+    if not 0.0 <= wind_power <= 20.0:
+        warnings.warn(
+            f"wind_power value is recommended to be between 0.0 and 20.0, "
+            f"(current value: {wind_power})", stacklevel=3)
+    if not 0.0 <= turbulence_power <= 2.0:
+        warnings.warn(
+            f"turbulence_power value is recommended to be between 0.0 and 2.0, "
+            f"(current value: {turbulence_power})", stacklevel=3)
+
+
 try:
     import gymnasium as gym
     from gymnasium import spaces
@@ -309,6 +324,10 @@ if gym is not None:
         engine, right engine); ``True``: ``Box(-1, 1, (2,))`` (main
         throttle, side throttle). Observation: the 8 values of Gymnasium's
         environment, in its bounds. ``portal=True`` is the portal variant.
+        ``enable_wind``, ``wind_power`` (N) and ``turbulence_power`` (N·m)
+        are Gymnasium's: while neither leg is down, a sideways force and a
+        torque, ``tanh(sin(0.02 t) + sin(0.01 pi t))`` times the power,
+        each count ``t`` starting at a random integer at the reset.
         Each step is one call into Rust (:class:`janus2d.LanderBatch` of
         one lander); an action outside the space raises
         :class:`janus2d.errors.InvalidInputError` (a ``ValueError``).
@@ -316,15 +335,20 @@ if gym is not None:
 
         metadata = {"render_modes": ["rgb_array"], "render_fps": FPS}
 
-        def __init__(self, render_mode=None, continuous=False, gravity=-10.0, portal=False):
+        def __init__(self, render_mode=None, continuous=False, gravity=-10.0, portal=False,
+                     enable_wind=False, wind_power=15.0, turbulence_power=1.5):
             if not -12.0 < gravity < 0.0:
                 raise ValueError(f"gravity {gravity}: between -12 and 0 (exclusive)")
+            wind_warnings(wind_power, turbulence_power)
             if render_mode not in (None, "rgb_array"):
                 raise ValueError(f"render_mode {render_mode!r}: None or 'rgb_array'")
             self.render_mode = render_mode
             self.continuous = continuous
             self.gravity = gravity
             self.portal = portal
+            self.enable_wind = enable_wind
+            self.wind_power = wind_power
+            self.turbulence_power = turbulence_power
             self.observation_space = spaces.Box(OBS_LOW, OBS_HIGH, dtype=np.float32)
             if continuous:
                 self.action_space = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
@@ -340,7 +364,8 @@ if gym is not None:
             if self.core is None:
                 self.core = janus2d.LanderBatch(
                     1, continuous=self.continuous, gravity=self.gravity,
-                    portal=self.portal, seed=core_seed,
+                    portal=self.portal, seed=core_seed, enable_wind=self.enable_wind,
+                    wind_power=self.wind_power, turbulence_power=self.turbulence_power,
                 )
             obs = self.core.reset(core_seed)
             return obs[0], {}

@@ -1,5 +1,5 @@
 """A vector LunarLander over one :class:`janus2d.LanderBatch`: N landers
-stepped in one Rust call on rayon threads (engines, world steps,
+stepped in one Rust call on the batch's threads (engines, world steps,
 observations, rewards, autoresets), the GIL released, the results as
 arrays.
 
@@ -17,7 +17,7 @@ from gymnasium.vector.utils import batch_space
 
 import janus2d
 
-from .lander import FPS, OBS_HIGH, OBS_LOW, PX, VIEW_H, VIEW_W
+from .lander import FPS, OBS_HIGH, OBS_LOW, PX, VIEW_H, VIEW_W, wind_warnings
 
 
 class LunarLanderVector(VectorEnv):
@@ -31,12 +31,17 @@ class LunarLanderVector(VectorEnv):
 
     def __init__(self, num_envs: int, threads: int = 1, continuous: bool = False,
                  gravity: float = -10.0, max_episode_steps: int = 1000,
-                 render_mode=None, portal: bool = False):
+                 render_mode=None, portal: bool = False, enable_wind: bool = False,
+                 wind_power: float = 15.0, turbulence_power: float = 1.5):
+        wind_warnings(wind_power, turbulence_power)
         self.num_envs = num_envs
         self.continuous = continuous
         self.gravity = gravity
         self.threads = threads
         self.portal = portal
+        self.enable_wind = enable_wind
+        self.wind_power = wind_power
+        self.turbulence_power = turbulence_power
         self.render_mode = render_mode
         self.max_episode_steps = max_episode_steps
         self.single_observation_space = spaces.Box(OBS_LOW, OBS_HIGH, dtype=np.float32)
@@ -58,6 +63,8 @@ class LunarLanderVector(VectorEnv):
                 self.num_envs, threads=self.threads, continuous=self.continuous,
                 gravity=self.gravity, portal=self.portal,
                 max_episode_steps=self.max_episode_steps, autoreset=True, seed=core_seed,
+                enable_wind=self.enable_wind, wind_power=self.wind_power,
+                turbulence_power=self.turbulence_power,
             )
         return self.core.reset(core_seed), {}
 

@@ -62,6 +62,69 @@ def terrain(rng: np.random.Generator) -> np.ndarray:
     return ys
 
 
+def hardcore_terrain(rng: np.random.Generator):
+    """Gymnasium's hardcore course: grass stretches (the damped random walk)
+    alternating with an obstacle drawn at random: a pit (3 or 4 steps wide,
+    4 deep, walls 1 step thick), a stump (a square 1 or 2 steps wide) or
+    stairs (3 or 4 steps of 4 steps' width, 1 step up or down each).
+    Returns ``(heights, polygons)``: the ground's heights (into the pits)
+    and the obstacles' outlines, m."""
+    grass, stump, stairs, pit = range(4)
+    state, velocity, y = grass, 0.0, TERRAIN_H
+    counter, oneshot = START_PAD, False
+    stair_steps = stair_width = stair_height = 0
+    base_y = 0.0
+    ys = np.empty(TERRAIN_STEPS)
+    polygons = []
+
+    def box(x0, y0, x1, y1):
+        return [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+
+    for i in range(TERRAIN_STEPS):
+        x = i * STEP
+        if state == grass and not oneshot:
+            velocity = 0.8 * velocity + 0.01 * np.sign(TERRAIN_H - y)
+            if i > START_PAD:
+                velocity += rng.uniform(-1.0, 1.0) / PX
+            y += velocity
+        elif state == pit and oneshot:
+            counter = int(rng.integers(3, 5))
+            wall = box(x, y - 4 * STEP, x + STEP, y)
+            polygons.append(wall)
+            polygons.append([(px + STEP * counter, py) for px, py in wall])
+            counter += 2
+            base_y = y
+        elif state == pit and not oneshot:
+            y = base_y
+            if counter > 1:
+                y -= 4 * STEP
+        elif state == stump and oneshot:
+            counter = int(rng.integers(1, 3))
+            polygons.append(box(x, y, x + counter * STEP, y + counter * STEP))
+        elif state == stairs and oneshot:
+            stair_height = 1 if rng.random() > 0.5 else -1
+            stair_width = int(rng.integers(4, 5))
+            stair_steps = int(rng.integers(3, 5))
+            base_y = y
+            for k in range(stair_steps):
+                polygons.append(box(
+                    x + k * stair_width * STEP, y + (k * stair_height - 1) * STEP,
+                    x + (k + 1) * stair_width * STEP, y + k * stair_height * STEP,
+                ))
+            counter = stair_steps * stair_width
+        elif state == stairs and not oneshot:
+            done = stair_steps * stair_width - counter - stair_height
+            y = base_y + done / stair_width * stair_height * STEP
+        oneshot = False
+        ys[i] = y
+        counter -= 1
+        if counter == 0:
+            counter = int(rng.integers(GRASS // 2, GRASS))
+            state = int(rng.integers(1, 4)) if state == grass else grass
+            oneshot = True
+    return ys, polygons
+
+
 class WalkerHandles:
     """The bodies and joints of one walker world."""
 
@@ -73,12 +136,16 @@ class WalkerHandles:
         self.bodies = [hull, lowers[0], lowers[1]]
 
 
-def build_world(rng: np.random.Generator):
-    """A walker on new random terrain: ``(world, handles)``; the same
-    creation order in every build, so handles carry over."""
+def build_world(rng: np.random.Generator, hardcore: bool = False):
+    """A walker on new random terrain (``hardcore``: Gymnasium's course
+    with pits, stumps and stairs): ``(world, handles)``; the bodies and
+    joints are created in the same order in every build, so their handles
+    carry over (the obstacles are shapes of the ground body)."""
     world = janus2d.World(gravity=(0.0, -10.0))
-    ys = terrain(rng)
+    ys, polygons = hardcore_terrain(rng) if hardcore else (terrain(rng), [])
     ground = world.create_body("static", (0.0, 0.0))
+    for poly in polygons:
+        world.create_polygon(ground, poly, friction=GROUND_FRICTION, category_bits=GROUND_BITS)
     for i in range(TERRAIN_STEPS - 1):
         world.create_segment(
             ground,
@@ -126,10 +193,12 @@ def build_world(rng: np.random.Generator):
 class WalkerSim:
     """N walkers in a WorldBatch, with Gymnasium's observation and reward."""
 
-    def __init__(self, n: int, rng: np.random.Generator, threads: int = 1):
+    def __init__(self, n: int, rng: np.random.Generator, threads: int = 1,
+                 hardcore: bool = False):
         self.n = n
         self.rng = rng
-        world, self.h = build_world(rng)
+        self.hardcore = hardcore
+        world, self.h = build_world(rng, hardcore)
         self.batch = janus2d.WorldBatch(world, n, threads=threads)
         self.prev_shaping = np.full(n, np.nan)
         angles = 1.5 * np.arange(10) / 10.0
@@ -139,7 +208,7 @@ class WalkerSim:
         """New terrain and a random sideways push for the walkers in ``mask``."""
         rng = self.rng if rng is None else rng
         for i in np.flatnonzero(mask):
-            world, _ = build_world(rng)
+            world, _ = build_world(rng, self.hardcore)
             self.batch.set_world(int(i), world)
         push = np.zeros((self.n, 1, 3))
         push[mask, 0, 0] = rng.uniform(-START_PUSH, START_PUSH, size=int(mask.sum()))
@@ -212,12 +281,14 @@ except ImportError:  # pragma: no cover - gymnasium is optional
 if gym is not None:
 
     class BipedalWalker(gym.Env):
-        """Gymnasium's BipedalWalker (normal terrain) on janus2d
-        (``janus2d/BipedalWalker-v0``)."""
+        """Gymnasium's BipedalWalker on janus2d (``janus2d/BipedalWalker-v0``;
+        ``hardcore=True``, ``janus2d/BipedalWalkerHardcore-v0``: the course
+        with pits, stumps and stairs)."""
 
         metadata = {"render_modes": ["rgb_array"], "render_fps": FPS}
 
-        def __init__(self, render_mode=None):
+        def __init__(self, render_mode=None, hardcore=False):
+            self.hardcore = bool(hardcore)
             if render_mode not in (None, "rgb_array"):
                 raise ValueError(f"render_mode {render_mode!r}: None or 'rgb_array'")
             self.render_mode = render_mode
@@ -228,7 +299,7 @@ if gym is not None:
         def reset(self, *, seed=None, options=None):
             super().reset(seed=seed)
             if self.sim is None or seed is not None:
-                self.sim = WalkerSim(1, self.np_random)
+                self.sim = WalkerSim(1, self.np_random, hardcore=self.hardcore)
             self.sim.rng = self.np_random
             fresh = np.ones(1, dtype=bool)
             self.sim.reset(fresh)
@@ -264,8 +335,11 @@ if gym is not None:
             "autoreset_mode": AutoresetMode.NEXT_STEP,
         }
 
-        def __init__(self, num_envs: int, threads: int = 1, max_episode_steps: int = 1600,
-                     render_mode=None):
+        def __init__(self, num_envs: int, threads: int = 1, max_episode_steps=None,
+                     render_mode=None, hardcore: bool = False):
+            if max_episode_steps is None:
+                max_episode_steps = 2000 if hardcore else 1600
+            self.hardcore = hardcore
             self.num_envs = num_envs
             self.threads = threads
             self.max_episode_steps = max_episode_steps
@@ -283,7 +357,8 @@ if gym is not None:
             if seed is not None:
                 self._rng = np.random.default_rng(seed)
             if self.sim is None or seed is not None:
-                self.sim = WalkerSim(self.num_envs, self._rng, threads=self.threads)
+                self.sim = WalkerSim(self.num_envs, self._rng, threads=self.threads,
+                                     hardcore=self.hardcore)
             mask = np.ones(self.num_envs, dtype=bool)
             self.sim.reset(mask, self._rng)
             obs, _, _ = self.sim.step(np.zeros((self.num_envs, 4)), mask)
