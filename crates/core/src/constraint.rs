@@ -48,6 +48,9 @@ pub enum SolverMode {
 /// Everything a constraint needs to know about the current step.
 #[derive(Clone, Debug)]
 pub struct StepContext {
+    /// Time the solver's stages (the step's profile; true unless the world
+    /// turned its stage timers off). The results do not depend on it.
+    pub profile: bool,
     /// Step length, s.
     pub dt: Real,
     /// 1 / dt, 1/s.

@@ -290,6 +290,10 @@ pub struct World {
     /// state: not serialized).
     #[cfg_attr(feature = "serde", serde(skip))]
     event_work: crate::profile::EventWork,
+    /// The stage timers are off ([`World::set_profiling`]; not state: not
+    /// serialized, so a restored world times its steps).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    profiling_off: bool,
     step_count: u64,
 }
 
@@ -334,6 +338,7 @@ impl World {
             step_profile: crate::profile::StepProfile::default(),
             counters: crate::profile::StepCounters::default(),
             event_work: crate::profile::EventWork::default(),
+            profiling_off: false,
             step_count: 0,
         })
     }
@@ -494,6 +499,7 @@ impl World {
             step_profile: self.step_profile.clone(),
             counters: self.counters,
             event_work: self.event_work,
+            profiling_off: self.profiling_off,
             step_count: self.step_count,
         }
     }

@@ -98,10 +98,15 @@ impl World {
     /// pool of more than one thread; serial otherwise).
     fn step_on(&mut self, dt: Real, team: &janus2d_core::parallel::Team) {
         let mut ctx = self.step_context(dt);
+        let profiling = !self.profiling_off;
+        ctx.profile = profiling;
         let mut event_work = crate::profile::EventWork::default();
         let start = std::time::Instant::now();
         let mut t = start;
         let mut lap = || {
+            if !profiling {
+                return 0.0;
+            }
             let now = std::time::Instant::now();
             let d = now.duration_since(t).as_secs_f64();
             t = now;
@@ -211,7 +216,7 @@ impl World {
                 dt,
                 |contacts, team| builder.store_impulses(contacts, solver, team),
                 |bodies, shapes, broadphase, team| {
-                    let start = std::time::Instant::now();
+                    let start = profiling.then(std::time::Instant::now);
                     let input = crate::continuous::ContinuousInput {
                         shapes,
                         broadphase,
@@ -221,7 +226,7 @@ impl World {
                         portal_rows,
                     };
                     continuous.run(bodies, &input, team);
-                    start.elapsed().as_secs_f64()
+                    start.map_or(0.0, |s| s.elapsed().as_secs_f64())
                 },
                 team,
             );
