@@ -233,6 +233,7 @@ fn the_left_engine_turns_the_lander_counterclockwise_as_in_gymnasium() {
 /// toward the target x, hover lower the closer it is, and at least
 /// `cruise` high until within 0.08 of the target; `target_x` and `cruise`
 /// in the observation's units (x: −1 left edge, 1 right edge).
+#[cfg(feature = "portals")]
 fn pilot(o: &[f32; OBS_WIDTH], target_x: f64, cruise: f64) -> i64 {
     let o = o.map(f64::from);
     let dx = o[0] - target_x;
