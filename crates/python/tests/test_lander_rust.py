@@ -228,8 +228,11 @@ def pinned_run(**kwargs):
 
 
 # The hashes of `pinned_run()` from the build before the wind options were
-# added (f32): the default lander is the same bit for bit.
-DEFAULT_HASHES = [0x8FF872F7C16BE21A, 0x2865EC39BFB1BFCB, 0xA42927F40C4BAB12,
+# added (f32): the default lander is the same bit for bit. Lander 0's
+# changed once since (0x8FF872F7C16BE21A before): issue 33's continuous
+# collision closes a jointed group's hinges after it rewinds it, and that
+# lander's legs were rewound on landing; the wind options changed nothing.
+DEFAULT_HASHES = [0xBD1602291BA579E3, 0x2865EC39BFB1BFCB, 0xA42927F40C4BAB12,
                   0xF6B27CEACBB0EB14, 0x8AA7E1C3767FCE18, 0xB3928314023794E0]
 
 
