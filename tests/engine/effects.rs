@@ -115,7 +115,11 @@ fn zero_gravity_means_no_gravity_work_and_no_joints_no_joint_rows() {
     world.step(DT).unwrap();
     assert_eq!(world.counters().gravity_bodies, 0);
     assert_eq!(world.counters().joint_rows, 0);
-    let (mut heavy, bodies) = boxes_on_ground(WorldDef::default(), 0.0);
+    // Every tree direct (a one-joint free tree of like masses is left to
+    // Gauss–Seidel by default: direct_free_tree_mass_ratio).
+    let mut every_tree = WorldDef::default();
+    every_tree.solver.direct_free_tree_mass_ratio = 0.0;
+    let (mut heavy, bodies) = boxes_on_ground(every_tree, 0.0);
     heavy
         .create_revolute_joint(&RevoluteJointDef::new(
             bodies[0],
@@ -135,6 +139,8 @@ fn zero_gravity_means_no_gravity_work_and_no_joints_no_joint_rows() {
 fn joint_loops_and_the_switch_leave_the_tree_solve_idle() {
     let mut settings = WorldDef::default();
     settings.sleep.enabled = false;
+    // Every tree direct (see the test above).
+    settings.solver.direct_free_tree_mass_ratio = 0.0;
     let (mut world, bodies) = boxes_on_ground(settings.clone(), 0.0);
     let hinge = |a, b| RevoluteJointDef::new(a, b, Vec2::new(0.0, 0.5), Vec2::new(0.0, -0.5));
     world
@@ -400,4 +406,73 @@ fn events_switched_off_everywhere_gather_nothing() {
         hit_points >= hit_events && hit_events >= 5,
         "each box lands once"
     );
+}
+
+/// The direct tree solve runs only where Gauss–Seidel would not hold:
+/// a short free chain of like masses (a ragdoll's limb) is left to the
+/// iterative rows; a mass spread at the ratio, a fixed end, or a path
+/// longer than the step's sweeps (`2 × substeps` joints) sends it to the
+/// tree (`SolverSettings::direct_free_tree_mass_ratio`).
+#[test]
+fn short_free_trees_of_like_masses_skip_the_tree_solve() {
+    // A horizontal chain of `links` boxes in zero gravity, hinged end to
+    // end; body 0 of mass `first_mass` (the rest 1 kg); pinned to a
+    // static body if `pinned`. Returns the direct rows of one step.
+    let direct_rows = |links: usize, first_mass: Real, pinned: bool, settings: WorldDef| {
+        let mut world = World::new(WorldDef {
+            gravity: Vec2::ZERO,
+            ..settings
+        })
+        .unwrap();
+        let mut bodies = Vec::new();
+        for i in 0..links {
+            let mass = if i == 0 { first_mass } else { 1.0 };
+            let b = world
+                .create_body(
+                    &BodyDef::dynamic(Vec2::new(i as Real, 0.0)).with_mass(mass, 0.1 * mass),
+                )
+                .unwrap();
+            bodies.push(b);
+        }
+        let hinge = |a, b| RevoluteJointDef::new(a, b, Vec2::new(0.5, 0.0), Vec2::new(-0.5, 0.0));
+        for pair in bodies.windows(2) {
+            world
+                .create_revolute_joint(&hinge(pair[0], pair[1]))
+                .unwrap();
+        }
+        if pinned {
+            let pin = world
+                .create_body(&BodyDef::fixed(Vec2::new(-1.0, 0.0)))
+                .unwrap();
+            world.create_revolute_joint(&hinge(pin, bodies[0])).unwrap();
+        }
+        world.step(DT).unwrap();
+        world.counters().direct_joint_rows
+    };
+    let default = WorldDef::default;
+    assert_eq!(default().solver.substeps, 4, "8 sweeps a step");
+    // 6 links, a path of 5 joints, masses 1 … 9.9: Gauss–Seidel.
+    assert_eq!(direct_rows(6, 9.9, false, default()), 0);
+    // A spread of 10 reaches the default ratio.
+    assert_eq!(direct_rows(6, 10.0, false, default()), 10);
+    // A fixed end: always the tree.
+    assert_eq!(direct_rows(6, 1.0, true, default()), 12);
+    // A path of 8 joints is within the sweeps, 9 is not.
+    assert_eq!(direct_rows(9, 1.0, false, default()), 0);
+    assert_eq!(direct_rows(10, 1.0, false, default()), 18);
+    // At 2 substeps (4 sweeps) the 6-link chain takes the tree.
+    let mut two = default();
+    two.solver.substeps = 2;
+    assert_eq!(direct_rows(6, 1.0, false, two), 10);
+    // Ratio 0: every tree; ∞: no short free tree.
+    let mut every = default();
+    every.solver.direct_free_tree_mass_ratio = 0.0;
+    assert_eq!(direct_rows(6, 1.0, false, every), 10);
+    let mut none = default();
+    none.solver.direct_free_tree_mass_ratio = Real::INFINITY;
+    assert_eq!(direct_rows(6, 1e6, false, none), 0);
+    // NaN is refused at the boundary.
+    let mut bad = default();
+    bad.solver.direct_free_tree_mass_ratio = Real::NAN;
+    assert!(World::new(bad).is_err());
 }

@@ -15,7 +15,7 @@ use janus2d_core::parallel::Team;
 
 use crate::joint::Joint;
 use crate::joint_colour::JointColours;
-use crate::joint_tree::JointForest;
+use crate::joint_tree::{JointForest, TreePolicy};
 
 /// Rows of the joint prepare's blocks on the team.
 const PREPARE_BLOCK: usize = 256;
@@ -43,7 +43,7 @@ impl JointBatch<'_> {
             }
         });
         self.forest
-            .build_on(self.joints, &bodies.states, ctx.direct_joints, team);
+            .build_on(self.joints, &bodies.states, TreePolicy::of(ctx), team);
     }
 }
 

@@ -165,6 +165,7 @@ use crate::parts::{
     PairMass, PointPart, angular_correction_cap, bounded_sum, cap, clamp_length, row_bound_of_k,
 };
 use janus2d_core::math::wrap_angle;
+use smallvec::SmallVec;
 
 const NONE: u32 = u32::MAX;
 
@@ -640,12 +641,17 @@ pub struct JointForest {
     correct: Vec<bool>,
     /// Per joint: its moving ends this step (see `moving_pair`).
     pairs: Vec<[u32; 3]>,
-    /// The pairs and switch the forest was last built from.
+    /// The pairs and policy the forest was last built from.
     built_pairs: Vec<[u32; 3]>,
-    built_enabled: bool,
+    built_policy: Option<TreePolicy>,
     // Build scratch.
     union: Vec<u32>,
     cyclic: Vec<bool>,
+    /// Per component root: held by a fixed end.
+    anchored: Vec<bool>,
+    /// Per component root: its moving bodies' smallest and largest inverse
+    /// mass.
+    inv_mass_range: Vec<(Real, Real)>,
     adjacency_start: Vec<u32>,
     adjacency: Vec<u32>,
     visited: Vec<bool>,
@@ -672,8 +678,102 @@ fn moving_pair(j: &Joint, states: &[BodyState]) -> [u32; 3] {
         return [0, 0, flags];
     }
     let end = |s: u32| if is_moving(states, s) { s } else { 0 };
-    [end(base.state_a), end(base.state_b), flags]
+    let (a, b) = (end(base.state_a), end(base.state_b));
+    let flags = if a != 0 && b != 0 {
+        flags | mass_bucket(base.masses.a.inv_mass, base.masses.b.inv_mass) << MASS_SHIFT
+    } else {
+        flags
+    };
+    [a, b, flags]
 }
+
+/// Pair flags from this bit up: the joint's own mass ratio in quarter
+/// octaves (see `mass_bucket`), so that a body's mass changed by more
+/// than about a fifth rebuilds the forest and its free-tree choice.
+const MASS_SHIFT: u32 = 2;
+
+/// `4 log₂` of the ratio of two moving bodies' masses, from their inverse
+/// masses, in 0 … 63 (63 for a body of infinite mass).
+#[inline]
+fn mass_bucket(inv_a: Real, inv_b: Real) -> u32 {
+    let (lo, hi) = if inv_a < inv_b {
+        (inv_a, inv_b)
+    } else {
+        (inv_b, inv_a)
+    };
+    if lo <= 0.0 || !(hi / lo).is_finite() {
+        return 63;
+    }
+    (4.0 * to_f64(hi / lo).log2()).clamp(0.0, 63.0) as u32
+}
+
+/// The longest path of a tree, in joints, from its joints in
+/// breadth-first order (`tree`, local body indices) over `bodies` bodies:
+/// each body's height above its deepest leaf, children before parents.
+fn tree_diameter(tree: &[TreeJoint], bodies: usize) -> usize {
+    // Per body: the two largest heights among its child subtrees (+1).
+    let mut heights: SmallVec<[(usize, usize); 32]> = SmallVec::new();
+    heights.resize(bodies, (0, 0));
+    let mut diameter = 0;
+    for tj in tree.iter().rev() {
+        let below = if tj.child == NONE {
+            1
+        } else {
+            heights[tj.child as usize].0 + 1
+        };
+        let h = &mut heights[tj.parent as usize];
+        if below > h.0 {
+            *h = (below, h.0);
+        } else if below > h.1 {
+            h.1 = below;
+        }
+        diameter = diameter.max(h.0 + h.1);
+    }
+    diameter
+}
+
+/// Which joint trees the forest solves directly: the world's
+/// [`SolverSettings::direct_joints`](janus2d_core::solver::SolverSettings::direct_joints)
+/// and
+/// [`SolverSettings::direct_free_tree_mass_ratio`](janus2d_core::solver::SolverSettings::direct_free_tree_mass_ratio).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct TreePolicy {
+    /// Any tree at all (false: every joint iterative).
+    pub enabled: bool,
+    /// A tree held by no fixed end is solved directly only if the spread
+    /// of its moving bodies' masses (heaviest ÷ lightest) reaches this
+    /// (dimensionless; `≤ 1`: every tree), or its longest path is more
+    /// joints than `2 × substeps`.
+    pub free_tree_mass_ratio: Real,
+    /// Substeps per step (each a solve and a relax sweep).
+    pub substeps: u32,
+}
+
+impl TreePolicy {
+    /// Every tree, whatever its masses (`enabled` false: none).
+    #[must_use]
+    pub const fn every_tree(enabled: bool) -> TreePolicy {
+        TreePolicy {
+            enabled,
+            free_tree_mass_ratio: 0.0,
+            substeps: 1,
+        }
+    }
+
+    /// The step's policy.
+    #[must_use]
+    pub fn of(ctx: &StepContext) -> TreePolicy {
+        TreePolicy {
+            enabled: ctx.direct_joints,
+            free_tree_mass_ratio: ctx.direct_free_tree_mass_ratio,
+            substeps: ctx.substeps,
+        }
+    }
+}
+
+/// Pair flag: the joint was in the tree when the forest was last built.
+const IN_TREE: u32 = 1;
 
 /// Pair flag: the tree solve cannot take the joint's rows (its kind has
 /// no point part, or it is soft), so a component holding it stays wholly
@@ -695,18 +795,26 @@ impl JointForest {
     }
 
     /// Finds the joint forest among the enabled joints and marks its joints
-    /// (`in_tree`). With `enabled` false every joint stays iterative.
+    /// (`in_tree`): every tree, whatever its masses
+    /// ([`TreePolicy::every_tree`]). With `enabled` false every joint stays
+    /// iterative.
     pub fn build(&mut self, joints: &mut [Joint], states: &[BodyState], enabled: bool) {
-        self.build_on(joints, states, enabled, &Team::serial());
+        self.build_on(
+            joints,
+            states,
+            TreePolicy::every_tree(enabled),
+            &Team::serial(),
+        );
     }
 
-    /// [`JointForest::build`] with the joints' moving ends read in blocks
-    /// on the step's team (the forest itself is found on the caller).
+    /// [`JointForest::build`] under `policy`, with the joints' moving ends
+    /// read in blocks on the step's team (the forest itself is found on
+    /// the caller).
     pub fn build_on(
         &mut self,
         joints: &mut [Joint],
         states: &[BodyState],
-        enabled: bool,
+        policy: TreePolicy,
         team: &Team,
     ) {
         const BLOCK: usize = 1024;
@@ -718,7 +826,7 @@ impl JointForest {
                 *pair = moving_pair(j, states);
             }
         });
-        self.update(joints, states.len(), enabled);
+        self.update(joints, states.len(), policy);
     }
 
     /// Prepares every enabled joint and finds the forest in the same pass
@@ -731,25 +839,26 @@ impl JointForest {
             }
             self.pairs.push(moving_pair(j, &bodies.states));
         }
-        self.update(joints, bodies.states.len(), ctx.direct_joints);
+        self.update(joints, bodies.states.len(), TreePolicy::of(ctx));
     }
 
     /// Rebuilds the forest when the joints' moving ends changed since the
     /// last build (joints created, destroyed, enabled or disabled, bodies
     /// woken, put to sleep or re-indexed); otherwise keeps it.
-    fn update(&mut self, joints: &mut [Joint], n: usize, enabled: bool) {
-        if enabled == self.built_enabled && self.pairs == self.built_pairs {
+    fn update(&mut self, joints: &mut [Joint], n: usize, policy: TreePolicy) {
+        if Some(policy) == self.built_policy && self.pairs == self.built_pairs {
             return;
         }
-        self.rebuild(joints, n, enabled);
-        self.built_enabled = enabled;
+        self.rebuild(joints, n, policy);
+        self.built_policy = Some(policy);
         self.built_pairs.clone_from(&self.pairs);
         for (pair, j) in self.built_pairs.iter_mut().zip(joints.iter()) {
-            pair[2] = (pair[2] & ITERATIVE) | u32::from(j.in_tree());
+            pair[2] = (pair[2] & !IN_TREE) | u32::from(j.in_tree());
         }
     }
 
-    fn rebuild(&mut self, joints: &mut [Joint], n: usize, enabled: bool) {
+    fn rebuild(&mut self, joints: &mut [Joint], n: usize, policy: TreePolicy) {
+        let enabled = policy.enabled;
         self.trees.clear();
         self.bodies.clear();
         self.joints.clear();
@@ -795,7 +904,28 @@ impl JointForest {
                 }
             }
         }
-        // Pass 2: the joints of loop-free components form the forest.
+        // Pass 2: which components are held by a fixed end, and the spread
+        // of their moving bodies' masses.
+        self.anchored.clear();
+        self.anchored.resize(n, false);
+        self.inv_mass_range.clear();
+        self.inv_mass_range.resize(n, (Real::MAX, 0.0));
+        for (i, &[a, b, flags]) in self.pairs.iter().enumerate() {
+            if (a == 0 && b == 0) || flags & ITERATIVE != 0 {
+                continue;
+            }
+            let root = find(&mut self.union, if a != 0 { a } else { b }) as usize;
+            self.anchored[root] |= a == 0 || b == 0;
+            let masses = &joints[i].base().masses;
+            let range = &mut self.inv_mass_range[root];
+            for (s, inv_mass) in [(a, masses.a.inv_mass), (b, masses.b.inv_mass)] {
+                if s != 0 {
+                    range.0 = range.0.min(inv_mass);
+                    range.1 = range.1.max(inv_mass);
+                }
+            }
+        }
+        // Pass 3: the joints of loop-free components form the forest.
         for (i, &[a, b, flags]) in self.pairs.iter().enumerate() {
             if (a == 0 && b == 0) || flags & ITERATIVE != 0 {
                 continue;
@@ -830,13 +960,18 @@ impl JointForest {
         }
         self.visited.clear();
         self.visited.resize(n, false);
+        let mut dropped = false;
         for t in 0..self.tree_joints.len() {
             let [a, b, _] = self.pairs[self.tree_joints[t] as usize];
             for root in [a, b] {
                 if root != 0 && !self.visited[root as usize] {
                     self.grow(root);
+                    dropped |= self.drop_if_iterative(joints, root, policy);
                 }
             }
+        }
+        if dropped {
+            self.tree_joints.retain(|&i| joints[i as usize].in_tree());
         }
         self.body_scratch
             .resize(self.bodies.len(), BodyScratch::ZERO);
@@ -844,6 +979,41 @@ impl JointForest {
             .resize(self.joints.len(), JointScratch::ZERO);
         self.wide_scratch
             .resize(self.joints.len(), WideScratch::ZERO);
+    }
+
+    /// Takes the tree just grown from `root` out of the forest again when
+    /// Gauss–Seidel holds it as well (see
+    /// [`TreePolicy::free_tree_mass_ratio`]): held by no fixed end, its
+    /// masses within the ratio, and its longest path no more joints than
+    /// the sweeps a step makes (solve and relax in each substep), so an
+    /// impulse crosses it within the step. Its joints go back to the
+    /// iterative rows. Returns whether it was dropped.
+    fn drop_if_iterative(&mut self, joints: &mut [Joint], root: u32, policy: TreePolicy) -> bool {
+        let component = find(&mut self.union, root) as usize;
+        let (inv_heaviest, inv_lightest) = self.inv_mass_range[component];
+        // m_heaviest ÷ m_lightest < ratio, as products (a zero inverse
+        // mass is an infinite spread).
+        let even = inv_heaviest > 0.0 && inv_lightest < policy.free_tree_mass_ratio * inv_heaviest;
+        if self.anchored[component] || !even {
+            return false;
+        }
+        let Some(&start) = self.trees.last() else {
+            return false;
+        };
+        let tree = &self.joints[start.joints as usize..];
+        if tree_diameter(tree, self.bodies.len() - start.bodies as usize)
+            > 2 * policy.substeps as usize
+        {
+            return false;
+        }
+        for tj in tree {
+            joints[tj.index as usize].base_mut().in_tree = false;
+        }
+        self.trees.pop();
+        self.joints.truncate(start.joints as usize);
+        self.bodies.truncate(start.bodies as usize);
+        self.parent_joint.truncate(start.bodies as usize);
+        true
     }
 
     /// Breadth-first from `root`, appending the tree's bodies and joints.

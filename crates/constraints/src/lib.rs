@@ -66,7 +66,7 @@ pub use joint_base::JointBase;
 pub use joint_colour::JointColours;
 pub use joint_def::{JointDefBase, JointFrame, KindDef, LimitsMut, MotorMut, SpringMut};
 pub use joint_solver::JointBatch;
-pub use joint_tree::JointForest;
+pub use joint_tree::{JointForest, TreePolicy};
 pub use motor::{MotorJoint, MotorJointDef};
 pub use mouse::{MouseJoint, MouseJointDef};
 pub use portal::{PortalBatch, PortalConstraint, PortalConstraintDef};

@@ -107,6 +107,10 @@ pub struct StepContext {
     pub direct_joint_softness: Softness,
     /// Largest correction speed of a directly solved joint, m/s (usual 5).
     pub direct_joint_max_correction_speed: Real,
+    /// Smallest mass spread of a free tree solved directly
+    /// (dimensionless), see
+    /// [`SolverSettings::direct_free_tree_mass_ratio`](crate::solver::SolverSettings::direct_free_tree_mass_ratio).
+    pub direct_free_tree_mass_ratio: Real,
 }
 
 /// One body's part of one Jacobian row.

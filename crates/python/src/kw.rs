@@ -182,7 +182,8 @@ pub fn world_def<V: Visitor>(d: &mut WorldDef, v: &mut V) -> PyResult<()> {
         contact_hertz_fraction, contact_damping_ratio, contact_push_max_velocity, joint_hertz,
         joint_hertz_fraction, joint_damping_ratio, joint_max_correction_speed,
         restitution_threshold, warm_starting, contact_mass_ratio_cap, joint_mass_ratio_cap,
-        direct_joints, direct_joint_hertz, direct_joint_max_correction_speed)?;
+        direct_joints, direct_joint_hertz, direct_joint_max_correction_speed,
+        direct_free_tree_mass_ratio)?;
     v.field("sleep_enabled", &mut d.sleep.enabled)?;
     v.field("sleep_linear_threshold", &mut d.sleep.linear_threshold)?;
     v.field("time_to_sleep", &mut d.sleep.time_to_sleep)

@@ -28,6 +28,7 @@ pub(crate) struct SettingsDef {
     direct_joints: bool,
     direct_joint_hertz: janus2d_core::math::Real,
     direct_joint_max_correction_speed: janus2d_core::math::Real,
+    direct_free_tree_mass_ratio: janus2d_core::math::Real,
 }
 
 /// Serde for the world's hash maps as key-sorted sequences: the bytes of

@@ -130,8 +130,9 @@ pub mod bytes {
     /// switch, the portal stage no longer keeps the last step's events;
     /// 13: shape definitions carry an offset, bodies their motion locks
     /// and enabled flag, and the world its disabled joints; 14: the
-    /// collision stage keeps the chains).
-    pub const SNAPSHOT_VERSION: u16 = 14;
+    /// collision stage keeps the chains; 15: the solver settings' free-tree
+    /// mass ratio, and the joint forest the policy it was built under).
+    pub const SNAPSHOT_VERSION: u16 = 15;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.

@@ -558,6 +558,8 @@ pub(crate) fn check_settings(s: &SolverSettings) -> Result<(), WorldError> {
             "direct_joint_max_correction_speed",
         ),
     ];
+    // (direct_free_tree_mass_ratio may be ∞: no free tree solved directly;
+    // SolverSettings::validate rejects NaN.)
     for (v, name) in reals {
         if !v.is_finite() {
             return Err(WorldError::NonFinite(name));
