@@ -128,6 +128,13 @@
 //! translate (or rotate) gets the placeholder mass 1 on that axis and a zero
 //! Jacobian column, so its `Δv` there is exactly zero.
 //!
+//! **Which trees.** A tree held by no fixed end whose masses lie within
+//! [`TreePolicy::free_tree_mass_ratio`] and whose longest path is at most
+//! the step's Gauss–Seidel sweeps (`2 × substeps` joints) is left to the
+//! iterative rows (a ragdoll: Gauss–Seidel holds it as well, for less;
+//! Box2D's `rain` 1.47 → about 1.2 × Box2D); it is grown and then dropped
+//! (`JointForest::drop_if_iterative`).
+//!
 //! Only joint components without a loop, and without a joint the tree
 //! cannot take (a soft weld, a motor joint: `Joint::tree_rows` is `None`)
 //! between two of their moving bodies, are solved directly; a joint the
