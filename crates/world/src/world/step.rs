@@ -257,7 +257,6 @@ impl World {
             self.joints.forget_impulses(b);
             self.collision.forget_impulses(b);
         }
-        self.joints.forget_non_finite();
         if has_portals {
             let (portals, mut stores) = self.portals_and_stores();
             portals.cross(&mut stores);
@@ -283,14 +282,17 @@ impl World {
                 .update(&input, &mut self.bodies, contacts, &self.joints);
             sp.sleep += lap();
         }
+        // Non-finite read-backs reset, the row counts and the threshold
+        // events, in one pass over the joints.
+        let joint_end = self.joints.end_step();
         sp.solver = report.profile;
         sp.total = start.elapsed().as_secs_f64();
         self.counters = crate::profile::StepCounters::gather(&crate::profile::CounterSources {
             collision_ran: has_shapes,
             collision: self.collision.counters(),
             contacts: self.contact_solver.len(),
-            joint_rows: self.joints.row_count(),
-            direct_joint_rows: self.joints.direct_row_count(),
+            joint_rows: joint_end.rows,
+            direct_joint_rows: joint_end.direct_rows,
             portal_stage_ran: has_portals,
             portals: self.portals.counters_for_step(has_portals),
             gravity: self.gravity != Vec2::ZERO,
@@ -305,7 +307,7 @@ impl World {
         self.events = StepEvents {
             non_finite_bodies: report.non_finite,
             collision: self.collision.take_events(),
-            joints: self.joints.threshold_events(),
+            joints: joint_end.events,
             #[cfg(feature = "portals")]
             portals: self.portals.take_events(),
             moves,
