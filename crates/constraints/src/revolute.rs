@@ -231,14 +231,22 @@ impl KindDef for RevoluteJointDef {
 }
 
 /// A revolute joint in solver form.
+///
+/// Laid out in declaration order (`repr(C)`), the fields a Gauss–Seidel
+/// point row reads first (its base, point part and softness: the first
+/// cache line of the joint) and the definition last: on Box2D's
+/// `joint_grid` (10,000 revolute joints, point rows only) the step took
+/// 9.5–9.7 ms against 10.0–10.1 ms in the compiler's own order (three
+/// alternating runs each, janus2d alone); the results are the same bits.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[repr(C)]
 pub struct RevoluteJoint {
-    /// The definition it was made from (limits, motor and spring settings).
-    pub def: RevoluteJointDef,
     /// State indices, masses and switches the solver reads.
     pub(crate) base: JointBase,
     pub(crate) point: PointPart,
+    /// Softness of the point rows for this step (mass-ratio aware).
+    point_softness: Softness,
     /// `θ_b − θ_a − θ_ref` at the start of the step, rad.
     delta_angle: Real,
     spring: AnglePart,
@@ -246,8 +254,8 @@ pub struct RevoluteJoint {
     lower: AnglePart,
     upper: AnglePart,
     spring_softness: Softness,
-    /// Softness of the point rows for this step (mass-ratio aware).
-    point_softness: Softness,
+    /// The definition it was made from (limits, motor and spring settings).
+    pub def: RevoluteJointDef,
 }
 
 /// The softness of the Gauss–Seidel point rows: the joint softness scaled
