@@ -132,7 +132,7 @@
 //! [`TreePolicy::free_tree_mass_ratio`] and whose longest path is at most
 //! the step's Gauss–Seidel sweeps (`2 × substeps` joints) is left to the
 //! iterative rows (a ragdoll: Gauss–Seidel holds it as well, for less;
-//! Box2D's `rain` 1.47 → about 1.2 × Box2D); it is grown and then dropped
+//! figures in docs/architecture.md); it is grown and then dropped
 //! (`JointForest::drop_if_iterative`).
 //!
 //! Only joint components without a loop, and without a joint the tree
@@ -654,11 +654,6 @@ pub struct JointForest {
     // Build scratch.
     union: Vec<u32>,
     cyclic: Vec<bool>,
-    /// Per component root: held by a fixed end.
-    anchored: Vec<bool>,
-    /// Per component root: its moving bodies' smallest and largest inverse
-    /// mass.
-    inv_mass_range: Vec<(Real, Real)>,
     adjacency_start: Vec<u32>,
     adjacency: Vec<u32>,
     visited: Vec<bool>,
@@ -699,8 +694,11 @@ fn moving_pair(j: &Joint, states: &[BodyState]) -> [u32; 3] {
 /// than about a fifth rebuilds the forest and its free-tree choice.
 const MASS_SHIFT: u32 = 2;
 
-/// `4 log₂` of the ratio of two moving bodies' masses, from their inverse
-/// masses, in 0 … 63 (63 for a body of infinite mass).
+/// The ratio of two moving bodies' masses (from their inverse masses) in
+/// quarter octaves, 0 … 63 (63 for a body of infinite mass): the f32
+/// exponent of the ratio and the top two bits of its mantissa, above
+/// those of 1. A bit shift, not a logarithm: every joint's pair is formed
+/// at every step.
 #[inline]
 fn mass_bucket(inv_a: Real, inv_b: Real) -> u32 {
     let (lo, hi) = if inv_a < inv_b {
@@ -708,10 +706,18 @@ fn mass_bucket(inv_a: Real, inv_b: Real) -> u32 {
     } else {
         (inv_b, inv_a)
     };
-    if lo <= 0.0 || !(hi / lo).is_finite() {
+    let ratio = to_f64(hi / lo) as f32;
+    if lo <= 0.0 || !ratio.is_finite() {
         return 63;
     }
-    (4.0 * to_f64(hi / lo).log2()).clamp(0.0, 63.0) as u32
+    ((ratio.to_bits() - 1.0f32.to_bits()) >> 21).min(63)
+}
+
+/// True when one of a tree's joints (`tree`, breadth-first) ends at a
+/// fixed body (static, kinematic or sleeping): it has no child.
+#[inline]
+fn is_anchored(tree: &[TreeJoint]) -> bool {
+    tree.iter().any(|tj| tj.child == NONE)
 }
 
 /// The longest path of a tree, in joints, from its joints in
@@ -911,28 +917,7 @@ impl JointForest {
                 }
             }
         }
-        // Pass 2: which components are held by a fixed end, and the spread
-        // of their moving bodies' masses.
-        self.anchored.clear();
-        self.anchored.resize(n, false);
-        self.inv_mass_range.clear();
-        self.inv_mass_range.resize(n, (Real::MAX, 0.0));
-        for (i, &[a, b, flags]) in self.pairs.iter().enumerate() {
-            if (a == 0 && b == 0) || flags & ITERATIVE != 0 {
-                continue;
-            }
-            let root = find(&mut self.union, if a != 0 { a } else { b }) as usize;
-            self.anchored[root] |= a == 0 || b == 0;
-            let masses = &joints[i].base().masses;
-            let range = &mut self.inv_mass_range[root];
-            for (s, inv_mass) in [(a, masses.a.inv_mass), (b, masses.b.inv_mass)] {
-                if s != 0 {
-                    range.0 = range.0.min(inv_mass);
-                    range.1 = range.1.max(inv_mass);
-                }
-            }
-        }
-        // Pass 3: the joints of loop-free components form the forest.
+        // Pass 2: the joints of loop-free components form the forest.
         for (i, &[a, b, flags]) in self.pairs.iter().enumerate() {
             if (a == 0 && b == 0) || flags & ITERATIVE != 0 {
                 continue;
@@ -973,7 +958,7 @@ impl JointForest {
             for root in [a, b] {
                 if root != 0 && !self.visited[root as usize] {
                     self.grow(root);
-                    dropped |= self.drop_if_iterative(joints, root, policy);
+                    dropped |= self.drop_if_iterative(joints, policy);
                 }
             }
         }
@@ -988,28 +973,35 @@ impl JointForest {
             .resize(self.joints.len(), WideScratch::ZERO);
     }
 
-    /// Takes the tree just grown from `root` out of the forest again when
+    /// Takes the tree just grown out of the forest again when
     /// Gauss–Seidel holds it as well (see
     /// [`TreePolicy::free_tree_mass_ratio`]): held by no fixed end, its
     /// masses within the ratio, and its longest path no more joints than
     /// the sweeps a step makes (solve and relax in each substep), so an
     /// impulse crosses it within the step. Its joints go back to the
     /// iterative rows. Returns whether it was dropped.
-    fn drop_if_iterative(&mut self, joints: &mut [Joint], root: u32, policy: TreePolicy) -> bool {
-        let component = find(&mut self.union, root) as usize;
-        let (inv_heaviest, inv_lightest) = self.inv_mass_range[component];
-        // m_heaviest ÷ m_lightest < ratio, as products (a zero inverse
-        // mass is an infinite spread).
-        let even = inv_heaviest > 0.0 && inv_lightest < policy.free_tree_mass_ratio * inv_heaviest;
-        if self.anchored[component] || !even {
-            return false;
-        }
+    fn drop_if_iterative(&mut self, joints: &mut [Joint], policy: TreePolicy) -> bool {
         let Some(&start) = self.trees.last() else {
             return false;
         };
         let tree = &self.joints[start.joints as usize..];
-        if tree_diameter(tree, self.bodies.len() - start.bodies as usize)
-            > 2 * policy.substeps as usize
+        if is_anchored(tree) {
+            return false;
+        }
+        // The moving bodies' inverse masses, from their joints (a free
+        // tree's joints all have two moving ends).
+        let (mut inv_heaviest, mut inv_lightest): (Real, Real) = (Real::MAX, 0.0);
+        for tj in tree {
+            let m = &joints[tj.index as usize].base().masses;
+            inv_heaviest = inv_heaviest.min(m.a.inv_mass).min(m.b.inv_mass);
+            inv_lightest = inv_lightest.max(m.a.inv_mass).max(m.b.inv_mass);
+        }
+        // m_heaviest ÷ m_lightest < ratio, as products (a zero inverse
+        // mass is an infinite spread).
+        let even = inv_heaviest > 0.0 && inv_lightest < policy.free_tree_mass_ratio * inv_heaviest;
+        if !even
+            || tree_diameter(tree, self.bodies.len() - start.bodies as usize)
+                > 2 * policy.substeps as usize
         {
             return false;
         }
@@ -1371,7 +1363,7 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
     // A tree held by a fixed end splits its feedback (see
     // VELOCITY_CORRECTION_SPEED) up to CORRECTION_SPEED_FACTOR times the
     // cap; a free tree keeps all of it, at the cap, in its velocities.
-    let anchored = tree.joints.iter().any(|tj| tj.child == NONE);
+    let anchored = is_anchored(tree.joints);
     let params = &TreeParams {
         anchored,
         ..*params

@@ -166,14 +166,12 @@ pub struct SolverSettings {
     /// solve and a relax per substep, so an impulse crosses the tree
     /// within the step), the tree's joints are solved by Gauss–Seidel like
     /// any other. The direct solve is for light links carrying heavy loads
-    /// and for long chains; a short free tree of like masses holds as well
-    /// under Gauss–Seidel at a fraction of the cost (Box2D's `rain`, 1,000
-    /// ragdolls whose longest path is 5 joints: the step about 18%
-    /// faster). A tree held by a static, kinematic or sleeping body always
-    /// takes it (a hanging chain stretches under Gauss–Seidel at any mass
-    /// ratio), and so does a longer one (a 20-link rope thrown onto a
-    /// floor opened to 2.9 cm under Gauss–Seidel, 4.6 mm direct). `≤ 1`:
-    /// every tree; `∞`: no short free tree.
+    /// and for long chains; a short free tree of like masses (a ragdoll)
+    /// holds as well under Gauss–Seidel at a fraction of the cost. A tree
+    /// held by a static, kinematic or sleeping body always takes it (a
+    /// hanging chain stretches under Gauss–Seidel at any mass ratio), and
+    /// so does a longer one (a thrown rope). Figures in
+    /// docs/architecture.md. `≤ 1`: every tree; `∞`: no short free tree.
     pub direct_free_tree_mass_ratio: Real,
 }
 

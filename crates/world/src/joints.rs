@@ -687,8 +687,7 @@ impl JointSet {
     }
 
     /// The joints' part of a step's end, in one pass over them (each pass
-    /// reads every joint from memory: on the 10,000-joint grid four
-    /// separate passes were 3–4% of the step):
+    /// reads every joint from memory):
     ///
     /// - every joint whose read-back is no longer finite starts afresh
     ///   (as [`forget_impulses`](Self::forget_impulses)): its kept
