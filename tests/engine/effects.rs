@@ -476,3 +476,34 @@ fn short_free_trees_of_like_masses_skip_the_tree_solve() {
     bad.solver.direct_free_tree_mass_ratio = Real::NAN;
     assert!(World::new(bad).is_err());
 }
+
+/// Guards the solver profile against counting the substep loop twice: the
+/// stages are timed inside the step, so they add up to no more than it,
+/// and with the timers off the solver's stages read zero.
+#[test]
+fn stage_times_add_up_to_no_more_than_the_step() {
+    let mut scene = janus2d_testbed::scenes::joint_grid(&WorldDef::default(), 30);
+    let world = &mut scene.world;
+    for _ in 0..5 {
+        world.step(DT).unwrap();
+        let p = world.profile();
+        let s = &p.solver;
+        let solver = s.prepare + s.integrate + s.warm_start + s.solve + s.relax;
+        let stages = p.broadphase + p.narrowphase + p.portals + p.continuous + p.sleep;
+        assert!(solver > 0.0, "the solver stages were not timed");
+        assert!(
+            stages + solver + s.restitution + s.finalize <= p.total,
+            "stages {} + solver {solver} exceed the step {}",
+            stages + s.restitution + s.finalize,
+            p.total
+        );
+    }
+    world.set_profiling(false);
+    world.step(DT).unwrap();
+    let s = &world.profile().solver;
+    assert_eq!(
+        (s.prepare, s.integrate, s.warm_start, s.solve, s.relax),
+        (0.0, 0.0, 0.0, 0.0, 0.0)
+    );
+    assert!(world.profile().total > 0.0);
+}

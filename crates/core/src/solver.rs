@@ -863,10 +863,6 @@ pub fn solve_step_on(
             &mut report.profile,
         );
     }
-    first.spread_over(
-        t.duration_since(loop_start).as_secs_f64(),
-        &mut report.profile,
-    );
     if ctx.restitution {
         for &i in &active {
             batches[i].apply_restitution_on(ctx, &mut bodies.states, team);
