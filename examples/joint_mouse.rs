@@ -47,7 +47,7 @@ fn main() -> Result<(), WorldError> {
         } else if step < 180 {
             target.x += 2.0 * DT;
         }
-        let mut def = world.joint_of::<MouseJoint>(mouse)?.def.clone();
+        let mut def = world.joint_of::<MouseJoint>(mouse)?.def().clone();
         def.target = target;
         world.set_joint_def(mouse, def.into())?;
         world.step(DT)?;
@@ -57,7 +57,7 @@ fn main() -> Result<(), WorldError> {
         }
     }
     let at = world.position(top)?;
-    let omega = janus2d::base::math::TAU * world.joint_of::<MouseJoint>(mouse)?.def.hertz;
+    let omega = janus2d::base::math::TAU * world.joint_of::<MouseJoint>(mouse)?.def().hertz;
     println!(
         "top box dragged from ({:.2}, {:.2}) to ({:.3}, {:.3}), {:.1} mm below the target (spring \
          sag g/(2πf)² = {:.1} mm), turned {:.1e} rad; largest pull {pull:.0} N (max_force {max_force} N)",

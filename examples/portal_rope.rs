@@ -38,8 +38,8 @@ fn gap_through_map(world: &World, joint: JointHandle, pair: PortalPairHandle) ->
         return Real::INFINITY;
     };
     let ends = [
-        (j.def.base.body_a, j.def.base.local_frame_a.anchor),
-        (j.def.base.body_b, j.def.base.local_frame_b.anchor),
+        (j.def().base.body_a, j.def().base.local_frame_a.anchor),
+        (j.def().base.body_b, j.def().base.local_frame_b.anchor),
     ];
     let anchor =
         |(b, l): (BodyHandle, Vec2)| world.transform(b).map_or(Vec2::ZERO, |xf| xf.apply(l));

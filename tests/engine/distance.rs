@@ -323,7 +323,7 @@ fn rope_100_to_1(swing: bool) -> (Real, Real, Vec2) {
         .unwrap();
     // The joint's gap is the distance of its world anchors: its length.
     let stretch = |w: &World, j: JointHandle| {
-        w.joint_gap(j).unwrap() - w.joint_of::<DistanceJoint>(j).unwrap().def.max_length
+        w.joint_gap(j).unwrap() - w.joint_of::<DistanceJoint>(j).unwrap().def().max_length
     };
     let (mut worst_a, mut worst_b): (Real, Real) = (Real::MIN, Real::MIN);
     for _ in 0..300 {
@@ -567,7 +567,7 @@ fn bad_distance_input_is_a_typed_error_and_changes_nothing() {
     w.set_joint_max_motor_force(j, 7.0).unwrap();
     w.set_joint_motor_speed(j, 0.25).unwrap();
     w.set_joint_spring(j, 3.0, 0.5).unwrap();
-    let d = &w.joint_of::<DistanceJoint>(j).unwrap().def;
+    let d = &w.joint_of::<DistanceJoint>(j).unwrap().def();
     assert_eq!(
         (d.min_length, d.max_length, d.enable_limit),
         (0.5, 1.5, true)

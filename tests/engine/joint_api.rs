@@ -115,7 +115,7 @@ fn user_data_from_the_definition_is_kept() {
 #[test]
 fn whole_definition_setter_validates_and_keeps_the_world_on_error() {
     let (mut world, bob, j) = pendulum(|_| {});
-    let def = world.revolute_joint(j).unwrap().def.clone();
+    let def = world.revolute_joint(j).unwrap().def().clone();
     // Another kind.
     let weld = WeldJointDef::new(def.base.body_a, def.base.body_b, Vec2::ZERO, Vec2::ZERO);
     let e = refused(&mut world, j, |w| w.set_joint_def(j, weld.into()));
@@ -142,7 +142,7 @@ fn whole_definition_setter_validates_and_keeps_the_world_on_error() {
     // A good change lands.
     let good = def.with_limits(-0.25, 0.5);
     world.set_joint_def(j, good.into()).unwrap();
-    let now = &world.revolute_joint(j).unwrap().def;
+    let now = &world.revolute_joint(j).unwrap().def();
     assert!(now.enable_limit);
     assert_eq!((now.lower_angle, now.upper_angle), (-0.25, 0.5));
     assert_eq!(world.validate(), Ok(()));
@@ -172,7 +172,10 @@ fn kind_setters_refuse_kinds_without_the_feature() {
     assert!(world.joint_of::<WeldJoint>(pin).is_err());
     assert!(world.joint_of::<RevoluteJoint>(pin).is_ok());
     world.set_joint_max_motor_torque(pin, 5.0).unwrap();
-    assert_eq!(world.revolute_joint(pin).unwrap().def.max_motor_torque, 5.0);
+    assert_eq!(
+        world.revolute_joint(pin).unwrap().def().max_motor_torque,
+        5.0
+    );
 }
 
 #[test]

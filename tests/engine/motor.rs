@@ -299,7 +299,7 @@ const DT: Real = 1.0 / 60.0;
 /// world frame) and `θ_b − θ_a − θ_ref − θ_off` (rad), from the bodies'
 /// transforms (as `MotorJoint::linear_error` and `angular_error`).
 pub(crate) fn motor_error(world: &World, joint: JointHandle) -> (Vec2, Real) {
-    let def = &world.joint_of::<MotorJoint>(joint).unwrap().def;
+    let def = &world.joint_of::<MotorJoint>(joint).unwrap().def();
     let (a, b) = (def.base.body_a, def.base.body_b);
     let (ta, tb) = (world.transform(a).unwrap(), world.transform(b).unwrap());
     let linear = tb.apply(def.base.local_frame_b.anchor) - ta.apply(def.target_anchor_a());
@@ -506,6 +506,6 @@ fn bad_motor_input_is_a_typed_error_and_changes_nothing() {
     assert_eq!(world.joint(joint).unwrap().def(), good.clone().into());
     let moved = good.with_offset(Vec2::new(0.5, 0.0), 0.25);
     world.set_joint_def(joint, moved.clone().into()).unwrap();
-    assert_eq!(world.joint_of::<MotorJoint>(joint).unwrap().def, moved);
+    assert_eq!(world.joint_of::<MotorJoint>(joint).unwrap().def(), &moved);
     assert_eq!(world.joint(joint).unwrap().kind(), JointKind::Motor);
 }

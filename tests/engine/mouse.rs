@@ -301,7 +301,7 @@ fn mouse_settles_at_its_static_error_and_bounds_its_force() {
     assert!((p - Vec2::new(3.0, 1.0 - sag)).length() < 5e-4, "{p:?}");
     assert!((force - Vec2::new(0.0, 20.0)).length() < 0.05, "{force:?}");
     let m = w.joint_of::<MouseJoint>(j).unwrap();
-    assert!((m.def.target - Vec2::new(3.0, 1.0)).length() == 0.0);
+    assert!((m.def().target - Vec2::new(3.0, 1.0)).length() == 0.0);
     // 10 N at most: falls at 5 m/s² (the pull always at its bound).
     let (w, b, j) = run(10.0);
     let force = w.joint_force(j).unwrap();
@@ -388,7 +388,7 @@ fn mouse_drags_a_box_out_of_pyramid20() {
             .world
             .joint_of::<MouseJoint>(mouse)
             .unwrap()
-            .def
+            .def()
             .clone();
         def.target = target;
         scene.world.set_joint_def(mouse, def.into()).unwrap();
@@ -399,7 +399,7 @@ fn mouse_drags_a_box_out_of_pyramid20() {
     }
     let p = scene.world.position(top).unwrap();
     let m = scene.world.joint_of::<MouseJoint>(mouse).unwrap();
-    let to_target = (p - m.def.target).length();
+    let to_target = (p - m.def().target).length();
     println!(
         "pyramid20 drag: top box from {grab:?} to {p:?} (target {target:?}, {to_target:.4} m off); worst other box moved {:.3} mm",
         1e3 * worst

@@ -527,7 +527,11 @@ fn bad_prismatic_input_is_a_typed_error_and_changes_nothing() {
     world.set_joint_motor_speed(joint, 0.5).unwrap();
     world.enable_joint_motor(joint, true).unwrap();
     world.enable_joint_limit(joint, true).unwrap();
-    let d = world.joint_of::<PrismaticJoint>(joint).unwrap().def.clone();
+    let d = world
+        .joint_of::<PrismaticJoint>(joint)
+        .unwrap()
+        .def()
+        .clone();
     assert!(d.enable_limit && d.enable_motor);
     assert_eq!(
         (d.lower_translation, d.upper_translation, d.max_motor_force),

@@ -105,7 +105,7 @@ fn joint_setters_reject_bad_values_and_leave_the_joint_unchanged() {
         Vec2::new(0.0, -0.5),
     );
     let j = world.create_revolute_joint(&def).unwrap();
-    let before = world.revolute_joint(j).unwrap().def.clone();
+    let before = world.revolute_joint(j).unwrap().def().clone();
     assert_eq!(
         world.set_joint_max_motor_torque(j, -1.0),
         Err(WorldError::OutOfRange("max_motor_torque"))
@@ -122,12 +122,12 @@ fn joint_setters_reject_bad_values_and_leave_the_joint_unchanged() {
         world.set_joint_spring(j, -2.0, 0.5),
         Err(WorldError::OutOfRange("spring"))
     );
-    assert_eq!(world.revolute_joint(j).unwrap().def, before);
+    assert_eq!(world.revolute_joint(j).unwrap().def(), &before);
     world.set_joint_limits(j, -0.5, 0.25).unwrap();
     world.enable_joint_limit(j, true).unwrap();
     world.set_joint_max_motor_torque(j, 10.0).unwrap();
     world.enable_joint_motor(j, true).unwrap();
-    let d = &world.revolute_joint(j).unwrap().def;
+    let d = &world.revolute_joint(j).unwrap().def();
     assert_eq!((d.lower_angle, d.upper_angle), (-0.5, 0.25));
     assert!(d.enable_limit && d.enable_motor && d.max_motor_torque == 10.0);
     assert_eq!(world.revolute_joint(j).unwrap().row_count(), 2 + 2 + 1);

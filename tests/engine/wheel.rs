@@ -277,7 +277,7 @@ fn bad_wheel_input_is_a_typed_error_and_changes_nothing() {
     world.set_joint_max_motor_torque(joint, 30.0).unwrap();
     world.enable_joint_motor(joint, true).unwrap();
     world.set_joint_spring(joint, 4.0, 0.5).unwrap();
-    let d = world.joint_of::<WheelJoint>(joint).unwrap().def.clone();
+    let d = world.joint_of::<WheelJoint>(joint).unwrap().def().clone();
     assert!(d.enable_limit && d.enable_motor && d.enable_spring);
     assert_eq!(
         (d.max_motor_torque, d.hertz, d.damping_ratio),

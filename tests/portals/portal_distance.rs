@@ -67,7 +67,7 @@ fn rod_through(eta: Real) -> Run {
         // The joint's two ends are always on one side (the world moves
         // both when both have crossed): its gap is a length in that
         // side's metres, during the crossings too.
-        let length = world.joint_of::<DistanceJoint>(joint).unwrap().def.length;
+        let length = world.joint_of::<DistanceJoint>(joint).unwrap().def().length;
         let gap = world.joint_gap(joint).unwrap();
         r.worst_error = r.worst_error.max((gap - length).abs());
         // Both out of the wall portal (x = −19.5, facing +x), no crossing.
@@ -76,7 +76,7 @@ fn rod_through(eta: Real) -> Run {
     }
     let j = world.joint_of::<DistanceJoint>(joint).unwrap();
     assert!(j.is_enabled());
-    r.def_length = j.def.length;
+    r.def_length = j.def().length;
     r.final_length = world.joint_gap(joint).unwrap();
     if report() {
         eprintln!(

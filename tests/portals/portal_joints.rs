@@ -213,7 +213,7 @@ fn jointed_pair_backs_out_whole() {
     assert_eq!(world.crossing_count(), 0);
     let j = world.revolute_joint(joint).unwrap();
     assert!(j.is_enabled());
-    assert_eq!((j.def.base.body_a, j.def.base.body_b), (a, b));
+    assert_eq!((j.def().base.body_a, j.def().base.body_b), (a, b));
     // Both back above the floor portal, moving up.
     for body in [a, b] {
         let p = world.position(body).unwrap();

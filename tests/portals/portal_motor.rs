@@ -60,8 +60,8 @@ fn local_center(world: &World, body: BodyHandle) -> Vec2 {
 fn error_through_map(world: &World, joint: JointHandle, pair: PortalPairHandle) -> Real {
     let j = world.joint_of::<MotorJoint>(joint).unwrap();
     let ends = [
-        (j.def.base.body_a, j.def.target_anchor_a()),
-        (j.def.base.body_b, j.def.base.local_frame_b.anchor),
+        (j.def().base.body_a, j.def().target_anchor_a()),
+        (j.def().base.body_b, j.def().base.local_frame_b.anchor),
     ];
     let at = |(b, l): (BodyHandle, Vec2)| world.transform(b).unwrap().apply(l);
     let mut error = (at(ends[0]) - at(ends[1])).length();
@@ -81,7 +81,7 @@ fn error_through_map(world: &World, joint: JointHandle, pair: PortalPairHandle) 
 
 /// The relative angle error `θ_b − θ_a − θ_ref − θ_off`, rad.
 fn angle_error(world: &World, joint: JointHandle) -> Real {
-    let def = &world.joint_of::<MotorJoint>(joint).unwrap().def;
+    let def = &world.joint_of::<MotorJoint>(joint).unwrap().def();
     let (qa, qb) = (
         world.transform(def.base.body_a).unwrap().q,
         world.transform(def.base.body_b).unwrap().q,
@@ -142,7 +142,7 @@ fn motor_joined_pair_keeps_its_offset_through_a_portal() {
         }
     }
     let j = world.joint_of::<MotorJoint>(joint).unwrap();
-    let offset = j.def.linear_offset;
+    let offset = j.def().linear_offset;
     if report() {
         eprintln!(
             "motor pair through η = {ETA}: worst error {:.3} mm while crossing, {:.3} mm after \
@@ -155,7 +155,7 @@ fn motor_joined_pair_keeps_its_offset_through_a_portal() {
     assert_eq!(disabled, 0);
     assert!(j.is_enabled());
     assert!(out_at.is_some(), "the pair did not come out");
-    assert_eq!((j.def.base.body_a, j.def.base.body_b), (a, b));
+    assert_eq!((j.def().base.body_a, j.def().base.body_b), (a, b));
     // The offset scaled with the pair: η × 0.6 m.
     assert!((offset - ETA * OFFSET).length() < 1e-5, "offset {offset}");
     assert!(

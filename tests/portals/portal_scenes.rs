@@ -573,8 +573,8 @@ fn joint_on_a_body_that_goes_through_follows_it() {
     let j = world.revolute_joint(joint).unwrap();
     assert!(j.is_enabled());
     // The joint now joins the box (on the exit side) and the buddy's copy there.
-    assert_eq!(j.def.base.body_a, scene.probe);
-    assert_eq!(Some(j.def.base.body_b), world.clone_of(buddy));
+    assert_eq!(j.def().base.body_a, scene.probe);
+    assert_eq!(Some(j.def().base.body_b), world.clone_of(buddy));
     assert!(worst_gap < 0.01, "joint gap {worst_gap} m");
     // The handle now refers to the object on the exit side (the wall at x = -20).
     assert!(world.position(scene.probe).unwrap().x < -15.0);

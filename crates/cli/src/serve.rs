@@ -450,7 +450,7 @@ impl Session {
             self.release();
             return Ok(());
         };
-        let mut def = j.def.clone().with_target(p);
+        let mut def = j.def().clone().with_target(p);
         def.base.local_frame_a.anchor = p;
         world.set_joint_def(g.joint, def.into())?;
         Ok(())

@@ -394,7 +394,7 @@ impl KindDef for DistanceJointDef {
 pub struct DistanceJoint {
     /// The definition it was made from (lengths, spring and motor as last
     /// set).
-    pub def: DistanceJointDef,
+    pub(crate) def: Box<DistanceJointDef>,
     /// State indices, masses and switches the solver reads.
     pub(crate) base: JointBase,
     /// Anchor on a relative to a's centre at the start of the step (world
@@ -442,7 +442,7 @@ impl DistanceJoint {
     /// A joint from a definition (validate it first).
     pub fn new(def: DistanceJointDef) -> Self {
         DistanceJoint {
-            def,
+            def: Box::new(def),
             base: JointBase::default(),
             frame_a: Vec2::ZERO,
             frame_b: Vec2::ZERO,

@@ -88,7 +88,7 @@ impl KindDef for FilterJointDef {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct FilterJoint {
     /// The definition it was made from.
-    pub def: FilterJointDef,
+    pub(crate) def: Box<FilterJointDef>,
     /// State indices and switches the colouring reads.
     pub(crate) base: JointBase,
 }
@@ -97,7 +97,7 @@ impl FilterJoint {
     /// A joint from a definition (validate it first).
     pub fn new(def: FilterJointDef) -> Self {
         FilterJoint {
-            def,
+            def: Box::new(def),
             base: JointBase::default(),
         }
     }

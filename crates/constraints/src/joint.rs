@@ -120,6 +120,15 @@ macro_rules! joint_kinds {
                     JointDef::$kind(def)
                 }
             }
+            impl $joint {
+                /// The definition it was made from, as it stands (kept
+                /// boxed, apart from the rows the solver sweeps).
+                #[inline]
+                #[must_use]
+                pub fn def(&self) -> &$def {
+                    &self.def
+                }
+            }
             impl From<$joint> for Joint {
                 fn from(j: $joint) -> Self {
                     Joint::$kind(j)
@@ -208,7 +217,7 @@ macro_rules! joint_kinds {
             /// Its definition as it stands (limits, motor and spring as last set).
             #[must_use]
             pub fn def(&self) -> JointDef {
-                match self { $( Joint::$kind(j) => JointDef::$kind(j.def.clone()), )* }
+                match self { $( Joint::$kind(j) => JointDef::$kind((*j.def).clone()), )* }
             }
 
             /// The shared part of its definition.
@@ -234,7 +243,7 @@ macro_rules! joint_kinds {
                     return Err(JointError::FixedField);
                 }
                 match (self, def) {
-                    $( (Joint::$kind(j), JointDef::$kind(d)) => j.def = d, )*
+                    $( (Joint::$kind(j), JointDef::$kind(d)) => *j.def = d, )*
                     #[allow(unreachable_patterns)]
                     _ => return Err(JointError::WrongKind),
                 }

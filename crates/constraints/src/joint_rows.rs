@@ -165,6 +165,16 @@ pub(crate) struct RowSolve {
     pub(crate) m: PairMass,
 }
 
+/// The bound on a point block's accumulated impulse (N·s): `max_length`
+/// (`Real::INFINITY` for none) or the row speed bound of its translation
+/// `K`, whichever is smaller. Depends on the masses only, so a joint may
+/// compute it at prepare.
+#[inline(always)]
+#[must_use]
+pub(crate) fn point_bound(m: &PairMass, max_length: Real) -> Real {
+    max_length.min(row_bound_of_k(m.a.inv_mass + m.b.inv_mass))
+}
+
 impl RowSolve {
     /// A linear row ([`AxisRow`]) with its terms and bounds.
     #[inline(always)]
@@ -204,15 +214,15 @@ impl RowSolve {
     }
 
     /// The point block at arms `r_a`, `r_b` (m), its bias a vector;
-    /// `max_length` bounds the accumulated impulse's length (N·s;
-    /// `Real::INFINITY` for none).
+    /// `bound` bounds the accumulated impulse's length (N·s; from
+    /// [`point_bound`], which a joint may keep from its prepare).
     #[inline(always)]
     pub(crate) fn point(
         &mut self,
         r_a: Vec2,
         r_b: Vec2,
         t: PointTerms,
-        max_length: Real,
+        bound: Real,
         impulse: &mut Vec2,
     ) {
         let (sa, sb) = (&mut self.sa, &mut self.sb);
@@ -223,7 +233,6 @@ impl RowSolve {
             soft_impulse(t.mass_scale, x.x, t.impulse_scale, impulse.x),
             soft_impulse(t.mass_scale, x.y, t.impulse_scale, impulse.y),
         );
-        let bound = max_length.min(row_bound_of_k(self.m.a.inv_mass + self.m.b.inv_mass));
         let sum = *impulse + lambda;
         let step = if sum.length_squared() <= bound * bound {
             *impulse = sum;

@@ -54,7 +54,7 @@ use janus2d_core::softness::Softness;
 
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef};
-use crate::joint_rows::{Bounds, PointTerms, RowSolve, Terms, WarmSide};
+use crate::joint_rows::{Bounds, PointTerms, RowSolve, Terms, WarmSide, point_bound};
 use crate::kind_rows::KindRows;
 use crate::parts::{AnglePart, PointPart};
 use crate::{JointError, check_anchor};
@@ -238,7 +238,7 @@ impl KindDef for MotorJointDef {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct MotorJoint {
     /// The definition it was made from.
-    pub def: MotorJointDef,
+    pub(crate) def: Box<MotorJointDef>,
     /// State indices, masses and switches the solver reads.
     pub(crate) base: JointBase,
     /// The linear rows (target point on a, anchor on b).
@@ -259,7 +259,7 @@ impl MotorJoint {
     /// A joint from a definition (validate it first).
     pub fn new(def: MotorJointDef) -> Self {
         MotorJoint {
-            def,
+            def: Box::new(def),
             base: JointBase::default(),
             point: PointPart::default(),
             angle: AnglePart::default(),
@@ -395,7 +395,7 @@ impl KindRows for MotorJoint {
             r_a,
             r_b,
             t,
-            self.max_linear_impulse,
+            point_bound(&s.m, self.max_linear_impulse),
             &mut self.point.impulse,
         );
     }

@@ -42,10 +42,10 @@
 //! let ground = bodies.create(&BodyDef::fixed(Vec2::ZERO)).unwrap();
 //! let ball = bodies.create(&BodyDef::dynamic(Vec2::new(0.0, 1.0))).unwrap();
 //! let mut joint = Joint::new(MouseJointDef::new(ground, ball, Vec2::new(0.0, 1.0), 1000.0).into());
-//! let mut def = joint.of::<MouseJoint>().unwrap().def.clone();
+//! let mut def = joint.of::<MouseJoint>().unwrap().def().clone();
 //! def.target = Vec2::new(2.0, 1.0);
 //! joint.set_def(def.into()).unwrap();
-//! assert_eq!(joint.of::<MouseJoint>().unwrap().def.target, Vec2::new(2.0, 1.0));
+//! assert_eq!(joint.of::<MouseJoint>().unwrap().def().target, Vec2::new(2.0, 1.0));
 //! ```
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState, InvMass};
@@ -226,7 +226,7 @@ impl KindDef for MouseJointDef {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct MouseJoint {
     /// The definition it was made from (the target as last set).
-    pub def: MouseJointDef,
+    pub(crate) def: Box<MouseJointDef>,
     /// State indices, masses and switches the solver reads.
     pub(crate) base: JointBase,
     /// Anchor on b relative to b's centre at the start of the step (world
@@ -257,7 +257,7 @@ impl MouseJoint {
     /// A joint from a definition (validate it first).
     pub fn new(def: MouseJointDef) -> Self {
         MouseJoint {
-            def,
+            def: Box::new(def),
             base: JointBase::default(),
             frame_b: Vec2::ZERO,
             delta_center: Vec2::ZERO,

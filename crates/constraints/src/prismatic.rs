@@ -440,7 +440,7 @@ impl KindDef for PrismaticJointDef {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PrismaticJoint {
     /// The definition it was made from (limits, motor and spring settings).
-    pub def: PrismaticJointDef,
+    pub(crate) def: Box<PrismaticJointDef>,
     /// State indices, masses and switches the solver reads.
     pub(crate) base: JointBase,
     /// The geometry at the start of the step.
@@ -487,7 +487,7 @@ impl PrismaticJoint {
     /// A joint from a definition (validate it first).
     pub fn new(def: PrismaticJointDef) -> Self {
         PrismaticJoint {
-            def,
+            def: Box::new(def),
             base: JointBase::default(),
             frame: SlideFrame::default(),
             delta_angle: 0.0,

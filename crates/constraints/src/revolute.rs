@@ -39,7 +39,7 @@ use janus2d_core::softness::Softness;
 
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
-use crate::joint_rows::{Bounds, PointTerms, RowSolve, Terms, WarmSide};
+use crate::joint_rows::{Bounds, PointTerms, RowSolve, Terms, WarmSide, point_bound};
 use crate::kind_rows::{KindRows, TreeRows};
 use crate::parts::{AnglePart, PairMass, PointPart, angular_correction_cap};
 use crate::{JointError, check_motor_speed, check_spring};
@@ -245,6 +245,12 @@ pub struct RevoluteJoint {
     pub(crate) point: PointPart,
     /// Softness of the point rows for this step (mass-ratio aware).
     point_softness: Softness,
+    /// The definition's row switches (spring, motor, limit), copied at
+    /// prepare so that the solve reads no line of the definition.
+    switches: Switches,
+    /// The point block's impulse bound for this step, N·s
+    /// ([`point_bound`], kept from prepare).
+    point_bound: Real,
     /// `θ_b − θ_a − θ_ref` at the start of the step, rad.
     delta_angle: Real,
     spring: AnglePart,
@@ -253,7 +259,26 @@ pub struct RevoluteJoint {
     upper: AnglePart,
     spring_softness: Softness,
     /// The definition it was made from (limits, motor and spring settings).
-    pub def: RevoluteJointDef,
+    pub(crate) def: Box<RevoluteJointDef>,
+}
+
+/// Which angle rows a revolute joint solves this step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+struct Switches {
+    spring: bool,
+    motor: bool,
+    limit: bool,
+}
+
+impl Switches {
+    fn of(def: &RevoluteJointDef) -> Self {
+        Switches {
+            spring: def.enable_spring,
+            motor: def.enable_motor,
+            limit: def.enable_limit,
+        }
+    }
 }
 
 /// The softness of the Gauss–Seidel point rows: the joint softness scaled
@@ -278,7 +303,8 @@ impl RevoluteJoint {
     /// A joint from a definition (validate it first).
     pub fn new(def: RevoluteJointDef) -> Self {
         RevoluteJoint {
-            def,
+            switches: Switches::of(&def),
+            def: Box::new(def),
             base: JointBase::default(),
             point: PointPart::default(),
             delta_angle: 0.0,
@@ -288,6 +314,7 @@ impl RevoluteJoint {
             upper: AnglePart::default(),
             spring_softness: Softness::RIGID,
             point_softness: Softness::RIGID,
+            point_bound: Real::INFINITY,
         }
     }
 
@@ -411,12 +438,13 @@ impl KindRows for RevoluteJoint {
     fn solve_rows(&mut self, ctx: &StepContext, use_bias: bool, s: &mut RowSolve) {
         // The angle depends on the rotations only, which the rows do not
         // change: one atan2 for the spring and the limits.
-        let angle = if self.def.enable_spring || self.def.enable_limit {
+        let on = self.switches;
+        let angle = if on.spring || on.limit {
             self.current_angle(&s.sa, &s.sb)
         } else {
             0.0
         };
-        if self.def.enable_spring && s.m.a.inv_inertia + s.m.b.inv_inertia > 0.0 {
+        if on.spring && s.m.a.inv_inertia + s.m.b.inv_inertia > 0.0 {
             // A spring: its feedback is its force, not capped.
             let t = Terms::soft(
                 self.spring_softness,
@@ -431,12 +459,12 @@ impl KindRows for RevoluteJoint {
                 &mut self.spring.impulse,
             );
         }
-        if self.def.enable_motor {
+        if on.motor {
             let t = Terms::motor(self.def.motor_speed);
             let bounds = Bounds::symmetric(ctx.h * self.def.max_motor_torque);
             s.angle(1.0, self.motor.mass, t, bounds, &mut self.motor.impulse);
         }
-        if self.def.enable_limit {
+        if on.limit {
             let soft = ctx.joint_softness;
             let max_bias = angular_correction_cap(ctx.joint_max_correction_speed);
             let lower = Terms::limit(
@@ -476,7 +504,7 @@ impl KindRows for RevoluteJoint {
                 ctx.joint_max_correction_speed,
                 use_bias,
             );
-            s.point(r_a, r_b, t, Real::INFINITY, &mut self.point.impulse);
+            s.point(r_a, r_b, t, self.point_bound, &mut self.point.impulse);
         }
     }
     #[inline(always)]
@@ -515,9 +543,15 @@ impl Constraint for RevoluteJoint {
         self.point.frame_a = q_a.rotate(self.def.base.local_frame_a.anchor - a.sim.local_center);
         self.point.frame_b = q_b.rotate(self.def.base.local_frame_b.anchor - b.sim.local_center);
         self.point.delta_center = b.sim.center - a.sim.center;
-        self.delta_angle = janus2d_core::math::wrap_angle(
-            q_a.relative_angle(q_b) - self.def.base.reference_angle(),
-        );
+        self.switches = Switches::of(&self.def);
+        // The angle is read by the spring and the limits only (one atan2).
+        self.delta_angle = if self.def.enable_spring || self.def.enable_limit {
+            janus2d_core::math::wrap_angle(
+                q_a.relative_angle(q_b) - self.def.base.reference_angle(),
+            )
+        } else {
+            0.0
+        };
         let m = &self.base.masses;
         for part in [
             &mut self.spring,
@@ -529,6 +563,7 @@ impl Constraint for RevoluteJoint {
         }
         self.spring_softness = Softness::new(self.def.hertz, self.def.damping_ratio, ctx.h);
         self.point_softness = point_softness(&self.def, ctx, m);
+        self.point_bound = point_bound(m, Real::INFINITY);
         if !ctx.warm_starting {
             self.point.impulse = Vec2::ZERO;
             self.spring.impulse = 0.0;

@@ -42,7 +42,7 @@ use janus2d_core::softness::Softness;
 
 use crate::joint_base::{JointBase, RowsAt};
 use crate::joint_def::{JointDefBase, KindDef};
-use crate::joint_rows::{Bounds, PointTerms, RowSolve, Terms, WarmSide};
+use crate::joint_rows::{Bounds, PointTerms, RowSolve, Terms, WarmSide, point_bound};
 use crate::kind_rows::{KindRows, TreeAngle, TreeRows};
 use crate::parts::{AnglePart, PairMass, PointPart, angular_correction_cap};
 use crate::{JointError, check_spring};
@@ -184,7 +184,7 @@ impl KindDef for WeldJointDef {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct WeldJoint {
     /// The definition it was made from.
-    pub def: WeldJointDef,
+    pub(crate) def: Box<WeldJointDef>,
     /// State indices, masses and switches the solver reads.
     pub(crate) base: JointBase,
     /// The point rows.
@@ -220,7 +220,7 @@ impl WeldJoint {
     /// A joint from a definition (validate it first).
     pub fn new(def: WeldJointDef) -> Self {
         WeldJoint {
-            def,
+            def: Box::new(def),
             base: JointBase::default(),
             point: PointPart::default(),
             angle: AnglePart::default(),
@@ -374,7 +374,13 @@ impl KindRows for WeldJoint {
                 use_bias,
             )
         };
-        s.point(r_a, r_b, t, Real::INFINITY, &mut self.point.impulse);
+        s.point(
+            r_a,
+            r_b,
+            t,
+            point_bound(&s.m, Real::INFINITY),
+            &mut self.point.impulse,
+        );
     }
     #[inline(always)]
     fn tree_rows(&self) -> Option<TreeRows<'_>> {

@@ -262,7 +262,7 @@ impl KindDef for WheelJointDef {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct WheelJoint {
     /// The definition it was made from (spring, limits and motor settings).
-    pub def: WheelJointDef,
+    pub(crate) def: Box<WheelJointDef>,
     /// State indices, masses and switches the solver reads.
     pub(crate) base: JointBase,
     /// The geometry at the start of the step.
@@ -287,7 +287,7 @@ impl WheelJoint {
     /// A joint from a definition (validate it first).
     pub fn new(def: WheelJointDef) -> Self {
         WheelJoint {
-            def,
+            def: Box::new(def),
             base: JointBase::default(),
             frame: SlideFrame::default(),
             perp_row: AxisRow::default(),

@@ -188,8 +188,8 @@ pub fn gap_through_map(world: &World, joint: JointHandle, pair: PortalPairHandle
         return Real::INFINITY;
     }
     let ends = [
-        (j.def.base.body_a, j.def.base.local_frame_a.anchor),
-        (j.def.base.body_b, j.def.base.local_frame_b.anchor),
+        (j.def().base.body_a, j.def().base.local_frame_a.anchor),
+        (j.def().base.body_b, j.def().base.local_frame_b.anchor),
     ];
     let world_anchor = |(b, l): (BodyHandle, Vec2)| world.transform(b).expect("live").apply(l);
     let mut gap = (world_anchor(ends[0]) - world_anchor(ends[1])).length();

@@ -637,24 +637,24 @@ fn draw_kind<D: DebugDraw + ?Sized>(
     };
     match joint {
         J::Prismatic(j) => axis_with_limits(
-            j.def
+            j.def()
                 .enable_limit
-                .then_some((j.def.lower_translation, j.def.upper_translation)),
+                .then_some((j.def().lower_translation, j.def().upper_translation)),
         ),
         J::Wheel(j) => axis_with_limits(
-            j.def
+            j.def()
                 .enable_limit
-                .then_some((j.def.lower_translation, j.def.upper_translation)),
+                .then_some((j.def().lower_translation, j.def().upper_translation)),
         ),
         J::Mouse(j) => {
-            draw.point(j.def.target, 2.0 * point_size, c);
-            draw.segment(pa, j.def.target, c);
+            draw.point(j.def().target, 2.0 * point_size, c);
+            draw.segment(pa, j.def().target, c);
         }
         J::Motor(j) => {
             let target = xa.apply(base.local_frame_a.anchor)
                 + xa.q.rotate(
                     janus2d_core::math::Rot::from_angle(base.local_frame_a.angle)
-                        .rotate(j.def.linear_offset),
+                        .rotate(j.def().linear_offset),
                 );
             draw.point(target, 2.0 * point_size, c);
         }

@@ -146,22 +146,22 @@ fn a_file_with_every_kind_builds_what_it_says() {
             JointKind::Filter
         ]
     );
-    let r = &w.joint_of::<RevoluteJoint>(h[0]).unwrap().def;
+    let r = &w.joint_of::<RevoluteJoint>(h[0]).unwrap().def();
     assert!(r.enable_limit && r.enable_motor && r.enable_spring);
     assert_eq!((r.max_motor_torque, r.target_angle), (10.0, 0.1));
     assert_eq!(r.base.force_threshold, 400.0);
     assert_eq!(w.joint_user_data(h[0]).unwrap(), 7);
-    let p = &w.joint_of::<PrismaticJoint>(h[1]).unwrap().def;
+    let p = &w.joint_of::<PrismaticJoint>(h[1]).unwrap().def();
     let axis = p.base.local_frame_a.axis();
     assert!(
         axis.x.abs() < 1e-6 && (axis.y - 1.0).abs() < 1e-6,
         "{axis:?}"
     );
     assert_eq!((p.max_motor_force, p.target_translation), (500.0, 1.0));
-    let wh = &w.joint_of::<WheelJoint>(h[2]).unwrap().def;
+    let wh = &w.joint_of::<WheelJoint>(h[2]).unwrap().def();
     assert!(wh.enable_spring && wh.enable_motor && !wh.enable_limit);
     assert!(wh.base.collide_connected);
-    let d = &w.joint_of::<DistanceJoint>(h[4]).unwrap().def;
+    let d = &w.joint_of::<DistanceJoint>(h[4]).unwrap().def();
     assert!(d.is_rope(), "{d:?}");
     assert!(
         (d.length - 2.5).abs() < 1e-6,
@@ -169,12 +169,12 @@ fn a_file_with_every_kind_builds_what_it_says() {
         d.length
     );
     assert_eq!(d.base.draw_scale, 2.0);
-    let m = &w.joint_of::<MotorJoint>(h[5]).unwrap().def;
+    let m = &w.joint_of::<MotorJoint>(h[5]).unwrap().def();
     assert_eq!(
         (m.max_force, m.max_torque, m.correction_factor),
         (100.0, 20.0, 0.2)
     );
-    let mouse = &w.joint_of::<MouseJoint>(h[6]).unwrap().def;
+    let mouse = &w.joint_of::<MouseJoint>(h[6]).unwrap().def();
     assert_eq!(
         (mouse.max_force, mouse.hertz, mouse.angular_hertz),
         (200.0, 3.0, 1.0)

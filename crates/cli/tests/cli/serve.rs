@@ -225,9 +225,9 @@ fn grab_drag_and_spawn() {
         let mouse = w
             .joint_of::<janus2d_constraints::MouseJoint>(joint)
             .unwrap();
-        assert_eq!(mouse.def.base.body_b, body);
+        assert_eq!(mouse.def().base.body_b, body);
         assert_eq!(
-            w.body_type(mouse.def.base.body_a),
+            w.body_type(mouse.def().base.body_a),
             Ok(janus2d_core::body::BodyType::Static)
         );
         assert_eq!((w.body_count(), w.joint_count()), (bodies + 1, joints + 1));
@@ -254,7 +254,7 @@ fn grab_drag_and_spawn() {
         .world()
         .joint_of::<janus2d_constraints::MouseJoint>(joint)
         .unwrap()
-        .def
+        .def()
         .target;
     assert_eq!(
         (target.x, target.y),

@@ -205,7 +205,7 @@ impl World {
     /// let pin = world
     ///     .create_joint(&RevoluteJointDef::new(ground, bob, Vec2::ZERO, Vec2::new(-1.0, 0.0)).into())
     ///     .unwrap();
-    /// let mut def = world.joint_of::<RevoluteJoint>(pin).unwrap().def.clone();
+    /// let mut def = world.joint_of::<RevoluteJoint>(pin).unwrap().def().clone();
     /// def.base.force_threshold = 400.0;
     /// world.set_joint_def(pin, def.into()).unwrap();
     /// assert_eq!(world.joint(pin).unwrap().def_base().force_threshold, 400.0);
