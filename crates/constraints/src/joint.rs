@@ -131,7 +131,9 @@ macro_rules! joint_kinds {
             }
             impl From<$joint> for Joint {
                 fn from(j: $joint) -> Self {
-                    Joint::$kind(j)
+                    let mut j = Joint::$kind(j);
+                    j.keep_def_reads();
+                    j
                 }
             }
             impl JointOfKind for $joint {
@@ -205,7 +207,9 @@ macro_rules! joint_kinds {
             /// A joint from a definition (validate it first).
             #[must_use]
             pub fn new(def: JointDef) -> Self {
-                match def { $( JointDef::$kind(d) => Joint::$kind($joint::new(d)), )* }
+                let mut j = match def { $( JointDef::$kind(d) => Joint::$kind($joint::new(d)), )* };
+                j.keep_def_reads();
+                j
             }
 
             /// Its kind.
@@ -242,11 +246,12 @@ macro_rules! joint_kinds {
                 if (a, b) != self.bodies() || def.base().collide_connected != self.collide_connected() {
                     return Err(JointError::FixedField);
                 }
-                match (self, def) {
+                match (&mut *self, def) {
                     $( (Joint::$kind(j), JointDef::$kind(d)) => *j.def = d, )*
                     #[allow(unreachable_patterns)]
                     _ => return Err(JointError::WrongKind),
                 }
+                self.keep_def_reads();
                 Ok(())
             }
 
@@ -266,6 +271,10 @@ macro_rules! joint_kinds {
             /// light clusters leave such bodies out).
             #[must_use]
             pub fn is_driven(&self) -> bool {
+                self.base().driven
+            }
+
+            fn drives(&self) -> bool {
                 match self { $( Joint::$kind(j) => KindRows::is_driven(j), )* }
             }
 
@@ -339,6 +348,7 @@ macro_rules! joint_kinds {
         impl Constraint for Joint {
             fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
                 match self { $( Joint::$kind(j) => Constraint::prepare(j, ctx, bodies), )* }
+                self.keep_def_reads();
             }
 
             fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
@@ -488,6 +498,31 @@ impl Joint {
         self.base().in_tree
     }
 
+    /// Copies what the step's end and the contact building read of the
+    /// definition into the base ([`JointBase::rows`],
+    /// [`JointBase::watched`], [`JointBase::driven`]): the definition
+    /// is boxed apart, and one more line per joint in those passes was a
+    /// tenth of a joint-only step's end.
+    fn keep_def_reads(&mut self) {
+        let rows = u8::try_from(self.row_count()).unwrap_or(u8::MAX);
+        let driven = self.drives();
+        let base = self.def_base();
+        let watched =
+            base.force_threshold < Real::INFINITY || base.torque_threshold < Real::INFINITY;
+        let b = self.base_mut();
+        b.rows = rows;
+        b.watched = watched;
+        b.driven = driven;
+    }
+
+    /// Rows it added to the solver at the last prepare when enabled (the
+    /// definition's [`Joint::row_count`] as it was then; a step's row
+    /// count reads this, not the definition).
+    #[must_use]
+    pub fn prepared_row_count(&self) -> usize {
+        usize::from(self.base().rows)
+    }
+
     /// Rows of this joint the tree solve takes when it is in a tree.
     #[must_use]
     pub fn tree_row_count(&self) -> usize {
@@ -530,11 +565,11 @@ impl Joint {
     /// before was not (one event per crossing; falling back below re-arms
     /// it).
     pub fn check_thresholds(&mut self) -> bool {
-        let base = self.def_base();
-        let (force_threshold, torque_threshold) = (base.force_threshold, base.torque_threshold);
-        if force_threshold == Real::INFINITY && torque_threshold == Real::INFINITY {
+        if !self.base().watched {
             return false;
         }
+        let base = self.def_base();
+        let (force_threshold, torque_threshold) = (base.force_threshold, base.torque_threshold);
         let over = self.is_enabled()
             && (self.constraint_force().length() > force_threshold
                 || self.constraint_torque().abs() > torque_threshold);

@@ -9,6 +9,7 @@
 //! | `in_tree`          | the tree build    | the kind's rows (tree rows skipped), colouring |
 //! | `inv_h`            | prepare (`load`)  | force and torque read-back                |
 //! | `over_threshold`   | the joint events  | the joint events (one per crossing)       |
+//! | `rows`, `watched`, `driven` | prepare, a new or replaced definition | the step's end (row count, joint events), the light clusters (driven bodies) |
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyState, SolverBody};
 use janus2d_core::constraint::{BodyJacobian, Row, StepContext};
@@ -45,6 +46,13 @@ pub struct JointBase {
     /// The last solved step's force or torque was above its threshold
     /// (the joint events report the crossing once).
     pub(crate) over_threshold: bool,
+    /// Rows the definition adds when the joint is enabled (kept so the
+    /// step's end reads no definition).
+    pub(crate) rows: u8,
+    /// The definition has a finite force or torque threshold.
+    pub(crate) watched: bool,
+    /// A motor of nonzero strength drives the bodies.
+    pub(crate) driven: bool,
 }
 
 impl Default for JointBase {
@@ -58,6 +66,9 @@ impl Default for JointBase {
             resting: false,
             inv_h: 0.0,
             over_threshold: false,
+            rows: 0,
+            watched: false,
+            driven: false,
         }
     }
 }

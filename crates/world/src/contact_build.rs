@@ -168,9 +168,13 @@ impl ContactBuilder {
         // light cluster (`Clusters::assign`).
         let excluded = &mut self.excluded;
         excluded.clear();
-        for body in driven.chain(objects.iter().map(|o| o.body)) {
-            if let Some(i) = bodies.state_index(body).filter(|&i| i != 0) {
-                excluded.push(i);
+        // Read only when a contact could make a cluster (a joint-only
+        // scene scans no joint here).
+        if !handoff.touching.is_empty() || !woken.is_empty() {
+            for body in driven.chain(objects.iter().map(|o| o.body)) {
+                if let Some(i) = bodies.state_index(body).filter(|&i| i != 0) {
+                    excluded.push(i);
+                }
             }
         }
         let candidates = handoff.touching.iter().map(|&k| k as usize).chain(woken);

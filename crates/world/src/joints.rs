@@ -709,7 +709,7 @@ impl JointSet {
                 j.set_enabled(enabled);
             }
             if j.is_enabled() {
-                end.rows += j.row_count();
+                end.rows += j.prepared_row_count();
             }
             if j.in_tree() {
                 end.direct_rows += j.tree_row_count();

@@ -131,8 +131,10 @@ pub mod bytes {
     /// 13: shape definitions carry an offset, bodies their motion locks
     /// and enabled flag, and the world its disabled joints; 14: the
     /// collision stage keeps the chains; 15: the solver settings' free-tree
-    /// mass ratio, and the joint forest the policy it was built under).
-    pub const SNAPSHOT_VERSION: u16 = 15;
+    /// mass ratio, and the joint forest the policy it was built under;
+    /// 16: a joint's base keeps its row count and threshold switch, a
+    /// revolute joint its row switches and point-block bound).
+    pub const SNAPSHOT_VERSION: u16 = 16;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.
