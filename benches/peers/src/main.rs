@@ -18,6 +18,7 @@
 //! | `sweep`   | error against ms/step at 1, 2, 4, 8 substeps, per engine (CSV + SVG)   |
 //! | `chart`   | `chart RUN.csv CHART.svg`: the ratio chart redrawn from an `all --csv` file |
 //! | `joints`  | the joint scenes (weld cantilever, car, elevator, spring bridge): ms/step and ratios, each engine's accuracy figures side by side; an engine without the scene's joint kind shows `n/a` (`--substeps N`, `--md FILE`) |
+//! | `memory`  | per scene and engine (one thread, a fresh child process each): peak resident memory (VmHWM) minus a baseline process, janus2d ÷ Box2D, bytes per body (`--csv`, default `docs/performance/memory.csv`) |
 //!
 //! Options: `--threads 1,2`, `--repeats N` (default 2), `--steps N`,
 //! `--scenes a,b`, `--engines janus2d,box2d,rapier`, `--csv FILE`,
@@ -26,6 +27,7 @@
 //! for Box2D's AVX2 build beside janus2d's x86-64-v3 build.
 
 mod box2d;
+mod memory;
 mod rapier;
 
 use std::fmt::Write as _;
@@ -105,7 +107,15 @@ fn parse_args() -> Args {
             cmd if first
                 && matches!(
                     cmd,
-                    "all" | "profile" | "hard" | "sweep" | "chart" | "joints" | "scaling"
+                    "all"
+                        | "profile"
+                        | "hard"
+                        | "sweep"
+                        | "chart"
+                        | "joints"
+                        | "scaling"
+                        | "memory"
+                        | "memory-one"
                 ) =>
             {
                 args.command = cmd.into()
@@ -1125,6 +1135,8 @@ fn main() {
         "chart" => cmd_chart(&args),
         "joints" => cmd_joints(&args),
         "scaling" => cmd_scaling(&args),
+        "memory" => memory::cmd_memory(&args),
+        "memory-one" => memory::cmd_memory_one(&args),
         _ => cmd_all(&args),
     }
 }
