@@ -56,17 +56,18 @@ pub struct ContactPointData {
 }
 
 /// A persistent contact between two shapes whose fat boxes overlap.
+///
+/// Laid out in declaration order (`repr(C)`): what the narrowphase and
+/// constraint building read every step first, the fields only events and
+/// hooks read (id, shape handles, user material ids) last.
 #[derive(Clone, Debug)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[repr(C)]
 pub struct Contact {
-    /// Stable id for the contact's whole life.
-    pub id: u32,
     /// Shape a (lower slot index).
     pub shape_a: u32,
     /// Shape b.
     pub shape_b: u32,
-    /// Handles of the two shapes (for events).
-    pub shapes: [ShapeHandle; 2],
     /// Body of shape a.
     pub body_a: BodyHandle,
     /// Body of shape b.
@@ -88,9 +89,6 @@ pub struct Contact {
     /// The rolling row's bound per unit normal impulse, m (the larger
     /// rolling resistance times the larger rolling radius; 0: none).
     pub rolling_resistance: Real,
-    /// The shapes' user material ids (`ShapeDef::user_material_id`), a's
-    /// then b's.
-    pub user_material_ids: [u64; 2],
     /// True when the manifold has points.
     pub touching: bool,
     /// True when either shape is a sensor (events only).
@@ -113,6 +111,13 @@ pub struct Contact {
     /// The poses and points the manifold was last computed at, for
     /// recycling it (see the narrowphase).
     pub(crate) recycle: RecycleCache,
+    /// Stable id for the contact's whole life.
+    pub id: u32,
+    /// Handles of the two shapes (for events).
+    pub shapes: [ShapeHandle; 2],
+    /// The shapes' user material ids (`ShapeDef::user_material_id`), a's
+    /// then b's.
+    pub user_material_ids: [u64; 2],
 }
 
 /// What a contact keeps of the step its manifold was computed in, so that

@@ -547,19 +547,24 @@ pub(crate) fn check_material_limit(v: Real, name: &'static str) -> Result<(), Wo
 }
 
 /// A shape attached to a body.
+///
+/// Laid out in declaration order (`repr(C)`): the proxy, box, body and
+/// geometry the narrowphase reads for every contact first, the definition
+/// (read when a pair is made and by the API) last.
 #[derive(Clone, Debug)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[repr(C)]
 pub struct ShapeData {
+    /// Broadphase proxy.
+    pub proxy: u32,
+    /// Tight world box at the end of the last step.
+    pub aabb: Aabb,
     /// The body it is attached to.
     pub body: BodyHandle,
     /// Geometry in the body frame.
     pub geometry: Shape,
     /// Material and filter.
     pub def: ShapeDef,
-    /// Broadphase proxy.
-    pub proxy: u32,
-    /// Tight world box at the end of the last step.
-    pub aabb: Aabb,
 }
 
 /// The size figures of a body's solid shapes that continuous collision

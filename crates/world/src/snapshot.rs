@@ -133,7 +133,8 @@ pub mod bytes {
     /// collision stage keeps the chains; 15: the solver settings' free-tree
     /// mass ratio, and the joint forest the policy it was built under;
     /// 16: a joint's base keeps its row count and threshold switch, a
-    /// revolute joint its row switches and point-block bound).
+    /// revolute joint its row switches and point-block bound; contacts and
+    /// shapes list their hot fields first).
     pub const SNAPSHOT_VERSION: u16 = 16;
     const HEADER: usize = 24;
 
