@@ -507,3 +507,56 @@ fn stage_times_add_up_to_no_more_than_the_step() {
     );
     assert!(world.profile().total > 0.0);
 }
+
+/// Guards the joint base's copies of its definition (row count, motor
+/// switch, threshold switch; kept so the step's end and contact building
+/// read no boxed definition): each setter and `set_joint_def` updates them
+/// at once, so the step's row counter, the driven flag and the joint
+/// events follow every change.
+#[test]
+fn joint_counters_follow_every_definition_change() {
+    let mut world = World::new(WorldDef {
+        gravity: Vec2::new(0.0, -10.0),
+        sleep: SleepSettings {
+            enabled: false,
+            ..Default::default()
+        },
+        ..Default::default()
+    })
+    .unwrap();
+    let ground = world.create_body(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+    let bob = world
+        .create_body(&BodyDef::dynamic(Vec2::new(1.0, 0.0)).with_mass(1.0, 0.1))
+        .unwrap();
+    let j = world
+        .create_revolute_joint(&RevoluteJointDef::new(
+            ground,
+            bob,
+            Vec2::ZERO,
+            Vec2::new(-1.0, 0.0),
+        ))
+        .unwrap();
+    world.step(DT).unwrap();
+    assert_eq!(world.counters().joint_rows, 2);
+    world.set_joint_limits(j, -0.1, 0.1).unwrap();
+    world.enable_joint_limit(j, true).unwrap();
+    world.step(DT).unwrap();
+    assert_eq!(world.counters().joint_rows, 4);
+    assert!(!world.joint(j).unwrap().is_driven());
+    world.set_joint_max_motor_torque(j, 5.0).unwrap();
+    world.enable_joint_motor(j, true).unwrap();
+    // Before any step: contact building reads the flag first.
+    assert!(world.joint(j).unwrap().is_driven());
+    world.step(DT).unwrap();
+    assert_eq!(world.counters().joint_rows, 5);
+    assert!(world.events().joints.is_empty());
+    // A threshold below the hanging bob's 10 N: one event next step.
+    let mut def = world.joint(j).unwrap().def();
+    def.base_mut().force_threshold = 1.0;
+    world.set_joint_def(j, def).unwrap();
+    world.step(DT).unwrap();
+    assert_eq!(world.events().joints.len(), 1);
+    world.set_joint_enabled(j, false).unwrap();
+    world.step(DT).unwrap();
+    assert_eq!(world.counters().joint_rows, 0);
+}

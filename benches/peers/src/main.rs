@@ -62,6 +62,17 @@ struct Args {
     out: PathBuf,
 }
 
+impl Args {
+    /// The scenes named on the command line, or Box2D's ten.
+    fn scene_names(&self) -> Vec<String> {
+        if self.names.is_empty() {
+            BOX2D_TEN.iter().map(|s| s.to_string()).collect()
+        } else {
+            self.names.clone()
+        }
+    }
+}
+
 fn parse_args() -> Args {
     let mut args = Args {
         command: "all".into(),
@@ -172,11 +183,7 @@ struct Row {
 }
 
 fn cmd_all(args: &Args) {
-    let names: Vec<String> = if args.names.is_empty() {
-        BOX2D_TEN.iter().map(|s| s.to_string()).collect()
-    } else {
-        args.names.clone()
-    };
+    let names = args.scene_names();
     println!(
         "peers: {} | repeats {} | steps {} | threads {:?} | build: {}",
         args.engines.join(", "),

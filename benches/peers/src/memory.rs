@@ -18,7 +18,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::Command;
 
-use janus2d_testbed::benchmarks::{self, BOX2D_TEN};
+use janus2d_testbed::benchmarks;
 use janus2d_testbed::engine::{Engine, EngineOptions, scripted_step};
 use janus2d_testbed::janus::Janus;
 
@@ -139,11 +139,7 @@ fn above(r: &Reading, baseline_kib: u64) -> i64 {
 /// thread, a fresh process each), as MiB, janus2d ÷ Box2D and bytes per body; writes `--csv`
 /// (default `docs/performance/memory.csv`).
 pub fn cmd_memory(args: &Args) {
-    let names: Vec<String> = if args.names.is_empty() {
-        BOX2D_TEN.iter().map(|s| s.to_string()).collect()
-    } else {
-        args.names.clone()
-    };
+    let names = args.scene_names();
     let csv_path = args
         .csv
         .clone()

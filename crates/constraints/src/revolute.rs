@@ -233,9 +233,10 @@ impl KindDef for RevoluteJointDef {
 /// A revolute joint in solver form.
 ///
 /// Laid out in declaration order (`repr(C)`): the fields a Gauss–Seidel
-/// point row reads (its base, point part and softness) first, near each
-/// other, and the definition, which the solve reads only for its
-/// switches, last (the measurement is in docs/performance.md).
+/// point row reads (its base, point part, softness, row switches and
+/// bound) first, near each other; the definition is boxed apart and the
+/// solve reads it only for the settings of a row that is switched on
+/// (the measurement is in docs/performance.md).
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[repr(C)]
