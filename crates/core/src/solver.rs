@@ -579,14 +579,19 @@ struct VelocityTerms {
 
 /// The [`VelocityTerms`] of every body, by state index (state 0 and the
 /// bodies that are not dynamic are marked so), in blocks on the team.
-fn velocity_terms(ctx: &StepContext, bodies: &BodySet, team: &Team) -> Vec<VelocityTerms> {
+fn velocity_terms(ctx: &StepContext, bodies: &BodySet, team: &Team) -> StepTerms {
     let h = ctx.h;
     let gravity = ctx.gravity;
     let has_gravity = gravity != Vec2::ZERO;
     let sims = &bodies.sims[..];
     let mut terms = vec![VelocityTerms::default(); sims.len()];
+    // The smallest speed limit, as the bits of an f64 (a limit is ≥ 0,
+    // and the bits of non-negative floats order as the floats do); no
+    // dynamic body: the largest Real.
+    let floor_bits = std::sync::atomic::AtomicU64::new(crate::math::to_f64(Real::MAX).to_bits());
     team.for_each_chunk_mut(&mut terms, BODY_BLOCK, |i, block| {
         let start = i * BODY_BLOCK;
+        let mut floor = Real::MAX;
         for (k, t) in block.iter_mut().enumerate() {
             let sim = &sims[start + k];
             if start + k == 0 || sim.body_type != BodyType::Dynamic {
@@ -605,9 +610,27 @@ fn velocity_terms(ctx: &StepContext, bodies: &BodySet, team: &Team) -> Vec<Veloc
                 max_v: sim.max_linear_speed,
                 max_w: sim.max_rotation * ctx.inv_h,
             };
+            floor = floor.min(sim.max_linear_speed.max(0.0));
         }
+        floor_bits.fetch_min(
+            crate::math::to_f64(floor).to_bits(),
+            std::sync::atomic::Ordering::Relaxed,
+        );
     });
-    terms
+    // Exact: the bits are of a Real widened to f64.
+    let floor = crate::math::from_f64(f64::from_bits(floor_bits.into_inner()));
+    StepTerms {
+        terms,
+        speed_floor_sq: floor * floor,
+    }
+}
+
+/// The step's [`VelocityTerms`] and the square of the smallest speed limit
+/// among them, m²/s²: a velocity no longer than that needs no clamp, so
+/// the passes after the solve read a body's terms only when it is faster.
+struct StepTerms {
+    terms: Vec<VelocityTerms>,
+    speed_floor_sq: Real,
 }
 
 /// [`integrate_velocities`] from precomputed terms (one per state: block
@@ -664,17 +687,29 @@ pub fn clamp_speed(v: Vec2, max: Real) -> Vec2 {
 /// under it too (`integrate_positions_on`). (The rotation
 /// limit stays a limit of the integration only: clamping spin after the
 /// solve changes valid scenes, spinner's hash among them.)
-fn clamp_velocity_terms(terms: &[VelocityTerms], states: &mut [BodyState], team: &Team) {
+fn clamp_velocity_terms(terms: &StepTerms, states: &mut [BodyState], team: &Team) {
     team.for_each_chunk_mut(states, BODY_BLOCK, |i, block| {
         let start = i * BODY_BLOCK;
-        for (t, state) in terms[start..start + block.len()].iter().zip(block) {
-            if !t.dynamic {
-                continue;
-            }
-            state.v = clamp_speed(state.v, t.max_v);
-            state.apply_locks();
+        for (k, state) in block.iter_mut().enumerate() {
+            clamp_to_terms(state, terms, start + k);
         }
     });
+}
+
+/// A dynamic body's velocity clamped to its speed limit, then its motion
+/// locks (only a dynamic body has lock flags): its terms are read only
+/// when it is faster than the smallest limit.
+#[inline(always)]
+fn clamp_to_terms(state: &mut BodyState, terms: &StepTerms, i: usize) {
+    if state.v.length_squared() > terms.speed_floor_sq {
+        let t = &terms.terms[i];
+        if t.dynamic {
+            state.v = clamp_speed(state.v, t.max_v);
+        }
+    }
+    // Motion locks: what the solve gave a locked axis does not move the
+    // body (a constraint that comes last).
+    state.apply_locks();
 }
 
 /// Integrates positions of moving bodies over one substep (into the deltas).
@@ -693,7 +728,7 @@ pub fn integrate_positions(ctx: &StepContext, bodies: &mut BodySet) {
 /// its `max_linear_speed` before it moves.
 fn integrate_positions_on(
     ctx: &StepContext,
-    terms: &[VelocityTerms],
+    terms: &StepTerms,
     states: &mut [BodyState],
     team: &Team,
 ) {
@@ -702,14 +737,8 @@ fn integrate_positions_on(
         let start = i * BODY_BLOCK;
         // State 0 is the static identity: it never moves.
         let skip = usize::from(i == 0);
-        let terms = &terms[start..start + block.len()];
-        for (t, state) in terms.iter().zip(block.iter_mut()).skip(skip) {
-            if t.dynamic {
-                state.v = clamp_speed(state.v, t.max_v);
-                // Motion locks: what the solve gave a locked axis does
-                // not move the body (a constraint that comes last).
-                state.apply_locks();
-            }
+        for (k, state) in block.iter_mut().enumerate().skip(skip) {
+            clamp_to_terms(state, terms, start + k);
             state.dq = state.dq.integrate(h * state.w);
             state.dp += h * state.v;
         }
@@ -827,7 +856,7 @@ pub fn solve_step_on(
         let timed = substep == 0 && ctx.profile;
         let lap = |t: &mut Instant| if timed { lap(t) } else { 0.0 };
         let flip = substep % 2 == 1;
-        integrate_velocity_terms(&terms, &mut bodies.states, team);
+        integrate_velocity_terms(&terms.terms, &mut bodies.states, team);
         first.integrate += lap(&mut t);
         if ctx.warm_starting {
             for &i in &active {

@@ -384,7 +384,7 @@ type PairOfShapes = (ShapeHandle, ShapeHandle, bool);
 /// looked up when an event is recorded, never iterated. Always equal as a
 /// value (it only speeds up the lists it indexes).
 #[derive(Clone, Default)]
-struct EventIndex(std::collections::HashMap<PairOfShapes, (u8, u32)>);
+struct EventIndex(crate::key_map::KeyMap<PairOfShapes, (u8, u32)>);
 
 impl PartialEq for EventIndex {
     fn eq(&self, _: &Self) -> bool {
@@ -555,7 +555,7 @@ impl CollisionEvents {
         if self.index.0.len() == total {
             return;
         }
-        let mut index = std::collections::HashMap::with_capacity(total);
+        let mut index = crate::key_map::KeyMap::with_capacity_and_hasher(total, Default::default());
         let keyed = [
             (
                 CONTACT_BEGIN,

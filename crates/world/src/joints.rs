@@ -18,7 +18,7 @@
 //! setters through the definition's `limits_mut`, `motor_mut` and
 //! `spring_mut` (`Err(WrongJointKind)` for a kind without one).
 
-use std::collections::HashMap;
+use crate::key_map::KeyMap;
 
 pub use janus2d_constraints::JointKind;
 use janus2d_constraints::{
@@ -66,7 +66,7 @@ pub struct JointEvent {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct NoCollide {
     #[cfg_attr(feature = "serde", serde(with = "crate::serde_maps::sorted_map"))]
-    pairs: HashMap<(u32, u32), u32>,
+    pairs: KeyMap<(u32, u32), u32>,
     /// `(clone, original)` body slots of the crossings in progress (set by
     /// the step from the portal stage; derived, so not in snapshots): a
     /// clone answers for its original, so the clones of two joined bodies
@@ -250,7 +250,7 @@ impl JointSet {
                 self.handles.len()
             ));
         }
-        let mut no_collide: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut no_collide: KeyMap<(u32, u32), u32> = KeyMap::default();
         for (k, &h) in self.handles.iter().enumerate() {
             let slot = self.slot(h).map_err(|e| format!("joint handle {k}: {e}"))?;
             if slot.index as usize != k {

@@ -49,6 +49,7 @@ pub(crate) mod hash;
 pub(crate) mod hooks;
 pub(crate) mod islands;
 pub(crate) mod joints;
+pub(crate) mod key_map;
 pub mod mover;
 pub(crate) mod narrowphase;
 pub mod portal;

@@ -39,7 +39,7 @@ pub(crate) mod sorted_map {
     use std::hash::Hash;
 
     /// Writes the map in key order.
-    pub(crate) fn serialize<K, V, S>(map: &HashMap<K, V>, s: S) -> Result<S::Ok, S::Error>
+    pub(crate) fn serialize<K, V, H, S>(map: &HashMap<K, V, H>, s: S) -> Result<S::Ok, S::Error>
     where
         K: serde::Serialize + Ord,
         V: serde::Serialize,
@@ -50,9 +50,10 @@ pub(crate) mod sorted_map {
     }
 
     /// Reads a map written by [`serialize`].
-    pub(crate) fn deserialize<'de, K, V, D>(d: D) -> Result<HashMap<K, V>, D::Error>
+    pub(crate) fn deserialize<'de, K, V, H, D>(d: D) -> Result<HashMap<K, V, H>, D::Error>
     where
         K: serde::Deserialize<'de> + Eq + Hash + Ord,
+        H: std::hash::BuildHasher + Default,
         V: serde::Deserialize<'de>,
         D: serde::Deserializer<'de>,
     {
