@@ -187,7 +187,13 @@ impl Collision {
     /// The events of the step, taken (the next step starts empty).
     #[inline]
     pub(crate) fn take_events(&mut self) -> CollisionEvents {
-        std::mem::take(&mut self.events)
+        self.events.take()
+    }
+
+    /// Hands back the lists of the events the last step reported (the
+    /// step is replacing them), so this step's events reuse their memory.
+    pub(crate) fn recycle_events(&mut self, old: CollisionEvents) {
+        self.events.recycle(old);
     }
 
     /// The shapes and the contacts, for the sleep stage (islands read the

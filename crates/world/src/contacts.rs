@@ -452,6 +452,36 @@ pub(crate) mod event_flags {
 }
 
 impl CollisionEvents {
+    /// Takes the step's events out, leaving empty lists behind. The pair
+    /// index stays (emptied, its allocation kept): it covers the lists
+    /// this store fills next.
+    pub(crate) fn take(&mut self) -> CollisionEvents {
+        let mut out = std::mem::take(self);
+        self.index = std::mem::take(&mut out.index);
+        self.index.0.clear();
+        out
+    }
+
+    /// Gives the allocations of an earlier step's events (`old`, read by
+    /// the user and now replaced) back to the lists that are still empty,
+    /// so a step does not grow its lists from nothing. The lists' contents
+    /// are unchanged: a list that holds events (recorded between steps)
+    /// keeps them.
+    pub(crate) fn recycle(&mut self, old: CollisionEvents) {
+        fn reuse<T>(list: &mut Vec<T>, mut old: Vec<T>) {
+            if list.is_empty() && old.capacity() > list.capacity() {
+                old.clear();
+                *list = old;
+            }
+        }
+        reuse(&mut self.contact_begin, old.contact_begin);
+        reuse(&mut self.contact_end, old.contact_end);
+        reuse(&mut self.sensor_begin, old.sensor_begin);
+        reuse(&mut self.sensor_end, old.sensor_end);
+        reuse(&mut self.hits, old.hits);
+        reuse(&mut self.forces, old.forces);
+    }
+
     /// Records a begin (`touching`) or end event of a contact, as the net
     /// change (type docs): an event that undoes the pair's pending opposite
     /// event removes it instead of being added. Contacts whose shapes turned
@@ -1194,5 +1224,53 @@ impl ContactSet {
     #[inline]
     pub(crate) fn awake_slice_mut(&mut self) -> &mut [Contact] {
         &mut self.awake
+    }
+}
+
+#[cfg(test)]
+mod event_list_tests {
+    use super::*;
+
+    fn pair(i: u32) -> ShapePairEvent {
+        ShapePairEvent {
+            shape_a: ShapeHandle::new(i, 0, 1),
+            shape_b: ShapeHandle::new(i + 1, 0, 1),
+        }
+    }
+
+    #[test]
+    fn recycled_event_lists_keep_what_they_hold_and_take_the_old_memory() {
+        let mut old = CollisionEvents::default();
+        old.contact_end.extend((0..64).map(pair));
+        old.sensor_end.reserve(32);
+        let capacity = old.contact_end.capacity();
+        let mut events = CollisionEvents::default();
+        // An end event recorded between steps (a destroyed shape).
+        events.contact_end.push(pair(100));
+        events.recycle(old);
+        // The list that held an event keeps exactly it.
+        assert_eq!(events.contact_end, vec![pair(100)]);
+        // The empty lists got the old allocations, emptied.
+        assert!(events.sensor_end.is_empty());
+        assert!(events.sensor_end.capacity() >= 32);
+        let mut again = CollisionEvents::default();
+        again.recycle(CollisionEvents {
+            contact_end: (0..64).map(pair).collect(),
+            ..CollisionEvents::default()
+        });
+        assert!(again.contact_end.is_empty());
+        assert!(again.contact_end.capacity() >= capacity.min(64));
+    }
+
+    #[test]
+    fn taking_the_events_leaves_an_index_that_covers_the_empty_lists() {
+        let mut events = CollisionEvents::default();
+        events.contact_end.push(pair(1));
+        events.sync_index();
+        assert_eq!(events.index.0.len(), 1);
+        let out = events.take();
+        assert_eq!(out.contact_end, vec![pair(1)]);
+        assert!(events.contact_end.is_empty());
+        assert_eq!(events.index.0.len(), 0);
     }
 }

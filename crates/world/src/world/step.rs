@@ -128,6 +128,10 @@ impl World {
                 .build_clipping(&self.bodies, self.collision.shape_store());
             sp.portals += lap();
         }
+        // Last step's collision events are replaced at this step's end:
+        // their lists' memory goes to the new ones.
+        self.collision
+            .recycle_events(std::mem::take(&mut self.events.collision));
         if has_shapes {
             // Clones answer for their originals in the joints' no-collide
             // pairs (set every step: crossings come and go).
