@@ -361,3 +361,32 @@ fn fast_ball_into_a_floor_portal_crosses_it() {
         "came out of the wall portal: {p}"
     );
 }
+
+/// The solve's finalize bounds each body's travel by the extents its
+/// shapes had at the step's start: a ball shrunk between steps counts as
+/// fast at the very next step (the new extent reached its per-step data),
+/// and the world stays valid throughout.
+#[test]
+fn a_shape_shrunk_between_steps_makes_its_body_fast_at_the_next_step() {
+    let mut world = World::new(zero_g()).unwrap();
+    let b = ball(
+        &mut world,
+        &BodyDef::dynamic(Vec2::new(-5.0, 0.0)).with_velocity(Vec2::new(12.0, 0.0)),
+        0.5,
+    );
+    // 0.2 m a step against a limit of 0.25 m: not fast.
+    for _ in 0..3 {
+        world.step(1.0 / 60.0).unwrap();
+        world.validate().unwrap();
+        assert_eq!(world.counters().toi_bodies, 0);
+    }
+    let shape = world.body_shapes(b).unwrap()[0];
+    world
+        .set_circle(shape, Circle::new(Vec2::ZERO, 0.02).unwrap())
+        .unwrap();
+    world.validate().unwrap();
+    // 0.2 m a step against a limit of 1 cm: fast.
+    world.step(1.0 / 60.0).unwrap();
+    world.validate().unwrap();
+    assert_eq!(world.counters().toi_bodies, 1);
+}

@@ -720,6 +720,16 @@ pub struct BodySim {
     /// `fixed_rotation`): [`BodyState::LOCK_X`] and
     /// [`BodyState::LOCK_Y`] bits, 0 without locks.
     pub linear_locks: u32,
+    /// How far the body may travel in a step before continuous collision
+    /// sweeps it, m (the world sets it from the body's solid shapes: a
+    /// fraction of the smallest one's extent); `Real::MAX` without a solid
+    /// shape. The solver's finalize compares each body's travel with it
+    /// ([`crate::solver::SolveReport::maybe_fast`]).
+    pub fast_travel: Real,
+    /// Largest distance from the body origin to the core of a solid
+    /// shape, m (0 without one): a turn moves the shapes by about this
+    /// times the rotation's chord.
+    pub core_reach: Real,
 }
 
 impl BodySim {
@@ -785,6 +795,8 @@ impl BodySim {
             enable_sleep: true,
             sleep_threshold: None,
             linear_locks: 0,
+            fast_travel: Real::MAX,
+            core_reach: 0.0,
         }
     }
 }
@@ -1191,6 +1203,8 @@ impl BodySet {
             enable_sleep: def.enable_sleep,
             sleep_threshold: def.sleep_threshold,
             linear_locks: def.motion_locks.linear_flags(),
+            fast_travel: Real::MAX,
+            core_reach: 0.0,
         };
         let location = if def.body_type == BodyType::Static {
             self.static_sims.push(sim);

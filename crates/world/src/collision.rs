@@ -190,6 +190,13 @@ impl Collision {
         self.events.take()
     }
 
+    /// Copies the shapes' extents that changed since the last step into
+    /// the bodies' per-step data, where the solve's finalize bounds each
+    /// body's travel against them (`crate::continuous::publish_extents`).
+    pub(crate) fn publish_extents(&mut self, bodies: &mut BodySet) {
+        crate::continuous::publish_extents(&mut self.shapes, bodies);
+    }
+
     /// Hands back the lists of the events the last step reported (the
     /// step is replacing them), so this step's events reuse their memory.
     pub(crate) fn recycle_events(&mut self, old: CollisionEvents) {

@@ -56,7 +56,7 @@
 //! A scene where nothing is fast does one cheap test per awake dynamic body
 //! and nothing else: [`ContinuousCounters::toi_bodies`] stays 0.
 
-use janus2d_core::body::{BodyLocation, BodySet, BodyType};
+use janus2d_core::body::{BodyLocation, BodySet, BodySim, BodyType};
 use janus2d_core::geometry::{
     LINEAR_SLOP, Shape, ShapeProxy, Sweep, ToiState, shape_distance, shape_extent, time_of_impact,
 };
@@ -66,7 +66,7 @@ use janus2d_core::parallel::Team;
 use crate::aperture::ContactClipping;
 use crate::broadphase::BroadPhase;
 use crate::joints::{JointSet, NoCollide};
-use crate::shapes::ShapeStore;
+use crate::shapes::{BodyExtent, ShapeStore};
 use janus2d_constraints::JointKind;
 
 /// Fraction of a body's smallest extent it may travel in one step before it
@@ -98,6 +98,65 @@ pub(crate) struct ContinuousInput<'a> {
     /// The portal rows (one per crossing): a crossing copy's twin moves
     /// with it.
     pub(crate) portal_rows: &'a [janus2d_constraints::PortalConstraint],
+    /// The solve's finalize found a body that may be fast
+    /// (`SolveReport::maybe_fast`); false: the stage scans nothing.
+    pub(crate) maybe_fast: bool,
+}
+
+/// How far a body with these extents may travel in a step before it
+/// counts as fast, m: [`FAST_FRACTION`] of its smallest solid extent, at
+/// least [`LINEAR_SLOP`]; `Real::MAX` without a solid shape.
+#[must_use]
+pub(crate) fn fast_travel(e: &BodyExtent) -> Real {
+    if e.min_extent == Real::MAX {
+        return Real::MAX;
+    }
+    (FAST_FRACTION * e.min_extent).max(LINEAR_SLOP)
+}
+
+/// The fast test of one dynamic body after the solve (module docs):
+/// its travel `|Δc| + |Δq| · (core_reach + |local centre|)` beyond
+/// [`fast_travel`]. Always within the solve's bound
+/// (`janus2d_core::solver::may_be_fast`), which lets the stage skip a
+/// step where no body comes near its limit.
+#[must_use]
+pub(crate) fn is_fast(sim: &BodySim, e: &BodyExtent) -> bool {
+    if e.min_extent == Real::MAX {
+        return false; // no solid shape
+    }
+    let dc = sim.center - sim.center0;
+    let q = sim.transform.q;
+    let q0 = sim.rotation0;
+    let chord = Vec2::new(q.c - q0.c, q.s - q0.s);
+    // A turn moves the covered region by |Δq| times the reach of
+    // the shapes' cores from the centre (their rounding turns in
+    // place): a wheel spinning on its centre is not fast.
+    let arm = e.core_reach + sim.local_center.length();
+    let threshold = fast_travel(e);
+    let lin = dc.length_squared();
+    let rot = chord.length_squared() * arm * arm;
+    // |Δc| + |Δq| arm ≤ √(2 (|Δc|² + |Δq|² arm²)): most bodies need no root.
+    if 2.0 * (lin + rot) <= threshold * threshold {
+        return false;
+    }
+    // Written as the negation of `≤` so a NaN travel counts as fast, as
+    // it always did.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    let fast = !(lin.sqrt() + rot.sqrt() <= threshold);
+    fast
+}
+
+/// Copies the extents of the bodies whose shapes changed into their
+/// per-step data (`BodySim::fast_travel`, `BodySim::core_reach`), where
+/// the solver's finalize reads them. The step calls it before the solve.
+pub(crate) fn publish_extents(shapes: &mut ShapeStore, bodies: &mut BodySet) {
+    for body in shapes.take_extent_changes() {
+        let e = shapes.extent_of(body);
+        if let Some(sim) = bodies.sim_mut(body) {
+            sim.fast_travel = fast_travel(&e);
+            sim.core_reach = e.core_reach;
+        }
+    }
 }
 
 /// The continuous stage: the switch, its scratch lists and its counters.
@@ -163,33 +222,16 @@ impl ContinuousStage {
         self.counters = ContinuousCounters::default();
         self.fast.clear();
         self.bullets.clear();
-        if !self.enabled {
+        if !self.enabled || !input.maybe_fast {
+            // Off, or the solve's finalize saw no body travel near its
+            // limit: nothing to scan.
             return;
         }
         for (i, sim) in bodies.sims.iter().enumerate().skip(1) {
             if sim.body_type != BodyType::Dynamic {
                 continue;
             }
-            let e = input.shapes.extent_of(sim.handle);
-            if e.min_extent == Real::MAX {
-                continue; // no solid shape
-            }
-            let dc = sim.center - sim.center0;
-            let q = sim.transform.q;
-            let q0 = sim.rotation0;
-            let chord = Vec2::new(q.c - q0.c, q.s - q0.s);
-            // A turn moves the covered region by |Δq| times the reach of
-            // the shapes' cores from the centre (their rounding turns in
-            // place): a wheel spinning on its centre is not fast.
-            let arm = e.core_reach + sim.local_center.length();
-            let threshold = (FAST_FRACTION * e.min_extent).max(LINEAR_SLOP);
-            let lin = dc.length_squared();
-            let rot = chord.length_squared() * arm * arm;
-            // |Δc| + |Δq| arm ≤ √(2 (|Δc|² + |Δq|² arm²)): most bodies need no root.
-            if 2.0 * (lin + rot) <= threshold * threshold {
-                continue;
-            }
-            if lin.sqrt() + rot.sqrt() <= threshold {
+            if !is_fast(sim, &input.shapes.extent_of(sim.handle)) {
                 continue;
             }
             if sim.bullet {
@@ -737,4 +779,78 @@ fn aperture_fraction(
         }
     }
     best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use janus2d_core::body::{BodyDef, BodySet};
+    use janus2d_core::solver::may_be_fast;
+    use proptest::prelude::*;
+
+    /// A body moved by `(dx, dy, dθ)` from a start pose, with shapes of
+    /// these extents, its local centre at `(lx, ly)`.
+    fn moved(extent: BodyExtent, motion: [Real; 3], local_center: Vec2) -> BodySim {
+        let mut bodies = BodySet::new();
+        let h = bodies
+            .create(&BodyDef::dynamic(Vec2::new(1.0, 2.0)))
+            .unwrap();
+        let mut sim = *bodies.sim(h).unwrap();
+        sim.local_center = local_center;
+        sim.center0 = Vec2::new(1.0, 2.0);
+        sim.rotation0 = Rot::from_angle(0.3);
+        sim.center = sim.center0 + Vec2::new(motion[0], motion[1]);
+        sim.transform.q = Rot::from_angle(0.3 + motion[2]);
+        sim.fast_travel = fast_travel(&extent);
+        sim.core_reach = extent.core_reach;
+        sim
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        /// The solve's bound never misses a body the exact test calls
+        /// fast: when it says no body may be fast, skipping the scan
+        /// changes nothing.
+        #[test]
+        fn the_finalize_bound_holds_every_fast_body(
+            min_extent in 1.0e-3f64..10.0,
+            reach_over in 0.0f64..5.0,
+            dx in -20.0f64..20.0,
+            dy in -20.0f64..20.0,
+            dtheta in -3.0f64..3.0,
+            scale in prop::sample::select(vec![1.0e-4f64, 1.0e-2, 0.1, 1.0]),
+            lx in -2.0f64..2.0,
+            ly in -2.0f64..2.0,
+        ) {
+            let e = BodyExtent {
+                min_extent: min_extent as Real,
+                max_extent: (min_extent * (1.0 + reach_over)) as Real,
+                core_reach: (min_extent * reach_over) as Real,
+            };
+            let motion = [(dx * scale) as Real, (dy * scale) as Real, (dtheta * scale) as Real];
+            let sim = moved(e, motion, Vec2::new(lx as Real, ly as Real));
+            if is_fast(&sim, &e) {
+                prop_assert!(may_be_fast(&sim), "fast but not flagged: {e:?} {motion:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_finalize_bound_is_not_everything() {
+        // A 1 m box that moved 1 cm and turned 0.01 rad is not flagged; one
+        // that moved 60 cm is fast and flagged.
+        let e = BodyExtent {
+            min_extent: 0.5,
+            max_extent: 0.71,
+            core_reach: 0.71,
+        };
+        let slow = moved(e, [0.01, 0.0, 0.01], Vec2::ZERO);
+        assert!(!may_be_fast(&slow));
+        let fast = moved(e, [0.6, 0.0, 0.0], Vec2::ZERO);
+        assert!(is_fast(&fast, &e) && may_be_fast(&fast));
+        // No solid shape: never.
+        let bare = moved(BodyExtent::default(), [50.0, 0.0, 1.0], Vec2::ZERO);
+        assert!(!is_fast(&bare, &BodyExtent::default()) && !may_be_fast(&bare));
+    }
 }

@@ -602,6 +602,9 @@ pub struct ShapeStore {
     body_shapes: Vec<SmallVec<[u32; 2]>>,
     /// Per body slot, the extents of its solid shapes.
     body_extents: Vec<BodyExtent>,
+    /// Bodies whose extents changed since the step last copied them into
+    /// their per-step data (`take_extent_changes`), in order of change.
+    extent_changes: Vec<BodyHandle>,
     /// Number of live shapes with hit events on (the hit pass runs only
     /// when some shape asks for it).
     hit_event_shapes: usize,
@@ -698,8 +701,19 @@ impl ShapeStore {
             .unwrap_or_default()
     }
 
-    /// Recomputes the extents of body slot `b` from its solid shapes.
-    pub(crate) fn refresh_extent(&mut self, b: usize) {
+    /// The bodies whose extents changed since the last call, oldest first
+    /// (a body may be listed more than once).
+    pub(crate) fn take_extent_changes(&mut self) -> Vec<BodyHandle> {
+        std::mem::take(&mut self.extent_changes)
+    }
+
+    /// Recomputes the extents of `body` from its solid shapes, and lists
+    /// it among the changes the step copies into its per-step data.
+    pub(crate) fn refresh_extent(&mut self, body: BodyHandle) {
+        if self.extent_changes.last() != Some(&body) {
+            self.extent_changes.push(body);
+        }
+        let b = body.index as usize;
         if self.body_extents.len() <= b {
             self.body_extents.resize(b + 1, BodyExtent::default());
         }
@@ -777,11 +791,34 @@ impl ShapeStore {
                 }
             }
         }
+        // The bodies' copies of their extents (what the solve's finalize
+        // reads) match the store's, but for changes the next step copies.
+        let mut pending = self.extent_changes.clone();
+        pending.sort_unstable();
+        for body in bodies.handles() {
+            if pending.binary_search(&body).is_ok() {
+                continue;
+            }
+            let e = self.extent_of(body);
+            let Some(sim) = bodies.sim(body) else {
+                continue;
+            };
+            let travel = crate::continuous::fast_travel(&e);
+            if sim.fast_travel.to_bits() != travel.to_bits()
+                || sim.core_reach.to_bits() != e.core_reach.to_bits()
+            {
+                return Err(format!(
+                    "body {body:?}: kept extents ({}, {}) are not its shapes' ({travel}, {})",
+                    sim.fast_travel, sim.core_reach, e.core_reach
+                ));
+            }
+        }
         Ok(())
     }
 
     /// Stores a shape and lists it under its body; returns its slot.
     pub fn insert(&mut self, data: ShapeData) -> u32 {
+        let data_body = data.body;
         let b = data.body.index as usize;
         self.hit_event_shapes += usize::from(data.def.enable_hit_events);
         self.force_event_shapes += usize::from(data.def.force_event_threshold.is_finite());
@@ -790,7 +827,7 @@ impl ShapeStore {
             self.body_shapes.resize(b + 1, SmallVec::new());
         }
         self.body_shapes[b].push(index);
-        self.refresh_extent(b);
+        self.refresh_extent(data_body);
         index
     }
 
@@ -806,7 +843,7 @@ impl ShapeStore {
         if let Some(list) = self.body_shapes.get_mut(data.body.index as usize) {
             list.retain(|i| *i != index);
         }
-        self.refresh_extent(data.body.index as usize);
+        self.refresh_extent(data.body);
         data
     }
 
@@ -826,8 +863,8 @@ impl ShapeStore {
             let s = self.body_shapes[ib][k];
             self.slots.live_mut(s).body = b;
         }
-        self.refresh_extent(ia);
-        self.refresh_extent(ib);
+        self.refresh_extent(a);
+        self.refresh_extent(b);
     }
 
     /// Exchanges what two live slots hold of their copies of one shape
@@ -852,8 +889,8 @@ impl ShapeStore {
         let a = self.slots.live_mut(i);
         (a.geometry, a.aabb, a.proxy, a.def.density) = b_old;
         let (bi, bj) = (self.slots.live(i).body, self.slots.live(j).body);
-        self.refresh_extent(bi.index as usize);
-        self.refresh_extent(bj.index as usize);
+        self.refresh_extent(bi);
+        self.refresh_extent(bj);
     }
 
     /// The mass, centre (body frame) and inertia about the centre of a

@@ -134,8 +134,10 @@ pub mod bytes {
     /// mass ratio, and the joint forest the policy it was built under;
     /// 16: a joint's base keeps its row count and threshold switch, a
     /// revolute joint its row switches and point-block bound; contacts and
-    /// shapes list their hot fields first).
-    pub const SNAPSHOT_VERSION: u16 = 16;
+    /// shapes list their hot fields first; 17: bodies keep their shapes'
+    /// fast-travel limit and core reach, and the shape store the bodies
+    /// whose extents changed since the last step).
+    pub const SNAPSHOT_VERSION: u16 = 17;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.

@@ -44,7 +44,7 @@ impl crate::collision::Collision {
         shape.geometry = geometry;
         shape.aabb = aabb;
         shape.proxy = proxy;
-        self.shapes.refresh_extent(body.index as usize);
+        self.shapes.refresh_extent(body);
     }
 }
 

@@ -500,7 +500,7 @@ impl World {
         let slot = self.shape_slot(shape)?;
         let body = self.collision.shapes.at(slot).body;
         self.collision.shapes.at_mut(slot).def.is_sensor = is_sensor;
-        self.collision.shapes.refresh_extent(body.index as usize);
+        self.collision.shapes.refresh_extent(body);
         self.repair_shape(slot);
         Ok(())
     }

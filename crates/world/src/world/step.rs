@@ -115,6 +115,7 @@ impl World {
         let mut sp = crate::profile::StepProfile::default();
         self.islands
             .apply_pending(self.sleep_settings.enabled, &mut self.bodies);
+        self.collision.publish_extents(&mut self.bodies);
         let has_shapes = self.collision.has_shapes();
         let has_portals = self.portals.is_active();
         if has_portals && self.portals.clone_aliases().next().is_some() {
@@ -219,6 +220,7 @@ impl World {
             let continuous = &mut self.continuous;
             let (no_collide, clipping) = (self.joints.no_collide(), self.portals.clipping());
             let portal_rows = self.portals.constraints();
+            let maybe_fast = report.maybe_fast;
             let joints = &self.joints;
             let (builder, solver) = (&self.contact_builder, &self.contact_solver);
             let continuous_time = self.collision.end_step(
@@ -234,6 +236,7 @@ impl World {
                         clipping,
                         joints,
                         portal_rows,
+                        maybe_fast,
                     };
                     continuous.run(bodies, &input, team);
                     start.map_or(0.0, |s| s.elapsed().as_secs_f64())
