@@ -3,6 +3,9 @@
 //! geometry (as Box2D v3's `b2SolveContinuous`).
 //!
 //! ```text
+//! in the solve's finalize (each pose written): maybe_fast, a bound of the
+//!   fast test below from the body's kept extents (BodySim::fast_travel,
+//!   core_reach); no body near its limit: the stage does nothing
 //! after the solve's finalize (start and end poses known), before proxies move:
 //!   fast test  (every awake dynamic body with a solid shape)
 //!     travel = |Δc| + |Δq| · (core_reach + |local centre|)
@@ -53,8 +56,11 @@
 //! `η Q Δc`, `θ₂ = θ₁ + const` by `Δθ`), so the portal rows stay as they
 //! were. Velocities are not touched: the closing adds no speed.
 //!
-//! A scene where nothing is fast does one cheap test per awake dynamic body
-//! and nothing else: [`ContinuousCounters::toi_bodies`] stays 0.
+//! A scene where nothing is fast pays a few multiplications per body in
+//! the finalize pass that already writes every pose, and nothing here:
+//! [`ContinuousCounters::toi_bodies`] stays 0. The bodies' copies of their
+//! extents are refreshed at the step's start for the bodies whose shapes
+//! changed ([`publish_extents`]).
 
 use janus2d_core::body::{BodyLocation, BodySet, BodySim, BodyType};
 use janus2d_core::geometry::{
