@@ -27,6 +27,7 @@
 //! for Box2D's AVX2 build beside janus2d's x86-64-v3 build.
 
 mod box2d;
+mod manifolds;
 mod memory;
 mod rapier;
 
@@ -127,6 +128,7 @@ fn parse_args() -> Args {
                         | "scaling"
                         | "memory"
                         | "memory-one"
+                        | "manifolds"
                 ) =>
             {
                 args.command = cmd.into()
@@ -1143,6 +1145,7 @@ fn main() {
         "joints" => cmd_joints(&args),
         "scaling" => cmd_scaling(&args),
         "memory" => memory::cmd_memory(&args),
+        "manifolds" => manifolds::cmd_manifolds(&args),
         "memory-one" => memory::cmd_memory_one(&args),
         _ => cmd_all(&args),
     }
