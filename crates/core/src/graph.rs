@@ -148,6 +148,11 @@ pub struct ConstraintGraph {
     /// graph takes one of them on that body.
     #[cfg_attr(feature = "serde", serde(skip))]
     reserved: Vec<u32>,
+    /// The reserved colours differ from the previous step's: only then
+    /// can a kept constraint's colour meet one of them (it was checked
+    /// against the same bits when it was last kept or coloured).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    reserved_changed: bool,
 }
 
 impl ConstraintGraph {
@@ -163,8 +168,11 @@ impl ConstraintGraph {
     /// one that holds such a colour takes another. Call before the step's
     /// [`ConstraintGraph::keep`]s; an empty slice reserves nothing.
     pub fn set_reserved(&mut self, bits: &[u32]) {
-        self.reserved.clear();
-        self.reserved.extend_from_slice(bits);
+        self.reserved_changed = self.reserved.as_slice() != bits;
+        if self.reserved_changed {
+            self.reserved.clear();
+            self.reserved.extend_from_slice(bits);
+        }
     }
 
     /// The colours reserved on either key (see
@@ -209,7 +217,7 @@ impl ConstraintGraph {
             self.kept += usize::from(entry.stamp != self.stamp);
             if entry.keys == keys
                 && (entry.colour as usize) < COLOURS
-                && self.reserved_on(keys) & (1 << entry.colour) == 0
+                && (!self.reserved_changed || self.reserved_on(keys) & (1 << entry.colour) == 0)
             {
                 self.entries[i].stamp = self.stamp;
                 return entry.colour;
@@ -467,5 +475,37 @@ mod tests {
         g.sweep();
         assert_eq!(g.len(), 1);
         g.check().unwrap();
+    }
+
+    #[test]
+    fn a_kept_colour_yields_to_a_new_reservation_and_stays_under_the_same_one() {
+        let mut g = ConstraintGraph::new();
+        g.begin_step();
+        assert_eq!(g.keep(0, [1, 2]), 0);
+        g.sweep();
+        // A joint now holds colour 0 on body 2: the contact moves on.
+        let mut bits = vec![0u32; 4];
+        bits[2] = 1;
+        g.set_reserved(&bits);
+        g.begin_step();
+        let moved = g.keep(0, [1, 2]);
+        assert_ne!(moved, 0);
+        g.sweep();
+        g.check().unwrap();
+        // The same reservation next step: the contact keeps its new colour
+        // (the per-contact check is skipped, the answer is the same).
+        g.set_reserved(&bits);
+        g.begin_step();
+        assert_eq!(g.keep(0, [1, 2]), moved);
+        // A constraint coloured afresh still avoids the reserved colour.
+        assert_ne!(g.keep(1, [2, 3]), 0);
+        g.sweep();
+        g.check().unwrap();
+        // The reservation moves to the contact's colour: it moves again.
+        let mut bits2 = vec![0u32; 4];
+        bits2[1] = 1 << moved;
+        g.set_reserved(&bits2);
+        g.begin_step();
+        assert_ne!(g.keep(0, [1, 2]), moved);
     }
 }
