@@ -347,14 +347,16 @@ impl Narrowphase {
                     // brings it back. (Contacts found between bodies
                     // created asleep come here; the rest go when a body
                     // falls asleep.)
-                    staged.swap(k, contacts.awake().len() - 1);
+                    // The last awake contact moves to k: so does its
+                    // record (k's own is not read again).
+                    staged[k] = staged[contacts.awake().len() - 1];
                     contacts.sleep_awake_at(k);
                     results.swap_remove(k);
                     continue;
                 }
                 ContactUpdate::Separated => {
                     // The last awake contact moves to k: so does its record.
-                    staged.swap(k, contacts.awake().len() - 1);
+                    staged[k] = staged[contacts.awake().len() - 1];
                     contacts.destroy_awake_at(k, events);
                     results.swap_remove(k);
                     continue;
