@@ -8,7 +8,9 @@ use janus2d::prelude::*;
 use janus2d_constraints::JointError;
 
 /// A 1 kg box hanging 1 m below a static pin, 4 substeps, sleep off.
-fn pendulum(def_edit: impl FnOnce(&mut RevoluteJointDef)) -> (World, BodyHandle, JointHandle) {
+pub(crate) fn pendulum(
+    def_edit: impl FnOnce(&mut RevoluteJointDef),
+) -> (World, BodyHandle, JointHandle) {
     let mut world = World::new(WorldDef {
         sleep: SleepSettings {
             enabled: false,

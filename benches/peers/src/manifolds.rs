@@ -27,7 +27,7 @@ use std::time::Instant;
 use boxdd_sys::ffi;
 use janus2d_core::geometry::manifold::collide;
 use janus2d_core::geometry::{Capsule, Circle, LINEAR_SLOP, Polygon, Segment, Shape};
-use janus2d_core::math::{Rot, Transform, Vec2};
+use janus2d_core::math::{Transform, Vec2};
 use janus2d_testbed::benchmarks;
 use janus2d_testbed::engine::{Engine, EngineOptions, scripted_step};
 use janus2d_testbed::janus::Janus;
@@ -55,19 +55,6 @@ fn rank(s: &Shape) -> Option<u8> {
 }
 
 const KINDS: [&str; 4] = ["segment", "polygon", "capsule", "circle"];
-
-/// `a`⁻¹ `b`: body b's frame in body a's.
-fn relative(a: &Transform, b: &Transform) -> Transform {
-    let (qa, qb) = (a.q, b.q);
-    let d = b.p - a.p;
-    Transform {
-        p: Vec2::new(qa.c * d.x + qa.s * d.y, -qa.s * d.x + qa.c * d.y),
-        q: Rot {
-            c: qa.c * qb.c + qa.s * qb.s,
-            s: qa.c * qb.s - qa.s * qb.c,
-        },
-    }
-}
 
 /// The recorded pairs of one scene, and how many contacts were left out.
 fn record(scene: &str, steps: usize) -> Result<(Vec<Pair>, usize), String> {
@@ -104,13 +91,13 @@ fn record(scene: &str, steps: usize) -> Result<(Vec<Pair>, usize), String> {
             Pair {
                 a: sa,
                 b: sb,
-                b_in_a: relative(&xa, &xb),
+                b_in_a: xa.inv_mul(&xb),
             }
         } else {
             Pair {
                 a: sb,
                 b: sa,
-                b_in_a: relative(&xb, &xa),
+                b_in_a: xb.inv_mul(&xa),
             }
         });
     }

@@ -723,8 +723,7 @@ pub struct BodySim {
     /// How far the body may travel in a step before continuous collision
     /// sweeps it, m (the world sets it from the body's solid shapes: a
     /// fraction of the smallest one's extent); `Real::MAX` without a solid
-    /// shape. The solver's finalize compares each body's travel with it
-    /// ([`crate::solver::SolveReport::maybe_fast`]).
+    /// shape. See [`BodySim::is_fast`].
     pub fast_travel: Real,
     /// Largest distance from the body origin to the core of a solid
     /// shape, m (0 without one): a turn moves the shapes by about this
@@ -768,6 +767,70 @@ impl BodySim {
             inv_mass: self.inv_mass,
             inv_inertia: self.inv_inertia,
         }
+    }
+
+    /// Whether the body travelled far enough in the step for continuous
+    /// collision to sweep it: `|Δc| + |Δq| · (core_reach + |local centre|)`
+    /// beyond [`BodySim::fast_travel`], from the start pose (`center0`,
+    /// `rotation0`) to the pose the solve wrote. A turn moves the covered
+    /// region by the rotation's chord times the reach of the shapes' cores
+    /// (their rounding turns in place), so a wheel spinning on its centre
+    /// is not fast. A NaN travel counts as fast.
+    #[must_use]
+    pub fn is_fast(&self) -> bool {
+        let threshold = self.fast_travel;
+        if threshold == Real::MAX {
+            return false; // no solid shape
+        }
+        let dc = self.center - self.center0;
+        let (q, q0) = (self.transform.q, self.rotation0);
+        let chord = Vec2::new(q.c - q0.c, q.s - q0.s);
+        let arm = self.core_reach + self.local_center.length();
+        let lin = dc.length_squared();
+        let rot = chord.length_squared() * arm * arm;
+        // |Δc| + |Δq| arm ≤ √(2 (|Δc|² + |Δq|² arm²)): most bodies need no root.
+        if 2.0 * (lin + rot) <= threshold * threshold {
+            return false;
+        }
+        // The negation of `≤`, so that a NaN travel counts as fast.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        let fast = !(lin.sqrt() + rot.sqrt() <= threshold);
+        fast
+    }
+
+    /// A bound of [`BodySim::is_fast`] without a square root, for the
+    /// solver's finalize ([`SolveReport::maybe_fast`](crate::solver::SolveReport::maybe_fast)): true whenever
+    /// `is_fast` is, since `(a + b)² ≤ 2 (a² + b²)` twice gives
+    /// `|Δc|² + |Δq|² · 2 (reach² + |local centre|²)` over a quarter of
+    /// `fast_travel²`, with a factor of two to spare for rounding.
+    ///
+    /// ```
+    /// use janus2d_core::body::{BodyDef, BodySet};
+    /// use janus2d_core::math::Vec2;
+    ///
+    /// let mut bodies = BodySet::new();
+    /// let h = bodies.create(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
+    /// let sim = bodies.sim_mut(h).unwrap();
+    /// sim.fast_travel = 0.05; // m
+    /// sim.center = Vec2::new(0.02, 0.0);
+    /// assert!(!sim.may_be_fast()); // 2 cm of 5 cm: within half the limit
+    /// sim.center = Vec2::new(0.04, 0.0);
+    /// assert!(sim.may_be_fast() && !sim.is_fast());
+    /// sim.center = Vec2::new(0.06, 0.0);
+    /// assert!(sim.may_be_fast() && sim.is_fast());
+    /// ```
+    #[inline(always)]
+    #[must_use]
+    pub fn may_be_fast(&self) -> bool {
+        let limit = self.fast_travel;
+        if limit == Real::MAX {
+            return false; // no solid shape
+        }
+        let (q, q0) = (self.transform.q, self.rotation0);
+        let chord_sq = (q.c - q0.c) * (q.c - q0.c) + (q.s - q0.s) * (q.s - q0.s);
+        let arm_sq = 2.0 * (self.core_reach * self.core_reach + self.local_center.length_squared());
+        let lin_sq = (self.center - self.center0).length_squared();
+        4.0 * (lin_sq + chord_sq * arm_sq) > limit * limit
     }
 
     fn sentinel() -> BodySim {

@@ -91,6 +91,11 @@ pub struct StepContext {
     /// False when no constraint of the step has restitution: the restitution
     /// stage is skipped (the world sets it from its contacts; usual true).
     pub restitution: bool,
+    /// The finalize bounds each body's travel for continuous collision
+    /// (`SolveReport::maybe_fast`); false when the world sweeps no body
+    /// (continuous collision off, or no shapes), so the pass pays nothing
+    /// for it (usual true).
+    pub fast_bodies: bool,
     /// Largest stiffening factor of a contact between moving bodies
     /// (dimensionless, `≥ 1`; 1 in the PGS baseline), see
     /// [`SolverSettings::contact_mass_ratio_cap`](crate::solver::SolverSettings::contact_mass_ratio_cap).

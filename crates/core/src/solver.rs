@@ -26,7 +26,7 @@
 
 use std::time::Instant;
 
-use crate::body::{BodyHandle, BodySet, BodySim, BodyState, BodyType};
+use crate::body::{BodyHandle, BodySet, BodyState, BodyType};
 use crate::constraint::{ConstraintBatch, SolverMode, StepContext};
 use crate::math::{Real, Vec2, vec_is_finite};
 use crate::parallel::{Team, with_team};
@@ -411,6 +411,7 @@ impl SolverSettings {
             warm_starting: self.warm_starting,
             mode: self.mode,
             restitution: true,
+            fast_bodies: true,
             contact_mass_ratio_cap: match self.mode {
                 SolverMode::SoftStep => self.contact_mass_ratio_cap.max(1.0),
                 SolverMode::PgsBaumgarte => 1.0,
@@ -466,12 +467,10 @@ pub struct SolveReport {
     /// unknown.
     pub poses_inside: bool,
     /// Some moving body may have travelled far enough in the step for
-    /// continuous collision to sweep it: `|Δc|² + |Δq|² · 2 (reach² +
-    /// |local centre|²)` exceeds a quarter of its [`BodySim::fast_travel`]
-    /// squared, a bound that holds whenever the continuous stage's exact
-    /// test (`|Δc| + |Δq| (reach + |local centre|)` beyond `fast_travel`)
-    /// does, with a factor of two to spare. When false no body is fast and
-    /// the continuous stage has nothing to scan.
+    /// continuous collision to sweep it ([`BodySim::may_be_fast`](crate::body::BodySim::may_be_fast), asked
+    /// only when [`StepContext::fast_bodies`]). When false no body is fast
+    /// ([`BodySim::is_fast`](crate::body::BodySim::is_fast)) and the continuous stage has nothing
+    /// to scan.
     pub maybe_fast: bool,
     /// Stage timings.
     pub profile: SolverProfile,
@@ -758,7 +757,7 @@ fn integrate_positions_on(
 /// ([`SolveReport::poses_inside`]). In blocks on the team; a body whose
 /// state is not finite is left for the serial pass after, which zeroes its
 /// motion and reports it (in body order).
-fn finalize_bodies(bodies: &mut BodySet, report: &mut SolveReport, team: &Team) {
+fn finalize_bodies(bodies: &mut BodySet, fast_bodies: bool, report: &mut SolveReport, team: &Team) {
     let finite = |state: &BodyState| {
         vec_is_finite(state.v)
             && state.w.is_finite()
@@ -780,7 +779,7 @@ fn finalize_bodies(bodies: &mut BodySet, report: &mut SolveReport, team: &Team) 
                 sim.transform.p = sim.center - sim.transform.q.rotate(sim.local_center);
                 sim.force = Vec2::ZERO;
                 sim.torque = 0.0;
-                fast |= may_be_fast(sim);
+                fast |= fast_bodies && sim.may_be_fast();
             } else {
                 any_bad.store(true, std::sync::atomic::Ordering::Relaxed);
             }
@@ -807,41 +806,6 @@ fn finalize_bodies(bodies: &mut BodySet, report: &mut SolveReport, team: &Team) 
         }
     }
     states[0] = BodyState::IDENTITY;
-}
-
-/// The finalize's fast-body bound ([`SolveReport::maybe_fast`]) for one
-/// body whose pose was just written: true when it may have travelled its
-/// [`BodySim::fast_travel`]. A superset of the continuous stage's exact
-/// test: `(a + b)² ≤ 2 (a² + b²)` twice, and a factor of two to spare for
-/// rounding.
-///
-/// ```
-/// use janus2d_core::body::{BodyDef, BodySet};
-/// use janus2d_core::math::Vec2;
-/// use janus2d_core::solver::may_be_fast;
-///
-/// let mut bodies = BodySet::new();
-/// let h = bodies.create(&BodyDef::dynamic(Vec2::ZERO)).unwrap();
-/// let sim = bodies.sim_mut(h).unwrap();
-/// sim.fast_travel = 0.05; // m
-/// sim.center = Vec2::new(0.02, 0.0);
-/// assert!(!may_be_fast(sim)); // 2 cm of 5 cm: within half the limit
-/// sim.center = Vec2::new(0.04, 0.0);
-/// assert!(may_be_fast(sim));
-/// ```
-#[inline(always)]
-#[must_use]
-pub fn may_be_fast(sim: &BodySim) -> bool {
-    let limit = sim.fast_travel;
-    if limit == Real::MAX {
-        return false; // no solid shape
-    }
-    let q = sim.transform.q;
-    let q0 = sim.rotation0;
-    let chord_sq = (q.c - q0.c) * (q.c - q0.c) + (q.s - q0.s) * (q.s - q0.s);
-    let arm_sq = 2.0 * (sim.core_reach * sim.core_reach + sim.local_center.length_squared());
-    let lin_sq = (sim.center - sim.center0).length_squared();
-    4.0 * (lin_sq + chord_sq * arm_sq) > limit * limit
 }
 
 /// Advances the bodies by one step, solving every batch of constraints.
@@ -952,7 +916,7 @@ pub fn solve_step_on(
     for &i in &active {
         batches[i].store_impulses();
     }
-    finalize_bodies(bodies, &mut report, team);
+    finalize_bodies(bodies, ctx.fast_bodies, &mut report, team);
     report.profile.finalize += clock(&mut t);
     report
 }

@@ -62,7 +62,7 @@
 //! extents are refreshed at the step's start for the bodies whose shapes
 //! changed ([`publish_extents`]).
 
-use janus2d_core::body::{BodyLocation, BodySet, BodySim, BodyType};
+use janus2d_core::body::{BodyLocation, BodySet, BodyType};
 use janus2d_core::geometry::{
     LINEAR_SLOP, Shape, ShapeProxy, Sweep, ToiState, shape_distance, shape_extent, time_of_impact,
 };
@@ -118,38 +118,6 @@ pub(crate) fn fast_travel(e: &BodyExtent) -> Real {
         return Real::MAX;
     }
     (FAST_FRACTION * e.min_extent).max(LINEAR_SLOP)
-}
-
-/// The fast test of one dynamic body after the solve (module docs):
-/// its travel `|Δc| + |Δq| · (core_reach + |local centre|)` beyond
-/// [`fast_travel`]. Always within the solve's bound
-/// (`janus2d_core::solver::may_be_fast`), which lets the stage skip a
-/// step where no body comes near its limit.
-#[must_use]
-pub(crate) fn is_fast(sim: &BodySim, e: &BodyExtent) -> bool {
-    if e.min_extent == Real::MAX {
-        return false; // no solid shape
-    }
-    let dc = sim.center - sim.center0;
-    let q = sim.transform.q;
-    let q0 = sim.rotation0;
-    let chord = Vec2::new(q.c - q0.c, q.s - q0.s);
-    // A turn moves the covered region by |Δq| times the reach of
-    // the shapes' cores from the centre (their rounding turns in
-    // place): a wheel spinning on its centre is not fast.
-    let arm = e.core_reach + sim.local_center.length();
-    let threshold = fast_travel(e);
-    let lin = dc.length_squared();
-    let rot = chord.length_squared() * arm * arm;
-    // |Δc| + |Δq| arm ≤ √(2 (|Δc|² + |Δq|² arm²)): most bodies need no root.
-    if 2.0 * (lin + rot) <= threshold * threshold {
-        return false;
-    }
-    // Written as the negation of `≤` so a NaN travel counts as fast, as
-    // it always did.
-    #[allow(clippy::neg_cmp_op_on_partial_ord)]
-    let fast = !(lin.sqrt() + rot.sqrt() <= threshold);
-    fast
 }
 
 /// Copies the extents of the bodies whose shapes changed into their
@@ -237,7 +205,7 @@ impl ContinuousStage {
             if sim.body_type != BodyType::Dynamic {
                 continue;
             }
-            if !is_fast(sim, &input.shapes.extent_of(sim.handle)) {
+            if !sim.is_fast() {
                 continue;
             }
             if sim.bullet {
@@ -790,8 +758,7 @@ fn aperture_fraction(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use janus2d_core::body::{BodyDef, BodySet};
-    use janus2d_core::solver::may_be_fast;
+    use janus2d_core::body::{BodyDef, BodySet, BodySim};
     use proptest::prelude::*;
 
     /// A body moved by `(dx, dy, dθ)` from a start pose, with shapes of
@@ -836,8 +803,8 @@ mod tests {
             };
             let motion = [(dx * scale) as Real, (dy * scale) as Real, (dtheta * scale) as Real];
             let sim = moved(e, motion, Vec2::new(lx as Real, ly as Real));
-            if is_fast(&sim, &e) {
-                prop_assert!(may_be_fast(&sim), "fast but not flagged: {e:?} {motion:?}");
+            if sim.is_fast() {
+                prop_assert!(sim.may_be_fast(), "fast but not flagged: {e:?} {motion:?}");
             }
         }
     }
@@ -852,11 +819,11 @@ mod tests {
             core_reach: 0.71,
         };
         let slow = moved(e, [0.01, 0.0, 0.01], Vec2::ZERO);
-        assert!(!may_be_fast(&slow));
+        assert!(!slow.may_be_fast());
         let fast = moved(e, [0.6, 0.0, 0.0], Vec2::ZERO);
-        assert!(is_fast(&fast, &e) && may_be_fast(&fast));
+        assert!(fast.is_fast() && fast.may_be_fast());
         // No solid shape: never.
         let bare = moved(BodyExtent::default(), [50.0, 0.0, 1.0], Vec2::ZERO);
-        assert!(!is_fast(&bare, &BodyExtent::default()) && !may_be_fast(&bare));
+        assert!(!bare.is_fast() && !bare.may_be_fast());
     }
 }

@@ -178,6 +178,7 @@ impl World {
         }
         // No restitution anywhere: no restitution pass.
         ctx.restitution = has_shapes && self.collision.has_restitution();
+        ctx.fast_bodies = has_shapes && self.continuous.enabled;
         let couple = has_portals && self.portals.copies_carry_joints(&self.joints);
         let mut graph = janus2d_constraints::GraphBatch {
             joints: self.joints.batch(),
