@@ -381,6 +381,7 @@ impl<L: Lane> ContactRows<L> {
     /// kept impulses, the mixed coefficients and the inverse masses
     /// `[m_a⁻¹, i_a⁻¹, m_b⁻¹, i_b⁻¹]` the impulses act with.
     #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
     pub(crate) fn set_lane(
         &mut self,
         k: usize,
@@ -561,6 +562,24 @@ impl<L: Lane> ContactRows<L> {
         inv_h: L,
         push_max: L,
     ) {
+        if self.surface.is_some() {
+            self.solve_rows::<USE_BIAS, true>(a, da, b, db, inv_h, push_max);
+        } else {
+            self.solve_rows::<USE_BIAS, false>(a, da, b, db, inv_h, push_max);
+        }
+    }
+
+    /// [`ContactRows::solve`] with (`SURFACE`) or without surface rows.
+    #[inline(always)]
+    fn solve_rows<const USE_BIAS: bool, const SURFACE: bool>(
+        &mut self,
+        a: &mut Velocity<L>,
+        da: &Delta<L>,
+        b: &mut Velocity<L>,
+        db: &Delta<L>,
+        inv_h: L,
+        push_max: L,
+    ) {
         let zero = L::splat(0.0);
         let (n_x, n_y) = (self.n_x, self.n_y);
         let (ja, jb) = (self.ja, self.jb);
@@ -613,9 +632,15 @@ impl<L: Lane> ContactRows<L> {
         self.max_normal_impulse[1] = d1.at_least(self.max_normal_impulse[1]);
 
         // Friction rows (towards the surface's tangent speed, if any).
-        let c_dot2 = self.friction_target((c_dot2 + k02 * d0) + k12 * d1);
+        let mut c_dot2 = (c_dot2 + k02 * d0) + k12 * d1;
+        if SURFACE {
+            c_dot2 = self.friction_target(c_dot2);
+        }
         let d2 = self.friction_row(2, c_dot2);
-        let c_dot3 = self.friction_target(((c_dot3 + k03 * d0) + k13 * d1) + k23 * d2);
+        let mut c_dot3 = ((c_dot3 + k03 * d0) + k13 * d1) + k23 * d2;
+        if SURFACE {
+            c_dot3 = self.friction_target(c_dot3);
+        }
         let d3 = self.friction_row(3, c_dot3);
 
         // The velocities, once: Δv = M⁻¹ Jᵀ Δλ summed over the rows.
@@ -625,7 +650,7 @@ impl<L: Lane> ContactRows<L> {
         let p_y = pn * n_y - pt * n_x;
         let mut l_a = dot_rows(&d, &ja);
         let mut l_b = dot_rows(&d, &jb);
-        if self.surface.is_some() {
+        if SURFACE {
             // The rolling row last: its Ċ = ω_b − ω_a advanced by the
             // rows above, K_ir = i_a⁻¹ (r_a × ·)_i + i_b⁻¹ (r_b × ·)_i.
             let (ka3, kb3) = (i_a * ja[3], i_b * jb[3]);

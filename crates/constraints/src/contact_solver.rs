@@ -50,7 +50,9 @@ use janus2d_core::parallel::{PlannedStates, StatePlan, Team};
 
 use crate::contact::{ContactConstraint, MAX_MANIFOLD_POINTS};
 use crate::contact_group::{Groups, solve_group};
-use crate::contact_row::{ContactRows, Delta, Velocity};
+#[cfg(feature = "f64")]
+use crate::contact_row::Delta;
+use crate::contact_row::{ContactRows, Velocity};
 use crate::lane::{Lane, Wide as W};
 
 pub use crate::contact_row::BLOCK_CONDITION;
@@ -733,6 +735,14 @@ const B: usize = 1;
 pub(crate) trait LaneStates {
     fn load(&self, side: usize, k: usize) -> BodyState;
     fn store(&mut self, side: usize, k: usize, v: Vec2, w: Real);
+    /// Writes the state's first quad, `[v.x, v.y, ω, flags]`: its
+    /// velocities, and flags as they were read.
+    #[cfg(not(feature = "f64"))]
+    #[inline(always)]
+    fn store_head(&mut self, side: usize, k: usize, head: wide::f32x4) {
+        let [x, y, w, _] = head.to_array();
+        self.store(side, k, Vec2::new(x, y), w);
+    }
 }
 
 /// The serial view: the whole state slice and the chunk's state indices.
@@ -754,6 +764,13 @@ impl LaneStates for Direct<'_> {
         s.v = v;
         s.w = w;
     }
+    #[cfg(not(feature = "f64"))]
+    #[inline(always)]
+    fn store_head(&mut self, side: usize, k: usize, head: wide::f32x4) {
+        let s = &mut self.states[self.index[side][k] as usize];
+        // A state is 32-byte aligned: its first quad is an aligned f32x4.
+        bytemuck::cast_mut::<BodyState, [wide::f32x4; 2]>(s)[0] = head;
+    }
 }
 
 /// Slots per chunk in the parallel stages' plan: both bodies of every lane.
@@ -774,8 +791,9 @@ impl LaneStates for PlannedStates<'_, PLAN_SLOTS> {
 }
 
 /// The lanes' velocities and position deltas on side `side`.
+#[cfg(feature = "f64")]
 #[inline(always)]
-fn load<S: LaneStates>(states: &S, side: usize) -> (Velocity<W>, Delta<W>) {
+fn load<S: LaneStates>(states: &S, side: usize) -> (Velocity<W>, Delta<W>, ()) {
     let mut v_x = [0.0; LANES];
     let mut v_y = [0.0; LANES];
     let mut w = [0.0; LANES];
@@ -805,12 +823,14 @@ fn load<S: LaneStates>(states: &S, side: usize) -> (Velocity<W>, Delta<W>) {
             q_c: W::from(q_c),
             q_s: W::from(q_s),
         },
+        (),
     )
 }
 
 /// The lanes' velocities only (the warm start needs no position deltas).
+#[cfg(feature = "f64")]
 #[inline(always)]
-fn load_velocity<S: LaneStates>(states: &S, side: usize) -> Velocity<W> {
+fn load_velocity<S: LaneStates>(states: &S, side: usize) -> (Velocity<W>, ()) {
     let mut v_x = [0.0; LANES];
     let mut v_y = [0.0; LANES];
     let mut w = [0.0; LANES];
@@ -820,22 +840,110 @@ fn load_velocity<S: LaneStates>(states: &S, side: usize) -> Velocity<W> {
         v_y[k] = s.v.y;
         w[k] = s.w;
     }
-    Velocity {
-        v_x: W::from(v_x),
-        v_y: W::from(v_y),
-        w: W::from(w),
-    }
+    (
+        Velocity {
+            v_x: W::from(v_x),
+            v_y: W::from(v_y),
+            w: W::from(w),
+        },
+        (),
+    )
 }
 
 /// Writes the lanes' velocities back.
+#[cfg(feature = "f64")]
 #[inline(always)]
-fn store<S: LaneStates>(states: &mut S, side: usize, v: &Velocity<W>) {
+fn store<S: LaneStates>(states: &mut S, side: usize, v: &Velocity<W>, _flags: ()) {
     let (v_x, v_y, w) = (v.v_x.to_array(), v.v_y.to_array(), v.w.to_array());
     for k in 0..LANES {
         states.store(side, k, Vec2::new(v_x[k], v_y[k]), w[k]);
     }
 }
 
+/// With `f32`, a [`BodyState`] is two aligned quads of four numbers,
+/// `[v.x, v.y, ω, flags | dp.x, dp.y, dq.c, dq.s]`: the lanes' states are
+/// read a quad at a time and turned into lanes by 4×4 transposes (as Box2D
+/// gathers its bodies), not number by number.
+#[cfg(not(feature = "f64"))]
+mod quads {
+    use super::LaneStates;
+    use crate::contact_row::{Delta, Velocity};
+    use crate::lane::{LANES, Wide as W};
+    use wide::f32x4;
+
+    /// Side `side`'s states as quads, lanes 0–3 then 4–7: the velocity
+    /// quads `[v.x, v.y, ω, flags]` and the delta quads.
+    #[inline(always)]
+    fn quads<S: LaneStates>(states: &S, side: usize, deltas: bool) -> [[[f32x4; 4]; 2]; 2] {
+        let mut q = [[[f32x4::ZERO; 4]; 2]; 2];
+        for k in 0..LANES {
+            let [head, tail]: [f32x4; 2] = bytemuck::cast(states.load(side, k));
+            q[0][k / 4][k % 4] = head;
+            if deltas {
+                q[1][k / 4][k % 4] = tail;
+            }
+        }
+        q
+    }
+
+    /// Two quads as the lanes 0–3 and 4–7 of one wide number.
+    #[inline(always)]
+    fn join(lo: f32x4, hi: f32x4) -> W {
+        bytemuck::cast([lo, hi])
+    }
+
+    /// The lanes' velocities and position deltas on side `side`.
+    #[inline(always)]
+    pub(super) fn load<S: LaneStates>(states: &S, side: usize) -> (Velocity<W>, Delta<W>, W) {
+        let [v, d] = quads(states, side, true);
+        let (v0, v1) = (f32x4::transpose(v[0]), f32x4::transpose(v[1]));
+        let (d0, d1) = (f32x4::transpose(d[0]), f32x4::transpose(d[1]));
+        (
+            Velocity {
+                v_x: join(v0[0], v1[0]),
+                v_y: join(v0[1], v1[1]),
+                w: join(v0[2], v1[2]),
+            },
+            Delta {
+                dp_x: join(d0[0], d1[0]),
+                dp_y: join(d0[1], d1[1]),
+                q_c: join(d0[2], d1[2]),
+                q_s: join(d0[3], d1[3]),
+            },
+            join(v0[3], v1[3]),
+        )
+    }
+
+    /// The lanes' velocities only (the warm start needs no position
+    /// deltas).
+    #[inline(always)]
+    pub(super) fn load_velocity<S: LaneStates>(states: &S, side: usize) -> (Velocity<W>, W) {
+        let [v, _] = quads(states, side, false);
+        let (v0, v1) = (f32x4::transpose(v[0]), f32x4::transpose(v[1]));
+        let v = Velocity {
+            v_x: join(v0[0], v1[0]),
+            v_y: join(v0[1], v1[1]),
+            w: join(v0[2], v1[2]),
+        };
+        (v, join(v0[3], v1[3]))
+    }
+
+    /// Writes the lanes' velocities back: 4×4 transposes into one quad
+    /// per lane, `[v.x, v.y, ω, flags]`, with the flags it read.
+    #[inline(always)]
+    pub(super) fn store<S: LaneStates>(states: &mut S, side: usize, v: &Velocity<W>, flags: W) {
+        let split = |x: W| -> [f32x4; 2] { bytemuck::cast(x) };
+        let (v_x, v_y, w, f) = (split(v.v_x), split(v.v_y), split(v.w), split(flags));
+        for half in 0..2 {
+            let q = f32x4::transpose([v_x[half], v_y[half], w[half], f[half]]);
+            for (i, &q) in q.iter().enumerate() {
+                states.store_head(side, 4 * half + i, q);
+            }
+        }
+    }
+}
+#[cfg(not(feature = "f64"))]
+use quads::{load, load_velocity, store};
 /// The lanes' velocities from the state slice (prepare).
 #[inline(always)]
 fn gather_velocity(states: &[BodyState], index: &[u32; LANES]) -> Velocity<W> {
@@ -914,23 +1022,23 @@ impl WideContact {
         if !self.rows.has_restitution() {
             return;
         }
-        let mut a = load_velocity(states, A);
-        let mut b = load_velocity(states, B);
+        let (mut a, flags_a) = load_velocity(states, A);
+        let (mut b, flags_b) = load_velocity(states, B);
         self.rows.restitution(&mut a, &mut b, threshold);
-        store(states, A, &a);
-        store(states, B, &b);
+        store(states, A, &a, flags_a);
+        store(states, B, &b, flags_b);
     }
 
     /// [`ContactRows::warm_start`] on the lanes, side a then side b.
     #[inline(always)]
     fn warm_start<S: LaneStates>(&mut self, states: &mut S) {
         let push = self.rows.warm_start();
-        let mut a = load_velocity(states, A);
+        let (mut a, flags_a) = load_velocity(states, A);
         self.rows.push_a(&push, &mut a);
-        store(states, A, &a);
-        let mut b = load_velocity(states, B);
+        store(states, A, &a, flags_a);
+        let (mut b, flags_b) = load_velocity(states, B);
         self.rows.push_b(&push, &mut b);
-        store(states, B, &b);
+        store(states, B, &b, flags_b);
     }
 
     /// One velocity iteration on every lane ([`ContactRows::solve`]).
@@ -941,13 +1049,13 @@ impl WideContact {
         inv_h: Real,
         push_max: Real,
     ) {
-        let (mut a, da) = load(states, A);
-        let (mut b, db) = load(states, B);
+        let (mut a, da, flags_a) = load(states, A);
+        let (mut b, db, flags_b) = load(states, B);
         let (inv_h, push_max) = (W::splat(inv_h), W::splat(push_max));
         self.rows
             .solve::<USE_BIAS>(&mut a, &da, &mut b, &db, inv_h, push_max);
-        store(states, A, &a);
-        store(states, B, &b);
+        store(states, A, &a, flags_a);
+        store(states, B, &b, flags_b);
     }
 }
 

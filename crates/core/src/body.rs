@@ -575,6 +575,7 @@ impl std::error::Error for BodyError {}
 /// The state is 32-byte aligned: a state never straddles two cache lines.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(not(feature = "f64"), derive(bytemuck::Pod, bytemuck::Zeroable))]
 #[repr(C, align(32))]
 pub struct BodyState {
     /// Linear velocity of the centre of mass, m/s.

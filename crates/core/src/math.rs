@@ -105,8 +105,9 @@ pub fn vec_is_finite(v: Vec2) -> bool {
 pub const UNIT_ROTATION_TOLERANCE: Real = 1e-3;
 
 /// A rotation stored as cosine and sine (unit length).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[repr(C)]
 pub struct Rot {
     /// Cosine of the angle.
     pub c: Real,

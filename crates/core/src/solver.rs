@@ -596,9 +596,11 @@ fn velocity_terms(ctx: &StepContext, bodies: &BodySet, team: &Team) -> StepTerms
     // and the bits of non-negative floats order as the floats do); no
     // dynamic body: the largest Real.
     let floor_bits = std::sync::atomic::AtomicU64::new(crate::math::to_f64(Real::MAX).to_bits());
+    let any_locks = std::sync::atomic::AtomicBool::new(false);
     team.for_each_chunk_mut(&mut terms, BODY_BLOCK, |i, block| {
         let start = i * BODY_BLOCK;
         let mut floor = Real::MAX;
+        let mut locks = 0;
         for (k, t) in block.iter_mut().enumerate() {
             let sim = &sims[start + k];
             if start + k == 0 || sim.body_type != BodyType::Dynamic {
@@ -618,6 +620,10 @@ fn velocity_terms(ctx: &StepContext, bodies: &BodySet, team: &Team) -> StepTerms
                 max_w: sim.max_rotation * ctx.inv_h,
             };
             floor = floor.min(sim.max_linear_speed.max(0.0));
+            locks |= sim.linear_locks;
+        }
+        if locks != 0 {
+            any_locks.store(true, std::sync::atomic::Ordering::Relaxed);
         }
         floor_bits.fetch_min(
             crate::math::to_f64(floor).to_bits(),
@@ -629,6 +635,7 @@ fn velocity_terms(ctx: &StepContext, bodies: &BodySet, team: &Team) -> StepTerms
     StepTerms {
         terms,
         speed_floor_sq: floor * floor,
+        locks: any_locks.into_inner(),
     }
 }
 
@@ -638,18 +645,28 @@ fn velocity_terms(ctx: &StepContext, bodies: &BodySet, team: &Team) -> StepTerms
 struct StepTerms {
     terms: Vec<VelocityTerms>,
     speed_floor_sq: Real,
+    /// Some dynamic body has motion locks: without any, the passes skip
+    /// the lock test (a scene without locks pays nothing for them).
+    locks: bool,
 }
 
 /// [`integrate_velocities`] from precomputed terms (one per state: block
 /// `i` of the states meets block `i` of the terms).
-fn integrate_velocity_terms(terms: &[VelocityTerms], states: &mut [BodyState], team: &Team) {
+fn integrate_velocity_terms(terms: &StepTerms, states: &mut [BodyState], team: &Team) {
     team.for_each_chunk_mut(states, BODY_BLOCK, |i, block| {
         let start = i * BODY_BLOCK;
-        integrate_terms(&terms[start..start + block.len()], block);
+        let block_terms = &terms.terms[start..start + block.len()];
+        if terms.locks {
+            integrate_terms::<true>(block_terms, block);
+        } else {
+            integrate_terms::<false>(block_terms, block);
+        }
     });
 }
 
-fn integrate_terms(terms: &[VelocityTerms], states: &mut [BodyState]) {
+/// One block's velocity integration; `LOCKS`: some body may have motion
+/// locks.
+fn integrate_terms<const LOCKS: bool>(terms: &[VelocityTerms], states: &mut [BodyState]) {
     for (t, state) in terms.iter().zip(states.iter_mut()) {
         if !t.dynamic {
             continue;
@@ -663,7 +680,9 @@ fn integrate_terms(terms: &[VelocityTerms], states: &mut [BodyState]) {
         state.v = v;
         state.w = w;
         // Motion locks: the locked components are zero before the solve.
-        state.apply_locks();
+        if LOCKS {
+            state.apply_locks();
+        }
     }
 }
 
@@ -697,8 +716,14 @@ pub fn clamp_speed(v: Vec2, max: Real) -> Vec2 {
 fn clamp_velocity_terms(terms: &StepTerms, states: &mut [BodyState], team: &Team) {
     team.for_each_chunk_mut(states, BODY_BLOCK, |i, block| {
         let start = i * BODY_BLOCK;
-        for (k, state) in block.iter_mut().enumerate() {
-            clamp_to_terms(state, terms, start + k);
+        if terms.locks {
+            for (k, state) in block.iter_mut().enumerate() {
+                clamp_to_terms::<true>(state, terms, start + k);
+            }
+        } else {
+            for (k, state) in block.iter_mut().enumerate() {
+                clamp_to_terms::<false>(state, terms, start + k);
+            }
         }
     });
 }
@@ -707,7 +732,7 @@ fn clamp_velocity_terms(terms: &StepTerms, states: &mut [BodyState], team: &Team
 /// locks (only a dynamic body has lock flags): its terms are read only
 /// when it is faster than the smallest limit.
 #[inline(always)]
-fn clamp_to_terms(state: &mut BodyState, terms: &StepTerms, i: usize) {
+fn clamp_to_terms<const LOCKS: bool>(state: &mut BodyState, terms: &StepTerms, i: usize) {
     if state.v.length_squared() > terms.speed_floor_sq {
         let t = &terms.terms[i];
         if t.dynamic {
@@ -716,7 +741,9 @@ fn clamp_to_terms(state: &mut BodyState, terms: &StepTerms, i: usize) {
     }
     // Motion locks: what the solve gave a locked axis does not move the
     // body (a constraint that comes last).
-    state.apply_locks();
+    if LOCKS {
+        state.apply_locks();
+    }
 }
 
 /// Integrates positions of moving bodies over one substep (into the deltas).
@@ -744,10 +771,20 @@ fn integrate_positions_on(
         let start = i * BODY_BLOCK;
         // State 0 is the static identity: it never moves.
         let skip = usize::from(i == 0);
-        for (k, state) in block.iter_mut().enumerate().skip(skip) {
-            clamp_to_terms(state, terms, start + k);
+        let integrate = |state: &mut BodyState| {
             state.dq = state.dq.integrate(h * state.w);
             state.dp += h * state.v;
+        };
+        if terms.locks {
+            for (k, state) in block.iter_mut().enumerate().skip(skip) {
+                clamp_to_terms::<true>(state, terms, start + k);
+                integrate(state);
+            }
+        } else {
+            for (k, state) in block.iter_mut().enumerate().skip(skip) {
+                clamp_to_terms::<false>(state, terms, start + k);
+                integrate(state);
+            }
         }
     });
 }
@@ -870,7 +907,7 @@ pub fn solve_step_on(
         let timed = substep == 0 && ctx.profile;
         let lap = |t: &mut Instant| if timed { lap(t) } else { 0.0 };
         let flip = substep % 2 == 1;
-        integrate_velocity_terms(&terms.terms, &mut bodies.states, team);
+        integrate_velocity_terms(&terms, &mut bodies.states, team);
         first.integrate += lap(&mut t);
         if ctx.warm_starting {
             for &i in &active {
