@@ -391,12 +391,13 @@ impl KindDef for DistanceJointDef {
 /// A distance joint in solver form.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[repr(C)]
 pub struct DistanceJoint {
+    /// State indices, masses and switches the solver reads.
+    pub(crate) base: JointBase,
     /// The definition it was made from (lengths, spring and motor as last
     /// set).
     pub(crate) def: Box<DistanceJointDef>,
-    /// State indices, masses and switches the solver reads.
-    pub(crate) base: JointBase,
     /// Anchor on a relative to a's centre at the start of the step (world
     /// frame), m.
     frame_a: Vec2,

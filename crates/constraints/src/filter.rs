@@ -86,11 +86,12 @@ impl KindDef for FilterJointDef {
 /// A filter joint in solver form: no rows.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[repr(C)]
 pub struct FilterJoint {
-    /// The definition it was made from.
-    pub(crate) def: Box<FilterJointDef>,
     /// State indices and switches the colouring reads.
     pub(crate) base: JointBase,
+    /// The definition it was made from.
+    pub(crate) def: Box<FilterJointDef>,
 }
 
 impl FilterJoint {

@@ -236,11 +236,12 @@ impl KindDef for MotorJointDef {
 /// A motor joint in solver form.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[repr(C)]
 pub struct MotorJoint {
-    /// The definition it was made from.
-    pub(crate) def: Box<MotorJointDef>,
     /// State indices, masses and switches the solver reads.
     pub(crate) base: JointBase,
+    /// The definition it was made from.
+    pub(crate) def: Box<MotorJointDef>,
     /// The linear rows (target point on a, anchor on b).
     pub(crate) point: PointPart,
     /// The angular row.

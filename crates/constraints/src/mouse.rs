@@ -224,11 +224,12 @@ impl KindDef for MouseJointDef {
 /// A mouse joint in solver form.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[repr(C)]
 pub struct MouseJoint {
-    /// The definition it was made from (the target as last set).
-    pub(crate) def: Box<MouseJointDef>,
     /// State indices, masses and switches the solver reads.
     pub(crate) base: JointBase,
+    /// The definition it was made from (the target as last set).
+    pub(crate) def: Box<MouseJointDef>,
     /// Anchor on b relative to b's centre at the start of the step (world
     /// frame), m.
     frame_b: Vec2,

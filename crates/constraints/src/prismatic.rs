@@ -438,11 +438,12 @@ impl KindDef for PrismaticJointDef {
 /// A prismatic joint in solver form.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[repr(C)]
 pub struct PrismaticJoint {
-    /// The definition it was made from (limits, motor and spring settings).
-    pub(crate) def: Box<PrismaticJointDef>,
     /// State indices, masses and switches the solver reads.
     pub(crate) base: JointBase,
+    /// The definition it was made from (limits, motor and spring settings).
+    pub(crate) def: Box<PrismaticJointDef>,
     /// The geometry at the start of the step.
     frame: SlideFrame,
     /// `θ_b − θ_a − θ_ref` at the start of the step, rad.

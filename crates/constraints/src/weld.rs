@@ -182,11 +182,12 @@ impl KindDef for WeldJointDef {
 /// A weld joint in solver form.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[repr(C)]
 pub struct WeldJoint {
-    /// The definition it was made from.
-    pub(crate) def: Box<WeldJointDef>,
     /// State indices, masses and switches the solver reads.
     pub(crate) base: JointBase,
+    /// The definition it was made from.
+    pub(crate) def: Box<WeldJointDef>,
     /// The point rows.
     pub(crate) point: PointPart,
     /// The angle row.

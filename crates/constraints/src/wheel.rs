@@ -260,11 +260,12 @@ impl KindDef for WheelJointDef {
 /// A wheel joint in solver form.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[repr(C)]
 pub struct WheelJoint {
-    /// The definition it was made from (spring, limits and motor settings).
-    pub(crate) def: Box<WheelJointDef>,
     /// State indices, masses and switches the solver reads.
     pub(crate) base: JointBase,
+    /// The definition it was made from (spring, limits and motor settings).
+    pub(crate) def: Box<WheelJointDef>,
     /// The geometry at the start of the step.
     frame: SlideFrame,
     /// The perpendicular row of the last iteration (the warm start's).

@@ -136,8 +136,9 @@ pub mod bytes {
     /// revolute joint its row switches and point-block bound; contacts and
     /// shapes list their hot fields first; 17: bodies keep their shapes'
     /// fast-travel limit and core reach, and the shape store the bodies
-    /// whose extents changed since the last step).
-    pub const SNAPSHOT_VERSION: u16 = 17;
+    /// whose extents changed since the last step; 18: every joint kind
+    /// lists its solver base first).
+    pub const SNAPSHOT_VERSION: u16 = 18;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.
