@@ -713,19 +713,29 @@ pub fn clamp_speed(v: Vec2, max: Real) -> Vec2 {
 /// under it too (`integrate_positions_on`). (The rotation
 /// limit stays a limit of the integration only: clamping spin after the
 /// solve changes valid scenes, spinner's hash among them.)
-fn clamp_velocity_terms(terms: &StepTerms, states: &mut [BodyState], team: &Team) {
-    team.for_each_chunk_mut(states, BODY_BLOCK, |i, block| {
-        let start = i * BODY_BLOCK;
-        if terms.locks {
-            for (k, state) in block.iter_mut().enumerate() {
-                clamp_to_terms::<true>(state, terms, start + k);
-            }
-        } else {
-            for (k, state) in block.iter_mut().enumerate() {
-                clamp_to_terms::<false>(state, terms, start + k);
-            }
+/// It runs in the finalize, on each block of states before its poses
+/// are written (the block starts at state `start`).
+#[inline(always)]
+fn clamp_velocity_terms(terms: &StepTerms, block: &mut [BodyState], start: usize) {
+    if terms.locks {
+        for (k, state) in block.iter_mut().enumerate() {
+            clamp_to_terms::<true>(state, terms, start + k);
         }
-    });
+    } else if any_faster(block, terms.speed_floor_sq) {
+        for (k, state) in block.iter_mut().enumerate() {
+            clamp_to_terms::<false>(state, terms, start + k);
+        }
+    }
+}
+
+/// Whether some state of `block` is faster than the step's smallest speed
+/// limit (`floor_sq` its square, m²/s²): one branch-free pass, so a block
+/// with nothing to clamp runs the plain integration.
+#[inline(always)]
+fn any_faster(block: &[BodyState], floor_sq: Real) -> bool {
+    block
+        .iter()
+        .fold(false, |any, s| any | (s.v.length_squared() > floor_sq))
 }
 
 /// A dynamic body's velocity clamped to its speed limit, then its motion
@@ -780,21 +790,33 @@ fn integrate_positions_on(
                 clamp_to_terms::<true>(state, terms, start + k);
                 integrate(state);
             }
-        } else {
+        } else if any_faster(block, terms.speed_floor_sq) {
             for (k, state) in block.iter_mut().enumerate().skip(skip) {
                 clamp_to_terms::<false>(state, terms, start + k);
+                integrate(state);
+            }
+        } else {
+            // Nothing to clamp: the plain loop.
+            for state in block.iter_mut().skip(skip) {
                 integrate(state);
             }
         }
     });
 }
 
-/// The step's end for every body: the pose from the deltas, forces
+/// The step's end for every body: velocities clamped to their speed
+/// limits (`clamp_velocity_terms`), the pose from the deltas, forces
 /// cleared, and whether every pose is inside [`POSE_LIMIT`]
 /// ([`SolveReport::poses_inside`]). In blocks on the team; a body whose
 /// state is not finite is left for the serial pass after, which zeroes its
 /// motion and reports it (in body order).
-fn finalize_bodies(bodies: &mut BodySet, fast_bodies: bool, report: &mut SolveReport, team: &Team) {
+fn finalize_bodies(
+    bodies: &mut BodySet,
+    terms: &StepTerms,
+    fast_bodies: bool,
+    report: &mut SolveReport,
+    team: &Team,
+) {
     let finite = |state: &BodyState| {
         vec_is_finite(state.v)
             && state.w.is_finite()
@@ -806,6 +828,7 @@ fn finalize_bodies(bodies: &mut BodySet, fast_bodies: bool, report: &mut SolveRe
     let any_fast = std::sync::atomic::AtomicBool::new(false);
     let BodySet { sims, states, .. } = bodies;
     team.for_each_chunk_pair_mut(sims, states, BODY_BLOCK, |i, sims, states| {
+        clamp_velocity_terms(terms, states, i * BODY_BLOCK);
         let skip = usize::from(i == 0);
         let mut outside = false;
         let mut fast = false;
@@ -949,11 +972,10 @@ pub fn solve_step_on(
         }
         report.profile.restitution += clock(&mut t);
     }
-    clamp_velocity_terms(&terms, &mut bodies.states, team);
     for &i in &active {
         batches[i].store_impulses();
     }
-    finalize_bodies(bodies, ctx.fast_bodies, &mut report, team);
+    finalize_bodies(bodies, &terms, ctx.fast_bodies, &mut report, team);
     report.profile.finalize += clock(&mut t);
     report
 }
