@@ -309,6 +309,8 @@ macro_rules! joint_kinds {
             /// [`RevoluteJoint::carry_through_portal`]).
             pub fn carry_through_portal(&mut self, rotation: Rot, scale: Real) {
                 match self { $( Joint::$kind(j) => KindRows::carry_through_portal(j, rotation, scale), )* }
+                // Its lengths changed (a rope's bounds decide its rows).
+                self.keep_def_reads();
             }
 
             #[inline(always)]
@@ -355,7 +357,6 @@ macro_rules! joint_kinds {
         impl Constraint for Joint {
             fn prepare(&mut self, ctx: &StepContext, bodies: &BodySet) {
                 match self { $( Joint::$kind(j) => Constraint::prepare(j, ctx, bodies), )* }
-                self.keep_def_reads();
             }
 
             fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
@@ -509,7 +510,9 @@ impl Joint {
     /// definition into the base ([`JointBase::rows`],
     /// [`JointBase::watched`], [`JointBase::driven`]): the definition
     /// is boxed apart, and one more line per joint in those passes was a
-    /// tenth of a joint-only step's end.
+    /// tenth of a joint-only step's end. Run whenever the definition
+    /// changes (made, [`Joint::set_def`], carried through a portal), not at
+    /// each prepare.
     fn keep_def_reads(&mut self) {
         let rows = u8::try_from(self.row_count()).unwrap_or(u8::MAX);
         let driven = self.drives();

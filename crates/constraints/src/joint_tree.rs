@@ -675,7 +675,7 @@ fn moving_pair(j: &Joint, states: &[BodyState]) -> [u32; 3] {
         } else {
             ITERATIVE
         };
-    if !base.enabled || j.row_count() == 0 {
+    if !base.enabled || base.rows == 0 {
         // Nothing to solve (a filter joint): not an edge at all.
         return [0, 0, flags];
     }
