@@ -23,9 +23,10 @@
 //!            light clusters' groups (crate::contact_group)
 //! warm start, solve (bias), relax (no bias), restitution
 //!            colour by colour (solve and relax reversed on alternate
-//!            sweeps), chunk by chunk: gather the lanes' body states, the
-//!            row code (ContactRows, the same as the overflow's) on
-//!            lanes, scatter the velocities; then the overflow, scalar,
+//!            sweeps), chunk by chunk: gather the lanes' body states (in
+//!            f32 a quad at a time, then 4×4 transposes), the row code
+//!            (ContactRows, the same as the overflow's) on lanes, scatter
+//!            the velocities the same way; then the overflow, scalar,
 //!            and each light cluster's group as one block
 //! store      the impulses of every lane and overflow constraint go back to
 //!            the pipeline's contacts, by contact index
