@@ -708,13 +708,14 @@ pub fn clamp_speed(v: Vec2, max: Real) -> Vec2 {
     unit * (max / unit.length())
 }
 
-/// The speed limit again after the last stages that changed velocities
-/// (relax, restitution), before the step ends; positions are integrated
-/// under it too (`integrate_positions_on`). (The rotation
-/// limit stays a limit of the integration only: clamping spin after the
-/// solve changes valid scenes, spinner's hash among them.)
-/// It runs in the finalize, on each block of states before its poses
-/// are written (the block starts at state `start`).
+/// The speed limit (and motion locks) on one block of states, the block
+/// starting at state `start`: before each substep's positions are
+/// integrated (`integrate_positions_on`), and again in the finalize after
+/// the last stages that changed velocities (relax, restitution). A block
+/// with no state above the step's smallest limit and no locks is only
+/// read once (`any_faster`). (The rotation limit stays a limit of the
+/// integration only: clamping spin after the solve changes valid scenes,
+/// spinner's hash among them.)
 #[inline(always)]
 fn clamp_velocity_terms(terms: &StepTerms, block: &mut [BodyState], start: usize) {
     if terms.locks {
@@ -728,8 +729,8 @@ fn clamp_velocity_terms(terms: &StepTerms, block: &mut [BodyState], start: usize
     }
 }
 
-/// The positions of a block of states over a substep of length `h` (s),
-/// nothing clamped: a loop of its own, which the compiler vectorises.
+/// The positions of a block of states over a substep of length `h` (s):
+/// a loop of its own, which the compiler vectorises.
 #[inline(never)]
 fn integrate_block(block: &mut [BodyState], h: Real) {
     for state in block {
@@ -777,9 +778,11 @@ pub fn integrate_positions(ctx: &StepContext, bodies: &mut BodySet) {
 }
 
 /// [`integrate_positions`] on the team, in blocks of bodies.
-/// The speed limit is applied on the way (the solve may have changed the
-/// velocities), in the same pass: a dynamic body's velocity is clamped to
-/// its `max_linear_speed` before it moves.
+/// The speed limit is applied first (the solve may have changed the
+/// velocities): a dynamic body's velocity is clamped to its
+/// `max_linear_speed` before it moves. Each body's clamp and move read
+/// only its own state, so clamping the block before moving it gives the
+/// same numbers as doing both body by body.
 fn integrate_positions_on(
     ctx: &StepContext,
     terms: &StepTerms,
@@ -788,27 +791,11 @@ fn integrate_positions_on(
 ) {
     let h = ctx.h;
     team.for_each_chunk_mut(states, BODY_BLOCK, |i, block| {
-        let start = i * BODY_BLOCK;
         // State 0 is the static identity: it never moves.
         let skip = usize::from(i == 0);
-        let integrate = |state: &mut BodyState| {
-            state.dq = state.dq.integrate(h * state.w);
-            state.dp += h * state.v;
-        };
-        if terms.locks {
-            for (k, state) in block.iter_mut().enumerate().skip(skip) {
-                clamp_to_terms::<true>(state, terms, start + k);
-                integrate(state);
-            }
-        } else if any_faster(block, terms.speed_floor_sq) {
-            for (k, state) in block.iter_mut().enumerate().skip(skip) {
-                clamp_to_terms::<false>(state, terms, start + k);
-                integrate(state);
-            }
-        } else {
-            // Nothing to clamp: the plain loop.
-            integrate_block(&mut block[skip..], h);
-        }
+        let block = &mut block[skip..];
+        clamp_velocity_terms(terms, block, i * BODY_BLOCK + skip);
+        integrate_block(block, h);
     });
 }
 
