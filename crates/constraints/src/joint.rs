@@ -302,6 +302,15 @@ macro_rules! joint_kinds {
                 match self { $( Joint::$kind(j) => KindRows::constraint_torque(j), )* }
             }
 
+            /// [`constraint_force`](Self::constraint_force) and
+            /// [`constraint_torque`](Self::constraint_torque) read together.
+            #[must_use]
+            pub fn read_back(&self) -> (Vec2, Real) {
+                match self {
+                    $( Joint::$kind(j) => (KindRows::constraint_force(j), KindRows::constraint_torque(j)), )*
+                }
+            }
+
             /// Carries the joint through a portal when both ends move to
             /// the other side (`rotation = Q`, `scale = 1/η`): its kept
             /// impulses turned and scaled, its lengths scaled by `η` (see
@@ -500,6 +509,7 @@ impl Joint {
 
     /// True when the last step solved its equality rows directly (it is
     /// part of a tree of joints, see [`crate::joint_tree`]).
+    #[inline]
     #[must_use]
     pub fn in_tree(&self) -> bool {
         self.base().in_tree
@@ -527,6 +537,7 @@ impl Joint {
     /// Rows it added to the solver at the last prepare when enabled (the
     /// definition's [`Joint::row_count`] as it was then; a step's row
     /// count reads this, not the definition).
+    #[inline]
     #[must_use]
     pub fn prepared_row_count(&self) -> usize {
         usize::from(self.base().rows)
@@ -574,14 +585,21 @@ impl Joint {
     /// before was not (one event per crossing; falling back below re-arms
     /// it).
     pub fn check_thresholds(&mut self) -> bool {
+        let (force, torque) = self.read_back();
+        self.check_thresholds_of(force, torque)
+    }
+
+    /// [`check_thresholds`](Self::check_thresholds) for a read-back already
+    /// taken (`force`, N; `torque`, N·m).
+    #[inline]
+    pub fn check_thresholds_of(&mut self, force: Vec2, torque: Real) -> bool {
         if !self.base().watched {
             return false;
         }
         let base = self.def_base();
         let (force_threshold, torque_threshold) = (base.force_threshold, base.torque_threshold);
         let over = self.is_enabled()
-            && (self.constraint_force().length() > force_threshold
-                || self.constraint_torque().abs() > torque_threshold);
+            && (force.length() > force_threshold || torque.abs() > torque_threshold);
         let b = self.base_mut();
         let crossed = over && !b.over_threshold;
         b.over_threshold = over;

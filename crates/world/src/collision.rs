@@ -826,4 +826,53 @@ mod tests {
         assert!(overlap(&world));
         assert!(world.validate().is_ok());
     }
+
+    /// A body built shape by shape widens its kept extents by each new
+    /// shape only; the result is what a recount of its shapes gives, to
+    /// the bit, and a removed shape recounts.
+    #[test]
+    fn extents_widened_shape_by_shape_equal_a_recount() {
+        use janus2d_core::geometry::{Capsule, Circle};
+        let mut world = World::new(WorldDef::default()).unwrap();
+        let body = world
+            .create_body(&BodyDef::dynamic(Vec2::new(0.0, 1.0)))
+            .unwrap();
+        let def = ShapeDef::default();
+        let mut last = None;
+        for k in 0..6 {
+            let x = k as Real * 0.7 - 1.5;
+            last = Some(
+                match k % 3 {
+                    0 => world.create_shape(
+                        body,
+                        &def,
+                        Polygon::make_offset_box(0.2, 0.4, Vec2::new(x, 0.1), 0.3),
+                    ),
+                    1 => world.create_shape(
+                        body,
+                        &def,
+                        Circle::new(Vec2::new(x, -0.2), 0.3).unwrap(),
+                    ),
+                    _ => world.create_shape(
+                        body,
+                        &def,
+                        Capsule::new(Vec2::new(x, 0.5), Vec2::new(x + 0.4, 0.9), 0.1).unwrap(),
+                    ),
+                }
+                .unwrap(),
+            );
+            let kept = world.collision.shapes.extent_of(body);
+            world.collision.shapes.refresh_extent(body);
+            let recount = world.collision.shapes.extent_of(body);
+            assert_eq!(kept, recount, "after shape {k}");
+            assert!(kept.max_extent > 0.0 && kept.min_extent < Real::MAX);
+        }
+        let before = world.collision.shapes.extent_of(body);
+        world.destroy_shape(last.unwrap()).unwrap();
+        let after = world.collision.shapes.extent_of(body);
+        assert!(
+            after.max_extent < before.max_extent,
+            "{after:?} vs {before:?}"
+        );
+    }
 }

@@ -383,8 +383,14 @@ type PairOfShapes = (ShapeHandle, ShapeHandle, bool);
 /// Pair → (list, position) of the pairs' events in [`CollisionEvents`]:
 /// looked up when an event is recorded, never iterated. Always equal as a
 /// value (it only speeds up the lists it indexes).
+///
+/// During a pass that meets each pair at most once and starts with empty
+/// lists (the narrowphase's, see [`CollisionEvents::begin_pass`]) no
+/// event can undo another, so the pass appends without indexing
+/// (`unindexed`); the next recorded event outside such a pass finds the
+/// index short of the lists and rebuilds it.
 #[derive(Clone, Default)]
-struct EventIndex(crate::key_map::KeyMap<PairOfShapes, (u8, u32)>);
+struct EventIndex(crate::key_map::KeyMap<PairOfShapes, (u8, u32)>, bool);
 
 impl PartialEq for EventIndex {
     fn eq(&self, _: &Self) -> bool {
@@ -496,6 +502,11 @@ impl CollisionEvents {
             (true, true) => (SENSOR_BEGIN, SENSOR_END),
             (false, true) => (SENSOR_END, SENSOR_BEGIN),
         };
+        if self.index.1 {
+            // A pass of distinct pairs over empty lists: nothing to undo.
+            self.append(c, this);
+            return;
+        }
         let key = pair_of_shapes(c.shapes[0], c.shapes[1], c.sensor);
         self.sync_index();
         match self.index.0.get(&key).copied() {
@@ -511,38 +522,61 @@ impl CollisionEvents {
             // a decoded snapshot's lists could hold it): nothing to add.
             Some(_) => {}
             None => {
-                let len = match this {
-                    CONTACT_BEGIN => {
-                        self.contact_begin.push(ContactBeginEvent {
-                            shape_a: c.shapes[0],
-                            shape_b: c.shapes[1],
-                            manifold: EventManifold::of(c),
-                        });
-                        self.contact_begin.len()
-                    }
-                    CONTACT_END => {
-                        self.contact_end.push(ShapePairEvent {
-                            shape_a: c.shapes[0],
-                            shape_b: c.shapes[1],
-                        });
-                        self.contact_end.len()
-                    }
-                    _ => {
-                        let b_is_sensor = c.event_flags & event_flags::SENSOR_IS_B != 0;
-                        let ev = SensorEvent {
-                            sensor_shape: c.shapes[usize::from(b_is_sensor)],
-                            visitor_shape: c.shapes[usize::from(!b_is_sensor)],
-                        };
-                        let list = if this == SENSOR_BEGIN {
-                            &mut self.sensor_begin
-                        } else {
-                            &mut self.sensor_end
-                        };
-                        list.push(ev);
-                        list.len()
-                    }
-                };
+                let len = self.append(c, this);
                 self.index.0.insert(key, (this, (len - 1) as u32));
+            }
+        }
+    }
+
+    /// Starts a pass that records each pair at most once (the
+    /// narrowphase's): when the lists are empty, its events are appended
+    /// without the pair index (see [`EventIndex`]) until
+    /// [`end_pass`](Self::end_pass).
+    pub(crate) fn begin_pass(&mut self) {
+        self.index.1 = self.contact_begin.is_empty()
+            && self.contact_end.is_empty()
+            && self.sensor_begin.is_empty()
+            && self.sensor_end.is_empty();
+    }
+
+    /// Ends the pass [`begin_pass`](Self::begin_pass) started: later
+    /// events look their pair up again.
+    pub(crate) fn end_pass(&mut self) {
+        self.index.1 = false;
+    }
+
+    /// Appends the event of contact `c` to list `this`; returns the list's
+    /// new length.
+    fn append(&mut self, c: &Contact, this: u8) -> usize {
+        match this {
+            CONTACT_BEGIN => {
+                self.contact_begin.push(ContactBeginEvent {
+                    shape_a: c.shapes[0],
+                    shape_b: c.shapes[1],
+                    manifold: EventManifold::of(c),
+                });
+                self.contact_begin.len()
+            }
+            CONTACT_END => {
+                self.contact_end.push(ShapePairEvent {
+                    shape_a: c.shapes[0],
+                    shape_b: c.shapes[1],
+                });
+                self.contact_end.len()
+            }
+            _ => {
+                let b_is_sensor = c.event_flags & event_flags::SENSOR_IS_B != 0;
+                let ev = SensorEvent {
+                    sensor_shape: c.shapes[usize::from(b_is_sensor)],
+                    visitor_shape: c.shapes[usize::from(!b_is_sensor)],
+                };
+                let list = if this == SENSOR_BEGIN {
+                    &mut self.sensor_begin
+                } else {
+                    &mut self.sensor_end
+                };
+                list.push(ev);
+                list.len()
             }
         }
     }
@@ -1260,6 +1294,74 @@ mod event_list_tests {
         });
         assert!(again.contact_end.is_empty());
         assert!(again.contact_end.capacity() >= capacity.min(64));
+    }
+
+    /// A contact between shapes `i` and `i + 1` that reports its events.
+    fn reporting_contact(i: u32) -> Contact {
+        Contact {
+            id: 0,
+            shape_a: i,
+            shape_b: i + 1,
+            shapes: [ShapeHandle::new(i, 0, 1), ShapeHandle::new(i + 1, 0, 1)],
+            body_a: BodyHandle::new(i, 0, 1),
+            body_b: BodyHandle::new(i + 1, 0, 1),
+            normal: Vec2::ZERO,
+            points: [ContactPointData::default(); 2],
+            point_count: 0,
+            friction: 0.6,
+            restitution: 0.0,
+            tangent_speed: 0.0,
+            rolling_resistance: 0.0,
+            user_material_ids: [0, 0],
+            touching: false,
+            sensor: false,
+            hit_events: false,
+            event_flags: event_flags::REPORT,
+            enabled: true,
+            still: [false, false],
+            solve_bodies: [(0, [0.0; 2]); 2],
+            recycle: RecycleCache::default(),
+        }
+    }
+
+    #[test]
+    fn an_event_after_the_narrowphase_pass_still_undoes_the_pass_event() {
+        let mut events = CollisionEvents::default();
+        events.begin_pass();
+        for i in [1, 5, 9] {
+            events.push(&reporting_contact(i), true);
+        }
+        events.end_pass();
+        // The pass appended without indexing.
+        assert_eq!(events.contact_begin.len(), 3);
+        assert_eq!(events.index.0.len(), 0);
+        // A shape destroyed later in the step ends the second contact: the
+        // index is rebuilt and the pair's begin goes instead of an end
+        // being added.
+        events.push(&reporting_contact(5), false);
+        let pairs: Vec<u32> = events
+            .contact_begin
+            .iter()
+            .map(|e| e.shape_a.index)
+            .collect();
+        assert_eq!(pairs, vec![1, 9]);
+        assert!(events.contact_end.is_empty());
+        assert_eq!(events.index.0.len(), 2);
+    }
+
+    #[test]
+    fn a_pass_over_lists_holding_events_still_nets_them_out() {
+        let mut events = CollisionEvents::default();
+        // Recorded between steps: contact 3 ended (a destroyed shape's).
+        events.push(&reporting_contact(3), false);
+        events.begin_pass();
+        // It touches again in the pass: the pending end is undone.
+        events.push(&reporting_contact(3), true);
+        events.push(&reporting_contact(7), true);
+        events.end_pass();
+        assert!(events.contact_end.is_empty());
+        assert_eq!(events.contact_begin.len(), 1);
+        assert_eq!(events.contact_begin[0].shape_a.index, 7);
     }
 
     #[test]

@@ -702,11 +702,14 @@ impl JointSet {
     pub(crate) fn end_step(&mut self) -> JointStepEnd {
         let mut end = JointStepEnd::default();
         for (k, j) in self.joints.iter_mut().enumerate() {
-            let (force, torque) = (j.constraint_force(), j.constraint_torque());
-            if !(force.x.is_finite() && force.y.is_finite() && torque.is_finite()) {
+            // One read of the kind's impulses serves the finiteness test
+            // and the thresholds.
+            let (mut force, mut torque) = j.read_back();
+            if !(force.x.is_finite() & force.y.is_finite() & torque.is_finite()) {
                 let enabled = j.is_enabled();
                 *j = Joint::new(j.def());
                 j.set_enabled(enabled);
+                (force, torque) = j.read_back();
             }
             if j.is_enabled() {
                 end.rows += j.prepared_row_count();
@@ -714,12 +717,12 @@ impl JointSet {
             if j.in_tree() {
                 end.direct_rows += j.tree_row_count();
             }
-            if j.check_thresholds() {
+            if j.check_thresholds_of(force, torque) {
                 end.events.push(JointEvent {
                     joint: self.handles[k],
                     user_data: j.def_base().user_data,
-                    force: j.constraint_force(),
-                    torque: j.constraint_torque(),
+                    force,
+                    torque,
                 });
             }
         }

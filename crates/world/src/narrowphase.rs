@@ -336,6 +336,8 @@ impl Narrowphase {
         // positions recorded in `touching` stay valid.
         let touching_list = &mut self.touching;
         touching_list.clear();
+        // Each contact is one pair, met once here.
+        events.begin_pass();
         let mut k = 0;
         let mut tested = 0;
         let mut touching_count = 0;
@@ -393,6 +395,7 @@ impl Narrowphase {
             }
             k += 1;
         }
+        events.end_pass();
         self.scanned = contacts.awake().len();
         self.results = results;
         counters.pairs_tested = tested;

@@ -584,6 +584,19 @@ pub struct BodyExtent {
     pub core_reach: Real,
 }
 
+impl BodyExtent {
+    /// Widens the extents by a solid shape's (a sensor adds nothing).
+    fn take_in(&mut self, shape: &ShapeData) {
+        if shape.def.is_sensor {
+            return;
+        }
+        let x = janus2d_core::geometry::shape_extent(&shape.geometry, Vec2::ZERO);
+        self.min_extent = self.min_extent.min(x.min_extent);
+        self.max_extent = self.max_extent.max(x.max_extent);
+        self.core_reach = self.core_reach.max(x.core_reach);
+    }
+}
+
 impl Default for BodyExtent {
     fn default() -> Self {
         BodyExtent {
@@ -710,6 +723,30 @@ impl ShapeStore {
     /// Recomputes the extents of `body` from its solid shapes, and lists
     /// it among the changes the step copies into its per-step data.
     pub(crate) fn refresh_extent(&mut self, body: BodyHandle) {
+        let b = self.note_extent_change(body);
+        let mut e = BodyExtent::default();
+        if let Some(list) = self.body_shapes.get(b) {
+            for &s in list {
+                e.take_in(self.slots.live(s));
+            }
+        }
+        self.body_extents[b] = e;
+    }
+
+    /// Adds the new shape `index` to the extents of `body`: a body built
+    /// shape by shape (a ground of thousands of pieces) costs one shape's
+    /// extent per shape, not its whole list again. The extents are minima
+    /// and maxima, so the result is the recomputed one to the bit.
+    fn extend_extent(&mut self, body: BodyHandle, index: u32) {
+        let b = self.note_extent_change(body);
+        let mut e = self.body_extents[b];
+        e.take_in(self.slots.live(index));
+        self.body_extents[b] = e;
+    }
+
+    /// Lists `body` among the extent changes and makes room for its
+    /// extents; returns its slot index.
+    fn note_extent_change(&mut self, body: BodyHandle) -> usize {
         if self.extent_changes.last() != Some(&body) {
             self.extent_changes.push(body);
         }
@@ -717,20 +754,7 @@ impl ShapeStore {
         if self.body_extents.len() <= b {
             self.body_extents.resize(b + 1, BodyExtent::default());
         }
-        let mut e = BodyExtent::default();
-        if let Some(list) = self.body_shapes.get(b) {
-            for &s in list {
-                let shape = self.slots.live(s);
-                if shape.def.is_sensor {
-                    continue;
-                }
-                let x = janus2d_core::geometry::shape_extent(&shape.geometry, Vec2::ZERO);
-                e.min_extent = e.min_extent.min(x.min_extent);
-                e.max_extent = e.max_extent.max(x.max_extent);
-                e.core_reach = e.core_reach.max(x.core_reach);
-            }
-        }
-        self.body_extents[b] = e;
+        b
     }
 
     /// Checks the store against the bodies (for `World::validate`): every
@@ -827,7 +851,7 @@ impl ShapeStore {
             self.body_shapes.resize(b + 1, SmallVec::new());
         }
         self.body_shapes[b].push(index);
-        self.refresh_extent(data_body);
+        self.extend_extent(data_body, index);
         index
     }
 
