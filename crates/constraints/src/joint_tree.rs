@@ -82,6 +82,30 @@
 //! (linear momentum is untouched), and the bias pass first re-weights the
 //! warm start's torque `r × λ`, applied earlier through `I`, to `Ĩ`.
 //!
+//! **Heavy trees.** `Γ_j = K_j / a2` builds joint `j`'s spring on its own
+//! bodies' masses, so a load `F` stretches it by `F K_j / ω²`: a light link
+//! under a heavy bob gives way by `F / (m_link ω²)`, whatever the exact
+//! solve does (3.0 cm at 10,000:1 and 500 Hz at the bottom of the swing).
+//! In a tree whose moving bodies' masses span more than
+//! [`HEAVY_TREE_RATIO`], every `K_j` in `Γ_j` (and in the held term `Γ_j
+//! λ_j`) is instead taken with every moving body as heavy as the tree's
+//! heaviest, or [`HEAVY_SPRING_FACTOR`] times its lightest if less
+//! ([`heavy_spring_inv_mass`], [`spring_inv_mass`]: `1/m → 1/m̃`,
+//! `1/I → (m / m̃) / I`). The springs are then stiff on the scale of the
+//! load they carry, as the contact groups build theirs on the heaviest
+//! body's mass (`janus2d_constraints::contact_group`); the Jacobians,
+//! the bodies' pivots and every impulse bound keep the true masses, so
+//! momentum is untouched. With no cap the 20-link chain with a heavy end
+//! diverged from 2,000:1.
+//!
+//! ```text
+//!  ratio               10     100    1,000  10,000  100,000
+//!  bob, own masses     0.14   0.40   3.0    29.7    3.7e4    mm, peak joint gap
+//!  bob, heavy springs  0.14   0.12   0.13   0.27    2.0
+//!  chain, own masses   8.3    4.3    6.8    9.2e6   9.8e6
+//!  chain, heavy        8.3    0.78   0.22   0.22    2.0
+//! ```
+//!
 //! **Layout.** Each tree keeps its bodies and its joints breadth-first from
 //! a root body, in two flat arrays; a joint knows its parent body and its
 //! child body (none for a fixed end). Going through the joints backwards,
@@ -562,6 +586,9 @@ struct WideScratch {
     g_child: Matrix3,
     /// Its `K = J M⁻¹ Jᵀ` from the joint's own masses.
     g_k: Matrix3,
+    /// Its `K` on the masses its springs are built on
+    /// ([`compliance_masses`]; `g_k` unless the tree is heavy).
+    g_k_spring: Matrix3,
     /// Its errors.
     g_c: DVec3,
     /// A copy of its accumulated impulses.
@@ -603,6 +630,7 @@ impl WideScratch {
         g_parent: Matrix3::ZERO,
         g_child: Matrix3::ZERO,
         g_k: Matrix3::ZERO,
+        g_k_spring: Matrix3::ZERO,
         g_c: DVec3::ZERO,
         g_impulse: [0.0; 3],
         g_linear: [false; 3],
@@ -1103,6 +1131,7 @@ impl JointForest {
             use_bias,
             correct: false,
             anchored: false,
+            heavy_inv_mass: 0.0,
         };
         self.solve_trees(joints, states, &params, team, false);
         for (&s, sc) in self.bodies.iter().zip(&self.body_scratch) {
@@ -1253,6 +1282,94 @@ struct TreeParams {
     /// The tree is held by a fixed end, so its feedback is split between
     /// the velocity solve and the correction pass (set per tree).
     anchored: bool,
+    /// The inverse mass its joints' springs are built on, 1/kg, when its
+    /// moving bodies' masses span more than [`HEAVY_TREE_RATIO`] (set per
+    /// tree, [`heavy_spring_inv_mass`]; 0 otherwise: each joint's own).
+    heavy_inv_mass: Real,
+}
+
+/// Mass spread within a tree (heaviest ÷ lightest moving body,
+/// dimensionless) above which its joints' springs are built on a heavier
+/// mass ([`heavy_spring_inv_mass`]).
+pub const HEAVY_TREE_RATIO: Real = 10.0;
+
+/// The most a heavy tree's springs are stiffened, as a factor on the
+/// lightest body's (dimensionless): its springs are built on the mass of
+/// its heaviest body or of 300 times its lightest, whichever is less.
+/// Unbounded, the 20-link chain with a heavy end diverged from 2,000:1
+/// (springs 2,000× stiffer than the links'; at 1,000× it opened to 9.4
+/// cm at 2,000:1); at 300× every ratio from 10:1 to 300,000:1 holds its
+/// joints within 2.1 mm (`mass_ratio_sweep`).
+pub const HEAVY_SPRING_FACTOR: Real = 300.0;
+
+/// The masses a joint's spring is built on: its own, or, in a tree whose
+/// masses span more than [`HEAVY_TREE_RATIO`], every moving body as heavy
+/// as the tree's spring mass (see [`spring_inv_mass`]). The soft row's
+/// static stretch under a load `F` is `F K / ω²`; on the light links'
+/// own `K` a heavy load stretches them by `F / (m_link ω²)` (1 cm at
+/// 10,000:1 and 500 Hz before any swing), on the heavy mass's by
+/// `F / (m_spring ω²)`.
+#[inline(always)]
+fn compliance_masses(m: &PairMass, params: &TreeParams) -> PairMass {
+    let heavy = params.heavy_inv_mass;
+    if heavy <= 0.0 {
+        return *m;
+    }
+    let scale = |b: InvMass| {
+        let (inv_mass, inv_inertia) = spring_inv_mass(b.inv_mass, b.inv_inertia, heavy);
+        InvMass {
+            inv_mass,
+            inv_inertia,
+        }
+    };
+    PairMass {
+        a: scale(m.a),
+        b: scale(m.b),
+    }
+}
+
+/// A moving body's inverse mass and inertia (1/kg, 1/(kg·m²)) as a heavy
+/// tree's springs see it, given the tree's spring inverse mass `heavy`
+/// (from [`heavy_spring_inv_mass`]; 0: the body's own): `1/m → heavy`,
+/// `1/I → (heavy · m) / I`, the body's shape kept. A fixed body (0) stays.
+#[inline(always)]
+#[must_use]
+pub fn spring_inv_mass(inv_mass: Real, inv_inertia: Real, heavy: Real) -> (Real, Real) {
+    if heavy > 0.0 && inv_mass > 0.0 {
+        (heavy, inv_inertia * (heavy / inv_mass))
+    } else {
+        (inv_mass, inv_inertia)
+    }
+}
+
+/// The inverse mass (1/kg) a tree's joint springs are built on, from its
+/// moving bodies' inverse masses: where the heaviest is more than
+/// [`HEAVY_TREE_RATIO`] times the lightest, the heaviest body's mass or
+/// [`HEAVY_SPRING_FACTOR`] times the lightest's, whichever is less; 0
+/// (each joint's own masses) otherwise.
+#[must_use]
+pub fn heavy_spring_inv_mass(inv_masses: impl IntoIterator<Item = Real>) -> Real {
+    let (mut lightest, mut heaviest) = (0.0 as Real, Real::MAX);
+    for inv in inv_masses {
+        if inv > 0.0 {
+            lightest = lightest.max(inv);
+            heaviest = heaviest.min(inv);
+        }
+    }
+    if heaviest < Real::MAX && lightest > HEAVY_TREE_RATIO * heaviest {
+        heaviest.max(lightest / HEAVY_SPRING_FACTOR)
+    } else {
+        0.0
+    }
+}
+
+/// [`heavy_spring_inv_mass`] of a tree's moving bodies, read from its
+/// joints' loaded masses.
+fn heavy_inv_mass(tree: &[TreeJoint], joints: &[Joint]) -> Real {
+    heavy_spring_inv_mass(tree.iter().flat_map(|tj| {
+        let m = joints[tj.index as usize].base().masses;
+        [m.a.inv_mass, m.b.inv_mass]
+    }))
 }
 
 /// Largest position-feedback speed of one tree joint that goes into the
@@ -1366,6 +1483,7 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
     let anchored = is_anchored(tree.joints);
     let params = &TreeParams {
         anchored,
+        heavy_inv_mass: heavy_inv_mass(tree.joints, joints),
         ..*params
     };
     let TreeParams {
@@ -1376,6 +1494,7 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
         use_bias,
         correct,
         anchored: _,
+        heavy_inv_mass: _,
     } = *params;
     let Tree {
         states: indices,
@@ -1415,7 +1534,7 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
         row.general = matches!(tree_rows, Some(TreeRows::General { .. }));
         row.split = false;
         if row.general {
-            general_rows(tj, row, w, j, bodies, states);
+            general_rows(tj, row, w, j, bodies, states, params);
             if correct {
                 w.g_impulse = [0.0; 3];
             }
@@ -1561,11 +1680,13 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
         let other = other_end(tj, row.fixed, bodies, states);
         let c_dot = from_f64(side)
             * ((parent.v + cross_sv(parent.w, r_parent)) - (other.v + cross_sv(other.w, r_other)));
-        // K in the joint's own order (a, b), as the joint's rows sum it.
+        // K in the joint's own order (a, b), as the joint's rows sum it,
+        // on the masses its spring is built on.
+        let masses = compliance_masses(&row.masses, params);
         let (k11, k12, k22) = if side > 0.0 {
-            PointPart::effective_mass(&row.masses, r_other, r_parent)
+            PointPart::effective_mass(&masses, r_other, r_parent)
         } else {
-            PointPart::effective_mass(&row.masses, r_parent, r_other)
+            PointPart::effective_mass(&masses, r_parent, r_other)
         };
         let (k11, k12, k22) = (to_f64(k11), to_f64(k12), to_f64(k22));
         let rhs = if correct {
@@ -1692,10 +1813,11 @@ fn eliminate_three(
     let c_dot = from_f64(side)
         * ((parent.v + cross_sv(parent.w, r_parent)) - (other.v + cross_sv(other.w, r_other)));
     let c_dot_angle = from_f64(side) * (parent.w - other.w);
+    let masses = compliance_masses(&row.masses, params);
     let k = if side > 0.0 {
-        three_row_k(&row.masses, r_other, r_parent)
+        three_row_k(&masses, r_other, r_parent)
     } else {
-        three_row_k(&row.masses, r_parent, r_other)
+        three_row_k(&masses, r_parent, r_other)
     };
     let compliance = params.compliance;
     let softness = params.softness;
@@ -1864,6 +1986,7 @@ fn general_rows(
     j: &Joint,
     bodies: &mut [BodyScratch],
     states: &[BodyState],
+    params: &TreeParams,
 ) {
     let base = j.base();
     let side = tj.side;
@@ -1887,6 +2010,17 @@ fn general_rows(
         (&rows.j_a, &rows.j_b, m.a, m.b)
     };
     w.g_k = block_k(j_parent, count, &m_parent) + block_k(j_other, count, &m_other);
+    w.g_k_spring = if params.heavy_inv_mass > 0.0 {
+        let spring = compliance_masses(&m, params);
+        let (s_parent, s_other) = if side > 0.0 {
+            (spring.b, spring.a)
+        } else {
+            (spring.a, spring.b)
+        };
+        block_k(j_parent, count, &s_parent) + block_k(j_other, count, &s_other)
+    } else {
+        w.g_k
+    };
     w.g_c = wide_rows(rows.c);
     w.g_impulse = rows.impulse;
     w.g_linear = rows.linear;
@@ -1934,7 +2068,7 @@ fn eliminate_general(
         // and the correction as VELOCITY_CORRECTION_SPEED says.
         let max = to_f64(params.linear_cap());
         let max_angular = to_f64(angular_correction_cap(params.max_correction_speed));
-        let held = (w.g_k * wide_rows(w.g_impulse)) * compliance;
+        let held = (w.g_k_spring * wide_rows(w.g_impulse)) * compliance;
         let mut bias = w.g_c * to_f64(params.softness.bias_rate);
         let clamp = |x: f64, m: f64| {
             if x > m {
@@ -1965,7 +2099,7 @@ fn eliminate_general(
     } else {
         -c_dot
     };
-    let mut d = w.g_k * -compliance;
+    let mut d = w.g_k_spring * -compliance;
     for i in w.g_count..3 {
         rhs[i] = 0.0;
         d.col_mut(i)[i] = -1.0;
