@@ -454,7 +454,17 @@ fn portal_blocked_exit_stops_the_body() {
 }
 
 /// Stream: 200 mixed shapes pouring through a portal pair for 30 s: body
-/// count conserved, no NaN, nothing leaked.
+/// count conserved, no NaN, nothing leaked, over at least 50 crossings.
+///
+/// How many pass is chaotic: the pour can stop on a granular arch over
+/// the 2 m aperture (shapes 0.3 m across, the arch's feet on the lips),
+/// as it does over a plain hole. Over 15 perturbed runs each (substeps
+/// 3, 4, 5, 6, 8; gravity's x 0 and ±0.01 m/s²) in f32 and f64, the
+/// funnel over a plain hole jammed in 10 of 30 (43–150 through), the
+/// portal in 5 of 30 (59–107 through) before its copies' contacts took
+/// both point orders and in 3 of 30 after (77–122 through; f64 at the
+/// default settings is one of them, 77). The bound asks for enough crossings to exercise the
+/// conservation, not for a pour that never arches (it was 100).
 #[test]
 fn portal_stream_conserves_bodies() {
     let mut scene = scenes::portal_stream(&WorldDef::default(), true);
@@ -487,7 +497,7 @@ fn portal_stream_conserves_bodies() {
         );
     }
     assert!(all_finite);
-    assert!(passes >= 100, "only {passes} passes");
+    assert!(passes >= 50, "only {passes} passes");
 }
 
 /// Destroying the pair mid-crossing removes the clone and its constraint;

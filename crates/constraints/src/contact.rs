@@ -160,8 +160,10 @@ impl ContactConstraint {
 
     /// One velocity iteration ([`ContactRows::solve`]): the normal rows
     /// (as a block or one by one), then the friction rows.
+    /// `BOTH_ORDERS`: the normal rows solved one by one are taken in both
+    /// orders and averaged ([`ContactRows::solve_both_orders`]).
     #[inline(always)]
-    pub(crate) fn solve_rows<const USE_BIAS: bool>(
+    pub(crate) fn solve_rows<const USE_BIAS: bool, const BOTH_ORDERS: bool>(
         &mut self,
         states: &mut [BodyState],
         inv_h: Real,
@@ -171,8 +173,13 @@ impl ContactConstraint {
         let (sa, sb) = (&states[ia], &states[ib]);
         let (mut a, da) = (Velocity::of(sa), Delta::of(sa));
         let (mut b, db) = (Velocity::of(sb), Delta::of(sb));
-        self.rows
-            .solve::<USE_BIAS>(&mut a, &da, &mut b, &db, inv_h, push_max);
+        if BOTH_ORDERS {
+            self.rows
+                .solve_both_orders::<USE_BIAS>(&mut a, &da, &mut b, &db, inv_h, push_max);
+        } else {
+            self.rows
+                .solve::<USE_BIAS>(&mut a, &da, &mut b, &db, inv_h, push_max);
+        }
         a.store(&mut states[ia]);
         b.store(&mut states[ib]);
     }
@@ -305,9 +312,9 @@ impl Constraint for ContactConstraint {
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
         let (inv_h, push_max) = (ctx.inv_h, ctx.contact_push_max_velocity);
         if use_bias {
-            self.solve_rows::<true>(states, inv_h, push_max);
+            self.solve_rows::<true, false>(states, inv_h, push_max);
         } else {
-            self.solve_rows::<false>(states, inv_h, push_max);
+            self.solve_rows::<false, false>(states, inv_h, push_max);
         }
     }
 
