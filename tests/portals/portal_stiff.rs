@@ -20,6 +20,23 @@ fn wall(world: &mut World, center: Vec2, hx: Real, hy: Real) -> BodyHandle {
     body_box(world, &BodyDef::fixed(center), hx, hy)
 }
 
+/// Two floors linked by a pair of floor portals (2 m apertures, both
+/// facing up), a slab over the exit with its lower face `slab_face` m
+/// above it, and a dynamic box of half size `half` dropped from 3.5 m at
+/// `x` over the entry: the scene of the blocked exit. Returns the box.
+fn blocked_aperture(world: &mut World, slab_face: Real, x: Real, half: Real) -> BodyHandle {
+    let entry_floor = wall(world, Vec2::new(0.0, -0.5), 5.0, 0.5);
+    let exit_floor = wall(world, Vec2::new(30.0, -0.5), 5.0, 0.5);
+    wall(world, Vec2::new(30.0, slab_face + 0.5), 3.0, 0.5);
+    world
+        .create_portal_pair(&PortalPairDef::new(
+            portal(entry_floor, Vec2::new(0.0, 0.5), Vec2::Y, 1.0),
+            portal(exit_floor, Vec2::new(0.0, 0.5), Vec2::Y, 1.0),
+        ))
+        .unwrap();
+    body_box(world, &BodyDef::dynamic(Vec2::new(x, 3.5)), half, half)
+}
+
 /// Steps `steps` times; returns the largest |C| while a crossing is in
 /// progress and the number of steps with one.
 fn run(world: &mut World, steps: usize, mut each: impl FnMut(&mut World)) -> (Real, usize) {
@@ -165,16 +182,7 @@ fn straddling_body_pressed_into_a_wall() {
 #[test]
 fn blocked_body_does_not_drift_sideways() {
     let mut world = World::new(WorldDef::default()).unwrap();
-    let entry_floor = wall(&mut world, Vec2::new(0.0, -0.5), 5.0, 0.5);
-    let exit_floor = wall(&mut world, Vec2::new(30.0, -0.5), 5.0, 0.5);
-    wall(&mut world, Vec2::new(30.0, 1.0), 3.0, 0.5); // lower face at y = 0.5
-    world
-        .create_portal_pair(&PortalPairDef::new(
-            portal(entry_floor, Vec2::new(0.0, 0.5), Vec2::Y, 1.0),
-            portal(exit_floor, Vec2::new(0.0, 0.5), Vec2::Y, 1.0),
-        ))
-        .unwrap();
-    let body = body_box(&mut world, &BodyDef::dynamic(Vec2::new(0.0, 3.5)), 0.5, 0.5);
+    let body = blocked_aperture(&mut world, 0.5, 0.0, 0.5);
     let (worst, crossing) = run(&mut world, 240, |_| {});
     let mut drift: Real = 0.0;
     let x0 = world.position(body).unwrap().x;
@@ -293,7 +301,7 @@ fn turning_dynamic_portal_bodies_stay_bounded_and_conserve_momentum() {
 /// under 1 cm/s for half a second), no step has a sideways speed above
 /// 5 mm/s over the next 4 s. Measured: every placement settles at 1.33 s
 /// and then moves at most 0.01 mm/s. Before the copy's contacts took
-/// their two points in both orders (`ContactRows::solve_both_orders`),
+/// their two points in both orders (`ContactRows::solve`'s `BOTH_ORDERS`),
 /// the clone's top hit the slab flat at 8 m/s but the first point of its
 /// manifold took the larger share (0.94 against 1.23 N·s): the box came
 /// away turning at 0.43 rad/s, rocked on one corner, settled only at
@@ -304,18 +312,9 @@ fn body_resting_across_a_blocked_aperture_does_not_jitter() {
     let mut failures = Vec::new();
     for (x, half) in [(0.0, 0.5), (0.3, 0.5), (-0.45, 0.5), (0.2, 0.4)] {
         let mut world = World::new(WorldDef::default()).unwrap();
-        let entry_floor = wall(&mut world, Vec2::new(0.0, -0.5), 5.0, 0.5);
-        let exit_floor = wall(&mut world, Vec2::new(30.0, -0.5), 5.0, 0.5);
-        // Lower face a box's half height above the exit: the clone's top
-        // rests against it with the object half through.
-        wall(&mut world, Vec2::new(30.0, half + 0.5), 3.0, 0.5);
-        world
-            .create_portal_pair(&PortalPairDef::new(
-                portal(entry_floor, Vec2::new(0.0, 0.5), Vec2::Y, 1.0),
-                portal(exit_floor, Vec2::new(0.0, 0.5), Vec2::Y, 1.0),
-            ))
-            .unwrap();
-        let body = body_box(&mut world, &BodyDef::dynamic(Vec2::new(x, 3.5)), half, half);
+        // The slab's face a box's half height above the exit: the clone's
+        // top rests against it with the object half through.
+        let body = blocked_aperture(&mut world, half, x, half);
         let mut still = 0;
         let mut settled_at = None;
         for step in 0..600 {
@@ -360,16 +359,7 @@ fn body_resting_across_a_blocked_aperture_does_not_jitter() {
 #[test]
 fn clone_meeting_a_slab_flat_is_pushed_evenly() {
     let mut world = World::new(WorldDef::default()).unwrap();
-    let entry_floor = wall(&mut world, Vec2::new(0.0, -0.5), 5.0, 0.5);
-    let exit_floor = wall(&mut world, Vec2::new(30.0, -0.5), 5.0, 0.5);
-    wall(&mut world, Vec2::new(30.0, 1.0), 3.0, 0.5);
-    world
-        .create_portal_pair(&PortalPairDef::new(
-            portal(entry_floor, Vec2::new(0.0, 0.5), Vec2::Y, 1.0),
-            portal(exit_floor, Vec2::new(0.0, 0.5), Vec2::Y, 1.0),
-        ))
-        .unwrap();
-    let body = body_box(&mut world, &BodyDef::dynamic(Vec2::new(0.0, 3.5)), 0.5, 0.5);
+    let body = blocked_aperture(&mut world, 0.5, 0.0, 0.5);
     let mut hit = None;
     let (mut spin, mut sideways): (Real, Real) = (0.0, 0.0);
     for step in 0..200 {

@@ -161,7 +161,7 @@ impl ContactConstraint {
     /// One velocity iteration ([`ContactRows::solve`]): the normal rows
     /// (as a block or one by one), then the friction rows.
     /// `BOTH_ORDERS`: the normal rows solved one by one are taken in both
-    /// orders and averaged ([`ContactRows::solve_both_orders`]).
+    /// orders and averaged (see [`ContactRows::solve`]).
     #[inline(always)]
     pub(crate) fn solve_rows<const USE_BIAS: bool, const BOTH_ORDERS: bool>(
         &mut self,
@@ -173,13 +173,8 @@ impl ContactConstraint {
         let (sa, sb) = (&states[ia], &states[ib]);
         let (mut a, da) = (Velocity::of(sa), Delta::of(sa));
         let (mut b, db) = (Velocity::of(sb), Delta::of(sb));
-        if BOTH_ORDERS {
-            self.rows
-                .solve_both_orders::<USE_BIAS>(&mut a, &da, &mut b, &db, inv_h, push_max);
-        } else {
-            self.rows
-                .solve::<USE_BIAS>(&mut a, &da, &mut b, &db, inv_h, push_max);
-        }
+        self.rows
+            .solve::<USE_BIAS, BOTH_ORDERS>(&mut a, &da, &mut b, &db, inv_h, push_max);
         a.store(&mut states[ia]);
         b.store(&mut states[ib]);
     }

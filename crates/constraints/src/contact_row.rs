@@ -552,8 +552,16 @@ impl<L: Lane> ContactRows<L> {
     /// holds, else one by one; the friction rows; then the velocities,
     /// once. `USE_BIAS`: the soft push-out (else relax). `da`, `db` are
     /// the bodies' position deltas.
+    ///
+    /// `BOTH_ORDERS`: the normal rows solved one by one are taken in both
+    /// orders and averaged (`Δλ = (Δλ_01 + Δλ_10) / 2`), for contacts that
+    /// may not use the block (a portal copy's, built on its object's
+    /// masses), so that a manifold met evenly (a flat face) is pushed
+    /// evenly. In one order the first point takes the larger share: a box
+    /// whose copy hit a ceiling flat at 8 m/s came away turning and rocked
+    /// on one corner for seconds.
     #[inline(always)]
-    pub(crate) fn solve<const USE_BIAS: bool>(
+    pub(crate) fn solve<const USE_BIAS: bool, const BOTH_ORDERS: bool>(
         &mut self,
         a: &mut Velocity<L>,
         da: &Delta<L>,
@@ -563,38 +571,13 @@ impl<L: Lane> ContactRows<L> {
         push_max: L,
     ) {
         if self.surface.is_some() {
-            self.solve_rows::<USE_BIAS, true, false>(a, da, b, db, inv_h, push_max);
+            self.solve_rows::<USE_BIAS, true, BOTH_ORDERS>(a, da, b, db, inv_h, push_max);
         } else {
-            self.solve_rows::<USE_BIAS, false, false>(a, da, b, db, inv_h, push_max);
+            self.solve_rows::<USE_BIAS, false, BOTH_ORDERS>(a, da, b, db, inv_h, push_max);
         }
     }
 
-    /// [`ContactRows::solve`] with the normal rows that are solved one by
-    /// one taken in both orders and averaged (`Δλ = (Δλ_01 + Δλ_10) / 2`):
-    /// for contacts that may not use the block (a portal copy's, built on
-    /// its object's masses), so that a manifold met evenly (a flat face)
-    /// is pushed evenly. In one order the first point takes the larger
-    /// share: a box whose copy hit a ceiling flat at 8 m/s came away
-    /// turning at 0.4 rad/s and rocked on one corner for seconds.
-    #[inline(always)]
-    pub(crate) fn solve_both_orders<const USE_BIAS: bool>(
-        &mut self,
-        a: &mut Velocity<L>,
-        da: &Delta<L>,
-        b: &mut Velocity<L>,
-        db: &Delta<L>,
-        inv_h: L,
-        push_max: L,
-    ) {
-        if self.surface.is_some() {
-            self.solve_rows::<USE_BIAS, true, true>(a, da, b, db, inv_h, push_max);
-        } else {
-            self.solve_rows::<USE_BIAS, false, true>(a, da, b, db, inv_h, push_max);
-        }
-    }
-
-    /// [`ContactRows::solve`] with (`SURFACE`) or without surface rows;
-    /// `BOTH_ORDERS`: see [`ContactRows::solve_both_orders`].
+    /// [`ContactRows::solve`] with (`SURFACE`) or without surface rows.
     #[inline(always)]
     fn solve_rows<const USE_BIAS: bool, const SURFACE: bool, const BOTH_ORDERS: bool>(
         &mut self,

@@ -1058,7 +1058,7 @@ impl WideContact {
         let (mut b, db, flags_b) = load(states, B);
         let (inv_h, push_max) = (W::splat(inv_h), W::splat(push_max));
         self.rows
-            .solve::<USE_BIAS>(&mut a, &da, &mut b, &db, inv_h, push_max);
+            .solve::<USE_BIAS, false>(&mut a, &da, &mut b, &db, inv_h, push_max);
         store(states, A, &a, flags_a);
         store(states, B, &b, flags_b);
     }
