@@ -141,7 +141,8 @@ fn build(case: &TreeCase, ctx: &StepContext) -> Built {
 
 /// The `K` blocks of the joints (their rows before the solve) as their
 /// trees' springs see them: every moving body at its tree's spring mass
-/// where the tree's masses span more than `HEAVY_TREE_RATIO`
+/// where the tree is anchored (a joint with one moving body) and its
+/// masses span more than `HEAVY_TREE_RATIO`
 /// (`joint_tree::heavy_spring_inv_mass`, `spring_inv_mass`); each
 /// joint's own `K` otherwise. A tree is a set of joints joined through
 /// moving bodies (a static pin joins none).
@@ -187,14 +188,24 @@ pub(super) fn spring_ks(before: &[ConstraintRows]) -> (Vec<[[f64; 3]; 3]>, f64) 
         .iter()
         .enumerate()
         .map(|(i, rows)| {
-            let heavy = heavy_spring_inv_mass(
+            let members = || {
                 before
                     .iter()
+                    .zip(&bodies)
                     .zip(&tree)
                     .filter(|(_, t)| **t == tree[i])
-                    .flat_map(|(r, _)| r.rows.iter().flat_map(|row| row.jacobian.iter()))
-                    .map(|e| e.inv_mass),
-            );
+            };
+            // Held by a fixed end: a joint with one moving body.
+            let anchored = members().any(|((_, b), _)| b.len() < 2);
+            let heavy = if anchored {
+                heavy_spring_inv_mass(
+                    members()
+                        .flat_map(|((r, _), _)| r.rows.iter().flat_map(|row| row.jacobian.iter()))
+                        .map(|e| e.inv_mass),
+                )
+            } else {
+                0.0
+            };
             let mut seen = rows.clone();
             for e in seen.rows.iter_mut().flat_map(|row| row.jacobian.iter_mut()) {
                 if heavy > 0.0 {

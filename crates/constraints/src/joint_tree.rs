@@ -86,8 +86,8 @@
 //! bodies' masses, so a load `F` stretches it by `F K_j / ω²`: a light link
 //! under a heavy bob gives way by `F / (m_link ω²)`, whatever the exact
 //! solve does (3.0 cm at 10,000:1 and 500 Hz at the bottom of the swing).
-//! In a tree whose moving bodies' masses span more than
-//! [`HEAVY_TREE_RATIO`], every `K_j` in `Γ_j` (and in the held term `Γ_j
+//! In a tree held by a fixed end whose moving bodies' masses span more
+//! than [`HEAVY_TREE_RATIO`], every `K_j` in `Γ_j` (and in the held term `Γ_j
 //! λ_j`) is instead taken with every moving body as heavy as the tree's
 //! heaviest, or [`HEAVY_SPRING_FACTOR`] times its lightest if less
 //! ([`heavy_spring_inv_mass`], [`spring_inv_mass`]: `1/m → 1/m̃`,
@@ -96,7 +96,11 @@
 //! body's mass (`janus2d_constraints::contact_group`); the Jacobians,
 //! the bodies' pivots and every impulse bound keep the true masses, so
 //! momentum is untouched. With no cap the 20-link chain with a heavy end
-//! diverged from 2,000:1.
+//! diverged from 2,000:1. Free trees (ragdolls, a lander's legs on its
+//! hull) keep their own springs, as they keep their whole feedback in
+//! their velocities (see [`VELOCITY_CORRECTION_SPEED`]): built on the
+//! heavy mass, the scripted lander of the Python environments no longer
+//! reached its portal within its episode.
 //!
 //! ```text
 //!  ratio               10     100    1,000  10,000  100,000
@@ -1282,9 +1286,10 @@ struct TreeParams {
     /// The tree is held by a fixed end, so its feedback is split between
     /// the velocity solve and the correction pass (set per tree).
     anchored: bool,
-    /// The inverse mass its joints' springs are built on, 1/kg, when its
-    /// moving bodies' masses span more than [`HEAVY_TREE_RATIO`] (set per
-    /// tree, [`heavy_spring_inv_mass`]; 0 otherwise: each joint's own).
+    /// The inverse mass its joints' springs are built on, 1/kg, when it is
+    /// anchored and its moving bodies' masses span more than
+    /// [`HEAVY_TREE_RATIO`] (set per tree, [`heavy_spring_inv_mass`]; 0
+    /// otherwise: each joint's own).
     heavy_inv_mass: Real,
 }
 
@@ -1302,8 +1307,8 @@ pub const HEAVY_TREE_RATIO: Real = 10.0;
 /// joints within 2.1 mm (`mass_ratio_sweep`).
 pub const HEAVY_SPRING_FACTOR: Real = 300.0;
 
-/// The masses a joint's spring is built on: its own, or, in a tree whose
-/// masses span more than [`HEAVY_TREE_RATIO`], every moving body as heavy
+/// The masses a joint's spring is built on: its own, or, in an anchored
+/// tree whose masses span more than [`HEAVY_TREE_RATIO`], every moving body as heavy
 /// as the tree's spring mass (see [`spring_inv_mass`]). The soft row's
 /// static stretch under a load `F` is `F K / ω²`; on the light links'
 /// own `K` a heavy load stretches them by `F / (m_link ω²)` (1 cm at
@@ -1483,7 +1488,13 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
     let anchored = is_anchored(tree.joints);
     let params = &TreeParams {
         anchored,
-        heavy_inv_mass: heavy_inv_mass(tree.joints, joints),
+        // Free trees (ragdolls, vehicles) keep their joints' own springs,
+        // as they keep the whole feedback in their velocities.
+        heavy_inv_mass: if anchored {
+            heavy_inv_mass(tree.joints, joints)
+        } else {
+            0.0
+        },
         ..*params
     };
     let TreeParams {
