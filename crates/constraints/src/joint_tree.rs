@@ -591,7 +591,8 @@ struct WideScratch {
     /// Its `K = J M⁻¹ Jᵀ` from the joint's own masses.
     g_k: Matrix3,
     /// Its `K` on the masses its springs are built on
-    /// ([`compliance_masses`]; `g_k` unless the tree is heavy).
+    /// ([`compliance_masses`]), set only in a heavy tree (read it through
+    /// [`WideScratch::spring_k`]).
     g_k_spring: Matrix3,
     /// Its errors.
     g_c: DVec3,
@@ -641,6 +642,17 @@ impl WideScratch {
         g_rest: DVec3::ZERO,
         g_count: 0,
     };
+
+    /// The `K` its springs are built on: `g_k_spring` in a heavy tree,
+    /// its own `g_k` otherwise.
+    #[inline(always)]
+    fn spring_k(&self, params: &TreeParams) -> Matrix3 {
+        if params.heavy_inv_mass > 0.0 {
+            self.g_k_spring
+        } else {
+            self.g_k
+        }
+    }
 }
 
 impl Default for JointScratch {
@@ -2021,17 +2033,15 @@ fn general_rows(
         (&rows.j_a, &rows.j_b, m.a, m.b)
     };
     w.g_k = block_k(j_parent, count, &m_parent) + block_k(j_other, count, &m_other);
-    w.g_k_spring = if params.heavy_inv_mass > 0.0 {
+    if params.heavy_inv_mass > 0.0 {
         let spring = compliance_masses(&m, params);
         let (s_parent, s_other) = if side > 0.0 {
             (spring.b, spring.a)
         } else {
             (spring.a, spring.b)
         };
-        block_k(j_parent, count, &s_parent) + block_k(j_other, count, &s_other)
-    } else {
-        w.g_k
-    };
+        w.g_k_spring = block_k(j_parent, count, &s_parent) + block_k(j_other, count, &s_other);
+    }
     w.g_c = wide_rows(rows.c);
     w.g_impulse = rows.impulse;
     w.g_linear = rows.linear;
@@ -2079,7 +2089,7 @@ fn eliminate_general(
         // and the correction as VELOCITY_CORRECTION_SPEED says.
         let max = to_f64(params.linear_cap());
         let max_angular = to_f64(angular_correction_cap(params.max_correction_speed));
-        let held = (w.g_k_spring * wide_rows(w.g_impulse)) * compliance;
+        let held = (w.spring_k(params) * wide_rows(w.g_impulse)) * compliance;
         let mut bias = w.g_c * to_f64(params.softness.bias_rate);
         let clamp = |x: f64, m: f64| {
             if x > m {
@@ -2110,7 +2120,7 @@ fn eliminate_general(
     } else {
         -c_dot
     };
-    let mut d = w.g_k_spring * -compliance;
+    let mut d = w.spring_k(params) * -compliance;
     for i in w.g_count..3 {
         rhs[i] = 0.0;
         d.col_mut(i)[i] = -1.0;

@@ -390,7 +390,12 @@ type PairOfShapes = (ShapeHandle, ShapeHandle, bool);
 /// (`unindexed`); the next recorded event outside such a pass finds the
 /// index short of the lists and rebuilds it.
 #[derive(Clone, Default)]
-struct EventIndex(crate::key_map::KeyMap<PairOfShapes, (u8, u32)>, bool);
+struct EventIndex {
+    /// Pair → (list, position).
+    pairs: crate::key_map::KeyMap<PairOfShapes, (u8, u32)>,
+    /// Inside such a pass: events are appended, not indexed.
+    unindexed: bool,
+}
 
 impl PartialEq for EventIndex {
     fn eq(&self, _: &Self) -> bool {
@@ -400,7 +405,7 @@ impl PartialEq for EventIndex {
 
 impl std::fmt::Debug for EventIndex {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "EventIndex({} pairs)", self.0.len())
+        write!(f, "EventIndex({} pairs)", self.pairs.len())
     }
 }
 
@@ -464,7 +469,7 @@ impl CollisionEvents {
     pub(crate) fn take(&mut self) -> CollisionEvents {
         let mut out = std::mem::take(self);
         self.index = std::mem::take(&mut out.index);
-        self.index.0.clear();
+        self.index.pairs.clear();
         out
     }
 
@@ -502,20 +507,20 @@ impl CollisionEvents {
             (true, true) => (SENSOR_BEGIN, SENSOR_END),
             (false, true) => (SENSOR_END, SENSOR_BEGIN),
         };
-        if self.index.1 {
+        if self.index.unindexed {
             // A pass of distinct pairs over empty lists: nothing to undo.
             self.append(c, this);
             return;
         }
         let key = pair_of_shapes(c.shapes[0], c.shapes[1], c.sensor);
         self.sync_index();
-        match self.index.0.get(&key).copied() {
+        match self.index.pairs.get(&key).copied() {
             Some((list, pos)) if list == opposite => {
                 // The pair is back where it was at the last report.
-                self.index.0.remove(&key);
+                self.index.pairs.remove(&key);
                 let pos = pos as usize;
                 if let Some(moved) = self.swap_remove_at(list, pos) {
-                    self.index.0.insert(moved, (list, pos as u32));
+                    self.index.pairs.insert(moved, (list, pos as u32));
                 }
             }
             // Already reported this way (touching alternates, so only
@@ -523,7 +528,7 @@ impl CollisionEvents {
             Some(_) => {}
             None => {
                 let len = self.append(c, this);
-                self.index.0.insert(key, (this, (len - 1) as u32));
+                self.index.pairs.insert(key, (this, (len - 1) as u32));
             }
         }
     }
@@ -533,7 +538,7 @@ impl CollisionEvents {
     /// without the pair index (see [`EventIndex`]) until
     /// [`end_pass`](Self::end_pass).
     pub(crate) fn begin_pass(&mut self) {
-        self.index.1 = self.contact_begin.is_empty()
+        self.index.unindexed = self.contact_begin.is_empty()
             && self.contact_end.is_empty()
             && self.sensor_begin.is_empty()
             && self.sensor_end.is_empty();
@@ -542,7 +547,7 @@ impl CollisionEvents {
     /// Ends the pass [`begin_pass`](Self::begin_pass) started: later
     /// events look their pair up again.
     pub(crate) fn end_pass(&mut self) {
-        self.index.1 = false;
+        self.index.unindexed = false;
     }
 
     /// Appends the event of contact `c` to list `this`; returns the list's
@@ -616,7 +621,7 @@ impl CollisionEvents {
             + self.contact_end.len()
             + self.sensor_begin.len()
             + self.sensor_end.len();
-        if self.index.0.len() == total {
+        if self.index.pairs.len() == total {
             return;
         }
         let mut index = crate::key_map::KeyMap::with_capacity_and_hasher(total, Default::default());
@@ -637,7 +642,7 @@ impl CollisionEvents {
                 index.insert(key, (list, pos as u32));
             }
         }
-        self.index.0 = index;
+        self.index.pairs = index;
     }
 }
 
@@ -1334,7 +1339,7 @@ mod event_list_tests {
         events.end_pass();
         // The pass appended without indexing.
         assert_eq!(events.contact_begin.len(), 3);
-        assert_eq!(events.index.0.len(), 0);
+        assert_eq!(events.index.pairs.len(), 0);
         // A shape destroyed later in the step ends the second contact: the
         // index is rebuilt and the pair's begin goes instead of an end
         // being added.
@@ -1346,7 +1351,7 @@ mod event_list_tests {
             .collect();
         assert_eq!(pairs, vec![1, 9]);
         assert!(events.contact_end.is_empty());
-        assert_eq!(events.index.0.len(), 2);
+        assert_eq!(events.index.pairs.len(), 2);
     }
 
     #[test]
@@ -1369,10 +1374,10 @@ mod event_list_tests {
         let mut events = CollisionEvents::default();
         events.contact_end.push(pair(1));
         events.sync_index();
-        assert_eq!(events.index.0.len(), 1);
+        assert_eq!(events.index.pairs.len(), 1);
         let out = events.take();
         assert_eq!(out.contact_end, vec![pair(1)]);
         assert!(events.contact_end.is_empty());
-        assert_eq!(events.index.0.len(), 0);
+        assert_eq!(events.index.pairs.len(), 0);
     }
 }
