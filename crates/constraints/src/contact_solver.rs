@@ -307,15 +307,15 @@ impl ContactSolver {
         };
         for (chunks, list) in self.colours.iter_mut().zip(&lists) {
             if list.len() > 16 * LANES {
-                // Blocks of 8 chunks on the team, in order.
+                // Blocks of 8 chunks on the team, each chunk made where it
+                // stays (a chunk is over a kilobyte: collecting blocks and
+                // copying them into place was most of this pass on two
+                // threads).
                 const CHUNKS: usize = 8;
-                let blocks = list.len().div_ceil(CHUNKS * LANES);
-                let built = team.map_blocks(blocks, |b| {
-                    let items =
-                        &list[b * CHUNKS * LANES..((b + 1) * CHUNKS * LANES).min(list.len())];
-                    items.chunks(LANES).map(build).collect::<Vec<_>>()
+                let count = list.len().div_ceil(LANES);
+                team.extend_mapped(chunks, count, CHUNKS, |c| {
+                    build(&list[c * LANES..((c + 1) * LANES).min(list.len())])
                 });
-                chunks.extend(built.into_iter().flatten());
                 continue;
             }
             chunks.extend(list.chunks(LANES).map(build));
