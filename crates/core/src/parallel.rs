@@ -271,7 +271,18 @@ impl Team<'_> {
     /// any order and concurrently: `job` must give the same result for
     /// block `i` whoever runs it.
     pub fn run(&self, blocks: usize, job: &(dyn Fn(usize) + Sync)) {
+        self.run_beside(blocks, job, || {});
+    }
+
+    /// [`Team::run`] with `beside` run on the leader first while the
+    /// followers already claim blocks (the leader then claims what is
+    /// left): serial work that does not touch the job's data costs no
+    /// follower a wait. On a serial team, `beside` runs, then the blocks
+    /// in order; either way `beside` runs before this returns, exactly
+    /// once.
+    pub fn run_beside(&self, blocks: usize, job: &(dyn Fn(usize) + Sync), beside: impl FnOnce()) {
         let Some(shared) = self.shared.filter(|_| blocks > 1) else {
+            beside();
             for i in 0..blocks {
                 job(i);
             }
@@ -309,6 +320,7 @@ impl Team<'_> {
             }
         }
         let retire = Retire(shared, epoch, blocks);
+        beside();
         shared.work(job, blocks, epoch + 1, 0);
         drop(retire);
         if shared.panicked.load(SeqCst) {
@@ -381,11 +393,29 @@ impl Team<'_> {
         len: usize,
         f: impl Fn(usize, &mut [A], &mut [B]) + Sync,
     ) {
+        self.for_each_chunk_pair_mut_beside(a, b, len, f, || {});
+    }
+
+    /// [`Team::for_each_chunk_pair_mut`] with `beside` run on the leader
+    /// while the followers start on the blocks (see [`Team::run_beside`]).
+    ///
+    /// # Panics
+    ///
+    /// When the slices' lengths differ (a bug of the caller, not input).
+    pub fn for_each_chunk_pair_mut_beside<A: Send, B: Send>(
+        &self,
+        a: &mut [A],
+        b: &mut [B],
+        len: usize,
+        f: impl Fn(usize, &mut [A], &mut [B]) + Sync,
+        beside: impl FnOnce(),
+    ) {
         assert_eq!(a.len(), b.len(), "paired slices differ in length");
         let len = len.max(1);
         let n = a.len();
         let blocks = n.div_ceil(len);
         if self.shared.is_none() || blocks <= 1 {
+            beside();
             for (i, (ca, cb)) in a.chunks_mut(len).zip(b.chunks_mut(len)).enumerate() {
                 f(i, ca, cb);
             }
@@ -393,21 +423,25 @@ impl Team<'_> {
         }
         let (base_a, base_b) = (Base(a.as_mut_ptr()), Base(b.as_mut_ptr()));
         let (base_a, base_b) = (&base_a, &base_b);
-        self.run(blocks, &|i| {
-            let start = i * len;
-            let count = len.min(n - start);
-            // SAFETY: for each slice, `start + count ≤ n` (equal lengths),
-            // block `i` is claimed once, and blocks do not overlap (module
-            // docs, point 2); both slices stay mutably borrowed until `run`
-            // returns.
-            let (ca, cb) = unsafe {
-                (
-                    std::slice::from_raw_parts_mut(base_a.0.add(start), count),
-                    std::slice::from_raw_parts_mut(base_b.0.add(start), count),
-                )
-            };
-            f(i, ca, cb);
-        });
+        self.run_beside(
+            blocks,
+            &|i| {
+                let start = i * len;
+                let count = len.min(n - start);
+                // SAFETY: for each slice, `start + count ≤ n` (equal lengths),
+                // block `i` is claimed once, and blocks do not overlap (module
+                // docs, point 2); both slices stay mutably borrowed until `run`
+                // returns.
+                let (ca, cb) = unsafe {
+                    (
+                        std::slice::from_raw_parts_mut(base_a.0.add(start), count),
+                        std::slice::from_raw_parts_mut(base_b.0.add(start), count),
+                    )
+                };
+                f(i, ca, cb);
+            },
+            beside,
+        );
     }
 }
 
@@ -1071,6 +1105,43 @@ mod tests {
                 .build()
                 .unwrap();
             assert_eq!(pool.install(|| with_team(run)), serial, "{threads} threads");
+        }
+    }
+
+    /// The leader's side work runs once, and every block runs once, on
+    /// any team; on a serial team the side work comes first.
+    #[test]
+    fn run_beside_runs_the_side_work_once_and_every_block() {
+        use std::sync::atomic::AtomicUsize;
+        let run = |team: &Team| {
+            let blocks: Vec<AtomicUsize> = (0..300).map(|_| AtomicUsize::new(0)).collect();
+            let (mut side, done_before) = (0, AtomicUsize::new(usize::MAX));
+            team.run_beside(
+                blocks.len(),
+                &|i| {
+                    blocks[i].fetch_add(1, SeqCst);
+                },
+                || {
+                    side += 1;
+                    let done = blocks.iter().filter(|b| b.load(SeqCst) > 0).count();
+                    done_before.store(done, SeqCst);
+                },
+            );
+            let counts: Vec<usize> = blocks.iter().map(|b| b.load(SeqCst)).collect();
+            (side, counts, done_before.into_inner())
+        };
+        let (side, counts, before) = run(&Team::serial());
+        assert_eq!((side, before), (1, 0));
+        assert!(counts.iter().all(|&c| c == 1));
+        #[cfg(feature = "parallel")]
+        for threads in [2, 4] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let (side, counts, _) = pool.install(|| with_team(run));
+            assert_eq!(side, 1, "{threads} threads");
+            assert!(counts.iter().all(|&c| c == 1), "{threads} threads");
         }
     }
 

@@ -109,7 +109,9 @@ impl Collision {
 
     /// The narrowphase over the pairs the broadphase holds: manifolds,
     /// impulses carried by feature, begin/end events, and in `wake` the
-    /// sleeping bodies a new touch wakes.
+    /// sleeping bodies a new touch wakes. `beside`: the caller's serial
+    /// work that reads nothing the narrowphase writes, run on the leader
+    /// while the other threads start on the contacts.
     pub(crate) fn collide(
         &mut self,
         bodies: &BodySet,
@@ -117,6 +119,7 @@ impl Collision {
         clipping: &crate::aperture::ContactClipping,
         wake: &mut Vec<BodyHandle>,
         team: &Team,
+        beside: impl FnOnce(),
     ) {
         let input = crate::narrowphase::NarrowphaseInput {
             shapes: &self.shapes,
@@ -133,6 +136,7 @@ impl Collision {
             &mut self.counters,
             wake,
             team,
+            beside,
         );
     }
 

@@ -288,6 +288,11 @@ impl Narrowphase {
     ///
     /// A touching contact between a sleeping body and an awake one lists
     /// the sleeping body in `wake`.
+    ///
+    /// `beside` is serial work of the caller's that shares no data with
+    /// the narrowphase: it runs first, on the leader while the followers
+    /// start on the contacts ([`Team::run_beside`]).
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn run(
         &mut self,
         input: &NarrowphaseInput<'_>,
@@ -296,6 +301,7 @@ impl Narrowphase {
         counters: &mut CollisionCounters,
         wake: &mut Vec<BodyHandle>,
         team: &Team,
+        beside: impl FnOnce(),
     ) {
         let mut results = std::mem::take(&mut self.results);
         results.clear();
@@ -319,14 +325,22 @@ impl Narrowphase {
                 let blocks = n.div_ceil(NARROW_BLOCK);
                 let outs: Vec<std::sync::Mutex<Vec<ContactUpdate>>> =
                     (0..blocks).map(|_| Default::default()).collect();
-                team.for_each_chunk_pair_mut(awake, &mut staged[..n], NARROW_BLOCK, |i, cs, ss| {
-                    let block: Vec<ContactUpdate> = cs.iter_mut().zip(ss).map(compute).collect();
-                    *outs[i].lock().unwrap_or_else(|e| e.into_inner()) = block;
-                });
+                team.for_each_chunk_pair_mut_beside(
+                    awake,
+                    &mut staged[..n],
+                    NARROW_BLOCK,
+                    |i, cs, ss| {
+                        let block: Vec<ContactUpdate> =
+                            cs.iter_mut().zip(ss).map(compute).collect();
+                        *outs[i].lock().unwrap_or_else(|e| e.into_inner()) = block;
+                    },
+                    beside,
+                );
                 for out in outs {
                     results.extend(out.into_inner().unwrap_or_else(|e| e.into_inner()));
                 }
             } else {
+                beside();
                 results.extend(awake.iter_mut().zip(staged[..n].iter_mut()).map(compute));
             }
         }

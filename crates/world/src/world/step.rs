@@ -146,8 +146,19 @@ impl World {
             sp.broadphase += lap();
             let mut wake = std::mem::take(&mut self.wake_list);
             wake.clear();
+            // The joints' colours for the contacts' graph to leave free,
+            // made on the leader while the other threads start on the
+            // narrowphase (they read the bodies only); a step with no
+            // awake contact colours none (joint-only scenes pay nothing
+            // here).
+            let reserve = self.collision.has_awake_contacts();
+            let (joints, bodies) = (&mut self.joints, &self.bodies);
             self.collision
-                .collide(&self.bodies, dt, self.portals.clipping(), &mut wake, team);
+                .collide(bodies, dt, self.portals.clipping(), &mut wake, team, || {
+                    if reserve {
+                        joints.refresh_reserved(bodies);
+                    }
+                });
             self.wake_all(&wake);
             let woke = !wake.is_empty();
             self.wake_list = wake;
@@ -155,10 +166,11 @@ impl World {
             self.islands.apply_touch_changes(touches, &self.bodies);
             self.portals
                 .object_masses(&self.bodies, &mut self.object_masses);
-            // The joints' colours for the contacts' graph to leave free;
-            // a step with no awake contact colours none (joint-only
-            // scenes pay nothing here).
-            if self.collision.has_awake_contacts() {
+            // Woken bodies take new state indices (the joints' keys), and
+            // a woken contact may be the first awake one: colour again
+            // (nothing to do when the keys are as they were). The same
+            // sequence for every thread count.
+            if (woke || !reserve) && self.collision.has_awake_contacts() {
                 self.joints.refresh_reserved(&self.bodies);
             }
             self.contact_builder.build(
