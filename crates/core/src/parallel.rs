@@ -47,7 +47,8 @@
 //!    The job cell itself is written only by the leader while the epoch is
 //!    idle and `active == 0`, when no follower reads it.
 //! 2. **Disjoint mutable blocks of one slice** ([`Team::for_each_chunk_mut`],
-//!    and of two equally long slices at once, [`Team::for_each_chunk_pair_mut`]).
+//!    and of two or three equally long slices at once,
+//!    [`Team::for_each_chunk_pair_mut`], [`Team::for_each_chunk_triple_mut_beside`]).
 //!    Block `i` is the sub-slice `[i·len, min((i+1)·len, n))`; a block is
 //!    run by the one thread whose swap of the job's epoch into the block's
 //!    claim flag returned another value (epochs never repeat within a team,
@@ -410,19 +411,59 @@ impl Team<'_> {
         f: impl Fn(usize, &mut [A], &mut [B]) + Sync,
         beside: impl FnOnce(),
     ) {
-        assert_eq!(a.len(), b.len(), "paired slices differ in length");
+        // A slice of `()` costs no memory.
+        let mut none = vec![(); a.len()];
+        self.for_each_chunk_triple_mut_beside(
+            a,
+            b,
+            &mut none,
+            len,
+            |i, ca, cb, _| f(i, ca, cb),
+            beside,
+        );
+    }
+
+    /// [`Team::for_each_chunk_pair_mut_beside`] over three slices of the
+    /// same length at once (the contacts, their staged records and their
+    /// results, say).
+    ///
+    /// # Panics
+    ///
+    /// When the slices' lengths differ (a bug of the caller, not input).
+    pub fn for_each_chunk_triple_mut_beside<A: Send, B: Send, C: Send>(
+        &self,
+        a: &mut [A],
+        b: &mut [B],
+        c: &mut [C],
+        len: usize,
+        f: impl Fn(usize, &mut [A], &mut [B], &mut [C]) + Sync,
+        beside: impl FnOnce(),
+    ) {
+        assert!(
+            a.len() == b.len() && a.len() == c.len(),
+            "chunked slices differ in length"
+        );
         let len = len.max(1);
         let n = a.len();
         let blocks = n.div_ceil(len);
         if self.shared.is_none() || blocks <= 1 {
             beside();
-            for (i, (ca, cb)) in a.chunks_mut(len).zip(b.chunks_mut(len)).enumerate() {
-                f(i, ca, cb);
+            for (i, ((ca, cb), cc)) in a
+                .chunks_mut(len)
+                .zip(b.chunks_mut(len))
+                .zip(c.chunks_mut(len))
+                .enumerate()
+            {
+                f(i, ca, cb, cc);
             }
             return;
         }
-        let (base_a, base_b) = (Base(a.as_mut_ptr()), Base(b.as_mut_ptr()));
-        let (base_a, base_b) = (&base_a, &base_b);
+        let bases = (
+            Base(a.as_mut_ptr()),
+            Base(b.as_mut_ptr()),
+            Base(c.as_mut_ptr()),
+        );
+        let bases = &bases;
         self.run_beside(
             blocks,
             &|i| {
@@ -430,15 +471,16 @@ impl Team<'_> {
                 let count = len.min(n - start);
                 // SAFETY: for each slice, `start + count ≤ n` (equal lengths),
                 // block `i` is claimed once, and blocks do not overlap (module
-                // docs, point 2); both slices stay mutably borrowed until `run`
+                // docs, point 2); the slices stay mutably borrowed until `run`
                 // returns.
-                let (ca, cb) = unsafe {
+                let (ca, cb, cc) = unsafe {
                     (
-                        std::slice::from_raw_parts_mut(base_a.0.add(start), count),
-                        std::slice::from_raw_parts_mut(base_b.0.add(start), count),
+                        std::slice::from_raw_parts_mut(bases.0.0.add(start), count),
+                        std::slice::from_raw_parts_mut(bases.1.0.add(start), count),
+                        std::slice::from_raw_parts_mut(bases.2.0.add(start), count),
                     )
                 };
-                f(i, ca, cb);
+                f(i, ca, cb, cc);
             },
             beside,
         );

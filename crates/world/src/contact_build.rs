@@ -250,15 +250,15 @@ impl ContactBuilder {
             const STILL: u32 = u32::MAX;
             const BLOCK: usize = 1024;
             let touching = handoff.touching;
-            solved.resize(touching.len(), entry(0, &StagedContact::default()));
-            team.for_each_chunk_mut(solved, BLOCK, |i, block| {
-                for (s, &k) in block.iter_mut().zip(&touching[i * BLOCK..]) {
-                    let record = &staged[k as usize];
-                    *s = entry(k as usize, record);
-                    if record.still == [true, true] {
-                        s.index = STILL;
-                    }
+            // Made where they stay (no serial fill of `solved` first).
+            team.extend_mapped(solved, touching.len(), BLOCK, |i| {
+                let k = touching[i] as usize;
+                let record = &staged[k];
+                let mut s = entry(k, record);
+                if record.still == [true, true] {
+                    s.index = STILL;
                 }
+                s
             });
             if solved.iter().any(|s| s.index == STILL) {
                 solved.retain(|s| s.index != STILL);

@@ -319,30 +319,22 @@ impl Narrowphase {
                 update
             };
             let awake = contacts.awake_slice_mut();
-            if team.threads() > 1 && n > NARROW_BLOCK {
-                // Blocks of contacts on the team, each block's results kept
-                // apart and joined in block order.
-                let blocks = n.div_ceil(NARROW_BLOCK);
-                let outs: Vec<std::sync::Mutex<Vec<ContactUpdate>>> =
-                    (0..blocks).map(|_| Default::default()).collect();
-                team.for_each_chunk_pair_mut_beside(
-                    awake,
-                    &mut staged[..n],
-                    NARROW_BLOCK,
-                    |i, cs, ss| {
-                        let block: Vec<ContactUpdate> =
-                            cs.iter_mut().zip(ss).map(compute).collect();
-                        *outs[i].lock().unwrap_or_else(|e| e.into_inner()) = block;
-                    },
-                    beside,
-                );
-                for out in outs {
-                    results.extend(out.into_inner().unwrap_or_else(|e| e.into_inner()));
-                }
-            } else {
-                beside();
-                results.extend(awake.iter_mut().zip(staged[..n].iter_mut()).map(compute));
-            }
+            // Each contact's result is written in its place, in blocks on
+            // the team (`beside` runs first on the leader, or alone before
+            // the blocks on a serial team).
+            results.resize(n, ContactUpdate::Asleep);
+            team.for_each_chunk_triple_mut_beside(
+                awake,
+                &mut staged[..n],
+                &mut results[..],
+                NARROW_BLOCK,
+                |_, cs, ss, rs| {
+                    for ((c, s), r) in cs.iter_mut().zip(ss).zip(rs) {
+                        *r = compute((c, s));
+                    }
+                },
+                beside,
+            );
         }
         // Serial pass over the results: a contact is read again only when
         // it is destroyed, begins or ends touching, or wakes a body, and a
