@@ -1142,12 +1142,18 @@ mod tests {
         assert_eq!(with_team(run), serial);
         #[cfg(feature = "parallel")]
         for threads in [2, 4] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            assert_eq!(pool.install(|| with_team(run)), serial, "{threads} threads");
+            assert_eq!(on_threads(threads, run), serial, "{threads} threads");
         }
+    }
+
+    /// `run` on a team of `threads` threads (a rayon pool of its own).
+    #[cfg(feature = "parallel")]
+    fn on_threads<R: Send>(threads: usize, run: impl FnOnce(&Team) -> R + Send) -> R {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| with_team(run))
     }
 
     /// The leader's side work runs once, and every block runs once, on
@@ -1177,11 +1183,7 @@ mod tests {
         assert!(counts.iter().all(|&c| c == 1));
         #[cfg(feature = "parallel")]
         for threads in [2, 4] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            let (side, counts, _) = pool.install(|| with_team(run));
+            let (side, counts, _) = on_threads(threads, run);
             assert_eq!(side, 1, "{threads} threads");
             assert!(counts.iter().all(|&c| c == 1), "{threads} threads");
         }
@@ -1204,15 +1206,7 @@ mod tests {
         assert_eq!(run(&Team::serial()), expected);
         #[cfg(feature = "parallel")]
         for threads in [2, 4] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            assert_eq!(
-                pool.install(|| with_team(run)),
-                expected,
-                "{threads} threads"
-            );
+            assert_eq!(on_threads(threads, run), expected, "{threads} threads");
         }
     }
 
@@ -1224,15 +1218,7 @@ mod tests {
         assert_eq!(run(&Team::serial()), expected);
         #[cfg(feature = "parallel")]
         for threads in [2, 4] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            assert_eq!(
-                pool.install(|| with_team(run)),
-                expected,
-                "{threads} threads"
-            );
+            assert_eq!(on_threads(threads, run), expected, "{threads} threads");
         }
     }
 
