@@ -179,6 +179,25 @@ impl ContactConstraint {
         b.store(&mut states[ib]);
     }
 
+    /// [`ContactConstraint::solve_rows`] with its switches read at run
+    /// time (the overflow's contacts differ in `both_orders`).
+    #[inline(always)]
+    pub(crate) fn solve_with(
+        &mut self,
+        states: &mut [BodyState],
+        use_bias: bool,
+        both_orders: bool,
+        inv_h: Real,
+        push_max: Real,
+    ) {
+        match (use_bias, both_orders) {
+            (true, false) => self.solve_rows::<true, false>(states, inv_h, push_max),
+            (false, false) => self.solve_rows::<false, false>(states, inv_h, push_max),
+            (true, true) => self.solve_rows::<true, true>(states, inv_h, push_max),
+            (false, true) => self.solve_rows::<false, true>(states, inv_h, push_max),
+        }
+    }
+
     /// The friction rows alone, one by one, from the bodies' velocities
     /// (after a coupled group has solved the normal rows):
     /// [`ContactRows::friction_row`] with the velocities updated after
@@ -306,11 +325,7 @@ impl Constraint for ContactConstraint {
 
     fn solve(&mut self, ctx: &StepContext, states: &mut [BodyState], use_bias: bool) {
         let (inv_h, push_max) = (ctx.inv_h, ctx.contact_push_max_velocity);
-        if use_bias {
-            self.solve_rows::<true, false>(states, inv_h, push_max);
-        } else {
-            self.solve_rows::<false, false>(states, inv_h, push_max);
-        }
+        self.solve_with(states, use_bias, false, inv_h, push_max);
     }
 
     fn apply_restitution(&mut self, ctx: &StepContext, states: &mut [BodyState]) {

@@ -592,12 +592,7 @@ impl ContactSolver {
             // A portal copy's contact has no block (see `prepare`): its two
             // points in both orders, so a flat face is pushed evenly.
             let hooked = self.hooked.get(k).copied().unwrap_or(false);
-            match (use_bias, hooked) {
-                (true, false) => c.solve_rows::<true, false>(states, inv_h, push_max),
-                (false, false) => c.solve_rows::<false, false>(states, inv_h, push_max),
-                (true, true) => c.solve_rows::<true, true>(states, inv_h, push_max),
-                (false, true) => c.solve_rows::<false, true>(states, inv_h, push_max),
-            }
+            c.solve_with(states, use_bias, hooked, inv_h, push_max);
         }
         for g in &self.groups.groups {
             let solved = if use_bias {
@@ -607,12 +602,7 @@ impl ContactSolver {
             };
             if !solved {
                 for &k in g.members() {
-                    let c = &mut self.overflow[k as usize];
-                    if use_bias {
-                        c.solve_rows::<true, false>(states, inv_h, push_max);
-                    } else {
-                        c.solve_rows::<false, false>(states, inv_h, push_max);
-                    }
+                    self.overflow[k as usize].solve_with(states, use_bias, false, inv_h, push_max);
                 }
             }
         }

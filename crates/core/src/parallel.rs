@@ -394,23 +394,6 @@ impl Team<'_> {
         len: usize,
         f: impl Fn(usize, &mut [A], &mut [B]) + Sync,
     ) {
-        self.for_each_chunk_pair_mut_beside(a, b, len, f, || {});
-    }
-
-    /// [`Team::for_each_chunk_pair_mut`] with `beside` run on the leader
-    /// while the followers start on the blocks (see [`Team::run_beside`]).
-    ///
-    /// # Panics
-    ///
-    /// When the slices' lengths differ (a bug of the caller, not input).
-    pub fn for_each_chunk_pair_mut_beside<A: Send, B: Send>(
-        &self,
-        a: &mut [A],
-        b: &mut [B],
-        len: usize,
-        f: impl Fn(usize, &mut [A], &mut [B]) + Sync,
-        beside: impl FnOnce(),
-    ) {
         // A slice of `()` costs no memory.
         let mut none = vec![(); a.len()];
         self.for_each_chunk_triple_mut_beside(
@@ -419,13 +402,14 @@ impl Team<'_> {
             &mut none,
             len,
             |i, ca, cb, _| f(i, ca, cb),
-            beside,
+            || {},
         );
     }
 
-    /// [`Team::for_each_chunk_pair_mut_beside`] over three slices of the
-    /// same length at once (the contacts, their staged records and their
-    /// results, say).
+    /// [`Team::for_each_chunk_pair_mut`] over three slices of the same
+    /// length at once (the contacts, their staged records and their
+    /// results, say), with `beside` run on the leader while the followers
+    /// start on the blocks (see [`Team::run_beside`]).
     ///
     /// # Panics
     ///
