@@ -226,6 +226,29 @@ pub(super) fn spring_ks(before: &[ConstraintRows]) -> (Vec<[[f64; 3]; 3]>, f64) 
     (ks, stiffening)
 }
 
+/// The longest lever arm squared (m²) over the joints' bodies: for each
+/// body of a joint, the sum of its angular Jacobian entries squared over
+/// the joint's two point rows, `(r × x̂)² + (r × ŷ)² = |r|²`.
+pub(super) fn lever_squared(rows: &[ConstraintRows]) -> f64 {
+    let mut longest: f64 = 0.0;
+    for joint in rows {
+        let mut arms: Vec<(BodyHandle, f64)> = Vec::new();
+        for e in joint
+            .rows
+            .iter()
+            .take(2)
+            .flat_map(|row| row.jacobian.iter())
+        {
+            match arms.iter_mut().find(|(b, _)| *b == e.body) {
+                Some((_, sum)) => *sum += d(e.angular * e.angular),
+                None => arms.push((e.body, d(e.angular * e.angular))),
+            }
+        }
+        longest = arms.iter().map(|(_, sum)| *sum).fold(longest, f64::max);
+    }
+    longest
+}
+
 pub(super) fn velocity(set: &BodySet, h: BodyHandle) -> (Vec2, Real) {
     let s = set.solver_body(h).state;
     (s.v, s.w)
@@ -236,73 +259,177 @@ pub(super) fn velocity(set: &BodySet, h: BodyHandle) -> (Vec2, Real) {
 /// on the tree's spring masses (`spring_ks`).
 #[test]
 fn tree_solve_satisfies_every_soft_row() {
-    let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
-    let soft = ctx.direct_joint_softness;
-    let compliance = d(soft.impulse_scale / soft.mass_scale);
     check("tree solve residual", tree_case(), |case| {
-        let mut b = build(&case, &ctx);
-        let mut forest = JointForest::default();
-        forest.build(&mut b.joints, &b.set.states, true);
-        prop_assert_eq!(forest.tree_joint_count(), b.joints.len());
-        let before: Vec<_> = b.joints.iter().map(|j| j.rows(&ctx, &b.set)).collect();
-        // Size of the terms whose rounding enters the residual.
-        let mut scale: f64 = case
-            .bodies
-            .iter()
-            .map(|s| d(s.v.length()) + 4.0 * d(s.w.abs()))
-            .fold(0.0, f64::max);
-        for rows in &before {
-            for i in 0..2 {
-                scale = scale.max(d(rows.row_velocity(i, |h| velocity(&b.set, h))).abs());
-                if case.use_bias {
-                    scale = scale.max(d(soft.bias_rate * rows.rows[i].c).abs());
-                }
-            }
-        }
-        let (ks, stiffening) = spring_ks(&before);
-        forest.solve(&ctx, &mut b.joints, &mut b.set.states, case.use_bias);
-        let mut worst: f64 = 0.0;
-        for ((j, rows), k) in b.joints.iter().zip(&before).zip(&ks) {
-            let after = j.rows(&ctx, &b.set);
-            let lambda = revolute(j).linear_impulse();
-            for i in 0..2 {
-                let c_dot = d(after.row_velocity(i, |h| velocity(&b.set, h)));
-                let bias = if case.use_bias {
-                    // The velocity solve's share of the capped feedback
-                    // (`joint_tree::VELOCITY_CORRECTION_SPEED`; the
-                    // joints start with no impulse, so nothing is held);
-                    // the rest moves the bodies in the correction pass.
-                    let c = Vec2::new(rows.rows[0].c, rows.rows[1].c);
-                    let clamp = |b: Vec2, cap: Real| {
-                        let len = b.length();
-                        if len > cap { b * (cap / len) } else { b }
-                    };
-                    let full = clamp(soft.bias_rate * c, ctx.direct_joint_max_correction_speed);
-                    d(clamp(full, VELOCITY_CORRECTION_SPEED)[i])
-                } else {
-                    0.0
-                };
-                let held = compliance * (k[i][0] * d(lambda.x) + k[i][1] * d(lambda.y));
-                worst = worst.max((c_dot + bias + held).abs());
-            }
-        }
-        // Rounding in the elimination grows with the spread of the masses
-        // and inertias (the pivots' condition) and the number of joints.
-        let spread = case
-            .bodies
-            .iter()
-            .flat_map(|b| [d(b.mass), d(b.inertia)])
-            .fold((f64::MAX, 0.0f64), |(lo, hi), x| (lo.min(x), hi.max(x)));
-        let n = b.joints.len() as f64;
-        // The regularised system's condition is at most the spread times
-        // (1 + a2): Γ = K / a2 keeps its smallest eigenvalue off zero; a
-        // heavy tree's springs, `stiffening` times stiffer, keep it that
-        // much less far off.
-        let a2 = d(soft.mass_scale / soft.impulse_scale);
-        let bound = 8.0 * n * EPS * (spread.1 / spread.0) * (1.0 + a2 * stiffening) * scale;
+        let (worst, bound) = tree_residual(&case)?;
         prop_assert!(worst <= bound, "residual {worst:e} > {bound:e}");
         Ok(worst / bound)
     });
+}
+
+/// Known limit, kept as a regression case: a tree closed into a loop
+/// through the ground (a heavy body pinned at its centre, a light body
+/// hinged to it, a second light body hinged to that one off its centre and
+/// pinned too; springs built on the heavy mass). The elimination folds the
+/// stiff pin rows into the bodies' pivots without pivoting, so the loop's
+/// one free motion is resolved from differences of pivots about 10⁴ times
+/// larger: in the f64 build the two loop joints' residual is 3.2e-5
+/// against a bound of 2.8e-6 (their impulses differ from a dense
+/// partial-pivoting solve of the same rows, residual 6.7e-16, by 1.3e-5
+/// of their size). One case in about 600,000 of the property test's
+/// random trees is of this kind.
+#[test]
+#[ignore = "known: a tree closed through the ground loses precision (residual 3.2e-5 > 2.8e-6, f64)"]
+fn tree_residual_of_a_loop_closed_through_the_ground() {
+    // The figures as the f64 run printed them (rounded to f32 in that
+    // build, where the case is not the same).
+    let masses: [f64; 9] = [
+        8.296_857_428_396_388,
+        25.211_626_644_395_817,
+        143.530_253_446_938_42,
+        206.704_079_669_980_9,
+        330.479_716_264_371_35,
+        4.453_608_089_868_529_5,
+        1.0,
+        1.0,
+        1.0,
+    ];
+    let v = |x: f64, y: f64| Vec2::new(x as Real, y as Real);
+    let mut bodies: Vec<BodySpec> = masses
+        .iter()
+        .map(|m| BodySpec::dynamic(Vec2::ZERO, *m as Real, 1.0))
+        .collect();
+    bodies[6].angle = -2.586_523_428_366_732_f64 as Real;
+    bodies[6].w = -1.297_626_931_421_639_f64 as Real;
+    let link = |parent, anchor_parent| Link {
+        parent,
+        anchor_parent,
+        anchor_child: Vec2::ZERO,
+    };
+    let z = Vec2::ZERO;
+    let case = TreeCase {
+        bodies,
+        links: vec![
+            link(0, z),
+            link(0, z),
+            link(0, z),
+            link(3, z),
+            link(0, z),
+            link(3, z),
+            link(3, z),
+            link(7, v(-0.759_995_379_990_794_3, -0.621_165_954_240_74)),
+            link(0, z),
+        ],
+        extra_pins: vec![(7, v(-0.821_080_700_299_547_7, 0.388_126_156_820_610_8))],
+        use_bias: false,
+    };
+    let (worst, bound) = tree_residual(&case).unwrap();
+    assert!(worst <= bound, "residual {worst:e} > {bound:e}");
+}
+
+/// A case the property test met in the f64 build (shrunk): a body pinned
+/// at its centre, a lighter one hinged to it and pinned a second time
+/// 1.4 m off its centre, so four rows hold its three degrees of freedom.
+/// Its residual, 3.3e-11, exceeded the bound (3.2e-11) until the bound
+/// took the lever arm in (see `tree_residual`).
+#[test]
+fn tree_residual_of_a_second_pin_off_the_centre() {
+    let mut light = BodySpec::dynamic(Vec2::ZERO, 1.0, 1.747_021);
+    light.w = -0.044_020_96;
+    let at_centre = |parent| Link {
+        parent,
+        anchor_parent: Vec2::ZERO,
+        anchor_child: Vec2::ZERO,
+    };
+    let case = TreeCase {
+        bodies: vec![BodySpec::dynamic(Vec2::ZERO, 12.365_637, 1.0), light],
+        links: vec![at_centre(0), at_centre(1)],
+        extra_pins: vec![(1, Vec2::new(-0.696_386, -1.225_805))],
+        use_bias: false,
+    };
+    let (worst, bound) = tree_residual(&case).unwrap();
+    assert!(
+        worst > 0.0 && worst <= bound,
+        "residual {worst:e} > {bound:e}"
+    );
+}
+
+/// The worst residual of one tree solve of `case` over its joints' point
+/// rows and its bound, `8 n eps (spread) (1 + a2 stiffening) (1 + r²)
+/// (speed scale)`.
+fn tree_residual(case: &TreeCase) -> Result<(f64, f64), TestCaseError> {
+    let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
+    let soft = ctx.direct_joint_softness;
+    let compliance = d(soft.impulse_scale / soft.mass_scale);
+    let mut b = build(case, &ctx);
+    let mut forest = JointForest::default();
+    forest.build(&mut b.joints, &b.set.states, true);
+    prop_assert_eq!(forest.tree_joint_count(), b.joints.len());
+    let before: Vec<_> = b.joints.iter().map(|j| j.rows(&ctx, &b.set)).collect();
+    // Size of the terms whose rounding enters the residual.
+    let mut scale: f64 = case
+        .bodies
+        .iter()
+        .map(|s| d(s.v.length()) + 4.0 * d(s.w.abs()))
+        .fold(0.0, f64::max);
+    for rows in &before {
+        for i in 0..2 {
+            scale = scale.max(d(rows.row_velocity(i, |h| velocity(&b.set, h))).abs());
+            if case.use_bias {
+                scale = scale.max(d(soft.bias_rate * rows.rows[i].c).abs());
+            }
+        }
+    }
+    let (ks, stiffening) = spring_ks(&before);
+    forest.solve(&ctx, &mut b.joints, &mut b.set.states, case.use_bias);
+    let mut worst: f64 = 0.0;
+    for ((j, rows), k) in b.joints.iter().zip(&before).zip(&ks) {
+        let after = j.rows(&ctx, &b.set);
+        let lambda = revolute(j).linear_impulse();
+        for i in 0..2 {
+            let c_dot = d(after.row_velocity(i, |h| velocity(&b.set, h)));
+            let bias = if case.use_bias {
+                // The velocity solve's share of the capped feedback
+                // (`joint_tree::VELOCITY_CORRECTION_SPEED`; the
+                // joints start with no impulse, so nothing is held);
+                // the rest moves the bodies in the correction pass.
+                let c = Vec2::new(rows.rows[0].c, rows.rows[1].c);
+                let clamp = |b: Vec2, cap: Real| {
+                    let len = b.length();
+                    if len > cap { b * (cap / len) } else { b }
+                };
+                let full = clamp(soft.bias_rate * c, ctx.direct_joint_max_correction_speed);
+                d(clamp(full, VELOCITY_CORRECTION_SPEED)[i])
+            } else {
+                0.0
+            };
+            let held = compliance * (k[i][0] * d(lambda.x) + k[i][1] * d(lambda.y));
+            worst = worst.max((c_dot + bias + held).abs());
+        }
+    }
+    // Rounding in the elimination grows with the spread of the masses
+    // and inertias (the pivots' condition) and the number of joints.
+    let spread = case
+        .bodies
+        .iter()
+        .flat_map(|b| [d(b.mass), d(b.inertia)])
+        .fold((f64::MAX, 0.0f64), |(lo, hi), x| (lo.min(x), hi.max(x)));
+    let n = b.joints.len() as f64;
+    // The regularised system's condition is at most the spread times
+    // (1 + a2): Γ = K / a2 keeps its smallest eigenvalue off zero; a
+    // heavy tree's springs, `stiffening` times stiffer, keep it that
+    // much less far off.
+    let a2 = d(soft.mass_scale / soft.impulse_scale);
+    // The rows' K mixes m⁻¹ with r² I⁻¹, so the rounding grows with the
+    // longest lever arm too (in metres, as the spread mixes kg and
+    // kg·m²), as in `weld_tree_residual`: `|r|²` of a body in a joint
+    // is the sum of its angular Jacobian entries squared over the two
+    // point rows (`r × x̂`, `r × ŷ`). Without it the bound failed in
+    // about one f64 run in thirty (the case of
+    // `tree_residual_of_a_second_pin_off_the_centre`).
+    let lever = lever_squared(&before);
+    let bound =
+        8.0 * n * EPS * (spread.1 / spread.0) * (1.0 + a2 * stiffening) * (1.0 + lever) * scale;
+    Ok((worst, bound))
 }
 
 #[test]
