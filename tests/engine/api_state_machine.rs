@@ -815,6 +815,7 @@ proptest! {
     #![proptest_config(ProptestConfig {
         cases: cases(),
         failure_persistence: None,
+        rng_seed: janus2d_testbed::support::named_seed("api_state_machine", ProptestConfig::default().rng_seed),
         ..ProptestConfig::default()
     })]
 

@@ -141,7 +141,11 @@ fn separation(local: &[Vec2; 2], axis: Vec2, x: [Vec2; 2], th: [Real; 2]) -> f64
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 256.max(ProptestConfig::default().cases), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig {
+        cases: 256.max(ProptestConfig::default().cases),
+        rng_seed: janus2d_testbed::support::named_seed("contact_properties", ProptestConfig::default().rng_seed),
+        ..ProptestConfig::default()
+    })]
 
     #[test]
     fn contact_jacobian_is_the_derivative_of_the_separation(c in case(), v in [vec(1.0), vec(1.0)], w in [real(-1.0, 1.0), real(-1.0, 1.0)]) {

@@ -769,6 +769,20 @@ pub fn report() -> bool {
     std::env::var("JANUS2D_REPORT").is_ok()
 }
 
+/// The seed a property named `name` draws its cases from: `seed` if it is
+/// fixed (`PROPTEST_RNG_SEED` set), else one fixed by the name (FNV-1a),
+/// so a run is the same on every machine. For `proptest!` blocks:
+/// `rng_seed: named_seed("name", ProptestConfig::default().rng_seed)`.
+#[must_use]
+pub fn named_seed(name: &str, seed: RngSeed) -> RngSeed {
+    match seed {
+        RngSeed::Random => RngSeed::Fixed(name.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+            (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+        })),
+        fixed => fixed,
+    }
+}
+
 /// Runs a property over at least 256 cases (more if `PROPTEST_CASES` asks;
 /// no failure persistence); the closure returns the measured error as a
 /// fraction of its bound (≤ 1 passes), and the worst fraction is printed
@@ -792,13 +806,7 @@ pub fn check<S: Strategy>(
     let mut config = Config::default();
     config.cases = config.cases.max(256);
     config.failure_persistence = None;
-    if config.rng_seed == RngSeed::Random {
-        // FNV-1a of the name: a fixed seed per property.
-        let seed = name.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
-            (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-        });
-        config.rng_seed = RngSeed::Fixed(seed);
-    }
+    config.rng_seed = named_seed(name, config.rng_seed);
     let cases = config.cases;
     let mut runner = TestRunner::new(config);
     let worst = Cell::new(0.0f64);
