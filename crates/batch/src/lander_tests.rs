@@ -237,7 +237,7 @@ fn the_left_engine_turns_the_lander_counterclockwise_as_in_gymnasium() {
 fn pilot(o: &[f32; OBS_WIDTH], target_x: f64, cruise: f64) -> i64 {
     let o = o.map(f64::from);
     let dx = o[0] - target_x;
-    let angle_target = (dx * 0.5 + o[2]).clamp(-0.4, 0.4);
+    let angle_target = (dx * 0.8 + o[2]).clamp(-0.4, 0.4);
     let floor = if dx.abs() > 0.08 { cruise } else { 0.0 };
     let hover_target = (0.55 * dx.abs()).max(floor);
     let mut angle_todo = (angle_target - o[4]) * 0.5 - o[5];
@@ -257,18 +257,18 @@ fn pilot(o: &[f32; OBS_WIDTH], target_x: f64, cruise: f64) -> i64 {
     }
 }
 
+/// Flies the pilot toward portal A from a reset with `push` (N, on the
+/// hull's centre for the first step); the step at which the hull, having
+/// crossed, is inside the pad chamber, or why not.
 #[cfg(feature = "portals")]
-#[test]
-fn a_piloted_lander_goes_through_the_portal_into_the_pad_chamber() {
+fn fly_into_the_pad_chamber(push: [f64; 2]) -> Result<usize, String> {
     let config = LanderConfig {
         portal: true,
         ..LanderConfig::default()
     };
     let mut batch = LanderBatch::new(1, config, 3, 1).unwrap();
     // Low terrain, so the entry slab (portal A on its top) stands clear.
-    batch
-        .reset_with(0, &[0.5; TERRAIN_DRAWS], [0.0, 0.0])
-        .unwrap();
+    batch.reset_with(0, &[0.5; TERRAIN_DRAWS], push).unwrap();
     let env = batch.env(0).unwrap();
     let (left, right) = env.bodies().pad;
     assert_eq!(env.world().portal_pair_count(), 1);
@@ -276,7 +276,6 @@ fn a_piloted_lander_goes_through_the_portal_into_the_pad_chamber() {
     let entry_x = (0.5 * left).min(VIEW_W / 2.0 - 0.5 * (right - left) - 2.5);
     let target = (entry_x - VIEW_W / 2.0) / (VIEW_W / 2.0);
     let roof_y = PAD_Y + ROOF_ABOVE_PAD;
-    let mut inside_at = None;
     for k in 0..600 {
         let o = batch.outcome(0).unwrap().observation;
         batch
@@ -286,17 +285,40 @@ fn a_piloted_lander_goes_through_the_portal_into_the_pad_chamber() {
         let p = env.world().position(env.bodies().hull).unwrap();
         let (x, y) = (to_f64(p.x), to_f64(p.y));
         if env.portal_crossings() > 0 && x > left && x < right && y < roof_y {
-            inside_at = Some(k);
-            break;
+            return Ok(k);
         }
-        assert!(
-            !batch.outcome(0).unwrap().terminated,
-            "ended at step {k} before crossing"
-        );
+        if batch.outcome(0).unwrap().terminated {
+            return Err(format!(
+                "ended at step {k} at ({x:.2}, {y:.2}) before crossing"
+            ));
+        }
     }
-    let k = inside_at.expect("the hull crossed and came out in the pad chamber");
-    // It flew there: the crossing is no accident of the first steps.
-    assert!(k > 100, "inside at step {k}");
+    Err("no crossing in 600 steps".into())
+}
+
+/// From a still start and eight pushes. The pilot tilts 0.8 rad per unit
+/// of distance: at 0.5 it stalled about 0.1 short of the entry (a tilt
+/// inside its 0.05 dead band) and crashed beside the slab from two of
+/// these nine starts, with the C library's atan2 as with the solver's,
+/// so which starts failed hung on rounding.
+#[cfg(feature = "portals")]
+#[test]
+fn a_piloted_lander_goes_through_the_portal_into_the_pad_chamber() {
+    for push in [
+        [0.0, 0.0],
+        [300.0, 0.0],
+        [-300.0, 0.0],
+        [0.0, 300.0],
+        [200.0, -200.0],
+        [100.0, 100.0],
+        [-150.0, 50.0],
+        [500.0, 0.0],
+        [-500.0, 0.0],
+    ] {
+        let k = fly_into_the_pad_chamber(push).unwrap_or_else(|e| panic!("push {push:?}: {e}"));
+        // It flew there: the crossing is no accident of the first steps.
+        assert!(k > 100, "push {push:?}: inside at step {k}");
+    }
 }
 
 #[test]
