@@ -249,6 +249,74 @@ pub(super) fn lever_squared(rows: &[ConstraintRows]) -> f64 {
     longest
 }
 
+/// The size of the velocity terms whose rounding enters a tree solve's
+/// residual (m/s): the bodies' speeds (`|v| + 4 |ω|`), the first `rows`
+/// rows' `J v` of each joint, and with a bias rate `β` (1/s) their `β C`.
+pub(super) fn speed_scale(
+    bodies: &[BodySpec],
+    before: &[ConstraintRows],
+    set: &BodySet,
+    rows: usize,
+    bias_rate: Option<Real>,
+) -> f64 {
+    let mut scale: f64 = bodies
+        .iter()
+        .map(|s| d(s.v.length()) + 4.0 * d(s.w.abs()))
+        .fold(0.0, f64::max);
+    for joint in before {
+        for i in 0..rows {
+            scale = scale.max(d(joint.row_velocity(i, |h| velocity(set, h))).abs());
+            if let Some(rate) = bias_rate {
+                scale = scale.max(d(rate * joint.rows[i].c).abs());
+            }
+        }
+    }
+    scale
+}
+
+/// One tree solve, measured: before it the speed scale of each joint's
+/// first `rows` rows ([`speed_scale`]) and the joints' spring `K`s with
+/// the trees' stiffening ([`spring_ks`]); returns the three.
+pub(super) fn solve_measured(
+    forest: &mut JointForest,
+    ctx: &StepContext,
+    (joints, set): (&mut [Joint], &mut BodySet),
+    (bodies, before, rows): (&[BodySpec], &[ConstraintRows], usize),
+    use_bias: bool,
+) -> (f64, Vec<[[f64; 3]; 3]>, f64) {
+    let rate = ctx.direct_joint_softness.bias_rate;
+    let scale = speed_scale(bodies, before, set, rows, use_bias.then_some(rate));
+    let (ks, stiffening) = spring_ks(before);
+    forest.solve(ctx, joints, &mut set.states, use_bias);
+    (scale, ks, stiffening)
+}
+
+/// The bound on a tree solve's residual, `8 n ε s (1 + a2 stiffening)
+/// (1 + r²) scale`: rounding in the elimination grows with the number of
+/// joints `n`, the spread `s` of the bodies' masses and inertias (the
+/// pivots' condition; kg and kg·m² mixed, lengths taken as metres), and
+/// the longest lever arm squared `r²` (m², the rows' `K` mixes `m⁻¹` with
+/// `r² I⁻¹`). The regularised system's condition is at most the spread
+/// times `1 + a2`: `Γ = K / a2` keeps its smallest eigenvalue off zero; a
+/// heavy tree's springs, `stiffening` times stiffer, keep it that much
+/// less far off.
+pub(super) fn residual_bound(
+    bodies: &[BodySpec],
+    joints: usize,
+    stiffening: f64,
+    lever_squared: f64,
+    scale: f64,
+) -> f64 {
+    let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
+    let soft = ctx.direct_joint_softness;
+    let a2 = d(soft.mass_scale / soft.impulse_scale);
+    let (lo, hi) = bodies
+        .iter()
+        .flat_map(|b| [d(b.mass), d(b.inertia)])
+        .fold((f64::MAX, 0.0f64), |(lo, hi), x| (lo.min(x), hi.max(x)));
+    8.0 * joints as f64 * EPS * (hi / lo) * (1.0 + a2 * stiffening) * (1.0 + lever_squared) * scale
+}
+
 pub(super) fn velocity(set: &BodySet, h: BodyHandle) -> (Vec2, Real) {
     let s = set.solver_body(h).state;
     (s.v, s.w)
@@ -365,22 +433,13 @@ fn tree_residual(case: &TreeCase) -> Result<(f64, f64), TestCaseError> {
     forest.build(&mut b.joints, &b.set.states, true);
     prop_assert_eq!(forest.tree_joint_count(), b.joints.len());
     let before: Vec<_> = b.joints.iter().map(|j| j.rows(&ctx, &b.set)).collect();
-    // Size of the terms whose rounding enters the residual.
-    let mut scale: f64 = case
-        .bodies
-        .iter()
-        .map(|s| d(s.v.length()) + 4.0 * d(s.w.abs()))
-        .fold(0.0, f64::max);
-    for rows in &before {
-        for i in 0..2 {
-            scale = scale.max(d(rows.row_velocity(i, |h| velocity(&b.set, h))).abs());
-            if case.use_bias {
-                scale = scale.max(d(soft.bias_rate * rows.rows[i].c).abs());
-            }
-        }
-    }
-    let (ks, stiffening) = spring_ks(&before);
-    forest.solve(&ctx, &mut b.joints, &mut b.set.states, case.use_bias);
+    let (scale, ks, stiffening) = solve_measured(
+        &mut forest,
+        &ctx,
+        (&mut b.joints, &mut b.set),
+        (&case.bodies, &before, 2),
+        case.use_bias,
+    );
     let mut worst: f64 = 0.0;
     for ((j, rows), k) in b.joints.iter().zip(&before).zip(&ks) {
         let after = j.rows(&ctx, &b.set);
@@ -406,29 +465,18 @@ fn tree_residual(case: &TreeCase) -> Result<(f64, f64), TestCaseError> {
             worst = worst.max((c_dot + bias + held).abs());
         }
     }
-    // Rounding in the elimination grows with the spread of the masses
-    // and inertias (the pivots' condition) and the number of joints.
-    let spread = case
-        .bodies
-        .iter()
-        .flat_map(|b| [d(b.mass), d(b.inertia)])
-        .fold((f64::MAX, 0.0f64), |(lo, hi), x| (lo.min(x), hi.max(x)));
-    let n = b.joints.len() as f64;
-    // The regularised system's condition is at most the spread times
-    // (1 + a2): Γ = K / a2 keeps its smallest eigenvalue off zero; a
-    // heavy tree's springs, `stiffening` times stiffer, keep it that
-    // much less far off.
-    let a2 = d(soft.mass_scale / soft.impulse_scale);
     // The rows' K mixes m⁻¹ with r² I⁻¹, so the rounding grows with the
-    // longest lever arm too (in metres, as the spread mixes kg and
-    // kg·m²), as in `weld_tree_residual`: `|r|²` of a body in a joint
-    // is the sum of its angular Jacobian entries squared over the two
-    // point rows (`r × x̂`, `r × ŷ`). Without it the bound failed in
-    // about one f64 run in thirty (the case of
-    // `tree_residual_of_a_second_pin_off_the_centre`).
-    let lever = lever_squared(&before);
-    let bound =
-        8.0 * n * EPS * (spread.1 / spread.0) * (1.0 + a2 * stiffening) * (1.0 + lever) * scale;
+    // longest lever arm too: `|r|²` of a body in a joint is the sum of its
+    // angular Jacobian entries squared over the two point rows (`r × x̂`,
+    // `r × ŷ`). Without it the bound failed in about one f64 run in
+    // thirty (the case of `tree_residual_of_a_second_pin_off_the_centre`).
+    let bound = residual_bound(
+        &case.bodies,
+        b.joints.len(),
+        stiffening,
+        lever_squared(&before),
+        scale,
+    );
     Ok((worst, bound))
 }
 

@@ -19,7 +19,7 @@ use janus2d_core::body::{BodySet, BodyType};
 use janus2d_core::constraint::{Constraint, StepContext};
 use janus2d_testbed::support::*;
 
-use super::joint_tree_properties::{pin_momentum_error, spring_ks, velocity};
+use super::joint_tree_properties::{pin_momentum_error, residual_bound, solve_measured, velocity};
 use proptest::prelude::*;
 
 const LINKS: usize = 10;
@@ -392,23 +392,17 @@ fn weld_tree_residual(case: &WeldCase) -> Result<(f64, f64), TestCaseError> {
     forest.build(&mut b.joints, &b.set.states, true);
     prop_assert_eq!(forest.tree_joint_count(), b.joints.len());
     let before: Vec<_> = b.joints.iter().map(|j| j.rows(&ctx, &b.set)).collect();
-    let mut scale: f64 = case
-        .bodies
-        .iter()
-        .map(|s| d(s.v.length()) + 4.0 * d(s.w.abs()))
-        .fold(0.0, f64::max);
     for rows in &before {
         prop_assert_eq!(rows.rows.len(), 3);
         prop_assert_eq!(rows.blocks[0].len, 3);
-        for i in 0..3 {
-            scale = scale.max(d(rows.row_velocity(i, |h| velocity(&b.set, h))).abs());
-            if case.use_bias {
-                scale = scale.max(d(soft.bias_rate * rows.rows[i].c).abs());
-            }
-        }
     }
-    let (ks, stiffening) = spring_ks(&before);
-    forest.solve(&ctx, &mut b.joints, &mut b.set.states, case.use_bias);
+    let (scale, ks, stiffening) = solve_measured(
+        &mut forest,
+        &ctx,
+        (&mut b.joints, &mut b.set),
+        (&case.bodies, &before, 3),
+        case.use_bias,
+    );
     let mut worst: f64 = 0.0;
     for ((j, rows), k) in b.joints.iter().zip(&before).zip(&ks) {
         let after = j.rows(&ctx, &b.set);
@@ -447,27 +441,18 @@ fn weld_tree_residual(case: &WeldCase) -> Result<(f64, f64), TestCaseError> {
             worst = worst.max((c_dot + bias[i] + held).abs());
         }
     }
-    let spread = case
-        .bodies
-        .iter()
-        .flat_map(|b| [d(b.mass), d(b.inertia)])
-        .fold((f64::MAX, 0.0f64), |(lo, hi), x| (lo.min(x), hi.max(x)));
-    let n = b.joints.len() as f64;
-    let a2 = d(soft.mass_scale / soft.impulse_scale);
     // The rows' K mixes m⁻¹ with r² I⁻¹: the elimination's rounding grows
-    // with the longest lever arm too (in metres, as the spread mixes kg
-    // and kg·m²). Without this factor the bound failed in about one f64
-    // run in fifteen, on the code before the joint kinds as after (the
-    // case of the test below: 2.5e-6 against 1.5e-6).
+    // with the longest lever arm too. Without this factor the bound failed
+    // in about one f64 run in fifteen, on the code before the joint kinds
+    // as after (the case of the test below: 2.5e-6 against 1.5e-6).
     let lever = case
         .links
         .iter()
         .flat_map(|(_, a, b)| [d(a.length_squared()), d(b.length_squared())])
         .fold(0.0f64, f64::max);
     // A heavy tree's springs, `stiffening` times stiffer, regularise the
-    // system that much less (see `tree_solve_satisfies_every_soft_row`).
-    let bound =
-        8.0 * n * EPS * (spread.1 / spread.0) * (1.0 + a2 * stiffening) * (1.0 + lever) * scale;
+    // system that much less (see `residual_bound`).
+    let bound = residual_bound(&case.bodies, b.joints.len(), stiffening, lever, scale);
     Ok((worst, bound))
 }
 
