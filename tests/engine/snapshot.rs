@@ -532,6 +532,27 @@ mod bytes {
         assert_eq!(seeds.len(), fuzz_seed_worlds().len(), "seeds in the corpus");
     }
 
+    /// The fuzzer's find at stop 47: bytes whose shape store carried another
+    /// owner id than the bodies decoded into a world that passed the
+    /// validator, and the shapes it made next had handles the world did
+    /// not resolve (a chain created on it failed the chain check). The
+    /// validator now checks that the stores agree, so the bytes are
+    /// refused.
+    #[test]
+    #[cfg(all(feature = "portals", not(feature = "f64")))]
+    fn a_snapshot_whose_stores_disagree_on_the_owner_is_refused() {
+        let inputs = fuzz_corpus_files("regression-owner-ids");
+        assert_eq!(inputs.len(), 1);
+        for (name, data) in inputs {
+            match fuzz_input(&data) {
+                Err(SnapshotError::Invalid(e)) => {
+                    assert!(e.to_string().contains("owner ids differ"), "{name}: {e}")
+                }
+                other => panic!("{name}: {other:?}"),
+            }
+        }
+    }
+
     /// Inputs the snapshot fuzz target failed on (issue 35), kept in its
     /// corpus as `regression-*`: each is refused, or decodes to a world
     /// that stays valid through steps. Each passed `validate` when decoded
@@ -548,6 +569,8 @@ mod bytes {
     /// | `contact-normal-tolerance` | rotations just within their tolerance | normals 0.2 % off unit after a step (the check allows 1 %) |
     /// | `crossing-entry` | a crossing's entry portal 32 | `validate` itself indexed out of bounds |
     /// | `unused-point-nan` | a NaN in a contact's unused second point | copied into the recycling cache two steps later |
+    /// | `owner-ids` | a shape store whose owner id was not the bodies' | a chain made on it failed the chain check (refused now) |
+
     #[test]
     #[cfg(all(feature = "portals", not(feature = "f64")))]
     fn snapshot_fuzz_regressions_are_refused_or_stay_valid() {

@@ -187,6 +187,12 @@ impl JointSet {
         }
     }
 
+    /// The owner id the set issues joint handles with (the world's).
+    #[inline]
+    pub(crate) fn owner(&self) -> u32 {
+        self.owner
+    }
+
     /// Number of joints.
     #[must_use]
     pub fn len(&self) -> usize {

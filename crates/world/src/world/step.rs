@@ -338,6 +338,16 @@ impl World {
     /// The world-level part of [`World::validate`]: gravity and settings
     /// within their limits, the contact solver's colours adding up.
     pub(crate) fn check_world_values(&self) -> Result<(), String> {
+        // One owner id: every store issues and resolves handles with the
+        // bodies' (a snapshot's bytes carry each store's copy).
+        let owner = self.bodies.owner();
+        if self.collision.owner != owner || self.joints.owner() != owner {
+            return Err(format!(
+                "owner ids differ: bodies {owner}, shapes {}, joints {}",
+                self.collision.owner,
+                self.joints.owner()
+            ));
+        }
         check_gravity(self.gravity).map_err(|e| e.to_string())?;
         check_settings(&self.settings).map_err(|e| e.to_string())?;
         self.sleep_settings.validate().map_err(|e| e.to_string())?;
