@@ -570,6 +570,7 @@ mod bytes {
     /// | `crossing-entry` | a crossing's entry portal 32 | `validate` itself indexed out of bounds |
     /// | `unused-point-nan` | a NaN in a contact's unused second point | copied into the recycling cache two steps later |
     /// | `owner-ids` | a shape store whose owner id was not the bodies' | a chain made on it failed the chain check (refused now) |
+    /// | `local-centre` | a box's local centre of mass at −1.7e29 m, its centre at its origin | the finalize's `p = c − q r` threw the origin beyond the pose limit, the reset kept it there, a contact stored an infinite separation |
 
     #[test]
     #[cfg(all(feature = "portals", not(feature = "f64")))]

@@ -1496,6 +1496,21 @@ impl BodySet {
                     sim.handle
                 ));
             }
+            // The centre of mass is where the transform puts the local
+            // centre (every step's finalize sets `p = c − q r`; creation and
+            // mass changes set `c = p + q r`), to the rounding of the
+            // largest term. A decoded body whose local centre disagreed
+            // kept a sane centre and threw its origin out at the next step.
+            let expected = sim.transform.p + sim.transform.q.rotate(sim.local_center);
+            // (Components, not lengths: a length squares, and overflows.)
+            let size =
+                1.0 + sim.transform.p.abs().max_element() + sim.local_center.abs().max_element();
+            if (sim.center - expected).abs().max_element() > 1e-5 * size {
+                return Err(format!(
+                    "body {:?}: centre of mass {:?} is not where its transform puts it ({expected:?})",
+                    sim.handle, sim.center
+                ));
+            }
             if !(sim.max_linear_speed >= 0.0
                 && sim.max_linear_speed <= crate::limits::MAX_SPEED
                 && sim.max_rotation >= 0.0
