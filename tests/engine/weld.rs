@@ -19,7 +19,9 @@ use janus2d_core::body::{BodySet, BodyType};
 use janus2d_core::constraint::{Constraint, StepContext};
 use janus2d_testbed::support::*;
 
-use super::joint_tree_properties::{pin_momentum_error, residual_bound, solve_measured, velocity};
+use super::joint_tree_properties::{
+    Measured, pin_momentum_error, residual_bound, solve_measured, velocity,
+};
 use proptest::prelude::*;
 
 const LINKS: usize = 10;
@@ -382,27 +384,28 @@ fn weld_tree_residual_of_a_light_inertia_under_a_long_arm() {
 }
 
 /// The worst residual of one tree solve of `case` over its welds' rows
-/// and its bound, `8 n eps (spread) (1 + a2) (speed scale)`.
+/// and its bound ([`residual_bound`](super::joint_tree_properties::residual_bound)).
 fn weld_tree_residual(case: &WeldCase) -> Result<(f64, f64), TestCaseError> {
     let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
     let soft = ctx.direct_joint_softness;
     let compliance = d(soft.impulse_scale / soft.mass_scale);
     let mut b = build(case, &ctx);
-    let mut forest = JointForest::default();
-    forest.build(&mut b.joints, &b.set.states, true);
-    prop_assert_eq!(forest.tree_joint_count(), b.joints.len());
-    let before: Vec<_> = b.joints.iter().map(|j| j.rows(&ctx, &b.set)).collect();
+    let Measured {
+        before,
+        scale,
+        ks,
+        stiffening,
+    } = solve_measured(
+        &ctx,
+        (&mut b.joints, &mut b.set),
+        &case.bodies,
+        3,
+        case.use_bias,
+    )?;
     for rows in &before {
         prop_assert_eq!(rows.rows.len(), 3);
         prop_assert_eq!(rows.blocks[0].len, 3);
     }
-    let (scale, ks, stiffening) = solve_measured(
-        &mut forest,
-        &ctx,
-        (&mut b.joints, &mut b.set),
-        (&case.bodies, &before, 3),
-        case.use_bias,
-    );
     let mut worst: f64 = 0.0;
     for ((j, rows), k) in b.joints.iter().zip(&before).zip(&ks) {
         let after = j.rows(&ctx, &b.set);
