@@ -13,6 +13,7 @@
 //! | [`RowSolve::linear`]          | 1    | `−n, −s_a │ n, s_b` ([`AxisRow`])  | scalar           | [`WarmSide::linear`], [`WarmSide::linear_at_arms`] |
 //! | [`RowSolve::angle`]           | 1    | `0, −σ │ 0, σ` (`σ = ±1`)          | scalar           | [`WarmSide::angle`]   |
 //! | [`RowSolve::point`]           | 2    | `−I, −perp(r_a) │ I, perp(r_b)`    | 2×2 block        | [`WarmSide::point`]   |
+//! | [`RowSolve::point_equality`]  | 2    | the same, bounded at prepare       | 2×2 block        | [`WarmSide::point`]   |
 //! | [`RowSolve::linear_angle`]    | 2    | a linear row and the angle row     | 2×2 block        | its two rows' shares  |
 //! | [`RowSolve::target`]          | 2    | `0, 0 │ I, perp(r_b)` (b only)     | 2×2 block        | [`WarmSide::target`]  |
 //! | [`RowSolve::spin_b`]          | 1    | `0, 0 │ 0, 1` (b only)             | scalar           | [`WarmSide::spin_b`]  |
@@ -28,7 +29,9 @@
 //! impulse is also held within
 //! [`ROW_SPEED_BOUND`](crate::parts::ROW_SPEED_BOUND) of its row's
 //! effective mass (bit for bit the plain sum below it), so rows that cannot
-//! all hold stop growing instead of overflowing.
+//! all hold stop growing instead of overflowing: in every iteration, except
+//! the equality point blocks, whose joints hold the kept impulse within it
+//! once a step, at prepare ([`RowSolve::point_equality`]).
 //!
 //! **Order.** A kind calls its rows in the order it wants them solved
 //! (Box2D's: spring, motor, limits, then the rigid point), so the sequence
@@ -225,14 +228,7 @@ impl RowSolve {
         bound: Real,
         impulse: &mut Vec2,
     ) {
-        let (sa, sb) = (&mut self.sa, &mut self.sb);
-        let c_dot = (sb.v + cross_sv(sb.w, r_b)) - (sa.v + cross_sv(sa.w, r_a));
-        let (k11, k12, k22) = PointPart::effective_mass(&self.m, r_a, r_b);
-        let x = solve22(k11, k12, k22, c_dot + t.bias);
-        let lambda = Vec2::new(
-            soft_impulse(t.mass_scale, x.x, t.impulse_scale, impulse.x),
-            soft_impulse(t.mass_scale, x.y, t.impulse_scale, impulse.y),
-        );
+        let lambda = self.point_step(r_a, r_b, t, *impulse);
         let sum = *impulse + lambda;
         let step = if sum.length_squared() <= bound * bound {
             *impulse = sum;
@@ -242,7 +238,40 @@ impl RowSolve {
             *impulse = clamp_length(sum, bound);
             *impulse - old
         };
-        apply_pair(sa, sb, &self.m, r_a, r_b, step, 0.0);
+        apply_pair(&mut self.sa, &mut self.sb, &self.m, r_a, r_b, step, 0.0);
+    }
+
+    /// The point block of an equality (a revolute or weld joint's rigid
+    /// point): [`RowSolve::point`] with a free sum. Its kept impulse is held
+    /// within [`point_bound`] once a step instead, at the joint's prepare
+    /// ([`PointPart::hold_within`]): within a step the sum grows by a few
+    /// iterations' steps at most, and across steps it stays bounded, so rows
+    /// that cannot all hold still never overflow (the check in the
+    /// iteration cost the joint grid's solve and relax 7 %).
+    #[inline(always)]
+    pub(crate) fn point_equality(
+        &mut self,
+        r_a: Vec2,
+        r_b: Vec2,
+        t: PointTerms,
+        impulse: &mut Vec2,
+    ) {
+        let lambda = self.point_step(r_a, r_b, t, *impulse);
+        *impulse += lambda;
+        apply_pair(&mut self.sa, &mut self.sb, &self.m, r_a, r_b, lambda, 0.0);
+    }
+
+    /// The point block's soft step `Δλ` for the kept impulse `impulse`.
+    #[inline(always)]
+    fn point_step(&self, r_a: Vec2, r_b: Vec2, t: PointTerms, impulse: Vec2) -> Vec2 {
+        let (sa, sb) = (&self.sa, &self.sb);
+        let c_dot = (sb.v + cross_sv(sb.w, r_b)) - (sa.v + cross_sv(sa.w, r_a));
+        let (k11, k12, k22) = PointPart::effective_mass(&self.m, r_a, r_b);
+        let x = solve22(k11, k12, k22, c_dot + t.bias);
+        Vec2::new(
+            soft_impulse(t.mass_scale, x.x, t.impulse_scale, impulse.x),
+            soft_impulse(t.mass_scale, x.y, t.impulse_scale, impulse.y),
+        )
     }
 
     /// A linear row and the angle row solved as one 2×2 block (a

@@ -303,6 +303,14 @@ impl PointPart {
         (r_a, r_b, c)
     }
 
+    /// Holds the kept impulse's length within `bound` (N·s), unchanged bit
+    /// for bit inside it: the once-a-step bound of an equality point block
+    /// (`RowSolve::point_equality`), at the joint's prepare.
+    #[inline(always)]
+    pub fn hold_within(&mut self, bound: Real) {
+        self.impulse = clamp_length(self.impulse, bound);
+    }
+
     /// The 2×2 effective mass `K = J M⁻¹ Jᵀ` as `(k11, k12, k22)`.
     #[inline(always)]
     pub fn effective_mass(m: &PairMass, r_a: Vec2, r_b: Vec2) -> (Real, Real, Real) {

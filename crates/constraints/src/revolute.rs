@@ -233,8 +233,8 @@ impl KindDef for RevoluteJointDef {
 /// A revolute joint in solver form.
 ///
 /// Laid out in declaration order (`repr(C)`): the fields a Gauss–Seidel
-/// point row reads (its base, point part, softness, row switches and
-/// bound) first, near each other; the definition is boxed apart and the
+/// point row reads (its base, point part, softness and row switches)
+/// first, near each other; the definition is boxed apart and the
 /// solve reads it only for the settings of a row that is switched on
 /// (the measurement is in docs/performance.md).
 #[derive(Clone, Debug, PartialEq)]
@@ -249,9 +249,6 @@ pub struct RevoluteJoint {
     /// The definition's row switches (spring, motor, limit), copied at
     /// prepare so that the solve reads no line of the definition.
     switches: Switches,
-    /// The point block's impulse bound for this step, N·s
-    /// ([`point_bound`], kept from prepare).
-    point_bound: Real,
     /// `θ_b − θ_a − θ_ref` at the start of the step, rad.
     delta_angle: Real,
     spring: AnglePart,
@@ -315,7 +312,6 @@ impl RevoluteJoint {
             upper: AnglePart::default(),
             spring_softness: Softness::RIGID,
             point_softness: Softness::RIGID,
-            point_bound: Real::INFINITY,
         }
     }
 
@@ -399,6 +395,7 @@ impl RevoluteJoint {
         self.def.enable_spring || self.def.enable_motor || self.def.enable_limit
     }
 
+    #[inline(always)]
     fn current_angle(&self, sa: &BodyState, sb: &BodyState) -> Real {
         janus2d_core::math::wrap_angle(self.delta_angle + sa.dq.relative_angle(sb.dq))
     }
@@ -505,7 +502,7 @@ impl KindRows for RevoluteJoint {
                 ctx.joint_max_correction_speed,
                 use_bias,
             );
-            s.point(r_a, r_b, t, self.point_bound, &mut self.point.impulse);
+            s.point_equality(r_a, r_b, t, &mut self.point.impulse);
         }
     }
     #[inline(always)]
@@ -564,7 +561,6 @@ impl Constraint for RevoluteJoint {
         }
         self.spring_softness = Softness::new(self.def.hertz, self.def.damping_ratio, ctx.h);
         self.point_softness = point_softness(&self.def, ctx, m);
-        self.point_bound = point_bound(m, Real::INFINITY);
         if !ctx.warm_starting {
             self.point.impulse = Vec2::ZERO;
             self.spring.impulse = 0.0;
@@ -572,6 +568,8 @@ impl Constraint for RevoluteJoint {
             self.lower.impulse = 0.0;
             self.upper.impulse = 0.0;
         }
+        // The point block's once-a-step bound (`RowSolve::point_equality`).
+        self.point.hold_within(point_bound(m, Real::INFINITY));
         if !self.def.enable_spring {
             self.spring.impulse = 0.0;
         }
@@ -670,6 +668,39 @@ mod tests {
     use super::*;
     use janus2d_core::body::BodyDef;
     use janus2d_core::solver::SolverSettings;
+
+    /// The point block's once-a-step bound (`RowSolve::point_equality` no
+    /// longer checks it in every iteration): a kept impulse past
+    /// `m_eff · ROW_SPEED_BOUND` (bodies of 1 and 100 kg: `m_eff = 100/101
+    /// kg`, bound 396,040 N·s) is held at the bound in its own direction at
+    /// prepare, and one inside it is kept bit for bit.
+    #[test]
+    fn a_kept_point_impulse_past_the_row_bound_is_held_at_prepare() {
+        let mut set = BodySet::new();
+        let a = set
+            .create(&BodyDef::dynamic(Vec2::ZERO).with_mass(1.0, 0.1))
+            .unwrap();
+        let b = set
+            .create(&BodyDef::dynamic(Vec2::new(1.0, 0.0)).with_mass(100.0, 10.0))
+            .unwrap();
+        let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
+        let mut joint = RevoluteJoint::new(RevoluteJointDef::new(
+            a,
+            b,
+            Vec2::new(0.5, 0.0),
+            Vec2::new(-0.5, 0.0),
+        ));
+        let bound = crate::parts::ROW_SPEED_BOUND / (1.0 + 0.01);
+        joint.point.impulse = Vec2::new(3.0e5, 4.0e5);
+        joint.prepare(&ctx, &set);
+        let held = joint.point.impulse;
+        assert!((held.length() - bound).abs() <= 1e-6 * bound, "{held:?}");
+        assert!((held.x / held.y - 0.75).abs() < 1e-6, "{held:?}");
+        let inside = Vec2::new(3.0e3, -4.0e3);
+        joint.point.impulse = inside;
+        joint.prepare(&ctx, &set);
+        assert_eq!(joint.point.impulse, inside);
+    }
 
     #[test]
     fn rows_report_the_mass_ratio_softness_the_solve_uses() {

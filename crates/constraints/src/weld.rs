@@ -375,13 +375,7 @@ impl KindRows for WeldJoint {
                 use_bias,
             )
         };
-        s.point(
-            r_a,
-            r_b,
-            t,
-            point_bound(&s.m, Real::INFINITY),
-            &mut self.point.impulse,
-        );
+        s.point_equality(r_a, r_b, t, &mut self.point.impulse);
     }
     #[inline(always)]
     fn tree_rows(&self) -> Option<TreeRows<'_>> {
@@ -427,6 +421,8 @@ impl Constraint for WeldJoint {
             self.point.impulse = Vec2::ZERO;
             self.angle.impulse = 0.0;
         }
+        // The point block's once-a-step bound (`RowSolve::point_equality`).
+        self.point.hold_within(point_bound(&m, Real::INFINITY));
     }
 
     fn warm_start(&mut self, _ctx: &StepContext, states: &mut [BodyState]) {
@@ -522,6 +518,31 @@ mod tests {
             far.validate(),
             Err(JointError::OutOfBounds { .. })
         ));
+    }
+
+    /// The point block's once-a-step bound, as the revolute joint's: a
+    /// kept impulse past `m_eff · ROW_SPEED_BOUND` (a 2 kg body welded to
+    /// the ground: bound 800,000 N·s) is held at the bound at prepare, its
+    /// direction kept; one inside it is kept bit for bit.
+    #[test]
+    fn a_kept_point_impulse_past_the_row_bound_is_held_at_prepare() {
+        let mut set = BodySet::new();
+        let a = set.create(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+        let b = set
+            .create(&BodyDef::dynamic(Vec2::new(1.0, 0.0)).with_mass(2.0, 0.5))
+            .unwrap();
+        let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
+        let mut joint = WeldJoint::new(WeldJointDef::new(a, b, Vec2::ZERO, Vec2::new(-1.0, 0.0)));
+        let bound = crate::parts::ROW_SPEED_BOUND * 2.0;
+        joint.point.impulse = Vec2::new(-6.0e5, 8.0e5) * 2.0;
+        joint.prepare(&ctx, &set);
+        let held = joint.point.impulse;
+        assert!((held.length() - bound).abs() <= 1e-6 * bound, "{held:?}");
+        assert!((held.x / held.y + 0.75).abs() < 1e-6, "{held:?}");
+        let inside = Vec2::new(2.0e3, 1.0);
+        joint.point.impulse = inside;
+        joint.prepare(&ctx, &set);
+        assert_eq!(joint.point.impulse, inside);
     }
 
     #[test]
