@@ -249,6 +249,11 @@ pub struct RevoluteJoint {
     /// The definition's row switches (spring, motor, limit), copied at
     /// prepare so that the solve reads no line of the definition.
     switches: Switches,
+    /// The angle rows' settings, copied at prepare with the switches
+    /// (not in a snapshot: every step's prepare copies them again from the
+    /// definition, which is).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    angles: AngleSettings,
     /// `θ_b − θ_a − θ_ref` at the start of the step, rad.
     delta_angle: Real,
     spring: AnglePart,
@@ -258,6 +263,37 @@ pub struct RevoluteJoint {
     spring_softness: Softness,
     /// The definition it was made from (limits, motor and spring settings).
     pub(crate) def: Box<RevoluteJointDef>,
+}
+
+/// The definition's settings the angle rows read in every iteration,
+/// copied at prepare: a ragdoll's joint runs all four angle rows, and
+/// reading them through the boxed definition cost a dependent load per
+/// joint and iteration (rain, one thread: solve 2.77 → 2.40 ms and relax
+/// 2.32 → 2.20 ms a step with the copy).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct AngleSettings {
+    /// The spring's rest angle, rad.
+    target_angle: Real,
+    /// The motor's target speed, rad/s.
+    motor_speed: Real,
+    /// The motor's largest torque, N·m.
+    max_motor_torque: Real,
+    /// The lower limit, rad.
+    lower_angle: Real,
+    /// The upper limit, rad.
+    upper_angle: Real,
+}
+
+impl AngleSettings {
+    fn of(def: &RevoluteJointDef) -> Self {
+        AngleSettings {
+            target_angle: def.target_angle,
+            motor_speed: def.motor_speed,
+            max_motor_torque: def.max_motor_torque,
+            lower_angle: def.lower_angle,
+            upper_angle: def.upper_angle,
+        }
+    }
 }
 
 /// Which angle rows a revolute joint solves this step.
@@ -302,6 +338,7 @@ impl RevoluteJoint {
     pub fn new(def: RevoluteJointDef) -> Self {
         RevoluteJoint {
             switches: Switches::of(&def),
+            angles: AngleSettings::of(&def),
             def: Box::new(def),
             base: JointBase::default(),
             point: PointPart::default(),
@@ -446,7 +483,7 @@ impl KindRows for RevoluteJoint {
             // A spring: its feedback is its force, not capped.
             let t = Terms::soft(
                 self.spring_softness,
-                angle - self.def.target_angle,
+                angle - self.angles.target_angle,
                 Real::INFINITY,
             );
             s.angle(
@@ -458,15 +495,15 @@ impl KindRows for RevoluteJoint {
             );
         }
         if on.motor {
-            let t = Terms::motor(self.def.motor_speed);
-            let bounds = Bounds::symmetric(ctx.h * self.def.max_motor_torque);
+            let t = Terms::motor(self.angles.motor_speed);
+            let bounds = Bounds::symmetric(ctx.h * self.angles.max_motor_torque);
             s.angle(1.0, self.motor.mass, t, bounds, &mut self.motor.impulse);
         }
         if on.limit {
             let soft = ctx.joint_softness;
             let max_bias = angular_correction_cap(ctx.joint_max_correction_speed);
             let lower = Terms::limit(
-                angle - self.def.lower_angle,
+                angle - self.angles.lower_angle,
                 soft,
                 ctx.inv_h,
                 use_bias,
@@ -480,7 +517,7 @@ impl KindRows for RevoluteJoint {
                 &mut self.lower.impulse,
             );
             let upper = Terms::limit(
-                self.def.upper_angle - angle,
+                self.angles.upper_angle - angle,
                 soft,
                 ctx.inv_h,
                 use_bias,
@@ -542,6 +579,7 @@ impl Constraint for RevoluteJoint {
         self.point.frame_b = q_b.rotate(self.def.base.local_frame_b.anchor - b.sim.local_center);
         self.point.delta_center = b.sim.center - a.sim.center;
         self.switches = Switches::of(&self.def);
+        self.angles = AngleSettings::of(&self.def);
         // The angle is read by the spring and the limits only (one atan2).
         self.delta_angle = if self.def.enable_spring || self.def.enable_limit {
             janus2d_core::math::wrap_angle(
