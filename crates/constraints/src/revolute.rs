@@ -707,13 +707,9 @@ mod tests {
     use janus2d_core::body::BodyDef;
     use janus2d_core::solver::SolverSettings;
 
-    /// The point block's once-a-step bound (`RowSolve::point_equality` no
-    /// longer checks it in every iteration): a kept impulse past
-    /// `m_eff · ROW_SPEED_BOUND` (bodies of 1 and 100 kg: `m_eff = 100/101
-    /// kg`, bound 396,040 N·s) is held at the bound in its own direction at
-    /// prepare, and one inside it is kept bit for bit.
-    #[test]
-    fn a_kept_point_impulse_past_the_row_bound_is_held_at_prepare() {
+    /// A joint between bodies of 1 and 100 kg (1 m apart, pinned halfway),
+    /// their set and a 60 Hz step's context.
+    fn one_to_a_hundred() -> (BodySet, RevoluteJoint, StepContext) {
         let mut set = BodySet::new();
         let a = set
             .create(&BodyDef::dynamic(Vec2::ZERO).with_mass(1.0, 0.1))
@@ -722,12 +718,23 @@ mod tests {
             .create(&BodyDef::dynamic(Vec2::new(1.0, 0.0)).with_mass(100.0, 10.0))
             .unwrap();
         let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
-        let mut joint = RevoluteJoint::new(RevoluteJointDef::new(
+        let joint = RevoluteJoint::new(RevoluteJointDef::new(
             a,
             b,
             Vec2::new(0.5, 0.0),
             Vec2::new(-0.5, 0.0),
         ));
+        (set, joint, ctx)
+    }
+
+    /// The point block's once-a-step bound (`RowSolve::point_equality` no
+    /// longer checks it in every iteration): a kept impulse past
+    /// `m_eff · ROW_SPEED_BOUND` (bodies of 1 and 100 kg: `m_eff = 100/101
+    /// kg`, bound 396,040 N·s) is held at the bound in its own direction at
+    /// prepare, and one inside it is kept bit for bit.
+    #[test]
+    fn a_kept_point_impulse_past_the_row_bound_is_held_at_prepare() {
+        let (set, mut joint, ctx) = one_to_a_hundred();
         let bound = crate::parts::ROW_SPEED_BOUND / (1.0 + 0.01);
         joint.point.impulse = Vec2::new(3.0e5, 4.0e5);
         joint.prepare(&ctx, &set);
@@ -742,21 +749,7 @@ mod tests {
 
     #[test]
     fn rows_report_the_mass_ratio_softness_the_solve_uses() {
-        let mut set = BodySet::new();
-        let a = set
-            .create(&BodyDef::dynamic(Vec2::ZERO).with_mass(1.0, 0.1))
-            .unwrap();
-        let b = set
-            .create(&BodyDef::dynamic(Vec2::new(1.0, 0.0)).with_mass(100.0, 10.0))
-            .unwrap();
-        let settings = SolverSettings::default();
-        let ctx = settings.context(1.0 / 60.0, Vec2::ZERO);
-        let mut joint = RevoluteJoint::new(RevoluteJointDef::new(
-            a,
-            b,
-            Vec2::new(0.5, 0.0),
-            Vec2::new(-0.5, 0.0),
-        ));
+        let (set, mut joint, ctx) = one_to_a_hundred();
         joint.prepare(&ctx, &set);
         assert_ne!(
             joint.point_softness, ctx.joint_softness,
