@@ -276,6 +276,9 @@ pub(super) fn speed_scale(
 
 /// One tree solve, measured ([`solve_measured`]).
 pub(super) struct Measured {
+    /// The direct joint softness's compliance `s_i / s_m` (the `Γ / K` of
+    /// the soft rows' `Ċ + b + Γ λ = 0`).
+    pub(super) compliance: f64,
     /// Each joint's rows before the solve.
     pub(super) before: Vec<ConstraintRows>,
     /// [`speed_scale`] of the rows before the solve, m/s.
@@ -303,7 +306,9 @@ pub(super) fn solve_measured(
     let scale = speed_scale(bodies, &before, set, rows, use_bias.then_some(rate));
     let (ks, stiffening) = spring_ks(&before);
     forest.solve(ctx, joints, &mut set.states, use_bias);
+    let soft = ctx.direct_joint_softness;
     Ok(Measured {
+        compliance: d(soft.impulse_scale / soft.mass_scale),
         before,
         scale,
         ks,
@@ -453,14 +458,8 @@ fn tree_residual_of_a_second_pin_off_the_centre() {
 fn tree_residual(case: &TreeCase) -> Result<(f64, f64), TestCaseError> {
     let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
     let soft = ctx.direct_joint_softness;
-    let compliance = d(soft.impulse_scale / soft.mass_scale);
     let mut b = build(case, &ctx);
-    let Measured {
-        before,
-        scale,
-        ks,
-        stiffening,
-    } = solve_measured(
+    let m = solve_measured(
         &ctx,
         (&mut b.joints, &mut b.set),
         &case.bodies,
@@ -468,7 +467,7 @@ fn tree_residual(case: &TreeCase) -> Result<(f64, f64), TestCaseError> {
         case.use_bias,
     )?;
     let mut worst: f64 = 0.0;
-    for ((j, rows), k) in b.joints.iter().zip(&before).zip(&ks) {
+    for ((j, rows), k) in b.joints.iter().zip(&m.before).zip(&m.ks) {
         let after = j.rows(&ctx, &b.set);
         let lambda = revolute(j).linear_impulse();
         for i in 0..2 {
@@ -488,7 +487,7 @@ fn tree_residual(case: &TreeCase) -> Result<(f64, f64), TestCaseError> {
             } else {
                 0.0
             };
-            let held = compliance * (k[i][0] * d(lambda.x) + k[i][1] * d(lambda.y));
+            let held = m.compliance * (k[i][0] * d(lambda.x) + k[i][1] * d(lambda.y));
             worst = worst.max((c_dot + bias + held).abs());
         }
     }
@@ -500,9 +499,9 @@ fn tree_residual(case: &TreeCase) -> Result<(f64, f64), TestCaseError> {
     let bound = residual_bound(
         &case.bodies,
         b.joints.len(),
-        stiffening,
-        lever_squared(&before),
-        scale,
+        m.stiffening,
+        lever_squared(&m.before),
+        m.scale,
     );
     Ok((worst, bound))
 }

@@ -19,9 +19,7 @@ use janus2d_core::body::{BodySet, BodyType};
 use janus2d_core::constraint::{Constraint, StepContext};
 use janus2d_testbed::support::*;
 
-use super::joint_tree_properties::{
-    Measured, pin_momentum_error, residual_bound, solve_measured, velocity,
-};
+use super::joint_tree_properties::{pin_momentum_error, residual_bound, solve_measured, velocity};
 use proptest::prelude::*;
 
 const LINKS: usize = 10;
@@ -388,26 +386,20 @@ fn weld_tree_residual_of_a_light_inertia_under_a_long_arm() {
 fn weld_tree_residual(case: &WeldCase) -> Result<(f64, f64), TestCaseError> {
     let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::ZERO);
     let soft = ctx.direct_joint_softness;
-    let compliance = d(soft.impulse_scale / soft.mass_scale);
     let mut b = build(case, &ctx);
-    let Measured {
-        before,
-        scale,
-        ks,
-        stiffening,
-    } = solve_measured(
+    let m = solve_measured(
         &ctx,
         (&mut b.joints, &mut b.set),
         &case.bodies,
         3,
         case.use_bias,
     )?;
-    for rows in &before {
+    for rows in &m.before {
         prop_assert_eq!(rows.rows.len(), 3);
         prop_assert_eq!(rows.blocks[0].len, 3);
     }
     let mut worst: f64 = 0.0;
-    for ((j, rows), k) in b.joints.iter().zip(&before).zip(&ks) {
+    for ((j, rows), k) in b.joints.iter().zip(&m.before).zip(&m.ks) {
         let after = j.rows(&ctx, &b.set);
         let w = weld(j);
         let lambda = [
@@ -440,7 +432,7 @@ fn weld_tree_residual(case: &WeldCase) -> Result<(f64, f64), TestCaseError> {
         };
         for i in 0..3 {
             let c_dot = d(after.row_velocity(i, |h| velocity(&b.set, h)));
-            let held = compliance * (0..3).map(|c| k[i][c] * lambda[c]).sum::<f64>();
+            let held = m.compliance * (0..3).map(|c| k[i][c] * lambda[c]).sum::<f64>();
             worst = worst.max((c_dot + bias[i] + held).abs());
         }
     }
@@ -455,7 +447,7 @@ fn weld_tree_residual(case: &WeldCase) -> Result<(f64, f64), TestCaseError> {
         .fold(0.0f64, f64::max);
     // A heavy tree's springs, `stiffening` times stiffer, regularise the
     // system that much less (see `residual_bound`).
-    let bound = residual_bound(&case.bodies, b.joints.len(), stiffening, lever, scale);
+    let bound = residual_bound(&case.bodies, b.joints.len(), m.stiffening, lever, m.scale);
     Ok((worst, bound))
 }
 

@@ -247,7 +247,7 @@ impl RowSolve {
     /// ([`PointPart::hold_within`]): within a step the sum grows by a few
     /// iterations' steps at most, and across steps it stays bounded, so rows
     /// that cannot all hold still never overflow (the check in the
-    /// iteration cost the joint grid's solve and relax 7 %).
+    /// iteration cost the joint grid measurably: docs/performance.md).
     #[inline(always)]
     pub(crate) fn point_equality(
         &mut self,

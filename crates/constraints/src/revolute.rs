@@ -268,8 +268,7 @@ pub struct RevoluteJoint {
 /// The definition's settings the angle rows read in every iteration,
 /// copied at prepare: a ragdoll's joint runs all four angle rows, and
 /// reading them through the boxed definition cost a dependent load per
-/// joint and iteration (rain, one thread: solve 2.77 → 2.40 ms and relax
-/// 2.32 → 2.20 ms a step with the copy).
+/// joint and iteration (the measurement is in docs/performance.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct AngleSettings {
     /// The spring's rest angle, rad.

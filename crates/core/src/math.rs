@@ -81,8 +81,7 @@ pub fn cross_vs(v: Vec2, s: Real) -> Vec2 {
 #[inline]
 pub fn wrap_angle(x: Real) -> Real {
     if x.abs() < PI {
-        // No division on the common path (it was a fifth of a joint's
-        // angle read in rain).
+        // No division on the common path (every joint angle read).
         return x;
     }
     let k = x / TAU;
