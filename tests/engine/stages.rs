@@ -191,6 +191,69 @@ fn island_splits_when_bodies_part_so_the_resting_one_sleeps() {
     );
 }
 
+/// A stack of three on the ground whose top box is carried off and kept
+/// moving, beside `far` boxes resting on a ground of their own: after
+/// two seconds, the islands of the low, middle and top box.
+fn three_part_after_the_top_leaves(far: usize) -> [(bool, Option<u32>); 3] {
+    let (mut world, _, boxes) = stack_on_ground(3);
+    let g = world
+        .create_body(&BodyDef::fixed(Vec2::new(200.0, -1.0)))
+        .unwrap();
+    world
+        .create_shape(g, &ShapeDef::default(), Polygon::make_box(150.0, 1.0))
+        .unwrap();
+    for i in 0..far {
+        let b = world
+            .create_body(&BodyDef::dynamic(Vec2::new(60.0 + 1.5 * i as Real, 0.5)))
+            .unwrap();
+        world
+            .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+            .unwrap();
+    }
+    for _ in 0..10 {
+        world.step(DT).unwrap();
+    }
+    let high = boxes[2];
+    world.set_transform(high, Vec2::new(5.0, 0.5), 0.0).unwrap();
+    for _ in 0..120 {
+        world
+            .set_linear_velocity(high, Vec2::new(1.0, 0.0))
+            .unwrap();
+        world.step(DT).unwrap();
+    }
+    let read = |b: BodyHandle| (world.is_sleeping(b).unwrap(), world.island_id(b));
+    [read(boxes[0]), read(boxes[1]), read(high)]
+}
+
+/// The split reads the links in one pass over the contact set when the
+/// island is a fair share of the world (no other boxes), and from each
+/// member's own contacts when it is small beside many others (150 boxes
+/// resting elsewhere): both must cut exactly the link that went.
+#[test]
+fn island_split_keeps_touching_bodies_together_read_either_way() {
+    for far in [0, 150] {
+        let [(low_asleep, low), (mid_asleep, mid), (high_asleep, high)] =
+            three_part_after_the_top_leaves(far);
+        assert!(
+            low_asleep && mid_asleep,
+            "{far} far boxes: the stack left sleeps"
+        );
+        assert!(!high_asleep, "{far} far boxes: the pushed box stays awake");
+        assert!(
+            low.is_some(),
+            "{far} far boxes: dynamic bodies have islands"
+        );
+        assert_eq!(
+            low, mid,
+            "{far} far boxes: the touching pair stays one island"
+        );
+        assert_ne!(
+            low, high,
+            "{far} far boxes: the box carried off has its own"
+        );
+    }
+}
+
 /// A ball drifting at 0.08 m/s in zero gravity: above the world's 0.05 m/s
 /// threshold it never sleeps; with its own threshold of 0.1 m/s it sleeps
 /// once it has been slow for `time_to_sleep`.

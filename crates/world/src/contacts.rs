@@ -785,6 +785,23 @@ impl ContactSet {
         })
     }
 
+    /// Calls `f` with the two bodies of every touching solid contact, in
+    /// contact-id order: one pass over the compact link array, for an
+    /// island split over a large share of the world.
+    pub(crate) fn for_each_solid_link(&self, mut f: impl FnMut(BodyHandle, BodyHandle)) {
+        for link in &self.links {
+            if link.solid {
+                f(link.bodies[0], link.bodies[1]);
+            }
+        }
+    }
+
+    /// The number of link slots (live and free contact ids): the length
+    /// of the pass [`for_each_solid_link`](Self::for_each_solid_link) makes.
+    pub(crate) fn link_slots(&self) -> usize {
+        self.links.len()
+    }
+
     /// True when shapes `a` and `b` (slots) have a contact.
     #[must_use]
     pub fn has_pair(&self, a: u32, b: u32) -> bool {

@@ -111,7 +111,8 @@ struct Island {
 /// joint removed / disabled,
 /// body destroyed
 /// sleepiest body's island  → split into its connected parts (one per step,
-///   has removed > 0           over the members' own contacts and joints)
+///   has removed > 0           union–find over its solid contacts and
+///                             enabled joints; still whole → order kept)
 /// every member rested      → the island sleeps: bodies and contacts leave
 ///   time_to_sleep             the awake lists
 /// ```
@@ -126,11 +127,19 @@ pub(crate) struct Islands {
     free: Vec<u32>,
     /// Bodies created with `awake = false`, put to sleep at the next step.
     pending: Vec<BodyHandle>,
+    /// Scratch of the sleep update (not state: not in snapshots): the
+    /// least rested member's time by island, kept at MAX between steps.
+    #[cfg_attr(feature = "serde", serde(skip))]
     min_time: Vec<Real>,
+    /// Scratch: the islands whose `min_time` this step set.
+    #[cfg_attr(feature = "serde", serde(skip))]
     touched: Vec<u32>,
-    seen: Vec<u32>,
-    stamp: u32,
-    stack: Vec<BodyHandle>,
+    /// Scratch of a split: the union–find parent of each member position.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    parent: Vec<u32>,
+    /// Scratch of a split: the part of each root position.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    part_of: Vec<u32>,
 }
 
 /// What the sleep update reads besides the bodies it changes.
@@ -230,13 +239,9 @@ impl Islands {
                 _ => return Err(format!("free island id {id} out of range or repeated")),
             }
         }
-        // Scratch kept between steps: `min_time` all at MAX, `seen` never
-        // ahead of the stamp (so a split visits every member).
+        // Scratch kept between steps: `min_time` all at MAX.
         if self.min_time.iter().any(|&t| t != Real::MAX) {
             return Err("island scratch times not reset".into());
-        }
-        if self.seen.iter().any(|&s| s > self.stamp) {
-            return Err("island scratch stamps ahead of the stamp".into());
         }
         let mut members = 0usize;
         for (id, island) in self.islands.iter().enumerate() {
@@ -558,65 +563,116 @@ impl Islands {
 
     /// Splits island `id` into its connected parts over the members' own
     /// touching solid contacts and enabled joints.
+    ///
+    /// Union–find over the members' positions (as Box2D's split), so a
+    /// contact is read once, not once from each body. The links come from
+    /// one pass over the contact set's compact link array when the island
+    /// holds a fair share of the world, else from each member's own
+    /// contacts (a small island in a large world); both give the same
+    /// parts. Each part keeps its members in island order, and the part of
+    /// the first member keeps the id. An island still in one piece keeps
+    /// its member order.
     fn split(&mut self, id: u32, contacts: &ContactSet, joints: &JointSet) {
         let members = std::mem::take(&mut self.islands[id as usize].members);
-        self.stamp = self.stamp.wrapping_add(1);
-        if self.stamp == 0 {
-            self.seen.iter_mut().for_each(|s| *s = 0);
-            self.stamp = 1;
-        }
-        let stamp = self.stamp;
-        let mut parts: Vec<Vec<BodyHandle>> = Vec::new();
-        for &start in &members {
-            let si = start.index as usize;
-            if self.seen.len() <= si {
-                self.seen.resize(si + 1, 0);
+        let n = members.len();
+        let mut parent = std::mem::take(&mut self.parent);
+        parent.clear();
+        parent.extend(0..n as u32);
+        let island_of = &self.island_of;
+        let position = &self.position;
+        // The member position of `b`, when it is a member of this island.
+        let place = |b: BodyHandle| -> Option<u32> {
+            let i = b.index as usize;
+            (island_of.get(i) == Some(&id)).then(|| position[i])
+        };
+        let mut join = |a: BodyHandle, b: BodyHandle| {
+            if let (Some(pa), Some(pb)) = (place(a), place(b)) {
+                union(&mut parent, pa, pb);
             }
-            if self.seen[si] == stamp {
-                continue;
-            }
-            self.seen[si] = stamp;
-            let mut part = Vec::new();
-            self.stack.clear();
-            self.stack.push(start);
-            while let Some(b) = self.stack.pop() {
-                part.push(b);
-                let via_contacts = contacts.links_of(b);
-                let via_joints = joints.of_body(b).iter().filter_map(|&j| {
-                    let joint = joints.get(j).ok()?;
-                    joint.is_enabled().then(|| joint.other_body(b)).flatten()
-                });
-                for other in via_contacts.chain(via_joints) {
-                    let oi = other.index as usize;
-                    if self.island(other) != id {
-                        continue;
-                    }
-                    if self.seen.len() <= oi {
-                        self.seen.resize(oi + 1, 0);
-                    }
-                    if self.seen[oi] != stamp {
-                        self.seen[oi] = stamp;
-                        self.stack.push(other);
-                    }
+        };
+        // A per-member walk reads a link at random per contact; the pass
+        // reads every link in order, about this many times cheaper each.
+        const SCAN_PER_WALK: usize = 32;
+        if n.saturating_mul(SCAN_PER_WALK) >= contacts.link_slots() {
+            contacts.for_each_solid_link(&mut join);
+        } else {
+            for &b in &members {
+                for other in contacts.links_of(b) {
+                    join(b, other);
                 }
             }
-            parts.push(part);
         }
-        let mut parts = parts.into_iter();
-        if let Some(first) = parts.next() {
-            for (k, m) in first.iter().enumerate() {
-                self.place(*m, id, k);
+        for &b in &members {
+            for &j in joints.of_body(b) {
+                if let Ok(joint) = joints.get(j)
+                    && joint.is_enabled()
+                    && let Some(other) = joint.other_body(b)
+                {
+                    join(b, other);
+                }
             }
-            let island = &mut self.islands[id as usize];
-            island.members = first;
-            island.removed = 0;
         }
-        for part in parts {
-            self.new_island(part);
+        // Parts in order of their first member.
+        let mut part_of = std::mem::take(&mut self.part_of);
+        part_of.clear();
+        part_of.resize(n, NONE);
+        let mut part_count = 0u32;
+        for i in 0..n as u32 {
+            let r = find(&mut parent, i);
+            if part_of[r as usize] == NONE {
+                part_of[r as usize] = part_count;
+                part_count += 1;
+            }
+        }
+        if part_count <= 1 {
+            let island = &mut self.islands[id as usize];
+            island.members = members;
+            island.removed = 0;
+        } else {
+            let mut parts: Vec<Vec<BodyHandle>> = vec![Vec::new(); part_count as usize];
+            for (i, &m) in members.iter().enumerate() {
+                let r = find(&mut parent, i as u32);
+                parts[part_of[r as usize] as usize].push(m);
+            }
+            let mut parts = parts.into_iter();
+            if let Some(first) = parts.next() {
+                for (k, m) in first.iter().enumerate() {
+                    self.place(*m, id, k);
+                }
+                let island = &mut self.islands[id as usize];
+                island.members = first;
+                island.removed = 0;
+            }
+            for part in parts {
+                self.new_island(part);
+            }
         }
         if self.islands[id as usize].members.is_empty() {
             self.free.push(id);
         }
+        self.parent = parent;
+        self.part_of = part_of;
+    }
+}
+
+/// The root of `i` (path halving: each visited entry skips to its
+/// grandparent).
+fn find(parent: &mut [u32], mut i: u32) -> u32 {
+    while parent[i as usize] != i {
+        let grand = parent[parent[i as usize] as usize];
+        parent[i as usize] = grand;
+        i = grand;
+    }
+    i
+}
+
+/// Joins the sets of `a` and `b`: the larger root points at the smaller
+/// (no rank array; the parts do not depend on which root wins).
+fn union(parent: &mut [u32], a: u32, b: u32) {
+    let (ra, rb) = (find(parent, a), find(parent, b));
+    if ra != rb {
+        let (low, high) = if ra < rb { (ra, rb) } else { (rb, ra) };
+        parent[high as usize] = low;
     }
 }
 

@@ -137,8 +137,9 @@ pub mod bytes {
     /// shapes list their hot fields first; 17: bodies keep their shapes'
     /// fast-travel limit and core reach, and the shape store the bodies
     /// whose extents changed since the last step; 18: every joint kind
-    /// lists its solver base first).
-    pub const SNAPSHOT_VERSION: u16 = 18;
+    /// lists its solver base first; 19: a revolute joint no longer keeps
+    /// its point block's bound, and the islands keep no scratch).
+    pub const SNAPSHOT_VERSION: u16 = 19;
     const HEADER: usize = 24;
 
     /// Why bytes are not a snapshot this build can restore.
