@@ -300,7 +300,14 @@ mod tests {
         }
         .prepare(&ctx, &set);
         let mut reserved = Vec::new();
-        colours.reserve(&joints, &mut reserved);
+        let body_slots: Vec<[u32; 2]> = joints
+            .iter()
+            .map(|j| {
+                let (a, b) = j.bodies();
+                [a.index, b.index]
+            })
+            .collect();
+        colours.reserve(&body_slots, &mut reserved);
         let mut graph = ConstraintGraph::new();
         graph.set_reserved(&reserved);
         graph.begin_step();

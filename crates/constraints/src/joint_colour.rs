@@ -197,14 +197,16 @@ impl JointColours {
     /// indices read from `bodies` (where the prepare will load them), not
     /// from the joints (where the last prepare left them). The contacts'
     /// graph reads the result ([`JointColours::reserve`]); the prepare then
-    /// finds the same keys and keeps the colours.
-    pub fn update_from(&mut self, joints: &[Joint], bodies: &BodySet) {
+    /// finds the same keys and keeps the colours. `body_slots[k]`: the
+    /// slots of joint `k`'s bodies a and b (the joint store keeps them, so
+    /// that this pass over every joint reads no definition).
+    pub fn update_from(&mut self, joints: &[Joint], body_slots: &[[u32; 2]], bodies: &BodySet) {
         self.keys.clear();
-        self.keys.extend(joints.iter().map(|j| {
-            let (a, b) = j.bodies();
-            let index = |h| bodies.state_index(h).unwrap_or(0);
-            key_at(j, index(a), index(b), &bodies.states)
-        }));
+        self.keys
+            .extend(joints.iter().zip(body_slots).map(|(j, &[a, b])| {
+                let index = |slot| bodies.state_index_at(slot).unwrap_or(0);
+                key_at(j, index(a), index(b), &bodies.states)
+            }));
         self.recolour_if_changed(joints.len(), bodies.states.len());
     }
 
@@ -388,17 +390,18 @@ impl JointColours {
     /// The contacts' persistent graph takes none of them
     /// ([`ConstraintGraph::set_reserved`](janus2d_core::graph::ConstraintGraph::set_reserved)),
     /// so that joints and contacts share the colours as Box2D's graph
-    /// does. From the last colouring (`joints` as they were then).
-    pub fn reserve(&self, joints: &[Joint], out: &mut Vec<u32>) {
+    /// does. From the last colouring; `body_slots` as in
+    /// [`JointColours::update_from`], for the joints as they were then.
+    pub fn reserve(&self, body_slots: &[[u32; 2]], out: &mut Vec<u32>) {
         out.clear();
-        for ((j, &colour), k) in joints.iter().zip(&self.colour_of).zip(&self.built_keys) {
+        for ((&[a, b], &colour), k) in body_slots.iter().zip(&self.colour_of).zip(&self.built_keys)
+        {
             if (colour as usize) >= COLOURS {
                 continue;
             }
-            let (a, b) = j.bodies();
-            for (body, bit) in [(a, WRITE_A), (b, WRITE_B)] {
+            for (slot, bit) in [(a, WRITE_A), (b, WRITE_B)] {
                 if k[2] & u32::from(bit) != 0 {
-                    let slot = body.index as usize;
+                    let slot = slot as usize;
                     if out.len() <= slot {
                         out.resize(slot + 1, 0);
                     }

@@ -1714,6 +1714,18 @@ impl BodySet {
         }
     }
 
+    /// [`state_index`](Self::state_index) of the body in live slot `slot`
+    /// (a handle's `index`), for a store that keeps its bodies' slots
+    /// rather than their handles (the joints); `None` for a free slot.
+    #[inline]
+    #[must_use]
+    pub fn state_index_at(&self, slot: u32) -> Option<u32> {
+        match self.records.at(slot)?.location {
+            BodyLocation::Moving(i) => Some(i),
+            BodyLocation::Static(_) | BodyLocation::Sleeping(_) => Some(0),
+        }
+    }
+
     /// A body as the solver sees it, or the static identity for a stale handle.
     pub fn solver_body(&self, handle: BodyHandle) -> SolverBody<'_> {
         match self.location(handle) {

@@ -139,7 +139,7 @@ impl ContactBuilder {
         bodies: &BodySet,
         woke: bool,
         objects: &[ObjectMass],
-        driven: impl Iterator<Item = BodyHandle>,
+        driven: impl Iterator<Item = u32>,
         mut pre_solve: Option<&mut PreSolveFn>,
         reserved: &[u32],
         solver: &mut ContactSolver,
@@ -171,8 +171,8 @@ impl ContactBuilder {
         // Read only when a contact could make a cluster (a joint-only
         // scene scans no joint here).
         if !handoff.touching.is_empty() || !woken.is_empty() {
-            for body in driven.chain(objects.iter().map(|o| o.body)) {
-                if let Some(i) = bodies.state_index(body).filter(|&i| i != 0) {
+            for slot in driven.chain(objects.iter().map(|o| o.body.index)) {
+                if let Some(i) = bodies.state_index_at(slot).filter(|&i| i != 0) {
                     excluded.push(i);
                 }
             }

@@ -140,6 +140,12 @@ pub struct JointSet {
     owner: u32,
     slots: Slots<JointSlot>,
     joints: Vec<Joint>,
+    /// By joint (as `joints`): the slots (`BodyHandle::index`) of its
+    /// bodies a and b. The colouring keys, the contacts' colour
+    /// reservation and the driven bodies read them for every joint at
+    /// every step; from here they stream, where the definitions are a
+    /// dependent load each (rain: a third of a millisecond a step).
+    body_slots: Vec<[u32; 2]>,
     handles: Vec<JointHandle>,
     body_joints: Vec<SmallVec<[JointHandle; 2]>>,
     pub(crate) no_collide: NoCollide,
@@ -238,12 +244,16 @@ impl JointSet {
     /// kind, each joint's bodies live and listing it, every
     /// body list holding live joints of that body, no-collide counts.
     pub(crate) fn check(&self, bodies: &janus2d_core::body::BodySet) -> Result<(), String> {
-        if self.handles.len() != self.slots.len() || self.joints.len() != self.slots.len() {
+        if self.handles.len() != self.slots.len()
+            || self.joints.len() != self.slots.len()
+            || self.body_slots.len() != self.slots.len()
+        {
             return Err(format!(
-                "{} handles, {} slots, {} joints",
+                "{} handles, {} slots, {} joints, {} body slot pairs",
                 self.handles.len(),
                 self.slots.len(),
-                self.joints.len()
+                self.joints.len(),
+                self.body_slots.len()
             ));
         }
         self.slots
@@ -280,6 +290,11 @@ impl JointSet {
                 return Err(format!("joint {k}: step rate {inv_h}"));
             }
             let (a, b) = j.bodies();
+            if self.body_slots[k] != [a.index, b.index] {
+                return Err(format!(
+                    "joint {k}: its kept body slots are not its bodies'"
+                ));
+            }
             for body in [a, b] {
                 if !bodies.contains(body) {
                     return Err(format!("joint {k}: body {body:?} is not live"));
@@ -398,6 +413,7 @@ impl JointSet {
         self.joints.push(Joint::new(def.clone()));
         self.handles.push(handle);
         let (a, b) = def.bodies();
+        self.body_slots.push([a.index, b.index]);
         for body in [a, b] {
             let i = body.index as usize;
             if self.body_joints.len() <= i {
@@ -431,6 +447,7 @@ impl JointSet {
             }
         }
         self.joints.swap_remove(i);
+        self.body_slots.swap_remove(i);
         self.handles.swap_remove(i);
         if i < self.joints.len() {
             let moved = self.handles[i];
@@ -457,13 +474,15 @@ impl JointSet {
         to: BodyHandle,
         anchor: janus2d_core::math::Vec2,
     ) -> Option<((BodyHandle, BodyHandle), (BodyHandle, BodyHandle))> {
-        let j = self.get_mut(joint).ok()?;
+        let i = self.slot(joint).ok()?.index as usize;
+        let j = &mut self.joints[i];
         let old = j.bodies();
         if !j.repoint(from, to, anchor) {
             return None;
         }
         let new = j.bodies();
         let collide = j.collide_connected();
+        self.body_slots[i] = [new.0.index, new.1.index];
         if let Some(list) = self.body_joints.get_mut(from.index as usize)
             && let Some(k) = list.iter().position(|h| *h == joint)
         {
@@ -562,10 +581,11 @@ impl JointSet {
             self.reserved_for = None;
             return;
         }
-        self.colours.update_from(&self.joints, bodies);
+        self.colours
+            .update_from(&self.joints, &self.body_slots, bodies);
         let made_from = (self.colours.generation(), self.joints.len());
         if self.reserved_for != Some(made_from) {
-            self.colours.reserve(&self.joints, &mut self.reserved);
+            self.colours.reserve(&self.body_slots, &mut self.reserved);
             self.reserved_for = Some(made_from);
         }
     }
@@ -576,17 +596,15 @@ impl JointSet {
         &self.reserved
     }
 
-    /// The bodies an enabled motor (of nonzero torque) turns: both bodies
-    /// of each such joint, in joint order. The light clusters leave them
-    /// out (`janus2d_constraints::contact_group`).
-    pub(crate) fn driven_bodies(&self) -> impl Iterator<Item = BodyHandle> + '_ {
+    /// The slots of the bodies an enabled motor (of nonzero torque) turns:
+    /// both bodies of each such joint, in joint order. The light clusters
+    /// leave them out (`janus2d_constraints::contact_group`).
+    pub(crate) fn driven_bodies(&self) -> impl Iterator<Item = u32> + '_ {
         self.joints
             .iter()
-            .filter(|j| j.is_enabled() && j.is_driven())
-            .flat_map(|j| {
-                let (a, b) = j.bodies();
-                [a, b]
-            })
+            .zip(&self.body_slots)
+            .filter(|(j, _)| j.is_enabled() && j.is_driven())
+            .flat_map(|(_, slots)| *slots)
     }
 
     /// Sets the motor speed (rad/s for an angular motor, m/s for a

@@ -138,7 +138,8 @@ pub mod bytes {
     /// fast-travel limit and core reach, and the shape store the bodies
     /// whose extents changed since the last step; 18: every joint kind
     /// lists its solver base first; 19: a revolute joint no longer keeps
-    /// its point block's bound, and the islands keep no scratch).
+    /// its point block's bound, the islands keep no scratch, and the joint
+    /// store keeps each joint's body slots).
     pub const SNAPSHOT_VERSION: u16 = 19;
     const HEADER: usize = 24;
 
