@@ -33,6 +33,7 @@
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::math::Real;
+use janus2d_core::union_find::{find, union};
 
 use crate::contacts::{ContactSet, TouchChanges};
 use crate::error::WorldError;
@@ -652,27 +653,6 @@ impl Islands {
         }
         self.parent = parent;
         self.part_of = part_of;
-    }
-}
-
-/// The root of `i` (path halving: each visited entry skips to its
-/// grandparent).
-fn find(parent: &mut [u32], mut i: u32) -> u32 {
-    while parent[i as usize] != i {
-        let grand = parent[parent[i as usize] as usize];
-        parent[i as usize] = grand;
-        i = grand;
-    }
-    i
-}
-
-/// Joins the sets of `a` and `b`: the larger root points at the smaller
-/// (no rank array; the parts do not depend on which root wins).
-fn union(parent: &mut [u32], a: u32, b: u32) {
-    let (ra, rb) = (find(parent, a), find(parent, b));
-    if ra != rb {
-        let (low, high) = if ra < rb { (ra, rb) } else { (rb, ra) };
-        parent[high as usize] = low;
     }
 }
 
