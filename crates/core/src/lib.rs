@@ -10,7 +10,8 @@
 //! | [`softness`]   | the one softness type of every soft row                    |
 //! | [`constraint`] | the constraint trait, rows, blocks, the step context        |
 //! | [`solver`]     | the soft step and the PGS baseline                          |
-//! | [`parallel`]   | the step's worker team (the one module that uses `unsafe`)  |
+//! | [`parallel`]   | the step's worker team (uses `unsafe`, with its proof)      |
+//! | [`hint`]       | a cache prefetch hint (the other module with `unsafe`)      |
 //! | [`geometry`]   | shapes, mass properties, bounding boxes, manifolds          |
 //! | [`limits`]     | the stated finite range of every input value                |
 //! | [`handle`]     | one generational handle type for every kind of object       |
@@ -25,6 +26,7 @@ pub mod contact_input;
 pub mod geometry;
 pub mod graph;
 pub mod handle;
+pub mod hint;
 pub mod limits;
 pub mod material;
 pub mod math;

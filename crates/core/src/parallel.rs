@@ -28,8 +28,8 @@
 //!
 //! # Safety
 //!
-//! This is the one module of `janus2d-core` that uses `unsafe` (the rest of
-//! the crate denies it). It does what safe Rust cannot express here:
+//! This and [`hint`](crate::hint) are the modules of `janus2d-core` that
+//! use `unsafe` (the rest of the crate denies it). It does what safe Rust cannot express here:
 //!
 //! 1. **A borrowed job handed to threads that outlive the call.** The
 //!    followers are started once per step, but every job borrows stage data

@@ -1,0 +1,32 @@
+//! Cache hints for passes whose next element sits behind a pointer.
+//!
+//! A joint keeps its definition boxed apart from its solver data, so a
+//! pass over the joints that reads the definitions (prepare) takes a
+//! dependent cache miss per joint: the hardware prefetcher follows
+//! strides, not pointers. [`prefetch`] asks for a later joint's line while
+//! the current one is worked on.
+//!
+//! This module and [`parallel`](crate::parallel) are the crate's only
+//! users of `unsafe`.
+#![allow(unsafe_code)]
+
+/// Asks the cache for the line holding `value`, ahead of a read. A hint
+/// only: it reads nothing and changes nothing, on any target (a no-op
+/// where no prefetch instruction is wired).
+#[inline(always)]
+pub fn prefetch<T>(value: &T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let p: *const i8 = (value as *const T).cast();
+        // SAFETY: `_mm_prefetch` is a hint that performs no memory access
+        // the program can observe: it cannot fault (even on an invalid
+        // address; here `p` comes from a live reference) and reads nothing
+        // into the program. Its one requirement, SSE, is part of the
+        // x86_64 baseline every x86_64 target enables.
+        unsafe {
+            core::arch::x86_64::_mm_prefetch::<{ core::arch::x86_64::_MM_HINT_T0 }>(p);
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = value;
+}
