@@ -72,6 +72,15 @@ impl<T> Slots<T> {
         }
     }
 
+    /// Asks the cache for slot `index`'s line ahead of a read of it
+    /// ([`crate::hint::prefetch`]); reads nothing of the slot itself.
+    #[inline(always)]
+    pub fn prefetch(&self, index: u32) {
+        if let Some(entry) = self.entries.get(index as usize) {
+            crate::hint::prefetch(&entry.1);
+        }
+    }
+
     /// The value in slot `index` if it is live (any generation).
     pub fn at(&self, index: u32) -> Option<&T> {
         self.entries.get(index as usize).and_then(|e| e.1.as_ref())

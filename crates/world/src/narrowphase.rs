@@ -329,8 +329,14 @@ impl Narrowphase {
                 &mut results[..],
                 NARROW_BLOCK,
                 |_, cs, ss, rs| {
-                    for ((c, s), r) in cs.iter_mut().zip(ss).zip(rs) {
-                        *r = compute((c, s));
+                    for i in 0..cs.len() {
+                        // The shapes a few contacts on: a contact's two
+                        // shape records are random loads (docs/performance.md).
+                        if let Some(ahead) = cs.get(i + SHAPES_AHEAD) {
+                            input.shapes.prefetch(ahead.shape_a);
+                            input.shapes.prefetch(ahead.shape_b);
+                        }
+                        rs[i] = compute((&mut cs[i], &mut ss[i]));
                     }
                 },
                 beside,
@@ -408,6 +414,9 @@ impl Narrowphase {
         counters.touching = touching_count;
     }
 }
+
+/// How many contacts ahead the narrowphase asks for the shape records.
+const SHAPES_AHEAD: usize = 4;
 
 /// Phase 1 of the narrowphase for one contact, on the contact alone: the
 /// new manifold (impulses carried over by feature id), the aperture

@@ -668,6 +668,13 @@ impl ShapeStore {
         self.slots.is_empty()
     }
 
+    /// Asks the cache for shape `index`'s record ahead of a read (the
+    /// narrowphase, a few contacts on).
+    #[inline(always)]
+    pub(crate) fn prefetch(&self, index: u32) {
+        self.slots.prefetch(index);
+    }
+
     /// The shape in live slot `index`.
     #[inline]
     #[must_use]
