@@ -1,10 +1,16 @@
-//! Cache hints for passes whose next element sits behind a pointer.
+//! Cache hints for passes whose next element sits behind a pointer or an
+//! index.
 //!
-//! A joint keeps its definition boxed apart from its solver data, so a
-//! pass over the joints that reads the definitions (prepare) takes a
-//! dependent cache miss per joint: the hardware prefetcher follows
-//! strides, not pointers. [`prefetch`] asks for a later joint's line while
-//! the current one is worked on.
+//! The hardware prefetcher follows strides, not pointers: a pass over the
+//! joints that reads their boxed definitions (prepare), or over the
+//! contacts that reads their shapes' records by slot (narrowphase), takes
+//! a dependent cache miss per element. [`prefetch`] asks for a later
+//! element's line while the current one is worked on.
+//!
+//! | user | asks for | ahead |
+//! |------|----------|-------|
+//! | joint prepare | the boxed definition | 4 joints |
+//! | narrowphase | both shape records ([`Slots::prefetch`](crate::slots::Slots::prefetch)) | 4 contacts |
 //!
 //! This module and [`parallel`](crate::parallel) are the crate's only
 //! users of `unsafe`.
