@@ -17,7 +17,7 @@
 #![no_main]
 
 use janus2d::prelude::*;
-use janus2d::world::{CharacterController, ExplosionDef, Snapshot};
+use janus2d::world::{CharacterController, ExplosionDef, Snapshot, SnapshotError};
 use libfuzzer_sys::fuzz_target;
 
 const DT: Real = 1.0 / 60.0;
@@ -211,10 +211,23 @@ fuzz_target!(|data: &[u8]| {
     } else {
         rest.to_vec()
     };
-    let Ok(snapshot) = Snapshot::from_bytes(&bytes) else {
-        return;
+    let snapshot = match Snapshot::from_bytes(&bytes) {
+        Ok(snapshot) => snapshot,
+        Err(SnapshotError::Decode(e)) if expect_decode() => {
+            panic!("JANUS_FUZZ_EXPECT_DECODE: the payload does not decode ({e}): a stale corpus")
+        }
+        Err(_) => return,
     };
     let world = snapshot.to_world();
     valid(&world, "as decoded");
     exercise(world, mode);
 });
+
+/// `JANUS_FUZZ_EXPECT_DECODE` is set: CI's run over the committed seeds
+/// and carried regression inputs, each of which must decode in the
+/// current format (refused by the validator is fine; undecodable means
+/// the corpus was not rewritten after a format change).
+fn expect_decode() -> bool {
+    static EXPECT: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *EXPECT.get_or_init(|| std::env::var_os("JANUS_FUZZ_EXPECT_DECODE").is_some())
+}

@@ -255,6 +255,7 @@ fn a_snapshot_with_chains_continues_bit_identically() {
         w.step(DT).unwrap();
     }
     assert_eq!(w.state_hash(), after);
+    #[cfg(feature = "serde")]
     {
         let bytes = saved.to_bytes();
         let mut back = janus2d::world::Snapshot::from_bytes(&bytes)

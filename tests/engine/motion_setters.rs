@@ -315,6 +315,7 @@ fn the_settings_survive_a_snapshot_and_the_continuation_is_identical() {
         copy.step(DT).unwrap();
     }
     assert_eq!(copy.state_hash(), after);
+    #[cfg(feature = "serde")]
     {
         let bytes = saved.to_bytes();
         let decoded = janus2d::world::Snapshot::from_bytes(&bytes).unwrap();

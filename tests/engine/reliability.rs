@@ -758,6 +758,7 @@ mod portals {
 /// Issue 35: snapshot bytes whose payload was changed (length and checksum
 /// recomputed) are an error or a world that steps, is destroyed piece by
 /// piece and validates without a panic.
+#[cfg(feature = "serde")]
 mod snapshot_bytes {
     use super::*;
     use janus2d::constraints::JointKind;

@@ -213,6 +213,7 @@ fn issue_32_state_continues_bit_exactly() {
     assert_eq!(world.state_hash(), after, "in place");
 }
 
+#[cfg(feature = "serde")]
 mod bytes {
     use super::*;
     use janus2d::world::{SNAPSHOT_VERSION, Snapshot, SnapshotError};
@@ -456,7 +457,7 @@ mod bytes {
 
     /// Writes the snapshot fuzz target's seeds (`fuzz/corpus/snapshot_bytes/
     /// seed-NAME`); run again whenever the snapshot format changes:
-    /// `cargo test --test engine -- --ignored write_the_snapshot_fuzz_corpus`.
+    /// `cargo test --features serde --test engine -- --ignored write_the_snapshot_fuzz_corpus`.
     #[test]
     #[ignore = "writes fuzz/corpus/snapshot_bytes"]
     fn write_the_snapshot_fuzz_corpus() {

@@ -283,6 +283,7 @@ fn snapshot_restores_surface_materials() {
         w.step(DT).unwrap();
     }
     assert_eq!(w.state_hash(), after);
+    #[cfg(feature = "serde")]
     {
         let bytes = w.snapshot().to_bytes();
         let back = janus2d::Snapshot::from_bytes(&bytes).unwrap();
