@@ -166,6 +166,16 @@ fn rain_ragdoll_falls_asleep_with_the_joint_tree_solve_on() {
     }
 }
 
+/// The top box is carried away to (5, 0.5) and kept moving along the
+/// ground at 1 m/s for two seconds.
+fn carry_off_and_push(world: &mut World, top: BodyHandle) {
+    world.set_transform(top, Vec2::new(5.0, 0.5), 0.0).unwrap();
+    for _ in 0..120 {
+        world.set_linear_velocity(top, Vec2::new(1.0, 0.0)).unwrap();
+        world.step(DT).unwrap();
+    }
+}
+
 #[test]
 fn island_splits_when_bodies_part_so_the_resting_one_sleeps() {
     let (mut world, _, boxes) = stack_on_ground(2);
@@ -173,14 +183,7 @@ fn island_splits_when_bodies_part_so_the_resting_one_sleeps() {
     for _ in 0..10 {
         world.step(DT).unwrap();
     }
-    // The top box is carried away and kept moving along the ground.
-    world.set_transform(high, Vec2::new(5.0, 0.5), 0.0).unwrap();
-    for _ in 0..120 {
-        world
-            .set_linear_velocity(high, Vec2::new(1.0, 0.0))
-            .unwrap();
-        world.step(DT).unwrap();
-    }
+    carry_off_and_push(&mut world, high);
     assert!(
         !world.is_sleeping(high).unwrap(),
         "the pushed box stays awake"
@@ -214,13 +217,7 @@ fn three_part_after_the_top_leaves(far: usize) -> [(bool, Option<u32>); 3] {
         world.step(DT).unwrap();
     }
     let high = boxes[2];
-    world.set_transform(high, Vec2::new(5.0, 0.5), 0.0).unwrap();
-    for _ in 0..120 {
-        world
-            .set_linear_velocity(high, Vec2::new(1.0, 0.0))
-            .unwrap();
-        world.step(DT).unwrap();
-    }
+    carry_off_and_push(&mut world, high);
     let read = |b: BodyHandle| (world.is_sleeping(b).unwrap(), world.island_id(b));
     [read(boxes[0]), read(boxes[1]), read(high)]
 }
