@@ -879,6 +879,19 @@ pub enum BodyLocation {
     Sleeping(u32),
 }
 
+impl BodyLocation {
+    /// The state index the solver reads for a body here: its own for a
+    /// moving body, 0 (the static identity) for a static or sleeping one.
+    #[inline]
+    #[must_use]
+    pub fn state_index(self) -> u32 {
+        match self {
+            BodyLocation::Moving(i) => i,
+            BodyLocation::Static(_) | BodyLocation::Sleeping(_) => 0,
+        }
+    }
+}
+
 /// Bookkeeping for one live body (its slot's generation is kept by the
 /// [`Slots`] that hold the records).
 #[derive(Clone, Debug, PartialEq)]
@@ -1708,10 +1721,7 @@ impl BodySet {
 
     /// The state index (0 for static bodies) of a live body.
     pub fn state_index(&self, handle: BodyHandle) -> Option<u32> {
-        match self.location(handle)? {
-            BodyLocation::Moving(i) => Some(i),
-            BodyLocation::Static(_) | BodyLocation::Sleeping(_) => Some(0),
-        }
+        self.location(handle).map(BodyLocation::state_index)
     }
 
     /// [`state_index`](Self::state_index) of the body in live slot `slot`
@@ -1720,10 +1730,7 @@ impl BodySet {
     #[inline]
     #[must_use]
     pub fn state_index_at(&self, slot: u32) -> Option<u32> {
-        match self.records.at(slot)?.location {
-            BodyLocation::Moving(i) => Some(i),
-            BodyLocation::Static(_) | BodyLocation::Sleeping(_) => Some(0),
-        }
+        self.records.at(slot).map(|r| r.location.state_index())
     }
 
     /// A body as the solver sees it, or the static identity for a stale handle.

@@ -29,7 +29,8 @@
 //! # Safety
 //!
 //! This and [`hint`](crate::hint) are the modules of `janus2d-core` that
-//! use `unsafe` (the rest of the crate denies it). It does what safe Rust cannot express here:
+//! use `unsafe` (the rest of the crate denies it). It does what safe Rust
+//! cannot express here:
 //!
 //! 1. **A borrowed job handed to threads that outlive the call.** The
 //!    followers are started once per step, but every job borrows stage data

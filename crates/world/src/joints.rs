@@ -144,7 +144,7 @@ pub struct JointSet {
     /// bodies a and b. The colouring keys, the contacts' colour
     /// reservation and the driven bodies read them for every joint at
     /// every step; from here they stream, where the definitions are a
-    /// dependent load each (rain: a third of a millisecond a step).
+    /// dependent load each (the measurement is in docs/performance.md).
     body_slots: Vec<[u32; 2]>,
     handles: Vec<JointHandle>,
     body_joints: Vec<SmallVec<[JointHandle; 2]>>,
