@@ -291,17 +291,14 @@ fn rope_example_comes_out_whole() {
 
 /// A rope drifting sideways onto the lip: the rope of the other tests,
 /// given 0.5 m/s along +x, reaches the aperture's edge while it pours; the
-/// links that no longer fit the aperture are dragged across the lip.
-/// Ignored: the bound is not met in f32. Measured with the lips acting as
-/// the aperture's sides (`crates/world/src/aperture.rs`): no joint is
-/// disabled; the worst gap through the map is 20.5 mm in f32 and 16.0 mm
-/// in f64, in the steps where a link held behind the plane for its joints
-/// meets the side of the slot and the rope below the exit is jerked
-/// (26.9 mm at 0.7 m/s, 3.2 mm at 1 m/s, 1.3 mm at 0.2, 0.3 and −0.5
-/// m/s). Before: one joint disabled at 0.5 m/s (a held copy slid out of
-/// the span) and enabled gaps up to 2.1 m; three disabled at 0.7 m/s.
+/// links that no longer fit the aperture are dragged across the lip. No
+/// joint is disabled and every gap through the map stays within 2 cm.
+/// Measured: 16.0 mm (f32), with a lip corner pushing a straddling link
+/// along the normal of the link's own face (`aperture.rs`, `side_wall`);
+/// 20.5 mm when it pushed along the aperture's tangent, which jerked a
+/// tilted link sideways at 4.9 m/s as it slid down past the corner. At
+/// 0.7 m/s: 11.3 mm (15.5 before), 1 m/s 3.0 mm (2.3), −0.5 m/s 1.3 mm.
 #[test]
-#[ignore = "a rope dragged across a lip: 20.5 mm in f32 (see the doc comment)"]
 fn rope_drifting_onto_the_lip_keeps_its_joints() {
     let (mut world, pair) = jointed_portal_world(1.0);
     let (links, joints) = rope(&mut world, 20);

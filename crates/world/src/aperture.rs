@@ -36,9 +36,12 @@
 //! its plane are dropped beside the span too (that part is on the other
 //! side), and the lips act as the sides of the aperture: where the copy's
 //! cross-section at the plane reaches past `|t| = w`, a lip corner pushes
-//! it back into the span (normal `∓t`, with a speculative margin of a few
-//! linear slops only: a fast grazing entry is through before its section
-//! would reach the far lip);
+//! it back into the span, as a corner pushes a face: along the normal of
+//! the copy's edge that crosses the plane there (or from a rounded
+//! vertex's centre), with a speculative margin of a few linear slops only
+//! (a fast grazing entry is through before its section would reach the
+//! far lip). A tilted link sliding down past the corner is pushed off its
+//! face, not jerked along the tangent at its sliding speed times the tilt;
 //! a copy wholly behind its plane (held there for its joints) is kept in
 //! the slot `|t| < w` as between two side walls. The deeper of this side
 //! contact and the clipped manifold is kept. Without it the two copies of
@@ -561,12 +564,20 @@ const SECTION_MARGIN_SLOPS: Real = 4.0;
 /// The contact of a crossing copy (pair side `copy`) with the sides of
 /// the aperture `clip` it passes through. Where the copy crosses the
 /// plane, its cross-section there must lie within the span `|t| < w`: the
-/// lip corners `P ± w t` hold it (a part behind the plane is on the other
-/// side, where it may reach past the span; a fast grazing entry does).
-/// A copy wholly behind its plane (held there for its joints) is held in
-/// the slot `|t| < w` behind the lips, as between two side walls. Normal
-/// `∓t` into the span; the deeper side, up to two points. `None` when
-/// neither side is near, or for a shape without an area.
+/// lip corners `L = P ± w t` hold it (a part behind the plane is on the
+/// other side, where it may reach past the span; a fast grazing entry
+/// does). The corner meets the feature of the section's end on its side:
+///
+/// | feature at the plane | normal (the copy's, toward `L`) | separation |
+/// |---|---|---|
+/// | core edge crossing at `t`, outward normal `m` | `m` | `(w − ±t)(m · ±t) − r` |
+/// | rounded vertex `C` within `r` of the plane | `(L − C)/‖L − C‖` | `‖L − C‖ − r` |
+/// | rounded vertex already past the lip | `±t` | `w − (±t + reach)` |
+///
+/// one point per side, the deeper side kept. A copy wholly behind its
+/// plane (held there for its joints) is held in the slot `|t| < w` behind
+/// the lips ([`slot_wall`]). `None` when neither side is near, or for a
+/// shape without an area.
 fn side_wall(clip: &ApertureClip, copy: usize, shapes: &PairShapes<'_>) -> Option<Manifold> {
     let xf = &shapes.transforms[copy];
     let capsule;
@@ -585,25 +596,33 @@ fn side_wall(clip: &ApertureClip, copy: usize, shapes: &PairShapes<'_>) -> Optio
         let d = xf.apply(v) - clip.point;
         (d.dot(n), d.dot(tangent))
     };
-    // Candidate points (s, t, reach along t beyond the point).
-    let mut reach: Vec<(Real, Real, Real)> = Vec::with_capacity(2 * core.len());
     let wholly = core.iter().all(|&v| coords(v).0 + radius <= 0.0);
+    if wholly {
+        return slot_wall(clip, copy, shapes, core, radius, &coords);
+    }
+    // The cross-section at the plane: the core's edges crossing it (their
+    // outward normal), and a rounded vertex within its radius of it (its
+    // centre).
+    let mut section: Vec<SectionFeature> = Vec::with_capacity(2 * core.len());
     for (k, &v) in core.iter().enumerate() {
         let (s0, t0) = coords(v);
-        if wholly {
-            reach.push((s0, t0, radius));
-            continue;
-        }
-        // The cross-section at the plane: the core's edges crossing it,
-        // and a rounded vertex within its radius of it.
         if s0.abs() < radius {
-            reach.push((0.0, t0, (radius * radius - s0 * s0).sqrt()));
+            section.push(SectionFeature::Cap {
+                centre: xf.apply(v),
+                t: t0,
+                reach: (radius * radius - s0 * s0).sqrt(),
+            });
         }
         if core.len() > 1 {
-            let (s1, t1) = coords(core[(k + 1) % core.len()]);
+            let next = core[(k + 1) % core.len()];
+            let (s1, t1) = coords(next);
             if (s0 < 0.0) != (s1 < 0.0) {
                 let u = s0 / (s0 - s1);
-                reach.push((0.0, t0 + u * (t1 - t0), radius));
+                let edge = xf.apply(next) - xf.apply(v);
+                section.push(SectionFeature::Edge {
+                    t: t0 + u * (t1 - t0),
+                    outward: Vec2::new(edge.y, -edge.x).normalize_or_zero(),
+                });
             }
         }
     }
@@ -611,27 +630,107 @@ fn side_wall(clip: &ApertureClip, copy: usize, shapes: &PairShapes<'_>) -> Optio
     // moves with the copy only while it straddles (a fast grazing entry is
     // through before its section would reach the far lip), so its
     // speculative margin is a few slops, not the step's travel.
-    let near_enough = if wholly {
-        shapes.speculative
-    } else {
-        shapes
-            .speculative
-            .min(SECTION_MARGIN_SLOPS * janus2d_core::geometry::LINEAR_SLOP)
-    };
+    let near_enough = shapes
+        .speculative
+        .min(SECTION_MARGIN_SLOPS * janus2d_core::geometry::LINEAR_SLOP);
+    let mut best: Option<Manifold> = None;
+    for (side, id) in [(-1.0, LIP_ID_LOW), (1.0, LIP_ID_HIGH)] {
+        let lip = clip.point + side * clip.half_width * tangent;
+        let toward_lip = side * tangent;
+        // (separation, the copy's outward normal toward the lip corner).
+        let touch = |f: &SectionFeature| -> Option<(Real, Vec2)> {
+            match *f {
+                SectionFeature::Edge { t, outward } => {
+                    let facing = outward.dot(toward_lip);
+                    // The other side's edge, or one along the plane.
+                    if facing <= 0.0 {
+                        return None;
+                    }
+                    let across = clip.half_width - side * t;
+                    Some((across * facing - radius, outward))
+                }
+                SectionFeature::Cap { centre, t, reach } => {
+                    let d = lip - centre;
+                    let length = d.length();
+                    if d.dot(toward_lip) > 0.0 && length > 0.0 {
+                        Some((length - radius, d / length))
+                    } else {
+                        // The centre is past the lip: push straight back.
+                        Some((clip.half_width - (side * t + reach), toward_lip))
+                    }
+                }
+            }
+        };
+        let Some((separation, outward)) = section
+            .iter()
+            .filter_map(touch)
+            .filter(|&(separation, _)| separation < near_enough)
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+        else {
+            continue;
+        };
+        let point = lip - 0.5 * separation * outward;
+        let mut m = Manifold {
+            // The pair's normal runs from a to b; the copy is pushed along
+            // minus its outward normal, away from the lip corner.
+            normal: if copy == 1 { -outward } else { outward },
+            point_count: 1,
+            ..Manifold::default()
+        };
+        m.points[0] = ManifoldPoint {
+            point,
+            anchor_a: point - shapes.transforms[0].p,
+            anchor_b: point - shapes.transforms[1].p,
+            separation,
+            id,
+        };
+        if best.is_none_or(|b: Manifold| separation < b.points[0].separation) {
+            best = Some(m);
+        }
+    }
+    best
+}
+
+/// Where a crossing copy's boundary meets its aperture's plane.
+#[derive(Clone, Copy, Debug)]
+enum SectionFeature {
+    /// A core edge crossing the plane at lateral coordinate `t`, with its
+    /// outward unit normal (world).
+    Edge { t: Real, outward: Vec2 },
+    /// A rounded vertex within its radius of the plane: its centre
+    /// (world), lateral coordinate `t` and its section's half-width there.
+    Cap { centre: Vec2, t: Real, reach: Real },
+}
+
+/// A copy wholly behind its plane (held there for its joints), kept in the
+/// slot `|t| < w` behind the lips as between two side walls: normal `∓t`
+/// into the span, the deeper side, up to two points.
+fn slot_wall(
+    clip: &ApertureClip,
+    copy: usize,
+    shapes: &PairShapes<'_>,
+    core: &[Vec2],
+    radius: Real,
+    coords: &dyn Fn(Vec2) -> (Real, Real),
+) -> Option<Manifold> {
+    let tangent = clip.normal.perp();
     let mut best: Option<Manifold> = None;
     for (side, id) in [(-1.0, LIP_ID_LOW), (1.0, LIP_ID_HIGH)] {
         let mut m = Manifold::default();
         // Into the span from this side, as the pair's normal (a to b).
         let into_span = -side * tangent;
         m.normal = if copy == 1 { into_span } else { -into_span };
-        let mut near: Vec<(Real, Real)> = reach
+        let mut near: Vec<(Real, Real)> = core
             .iter()
-            .map(|&(s, t, r)| (clip.half_width - (side * t + r), s))
-            .filter(|&(separation, _)| separation < near_enough)
+            .map(|&v| {
+                let (s, t) = coords(v);
+                (clip.half_width - (side * t + radius), s)
+            })
+            .filter(|&(separation, _)| separation < shapes.speculative)
             .collect();
         near.sort_by(|a, b| a.0.total_cmp(&b.0));
         for (k, &(separation, s)) in near.iter().take(2).enumerate() {
-            let point = clip.point + side * clip.half_width * tangent + s * n
+            let point = clip.point + side * clip.half_width * tangent + s * clip.normal
                 - 0.5 * separation * into_span;
             m.points[k] = ManifoldPoint {
                 point,
