@@ -901,4 +901,38 @@ mod tests {
         clipping.clip_manifold(handle(1), handle(2), &PairMotion::default(), None, &mut m);
         assert_eq!(m.point_count, 0);
     }
+
+    /// A tilted link straddling the plane with its face at the lip corner
+    /// is pushed off that face (the pair's normal is minus the face's
+    /// outward normal), by the corner's distance to the face, not along
+    /// the aperture's tangent.
+    #[test]
+    fn lip_corner_pushes_a_tilted_copy_off_its_face() {
+        let clipping = floor_with(&[0.0], 0.5);
+        let clip = &clipping.clips[0];
+        let tilt: Real = 0.33;
+        let link = Shape::Polygon(janus2d_core::geometry::Polygon::make_box(0.05, 0.25));
+        let wall = Shape::Polygon(janus2d_core::geometry::Polygon::make_box(4.0, 0.5));
+        let centre = Vec2::new(0.45, 0.0);
+        let shapes = PairShapes {
+            shapes: [&wall, &link],
+            transforms: [
+                Transform::new(Vec2::new(0.0, -0.5), 0.0),
+                Transform::new(centre, tilt),
+            ],
+            speculative: 0.04,
+        };
+        let m = side_wall(clip, 1, &shapes).expect("the lip touches the link");
+        assert_eq!(m.point_count, 1);
+        let face = Vec2::new(tilt.cos(), tilt.sin());
+        assert!((m.normal + face).length() < 1e-5, "normal {}", m.normal);
+        let corner = Vec2::new(0.5, 0.0);
+        let expected = (corner - centre).dot(face) - 0.05;
+        let got = m.points[0].separation;
+        assert!(
+            (got - expected).abs() < 1e-5,
+            "separation {got} vs {expected}"
+        );
+        assert!(got < 0.0);
+    }
 }
