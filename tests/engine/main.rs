@@ -26,6 +26,7 @@ mod joint_events;
 mod joint_tree_mixed;
 mod joint_tree_properties;
 mod kinematic_targets;
+mod module_imports;
 mod motion_setters;
 mod motor;
 mod mouse;

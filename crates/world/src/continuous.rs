@@ -72,12 +72,8 @@ use janus2d_core::parallel::Team;
 use crate::aperture::ContactClipping;
 use crate::broadphase::BroadPhase;
 use crate::joints::{JointSet, NoCollide};
-use crate::shapes::{BodyExtent, ShapeStore};
+use crate::shapes::{FAST_FRACTION, ShapeStore};
 use janus2d_constraints::JointKind;
-
-/// Fraction of a body's smallest extent it may travel in one step before it
-/// counts as fast (dimensionless; usual 0.5, Box2D's safety factor).
-pub const FAST_FRACTION: Real = 0.5;
 
 /// Work of the last continuous pass.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -109,17 +105,6 @@ pub(crate) struct ContinuousInput<'a> {
     pub(crate) maybe_fast: bool,
 }
 
-/// How far a body with these extents may travel in a step before it
-/// counts as fast, m: [`FAST_FRACTION`] of its smallest solid extent, at
-/// least [`LINEAR_SLOP`]; `Real::MAX` without a solid shape.
-#[must_use]
-pub(crate) fn fast_travel(e: &BodyExtent) -> Real {
-    if e.min_extent == Real::MAX {
-        return Real::MAX;
-    }
-    (FAST_FRACTION * e.min_extent).max(LINEAR_SLOP)
-}
-
 /// Copies the extents of the bodies whose shapes changed into their
 /// per-step data (`BodySim::fast_travel`, `BodySim::core_reach`), where
 /// the solver's finalize reads them. The step calls it before the solve.
@@ -127,7 +112,7 @@ pub(crate) fn publish_extents(shapes: &mut ShapeStore, bodies: &mut BodySet) {
     for body in shapes.take_extent_changes() {
         let e = shapes.extent_of(body);
         if let Some(sim) = bodies.sim_mut(body) {
-            sim.fast_travel = fast_travel(&e);
+            sim.fast_travel = e.fast_travel();
             sim.core_reach = e.core_reach;
         }
     }
@@ -758,6 +743,7 @@ fn aperture_fraction(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::shapes::BodyExtent;
     use janus2d_core::body::{BodyDef, BodySet, BodySim};
     use proptest::prelude::*;
 
@@ -774,7 +760,7 @@ mod tests {
         sim.rotation0 = Rot::from_angle(0.3);
         sim.center = sim.center0 + Vec2::new(motion[0], motion[1]);
         sim.transform.q = Rot::from_angle(0.3 + motion[2]);
-        sim.fast_travel = fast_travel(&extent);
+        sim.fast_travel = extent.fast_travel();
         sim.core_reach = extent.core_reach;
         sim
     }

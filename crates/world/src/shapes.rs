@@ -584,7 +584,23 @@ pub struct BodyExtent {
     pub core_reach: Real,
 }
 
+/// Fraction of a body's smallest extent it may travel in one step before it
+/// counts as fast for continuous collision (dimensionless; usual 0.5,
+/// Box2D's safety factor).
+pub const FAST_FRACTION: Real = 0.5;
+
 impl BodyExtent {
+    /// How far a body with these extents may travel in a step before it
+    /// counts as fast, m: [`FAST_FRACTION`] of its smallest solid extent,
+    /// at least the linear slop; `Real::MAX` without a solid shape.
+    #[must_use]
+    pub fn fast_travel(&self) -> Real {
+        if self.min_extent == Real::MAX {
+            return Real::MAX;
+        }
+        (FAST_FRACTION * self.min_extent).max(janus2d_core::geometry::LINEAR_SLOP)
+    }
+
     /// Widens the extents by a solid shape's (a sensor adds nothing).
     fn take_in(&mut self, shape: &ShapeData) {
         if shape.def.is_sensor {
@@ -834,7 +850,7 @@ impl ShapeStore {
             let Some(sim) = bodies.sim(body) else {
                 continue;
             };
-            let travel = crate::continuous::fast_travel(&e);
+            let travel = e.fast_travel();
             if sim.fast_travel.to_bits() != travel.to_bits()
                 || sim.core_reach.to_bits() != e.core_reach.to_bits()
             {
