@@ -289,6 +289,25 @@ fn rope_example_comes_out_whole() {
     }
 }
 
+/// The rope of the other tests with every link given `drift` m/s along +x
+/// (η = `eta`), run for 300 steps (printed with `JANUS2D_REPORT=1`).
+fn dragged_rope(eta: Real, drift: Real) -> Run {
+    let (mut world, pair) = jointed_portal_world(eta);
+    let (links, joints) = rope(&mut world, 20);
+    for &b in &links {
+        world.set_linear_velocity(b, Vec2::new(drift, 0.0)).unwrap();
+    }
+    let r = run(&mut world, pair, &joints, 300, |w| w.crossing_count() == 0);
+    if report() {
+        eprintln!(
+            "dragged rope η = {eta}, {drift:+} m/s: worst gap {:.1} mm, {} disabled",
+            1e3 * r.worst_gap,
+            r.disabled
+        );
+    }
+    r
+}
+
 /// A rope drifting sideways onto the lip: the rope of the other tests,
 /// given 0.5 m/s along +x, reaches the aperture's edge while it pours; the
 /// links that no longer fit the aperture are dragged across the lip. No
@@ -300,19 +319,7 @@ fn rope_example_comes_out_whole() {
 /// 0.7 m/s: 11.3 mm (15.5 before), 1 m/s 3.0 mm (2.3), −0.5 m/s 1.3 mm.
 #[test]
 fn rope_drifting_onto_the_lip_keeps_its_joints() {
-    let (mut world, pair) = jointed_portal_world(1.0);
-    let (links, joints) = rope(&mut world, 20);
-    for &b in &links {
-        world.set_linear_velocity(b, Vec2::new(0.5, 0.0)).unwrap();
-    }
-    let r = run(&mut world, pair, &joints, 300, |w| w.crossing_count() == 0);
-    if report() {
-        eprintln!(
-            "drifting rope: worst gap {:.1} mm, {} disabled",
-            1e3 * r.worst_gap,
-            r.disabled
-        );
-    }
+    let r = dragged_rope(1.0, 0.5);
     assert_eq!(r.disabled, 0);
     assert!(
         r.worst_gap <= 0.02,
@@ -342,20 +349,8 @@ fn rope_dragged_onto_a_lip_over_speeds_and_eta_keeps_the_cases_that_held() {
     let mut failed = Vec::new();
     for (eta, held) in holds {
         for v in all {
-            let (mut world, pair) = jointed_portal_world(eta);
-            let (links, joints) = rope(&mut world, 20);
-            for &b in &links {
-                world.set_linear_velocity(b, Vec2::new(v, 0.0)).unwrap();
-            }
-            let r = run(&mut world, pair, &joints, 300, |w| w.crossing_count() == 0);
+            let r = dragged_rope(eta, v);
             let ok = r.disabled == 0 && r.worst_gap <= 0.02;
-            if report() {
-                eprintln!(
-                    "dragged rope η = {eta}, {v:+} m/s: worst gap {:.1} mm, {} disabled",
-                    1e3 * r.worst_gap,
-                    r.disabled
-                );
-            }
             if held.contains(&v) && !ok {
                 failed.push(format!("η = {eta}, {v} m/s: {r:?}"));
             }
