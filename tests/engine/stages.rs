@@ -8,27 +8,24 @@ use janus2d_testbed::benchmarks::{rain, rain_group};
 use janus2d_testbed::desc::{Action, Script};
 use janus2d_testbed::janus::{Janus, world_def};
 use janus2d_testbed::scenes::DT;
+use janus2d_testbed::support::wall;
 
 fn stack_on_ground(n: usize) -> (World, BodyHandle, Vec<BodyHandle>) {
     let mut world = World::new(WorldDef::default()).unwrap();
-    let g = world
-        .create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0)))
-        .unwrap();
-    world
-        .create_shape(g, &ShapeDef::default(), Polygon::make_box(20.0, 1.0))
-        .unwrap();
+    let g = wall(&mut world, Vec2::new(0.0, -1.0), 20.0, 1.0);
     let boxes = (0..n)
-        .map(|i| {
-            let b = world
-                .create_body(&BodyDef::dynamic(Vec2::new(0.0, 0.5 + i as Real)))
-                .unwrap();
-            world
-                .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
-                .unwrap();
-            b
-        })
+        .map(|i| unit_box(&mut world, Vec2::new(0.0, 0.5 + i as Real)))
         .collect();
     (world, g, boxes)
+}
+
+/// A dynamic 1 m box at `at`.
+fn unit_box(world: &mut World, at: Vec2) -> BodyHandle {
+    let b = world.create_body(&BodyDef::dynamic(at)).unwrap();
+    world
+        .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    b
 }
 
 #[test]
@@ -199,19 +196,9 @@ fn island_splits_when_bodies_part_so_the_resting_one_sleeps() {
 /// two seconds, the islands of the low, middle and top box.
 fn three_part_after_the_top_leaves(far: usize) -> [(bool, Option<u32>); 3] {
     let (mut world, _, boxes) = stack_on_ground(3);
-    let g = world
-        .create_body(&BodyDef::fixed(Vec2::new(200.0, -1.0)))
-        .unwrap();
-    world
-        .create_shape(g, &ShapeDef::default(), Polygon::make_box(150.0, 1.0))
-        .unwrap();
+    wall(&mut world, Vec2::new(200.0, -1.0), 150.0, 1.0);
     for i in 0..far {
-        let b = world
-            .create_body(&BodyDef::dynamic(Vec2::new(60.0 + 1.5 * i as Real, 0.5)))
-            .unwrap();
-        world
-            .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
-            .unwrap();
+        unit_box(&mut world, Vec2::new(60.0 + 1.5 * i as Real, 0.5));
     }
     for _ in 0..10 {
         world.step(DT).unwrap();
