@@ -207,6 +207,20 @@ impl ContactSolver {
 
     /// Adds a contact to its colour ([`OVERFLOW`]: solved scalar).
     pub fn push(&mut self, colour: u8, lane: &ContactLane) -> LanePlace {
+        self.push_with(colour, lane, lane.contact_index, lane.cluster)
+    }
+
+    /// [`ContactSolver::push`] with the contact's index and light clusters
+    /// given apart from `lane` (whose own `contact_index` and `cluster`
+    /// are not read): the caller pushes a staged lane as it is, with no
+    /// copy to set them.
+    pub fn push_with(
+        &mut self,
+        colour: u8,
+        lane: &ContactLane,
+        contact_index: u32,
+        cluster: [u32; 2],
+    ) -> LanePlace {
         self.len += 1;
         let count = lane.point_count.min(MAX_MANIFOLD_POINTS);
         if colour >= OVERFLOW {
@@ -222,13 +236,13 @@ impl ContactSolver {
                 &lane.points[..count],
                 lane.friction,
                 lane.restitution,
-                lane.contact_index,
+                contact_index,
             );
             c.set_surface(lane.tangent_speed, lane.rolling_resistance);
             c.state_a = lane.state_a;
             c.state_b = lane.state_b;
             self.overflow.push(c);
-            self.clusters.push(lane.cluster);
+            self.clusters.push(cluster);
             return place;
         }
         if self.colours.len() < COLOURS {
@@ -244,7 +258,7 @@ impl ContactSolver {
             chunk: chunks.len() as u32 - 1,
         };
         let chunk = chunks.last_mut().expect("a chunk with a free lane");
-        chunk.push(lane, count);
+        chunk.push(lane, count, contact_index);
         place
     }
 
@@ -301,7 +315,7 @@ impl ContactSolver {
             for &i in items {
                 let lane = lane(i as usize);
                 let count = lane.point_count.min(MAX_MANIFOLD_POINTS);
-                chunk.push(&lane, count);
+                chunk.push(&lane, count, lane.contact_index);
             }
             chunk
         };
@@ -635,7 +649,7 @@ const SERIAL_CHUNKS: usize = 32;
 /// Contacts from which [`ContactSolver::push_all`] fills the chunks on
 /// threads (fewer are pushed in order on the caller: the lists and tasks
 /// cost more than the filling).
-const PARALLEL_PUSH: usize = 4096;
+pub const PARALLEL_PUSH: usize = 4096;
 
 /// Chunks per block for `chunks` chunks on `team`: about four blocks per
 /// thread (each claim is an atomic increment on a shared line), at least
@@ -972,9 +986,9 @@ impl WideContact {
         }
     }
 
-    /// Writes a contact into the next free lane
+    /// Writes contact `contact_index` into the next free lane
     /// ([`ContactRows::set_lane`]).
-    fn push(&mut self, lane: &ContactLane, count: usize) {
+    fn push(&mut self, lane: &ContactLane, count: usize, contact_index: u32) {
         let k = self.len;
         self.len += 1;
         self.state_a[k] = lane.state_a;
@@ -986,7 +1000,7 @@ impl WideContact {
         if lane.state_b != 0 && (m_b > 0.0 || i_b > 0.0) {
             self.moving |= 1 << (LANES + k);
         }
-        self.contact[k] = lane.contact_index;
+        self.contact[k] = contact_index;
         self.second.set_lane(k, if count > 1 { 1.0 } else { 0.0 });
         self.rows.set_lane(
             k,

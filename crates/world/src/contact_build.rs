@@ -18,7 +18,7 @@
 use janus2d_constraints::ObjectMass;
 use janus2d_constraints::contact_group::{Clusters, ContactBodies, NO_CLUSTER, light_pair};
 use janus2d_constraints::contact_solver::{
-    ContactLane, ContactSolver, LanePlace, OVERFLOW, PointImpulse,
+    ContactLane, ContactSolver, LanePlace, OVERFLOW, PARALLEL_PUSH, PointImpulse,
 };
 use janus2d_core::body::{BodyHandle, BodySet};
 use janus2d_core::graph::{ConstraintGraph, NO_BODY};
@@ -99,6 +99,25 @@ pub(crate) struct ContactBuilder {
     /// build).
     #[cfg_attr(feature = "serde", serde(skip))]
     excluded: Vec<u32>,
+    /// Last step had a light pair (its contacts went through the light
+    /// clusters): this step's build then pushes after the clusters are
+    /// known rather than during its first pass. Only where the work is
+    /// done depends on it, not the result.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    had_light: bool,
+}
+
+/// The colour of a solved contact: its colour in the persistent graph
+/// (kept from last step while its moving bodies stay the same), or the
+/// overflow for a portal copy's contact (it keeps its place in the graph).
+#[inline]
+fn colour_of(graph: &mut ConstraintGraph, s: &SolvedContact) -> u8 {
+    let colour = graph.keep(s.id, s.keys);
+    if s.copy {
+        OVERFLOW
+    } else {
+        colour.min(OVERFLOW)
+    }
 }
 
 impl ContactBuilder {
@@ -208,7 +227,28 @@ impl ContactBuilder {
         };
         // A portal copy: its contacts take the object-mass hook, in the overflow.
         let is_copy = |body: BodyHandle| objects.iter().any(|o| o.body == body);
-        // Pass 1: the solved contacts, in contact order (colours below).
+        // The joints' colours stay theirs: a contact takes none of them on
+        // a body a joint moves in it (the solve runs a colour's joints and
+        // contacts as one job).
+        let graph = &mut self.graph;
+        graph.set_reserved(reserved);
+        graph.begin_step();
+        let colours = &mut self.colours;
+        colours.clear();
+        let places = &mut self.places;
+        places.clear();
+        let (mut rows, mut bouncy, mut any_light) = (0, 0, false);
+        // A contact between a light body and a heavy one with neither body
+        // excluded: the light clusters are looked for below.
+        let light = |s: &SolvedContact| {
+            light_pair(s.moving, s.inv_mass)
+                && !excluded.contains(&s.state[0])
+                && !excluded.contains(&s.state[1])
+        };
+        // Pass 1: the solved contacts, in contact order, each given its
+        // colour from the persistent graph, keyed by the bodies' slots (a
+        // contact keeps last step's colour while its moving bodies stay the
+        // same; the contacts not solved this step leave it), and counted.
         solver.begin();
         let awake = contacts.awake();
         solved.clear();
@@ -241,6 +281,7 @@ impl ContactBuilder {
             && scanned == n
             && team.threads() > 1
             && handoff.touching.len() >= PARALLEL_BUILD;
+        let mut pushed = false;
         if parallel {
             let staged = &*staged;
             // Written in place: each block of `solved` from its own
@@ -263,7 +304,23 @@ impl ContactBuilder {
             if solved.iter().any(|s| s.index == STILL) {
                 solved.retain(|s| s.index != STILL);
             }
+            for s in solved.iter() {
+                colours.push(colour_of(graph, s));
+                rows += 2 * usize::from(s.point_count);
+                bouncy += usize::from(s.bouncy);
+                any_light = any_light || light(s);
+            }
         } else {
+            // Serial: each contact is also pushed into its colour's chunk
+            // here, while its staged record is in cache (read once, not
+            // again by `push_all` below), unless a light pair could put it
+            // in a cluster (then all go through `push_all` after the
+            // clusters are known). Last step's clusters predict this
+            // step's; a light pair met while pushing starts the push over.
+            // The chunks are those `push_all` fills on one thread, in the
+            // same order.
+            let mut fused =
+                !self.had_light && (team.threads() == 1 || handoff.touching.len() < PARALLEL_PUSH);
             for k in candidates {
                 let record = &staged[k];
                 let [sa, sb] = record.still;
@@ -307,43 +364,28 @@ impl ContactBuilder {
                     view.apply_to(&mut staged[k].lane);
                 }
                 let record = &staged[k];
-                solved.push(entry(k, record));
+                let s = entry(k, record);
+                let colour = colour_of(graph, &s);
+                colours.push(colour);
+                rows += 2 * usize::from(s.point_count);
+                bouncy += usize::from(s.bouncy);
+                if !any_light && light(&s) {
+                    any_light = true;
+                    if fused {
+                        fused = false;
+                        solver.begin();
+                        places.clear();
+                    }
+                }
+                if fused {
+                    places.push(solver.push_with(colour, &record.lane, s.index, s.cluster));
+                }
+                solved.push(s);
             }
-        }
-        // One pass over the solved contacts: colours from the persistent
-        // graph, keyed by the bodies' slots (a contact keeps last step's colour
-        // while its moving bodies stay the same; the contacts not solved this
-        // step leave it), the counters, and whether any moving pair is light
-        // beside the other with neither body excluded (then the light clusters
-        // are looked for below). (Three passes over `solved` before: on
-        // many_pyramids at 2 threads they were most of the leader's serial
-        // build time.)
-        let graph = &mut self.graph;
-        // The joints' colours stay theirs: a contact takes none of them on
-        // a body a joint moves in it (the solve runs a colour's joints and
-        // contacts as one job).
-        graph.set_reserved(reserved);
-        graph.begin_step();
-        let colours = &mut self.colours;
-        colours.clear();
-        let (mut rows, mut bouncy, mut any_light) = (0, 0, false);
-        for s in solved.iter() {
-            let colour = graph.keep(s.id, s.keys);
-            // A portal copy's contacts are solved in the overflow (they keep
-            // their place in the graph).
-            colours.push(if s.copy {
-                OVERFLOW
-            } else {
-                colour.min(OVERFLOW)
-            });
-            rows += 2 * usize::from(s.point_count);
-            bouncy += usize::from(s.bouncy);
-            any_light = any_light
-                || (light_pair(s.moving, s.inv_mass)
-                    && !excluded.contains(&s.state[0])
-                    && !excluded.contains(&s.state[1]));
+            pushed = fused;
         }
         graph.sweep();
+        self.had_light = any_light;
         // Light clusters (`contact_group`): their contacts go to the overflow
         // this step (keeping their place in the graph), where the solver takes
         // each cluster's contacts as one block.
@@ -375,22 +417,24 @@ impl ContactBuilder {
                 }
             }
         }
-        // Pass 2: each contact into its colour, in contact order.
+        // Pass 2 (unless pass 1 pushed them): each contact into its colour,
+        // in contact order.
         let (solved, staged) = (&*solved, &*staged);
-        let places = &mut self.places;
-        solver.push_all(
-            colours,
-            |i| {
-                let s = &solved[i];
-                ContactLane {
-                    contact_index: s.index,
-                    cluster: s.cluster,
-                    ..staged[s.index as usize].lane
-                }
-            },
-            places,
-            team,
-        );
+        if !pushed {
+            solver.push_all(
+                colours,
+                |i| {
+                    let s = &solved[i];
+                    ContactLane {
+                        contact_index: s.index,
+                        cluster: s.cluster,
+                        ..staged[s.index as usize].lane
+                    }
+                },
+                places,
+                team,
+            );
+        }
         // By contact, for storing the impulses on the threads (one thread
         // stores by the solver's order and needs none of it).
         let place_of = &mut self.place_of;
