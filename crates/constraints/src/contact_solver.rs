@@ -262,16 +262,26 @@ impl ContactSolver {
         place
     }
 
-    /// [`ContactSolver::push`] for many contacts at once: contact `i` goes
-    /// into colour `colours[i]` with the lane data `lane(i)`, and its place
-    /// into `places[i]`. The result is the one of pushing them in order;
-    /// with the `parallel` feature and more than one thread the chunks are
-    /// filled in blocks on `team` (each chunk from its own contacts, so
-    /// the order within a colour is kept).
-    pub fn push_all<F>(&mut self, colours: &[u8], lane: F, places: &mut Vec<LanePlace>, team: &Team)
-    where
-        F: Fn(usize) -> ContactLane + Sync,
+    /// [`ContactSolver::push_with`] for many contacts at once: contact `i`
+    /// goes into colour `colours[i]` with the lane data, index and
+    /// clusters `lane(i)`, and its place into `places[i]`. The result is
+    /// the one of pushing them in order; with the `parallel` feature and
+    /// more than one thread the chunks are filled in blocks on `team`
+    /// (each chunk from its own contacts, so the order within a colour is
+    /// kept).
+    pub fn push_all<'l, F>(
+        &mut self,
+        colours: &[u8],
+        lane: F,
+        places: &mut Vec<LanePlace>,
+        team: &Team,
+    ) where
+        F: Fn(usize) -> (&'l ContactLane, u32, [u32; 2]) + Sync,
     {
+        let push = |solver: &mut Self, colour: u8, i: usize| {
+            let (lane, index, cluster) = lane(i);
+            solver.push_with(colour, lane, index, cluster)
+        };
         places.clear();
         if self.colours.len() < COLOURS {
             self.colours.resize_with(COLOURS, Vec::new);
@@ -284,7 +294,7 @@ impl ContactSolver {
         if serial || self.colours.iter().any(|c| !c.is_empty()) {
             // Open chunks: keep push's order exactly.
             for (i, &colour) in colours.iter().enumerate() {
-                places.push(self.push(colour, &lane(i)));
+                places.push(push(self, colour, i));
             }
             return;
         }
@@ -295,7 +305,7 @@ impl ContactSolver {
         }
         for (i, &colour) in colours.iter().enumerate() {
             if colour >= OVERFLOW {
-                places.push(self.push(colour, &lane(i)));
+                places.push(push(self, colour, i));
             } else {
                 // The j-th contact of a colour goes to chunk j / LANES.
                 let list = &mut lists[colour as usize];
@@ -313,9 +323,9 @@ impl ContactSolver {
         let build = |items: &[u32]| {
             let mut chunk = WideContact::empty();
             for &i in items {
-                let lane = lane(i as usize);
+                let (lane, index, _) = lane(i as usize);
                 let count = lane.point_count.min(MAX_MANIFOLD_POINTS);
-                chunk.push(&lane, count, lane.contact_index);
+                chunk.push(lane, count, index);
             }
             chunk
         };

@@ -18,7 +18,7 @@
 use janus2d_constraints::ObjectMass;
 use janus2d_constraints::contact_group::{Clusters, ContactBodies, NO_CLUSTER, light_pair};
 use janus2d_constraints::contact_solver::{
-    ContactLane, ContactSolver, LanePlace, OVERFLOW, PARALLEL_PUSH, PointImpulse,
+    ContactSolver, LanePlace, OVERFLOW, PARALLEL_PUSH, PointImpulse,
 };
 use janus2d_core::body::{BodyHandle, BodySet};
 use janus2d_core::graph::{ConstraintGraph, NO_BODY};
@@ -425,11 +425,7 @@ impl ContactBuilder {
                 colours,
                 |i| {
                     let s = &solved[i];
-                    ContactLane {
-                        contact_index: s.index,
-                        cluster: s.cluster,
-                        ..staged[s.index as usize].lane
-                    }
+                    (&staged[s.index as usize].lane, s.index, s.cluster)
                 },
                 places,
                 team,
