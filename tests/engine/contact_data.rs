@@ -283,3 +283,41 @@ fn destroying_a_touching_shape_reports_its_contact_end_at_the_next_step() {
     assert_eq!(ended(&w, g_shape, s), 1);
     assert_eq!(w.body_contacts(b).unwrap().count(), 0);
 }
+
+/// A box 5 cm above the ground (beyond the 2 cm speculative distance),
+/// no gravity, moving at `velocity` for one step: the number of touching
+/// contacts after it and the box's height.
+fn box_above_ground_after_a_step(velocity: Vec2) -> (usize, Real) {
+    let mut world = World::new(WorldDef {
+        gravity: Vec2::ZERO,
+        ..WorldDef::default()
+    })
+    .unwrap();
+    ground(&mut world, 0.0);
+    let b = world
+        .create_body(&BodyDef::dynamic(Vec2::new(0.0, 0.55)).with_velocity(velocity))
+        .unwrap();
+    world
+        .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+        .unwrap();
+    world.step(DT).unwrap();
+    (world.touching_contact_count(), world.position(b).unwrap().y)
+}
+
+#[test]
+fn speculative_points_come_only_where_the_bodies_can_close_the_gap() {
+    // Sliding along the ground at 12 m/s: the pair's reach within the step
+    // (2 cm + 12 m/s × 1/60 s = 22 cm) covers the 5 cm gap, but nothing
+    // closes it, so no point is kept and nothing touches.
+    let (touching, y) = box_above_ground_after_a_step(Vec2::new(12.0, 0.0));
+    assert_eq!(touching, 0, "a box sliding past the ground touches it");
+    assert!((y - 0.55).abs() < 1e-6, "the sliding box moved to y = {y}");
+    // Falling at 6 m/s (10 cm a step) it closes the gap: the point is kept
+    // and the box stops on the ground instead of passing into it.
+    let (touching, y) = box_above_ground_after_a_step(Vec2::new(0.0, -6.0));
+    assert_eq!(touching, 1, "a box falling onto the ground has no contact");
+    assert!(
+        y > 0.5 - 0.005,
+        "the falling box went into the ground to y = {y}"
+    );
+}
