@@ -4,12 +4,17 @@
 //! ```text
 //! narrowphase ──Handoff { touching, scanned, staged lanes }──▶ build
 //!   pass 1   the contacts the solve takes (pre-solve hook, still bodies,
-//!            portal copies), their graph keys and light-pair flags
-//!   colours  each keeps its colour in the persistent ConstraintGraph
+//!            portal copies), their graph keys and light-pair flags;
+//!            each keeps its colour in the persistent ConstraintGraph
 //!   clusters light bodies under heavy ones (contact_group)
 //!   push     lanes into the ContactSolver's colour chunks, the rest to
 //!            its overflow; places kept for storing the impulses back
 //! ```
+//!
+//! On one thread (or below `PARALLEL_PUSH` contacts) with no light pair
+//! last step, pass 1 also pushes each contact as it goes, while its staged
+//! lane is in cache; the chunks are those the push would fill, in the same
+//! order.
 //!
 //! The builder owns what lives from step to step on the solver side: the
 //! graph (kept in snapshots: a step continues from its colours), the
