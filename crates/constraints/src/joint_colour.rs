@@ -76,6 +76,9 @@ use crate::joint::Joint;
 use crate::joint_base::is_moving;
 use crate::parts::{PairOf, WRITE_A, WRITE_B};
 
+/// How many joints ahead a colour's solve asks for the joint record.
+const JOINTS_AHEAD: usize = 2;
+
 /// No position: a joint that is not solved (disabled or resting).
 const NONE: u32 = u32::MAX;
 
@@ -465,6 +468,14 @@ impl JointColours {
             return;
         };
         for p in start as usize..end as usize {
+            // The joint a few places on: colour order is not storage order.
+            if let Some(j) = self
+                .order
+                .get(p + JOINTS_AHEAD)
+                .and_then(|&ahead| joints.get(ahead as usize))
+            {
+                janus2d_core::hint::prefetch(j);
+            }
             let j = &mut joints[self.order[p] as usize];
             let mut pair = PairOf::new(states, j.base().state_a, j.base().state_b, self.writes[p]);
             j.solve_pair(ctx, &mut pair, use_bias);
