@@ -262,6 +262,15 @@ impl ContactSolver {
         place
     }
 
+    /// Whether [`ContactSolver::push_all`] fills the chunks of `count`
+    /// contacts in contact order on the caller (one thread, or fewer than
+    /// `PARALLEL_PUSH`), as pushing them one by one with
+    /// [`ContactSolver::push_with`] does.
+    #[must_use]
+    pub fn pushes_in_order(count: usize, team: &Team) -> bool {
+        team.threads() == 1 || count < PARALLEL_PUSH
+    }
+
     /// [`ContactSolver::push_with`] for many contacts at once: contact `i`
     /// goes into colour `colours[i]` with the lane data, index and
     /// clusters `lane(i)`, and its place into `places[i]`. The result is
@@ -290,8 +299,8 @@ impl ContactSolver {
         // are then read in order and the open chunks (one per colour) stay
         // in cache; the per-colour lists below read the contacts out of
         // order, which only pays when threads share the filling.
-        let serial = team.threads() == 1 || colours.len() < PARALLEL_PUSH;
-        if serial || self.colours.iter().any(|c| !c.is_empty()) {
+        if Self::pushes_in_order(colours.len(), team) || self.colours.iter().any(|c| !c.is_empty())
+        {
             // Open chunks: keep push's order exactly.
             for (i, &colour) in colours.iter().enumerate() {
                 places.push(push(self, colour, i));
@@ -659,7 +668,7 @@ const SERIAL_CHUNKS: usize = 32;
 /// Contacts from which [`ContactSolver::push_all`] fills the chunks on
 /// threads (fewer are pushed in order on the caller: the lists and tasks
 /// cost more than the filling).
-pub const PARALLEL_PUSH: usize = 4096;
+const PARALLEL_PUSH: usize = 4096;
 
 /// Chunks per block for `chunks` chunks on `team`: about four blocks per
 /// thread (each claim is an atomic increment on a shared line), at least

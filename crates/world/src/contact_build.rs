@@ -11,7 +11,8 @@
 //!            its overflow; places kept for storing the impulses back
 //! ```
 //!
-//! On one thread (or below `PARALLEL_PUSH` contacts) with no light pair
+//! Where the solver pushes in contact order
+//! (`ContactSolver::pushes_in_order`) and there was no light pair
 //! last step, pass 1 also pushes each contact as it goes, while its staged
 //! lane is in cache; the chunks are those the push would fill, in the same
 //! order.
@@ -22,9 +23,7 @@
 
 use janus2d_constraints::ObjectMass;
 use janus2d_constraints::contact_group::{Clusters, ContactBodies, NO_CLUSTER, light_pair};
-use janus2d_constraints::contact_solver::{
-    ContactSolver, LanePlace, OVERFLOW, PARALLEL_PUSH, PointImpulse,
-};
+use janus2d_constraints::contact_solver::{ContactSolver, LanePlace, OVERFLOW, PointImpulse};
 use janus2d_core::body::{BodyHandle, BodySet};
 use janus2d_core::graph::{ConstraintGraph, NO_BODY};
 use janus2d_core::math::{Real, Vec2};
@@ -243,12 +242,21 @@ impl ContactBuilder {
         let places = &mut self.places;
         places.clear();
         let (mut rows, mut bouncy, mut any_light) = (0, 0, false);
-        // A contact between a light body and a heavy one with neither body
-        // excluded: the light clusters are looked for below.
-        let light = |s: &SolvedContact| {
-            light_pair(s.moving, s.inv_mass)
+        // Each solved contact once: its colour (pushed to `colours` and
+        // returned), the counters, and whether it is the first contact
+        // between a light body and a heavy one with neither body excluded
+        // (then the light clusters are looked for below).
+        let mut take = |s: &SolvedContact| -> (u8, bool) {
+            let colour = colour_of(graph, s);
+            colours.push(colour);
+            rows += 2 * usize::from(s.point_count);
+            bouncy += usize::from(s.bouncy);
+            let first_light = !any_light
+                && light_pair(s.moving, s.inv_mass)
                 && !excluded.contains(&s.state[0])
-                && !excluded.contains(&s.state[1])
+                && !excluded.contains(&s.state[1]);
+            any_light |= first_light;
+            (colour, first_light)
         };
         // Pass 1: the solved contacts, in contact order, each given its
         // colour from the persistent graph, keyed by the bodies' slots (a
@@ -310,10 +318,7 @@ impl ContactBuilder {
                 solved.retain(|s| s.index != STILL);
             }
             for s in solved.iter() {
-                colours.push(colour_of(graph, s));
-                rows += 2 * usize::from(s.point_count);
-                bouncy += usize::from(s.bouncy);
-                any_light = any_light || light(s);
+                take(s);
             }
         } else {
             // Serial: each contact is also pushed into its colour's chunk
@@ -324,8 +329,8 @@ impl ContactBuilder {
             // step's; a light pair met while pushing starts the push over.
             // The chunks are those `push_all` fills on one thread, in the
             // same order.
-            let mut fused =
-                !self.had_light && (team.threads() == 1 || handoff.touching.len() < PARALLEL_PUSH);
+            let mut fused = !self.had_light
+                && ContactSolver::pushes_in_order(handoff.touching.len() + (n - scanned), team);
             for k in candidates {
                 let record = &staged[k];
                 let [sa, sb] = record.still;
@@ -370,17 +375,11 @@ impl ContactBuilder {
                 }
                 let record = &staged[k];
                 let s = entry(k, record);
-                let colour = colour_of(graph, &s);
-                colours.push(colour);
-                rows += 2 * usize::from(s.point_count);
-                bouncy += usize::from(s.bouncy);
-                if !any_light && light(&s) {
-                    any_light = true;
-                    if fused {
-                        fused = false;
-                        solver.begin();
-                        places.clear();
-                    }
+                let (colour, first_light) = take(&s);
+                if first_light && fused {
+                    fused = false;
+                    solver.begin();
+                    places.clear();
                 }
                 if fused {
                     places.push(solver.push_with(colour, &record.lane, s.index, s.cluster));

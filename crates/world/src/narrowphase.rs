@@ -473,9 +473,9 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
     }
     // (A recycled manifold needs no speculative distance, nor the bodies'
     // velocities: their states are read only here.)
-    let approach = (body_b.state.v - body_a.state.v).length()
-        + body_a.state.w.abs() * reach_a
-        + body_b.state.w.abs() * reach_b;
+    // How fast a turn of either body sweeps its shape's reach.
+    let turn_speed = body_a.state.w.abs() * reach_a + body_b.state.w.abs() * reach_b;
+    let approach = (body_b.state.v - body_a.state.v).length() + turn_speed;
     let speculative = SPECULATIVE_DISTANCE + input.dt * approach;
     // The tight boxes (of the current poses) apart by more than the
     // speculative distance along x or y: the shapes are too, no point can
@@ -521,7 +521,7 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
             (body_a.state.v, body_a.state.w),
             (body_b.state.v, body_b.state.w),
         ],
-        body_a.state.w.abs() * reach_a + body_b.state.w.abs() * reach_b,
+        turn_speed,
         input.dt,
     );
     let was_touching = c.touching;
