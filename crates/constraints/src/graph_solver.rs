@@ -201,9 +201,9 @@ impl ConstraintBatch for GraphBatch<'_> {
     }
     fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
         self.contacts.prepare_on(ctx, bodies, team);
-        self.joints.prepare_rows_on(ctx, bodies, team);
+        self.joints.prepare_on(ctx, bodies, team);
         let (colours, contacts) = (&mut *self.joints.colours, &*self.contacts.solver);
-        colours.update_beside(self.joints.joints, &bodies.states, contacts, team);
+        colours.check_beside(self.joints.joints, &bodies.states, contacts, team);
     }
     fn warm_start_on(&mut self, ctx: &StepContext, states: &mut [BodyState], team: &Team) {
         if self.joints.count() > 0 {

@@ -213,9 +213,18 @@ impl JointColours {
         self.recolour_if_changed(joints.len(), bodies.states.len());
     }
 
+    /// The buffer of this step's keys, one per joint, for a caller that
+    /// fills it with [`key`] in its own pass over the joints (the batch's
+    /// prepare does, while each joint is in cache) before
+    /// [`JointColours::recolour_if_changed`].
+    pub(crate) fn keys_for(&mut self, joint_count: usize) -> &mut [Key] {
+        self.keys.resize(joint_count, [0; 3]);
+        &mut self.keys
+    }
+
     /// Colours the joints again when this step's keys (in `keys`) or the
     /// state count differ from the last colouring's.
-    fn recolour_if_changed(&mut self, joint_count: usize, state_count: usize) {
+    pub(crate) fn recolour_if_changed(&mut self, joint_count: usize, state_count: usize) {
         if self.keys == self.built_keys
             && state_count == self.built_states
             && self.position.len() == joint_count
@@ -362,20 +371,19 @@ impl JointColours {
         });
     }
 
-    /// [`JointColours::update_on`] beside the colours of `contacts` (the
-    /// graph batch's prepare, after the contacts' own), then, on a team of
+    /// After the colours' update beside the colours of `contacts` (the
+    /// graph batch's prepare, after the contacts' own): on a team of
     /// several threads, the two plans checked against each other
-    /// ([`CrossPlan`]): the contacts took their colours around the joints'
+    /// ([`CrossPlan`]). The contacts took their colours around the joints'
     /// ([`JointColours::reserve`]), so a colour's joints and contacts can
     /// run as one job.
-    pub(crate) fn update_beside(
+    pub(crate) fn check_beside(
         &mut self,
         joints: &[Joint],
         states: &[BodyState],
         contacts: &ContactSolver,
         team: &Team,
     ) {
-        self.update_on(joints, states, team);
         if team.threads() > 1 && !joints.is_empty() && !contacts.is_empty() {
             self.cross.verify(&self.plan, contacts.plan(), states.len());
         }
@@ -571,7 +579,7 @@ impl JointColours {
 type Key = [u32; 3];
 
 #[inline]
-fn key(j: &Joint, states: &[BodyState]) -> Key {
+pub(crate) fn key(j: &Joint, states: &[BodyState]) -> Key {
     let base = j.base();
     key_at(j, base.state_a, base.state_b, states)
 }

@@ -3,7 +3,7 @@
 //!
 //! | stage          | what runs                                                   |
 //! |----------------|-------------------------------------------------------------|
-//! | prepare        | each enabled joint's rows (blocks on the team), then [`JointForest`] and [`JointColours`] |
+//! | prepare        | each enabled joint's rows, forest pair and colour key in one pass (blocks on the team), then [`JointForest`] and [`JointColours`] |
 //! | warm start     | [`JointColours`]: per moving body, its joints' shares in storage order |
 //! | solve, relax   | [`JointColours`]: the Gauss–Seidel rows colour by colour     |
 //! | late solve     | [`JointForest`]: the point rows of joint trees, exactly      |
@@ -14,8 +14,8 @@ use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
 use janus2d_core::parallel::Team;
 
 use crate::joint::Joint;
-use crate::joint_colour::JointColours;
-use crate::joint_tree::{JointForest, TreePolicy};
+use crate::joint_colour::{JointColours, key};
+use crate::joint_tree::{JointForest, TreePolicy, moving_pair};
 
 /// Rows of the joint prepare's blocks on the team.
 const PREPARE_BLOCK: usize = 256;
@@ -32,26 +32,47 @@ pub struct JointBatch<'a> {
 }
 
 impl JointBatch<'_> {
-    /// The prepare without the colouring: each joint's rows, then the
-    /// forest from the prepared joints (the same as `JointForest::prepare`).
-    /// Each joint's prepare reads the bodies and writes only itself: blocks
-    /// of joints on the team.
-    pub(crate) fn prepare_rows_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
-        team.for_each_chunk_mut(self.joints, PREPARE_BLOCK, |_, block| {
-            for i in 0..block.len() {
-                // The definition a few joints on, boxed apart: its miss
-                // overlaps this joint's prepare (docs/performance.md).
-                if let Some(ahead) = block.get(i + PREFETCH_AHEAD) {
-                    janus2d_core::hint::prefetch(ahead.def_base());
+    /// Each joint's rows, its pair of moving ends for the forest and its
+    /// colour key, in one pass over the joints while each is in cache
+    /// (blocks on the team: a joint's prepare reads the bodies and writes
+    /// only itself); then the forest and the colours from those.
+    fn prepare_all_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
+        let states = &bodies.states;
+        let count = self.joints.len();
+        let pairs = self.forest.pairs_for(count);
+        let keys = self.colours.keys_for(count);
+        team.for_each_chunk_triple_mut_beside(
+            self.joints,
+            pairs,
+            keys,
+            PREPARE_BLOCK,
+            |_, block, pairs, keys| {
+                for i in 0..block.len() {
+                    // The definition a few joints on, boxed apart: its miss
+                    // overlaps this joint's prepare (docs/performance.md).
+                    if let Some(ahead) = block.get(i + PREFETCH_AHEAD) {
+                        janus2d_core::hint::prefetch(ahead.def_base());
+                    }
+                    let j = &mut block[i];
+                    if j.is_enabled() {
+                        j.prepare(ctx, bodies);
+                    }
+                    pairs[i] = moving_pair(j, states);
+                    keys[i] = key(j, states);
                 }
-                let j = &mut block[i];
-                if j.is_enabled() {
-                    j.prepare(ctx, bodies);
-                }
-            }
-        });
-        self.forest
-            .build_on(self.joints, &bodies.states, TreePolicy::of(ctx), team);
+            },
+            || {},
+        );
+        if self
+            .forest
+            .update(self.joints, states.len(), TreePolicy::of(ctx))
+        {
+            // The rebuild moved joints into or out of trees, which decides
+            // whether they have Gauss–Seidel rows: their keys again.
+            self.colours.update_on(self.joints, states, team);
+        } else {
+            self.colours.recolour_if_changed(count, states.len());
+        }
     }
 }
 
@@ -87,8 +108,7 @@ impl ConstraintBatch for JointBatch<'_> {
         // Joints keep their impulses in place.
     }
     fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
-        self.prepare_rows_on(ctx, bodies, team);
-        self.colours.update_on(self.joints, &bodies.states, team);
+        self.prepare_all_on(ctx, bodies, team);
     }
     fn warm_start_on(&mut self, _ctx: &StepContext, states: &mut [BodyState], team: &Team) {
         self.colours.warm_start(self.joints, states, team);

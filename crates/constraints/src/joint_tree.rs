@@ -711,7 +711,7 @@ pub struct JointForest {
 /// `in_tree` flag, so that a joint created since the last build (flag
 /// unset) forces a rebuild even where the ends repeat.
 #[inline]
-fn moving_pair(j: &Joint, states: &[BodyState]) -> [u32; 3] {
+pub(crate) fn moving_pair(j: &Joint, states: &[BodyState]) -> [u32; 3] {
     let base = j.base();
     let flags = u32::from(base.in_tree)
         | if j.tree_rows().is_some() {
@@ -875,15 +875,23 @@ impl JointForest {
         team: &Team,
     ) {
         const BLOCK: usize = 1024;
-        self.pairs.resize(joints.len(), [0; 3]);
         let read = &*joints;
-        team.for_each_chunk_mut(&mut self.pairs, BLOCK, |i, block| {
+        team.for_each_chunk_mut(self.pairs_for(read.len()), BLOCK, |i, block| {
             let first = i * BLOCK;
             for (pair, j) in block.iter_mut().zip(&read[first..]) {
                 *pair = moving_pair(j, states);
             }
         });
         self.update(joints, states.len(), policy);
+    }
+
+    /// The buffer of this step's pairs, one per joint, for a caller that
+    /// fills it with [`moving_pair`] in its own pass over the joints (the
+    /// batch's prepare does, while each joint is in cache) before
+    /// [`JointForest::update`].
+    pub(crate) fn pairs_for(&mut self, joint_count: usize) -> &mut [[u32; 3]] {
+        self.pairs.resize(joint_count, [0; 3]);
+        &mut self.pairs
     }
 
     /// Prepares every enabled joint and finds the forest in the same pass
@@ -902,9 +910,11 @@ impl JointForest {
     /// Rebuilds the forest when the joints' moving ends changed since the
     /// last build (joints created, destroyed, enabled or disabled, bodies
     /// woken, put to sleep or re-indexed); otherwise keeps it.
-    fn update(&mut self, joints: &mut [Joint], n: usize, policy: TreePolicy) {
+    /// Whether it rebuilt: a rebuild may move joints into or out of trees
+    /// (`in_tree`), which decides whether they keep Gauss–Seidel rows.
+    pub(crate) fn update(&mut self, joints: &mut [Joint], n: usize, policy: TreePolicy) -> bool {
         if Some(policy) == self.built_policy && self.pairs == self.built_pairs {
-            return;
+            return false;
         }
         self.rebuild(joints, n, policy);
         self.built_policy = Some(policy);
@@ -912,6 +922,7 @@ impl JointForest {
         for (pair, j) in self.built_pairs.iter_mut().zip(joints.iter()) {
             pair[2] = (pair[2] & !IN_TREE) | u32::from(j.in_tree());
         }
+        true
     }
 
     fn rebuild(&mut self, joints: &mut [Joint], n: usize, policy: TreePolicy) {
