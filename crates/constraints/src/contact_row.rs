@@ -414,6 +414,44 @@ impl<L: Lane> ContactRows<L> {
             self.impulse[i].set_lane(k, p.normal_impulse);
             self.impulse[i + 2].set_lane(k, p.tangent_impulse);
         }
+        // A one-point manifold's second point as in an empty chunk (a
+        // reused chunk holds an earlier lane's there).
+        for i in points.len().min(MAX_MANIFOLD_POINTS)..MAX_MANIFOLD_POINTS {
+            self.clear_point(k, i);
+        }
+    }
+
+    /// Point `i` of lane `k`'s inputs zero: its Jacobians, kept impulses
+    /// and separation.
+    #[inline(always)]
+    fn clear_point(&mut self, k: usize, i: usize) {
+        for row in [i, i + 2] {
+            self.ja[row].set_lane(k, 0.0);
+            self.jb[row].set_lane(k, 0.0);
+            self.impulse[row].set_lane(k, 0.0);
+        }
+        self.base_separation[i].set_lane(k, 0.0);
+    }
+
+    /// Lane `k` as in [`ContactRows::empty`]: every input
+    /// [`ContactRows::set_lane`] writes zero (the prepare computes the
+    /// other rows from them).
+    pub(crate) fn clear_lane(&mut self, k: usize) {
+        for field in [
+            &mut self.n_x,
+            &mut self.n_y,
+            &mut self.inv_mass_a,
+            &mut self.inv_inertia_a,
+            &mut self.inv_mass_b,
+            &mut self.inv_inertia_b,
+            &mut self.friction,
+            &mut self.restitution,
+        ] {
+            field.set_lane(k, 0.0);
+        }
+        for i in 0..MAX_MANIFOLD_POINTS {
+            self.clear_point(k, i);
+        }
     }
 
     /// Effective masses, the 2×2 normal block and its condition test, the

@@ -112,6 +112,70 @@ pub(crate) struct WideContact {
     rows: ContactRows<W>,
 }
 
+/// A colour's chunks: the first `used` are this step's, the rest were an
+/// earlier step's and wait to be reused. A chunk is over a kilobyte, and
+/// writing a new one whole (zeroed, then moved into place) was a tenth of
+/// the contact hand-off; a reused chunk has its header reset
+/// ([`WideContact::reopen`]), its lanes overwritten as contacts are pushed
+/// and the free lanes of a colour's last chunk cleared before the prepare
+/// ([`Chunks::seal`]), which leaves it as a new chunk would be.
+#[derive(Clone, Debug, Default)]
+struct Chunks {
+    all: Vec<WideContact>,
+    used: usize,
+}
+
+impl std::ops::Deref for Chunks {
+    type Target = [WideContact];
+    fn deref(&self) -> &[WideContact] {
+        &self.all[..self.used]
+    }
+}
+
+impl std::ops::DerefMut for Chunks {
+    fn deref_mut(&mut self) -> &mut [WideContact] {
+        &mut self.all[..self.used]
+    }
+}
+
+impl Chunks {
+    /// No chunk in use (their memory kept).
+    fn clear(&mut self) {
+        self.used = 0;
+    }
+
+    /// One more chunk in use, with no lane: a kept one reopened, or a new
+    /// one.
+    fn open(&mut self) {
+        match self.all.get_mut(self.used) {
+            Some(kept) => kept.reopen(),
+            None => self.all.push(WideContact::empty()),
+        }
+        self.used += 1;
+        // The colour's next kept chunk, written over the next pushes.
+        if let Some(next) = self.all.get(self.used) {
+            janus2d_core::hint::prefetch_all(next);
+        }
+    }
+
+    /// The free lanes of the last chunk in use cleared (a reused chunk
+    /// holds an earlier step's lanes there): call once the pushes are
+    /// done.
+    fn seal(&mut self) {
+        if let Some(last) = self.last_mut() {
+            last.clear_free_lanes();
+        }
+    }
+
+    /// The chunks made anew by `fill`, which appends them to the (emptied)
+    /// list: the parallel push builds each chunk where it stays.
+    fn extend_fresh(&mut self, fill: impl FnOnce(&mut Vec<WideContact>)) {
+        self.all.truncate(self.used);
+        fill(&mut self.all);
+        self.used = self.all.len();
+    }
+}
+
 pub use crate::contact_row::PointImpulse;
 pub use janus2d_core::contact_input::ContactLane;
 
@@ -140,7 +204,7 @@ pub struct LanePlace {
 #[derive(Clone, Debug, Default)]
 pub struct ContactSolver {
     /// Chunks per colour; the last chunk of a colour may have free lanes.
-    colours: Vec<Vec<WideContact>>,
+    colours: Vec<Chunks>,
     /// Contacts solved one by one (or in the coupled groups of light
     /// clusters, see [`crate::contact_group`]).
     overflow: Vec<ContactConstraint>,
@@ -196,7 +260,7 @@ impl ContactSolver {
     /// Drops every contact (the colours come from the caller's
     /// [`ConstraintGraph`](janus2d_core::graph::ConstraintGraph)).
     pub fn begin(&mut self) {
-        self.colours.resize_with(COLOURS, Vec::new);
+        self.colours.resize_with(COLOURS, Chunks::default);
         for chunks in &mut self.colours {
             chunks.clear();
         }
@@ -246,18 +310,19 @@ impl ContactSolver {
             return place;
         }
         if self.colours.len() < COLOURS {
-            self.colours.resize_with(COLOURS, Vec::new);
+            self.colours.resize_with(COLOURS, Chunks::default);
         }
         let chunks = &mut self.colours[colour as usize];
         if chunks.last().is_none_or(|c| c.len == LANES) {
-            chunks.push(WideContact::empty());
+            chunks.open();
         }
+        let index = chunks.len() - 1;
+        let chunk = &mut chunks[index];
         let place = LanePlace {
             colour,
-            lane: chunks.last().map_or(0, |c| c.len as u8),
-            chunk: chunks.len() as u32 - 1,
+            lane: chunk.len as u8,
+            chunk: index as u32,
         };
-        let chunk = chunks.last_mut().expect("a chunk with a free lane");
         chunk.push(lane, count, contact_index);
         place
     }
@@ -293,7 +358,7 @@ impl ContactSolver {
         };
         places.clear();
         if self.colours.len() < COLOURS {
-            self.colours.resize_with(COLOURS, Vec::new);
+            self.colours.resize_with(COLOURS, Chunks::default);
         }
         // One thread (or open chunks): push in contact order. The contacts
         // are then read in order and the open chunks (one per colour) stay
@@ -346,12 +411,14 @@ impl ContactSolver {
                 // threads).
                 const CHUNKS: usize = 8;
                 let count = list.len().div_ceil(LANES);
-                team.extend_mapped(chunks, count, CHUNKS, |c| {
-                    build(&list[c * LANES..((c + 1) * LANES).min(list.len())])
+                chunks.extend_fresh(|all| {
+                    team.extend_mapped(all, count, CHUNKS, |c| {
+                        build(&list[c * LANES..((c + 1) * LANES).min(list.len())])
+                    });
                 });
                 continue;
             }
-            chunks.extend(list.chunks(LANES).map(build));
+            chunks.extend_fresh(|all| all.extend(list.chunks(LANES).map(build)));
         }
         self.len += lists.iter().map(Vec::len).sum::<usize>();
         self.lists = lists;
@@ -381,7 +448,7 @@ impl ContactSolver {
     /// every contact: the impulses to keep for the next step's warm start
     /// and the step's totals.
     pub fn for_each_impulse(&self, mut store: impl FnMut(u32, usize, PointImpulse)) {
-        for chunk in self.colours.iter().flatten() {
+        for chunk in self.colours.iter().flat_map(|chunks| chunks.iter()) {
             let impulse = chunk.rows.impulse.map(W::to_array);
             let base = chunk.rows.step_base.map(W::to_array);
             let second = chunk.second.to_array();
@@ -413,7 +480,7 @@ impl ContactSolver {
     /// that approached faster than `threshold` (m/s) before the solve and
     /// pushed (a positive normal impulse increment).
     pub fn for_each_approach(&self, threshold: Real, mut hit: impl FnMut(u32, usize, Real)) {
-        for chunk in self.colours.iter().flatten() {
+        for chunk in self.colours.iter().flat_map(|chunks| chunks.iter()) {
             let approach = chunk.rows.relative_velocity.map(W::to_array);
             let pushed = chunk.rows.max_normal_impulse.map(W::to_array);
             let second = chunk.second.to_array();
@@ -455,7 +522,7 @@ impl ContactSolver {
         out.clear();
         out.resize(state_count, 0);
         for (c, chunks) in self.colours.iter().enumerate() {
-            for chunk in chunks {
+            for chunk in chunks.iter() {
                 for k in 0..chunk.len {
                     for (side, states) in [&chunk.state_a, &chunk.state_b].into_iter().enumerate() {
                         let moving = chunk.moving & (1 << (side * LANES + k)) != 0;
@@ -508,7 +575,7 @@ impl ContactSolver {
     /// Whether colour `c` runs on the caller alone (short, or a serial
     /// team): see `colour_stage`.
     pub(crate) fn colour_is_short(&self, c: usize, team: &Team) -> bool {
-        let chunks = self.colours.get(c).map_or(0, Vec::len);
+        let chunks = self.colours.get(c).map_or(0, |chunks| chunks.len());
         team.threads() == 1 || chunks <= SERIAL_CHUNKS || c >= self.plan.group_count()
     }
 
@@ -521,6 +588,9 @@ impl ContactSolver {
     ) {
         let states = &bodies.states[..];
         for chunks in &mut self.colours {
+            chunks.seal();
+        }
+        for chunks in &mut self.colours {
             let per_block = block_len(team, chunks.len());
             team.for_each_chunk_mut(chunks, per_block, |_, block| {
                 for chunk in block {
@@ -532,7 +602,7 @@ impl ContactSolver {
         if team.threads() > 1 {
             for chunks in &self.colours {
                 self.plan.begin_group();
-                for chunk in chunks {
+                for chunk in chunks.iter() {
                     let mut slots = [0; PLAN_SLOTS];
                     slots[..LANES].copy_from_slice(&chunk.state_a);
                     slots[LANES..].copy_from_slice(&chunk.state_b);
@@ -1005,6 +1075,28 @@ impl WideContact {
         }
     }
 
+    /// A kept chunk made ready for this step's lanes: no lane in use, every
+    /// lane's header as in [`WideContact::empty`], no surface rows. The
+    /// rows' lanes are overwritten by [`WideContact::push`], or cleared by
+    /// [`WideContact::clear_free_lanes`].
+    fn reopen(&mut self) {
+        self.state_a = [0; LANES];
+        self.state_b = [0; LANES];
+        self.contact = [u32::MAX; LANES];
+        self.len = 0;
+        self.second = W::splat(0.0);
+        self.moving = 0;
+        self.rows.surface = None;
+    }
+
+    /// The lanes from `len` on as a new chunk's: every row input zero
+    /// (what the prepare computes the rest from).
+    fn clear_free_lanes(&mut self) {
+        for k in self.len..LANES {
+            self.rows.clear_lane(k);
+        }
+    }
+
     /// Writes contact `contact_index` into the next free lane
     /// ([`ContactRows::set_lane`]).
     fn push(&mut self, lane: &ContactLane, count: usize, contact_index: u32) {
@@ -1150,5 +1242,101 @@ impl ConstraintBatch for ContactBatch<'_> {
 
     fn apply_restitution_on(&mut self, ctx: &StepContext, states: &mut [BodyState], team: &Team) {
         self.solver.apply_restitution(ctx, states, team);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ContactPointInput;
+    use janus2d_core::body::BodyDef;
+    use janus2d_core::math::{Vec2, to_f64};
+    use janus2d_core::solver::SolverSettings;
+
+    /// Contact `i` between bodies `2i` and `2i + 1` of `set`, with
+    /// `points` points carrying `impulse` and, when `surface`, a tangent
+    /// speed and rolling resistance.
+    fn lane(set: &BodySet, i: usize, points: usize, impulse: Real, surface: bool) -> ContactLane {
+        let handle = |k: usize| set.handles().nth(k).unwrap();
+        let (a, b) = (handle(2 * i), handle(2 * i + 1));
+        let point = |y: Real| ContactPointInput {
+            anchor_a: Vec2::new(0.5, y),
+            anchor_b: Vec2::new(-0.5, y),
+            separation: -0.01 * (1 + i % 3) as Real,
+            normal_impulse: impulse,
+            tangent_impulse: 0.1 * impulse,
+        };
+        ContactLane {
+            body_a: a,
+            body_b: b,
+            state_a: set.state_index(a).unwrap(),
+            state_b: set.state_index(b).unwrap(),
+            inv_masses: [1.0, 2.0, 0.5, 1.5],
+            normal: Vec2::new(1.0, 0.1 * i as Real).normalize(),
+            points: [point(0.25), point(-0.25)],
+            point_count: points,
+            friction: 0.3 + 0.05 * i as Real,
+            restitution: 0.0,
+            tangent_speed: if surface { 0.7 } else { 0.0 },
+            rolling_resistance: if surface { 0.02 } else { 0.0 },
+            contact_index: i as u32,
+            cluster: [crate::contact_group::NO_CLUSTER; 2],
+        }
+    }
+
+    /// Pushes `lanes` into colour 0 of `solver` (after `begin`), runs a
+    /// substep's stages and returns the bits of every velocity and kept
+    /// impulse.
+    fn step(solver: &mut ContactSolver, set: &BodySet, lanes: &[ContactLane]) -> Vec<u64> {
+        solver.begin();
+        for l in lanes {
+            solver.push(0, l);
+        }
+        let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::new(0.0, -10.0));
+        let team = Team::serial();
+        solver.prepare(&ctx, set, &[], &team);
+        let mut states = set.states.clone();
+        solver.warm_start(&mut states, &team);
+        solver.solve(&ctx, &mut states, true, false, &team);
+        solver.solve(&ctx, &mut states, false, true, &team);
+        let mut bits: Vec<u64> = states
+            .iter()
+            .flat_map(|s| [s.v.x, s.v.y, s.w])
+            .map(|x| to_f64(x).to_bits())
+            .collect();
+        solver.for_each_impulse(|c, point, p| {
+            bits.push(u64::from(c) << 8 | point as u64);
+            for x in [p.normal, p.tangent, p.total_normal, p.total_tangent] {
+                bits.push(to_f64(x).to_bits());
+            }
+        });
+        bits
+    }
+
+    /// A chunk kept from an earlier step (two-point lanes with surface
+    /// rows, in more chunks than now) and reused for one-point lanes
+    /// solves exactly as a new chunk: its second points, free lanes and
+    /// surface rows hold nothing of the earlier lanes.
+    #[test]
+    fn a_reused_chunk_solves_as_a_new_one() {
+        let mut set = BodySet::new();
+        for k in 0..8 * LANES {
+            let def =
+                BodyDef::dynamic(Vec2::new(k as Real, 0.0)).with_angular_velocity(0.1 * k as Real);
+            set.create(&def).unwrap();
+        }
+        let earlier: Vec<_> = (0..3 * LANES)
+            .map(|i| lane(&set, i, 2, 5.0, true))
+            .collect();
+        let now: Vec<_> = (0..LANES + 3)
+            .map(|i| lane(&set, i, 1, 0.02, false))
+            .collect();
+        let mut reused = ContactSolver::new();
+        let first = step(&mut reused, &set, &earlier);
+        let again = step(&mut reused, &set, &now);
+        let fresh = step(&mut ContactSolver::new(), &set, &now);
+        assert_eq!(again, fresh);
+        // The earlier lanes did act (the test would notice stale rows).
+        assert_ne!(first[..3 * 8 * LANES], fresh[..3 * 8 * LANES]);
     }
 }
