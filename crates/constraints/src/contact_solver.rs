@@ -167,12 +167,32 @@ impl Chunks {
         }
     }
 
-    /// The chunks made anew by `fill`, which appends them to the (emptied)
-    /// list: the parallel push builds each chunk where it stays.
-    fn extend_fresh(&mut self, fill: impl FnOnce(&mut Vec<WideContact>)) {
-        self.all.truncate(self.used);
-        fill(&mut self.all);
-        self.used = self.all.len();
+    /// `count` chunks in use (after [`Chunks::clear`]), each reopened and
+    /// handed to `fill(c, chunk)` with its index, in blocks of `per_block`
+    /// chunks on `team` (the parallel push fills each chunk where it
+    /// stays).
+    fn fill_on(
+        &mut self,
+        count: usize,
+        per_block: usize,
+        team: &Team,
+        fill: impl Fn(usize, &mut WideContact) + Sync,
+    ) {
+        debug_assert_eq!(self.used, 0, "chunks filled after a clear");
+        if self.all.len() < count {
+            self.all.resize_with(count, WideContact::empty);
+        }
+        self.used = count;
+        team.for_each_chunk_mut(&mut self.all[..count], per_block, |b, block| {
+            for k in 0..block.len() {
+                if let Some(next) = block.get(k + 1) {
+                    janus2d_core::hint::prefetch_all(next);
+                }
+                let chunk = &mut block[k];
+                chunk.reopen();
+                fill(b * per_block + k, chunk);
+            }
+        });
     }
 }
 
@@ -391,34 +411,26 @@ impl ContactSolver {
                 list.push(i as u32);
             }
         }
-        // Each chunk is made and filled from its own contacts, so the
-        // chunks of a colour can be built at once (no serial zeroing of
-        // the chunks first).
-        let build = |items: &[u32]| {
-            let mut chunk = WideContact::empty();
-            for &i in items {
+        // Each chunk is filled from its own contacts, so the chunks of a
+        // colour can be filled at once.
+        let fill = |list: &[u32], c: usize, chunk: &mut WideContact| {
+            for &i in &list[c * LANES..((c + 1) * LANES).min(list.len())] {
                 let (lane, index, _) = lane(i as usize);
                 let count = lane.point_count.min(MAX_MANIFOLD_POINTS);
                 chunk.push(lane, count, index);
             }
-            chunk
         };
         for (chunks, list) in self.colours.iter_mut().zip(&lists) {
-            if list.len() > 16 * LANES {
-                // Blocks of 8 chunks on the team, each chunk made where it
-                // stays (a chunk is over a kilobyte: collecting blocks and
-                // copying them into place was most of this pass on two
-                // threads).
-                const CHUNKS: usize = 8;
-                let count = list.len().div_ceil(LANES);
-                chunks.extend_fresh(|all| {
-                    team.extend_mapped(all, count, CHUNKS, |c| {
-                        build(&list[c * LANES..((c + 1) * LANES).min(list.len())])
-                    });
-                });
-                continue;
-            }
-            chunks.extend_fresh(|all| all.extend(list.chunks(LANES).map(build)));
+            // Blocks of 8 chunks on the team where the colour is long.
+            const CHUNKS: usize = 8;
+            let on = if list.len() > 16 * LANES {
+                team
+            } else {
+                &Team::serial()
+            };
+            chunks.fill_on(list.len().div_ceil(LANES), CHUNKS, on, |c, chunk| {
+                fill(list, c, chunk);
+            });
         }
         self.len += lists.iter().map(Vec::len).sum::<usize>();
         self.lists = lists;
