@@ -243,6 +243,10 @@ pub struct ContactSolver {
     plan: StatePlan<PLAN_SLOTS>,
 }
 
+/// How many chunks on [`ContactSolver::for_each_impulse_into`] asks for
+/// the contacts it will write.
+const CHUNKS_AHEAD: usize = 1;
+
 /// The colour slot of the overflow (solved scalar, one contact at a time).
 pub const OVERFLOW: u8 = COLOURS as u8;
 
@@ -460,30 +464,52 @@ impl ContactSolver {
     /// every contact: the impulses to keep for the next step's warm start
     /// and the step's totals.
     pub fn for_each_impulse(&self, mut store: impl FnMut(u32, usize, PointImpulse)) {
-        for chunk in self.colours.iter().flat_map(|chunks| chunks.iter()) {
-            let impulse = chunk.rows.impulse.map(W::to_array);
-            let base = chunk.rows.step_base.map(W::to_array);
-            let second = chunk.second.to_array();
-            for k in 0..chunk.len {
-                let points = if second[k] > 0.0 { 2 } else { 1 };
-                for i in 0..points {
-                    let (n, t) = (impulse[i][k], impulse[i + 2][k]);
-                    store(
-                        chunk.contact[k],
-                        i,
-                        PointImpulse {
-                            normal: n,
-                            tangent: t,
-                            total_normal: base[i][k] + n,
-                            total_tangent: base[i + 2][k] + t,
-                        },
-                    );
+        self.for_each_impulse_into(&mut (), |_, _| {}, |_, c, point, p| store(c, point, p));
+    }
+
+    /// [`ContactSolver::for_each_impulse`] into `target`, with
+    /// `ahead(target, contact_index)` called for the contacts of the chunk
+    /// `CHUNKS_AHEAD` on before a chunk's impulses are stored (chunks are in colour
+    /// order, not contact order: the caller can ask for the lines it will
+    /// write next).
+    pub fn for_each_impulse_into<T>(
+        &self,
+        target: &mut T,
+        ahead: impl Fn(&T, u32),
+        mut store: impl FnMut(&mut T, u32, usize, PointImpulse),
+    ) {
+        for chunks in &self.colours {
+            for (j, chunk) in chunks.iter().enumerate() {
+                if let Some(next) = chunks.get(j + CHUNKS_AHEAD) {
+                    for &c in &next.contact[..next.len] {
+                        ahead(target, c);
+                    }
+                }
+                let impulse = chunk.rows.impulse.map(W::to_array);
+                let base = chunk.rows.step_base.map(W::to_array);
+                let second = chunk.second.to_array();
+                for k in 0..chunk.len {
+                    let points = if second[k] > 0.0 { 2 } else { 1 };
+                    for i in 0..points {
+                        let (n, t) = (impulse[i][k], impulse[i + 2][k]);
+                        store(
+                            target,
+                            chunk.contact[k],
+                            i,
+                            PointImpulse {
+                                normal: n,
+                                tangent: t,
+                                total_normal: base[i][k] + n,
+                                total_tangent: base[i + 2][k] + t,
+                            },
+                        );
+                    }
                 }
             }
         }
         for c in &self.overflow {
             for i in 0..c.point_count() {
-                store(c.contact_index, i, c.point_impulse(i));
+                store(target, c.contact_index, i, c.point_impulse(i));
             }
         }
     }

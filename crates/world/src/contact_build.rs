@@ -487,11 +487,19 @@ impl ContactBuilder {
             });
             return;
         }
-        solver.for_each_impulse(|index, point, impulse| {
-            keep(
-                &mut contacts.awake_mut(index as usize).points[point],
-                impulse,
-            );
-        });
+        solver.for_each_impulse_into(
+            contacts,
+            |contacts, index| {
+                if let Some(c) = contacts.awake().get(index as usize) {
+                    janus2d_core::hint::prefetch_all(&c.points);
+                }
+            },
+            |contacts, index, point, impulse| {
+                keep(
+                    &mut contacts.awake_mut(index as usize).points[point],
+                    impulse,
+                );
+            },
+        );
     }
 }
