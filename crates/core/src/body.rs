@@ -1785,6 +1785,19 @@ impl BodySet {
         self.solver_body(handle)
     }
 
+    /// Asks for the lines [`BodySet::solver_body_hinted`] reads for state
+    /// index `hint` (its sim and state), a few contacts before the
+    /// narrowphase reads them: a hint only, nothing is read or changed.
+    #[inline]
+    pub fn prefetch_hinted(&self, hint: u32) {
+        if let (Some(sim), Some(state)) =
+            (self.sims.get(hint as usize), self.states.get(hint as usize))
+        {
+            crate::hint::prefetch_all(sim);
+            crate::hint::prefetch(state);
+        }
+    }
+
     /// Handles of all live bodies in slot order (deterministic).
     pub fn handles(&self) -> impl Iterator<Item = BodyHandle> + '_ {
         self.records

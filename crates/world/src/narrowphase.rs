@@ -340,6 +340,10 @@ impl Narrowphase {
                         if let Some(ahead) = cs.get(i + SHAPES_AHEAD) {
                             input.shapes.prefetch(ahead.shape_a);
                             input.shapes.prefetch(ahead.shape_b);
+                            // Its bodies too, where last step found them.
+                            let [(hint_a, _), (hint_b, _)] = ahead.solve_bodies;
+                            input.bodies.prefetch_hinted(hint_a);
+                            input.bodies.prefetch_hinted(hint_b);
                         }
                         rs[i] = compute((&mut cs[i], &mut ss[i]));
                     }
