@@ -487,24 +487,16 @@ impl ContactSolver {
                 }
                 let impulse = chunk.rows.impulse.map(W::to_array);
                 let base = chunk.rows.step_base.map(W::to_array);
-                let second = chunk.second.to_array();
-                for k in 0..chunk.len {
-                    let points = if second[k] > 0.0 { 2 } else { 1 };
-                    for i in 0..points {
-                        let (n, t) = (impulse[i][k], impulse[i + 2][k]);
-                        store(
-                            target,
-                            chunk.contact[k],
-                            i,
-                            PointImpulse {
-                                normal: n,
-                                tangent: t,
-                                total_normal: base[i][k] + n,
-                                total_tangent: base[i + 2][k] + t,
-                            },
-                        );
-                    }
-                }
+                chunk.for_each_point(|k, i| {
+                    let (n, t) = (impulse[i][k], impulse[i + 2][k]);
+                    let p = PointImpulse {
+                        normal: n,
+                        tangent: t,
+                        total_normal: base[i][k] + n,
+                        total_tangent: base[i + 2][k] + t,
+                    };
+                    store(target, chunk.contact[k], i, p);
+                });
             }
         }
         for c in &self.overflow {
@@ -521,16 +513,12 @@ impl ContactSolver {
         for chunk in self.colours.iter().flat_map(|chunks| chunks.iter()) {
             let approach = chunk.rows.relative_velocity.map(W::to_array);
             let pushed = chunk.rows.max_normal_impulse.map(W::to_array);
-            let second = chunk.second.to_array();
-            for k in 0..chunk.len {
-                let points = if second[k] > 0.0 { 2 } else { 1 };
-                for i in 0..points {
-                    let speed = -approach[i][k];
-                    if speed > threshold && pushed[i][k] > 0.0 {
-                        hit(chunk.contact[k], i, speed);
-                    }
+            chunk.for_each_point(|k, i| {
+                let speed = -approach[i][k];
+                if speed > threshold && pushed[i][k] > 0.0 {
+                    hit(chunk.contact[k], i, speed);
                 }
-            }
+            });
         }
         for c in &self.overflow {
             for i in 0..c.point_count() {
@@ -627,8 +615,6 @@ impl ContactSolver {
         let states = &bodies.states[..];
         for chunks in &mut self.colours {
             chunks.seal();
-        }
-        for chunks in &mut self.colours {
             let per_block = block_len(team, chunks.len());
             team.for_each_chunk_mut(chunks, per_block, |_, block| {
                 for chunk in block {
@@ -1125,6 +1111,19 @@ impl WideContact {
         self.second = W::splat(0.0);
         self.moving = 0;
         self.rows.surface = None;
+    }
+
+    /// Calls `f(lane, point)` for each point of each lane in use (a lane's
+    /// second point where its manifold has one).
+    #[inline]
+    fn for_each_point(&self, mut f: impl FnMut(usize, usize)) {
+        let second = self.second.to_array();
+        for (k, &two) in second.iter().enumerate().take(self.len) {
+            f(k, 0);
+            if two > 0.0 {
+                f(k, 1);
+            }
+        }
     }
 
     /// The lanes from `len` on as a new chunk's: every row input zero
