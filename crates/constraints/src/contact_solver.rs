@@ -123,6 +123,9 @@ pub(crate) struct WideContact {
 struct Chunks {
     all: Vec<WideContact>,
     used: usize,
+    /// The chunks of this push block begin here ([`PUSH_BLOCK`]): none of
+    /// an earlier block takes more lanes.
+    block_start: usize,
 }
 
 impl std::ops::Deref for Chunks {
@@ -142,6 +145,7 @@ impl Chunks {
     /// No chunk in use (their memory kept).
     fn clear(&mut self) {
         self.used = 0;
+        self.block_start = 0;
     }
 
     /// One more chunk in use, with no lane: a kept one reopened, or a new
@@ -167,32 +171,11 @@ impl Chunks {
         }
     }
 
-    /// `count` chunks in use (after [`Chunks::clear`]), each reopened and
-    /// handed to `fill(c, chunk)` with its index, in blocks of `per_block`
-    /// chunks on `team` (the parallel push fills each chunk where it
-    /// stays).
-    fn fill_on(
-        &mut self,
-        count: usize,
-        per_block: usize,
-        team: &Team,
-        fill: impl Fn(usize, &mut WideContact) + Sync,
-    ) {
-        debug_assert_eq!(self.used, 0, "chunks filled after a clear");
-        if self.all.len() < count {
-            self.all.resize_with(count, WideContact::empty);
-        }
-        self.used = count;
-        team.for_each_chunk_mut(&mut self.all[..count], per_block, |b, block| {
-            for k in 0..block.len() {
-                if let Some(next) = block.get(k + 1) {
-                    janus2d_core::hint::prefetch_all(next);
-                }
-                let chunk = &mut block[k];
-                chunk.reopen();
-                fill(b * per_block + k, chunk);
-            }
-        });
+    /// A new push block begins ([`PUSH_BLOCK`]): the last chunk is
+    /// sealed and the block's first push opens a chunk of its own.
+    fn begin_block(&mut self) {
+        self.seal();
+        self.block_start = self.used;
     }
 }
 
@@ -236,8 +219,9 @@ pub struct ContactSolver {
     groups: Groups,
     /// Number of contacts pushed since [`ContactSolver::begin`].
     len: usize,
-    /// Scratch of [`ContactSolver::push_all`]: the contacts of each colour.
-    lists: Vec<Vec<u32>>,
+    /// Scratch of [`ContactSolver::push_all`]: each push block's contacts
+    /// per colour.
+    block_counts: Vec<[u32; COLOURS]>,
     /// Which states each chunk reads and writes, one group per colour,
     /// verified at prepare (parallel stages only).
     plan: StatePlan<PLAN_SLOTS>,
@@ -309,35 +293,20 @@ impl ContactSolver {
         contact_index: u32,
         cluster: [u32; 2],
     ) -> LanePlace {
+        if self.len > 0 && self.len.is_multiple_of(PUSH_BLOCK) {
+            for chunks in &mut self.colours {
+                chunks.begin_block();
+            }
+        }
         self.len += 1;
-        let count = lane.point_count.min(MAX_MANIFOLD_POINTS);
         if colour >= OVERFLOW {
-            let place = LanePlace {
-                colour: OVERFLOW,
-                lane: 0,
-                chunk: self.overflow.len() as u32,
-            };
-            let mut c = ContactConstraint::new(
-                lane.body_a,
-                lane.body_b,
-                lane.normal,
-                &lane.points[..count],
-                lane.friction,
-                lane.restitution,
-                contact_index,
-            );
-            c.set_surface(lane.tangent_speed, lane.rolling_resistance);
-            c.state_a = lane.state_a;
-            c.state_b = lane.state_b;
-            self.overflow.push(c);
-            self.clusters.push(cluster);
-            return place;
+            return self.push_overflow(lane, contact_index, cluster);
         }
         if self.colours.len() < COLOURS {
             self.colours.resize_with(COLOURS, Chunks::default);
         }
         let chunks = &mut self.colours[colour as usize];
-        if chunks.last().is_none_or(|c| c.len == LANES) {
+        if chunks.used == chunks.block_start || chunks.last().is_none_or(|c| c.len == LANES) {
             chunks.open();
         }
         let index = chunks.len() - 1;
@@ -347,7 +316,41 @@ impl ContactSolver {
             lane: chunk.len as u8,
             chunk: index as u32,
         };
-        chunk.push(lane, count, contact_index);
+        chunk.push(
+            lane,
+            lane.point_count.min(MAX_MANIFOLD_POINTS),
+            contact_index,
+        );
+        place
+    }
+
+    /// Appends a contact to the overflow (not counted in `len`).
+    fn push_overflow(
+        &mut self,
+        lane: &ContactLane,
+        contact_index: u32,
+        cluster: [u32; 2],
+    ) -> LanePlace {
+        let count = lane.point_count.min(MAX_MANIFOLD_POINTS);
+        let place = LanePlace {
+            colour: OVERFLOW,
+            lane: 0,
+            chunk: self.overflow.len() as u32,
+        };
+        let mut c = ContactConstraint::new(
+            lane.body_a,
+            lane.body_b,
+            lane.normal,
+            &lane.points[..count],
+            lane.friction,
+            lane.restitution,
+            contact_index,
+        );
+        c.set_surface(lane.tangent_speed, lane.rolling_resistance);
+        c.state_a = lane.state_a;
+        c.state_b = lane.state_b;
+        self.overflow.push(c);
+        self.clusters.push(cluster);
         place
     }
 
@@ -364,9 +367,8 @@ impl ContactSolver {
     /// goes into colour `colours[i]` with the lane data, index and
     /// clusters `lane(i)`, and its place into `places[i]`. The result is
     /// the one of pushing them in order; with the `parallel` feature and
-    /// more than one thread the chunks are filled in blocks on `team`
-    /// (each chunk from its own contacts, so the order within a colour is
-    /// kept).
+    /// more than one thread the [`PUSH_BLOCK`]s are filled at once on
+    /// `team`, each reading its contacts in order into chunks of its own.
     pub fn push_all<'l, F>(
         &mut self,
         colours: &[u8],
@@ -384,60 +386,74 @@ impl ContactSolver {
         if self.colours.len() < COLOURS {
             self.colours.resize_with(COLOURS, Chunks::default);
         }
-        // One thread (or open chunks): push in contact order. The contacts
-        // are then read in order and the open chunks (one per colour) stay
-        // in cache; the per-colour lists below read the contacts out of
-        // order, which only pays when threads share the filling.
-        if Self::pushes_in_order(colours.len(), team) || self.colours.iter().any(|c| !c.is_empty())
-        {
-            // Open chunks: keep push's order exactly.
+        // One thread, few contacts, or contacts pushed already: push in
+        // contact order on the caller, the open chunks (one per colour) in
+        // cache.
+        if Self::pushes_in_order(colours.len(), team) || self.len > 0 {
+            // Contacts pushed already: keep push's order exactly.
             for (i, &colour) in colours.iter().enumerate() {
                 places.push(push(self, colour, i));
             }
             return;
         }
-        let mut lists = std::mem::take(&mut self.lists);
-        lists.resize_with(COLOURS, Vec::new);
-        for list in &mut lists {
-            list.clear();
-        }
+        // On the team: the overflow first, on the caller, then each push
+        // block's contacts into chunks of its own, in blocks on the team;
+        // the chunks are those the pushes in order make.
+        let n = colours.len();
+        let blocks = n.div_ceil(PUSH_BLOCK);
+        let mut counts = std::mem::take(&mut self.block_counts);
+        counts.clear();
+        counts.resize(blocks, [0; COLOURS]);
+        places.resize(
+            n,
+            LanePlace {
+                colour: OVERFLOW,
+                lane: 0,
+                chunk: 0,
+            },
+        );
         for (i, &colour) in colours.iter().enumerate() {
             if colour >= OVERFLOW {
-                places.push(push(self, colour, i));
+                let (lane, index, cluster) = lane(i);
+                places[i] = self.push_overflow(lane, index, cluster);
             } else {
-                // The j-th contact of a colour goes to chunk j / LANES.
-                let list = &mut lists[colour as usize];
-                places.push(LanePlace {
-                    colour,
-                    lane: (list.len() % LANES) as u8,
-                    chunk: (list.len() / LANES) as u32,
-                });
-                list.push(i as u32);
+                counts[i / PUSH_BLOCK][colour as usize] += 1;
             }
         }
-        // Each chunk is filled from its own contacts, so the chunks of a
-        // colour can be filled at once.
-        let fill = |list: &[u32], c: usize, chunk: &mut WideContact| {
-            for &i in &list[c * LANES..((c + 1) * LANES).min(list.len())] {
-                let (lane, index, _) = lane(i as usize);
-                let count = lane.point_count.min(MAX_MANIFOLD_POINTS);
-                chunk.push(lane, count, index);
+        self.len += n;
+        // Block b's chunks of colour c come after those of the blocks
+        // before it.
+        let mut works: Vec<PushBlock<'_>> = places
+            .chunks_mut(PUSH_BLOCK)
+            .map(|places| PushBlock {
+                places,
+                chunks: std::array::from_fn(|_| &mut [][..]),
+                first: [0; COLOURS],
+            })
+            .collect();
+        for (c, chunks) in self.colours.iter_mut().enumerate() {
+            let total: usize = counts.iter().map(|k| (k[c] as usize).div_ceil(LANES)).sum();
+            if chunks.all.len() < total {
+                chunks.all.resize_with(total, WideContact::empty);
             }
-        };
-        for (chunks, list) in self.colours.iter_mut().zip(&lists) {
-            // Blocks of 8 chunks on the team where the colour is long.
-            const CHUNKS: usize = 8;
-            let on = if list.len() > 16 * LANES {
-                team
-            } else {
-                &Team::serial()
-            };
-            chunks.fill_on(list.len().div_ceil(LANES), CHUNKS, on, |c, chunk| {
-                fill(list, c, chunk);
-            });
+            chunks.used = total;
+            chunks.block_start = total;
+            let mut rest = &mut chunks.all[..total];
+            let mut first = 0;
+            for (work, k) in works.iter_mut().zip(&counts) {
+                let (mine, tail) = rest.split_at_mut((k[c] as usize).div_ceil(LANES));
+                rest = tail;
+                work.first[c] = first;
+                first += mine.len() as u32;
+                work.chunks[c] = mine;
+            }
         }
-        self.len += lists.iter().map(Vec::len).sum::<usize>();
-        self.lists = lists;
+        team.for_each_chunk_mut(&mut works, 1, |b, work| {
+            for work in work {
+                work.fill(&colours[b * PUSH_BLOCK..], |i| lane(b * PUSH_BLOCK + i));
+            }
+        });
+        self.block_counts = counts;
     }
 
     /// The impulses of point `point` of the contact at `place` (as
@@ -763,6 +779,62 @@ const SERIAL_CHUNKS: usize = 32;
 /// threads (fewer are pushed in order on the caller: the lists and tasks
 /// cost more than the filling).
 const PARALLEL_PUSH: usize = 4096;
+
+/// Contacts per push block: every [`PUSH_BLOCK`] contacts pushed, each
+/// colour begins a new chunk, so that the blocks can be filled at once on
+/// a team and the chunks are the same for every thread count (a
+/// block's partly filled last chunks cost at most a chunk per colour in
+/// use, about 1 % more chunks).
+pub const PUSH_BLOCK: usize = 4096;
+
+/// One push block's share of [`ContactSolver::push_all`]: its places, and
+/// per colour its chunks and the index of the first of them.
+struct PushBlock<'a> {
+    places: &'a mut [LanePlace],
+    chunks: [&'a mut [WideContact]; COLOURS],
+    first: [u32; COLOURS],
+}
+
+impl PushBlock<'_> {
+    /// Pushes the block's contacts (`colours[j]`, `lane(j)` for the j-th)
+    /// into its chunks in order; the overflow's were placed already.
+    fn fill<'l>(
+        &mut self,
+        colours: &[u8],
+        lane: impl Fn(usize) -> (&'l ContactLane, u32, [u32; 2]),
+    ) {
+        let mut pushed = [0usize; COLOURS];
+        for (j, (place, &colour)) in self.places.iter_mut().zip(colours).enumerate() {
+            if colour >= OVERFLOW {
+                continue;
+            }
+            let c = colour as usize;
+            let k = pushed[c];
+            pushed[c] += 1;
+            let (at, lane_k) = (k / LANES, k % LANES);
+            let chunks = &mut *self.chunks[c];
+            if lane_k == 0 {
+                chunks[at].reopen();
+                // The colour's next chunk, written over the next pushes.
+                if let Some(next) = chunks.get(at + 1) {
+                    janus2d_core::hint::prefetch_all(next);
+                }
+            }
+            let (lane, index, _) = lane(j);
+            chunks[at].push(lane, lane.point_count.min(MAX_MANIFOLD_POINTS), index);
+            *place = LanePlace {
+                colour,
+                lane: lane_k as u8,
+                chunk: self.first[c] + at as u32,
+            };
+        }
+        for chunks in &mut self.chunks {
+            if let Some(last) = chunks.last_mut() {
+                last.clear_free_lanes();
+            }
+        }
+    }
+}
 
 /// Chunks per block for `chunks` chunks on `team`: about four blocks per
 /// thread (each claim is an atomic increment on a shared line), at least
@@ -1375,5 +1447,77 @@ mod tests {
         assert_eq!(again, fresh);
         // The earlier lanes did act (the test would notice stale rows).
         assert_ne!(first[..3 * 8 * LANES], fresh[..3 * 8 * LANES]);
+    }
+
+    /// Pushes `count` one-point contacts (contact `i` between bodies `2i`
+    /// and `2i + 1`, in colour `i % 5`, every 97th in the overflow) with
+    /// `push_all` on `team`; returns the places and, in the chunks' order,
+    /// each lane's contact, point and kept normal impulse.
+    fn push_all_on(
+        set: &BodySet,
+        count: usize,
+        team: &Team,
+    ) -> (Vec<LanePlace>, Vec<(u32, usize, u64)>) {
+        let lanes: Vec<_> = (0..count)
+            .map(|i| lane(set, i, 1, 0.5 + i as Real, false))
+            .collect();
+        let colours: Vec<u8> = (0..count)
+            .map(|i| if i % 97 == 0 { OVERFLOW } else { (i % 5) as u8 })
+            .collect();
+        let mut solver = ContactSolver::new();
+        solver.begin();
+        let mut places = Vec::new();
+        solver.push_all(
+            &colours,
+            |i| (&lanes[i], i as u32, lanes[i].cluster),
+            &mut places,
+            team,
+        );
+        assert_eq!(solver.len(), count);
+        let mut order = Vec::new();
+        solver.for_each_impulse(|c, point, p| order.push((c, point, to_f64(p.normal).to_bits())));
+        (places, order)
+    }
+
+    /// `push_all` on a team fills the push blocks at once into the chunks
+    /// that pushing the contacts one by one makes: the same places and
+    /// the same lanes in every chunk, for 2 and 4 threads.
+    #[test]
+    fn pushing_on_a_team_makes_the_chunks_of_pushing_in_order() {
+        let count = 2 * PUSH_BLOCK + 777;
+        let mut set = BodySet::new();
+        for k in 0..2 * count {
+            set.create(&BodyDef::dynamic(Vec2::new(k as Real, 0.0)))
+                .unwrap();
+        }
+        let (places, order) = push_all_on(&set, count, &Team::serial());
+        // A block's last chunks stay partly filled: more chunks than the
+        // colours' contacts would fill alone.
+        let chunk_count = |colour: u8| {
+            places
+                .iter()
+                .filter(|p| p.colour == colour)
+                .map(|p| p.chunk)
+                .max()
+                .map_or(0, |c| c + 1) as usize
+        };
+        let in_colour = |colour: u8| places.iter().filter(|p| p.colour == colour).count();
+        assert!(chunk_count(0) > in_colour(0).div_ceil(LANES));
+        assert_eq!(order.len(), count);
+        #[cfg(feature = "parallel")]
+        for threads in [2, 4] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let on_team = pool.install(|| {
+                janus2d_core::parallel::with_team(|team| push_all_on(&set, count, team))
+            });
+            assert_eq!(
+                on_team,
+                (places.clone(), order.clone()),
+                "{threads} threads"
+            );
+        }
     }
 }
