@@ -23,6 +23,9 @@
 //! each constraint's colour from step to step (the contacts: a contact
 //! keeps its colour while it touches).
 
+use std::sync::atomic::AtomicU32;
+use std::sync::atomic::Ordering::Relaxed;
+
 /// Number of colours.
 pub const COLOURS: usize = 24;
 
@@ -82,8 +85,6 @@ struct GraphEntry {
     /// Its colour; [`GraphEntry::OUT`] when not in the graph,
     /// [`COLOURS`] when in the overflow.
     colour: u8,
-    /// The step it was last kept in.
-    stamp: u32,
     /// Body key of each side ([`NO_BODY`]: takes no colour).
     keys: [u32; 2],
 }
@@ -92,9 +93,46 @@ impl GraphEntry {
     const OUT: u8 = u8::MAX;
     const VACANT: GraphEntry = GraphEntry {
         colour: Self::OUT,
-        stamp: 0,
         keys: [NO_BODY; 2],
     };
+}
+
+/// Per constraint id, the step it was last kept in (0: not kept). Atomic,
+/// so that [`ConstraintGraph::keep_shared`] stamps from many threads at
+/// once; a plain load or store on every target the engine builds for.
+#[derive(Debug, Default)]
+struct Stamps(Vec<AtomicU32>);
+
+impl Clone for Stamps {
+    fn clone(&self) -> Self {
+        Stamps(
+            self.0
+                .iter()
+                .map(|s| AtomicU32::new(s.load(Relaxed)))
+                .collect(),
+        )
+    }
+}
+
+impl Stamps {
+    /// Constraint `id`'s stamp (0 past the end).
+    #[inline]
+    fn get(&self, id: usize) -> u32 {
+        self.0.get(id).map_or(0, |s| s.load(Relaxed))
+    }
+
+    /// Sets constraint `id`'s stamp (`id` within [`Stamps::cover`]).
+    #[inline]
+    fn set(&mut self, id: usize, stamp: u32) {
+        *self.0[id].get_mut() = stamp;
+    }
+
+    /// Stamps for ids below `len` (new ones 0).
+    fn cover(&mut self, len: usize) {
+        if self.0.len() < len {
+            self.0.resize_with(len, AtomicU32::default);
+        }
+    }
 }
 
 /// The persistent constraint graph: colours over the moving bodies that
@@ -113,6 +151,9 @@ impl GraphEntry {
 ///              same keys as stored, in a colour: that colour
 ///              otherwise: out (bits cleared), then the lowest free colour
 ///              (a pair with one moving body: from STATIC_FIRST up)
+///            (or keep_shared(c, keys) on many threads first: the
+///             constraints of the first case, stamped at once; the rest
+///             through keep, in the same order)
 ///            sweep(): every entry not kept this step leaves (bits cleared)
 /// ```
 ///
@@ -136,6 +177,11 @@ pub struct ConstraintGraph {
     /// Ids with an entry in the graph (or the overflow), in the order they
     /// entered (the sweep's order).
     members: Vec<u32>,
+    /// By constraint id: the step it was last kept in. Not in snapshots:
+    /// a step compares them with its own stamp only, which no earlier
+    /// stamp equals.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    stamps: Stamps,
     /// The current step's stamp.
     stamp: u32,
     /// Members kept (stamped) since [`ConstraintGraph::begin_step`]: when
@@ -194,12 +240,48 @@ impl ConstraintGraph {
         self.stamp = self.stamp.wrapping_add(1);
         if self.stamp == 0 {
             // Wrapped: stamps of 0 mean "not kept"; the rest restart.
-            for e in &mut self.entries {
-                e.stamp = 0;
+            for s in &mut self.stamps.0 {
+                *s.get_mut() = 0;
             }
             self.stamp = 1;
         }
+        self.stamps.cover(self.entries.len());
         self.kept = 0;
+    }
+
+    /// Whether constraint `id` between the bodies with keys `keys` keeps
+    /// its colour this step, as [`ConstraintGraph::keep`] would find: then
+    /// it is stamped as kept and its colour returned, from any number of
+    /// threads at once (each id once a step; tell the graph how many with
+    /// [`ConstraintGraph::note_kept`]). `None`: it must go through `keep`
+    /// (it is new, its bodies changed, or it waits in the overflow), in
+    /// the same order as on one thread.
+    #[must_use]
+    pub fn keep_shared(&self, id: u32, keys: [u32; 2]) -> Option<u8> {
+        let i = id as usize;
+        let entry = *self.entries.get(i)?;
+        let stamp = self.stamps.0.get(i)?;
+        if entry.colour == GraphEntry::OUT
+            || !self.keeps(entry, keys)
+            || stamp.load(Relaxed) == self.stamp
+        {
+            return None;
+        }
+        stamp.store(self.stamp, Relaxed);
+        Some(entry.colour)
+    }
+
+    /// Counts `count` constraints kept by [`ConstraintGraph::keep_shared`].
+    pub fn note_kept(&mut self, count: usize) {
+        self.kept += count;
+    }
+
+    /// Whether an entry in the graph keeps its colour for `keys`.
+    #[inline]
+    fn keeps(&self, entry: GraphEntry, keys: [u32; 2]) -> bool {
+        entry.keys == keys
+            && (entry.colour as usize) < COLOURS
+            && (!self.reserved_changed || self.reserved_on(keys) & (1 << entry.colour) == 0)
     }
 
     /// The colour of constraint `id` between the bodies with keys `keys`
@@ -211,15 +293,13 @@ impl ConstraintGraph {
         if self.entries.len() <= i {
             self.entries.resize(i + 1, GraphEntry::VACANT);
         }
+        self.stamps.cover(i + 1);
         let entry = self.entries[i];
         if entry.colour != GraphEntry::OUT {
             // (A second keep of the same id in a step counts once.)
-            self.kept += usize::from(entry.stamp != self.stamp);
-            if entry.keys == keys
-                && (entry.colour as usize) < COLOURS
-                && (!self.reserved_changed || self.reserved_on(keys) & (1 << entry.colour) == 0)
-            {
-                self.entries[i].stamp = self.stamp;
+            self.kept += usize::from(self.stamps.get(i) != self.stamp);
+            if self.keeps(entry, keys) {
+                self.stamps.set(i, self.stamp);
                 return entry.colour;
             }
             // Its bodies changed, or it waits in the overflow: again.
@@ -236,11 +316,8 @@ impl ConstraintGraph {
                 }
             }
         }
-        self.entries[i] = GraphEntry {
-            colour,
-            stamp: self.stamp,
-            keys,
-        };
+        self.entries[i] = GraphEntry { colour, keys };
+        self.stamps.set(i, self.stamp);
         colour
     }
 
@@ -253,7 +330,7 @@ impl ConstraintGraph {
         let mut members = std::mem::take(&mut self.members);
         members.retain(|&id| {
             let entry = self.entries[id as usize];
-            if entry.stamp == self.stamp {
+            if self.stamps.get(id as usize) == self.stamp {
                 return true;
             }
             self.clear_bits(entry);
@@ -451,6 +528,65 @@ mod tests {
         g.begin_step();
         assert_eq!(g.keep(extra, [0, extra + 1]), 0);
         g.check().unwrap();
+    }
+
+    /// Keeping shared where it can, then the rest in order, leaves the
+    /// graph as keeping every constraint in order does: the same colours,
+    /// the same members after the sweep.
+    #[test]
+    fn keeping_shared_then_in_order_colours_as_keeping_in_order() {
+        // Step 1: a chain of bodies and a few ground contacts.
+        let first: Vec<(u32, [u32; 2])> = (0..40)
+            .map(|k| (k, if k % 7 == 0 { [k, NO_BODY] } else { [k, k + 1] }))
+            .collect();
+        // Step 2: 5 and 12 leave, 3 and 20 change bodies, 41 and 42 are new.
+        let second: Vec<(u32, [u32; 2])> = first
+            .iter()
+            .filter(|(id, _)| *id != 5 && *id != 12)
+            .map(|&(id, keys)| match id {
+                3 => (id, [3, 30]),
+                20 => (id, [20, 2]),
+                _ => (id, keys),
+            })
+            .chain([(41, [5, 6]), (42, [12, NO_BODY])])
+            .collect();
+        let mut in_order = ConstraintGraph::new();
+        let mut shared = ConstraintGraph::new();
+        for g in [&mut in_order, &mut shared] {
+            g.begin_step();
+            for &(id, keys) in &first {
+                g.keep(id, keys);
+            }
+            g.sweep();
+        }
+        in_order.begin_step();
+        let expected: Vec<u8> = second
+            .iter()
+            .map(|&(id, keys)| in_order.keep(id, keys))
+            .collect();
+        in_order.sweep();
+        shared.begin_step();
+        let kept: Vec<Option<u8>> = second
+            .iter()
+            .map(|&(id, keys)| shared.keep_shared(id, keys))
+            .collect();
+        assert_eq!(
+            kept.iter().filter(|k| k.is_none()).count(),
+            4,
+            "3, 20, 41 and 42 go in order"
+        );
+        shared.note_kept(kept.iter().filter(|k| k.is_some()).count());
+        let colours: Vec<u8> = second
+            .iter()
+            .zip(&kept)
+            .map(|(&(id, keys), k)| k.unwrap_or_else(|| shared.keep(id, keys)))
+            .collect();
+        shared.sweep();
+        assert_eq!(colours, expected);
+        assert_eq!(shared.len(), in_order.len());
+        assert_eq!(shared.members, in_order.members);
+        assert_eq!(shared.body_colours, in_order.body_colours);
+        shared.check().unwrap();
     }
 
     #[test]

@@ -6,6 +6,8 @@
 //!   pass 1   the contacts the solve takes (pre-solve hook, still bodies,
 //!            portal copies), their graph keys and light-pair flags;
 //!            each keeps its colour in the persistent ConstraintGraph
+//!            (on threads: those whose colour holds are kept on the team,
+//!            ConstraintGraph::keep_shared; the rest in order after)
 //!   clusters light bodies under heavy ones (contact_group)
 //!   push     lanes into the ContactSolver's colour chunks, the rest to
 //!            its overflow; places kept for storing the impulses back
@@ -72,7 +74,14 @@ struct SolvedContact {
     point_count: u8,
     /// Its restitution is positive.
     bouncy: bool,
+    /// Its colour when the build's parallel pass found it kept
+    /// ([`ConstraintGraph::keep_shared`]), else [`NOT_KEPT`].
+    kept: u8,
 }
+
+/// [`SolvedContact::kept`] of a contact whose colour comes from
+/// [`ConstraintGraph::keep`].
+const NOT_KEPT: u8 = u8::MAX;
 
 /// Constraint building's state: the persistent constraint graph and the
 /// buffers it reuses from step to step.
@@ -116,7 +125,11 @@ pub(crate) struct ContactBuilder {
 /// overflow for a portal copy's contact (it keeps its place in the graph).
 #[inline]
 fn colour_of(graph: &mut ConstraintGraph, s: &SolvedContact) -> u8 {
-    let colour = graph.keep(s.id, s.keys);
+    let colour = if s.kept == NOT_KEPT {
+        graph.keep(s.id, s.keys)
+    } else {
+        s.kept
+    };
     if s.copy {
         OVERFLOW
     } else {
@@ -246,7 +259,7 @@ impl ContactBuilder {
         // returned), the counters, and whether it is the first contact
         // between a light body and a heavy one with neither body excluded
         // (then the light clusters are looked for below).
-        let mut take = |s: &SolvedContact| -> (u8, bool) {
+        let mut take = |s: &SolvedContact, graph: &mut ConstraintGraph| -> (u8, bool) {
             let colour = colour_of(graph, s);
             colours.push(colour);
             rows += 2 * usize::from(s.point_count);
@@ -283,6 +296,7 @@ impl ContactBuilder {
                 cluster: [NO_CLUSTER; 2],
                 point_count: lane.point_count as u8,
                 bouncy: lane.restitution > 0.0,
+                kept: NOT_KEPT,
             }
         };
         // With threads, no hook and nothing woken since the narrowphase, the
@@ -304,22 +318,30 @@ impl ContactBuilder {
             const STILL: u32 = u32::MAX;
             const BLOCK: usize = 1024;
             let touching = handoff.touching;
-            // Made where they stay (no serial fill of `solved` first).
+            // Made where they stay (no serial fill of `solved` first),
+            // each keeping its colour here when it can: only the contacts
+            // that take a colour afresh go through the graph in order.
+            let shared = &*graph;
             team.extend_mapped(solved, touching.len(), BLOCK, |i| {
                 let k = touching[i] as usize;
                 let record = &staged[k];
                 let mut s = entry(k, record);
                 if record.still == [true, true] {
                     s.index = STILL;
+                } else if let Some(colour) = shared.keep_shared(s.id, s.keys) {
+                    s.kept = colour;
                 }
                 s
             });
             if solved.iter().any(|s| s.index == STILL) {
                 solved.retain(|s| s.index != STILL);
             }
+            let mut kept = 0;
             for s in solved.iter() {
-                take(s);
+                kept += usize::from(s.kept != NOT_KEPT);
+                take(s, graph);
             }
+            graph.note_kept(kept);
         } else {
             // Serial: each contact is also pushed into its colour's chunk
             // here, while its staged record is in cache (read once, not
@@ -375,7 +397,7 @@ impl ContactBuilder {
                 }
                 let record = &staged[k];
                 let s = entry(k, record);
-                let (colour, first_light) = take(&s);
+                let (colour, first_light) = take(&s, graph);
                 if first_light && fused {
                     fused = false;
                     solver.begin();
