@@ -1506,13 +1506,10 @@ mod tests {
         assert_eq!(order.len(), count);
         #[cfg(feature = "parallel")]
         for threads in [2, 4] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            let on_team = pool.install(|| {
-                janus2d_core::parallel::with_team(|team| push_all_on(&set, count, team))
-            });
+            let on_team = janus2d_core::parallel::with_threads(threads, |team| {
+                push_all_on(&set, count, team)
+            })
+            .unwrap();
             assert_eq!(
                 on_team,
                 (places.clone(), order.clone()),

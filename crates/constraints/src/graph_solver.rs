@@ -452,12 +452,8 @@ mod tests {
         assert_eq!((team_bits, team_colours), (bits.clone(), colours.clone()));
         #[cfg(feature = "parallel")]
         for threads in [2, 4] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
             let (team_bits, team_colours, paired) =
-                pool.install(|| janus2d_core::parallel::with_team(run_stages));
+                janus2d_core::parallel::with_threads(threads, run_stages).unwrap();
             assert!(paired, "{threads} threads: one job per colour");
             assert_eq!(team_bits, bits, "{threads} threads");
             assert_eq!(team_colours, colours, "{threads} threads");

@@ -804,11 +804,7 @@ mod tests {
         assert_eq!(team, serial);
         #[cfg(feature = "parallel")]
         for threads in [2, 4] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            let team = pool.install(|| janus2d_core::parallel::with_team(run_stages));
+            let team = janus2d_core::parallel::with_threads(threads, run_stages).unwrap();
             assert_eq!(team, serial, "{threads} threads");
         }
     }

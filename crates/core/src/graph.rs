@@ -80,7 +80,6 @@ pub const NO_BODY: u32 = u32::MAX;
 
 /// A [`ConstraintGraph`] constraint's colour and the bodies it holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 struct GraphEntry {
     /// Its colour; [`GraphEntry::OUT`] when not in the graph,
     /// [`COLOURS`] when in the overflow.
@@ -168,7 +167,6 @@ impl Stamps {
 /// constraint whose bodies already appear in every colour goes to the
 /// overflow ([`COLOURS`]), and tries again each step.
 #[derive(Clone, Debug, Default)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ConstraintGraph {
     /// By body key: bit `c` set, the body appears in colour `c`.
     body_colours: Vec<u32>,
@@ -177,27 +175,22 @@ pub struct ConstraintGraph {
     /// Ids with an entry in the graph (or the overflow), in the order they
     /// entered (the sweep's order).
     members: Vec<u32>,
-    /// By constraint id: the step it was last kept in. Not in snapshots:
-    /// a step compares them with its own stamp only, which no earlier
-    /// stamp equals.
-    #[cfg_attr(feature = "serde", serde(skip))]
+    /// By constraint id: the step it was last kept in (in snapshots with
+    /// its entry).
     stamps: Stamps,
     /// The current step's stamp.
     stamp: u32,
     /// Members kept (stamped) since [`ConstraintGraph::begin_step`]: when
     /// that is every member, the sweep has nothing to remove and skips its
     /// pass (a settled scene's usual step).
-    #[cfg_attr(feature = "serde", serde(skip))]
     kept: usize,
     /// By body key: colours held by other constraints this step (the
     /// joints', [`ConstraintGraph::set_reserved`]); no constraint of the
     /// graph takes one of them on that body.
-    #[cfg_attr(feature = "serde", serde(skip))]
     reserved: Vec<u32>,
     /// The reserved colours differ from the previous step's: only then
     /// can a kept constraint's colour meet one of them (it was checked
     /// against the same bits when it was last kept or coloured).
-    #[cfg_attr(feature = "serde", serde(skip))]
     reserved_changed: bool,
 }
 
@@ -447,6 +440,77 @@ impl ConstraintGraph {
         } else {
             free.trailing_zeros() as u8
         }
+    }
+}
+
+/// The graph as snapshots hold it: each entry with its stamp (the layout
+/// from before the stamps moved apart, so snapshots kept their format).
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+struct StoredGraph {
+    body_colours: Vec<u32>,
+    entries: Vec<StoredEntry>,
+    members: Vec<u32>,
+    stamp: u32,
+}
+
+/// A [`GraphEntry`] and its stamp, as snapshots hold them.
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+struct StoredEntry {
+    colour: u8,
+    stamp: u32,
+    keys: [u32; 2],
+}
+
+#[cfg(feature = "serde")]
+impl serde::Serialize for ConstraintGraph {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let entries = self
+            .entries
+            .iter()
+            .enumerate()
+            .map(|(i, e)| StoredEntry {
+                colour: e.colour,
+                stamp: self.stamps.get(i),
+                keys: e.keys,
+            })
+            .collect();
+        let stored = StoredGraph {
+            body_colours: self.body_colours.clone(),
+            entries,
+            members: self.members.clone(),
+            stamp: self.stamp,
+        };
+        stored.serialize(serializer)
+    }
+}
+
+#[cfg(feature = "serde")]
+impl<'de> serde::Deserialize<'de> for ConstraintGraph {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let stored = StoredGraph::deserialize(deserializer)?;
+        let stamps = stored
+            .entries
+            .iter()
+            .map(|e| AtomicU32::new(e.stamp))
+            .collect();
+        let entries = stored
+            .entries
+            .iter()
+            .map(|e| GraphEntry {
+                colour: e.colour,
+                keys: e.keys,
+            })
+            .collect();
+        Ok(ConstraintGraph {
+            body_colours: stored.body_colours,
+            entries,
+            members: stored.members,
+            stamps: Stamps(stamps),
+            stamp: stored.stamp,
+            ..ConstraintGraph::default()
+        })
     }
 }
 

@@ -898,6 +898,24 @@ pub fn with_team<R: Send>(leader: impl FnOnce(&Team) -> R + Send) -> R {
     leader(&Team::serial())
 }
 
+/// Runs `leader` with a team of `threads` threads, in a rayon pool of its
+/// own ([`with_team`] inside that pool): a run on a chosen thread count
+/// beside the global pool's (the thread-count determinism checks).
+///
+/// # Errors
+///
+/// When rayon cannot build the pool (the system refused a thread).
+#[cfg(feature = "parallel")]
+pub fn with_threads<R: Send>(
+    threads: usize,
+    leader: impl FnOnce(&Team) -> R + Send,
+) -> Result<R, rayon::ThreadPoolBuildError> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()?;
+    Ok(pool.install(|| with_team(leader)))
+}
+
 #[cfg(feature = "parallel")]
 fn broadcast_team<R: Send>(leader: impl FnOnce(&Team) -> R + Send) -> R {
     use std::sync::Mutex;

@@ -75,13 +75,21 @@ struct SolvedContact {
     /// Its restitution is positive.
     bouncy: bool,
     /// Its colour when the build's parallel pass found it kept
-    /// ([`ConstraintGraph::keep_shared`]), else [`NOT_KEPT`].
+    /// ([`ConstraintGraph::keep_shared`]), else [`NOT_KEPT`] (not in
+    /// snapshots: each build makes it afresh).
+    #[cfg_attr(feature = "serde", serde(skip, default = "not_kept"))]
     kept: u8,
 }
 
 /// [`SolvedContact::kept`] of a contact whose colour comes from
 /// [`ConstraintGraph::keep`].
 const NOT_KEPT: u8 = u8::MAX;
+
+/// [`NOT_KEPT`], for a decoded snapshot's solved contacts.
+#[cfg(feature = "serde")]
+fn not_kept() -> u8 {
+    NOT_KEPT
+}
 
 /// Constraint building's state: the persistent constraint graph and the
 /// buffers it reuses from step to step.
