@@ -390,7 +390,6 @@ impl ContactSolver {
         // contact order on the caller, the open chunks (one per colour) in
         // cache.
         if Self::pushes_in_order(colours.len(), team) || self.len > 0 {
-            // Contacts pushed already: keep push's order exactly.
             for (i, &colour) in colours.iter().enumerate() {
                 places.push(push(self, colour, i));
             }

@@ -856,33 +856,10 @@ impl JointForest {
     /// ([`TreePolicy::every_tree`]). With `enabled` false every joint stays
     /// iterative.
     pub fn build(&mut self, joints: &mut [Joint], states: &[BodyState], enabled: bool) {
-        self.build_on(
-            joints,
-            states,
-            TreePolicy::every_tree(enabled),
-            &Team::serial(),
-        );
-    }
-
-    /// [`JointForest::build`] under `policy`, with the joints' moving ends
-    /// read in blocks on the step's team (the forest itself is found on
-    /// the caller).
-    pub fn build_on(
-        &mut self,
-        joints: &mut [Joint],
-        states: &[BodyState],
-        policy: TreePolicy,
-        team: &Team,
-    ) {
-        const BLOCK: usize = 1024;
-        let read = &*joints;
-        team.for_each_chunk_mut(self.pairs_for(read.len()), BLOCK, |i, block| {
-            let first = i * BLOCK;
-            for (pair, j) in block.iter_mut().zip(&read[first..]) {
-                *pair = moving_pair(j, states);
-            }
-        });
-        self.update(joints, states.len(), policy);
+        for (pair, j) in self.pairs_for(joints.len()).iter_mut().zip(joints.iter()) {
+            *pair = moving_pair(j, states);
+        }
+        self.update(joints, states.len(), TreePolicy::every_tree(enabled));
     }
 
     /// The buffer of this step's pairs, one per joint, for a caller that
