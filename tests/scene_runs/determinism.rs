@@ -38,16 +38,21 @@ fn determinism_hash_matches_golden_value() {
     );
 }
 
-/// Pyramid 20 plus the portal drop, 120 steps: a hash of every body.
+/// Pyramid 20 plus the portal drop, 120 steps: a hash of every body. Both
+/// worlds are below [`janus2d::world::TEAM_MIN_WORK`], so they are put on
+/// the team (`set_team_min_work(0)`) for the thread-count check to reach
+/// the parallel stages.
 fn contact_scene_hash() -> u64 {
     let def = janus2d_testbed::scenes::shared_settings();
     let mut pyramid = janus2d_testbed::scenes::large_pyramid(&def, 20);
+    pyramid.world.set_team_min_work(0);
     for _ in 0..120 {
         pyramid.world.step(1.0 / 60.0).unwrap();
     }
     #[cfg(feature = "portals")]
     {
         let (mut drop, _) = janus2d_testbed::scenes::portal_drop(&def);
+        drop.world.set_team_min_work(0);
         for _ in 0..90 {
             drop.world.step(1.0 / 60.0).unwrap();
         }
@@ -60,6 +65,35 @@ fn contact_scene_hash() -> u64 {
 #[test]
 fn contact_scene_hash_is_stable_across_runs() {
     assert_eq!(contact_scene_hash(), contact_scene_hash());
+}
+
+/// A world below [`janus2d::world::TEAM_MIN_WORK`] steps on the calling
+/// thread alone; put on a 2-thread team it must end in the same state, bit
+/// for bit (pyramid 20, about 610 work: 210 boxes and their contacts).
+#[cfg(feature = "parallel")]
+#[test]
+fn small_world_stepped_alone_or_on_the_team_is_identical() {
+    let run = |team_min_work: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap()
+            .install(|| {
+                let def = janus2d_testbed::scenes::shared_settings();
+                let mut pyramid = janus2d_testbed::scenes::large_pyramid(&def, 20);
+                pyramid.world.set_team_min_work(team_min_work);
+                for _ in 0..60 {
+                    pyramid.world.step(1.0 / 60.0).unwrap();
+                }
+                let work = pyramid.world.awake_body_count() + pyramid.world.awake_contact_count();
+                assert!(
+                    work < janus2d::world::TEAM_MIN_WORK,
+                    "pyramid 20 is a small world ({work} work)"
+                );
+                pyramid.world.state_hash()
+            })
+    };
+    assert_eq!(run(janus2d::world::TEAM_MIN_WORK), run(0));
 }
 
 /// With the `parallel` feature the narrowphase runs on rayon: the result
@@ -127,6 +161,8 @@ fn benchmark_scenes_are_identical_for_any_thread_count() {
 /// 120 steps: the hash of the final state.
 fn every_joint_kind_hash() -> u64 {
     let mut world = janus2d_testbed::support::every_joint_kind_world();
+    // Put on the team whatever its size (see `contact_scene_hash`).
+    world.set_team_min_work(0);
     for _ in 0..120 {
         world.step(1.0 / 60.0).unwrap();
     }

@@ -20,7 +20,9 @@
 //! | `joints`  | the joint scenes (weld cantilever, car, elevator, spring bridge): ms/step and ratios, each engine's accuracy figures side by side; an engine without the scene's joint kind shows `n/a` (`--substeps N`, `--md FILE`) |
 //! | `memory`  | per scene and engine (one thread, a fresh child process each): peak resident memory (VmHWM) minus a baseline process, janus2d ÷ Box2D, bytes per body (`--csv`, default `docs/performance/memory.csv`) |
 //!
-//! Options: `--threads 1,2`, `--repeats N` (default 2), `--steps N`,
+//! Options: `--threads 1,2` (`all`, `profile`; `scaling` runs each count
+//! given, one thread by default; `hard` and `sweep` run every engine on the
+//! first count given, one thread by default), `--repeats N` (default 2), `--steps N`,
 //! `--scenes a,b`, `--engines janus2d,box2d,rapier`, `--csv FILE`,
 //! `--svg FILE` (bar chart of the ratios), `--out DIR` (sweep output).
 //! Build with `--features simd-avx2` and `RUSTFLAGS="-C target-cpu=x86-64-v3"`
@@ -53,6 +55,9 @@ struct Args {
     command: String,
     names: Vec<String>,
     threads: Vec<usize>,
+    /// Whether `--threads` was on the command line (the hard cases, the
+    /// sweep and the scaling run default to one thread).
+    threads_given: bool,
     repeats: usize,
     steps: Option<usize>,
     substeps: Option<u32>,
@@ -79,6 +84,7 @@ fn parse_args() -> Args {
         command: "all".into(),
         names: Vec::new(),
         threads: vec![1, 2],
+        threads_given: false,
         repeats: 2,
         steps: None,
         substeps: None,
@@ -100,6 +106,7 @@ fn parse_args() -> Args {
     while let Some(a) = it.next() {
         match a.as_str() {
             "--threads" => {
+                args.threads_given = true;
                 args.threads = list(it.next())
                     .iter()
                     .map(|t| t.parse().expect("--threads 1,2"))
@@ -544,12 +551,12 @@ fn cmd_chart(args: &Args) {
     println!("wrote {svg}");
 }
 
-/// The scenes of the scaling run: the large pyramid at 10, 20, 50, 100
-/// and 200 rows, and many_pyramids at 1/4, 1/2, 1 and 2 times its count
+/// The scenes of the scaling run: the large pyramid at 5, 10, 20, 50,
+/// 100 and 200 rows, and many_pyramids at 1/4, 1/2, 1 and 2 times its count
 /// (5, 10, 20 and 40 rows of 20 pyramids).
 fn scaling_scenes() -> Vec<(&'static str, usize, janus2d_testbed::desc::SceneDesc)> {
     let mut out = Vec::new();
-    for rows in [10, 20, 50, 100, 200] {
+    for rows in [5, 10, 20, 30, 40, 50, 100, 200] {
         out.push(("large_pyramid", rows, benchmarks::pyramid(rows)));
     }
     for rows in [5, 10, 20, 40] {
@@ -562,25 +569,43 @@ fn scaling_scenes() -> Vec<(&'static str, usize, janus2d_testbed::desc::SceneDes
     out
 }
 
-/// `scaling`: ms per step and µs per body per step of each engine (one
-/// thread) on the scaling scenes, in one run; prints a table, writes
+/// `scaling`: ms per step and µs per body per step of each engine on the
+/// scaling scenes, in one run, on one thread (or on each count of
+/// `--threads` when given; the chart plots one thread); prints a table, writes
 /// `--csv` (default `docs/performance/scaling.csv`) and `--svg` (default
 /// `docs/performance/scaling.svg`). `--steps` (default 120) timed steps
 /// each, best of `--repeats`.
 fn cmd_scaling(args: &Args) {
     let steps = args.steps.unwrap_or(120);
-    let scenes = scaling_scenes();
+    // `--scenes large_pyramid,many_pyramids:10` picks families or sizes.
+    let scenes: Vec<_> = scaling_scenes()
+        .into_iter()
+        .filter(|(family, size, _)| {
+            args.names.is_empty()
+                || args
+                    .names
+                    .iter()
+                    .any(|n| n == family || *n == format!("{family}:{size}"))
+        })
+        .collect();
+    let thread_counts = if args.threads_given {
+        args.threads.clone()
+    } else {
+        vec![1]
+    };
     println!(
-        "scaling: {} | {} steps, best of {} | one thread",
+        "scaling: {} | {} steps, best of {} | threads {:?}",
         args.engines.join(", "),
         steps,
-        args.repeats
+        args.repeats,
+        thread_counts
     );
     println!(
-        "{:<14} {:>5} {:>7} {}",
+        "{:<14} {:>5} {:>7} {:>3} {}",
         "family",
         "size",
         "bodies",
+        "thr",
         args.engines
             .iter()
             .map(|e| format!("{:>10} {:>8}", format!("{e} ms"), "µs/body"))
@@ -588,46 +613,51 @@ fn cmd_scaling(args: &Args) {
             .join(" ")
             + "  janus2d ÷ Box2D"
     );
-    // (family, size, bodies, engine, ms per step)
+    // (family, size, bodies, engine, ms per step), one thread only: the
+    // chart plots the cost per body of one thread.
     let mut points: Vec<(&str, usize, usize, String, f64)> = Vec::new();
-    let mut csv = String::from("family,size,bodies,engine,ms_per_step,us_per_body\n");
+    let mut csv = String::from("family,size,bodies,threads,engine,ms_per_step,us_per_body\n");
     for (family, size, desc) in &scenes {
         let bodies = desc
             .bodies
             .iter()
             .filter(|b| b.kind == janus2d_testbed::desc::BodyKind::Dynamic)
             .count();
-        let mut line = format!("{family:<14} {size:>5} {bodies:>7}");
-        let mut ms_of = std::collections::BTreeMap::new();
-        for engine in &args.engines {
-            let ms = match time_on(
-                engine,
-                desc,
-                1,
-                &Args {
-                    steps: Some(steps),
-                    ..args.clone()
-                },
-            ) {
-                Ok(t) => t.ms_per_step(),
-                Err(e) => {
-                    eprintln!("{engine} {family} {size}: {e}");
-                    f64::NAN
+        for &threads in &thread_counts {
+            let mut line = format!("{family:<14} {size:>5} {bodies:>7} {threads:>3}");
+            let mut ms_of = std::collections::BTreeMap::new();
+            for engine in &args.engines {
+                let ms = match time_on(
+                    engine,
+                    desc,
+                    threads,
+                    &Args {
+                        steps: Some(steps),
+                        ..args.clone()
+                    },
+                ) {
+                    Ok(t) => t.ms_per_step(),
+                    Err(e) => {
+                        eprintln!("{engine} {family} {size}: {e}");
+                        f64::NAN
+                    }
+                };
+                let per_body = 1e3 * ms / bodies.max(1) as f64;
+                let _ = write!(line, " {ms:>10.3} {per_body:>8.3}");
+                let _ = writeln!(
+                    csv,
+                    "{family},{size},{bodies},{threads},{engine},{ms:.4},{per_body:.4}"
+                );
+                ms_of.insert(engine.clone(), ms);
+                if threads == 1 {
+                    points.push((family, *size, bodies, engine.clone(), ms));
                 }
-            };
-            let per_body = 1e3 * ms / bodies.max(1) as f64;
-            let _ = write!(line, " {ms:>10.3} {per_body:>8.3}");
-            let _ = writeln!(
-                csv,
-                "{family},{size},{bodies},{engine},{ms:.4},{per_body:.4}"
-            );
-            ms_of.insert(engine.clone(), ms);
-            points.push((family, *size, bodies, engine.clone(), ms));
+            }
+            if let (Some(j), Some(b)) = (ms_of.get("janus2d"), ms_of.get("Box2D")) {
+                let _ = write!(line, "  {:.2}", j / b);
+            }
+            println!("{line}");
         }
-        if let (Some(j), Some(b)) = (ms_of.get("janus2d"), ms_of.get("Box2D")) {
-            let _ = write!(line, "  {:.2}", j / b);
-        }
-        println!("{line}");
     }
     let csv_path = args
         .csv
@@ -762,11 +792,25 @@ fn cmd_profile(args: &Args) {
     );
 }
 
-fn run_case(engine: &str, case: &HardCase) -> Result<hard::Outcome, String> {
-    match engine {
+/// Runs a hard case on one engine in a pool of `threads` threads (the
+/// first `--threads` figure, 1 by default), so every engine's ms/step is
+/// measured on the same thread count: janus2d steps on the pool it runs
+/// in, and the machine's global pool would give it every core.
+fn run_case(engine: &str, case: &HardCase, threads: usize) -> Result<hard::Outcome, String> {
+    pool(threads).install(|| match engine {
         "janus2d" => case.run::<Janus>(),
         "Box2D" => case.run::<Box2d>(),
         _ => case.run::<Rapier>(),
+    })
+}
+
+/// The thread count of the hard cases and the sweep: the first of
+/// `--threads` when given, else 1.
+fn case_threads(args: &Args) -> usize {
+    if args.threads_given {
+        args.threads.first().copied().unwrap_or(1)
+    } else {
+        1
     }
 }
 
@@ -784,13 +828,14 @@ fn cmd_hard(args: &Args) {
     let mut passes = vec![0usize; args.engines.len()];
     let mut failed: Vec<Vec<&str>> = vec![Vec::new(); args.engines.len()];
     println!(
-        "hard cases: {} substeps, 1/60 s, sleep off; one metric code for every engine",
-        args.substeps.unwrap_or(4)
+        "hard cases: {} substeps, 1/60 s, sleep off, {} thread(s); one metric code for every engine",
+        args.substeps.unwrap_or(4),
+        case_threads(args)
     );
     for case in &cases {
         println!("\n{} [Box2D v3.1: {}]", case.name, case.box2d);
         for (k, engine) in args.engines.iter().enumerate() {
-            match run_case(engine, case) {
+            match run_case(engine, case, case_threads(args)) {
                 Ok(o) => {
                     if o.pass {
                         passes[k] += 1;
@@ -904,7 +949,7 @@ fn cmd_sweep(args: &Args) {
                 if let Some(steps) = args.steps {
                     case.steps = steps;
                 }
-                match run_case(engine, &case) {
+                match run_case(engine, &case, case_threads(args)) {
                     Ok(o) => {
                         let value = o.figures.get(s.figure);
                         println!(

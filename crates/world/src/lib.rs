@@ -93,4 +93,4 @@ pub use snapshot::Snapshot;
 #[cfg(feature = "serde")]
 pub use snapshot::bytes::{SNAPSHOT_MAGIC, SNAPSHOT_VERSION, SnapshotError};
 pub use validate::{Invariant, InvariantError};
-pub use world::{BodyMoveEvent, ExplosionDef, StepEvents, World, WorldDef};
+pub use world::{BodyMoveEvent, ExplosionDef, StepEvents, TEAM_MIN_WORK, World, WorldDef};

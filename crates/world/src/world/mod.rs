@@ -294,6 +294,14 @@ pub struct World {
     /// serialized, so a restored world times its steps).
     #[cfg_attr(feature = "serde", serde(skip))]
     profiling_off: bool,
+    /// The work below which a step runs on the calling thread alone
+    /// ([`World::set_team_min_work`]; not state: not serialized, so a
+    /// restored world has the default).
+    #[cfg_attr(
+        feature = "serde",
+        serde(skip, default = "crate::world::step::default_team_min_work")
+    )]
+    team_min_work: usize,
     step_count: u64,
 }
 
@@ -339,6 +347,7 @@ impl World {
             counters: crate::profile::StepCounters::default(),
             event_work: crate::profile::EventWork::default(),
             profiling_off: false,
+            team_min_work: TEAM_MIN_WORK,
             step_count: 0,
         })
     }
@@ -500,6 +509,7 @@ impl World {
             counters: self.counters,
             event_work: self.event_work,
             profiling_off: self.profiling_off,
+            team_min_work: self.team_min_work,
             step_count: self.step_count,
         }
     }
@@ -519,6 +529,7 @@ mod queries;
 mod shape_edit;
 mod shapes;
 mod step;
+pub use step::TEAM_MIN_WORK;
 /// Gravity: finite, its length at most
 /// [`MAX_GRAVITY`](janus2d_core::limits::MAX_GRAVITY).
 pub(super) fn check_gravity(gravity: Vec2) -> Result<(), WorldError> {

@@ -3,6 +3,25 @@
 
 use super::*;
 
+/// The default of [`World::set_team_min_work`]: a world whose step's
+/// work (awake moving bodies + awake contacts + joints) is below it steps
+/// on the calling thread alone, whatever rayon pool it runs in.
+///
+/// Waking the team (one rayon broadcast a step, and followers that wait
+/// through the serial stages) costs a few to tens of µs a step; a small
+/// world's parallel stages save less than that. Measured on the large
+/// pyramid, 2 threads against 1, best of 5 runs of 300 steps on a 2-core
+/// machine (`janus2d-peers scaling --threads 2`): 15 bodies 16–22 against
+/// 13 µs, 210 bodies (≈ 610 work) 141 against 138 µs, 465 bodies
+/// (≈ 1,400) 0.30 against 0.31 ms, 820 bodies (≈ 2,400) 0.46–0.49 against
+/// 0.56–0.57 ms.
+pub const TEAM_MIN_WORK: usize = 1024;
+
+#[cfg(feature = "serde")]
+pub(crate) fn default_team_min_work() -> usize {
+    TEAM_MIN_WORK
+}
+
 /// `dt` finite, positive and within
 /// [`TIME_STEP_RANGE`](janus2d_core::limits::TIME_STEP_RANGE).
 pub(super) fn check_time_step(dt: Real) -> Result<(), WorldError> {
@@ -62,8 +81,46 @@ impl World {
     /// number finite.
     pub fn step(&mut self, dt: Real) -> Result<(), WorldError> {
         check_time_step(dt)?;
-        janus2d_core::parallel::with_team(|team| self.step_on(dt, team));
+        if self.step_work() < self.team_min_work {
+            self.step_on(dt, &janus2d_core::parallel::Team::serial());
+        } else {
+            janus2d_core::parallel::with_team(|team| self.step_on(dt, team));
+        }
         Ok(())
+    }
+
+    /// The step's work as [`TEAM_MIN_WORK`] counts it: awake moving
+    /// bodies, awake contacts (those of the last step) and joints.
+    fn step_work(&self) -> usize {
+        self.bodies.moving_count() + self.collision.contacts.awake().len() + self.joints.len()
+    }
+
+    /// Sets the work (awake moving bodies + awake contacts + joints, as
+    /// counted when a step begins) below which [`World::step`] runs on the
+    /// calling thread alone instead of on its rayon pool's team; default
+    /// [`TEAM_MIN_WORK`]. 0 puts every step on the team, `usize::MAX`
+    /// none. The state is the same bit for bit either way (the parallel
+    /// stages give the same results on any thread count); only the time
+    /// differs. Not in a snapshot's bytes: a world read back from bytes
+    /// has the default.
+    ///
+    /// ```
+    /// use janus2d_world::{World, WorldDef, TEAM_MIN_WORK};
+    /// let mut world = World::new(WorldDef::default()).unwrap();
+    /// assert_eq!(world.team_min_work(), TEAM_MIN_WORK);
+    /// world.set_team_min_work(0);
+    /// world.step(1.0 / 60.0).unwrap();
+    /// assert_eq!(world.team_min_work(), 0);
+    /// ```
+    pub fn set_team_min_work(&mut self, work: usize) {
+        self.team_min_work = work;
+    }
+
+    /// The work below which a step runs on the calling thread alone
+    /// ([`World::set_team_min_work`]).
+    #[must_use]
+    pub fn team_min_work(&self) -> usize {
+        self.team_min_work
     }
 
     /// [`World::step`] on the calling thread alone, whatever rayon pool it
