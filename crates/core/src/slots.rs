@@ -113,6 +113,15 @@ impl<T> Slots<T> {
             .expect("slot index handed out by this store")
     }
 
+    /// Every slot by index as `(generation, value)` (`None`: free), for a
+    /// pass that splits the slots among threads (a
+    /// [`Team`](crate::parallel::Team)'s blocks). A pass may change the
+    /// live values; it must leave every generation, and which slots are
+    /// free, as it found them.
+    pub fn entries_mut(&mut self) -> &mut [(u32, Option<T>)] {
+        &mut self.entries
+    }
+
     /// Mutable access to slot `index` if it is live (any generation).
     pub fn at_mut(&mut self, index: u32) -> Option<&mut T> {
         self.entries

@@ -324,19 +324,8 @@ impl BroadPhase {
     /// their swept box.
     pub fn move_proxy_in_batch_swept(&mut self, proxy: u32, tight: Aabb, sweep: Vec2) -> bool {
         let slot = self.slot(proxy);
-        let half = 0.5 * slot.margin;
-        let query = if sweep.length_squared() > half * half {
-            bounded(Aabb::new(
-                tight.lower + sweep.min(Vec2::ZERO),
-                tight.upper + sweep.max(Vec2::ZERO),
-            ))
-        } else {
-            bounded(tight)
-        };
-        // Static proxies do not move; a proxy with the tree's whole margin
-        // (a large shape, or any in a world with uniform margins) keeps one
-        // box, swept, for all its pairs.
-        if slot.is_static || self.uniform_margin || slot.margin >= self.dynamic_tree.margin() {
+        let query = swept_query(&slot, tight, sweep);
+        if self.one_box(&slot) {
             return self.move_proxy_in_batch(proxy, query);
         }
         let mut moved = false;
@@ -366,6 +355,25 @@ impl BroadPhase {
             self.mark_moved(proxy);
         }
         moved
+    }
+
+    /// True when [`move_proxy_in_batch_swept`](Self::move_proxy_in_batch_swept)
+    /// with these arguments would change nothing: its boxes hold the
+    /// shape's. Reads only, so a pass on threads can ask it for every shape
+    /// and leave the (few) moves to the caller, in order.
+    #[must_use]
+    pub fn keeps_boxes(&self, proxy: u32, tight: Aabb, sweep: Vec2) -> bool {
+        let slot = self.slot(proxy);
+        slot.fat.contains(&swept_query(&slot, tight, sweep))
+            && (self.one_box(&slot) || slot.core.contains(&tight))
+    }
+
+    /// Static proxies do not move; a proxy with the tree's whole margin (a
+    /// large shape, or any in a world with uniform margins) keeps one box,
+    /// swept, for all its pairs.
+    #[inline]
+    fn one_box(&self, slot: &ProxySlot) -> bool {
+        slot.is_static || self.uniform_margin || slot.margin >= self.dynamic_tree.margin()
     }
 
     /// Ends a batch of [`move_proxy_in_batch`](Self::move_proxy_in_batch):
@@ -810,6 +818,23 @@ impl BroadPhase {
     }
 }
 
+/// The box a shape with tight box `tight`, moving by `sweep` in a step,
+/// asks its proxy's tree box to hold
+/// ([`BroadPhase::move_proxy_in_batch_swept`]): swept when the move is more
+/// than half the proxy's margin, else the tight box.
+#[inline]
+fn swept_query(slot: &ProxySlot, tight: Aabb, sweep: Vec2) -> Aabb {
+    let half = 0.5 * slot.margin;
+    if sweep.length_squared() > half * half {
+        bounded(Aabb::new(
+            tight.lower + sweep.min(Vec2::ZERO),
+            tight.upper + sweep.max(Vec2::ZERO),
+        ))
+    } else {
+        bounded(tight)
+    }
+}
+
 /// Whether two proxies' boxes overlap as a pair needs: the core boxes
 /// (without the velocity sweep) of two movable proxies, the tree boxes
 /// otherwise (a swept box against static geometry, so that a fast shape
@@ -1247,5 +1272,60 @@ mod tests {
         assert_eq!(out, vec![(1, 2), (1, 3)]);
         assert!(bp.test_overlap(a, b));
         bp.validate();
+    }
+
+    /// The proxy update asks `keeps_boxes` for every shape on the team and
+    /// moves only the others: where it answers true, a swept move must
+    /// change nothing (no move, same boxes, no pair reported after), and
+    /// where it answers false, the move must move. Small proxies (sized
+    /// margins, boxes split into tree and core) and large ones, static ones
+    /// and swept moves.
+    #[test]
+    fn keeps_boxes_is_true_exactly_when_a_swept_move_changes_nothing() {
+        let mut rng = Lcg(7);
+        let mut bp = BroadPhase::new();
+        let mut ids = Vec::new();
+        for i in 0..400u32 {
+            let b = random_box(&mut rng, 40.0);
+            let margin = if i % 3 == 0 { 0.1 } else { 0.03 };
+            ids.push(bp.create_proxy_with_margin(b, payload_of(i), i % 10 == 0, margin));
+        }
+        let mut pairs = Vec::new();
+        bp.update_pairs(|_, _| true, &mut pairs, &Team::serial());
+        let (mut kept, mut moved) = (0, 0);
+        for round in 0..20 {
+            for &id in &ids {
+                let step = if round % 2 == 0 { 0.02 } else { 0.2 };
+                let d = Vec2::new(rng.range(-step, step), rng.range(-step, step));
+                let tight = translate(bp.fat_aabb(id), d).fattened(-0.03);
+                let sweep = Vec2::new(rng.range(-step, step), rng.range(-step, step));
+                let before = bp.slot(id);
+                let keeps = bp.keeps_boxes(id, tight, sweep);
+                let did = bp.move_proxy_in_batch_swept(id, tight, sweep);
+                let after = bp.slot(id);
+                if keeps {
+                    kept += 1;
+                    assert!(!did, "round {round}, proxy {id}: kept, yet moved");
+                    assert_eq!(
+                        (before.fat, before.core),
+                        (after.fat, after.core),
+                        "round {round}, proxy {id}: kept, yet its boxes changed"
+                    );
+                } else {
+                    moved += 1;
+                    assert!(
+                        did || before.is_static,
+                        "round {round}, proxy {id}: not kept, yet not moved"
+                    );
+                }
+            }
+            bp.finish_moves();
+            bp.update_pairs(|_, _| true, &mut pairs, &Team::serial());
+            bp.validate();
+        }
+        assert!(
+            kept > 1000 && moved > 1000,
+            "both answers met: kept {kept}, moved {moved}"
+        );
     }
 }

@@ -698,6 +698,13 @@ impl ShapeStore {
         self.slots.live(index)
     }
 
+    /// Every shape slot by index as `(generation, shape)` (`None`: free),
+    /// for the proxy update's pass on the team ([`Slots::entries_mut`]).
+    #[inline]
+    pub(crate) fn entries_mut(&mut self) -> &mut [(u32, Option<ShapeData>)] {
+        self.slots.entries_mut()
+    }
+
     /// Mutable access to live slot `index`.
     #[inline]
     pub fn at_mut(&mut self, index: u32) -> &mut ShapeData {
