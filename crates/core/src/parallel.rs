@@ -381,6 +381,29 @@ impl Team<'_> {
         self.for_each_chunk_pair_mut(items, &mut none, len, |i, chunk, _| f(i, chunk));
     }
 
+    /// [`Team::for_each_chunk_mut`] with `beside`, serial work of the
+    /// caller's that shares no data with `items`, run first on the leader
+    /// while the other threads start on the blocks (on a serial team, before
+    /// the blocks).
+    pub fn for_each_chunk_mut_beside<T: Send>(
+        &self,
+        items: &mut [T],
+        len: usize,
+        f: impl Fn(usize, &mut [T]) + Sync,
+        beside: impl FnOnce(),
+    ) {
+        let mut none = vec![(); items.len()];
+        let mut none_too = vec![(); items.len()];
+        self.for_each_chunk_triple_mut_beside(
+            items,
+            &mut none,
+            &mut none_too,
+            len,
+            |i, chunk, _, _| f(i, chunk),
+            beside,
+        );
+    }
+
     /// [`Team::for_each_chunk_mut`] over two slices of the same length at
     /// once: `f(i, a_block, b_block)` gets the same item range of both
     /// (the body sims and their states, say).

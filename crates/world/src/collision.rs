@@ -549,30 +549,41 @@ impl Collision {
         read
     }
 
-    /// The step's end for the pipeline: the solved impulses go back into
-    /// the contacts (`store`), `advance` (continuous collision: it moves
-    /// fast bodies, reading the shapes and the broadphase) runs, and the
-    /// proxies then follow the new poses; each on the step's team. Returns
-    /// what `advance` returned.
+    /// The step's end for the pipeline: `advance` (continuous collision:
+    /// it moves fast bodies, reading the shapes and the broadphase) runs,
+    /// the shapes' boxes follow the new poses, and then the solved impulses
+    /// go back into the contacts (`store`) while the leader moves the
+    /// proxies that left their boxes and rebuilds the tree (`beside`, the
+    /// serial part of the proxy update: it shares no data with the
+    /// contacts). Each on the step's team. Returns what `advance` returned.
+    ///
+    /// ```text
+    /// team:    advance ─ boxes ─┬─ store (blocks of contacts) ─┐
+    /// leader:                   └─ proxy moves, tree rebuild ──┴─ done
+    /// ```
     pub(crate) fn end_step<R>(
         &mut self,
         bodies: &mut BodySet,
         dt: Real,
-        store: impl FnOnce(&mut ContactSet, &Team),
+        store: impl FnOnce(&mut ContactSet, &Team, &mut dyn FnMut()),
         advance: impl FnOnce(&mut BodySet, &ShapeStore, &BroadPhase, &Team) -> R,
         team: &Team,
     ) -> R {
-        store(&mut self.contacts, team);
         let out = advance(bodies, &self.shapes, &self.broadphase, team);
-        self.counters.proxies_moved =
-            Self::update_proxies(&mut self.shapes, &mut self.broadphase, bodies, dt, team);
+        let bodies = &*bodies;
+        let order = Self::update_boxes(&mut self.shapes, &self.broadphase, bodies, dt, team);
+        let (shapes, broadphase) = (&self.shapes, &mut self.broadphase);
+        let mut moved = 0;
+        let mut beside = || moved = Self::move_proxies(&order, shapes, broadphase, bodies, dt);
+        store(&mut self.contacts, team, &mut beside);
+        self.counters.proxies_moved = moved;
         out
     }
 
-    /// Recomputes the boxes of the shapes of moving bodies and moves their
-    /// proxies when they left their fat boxes; returns the number of
-    /// proxies moved. Touches only the shapes and the broadphase (see
-    /// [`Collision::end_step`]).
+    /// Recomputes the boxes of the shapes of moving bodies and lists the
+    /// shapes whose proxies left their fat boxes, in the order
+    /// [`Collision::move_proxies`] moves them. Touches only the shapes (and
+    /// reads the broadphase; see [`Collision::end_step`]).
     ///
     /// A shape that travels more than half its fat margin in a step gets a
     /// swept box ([`BroadPhase::move_proxy_in_batch_swept`]), so pairs
@@ -596,18 +607,18 @@ impl Collision {
     /// more than the whole pass on one thread (0.8–1.6 ms); now the pass
     /// takes 0.5–0.8 ms on two threads, and on one about what the pass by
     /// body took.
-    fn update_proxies(
+    fn update_boxes(
         shapes: &mut ShapeStore,
-        broadphase: &mut BroadPhase,
+        broadphase: &BroadPhase,
         bodies: &BodySet,
         dt: Real,
         team: &Team,
-    ) -> usize {
+    ) -> Vec<(u32, usize, u32)> {
         const BLOCK: usize = 512;
         let entries = shapes.entries_mut();
         let mut moves = vec![false; entries.len()];
         {
-            let read = &*broadphase;
+            let read = broadphase;
             team.for_each_chunk_pair_mut(entries, &mut moves, BLOCK, |_, block, flags| {
                 for ((_, entry), flag) in block.iter_mut().zip(flags) {
                     let Some(shape) = entry else { continue };
@@ -636,8 +647,21 @@ impl Collision {
             order.push((i, place, s));
         }
         order.sort_unstable();
+        order
+    }
+
+    /// Moves the proxies [`Collision::update_boxes`] listed (`order`: body
+    /// state index, place in the body's shape list, shape slot), then
+    /// rebuilds the movable proxies' tree; returns the number moved.
+    fn move_proxies(
+        order: &[(u32, usize, u32)],
+        shapes: &ShapeStore,
+        broadphase: &mut BroadPhase,
+        bodies: &BodySet,
+        dt: Real,
+    ) -> usize {
         let mut moved = 0;
-        for (i, _, s) in order {
+        for &(i, _, s) in order {
             let shape = shapes.at(s);
             let sweep = dt * bodies.states[i as usize].v;
             if broadphase.move_proxy_in_batch_swept(shape.proxy, bounded(shape.aabb), sweep) {

@@ -481,13 +481,15 @@ impl ContactBuilder {
 
     /// Copies solved impulses back into the contacts (for warm starting);
     /// `places` is where the solver holds each awake contact's impulses
-    /// (`place_of`). Touches only the contacts: it runs beside continuous
-    /// collision and the proxy update (`Collision::end_step`).
+    /// (`place_of`). Touches only the contacts: `beside` (the proxy moves
+    /// and the tree rebuild, `Collision::end_step`) runs on the leader
+    /// while the team stores, or first on one thread.
     pub(crate) fn store_impulses(
         &self,
         contacts: &mut ContactSet,
         solver: &ContactSolver,
         team: &Team,
+        beside: &mut dyn FnMut(),
     ) {
         let places = &self.place_of[..];
         // A non-finite impulse (a solve that blew up) is not kept for warm
@@ -506,17 +508,23 @@ impl ContactBuilder {
             // scatter below measured faster: 6.8% of many_pyramids' samples
             // against 10.2% for this gather.)
             const BLOCK: usize = 1024;
-            team.for_each_chunk_mut(contacts.awake_slice_mut(), BLOCK, |i, block| {
-                for (c, place) in block.iter_mut().zip(&places[i * BLOCK..]) {
-                    if Self::is_solved(place) {
-                        for k in 0..c.point_count {
-                            keep(&mut c.points[k], solver.point_impulse_at(*place, k));
+            team.for_each_chunk_mut_beside(
+                contacts.awake_slice_mut(),
+                BLOCK,
+                |i, block| {
+                    for (c, place) in block.iter_mut().zip(&places[i * BLOCK..]) {
+                        if Self::is_solved(place) {
+                            for k in 0..c.point_count {
+                                keep(&mut c.points[k], solver.point_impulse_at(*place, k));
+                            }
                         }
                     }
-                }
-            });
+                },
+                beside,
+            );
             return;
         }
+        beside();
         solver.for_each_impulse_into(
             contacts,
             |contacts, index| {

@@ -285,8 +285,9 @@ impl World {
         }
         lap();
         if has_shapes {
-            // The impulses go back into the contacts beside continuous
-            // collision and the proxy update (`Collision::end_step`).
+            // Continuous collision, the proxies' boxes, then the impulses
+            // back into the contacts beside the proxy moves
+            // (`Collision::end_step`).
             let continuous = &mut self.continuous;
             let (no_collide, clipping) = (self.joints.no_collide(), self.portals.clipping());
             let portal_rows = self.portals.constraints();
@@ -296,7 +297,7 @@ impl World {
             let continuous_time = self.collision.end_step(
                 &mut self.bodies,
                 dt,
-                |contacts, team| builder.store_impulses(contacts, solver, team),
+                |contacts, team, beside| builder.store_impulses(contacts, solver, team, beside),
                 |bodies, shapes, broadphase, team| {
                     let start = profiling.then(std::time::Instant::now);
                     let input = crate::continuous::ContinuousInput {
