@@ -551,8 +551,8 @@ fn cmd_chart(args: &Args) {
     println!("wrote {svg}");
 }
 
-/// The scenes of the scaling run: the large pyramid at 5, 10, 20, 50,
-/// 100 and 200 rows, and many_pyramids at 1/4, 1/2, 1 and 2 times its count
+/// The scenes of the scaling run: the large pyramid at 5, 10, 20, 30,
+/// 40, 50, 100 and 200 rows, and many_pyramids at 1/4, 1/2, 1 and 2 times its count
 /// (5, 10, 20 and 40 rows of 20 pyramids).
 fn scaling_scenes() -> Vec<(&'static str, usize, janus2d_testbed::desc::SceneDesc)> {
     let mut out = Vec::new();
@@ -797,10 +797,17 @@ fn cmd_profile(args: &Args) {
 /// measured on the same thread count: janus2d steps on the pool it runs
 /// in, and the machine's global pool would give it every core.
 fn run_case(engine: &str, case: &HardCase, threads: usize) -> Result<hard::Outcome, String> {
+    fn on<E: janus2d_testbed::engine::Engine>(
+        case: &HardCase,
+        threads: usize,
+    ) -> Result<hard::Outcome, String> {
+        let mut built = E::build(&case.desc, EngineOptions { threads })?;
+        Ok(case.measure(&mut built))
+    }
     pool(threads).install(|| match engine {
-        "janus2d" => case.run::<Janus>(),
-        "Box2D" => case.run::<Box2d>(),
-        _ => case.run::<Rapier>(),
+        "janus2d" => on::<Janus>(case, threads),
+        "Box2D" => on::<Box2d>(case, threads),
+        _ => on::<Rapier>(case, threads),
     })
 }
 

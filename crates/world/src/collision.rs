@@ -571,13 +571,63 @@ impl Collision {
     ) -> R {
         let out = advance(bodies, &self.shapes, &self.broadphase, team);
         let bodies = &*bodies;
-        let order = Self::update_boxes(&mut self.shapes, &self.broadphase, bodies, dt, team);
-        let (shapes, broadphase) = (&self.shapes, &mut self.broadphase);
         let mut moved = 0;
-        let mut beside = || moved = Self::move_proxies(&order, shapes, broadphase, bodies, dt);
-        store(&mut self.contacts, team, &mut beside);
+        if Self::boxes_by_slot(team, bodies, &self.shapes) {
+            let order = Self::update_boxes(&mut self.shapes, &self.broadphase, bodies, dt, team);
+            let (shapes, broadphase) = (&self.shapes, &mut self.broadphase);
+            let mut beside = || moved = Self::move_proxies(&order, shapes, broadphase, bodies, dt);
+            store(&mut self.contacts, team, &mut beside);
+        } else {
+            let (shapes, broadphase) = (&mut self.shapes, &mut self.broadphase);
+            let mut beside =
+                || moved = Self::update_proxies_by_body(shapes, broadphase, bodies, dt);
+            store(&mut self.contacts, team, &mut beside);
+        }
         self.counters.proxies_moved = moved;
         out
+    }
+
+    /// Whether the proxy update goes over the shape slots on the team
+    /// ([`Collision::update_boxes`]) rather than over the moving bodies on
+    /// the leader ([`Collision::update_proxies_by_body`]): with more than
+    /// one thread, at least 1,024 moving bodies, and moving bodies at least
+    /// half as many as the shapes. The pass by slot visits every shape,
+    /// static or asleep ones too, so where most shapes do not move (a
+    /// level's static geometry, a sleeping pile) the pass by body, whose
+    /// cost follows the moving bodies alone, is cheaper. Both move the
+    /// proxies in the same order.
+    fn boxes_by_slot(team: &Team, bodies: &BodySet, shapes: &ShapeStore) -> bool {
+        let moving = bodies.moving_count();
+        team.threads() > 1 && moving >= 1024 && 2 * moving >= shapes.len()
+    }
+
+    /// Recomputes the boxes of the shapes of moving bodies and moves their
+    /// proxies when they left their fat boxes, body by body in state order
+    /// (each body's shapes in its list's order); returns the number moved.
+    /// The pass for one thread and for worlds whose shapes mostly do not
+    /// move ([`Collision::boxes_by_slot`]).
+    fn update_proxies_by_body(
+        shapes: &mut ShapeStore,
+        broadphase: &mut BroadPhase,
+        bodies: &BodySet,
+        dt: Real,
+    ) -> usize {
+        let mut moved = 0;
+        for (sim, state) in bodies.sims.iter().zip(&bodies.states).skip(1) {
+            let sweep = dt * state.v;
+            let n = shapes.of_body(sim.handle).len();
+            for k in 0..n {
+                let s = shapes.of_body(sim.handle)[k];
+                let shape = shapes.at_mut(s);
+                let tight = shape.geometry.compute_aabb(&sim.transform);
+                shape.aabb = tight;
+                if broadphase.move_proxy_in_batch_swept(shape.proxy, bounded(tight), sweep) {
+                    moved += 1;
+                }
+            }
+        }
+        broadphase.finish_moves();
+        moved
     }
 
     /// Recomputes the boxes of the shapes of moving bodies and lists the
@@ -599,14 +649,14 @@ impl Collision {
     ///                                      in the body's shape list), moved
     /// ```
     ///
-    /// The moves keep the order of a pass over the bodies, so the tree and
-    /// its move buffer are the same on any thread count. Before (stop 54),
-    /// the team computed the boxes by body and the leader then wrote every
-    /// shape's box and asked every proxy in body order: on many_pyramids
-    /// (22,000 bodies, two threads) that loop alone took 1.2–1.5 ms a step,
-    /// more than the whole pass on one thread (0.8–1.6 ms); now the pass
-    /// takes 0.5–0.8 ms on two threads, and on one about what the pass by
-    /// body took.
+    /// The moves keep the order of the pass by body
+    /// ([`Collision::update_proxies_by_body`]), so the tree and its move
+    /// buffer are the same on any thread count. Before (stop 54), the team
+    /// computed the boxes by body and the leader then wrote every shape's
+    /// box and asked every proxy in body order: on many_pyramids (22,000
+    /// bodies, two threads) that loop alone took 1.2–1.5 ms a step, more
+    /// than the whole pass by body on one thread (0.8–1.6 ms); by slot the
+    /// update takes 0.5–0.8 ms on two threads.
     fn update_boxes(
         shapes: &mut ShapeStore,
         broadphase: &BroadPhase,
@@ -618,7 +668,6 @@ impl Collision {
         let entries = shapes.entries_mut();
         let mut moves = vec![false; entries.len()];
         {
-            let read = broadphase;
             team.for_each_chunk_pair_mut(entries, &mut moves, BLOCK, |_, block, flags| {
                 for ((_, entry), flag) in block.iter_mut().zip(flags) {
                     let Some(shape) = entry else { continue };
@@ -629,7 +678,11 @@ impl Collision {
                     }
                     let tight = shape.geometry.compute_aabb(&bodies.sims[i].transform);
                     shape.aabb = tight;
-                    *flag = !read.keeps_boxes(shape.proxy, bounded(tight), dt * bodies.states[i].v);
+                    *flag = !broadphase.keeps_boxes(
+                        shape.proxy,
+                        bounded(tight),
+                        dt * bodies.states[i].v,
+                    );
                 }
             });
         }
