@@ -137,6 +137,12 @@ pub(crate) struct RecycleCache {
     /// Separation of each point then, m. (The anchors then are the
     /// points' own: recycling keeps them.)
     pub separation: [Real; 2],
+    /// When the manifold then was empty on a separating-axis test: that
+    /// test's clearance, m, and `relative` is of the bodies' origins
+    /// (`x_a⁻¹ x_b`), not their centres (the narrowphase's `keeps_empty`).
+    /// Else 0. Not saved: a restored world tests its empty pairs again.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub clearance: Real,
 }
 
 impl Contact {

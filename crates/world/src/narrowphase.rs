@@ -5,9 +5,15 @@
 //! phase 1 (parallel with `parallel`)   each awake contact alone, in place:
 //!     both bodies still      → Asleep (kept as is)
 //!     fat boxes apart        → Separated
-//!     moved little since the
-//!     manifold was computed  → Updated: the manifold kept, separations
+//!     touching, moved little
+//!     since the manifold was
+//!     computed               → Updated: the manifold kept, separations
 //!                              updated from its anchors (recycle)
+//!     tight boxes apart by
+//!     more than speculative  → Updated: empty
+//!     empty, and moved less
+//!     than its clearance     → Updated: empty, untested (keeps_empty;
+//!                              what the test would give)
 //!     else                   → Updated: collide(a, b, speculative),
 //!                              aperture clipping applied, the points that
 //!                              cannot close within the step dropped,
@@ -26,7 +32,7 @@
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
 use janus2d_core::contact_input::{ContactLane, ContactPointInput, NO_CLUSTER};
-use janus2d_core::geometry::{Aabb, Manifold, collide};
+use janus2d_core::geometry::{Aabb, Manifold, collide_with_clearance};
 use janus2d_core::math::{Real, Rot, Transform, Vec2};
 use janus2d_core::parallel::Team;
 
@@ -485,16 +491,57 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
     // speculative distance along x or y: the shapes are too, no point can
     // come within it, and the manifold is empty without computing it.
     let gap = (sa.aabb.lower - sb.aabb.upper).max(sb.aabb.lower - sa.aabb.upper);
-    let mut manifold = if gap.x > speculative || gap.y > speculative {
+    let apart = gap.x > speculative || gap.y > speculative;
+    if apart && input.unclipped {
+        // Empty: the boxes are read afresh every step, so the cache, and
+        // any clearance it holds, stays as it was.
+        c.recycle.valid = false;
+        c.still = [body_a.state_index == 0, body_b.state_index == 0];
+        c.solve_bodies = [solve_body(&body_a), solve_body(&body_b)];
+        let was_touching = c.touching;
+        c.normal = Vec2::ZERO;
+        c.point_count = 0;
+        c.touching = false;
+        return ContactUpdate::Updated {
+            was_touching,
+            touching: false,
+            solid: false,
+            wake: false,
+        };
+    }
+    let mut clearance = 0.0;
+    let mut manifold = if apart {
+        // (Aperture clipping may add points at an aperture's edge.)
         Manifold::default()
+    } else if recyclable
+        && c.point_count == 0
+        && !c.touching
+        && keeps_empty(
+            &c.recycle,
+            [&sim_a.transform, &sim_b.transform],
+            [&sa.aabb, &sb.aabb],
+            speculative,
+        )
+    {
+        // The same as testing again, which would find it empty.
+        c.still = [body_a.state_index == 0, body_b.state_index == 0];
+        c.solve_bodies = [solve_body(&body_a), solve_body(&body_b)];
+        return ContactUpdate::Updated {
+            was_touching: false,
+            touching: false,
+            solid: false,
+            wake: false,
+        };
     } else {
-        collide(
+        let (m, clear) = collide_with_clearance(
             &sa.geometry,
             &sim_a.transform,
             &sb.geometry,
             &sim_b.transform,
             speculative,
-        )
+        );
+        clearance = clear;
+        m
     };
     if !input.unclipped {
         // Before the manifold is stored, so that points made at aperture
@@ -530,12 +577,20 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
     );
     let was_touching = c.touching;
     update_manifold(c, &manifold, offset);
+    let cleared = clearance > 0.0 && input.unclipped && c.point_count == 0;
     c.recycle = RecycleCache {
         valid: c.point_count > 0,
         q_a: sim_a.transform.q,
         q_b: sim_b.transform.q,
-        relative: centre_frame(sim_a).inv_mul(&centre_frame(sim_b)),
+        relative: if cleared {
+            // An empty manifold's cache is of the bodies' origins (see
+            // `keeps_empty`).
+            sim_a.transform.inv_mul(&sim_b.transform)
+        } else {
+            centre_frame(sim_a).inv_mul(&centre_frame(sim_b))
+        },
         separation: [c.points[0].separation, c.points[1].separation],
+        clearance: if cleared { clearance } else { 0.0 },
     };
     c.still = [body_a.state_index == 0, body_b.state_index == 0];
     c.solve_bodies = [solve_body(&body_a), solve_body(&body_b)];
@@ -679,6 +734,65 @@ fn recycle(
     true
 }
 
+/// Keeps an empty manifold empty without testing the pair again: when the
+/// test at the cached poses ended on a clearance `s₀` (see
+/// [`collide_with_clearance`]), no point of either shape has since moved
+/// by more than `m` relative to the other shape, and `s₀ − m` still
+/// exceeds the speculative distance `d` (plus a rounding margin), the same
+/// test now ends the same way: the manifold would be empty.
+///
+/// `m` is the larger of the two shapes' motions in each other's frame,
+/// from the bodies' origins (which shape edits and mass changes leave
+/// where they are; a shape edit destroys its contacts):
+/// `m_b = |Δp| + 2 |sin(Δθ / 2)| R_b` for b in a's frame, with `p`, `θ` the
+/// relative pose `x_a⁻¹ x_b` and `R_b` the reach of b's box from b's
+/// origin, and the same for a in b's frame (`x_b⁻¹ x_a`).
+///
+/// Measured on compounds (3,000 bodies of two triangles; janus2d alone):
+/// of about 31,000 awake contacts, 12,000 touching ones are recycled and
+/// 6,000 have boxes apart; of the 12,000 tested, most are empty.
+///
+/// `cache`: the contact's, whose manifold is empty; `poses`: the bodies'
+/// origins now; `boxes`: the shapes' tight boxes now.
+fn keeps_empty(
+    cache: &RecycleCache,
+    poses: [&Transform; 2],
+    boxes: [&Aabb; 2],
+    speculative: Real,
+) -> bool {
+    if cache.clearance <= speculative {
+        return false;
+    }
+    let [xf_a, xf_b] = poses;
+    let relative = xf_a.inv_mul(xf_b);
+    let then = cache.relative;
+    // |R₁ − R₀| = 2 |sin(Δθ / 2)| = |(cos Δθ − 1, sin Δθ)|.
+    let dq = relative.q.inv_mul(then.q);
+    let chord = Vec2::new(dq.c - 1.0, dq.s).length();
+    let reach = |aabb: &Aabb, origin: Vec2| {
+        (aabb.lower - origin)
+            .abs()
+            .max((aabb.upper - origin).abs())
+            .length()
+    };
+    // b in a's frame; a in b's frame (the inverse pose's translation).
+    let moved_b = (relative.p - then.p).length() + chord * reach(boxes[1], xf_b.p);
+    let inverse = |x: &Transform| x.q.inv_rotate(-x.p);
+    let moved_a = (inverse(&relative) - inverse(&then)).length() + chord * reach(boxes[0], xf_a.p);
+    // Rounding: the test and this bound each round the relative pose at
+    // the bodies' distance from the world origin.
+    let far = xf_a.p.abs().max_element() + xf_b.p.abs().max_element();
+    let margin = CLEARANCE_MARGIN + 8.0 * Real::EPSILON * far;
+    // (NaN poses test again.)
+    cache.clearance - moved_b.max(moved_a) > speculative + margin
+}
+
+/// The least margin (m) by which a kept empty manifold's clearance must
+/// exceed the speculative distance after the bodies' motion
+/// ([`keeps_empty`]): above the rounding of the separating-axis test at
+/// metre scale.
+const CLEARANCE_MARGIN: Real = 1e-4;
+
 /// A body's state index and inverse masses as the solve takes them (zero
 /// masses for the static identity state 0).
 #[inline]
@@ -716,5 +830,145 @@ fn update_manifold(c: &mut Contact, m: &Manifold, offset: [Vec2; 2]) {
             p.tangent_impulse = o.tangent_impulse;
         }
         c.points[i] = p;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use janus2d_core::geometry::{Capsule, Circle, Polygon, Segment, Shape, collide};
+    use proptest::prelude::*;
+
+    /// The shapes the soundness property draws from.
+    fn shape(kind: usize) -> Shape {
+        match kind {
+            0 => Shape::Polygon(Polygon::make_box(0.5, 0.3)),
+            1 => Shape::Polygon(Polygon::make_offset_box(
+                0.2,
+                0.6,
+                Vec2::new(0.3, -0.1),
+                0.4,
+            )),
+            2 => Shape::Polygon(Polygon::make_rounded_box(0.3, 0.2, 0.1)),
+            3 => Shape::Circle(Circle::new(Vec2::new(0.1, 0.2), 0.35).unwrap()),
+            4 => Shape::Capsule(
+                Capsule::new(Vec2::new(-0.3, 0.0), Vec2::new(0.4, 0.1), 0.15).unwrap(),
+            ),
+            _ => Shape::Segment(Segment {
+                point1: Vec2::new(-1.0, 0.2),
+                point2: Vec2::new(1.0, -0.2),
+            }),
+        }
+    }
+
+    /// The cache a narrowphase test at `poses` leaves for an empty
+    /// manifold (origins' relative pose and the clearance).
+    fn empty_cache(shapes: [&Shape; 2], poses: [&Transform; 2], spec: Real) -> RecycleCache {
+        let (m, clearance) = collide_with_clearance(shapes[0], poses[0], shapes[1], poses[1], spec);
+        RecycleCache {
+            relative: poses[0].inv_mul(poses[1]),
+            clearance: if m.point_count == 0 { clearance } else { 0.0 },
+            ..RecycleCache::default()
+        }
+    }
+
+    /// Whether the narrowphase keeps the empty manifold at `poses`.
+    fn kept(cache: &RecycleCache, shapes: [&Shape; 2], poses: [&Transform; 2], spec: Real) -> bool {
+        let boxes = [
+            shapes[0].compute_aabb(poses[0]),
+            shapes[1].compute_aabb(poses[1]),
+        ];
+        keeps_empty(cache, poses, [&boxes[0], &boxes[1]], spec)
+    }
+
+    #[test]
+    fn an_empty_pair_moved_less_than_its_clearance_is_kept_and_one_moved_more_is_tested() {
+        let b = Shape::Polygon(Polygon::make_box(0.5, 0.5));
+        let a0 = Transform::new(Vec2::ZERO, 0.0);
+        // 0.3 m apart: clearance 0.3.
+        let b0 = Transform::new(Vec2::new(1.3, 0.0), 0.0);
+        let cache = empty_cache([&b, &b], [&a0, &b0], 0.02);
+        assert!((cache.clearance - 0.3).abs() < 1e-5);
+        // b closer by 0.2 m and turned 0.05 rad: its corners reach 0.71 m
+        // from its origin, so it moved at most 0.2 + 0.036 m, leaving
+        // 0.064 m over the speculative distance.
+        let b1 = Transform::new(Vec2::new(1.1, 0.0), 0.05);
+        assert!(kept(&cache, [&b, &b], [&a0, &b1], 0.02));
+        assert_eq!(collide(&b, &a0, &b, &b1, 0.02).point_count, 0);
+        // The same motion with a speculative distance the clearance no
+        // longer covers: tested again.
+        assert!(!kept(&cache, [&b, &b], [&a0, &b1], 0.07));
+        // Moved by 0.29 m: tested again (and the test finds points).
+        let b2 = Transform::new(Vec2::new(1.01, 0.0), 0.0);
+        assert!(!kept(&cache, [&b, &b], [&a0, &b2], 0.02));
+        assert!(collide(&b, &a0, &b, &b2, 0.02).point_count > 0);
+        // Both bodies carried together far away and turned: no relative
+        // motion, kept.
+        let q = Transform::new(Vec2::new(40.0, -7.0), 1.0);
+        let (a3, b3) = (q.mul(&a0), q.mul(&b0));
+        assert!(kept(&cache, [&b, &b], [&a3, &b3], 0.02));
+        // A turn is motion: a 2 m segment 0.3 m above a box turns 0.3 rad
+        // about its middle, which brings its end 0.3 m down onto the box
+        // while its origin stays where it was.
+        let segment = Shape::Segment(Segment {
+            point1: Vec2::new(-1.0, 0.0),
+            point2: Vec2::new(1.0, 0.0),
+        });
+        let s0 = Transform::new(Vec2::new(1.2, 0.8), 0.0);
+        let cache = empty_cache([&b, &segment], [&a0, &s0], 0.02);
+        assert!((cache.clearance - 0.3).abs() < 1e-5);
+        let s1 = Transform::new(Vec2::new(1.2, 0.8), 0.3);
+        assert!(collide(&b, &a0, &segment, &s1, 0.02).point_count > 0);
+        assert!(!kept(&cache, [&b, &segment], [&a0, &s1], 0.02));
+        // A contact whose last test found points has no clearance.
+        let touching = empty_cache([&b, &b], [&a0, &b2], 0.02);
+        assert_eq!(touching.clearance, 0.0);
+        assert!(!kept(&touching, [&b, &b], [&a0, &b2], 0.02));
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig {
+            cases: 4000,
+            // A fixed set of cases unless PROPTEST_RNG_SEED asks for another.
+            rng_seed: match ProptestConfig::default().rng_seed {
+                proptest::test_runner::RngSeed::Random => {
+                    proptest::test_runner::RngSeed::Fixed(0x6a61_6e75_7332_6465)
+                }
+                fixed => fixed,
+            },
+            ..ProptestConfig::default()
+        })]
+
+        /// A kept empty manifold is the one the test would give: whenever
+        /// `keeps_empty` holds after any motion of both bodies, `collide`
+        /// at the new poses finds no point. (Of the 4,000 fixed cases,
+        /// 3,133 are kept.)
+        #[test]
+        fn a_kept_empty_manifold_is_one_the_test_finds_empty(
+            kind_a in 0usize..6,
+            kind_b in 0usize..6,
+            far in prop::array::uniform2(-60.0f64..60.0),
+            angle_a in -3.2f64..3.2,
+            offset in prop::array::uniform2(-2.5f64..2.5),
+            angle_b in -3.2f64..3.2,
+            move_a in prop::array::uniform3(-0.15f64..0.15),
+            move_b in prop::array::uniform3(-0.15f64..0.15),
+            spec_then in 0.02f64..0.1,
+            spec_now in 0.02f64..0.1,
+        ) {
+            let (sa, sb) = (shape(kind_a), shape(kind_b));
+            let v = |x: [f64; 2]| Vec2::new(x[0] as Real, x[1] as Real);
+            let a0 = Transform::new(v(far), angle_a as Real);
+            let b0 = Transform::new(v(far) + v(offset), angle_b as Real);
+            let cache = empty_cache([&sa, &sb], [&a0, &b0], spec_then as Real);
+            let moved = |x: &Transform, m: [f64; 3]| {
+                Transform::new(x.p + v([m[0], m[1]]), x.q.angle() + m[2] as Real)
+            };
+            let (a1, b1) = (moved(&a0, move_a), moved(&b0, move_b));
+            if kept(&cache, [&sa, &sb], [&a1, &b1], spec_now as Real) {
+                let m = collide(&sa, &a1, &sb, &b1, spec_now as Real);
+                prop_assert_eq!(m.point_count, 0);
+            }
+        }
     }
 }

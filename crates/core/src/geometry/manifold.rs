@@ -129,12 +129,60 @@ pub fn feature_id(feature_a: usize, feature_b: usize) -> u16 {
     (((feature_a & 0xff) << 8) | (feature_b & 0xff)) as u16
 }
 
+/// [`collide`], and when the manifold is empty because the shapes lie
+/// apart along one of their faces' normals (or along the line between a
+/// circle's centre and its nearest feature), that separation less the
+/// radii, m: the *clearance*. Otherwise (points found, or a pair without
+/// such a test) the clearance is 0.
+///
+/// The clearance is a lower bound on the test it comes from: while no
+/// point of either shape moves by more than `m` relative to the other
+/// (`m = |Δp| + 2 |sin(Δθ / 2)| R`, the relative translation plus the turn
+/// at the moving shape's reach `R`), the same test gives at least
+/// `clearance − m`, so the manifold stays empty while
+/// `clearance − m > speculative_distance`. The narrowphase keeps empty
+/// manifolds that way without testing again (as Box2D v3.2 recycles the
+/// non-touching ones, but exact: a kept empty manifold is the one the test
+/// would give).
+///
+/// ```
+/// use janus2d_core::geometry::{Polygon, Shape, collide_with_clearance};
+/// use janus2d_core::math::{Rot, Transform, Vec2};
+/// let b = Shape::Polygon(Polygon::make_box(0.5, 0.5));
+/// let xf_a = Transform::IDENTITY;
+/// let xf_b = Transform { p: Vec2::new(1.3, 0.0), q: Rot::IDENTITY };
+/// let (m, clearance) = collide_with_clearance(&b, &xf_a, &b, &xf_b, 0.02);
+/// assert_eq!(m.point_count, 0);
+/// assert!((clearance - 0.3).abs() < 1e-5);
+/// ```
+#[must_use]
+#[inline]
+pub fn collide_with_clearance(
+    shape_a: &Shape,
+    xf_a: &Transform,
+    shape_b: &Shape,
+    xf_b: &Transform,
+    speculative_distance: Real,
+) -> (Manifold, Real) {
+    let mut clearance = 0.0;
+    let m = collide_into(
+        shape_a,
+        xf_a,
+        shape_b,
+        xf_b,
+        speculative_distance,
+        &mut clearance,
+    );
+    (m, clearance)
+}
+
 /// Contact manifold between two shapes placed by `xf_a` and `xf_b`.
 ///
 /// Points are reported when their separation is below
 /// `speculative_distance` (usually [`SPECULATIVE_DISTANCE`](super::SPECULATIVE_DISTANCE)).
 /// See the module docs for the conventions and [`super`] for which routine
 /// handles which pair. Deterministic; never NaN for valid shapes.
+#[must_use]
 pub fn collide(
     shape_a: &Shape,
     xf_a: &Transform,
@@ -142,45 +190,58 @@ pub fn collide(
     xf_b: &Transform,
     speculative_distance: Real,
 ) -> Manifold {
+    collide_into(shape_a, xf_a, shape_b, xf_b, speculative_distance, &mut 0.0)
+}
+
+/// The dispatch of [`collide`]; writes the clearance
+/// ([`collide_with_clearance`]) where a routine's test ends it.
+fn collide_into(
+    shape_a: &Shape,
+    xf_a: &Transform,
+    shape_b: &Shape,
+    xf_b: &Transform,
+    speculative_distance: Real,
+    clear: &mut Real,
+) -> Manifold {
     use Shape as S;
     let spec = speculative_distance;
     match (shape_a, shape_b) {
         // Circle against anything.
-        (S::Circle(a), S::Circle(b)) => collide_circles(a, xf_a, b, xf_b, spec),
+        (S::Circle(a), S::Circle(b)) => collide_circles(a, xf_a, b, xf_b, spec, clear),
         (S::Capsule(a), S::Circle(b)) => {
-            collide_capsule_circle(a.center1, a.center2, a.radius, xf_a, b, xf_b, spec)
+            collide_capsule_circle(a.center1, a.center2, a.radius, xf_a, b, xf_b, spec, clear)
         }
         (S::Segment(a), S::Circle(b)) => {
-            collide_capsule_circle(a.point1, a.point2, 0.0, xf_a, b, xf_b, spec)
+            collide_capsule_circle(a.point1, a.point2, 0.0, xf_a, b, xf_b, spec, clear)
         }
-        (S::Polygon(a), S::Circle(b)) => collide_polygon_circle(a, xf_a, b, xf_b, spec),
+        (S::Polygon(a), S::Circle(b)) => collide_polygon_circle(a, xf_a, b, xf_b, spec, clear),
         (S::ChainSegment(a), S::Circle(b)) => collide_chain_circle(a, xf_a, b, xf_b, spec),
-        (S::Circle(_), _) => collide(shape_b, xf_b, shape_a, xf_a, spec).flipped(),
+        (S::Circle(_), _) => collide_into(shape_b, xf_b, shape_a, xf_a, spec, clear).flipped(),
 
         // Capsule / segment pairs: closest points of the two cores.
         (S::Capsule(a), S::Capsule(b)) => collide_capsules(
-            a.center1, a.center2, a.radius, xf_a, b.center1, b.center2, b.radius, xf_b, spec,
+            a.center1, a.center2, a.radius, xf_a, b.center1, b.center2, b.radius, xf_b, spec, clear,
         ),
         (S::Capsule(a), S::Segment(b)) => collide_capsules(
-            a.center1, a.center2, a.radius, xf_a, b.point1, b.point2, 0.0, xf_b, spec,
+            a.center1, a.center2, a.radius, xf_a, b.point1, b.point2, 0.0, xf_b, spec, clear,
         ),
         (S::Segment(a), S::Capsule(b)) => collide_capsules(
-            a.point1, a.point2, 0.0, xf_a, b.center1, b.center2, b.radius, xf_b, spec,
+            a.point1, a.point2, 0.0, xf_a, b.center1, b.center2, b.radius, xf_b, spec, clear,
         ),
         (S::Segment(a), S::Segment(b)) => collide_capsules(
-            a.point1, a.point2, 0.0, xf_a, b.point1, b.point2, 0.0, xf_b, spec,
+            a.point1, a.point2, 0.0, xf_a, b.point1, b.point2, 0.0, xf_b, spec, clear,
         ),
 
         // Polygon pairs (capsules and segments as 2-vertex polygons).
-        (S::Polygon(a), S::Polygon(b)) => collide_polygons(a, xf_a, b, xf_b, spec),
+        (S::Polygon(a), S::Polygon(b)) => collide_polygons_inner(a, xf_a, b, xf_b, spec, clear),
         (S::Polygon(a), S::Capsule(_) | S::Segment(_)) => {
-            collide_polygons(a, xf_a, &as_polygon(shape_b), xf_b, spec)
+            collide_polygons_inner(a, xf_a, &as_polygon(shape_b), xf_b, spec, clear)
         }
         (S::Capsule(_) | S::Segment(_), S::Polygon(b)) => {
-            collide_polygons(&as_polygon(shape_a), xf_a, b, xf_b, spec)
+            collide_polygons_inner(&as_polygon(shape_a), xf_a, b, xf_b, spec, clear)
         }
 
-        // One-sided chain segments.
+        // One-sided chain segments (one-sided: no clearance).
         (S::ChainSegment(a), S::ChainSegment(b)) => collide_chains(a, xf_a, b, xf_b, spec),
         (S::ChainSegment(a), _) => collide_chain_polygon(a, xf_a, &as_polygon(shape_b), xf_b, spec),
         (_, S::ChainSegment(b)) => {
@@ -208,8 +269,11 @@ fn as_polygon(s: &Shape) -> Polygon {
 
 /// Contact between a disc of radius `ra` at `pa` and one of radius `rb` at
 /// `pb`, both in A's local frame. `fallback` (unit) is the normal used when
-/// the centres coincide.
+/// the centres coincide. `clear`: the clearance where the discs are apart
+/// (their distance less the radii, which a motion of either centre by `m`
+/// changes by at most `m`).
 #[inline]
+#[allow(clippy::too_many_arguments)]
 fn point_contact(
     xf_a: &Transform,
     xf_b: &Transform,
@@ -220,17 +284,20 @@ fn point_contact(
     fallback: Vec2,
     spec: Real,
     id: u16,
+    clear: &mut Real,
 ) -> Manifold {
     let d = pb - pa;
     let dist_sq = d.length_squared();
     let max = ra + rb + spec;
     if dist_sq >= max * max {
+        *clear = dist_sq.sqrt() - ra - rb;
         return Manifold::EMPTY;
     }
     let dist = dist_sq.sqrt();
     let normal = if dist > EPSILON { d / dist } else { fallback };
     let separation = dist - ra - rb;
     if separation >= spec {
+        *clear = separation;
         return Manifold::EMPTY;
     }
     let ca = pa + ra * normal;
@@ -250,6 +317,7 @@ fn collide_circles(
     b: &Circle,
     xf_b: &Transform,
     spec: Real,
+    clear: &mut Real,
 ) -> Manifold {
     let xf = xf_a.inv_mul(xf_b);
     let pb = xf.apply(b.center);
@@ -263,6 +331,7 @@ fn collide_circles(
         Vec2::new(0.0, 1.0),
         spec,
         0,
+        clear,
     )
 }
 
@@ -276,6 +345,7 @@ fn collide_capsule_circle(
     b: &Circle,
     xf_b: &Transform,
     spec: Real,
+    clear: &mut Real,
 ) -> Manifold {
     let xf = xf_a.inv_mul(xf_b);
     let c = xf.apply(b.center);
@@ -288,7 +358,7 @@ fn collide_capsule_circle(
     };
     let q = a1 + t * e;
     let fallback = normalize_or(e, Vec2::new(1.0, 0.0)).perp();
-    point_contact(xf_a, xf_b, q, ra, c, b.radius, fallback, spec, 0)
+    point_contact(xf_a, xf_b, q, ra, c, b.radius, fallback, spec, 0, clear)
 }
 
 /// Polygon–circle: the edge of greatest separation, then its vertex or face
@@ -299,6 +369,7 @@ fn collide_polygon_circle(
     b: &Circle,
     xf_b: &Transform,
     spec: Real,
+    clear: &mut Real,
 ) -> Manifold {
     let xf = xf_a.inv_mul(xf_b);
     let c = xf.apply(b.center);
@@ -314,6 +385,10 @@ fn collide_polygon_circle(
         }
     }
     if separation - radius > spec {
+        // (The largest face separation of the centre: a motion of it by
+        // `m` changes it by at most `m`. The vertex regions' empty ends
+        // give none: the next test may take the face.)
+        *clear = separation - radius;
         return Manifold::EMPTY;
     }
     let v1 = a.vertices[best];
@@ -332,6 +407,7 @@ fn collide_polygon_circle(
             a.normals[best],
             spec,
             0,
+            &mut 0.0,
         )
     } else if u2 < 0.0 && separation > EPSILON {
         // Vertex region of v2.
@@ -345,6 +421,7 @@ fn collide_polygon_circle(
             a.normals[best],
             spec,
             0,
+            &mut 0.0,
         )
     } else {
         // Face region (also when the centre is inside).
@@ -460,6 +537,7 @@ fn collide_capsules(
     rb: Real,
     xf_b: &Transform,
     spec: Real,
+    clear: &mut Real,
 ) -> Manifold {
     let xf = xf_a.inv_mul(xf_b);
     // A's frame shifted to a1.
@@ -472,6 +550,9 @@ fn collide_capsules(
     let radius = ra + rb;
     let max = radius + spec;
     if sd.dist_sq >= max * max {
+        // (The cores' distance: a motion of either by `m` changes it by at
+        // most `m`.)
+        *clear = sd.dist_sq.sqrt() - radius;
         return Manifold::EMPTY;
     }
     let d_ab = xf_a.p - xf_b.p;
@@ -594,12 +675,26 @@ fn next_index(i: usize, count: usize) -> usize {
 /// vertex indices); otherwise the incident edge is clipped to the reference
 /// edge, giving points with ids `(i11, i22)` and `(i12, i21)` (reference edge
 /// vertices `i11 → i12`, incident edge `i21 → i22`, written A-first).
+#[inline]
 pub(crate) fn collide_polygons(
     pa: &Polygon,
     xf_a: &Transform,
     pb: &Polygon,
     xf_b: &Transform,
     spec: Real,
+) -> Manifold {
+    collide_polygons_inner(pa, xf_a, pb, xf_b, spec, &mut 0.0)
+}
+
+/// The polygon routine; writes the clearance where a separating-axis
+/// test ends it.
+fn collide_polygons_inner(
+    pa: &Polygon,
+    xf_a: &Transform,
+    pb: &Polygon,
+    xf_b: &Transform,
+    spec: Real,
+    clearance: &mut Real,
 ) -> Manifold {
     let origin = pa.vertices[0];
     let xf = xf_a.inv_mul(xf_b);
@@ -628,10 +723,12 @@ pub(crate) fn collide_polygons(
 
     let (edge_a, sep_a) = find_max_separation(&la, &lb);
     if sep_a - radius > spec {
+        *clearance = sep_a - radius;
         return Manifold::EMPTY;
     }
     let (edge_b, sep_b) = find_max_separation(&lb, &la);
     if sep_b - radius > spec {
+        *clearance = sep_b - radius;
         return Manifold::EMPTY;
     }
 
@@ -849,7 +946,18 @@ fn collide_chain_circle(
     } else {
         p1 + u * e
     };
-    point_contact(xf_a, xf_b, q, 0.0, c, b.radius, right_perp(u1), spec, 0)
+    point_contact(
+        xf_a,
+        xf_b,
+        q,
+        0.0,
+        c,
+        b.radius,
+        right_perp(u1),
+        spec,
+        0,
+        &mut 0.0,
+    )
 }
 
 /// Chain segment–polygon (capsules and segments as 2-vertex polygons): no

@@ -65,7 +65,7 @@ pub use distance::{
 };
 pub use manifold::{
     CAPSULE_PARALLEL_SINE, CHAIN_FACE_SINE, Manifold, ManifoldPoint, REFERENCE_FACE_TOLERANCE,
-    collide, feature_id,
+    collide, collide_with_clearance, feature_id,
 };
 pub use mass::MassData;
 pub use ray::{CastHit, RayInput};
