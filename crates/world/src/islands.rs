@@ -487,12 +487,16 @@ impl Islands {
         }
         // Timers (slot 0 is the static sentinel).
         for i in 1..n {
-            let (handle, center) = (bodies.sims[i].handle, bodies.sims[i].center);
-            let reach = input.shapes.reach(handle, center);
             let st = bodies.states[i];
             let sim = &mut bodies.sims[i];
             let tol2 = sim.sleep_threshold.map_or(tol2, |t| t * t);
-            let slow = st.v.length_squared() <= tol2 && st.w * st.w * reach * reach <= tol2;
+            // The shapes' reach (random reads of the shape records) only
+            // where the linear speed leaves the turn to decide.
+            let turn_slow = || {
+                let reach = input.shapes.reach(sim.handle, sim.center);
+                st.w * st.w * reach * reach <= tol2
+            };
+            let slow = st.v.length_squared() <= tol2 && turn_slow();
             if sim.body_type == BodyType::Dynamic && slow && sim.enable_sleep {
                 sim.sleep_time += input.dt;
             } else {
