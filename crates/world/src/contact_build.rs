@@ -39,6 +39,10 @@ use crate::narrowphase::{PreSolve, PreSolveFn, StagedContact, solve_body, stage}
 /// threads (below, the tasks cost more than the pass).
 const PARALLEL_BUILD: usize = 4096;
 
+/// How many contacts ahead the build's serial pass asks for the graph
+/// entry it will keep.
+const GRAPH_AHEAD: usize = 8;
+
 /// [`Narrowphase::place_of`] of a contact that is not solved this step.
 const UNSOLVED: LanePlace = LanePlace {
     colour: u8::MAX,
@@ -361,7 +365,16 @@ impl ContactBuilder {
             // same order.
             let mut fused = !self.had_light
                 && ContactSolver::pushes_in_order(handoff.touching.len() + (n - scanned), team);
-            for k in candidates {
+            let touching = handoff.touching;
+            for (i, k) in candidates.enumerate() {
+                // The graph entry a few contacts on (a random read by id),
+                // and the staged record whose id that will read, further on.
+                if let Some(&ahead) = touching.get(i + 2 * GRAPH_AHEAD) {
+                    janus2d_core::hint::prefetch(&staged[ahead as usize]);
+                }
+                if let Some(&ahead) = touching.get(i + GRAPH_AHEAD) {
+                    graph.prefetch(staged[ahead as usize].id);
+                }
                 let record = &staged[k];
                 let [sa, sb] = record.still;
                 if (sa && sb) || (k >= scanned && !awake[k].is_solid_touching()) {
