@@ -335,6 +335,13 @@ impl ContactBuilder {
             // that take a colour afresh go through the graph in order.
             let shared = &*graph;
             team.extend_mapped(solved, touching.len(), BLOCK, |i| {
+                // As the serial pass below: the graph entry ahead.
+                if let Some(&ahead) = touching.get(i + 2 * GRAPH_AHEAD) {
+                    janus2d_core::hint::prefetch(&staged[ahead as usize]);
+                }
+                if let Some(&ahead) = touching.get(i + GRAPH_AHEAD) {
+                    shared.prefetch(staged[ahead as usize].id);
+                }
                 let k = touching[i] as usize;
                 let record = &staged[k];
                 let mut s = entry(k, record);
