@@ -243,6 +243,13 @@ pub fn cmd_memory(args: &Args) {
             (logs.0 / logs.1 as f64).exp()
         );
     }
-    std::fs::write(&csv_path, csv).expect("write csv");
-    println!("wrote {}", csv_path.display());
+    // (Run from elsewhere than the repository's root, the default folder
+    // may not exist: made, or the failure reported after the table.)
+    if let Some(dir) = csv_path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        let _ = std::fs::create_dir_all(dir);
+    }
+    match std::fs::write(&csv_path, csv) {
+        Ok(()) => println!("wrote {}", csv_path.display()),
+        Err(e) => eprintln!("could not write {}: {e}", csv_path.display()),
+    }
 }
