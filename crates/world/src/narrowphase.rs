@@ -452,13 +452,10 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
         return ContactUpdate::Separated;
     }
     let (sim_a, sim_b) = (body_a.sim, body_b.sim);
-    let reach = |aabb: &Aabb, center: Vec2| {
-        (aabb.lower - center)
-            .abs()
-            .max((aabb.upper - center).abs())
-            .length()
-    };
-    let (reach_a, reach_b) = (reach(&sa.aabb, sim_a.center), reach(&sb.aabb, sim_b.center));
+    let (reach_a, reach_b) = (
+        sa.aabb.reach_from(sim_a.center),
+        sb.aabb.reach_from(sim_b.center),
+    );
     // Not where a portal clips manifolds or a sleeping body may need waking.
     let recyclable = input.unclipped && !body_a.sleeping && !body_b.sleeping;
     // How far a turn of either body moves its shape (static bodies turn
@@ -472,8 +469,7 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
     };
     let extent = turning_reach(sim_a, reach_a).max(turning_reach(sim_b, reach_b));
     if recyclable && recycle(c, &body_a, &body_b, extent) {
-        c.still = [body_a.state_index == 0, body_b.state_index == 0];
-        c.solve_bodies = [solve_body(&body_a), solve_body(&body_b)];
+        read_bodies(c, &body_a, &body_b);
         return ContactUpdate::Updated {
             was_touching: c.touching,
             touching: c.touching,
@@ -496,8 +492,7 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
         // Empty: the boxes are read afresh every step, so the cache, and
         // any clearance it holds, stays as it was.
         c.recycle.valid = false;
-        c.still = [body_a.state_index == 0, body_b.state_index == 0];
-        c.solve_bodies = [solve_body(&body_a), solve_body(&body_b)];
+        read_bodies(c, &body_a, &body_b);
         let was_touching = c.touching;
         c.normal = Vec2::ZERO;
         c.point_count = 0;
@@ -524,8 +519,7 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
         )
     {
         // The same as testing again, which would find it empty.
-        c.still = [body_a.state_index == 0, body_b.state_index == 0];
-        c.solve_bodies = [solve_body(&body_a), solve_body(&body_b)];
+        read_bodies(c, &body_a, &body_b);
         return ContactUpdate::Updated {
             was_touching: false,
             touching: false,
@@ -592,8 +586,7 @@ fn update_in_place(c: &mut Contact, input: &NarrowphaseInput<'_>) -> ContactUpda
         separation: [c.points[0].separation, c.points[1].separation],
         clearance: if cleared { clearance } else { 0.0 },
     };
-    c.still = [body_a.state_index == 0, body_b.state_index == 0];
-    c.solve_bodies = [solve_body(&body_a), solve_body(&body_b)];
+    read_bodies(c, &body_a, &body_b);
     c.touching = c.point_count > 0;
     // The still body (if any) is asleep: it wakes.
     let wake = c.touching
@@ -748,9 +741,11 @@ fn recycle(
 /// relative pose `x_a⁻¹ x_b` and `R_b` the reach of b's box from b's
 /// origin, and the same for a in b's frame (`x_b⁻¹ x_a`).
 ///
-/// Measured on compounds (3,000 bodies of two triangles; janus2d alone):
-/// of about 31,000 awake contacts, 12,000 touching ones are recycled and
-/// 6,000 have boxes apart; of the 12,000 tested, most are empty.
+/// Measured on compounds (3,000 bodies of two triangles; janus2d alone,
+/// counters added for the measurement): of about 31,000 awake contacts a
+/// step, 12,000 touching ones are recycled and 6,000 have boxes apart; of
+/// the 12,400 tested before this, about 9,600 came back empty, and 8,100
+/// tests a step are now skipped.
 ///
 /// `cache`: the contact's, whose manifold is empty; `poses`: the bodies'
 /// origins now; `boxes`: the shapes' tight boxes now.
@@ -769,16 +764,11 @@ fn keeps_empty(
     // |R₁ − R₀| = 2 |sin(Δθ / 2)| = |(cos Δθ − 1, sin Δθ)|.
     let dq = relative.q.inv_mul(then.q);
     let chord = Vec2::new(dq.c - 1.0, dq.s).length();
-    let reach = |aabb: &Aabb, origin: Vec2| {
-        (aabb.lower - origin)
-            .abs()
-            .max((aabb.upper - origin).abs())
-            .length()
-    };
     // b in a's frame; a in b's frame (the inverse pose's translation).
-    let moved_b = (relative.p - then.p).length() + chord * reach(boxes[1], xf_b.p);
+    let moved_b = (relative.p - then.p).length() + chord * boxes[1].reach_from(xf_b.p);
     let inverse = |x: &Transform| x.q.inv_rotate(-x.p);
-    let moved_a = (inverse(&relative) - inverse(&then)).length() + chord * reach(boxes[0], xf_a.p);
+    let moved_a =
+        (inverse(&relative) - inverse(&then)).length() + chord * boxes[0].reach_from(xf_a.p);
     // Rounding: the test and this bound each round the relative pose at
     // the bodies' distance from the world origin.
     let far = xf_a.p.abs().max_element() + xf_b.p.abs().max_element();
@@ -792,6 +782,19 @@ fn keeps_empty(
 /// ([`keeps_empty`]): above the rounding of the separating-axis test at
 /// metre scale.
 const CLEARANCE_MARGIN: Real = 1e-4;
+
+/// Records what this step's narrowphase read of the contact's bodies:
+/// whether each is still (static or asleep) and what the solve takes of
+/// each ([`solve_body`]).
+#[inline]
+fn read_bodies(
+    c: &mut Contact,
+    body_a: &janus2d_core::body::SolverBody<'_>,
+    body_b: &janus2d_core::body::SolverBody<'_>,
+) {
+    c.still = [body_a.state_index == 0, body_b.state_index == 0];
+    c.solve_bodies = [solve_body(body_a), solve_body(body_b)];
+}
 
 /// A body's state index and inverse masses as the solve takes them (zero
 /// masses for the static identity state 0).

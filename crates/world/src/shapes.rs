@@ -962,13 +962,7 @@ impl ShapeStore {
     pub fn reach(&self, body: BodyHandle, center: Vec2) -> Real {
         self.of_body(body)
             .iter()
-            .map(|&s| {
-                let a = &self.at(s).aabb;
-                (a.lower - center)
-                    .abs()
-                    .max((a.upper - center).abs())
-                    .length()
-            })
+            .map(|&s| self.at(s).aabb.reach_from(center))
             .fold(0.0, Real::max)
     }
 }

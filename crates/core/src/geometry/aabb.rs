@@ -62,6 +62,25 @@ impl Aabb {
         2.0 * ((self.upper.x - self.lower.x) + (self.upper.y - self.lower.y))
     }
 
+    /// The largest distance from `point` to a corner of the box, m: no
+    /// point inside the box lies farther from `point` (a shape's reach
+    /// from its body's centre or origin, what a turn of the body sweeps).
+    ///
+    /// ```
+    /// use janus2d_core::geometry::Aabb;
+    /// use janus2d_core::math::Vec2;
+    /// let b = Aabb::new(Vec2::new(-1.0, 0.0), Vec2::new(3.0, 2.0));
+    /// assert_eq!(b.reach_from(Vec2::ZERO), Vec2::new(3.0, 2.0).length());
+    /// ```
+    #[inline]
+    #[must_use]
+    pub fn reach_from(&self, point: Vec2) -> Real {
+        (self.lower - point)
+            .abs()
+            .max((self.upper - point).abs())
+            .length()
+    }
+
     /// Centre of the box.
     #[inline]
     pub fn center(&self) -> Vec2 {
