@@ -118,7 +118,7 @@ pub struct BroadPhase {
     pair_stack: Vec<(u32, u32)>,
     /// Scratch of the dynamic tree's partial rebuild.
     #[cfg_attr(feature = "serde", serde(skip))]
-    rebuild_items: Vec<u32>,
+    rebuild_items: Vec<(Vec2, u32)>,
     /// Scratch of the bulk pair search: per node of each tree (dynamic,
     /// static), whether its subtree holds a moved proxy.
     #[cfg_attr(feature = "serde", serde(skip))]
@@ -297,7 +297,7 @@ impl BroadPhase {
         }
         let moved = self
             .dynamic_tree
-            .enlarge_proxy_with_margin(slot.leaf, aabb, slot.margin);
+            .enlarge_leaf_with_margin(slot.leaf, aabb, slot.margin);
         if moved {
             let fat = self.dynamic_tree.fat_aabb(slot.leaf);
             self.proxies[proxy as usize].fat = fat;
@@ -332,7 +332,7 @@ impl BroadPhase {
         if !slot.fat.contains(&query)
             && self
                 .dynamic_tree
-                .enlarge_proxy_with_margin(slot.leaf, query, slot.margin)
+                .enlarge_leaf_with_margin(slot.leaf, query, slot.margin)
         {
             self.proxies[proxy as usize].fat = self.dynamic_tree.fat_aabb(slot.leaf);
             moved = true;
@@ -341,7 +341,7 @@ impl BroadPhase {
             // A new core must lie inside the tree box, or a pair it makes
             // would not be found: the tree box grows to the swept box with
             // its margin unless it holds that already.
-            if self.dynamic_tree.enlarge_proxy_with_margin(
+            if self.dynamic_tree.enlarge_leaf_with_margin(
                 slot.leaf,
                 query.fattened(slot.margin),
                 0.0,
@@ -377,10 +377,26 @@ impl BroadPhase {
     }
 
     /// Ends a batch of [`move_proxy_in_batch`](Self::move_proxy_in_batch):
-    /// one partial rebuild of the movable proxies' tree
-    /// ([`DynamicTree::rebuild`]).
+    /// the movable proxies' tree is rebuilt where the moves grew it, or
+    /// whole when many moved ([`DynamicTree::finish_enlarged`]), on the
+    /// caller.
     pub fn finish_moves(&mut self) {
-        self.dynamic_tree.rebuild(&mut self.rebuild_items);
+        self.finish_moves_on(&Team::serial());
+    }
+
+    /// [`finish_moves`](Self::finish_moves) with a whole-tree rebuild's
+    /// spans built on `team`; the tree is the same for any team.
+    pub fn finish_moves_on(&mut self, team: &Team) {
+        self.dynamic_tree
+            .finish_enlarged(&mut self.rebuild_items, team);
+    }
+
+    /// Whether the batch so far moved enough proxies for
+    /// [`finish_moves`](Self::finish_moves) to rebuild the whole tree
+    /// ([`DynamicTree::pending_is_bulk`]): worth doing on a team.
+    #[must_use]
+    pub fn moves_are_bulk(&self) -> bool {
+        self.dynamic_tree.pending_is_bulk()
     }
 
     /// True when `proxy` names a live proxy (never panics; for checks).

@@ -583,6 +583,9 @@ impl Collision {
                 || moved = Self::update_proxies_by_body(shapes, broadphase, bodies, dt);
             store(&mut self.contacts, team, &mut beside);
         }
+        // A batch of many moves left the whole tree to rebuild: its spans
+        // on the team, now that the store is done.
+        self.broadphase.finish_moves_on(team);
         self.counters.proxies_moved = moved;
         out
     }
@@ -626,8 +629,17 @@ impl Collision {
                 }
             }
         }
-        broadphase.finish_moves();
+        Self::finish_few_moves(broadphase);
         moved
+    }
+
+    /// Ends the batch of proxy moves here, beside the impulse store, when
+    /// it moved few proxies; a batch of many is left for
+    /// [`Collision::end_step`] to rebuild the whole tree on the team.
+    fn finish_few_moves(broadphase: &mut BroadPhase) {
+        if !broadphase.moves_are_bulk() {
+            broadphase.finish_moves();
+        }
     }
 
     /// Recomputes the boxes of the shapes of moving bodies and lists the
@@ -721,7 +733,7 @@ impl Collision {
                 moved += 1;
             }
         }
-        broadphase.finish_moves();
+        Self::finish_few_moves(broadphase);
         moved
     }
 

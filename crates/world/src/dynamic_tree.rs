@@ -58,6 +58,7 @@
 //! | `create_proxy`, `destroy_proxy`      | O(log n); ids are node indices, stable until destroyed   |
 //! | `move_proxy`                         | one `contains` test; re-insert only when it fails        |
 //! | `enlarge_proxy`, then `rebuild`      | a batch of moves: ancestors only grow and are marked; one partial top-down rebuild of the marked nodes (as Box2D v3) |
+//! | `enlarge_leaf_with_margin`, then `finish_enlarged` | the same with the ancestors' growth deferred to the batch's end; a batch that moved a quarter of the proxies or more rebuilds the whole tree from its leaves instead, its spans on a team |
 //! | insert / remove a leaf               | best sibling by perimeter, then refit and rotate upwards |
 //! | `query`, `query_proxies`             | O(log n + k), iterative, stops when the callback says so |
 //! | `ray_query`                          | the boxes a segment touches (slab test per node)         |
@@ -67,6 +68,7 @@
 
 use janus2d_core::geometry::Aabb;
 use janus2d_core::math::{Real, Vec2};
+use janus2d_core::parallel::Team;
 
 /// The "no node" index (`u32::MAX`), used for absent parents and children.
 pub const NULL_NODE: u32 = u32::MAX;
@@ -80,6 +82,23 @@ pub const SLACK_LEVELS: u32 = 6;
 /// Default fat-box margin, in metres (0.1 m): how far a shape may move
 /// before its proxy is re-inserted into the tree.
 pub const DEFAULT_AABB_MARGIN: Real = 0.1;
+
+/// A batch of deferred moves ([`DynamicTree::enlarge_leaf_with_margin`])
+/// that enlarged at least one proxy in this many rebuilds the whole tree
+/// from its leaves ([`DynamicTree::finish_enlarged`]) rather than growing
+/// each leaf's ancestors and rebuilding the grown part. In scenes where
+/// most shapes are in flight (smash, washer, spinner, rain, joint_grid:
+/// 50–94% of the proxies move each step) the ancestors' walks cost as
+/// much as the rebuild and leave nearly every internal node to rebuild.
+pub const FULL_REBUILD_DIVISOR: usize = 4;
+
+/// The whole-tree rebuild splits the top of the tree on the caller down to
+/// spans of at most `1/TOP_SPLIT_SHARE` of the leaves (and at least
+/// [`MIN_SPAN`]); each span below is built as a block of the team.
+const TOP_SPLIT_SHARE: usize = 8;
+
+/// Smallest span of leaves the whole-tree rebuild hands to a block.
+const MIN_SPAN: usize = 256;
 
 /// Inline capacity of the traversal stack. A depth-first traversal needs at
 /// most `height + 1` entries, so the heap fallback is never used by trees of
@@ -209,6 +228,11 @@ pub struct DynamicTree {
     free_list: u32,
     proxy_count: u32,
     margin: Real,
+    /// Leaves given new boxes by [`DynamicTree::enlarge_leaf_with_margin`]
+    /// whose ancestors wait for [`DynamicTree::finish_enlarged`]. Empty
+    /// between batches (so never in a snapshot).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pending: Vec<u32>,
 }
 
 impl Default for DynamicTree {
@@ -236,6 +260,7 @@ impl DynamicTree {
             free_list: NULL_NODE,
             proxy_count: 0,
             margin,
+            pending: Vec::new(),
         }
     }
 
@@ -364,8 +389,67 @@ impl DynamicTree {
         if self.nodes[id as usize].aabb.contains(&aabb) {
             return false;
         }
-        let fat = aabb.fattened(margin);
-        self.nodes[id as usize].aabb = fat;
+        self.nodes[id as usize].aabb = aabb.fattened(margin);
+        self.grow_ancestors(id);
+        true
+    }
+
+    /// [`enlarge_proxy_with_margin`](Self::enlarge_proxy_with_margin) with
+    /// the ancestors left for later: the leaf takes its new fat box now and
+    /// is listed, and [`finish_enlarged`](Self::finish_enlarged), which
+    /// must end the batch before any query or other change, grows the
+    /// ancestors of every listed leaf (or rebuilds the whole tree when
+    /// many were listed). Returns whether the leaf moved.
+    pub fn enlarge_leaf_with_margin(&mut self, id: u32, aabb: Aabb, margin: Real) -> bool {
+        self.check_proxy(id);
+        debug_assert!(aabb.is_valid(), "invalid AABB {aabb:?}");
+        if self.nodes[id as usize].aabb.contains(&aabb) {
+            return false;
+        }
+        self.nodes[id as usize].aabb = aabb.fattened(margin);
+        self.pending.push(id);
+        true
+    }
+
+    /// Whether the batch of [`enlarge_leaf_with_margin`](Self::enlarge_leaf_with_margin)
+    /// calls so far moved at least one proxy in [`FULL_REBUILD_DIVISOR`],
+    /// so that [`finish_enlarged`](Self::finish_enlarged) will rebuild the
+    /// whole tree.
+    #[must_use]
+    pub fn pending_is_bulk(&self) -> bool {
+        !self.pending.is_empty()
+            && self.pending.len() * FULL_REBUILD_DIVISOR >= self.proxy_count as usize
+    }
+
+    /// Ends a batch of [`enlarge_leaf_with_margin`](Self::enlarge_leaf_with_margin):
+    /// for a bulk batch ([`pending_is_bulk`](Self::pending_is_bulk)) the
+    /// whole tree is rebuilt from its leaves, its top on the caller and the
+    /// spans below as blocks of `team`; otherwise each listed leaf's
+    /// ancestors grow to cover it, in the order listed (exactly as
+    /// [`enlarge_proxy_with_margin`](Self::enlarge_proxy_with_margin) at
+    /// the time of the move), and [`rebuild`](Self::rebuild) rebuilds the
+    /// grown part. The tree comes out the same for any team.
+    pub fn finish_enlarged(&mut self, items: &mut Vec<(Vec2, u32)>, team: &Team) {
+        if self.pending.is_empty() {
+            return;
+        }
+        let bulk = self.pending_is_bulk();
+        let mut pending = std::mem::take(&mut self.pending);
+        if bulk {
+            self.rebuild_from_leaves(items, team);
+        } else {
+            for &id in &pending {
+                self.grow_ancestors(id);
+            }
+            self.rebuild(items);
+        }
+        pending.clear();
+        self.pending = pending;
+    }
+
+    /// Grows the ancestors of leaf `id` to cover its box, marking them.
+    fn grow_ancestors(&mut self, id: u32) {
+        let fat = self.nodes[id as usize].aabb;
         let mut index = self.nodes[id as usize].parent;
         // Grow the ancestors until one already covers the new box…
         while index != NULL_NODE {
@@ -386,7 +470,110 @@ impl DynamicTree {
             self.nodes[index as usize].enlarged = true;
             index = self.nodes[index as usize].parent;
         }
-        true
+    }
+
+    /// Rebuilds the whole tree from its leaves, top down, each node split
+    /// as [`rebuild`](Self::rebuild) splits (at the middle of its leaves'
+    /// centres along the longer axis). The leaves are taken in node order
+    /// and the internal nodes keep their slots: a span of `k` leaves owns
+    /// `k − 1` consecutive internal slots (in node order), the first part
+    /// of them its first child's, then its second child's, then its own
+    /// root, so every span's nodes are known before it is built. The top
+    /// spans are split here; those of at most `n / TOP_SPLIT_SHARE` leaves
+    /// are built as blocks of `team`, then written in block order and the
+    /// top refitted. The result depends on the leaves alone, not on the
+    /// team.
+    ///
+    /// ```text
+    /// caller:  leaves, internal slots ─ top splits ─┐            ┌─ write, refit top
+    /// team:                                         └─ spans ────┘
+    /// ```
+    fn rebuild_from_leaves(&mut self, items: &mut Vec<(Vec2, u32)>, team: &Team) {
+        items.clear();
+        let mut slots = Vec::with_capacity(self.proxy_count as usize);
+        for (i, node) in self.nodes.iter().enumerate() {
+            if !node.allocated {
+                continue;
+            }
+            if node.is_leaf() {
+                items.push((centre_of(&node.aabb), i as u32));
+            } else {
+                slots.push(i as u32);
+            }
+        }
+        let n = items.len();
+        if n == 0 {
+            return;
+        }
+        debug_assert_eq!(slots.len() + 1, n, "a full tree has n - 1 internal nodes");
+        let cut = (n / TOP_SPLIT_SHARE).max(MIN_SPAN);
+        let mut top = Vec::new();
+        let mut spans = Vec::new();
+        let mut work = vec![Span {
+            start: 0,
+            end: n,
+            slot: 0,
+            parent: NULL_NODE,
+            first: true,
+        }];
+        while let Some(span) = work.pop() {
+            if span.end - span.start <= cut {
+                spans.push(span);
+                continue;
+            }
+            let split = span.start + partition_mid(&mut items[span.start..span.end]);
+            let id = slots[span.slot + span.end - span.start - 2];
+            self.nodes[id as usize] = Node {
+                allocated: true,
+                ..Node::EMPTY
+            };
+            self.place(id, span.parent, span.first);
+            top.push(id);
+            work.push(Span {
+                start: split,
+                end: span.end,
+                slot: span.slot + split - span.start - 1,
+                parent: id,
+                first: false,
+            });
+            work.push(Span {
+                start: span.start,
+                end: split,
+                slot: span.slot,
+                parent: id,
+                first: true,
+            });
+        }
+        let built = {
+            let (nodes, items, slots) = (&self.nodes, &items[..], &slots[..]);
+            team.map_blocks(spans.len(), |k| build_span(nodes, items, slots, spans[k]))
+        };
+        for (span, built) in spans.iter().zip(built) {
+            for (id, node) in built.made {
+                self.nodes[id as usize] = node;
+            }
+            for (leaf, parent) in built.leaves {
+                self.nodes[leaf as usize].parent = parent;
+            }
+            self.place(built.root, span.parent, span.first);
+        }
+        // The top nodes were made parents first: refit in reverse.
+        for &id in top.iter().rev() {
+            self.refit(id);
+        }
+    }
+
+    /// Hangs `id` under `parent` as its first or second child (or makes it
+    /// the root when `parent` is [`NULL_NODE`]).
+    fn place(&mut self, id: u32, parent: u32, first: bool) {
+        self.nodes[id as usize].parent = parent;
+        if parent == NULL_NODE {
+            self.root = id;
+        } else if first {
+            self.nodes[parent as usize].child1 = id;
+        } else {
+            self.nodes[parent as usize].child2 = id;
+        }
     }
 
     /// Rebuilds the part of the tree above the leaves moved by
@@ -396,7 +583,7 @@ impl DynamicTree {
     /// centres along the longer axis (half by count when that leaves a side
     /// empty). Afterwards every internal box is again exactly the union of
     /// its children. Costs nothing when nothing was enlarged.
-    pub fn rebuild(&mut self, items: &mut Vec<u32>) {
+    pub fn rebuild(&mut self, items: &mut Vec<(Vec2, u32)>) {
         items.clear();
         if self.root == NULL_NODE || !self.nodes[self.root as usize].enlarged {
             return;
@@ -411,7 +598,7 @@ impl DynamicTree {
     /// along the longer axis. Proxy ids (the leaves) do not change. For a
     /// tree grown one insertion at a time in an unlucky order (a static
     /// ground of boxes inserted row by row grows tall and overlapping).
-    pub fn rebuild_all(&mut self, items: &mut Vec<u32>) {
+    pub fn rebuild_all(&mut self, items: &mut Vec<(Vec2, u32)>) {
         items.clear();
         if self.root == NULL_NODE {
             return;
@@ -421,13 +608,14 @@ impl DynamicTree {
 
     /// Frees the internal nodes from the root down to the items (the
     /// leaves, and with `whole` false the subtrees not enlarged), collects
-    /// the items and joins them again top down under a new root.
-    fn rejoin(&mut self, items: &mut Vec<u32>, whole: bool) {
+    /// the items with their boxes' centres and joins them again top down
+    /// under a new root.
+    fn rejoin(&mut self, items: &mut Vec<(Vec2, u32)>, whole: bool) {
         let mut stack = NodeStack::new(self.root);
         while let Some(index) = stack.pop() {
             let node = self.nodes[index as usize];
             if node.is_leaf() || !(whole || node.enlarged) {
-                items.push(index);
+                items.push((centre_of(&node.aabb), index));
             } else {
                 stack.push(node.child2);
                 stack.push(node.child1);
@@ -447,11 +635,13 @@ impl DynamicTree {
         self.height() > balanced + SLACK_LEVELS
     }
 
-    /// Joins `items` (roots of subtrees) under new internal nodes, top down
-    /// and without recursion; returns the new root.
-    fn build_top_down(&mut self, items: &mut [u32]) -> u32 {
+    /// Joins `items` (roots of subtrees, each with its box's centre) under
+    /// new internal nodes, top down and without recursion; returns the new
+    /// root. The centres travel with the ids, so each split reads one
+    /// contiguous array rather than every item's node.
+    fn build_top_down(&mut self, items: &mut [(Vec2, u32)]) -> u32 {
         if items.len() == 1 {
-            return items[0];
+            return items[0].1;
         }
         // (range of items, parent, as child1) still to build.
         let mut work: Vec<(usize, usize, u32, bool)> = vec![(0, items.len(), NULL_NODE, true)];
@@ -459,9 +649,9 @@ impl DynamicTree {
         let mut root = NULL_NODE;
         while let Some((start, end, parent, first)) = work.pop() {
             let node = if end - start == 1 {
-                items[start]
+                items[start].1
             } else {
-                let split = start + self.partition_mid(&mut items[start..end]);
+                let split = start + partition_mid(&mut items[start..end]);
                 let node = self.allocate_node();
                 made.push(node);
                 work.push((split, end, node, false));
@@ -482,36 +672,6 @@ impl DynamicTree {
             self.refit(node);
         }
         root
-    }
-
-    /// Reorders `items` so that the first `k` lie below the middle of their
-    /// centres' box along its longer axis and returns `k` (in `1..len`).
-    fn partition_mid(&self, items: &mut [u32]) -> usize {
-        let centre = |i: u32| {
-            let b = &self.nodes[i as usize].aabb;
-            (b.lower + b.upper) * 0.5
-        };
-        let (mut lo, mut hi) = (Vec2::splat(Real::INFINITY), Vec2::splat(Real::NEG_INFINITY));
-        for &i in items.iter() {
-            let c = centre(i);
-            lo = lo.min(c);
-            hi = hi.max(c);
-        }
-        let extent = hi - lo;
-        let axis = usize::from(extent.y > extent.x);
-        let mid = 0.5 * (lo[axis] + hi[axis]);
-        let mut k = 0;
-        for j in 0..items.len() {
-            if centre(items[j])[axis] < mid {
-                items.swap(j, k);
-                k += 1;
-            }
-        }
-        if k == 0 || k == items.len() {
-            // Every centre on one side (all equal): halve by count.
-            k = items.len() / 2;
-        }
-        k
     }
 
     /// The fat box of a proxy.
@@ -1255,6 +1415,138 @@ fn segment_touches_box(origin: Vec2, d: Vec2, max_fraction: Real, b: &Aabb) -> b
     true
 }
 
+/// A span of the whole-tree rebuild's leaves, `start..end`, to join under
+/// `parent` as its first or second child.
+#[derive(Clone, Copy)]
+struct Span {
+    start: usize,
+    end: usize,
+    /// The first of the span's `end − start − 1` internal slots; the last
+    /// one is the span's root.
+    slot: usize,
+    parent: u32,
+    first: bool,
+}
+
+/// What [`build_span`] made: the span's internal nodes (slot, node), its
+/// leaves' parents (leaf, parent) and its root (a leaf when the span holds
+/// one).
+struct BuiltSpan {
+    made: Vec<(u32, Node)>,
+    leaves: Vec<(u32, u32)>,
+    root: u32,
+}
+
+/// Builds the subtree of one span of [`DynamicTree::rebuild_from_leaves`]
+/// from the shared leaves (`items`, centre and id, in span order) and
+/// internal slots, reading only the leaves' boxes from `nodes`. The span's
+/// root is left without a parent; the caller hangs it.
+fn build_span(nodes: &[Node], items: &[(Vec2, u32)], slots: &[u32], span: Span) -> BuiltSpan {
+    const NONE: usize = usize::MAX;
+    let mut local = items[span.start..span.end].to_vec();
+    let len = local.len();
+    let mut made: Vec<(u32, Node)> = Vec::with_capacity(len.saturating_sub(1));
+    // Local indices of each made node's children in `made` (NONE: a leaf).
+    let mut kids: Vec<[usize; 2]> = Vec::with_capacity(len.saturating_sub(1));
+    let mut leaves = Vec::with_capacity(len);
+    let mut root = NULL_NODE;
+    // (range of `local`, its first internal slot, local index of the
+    // parent or NONE, as child1).
+    let mut work: Vec<(usize, usize, usize, usize, bool)> = vec![(0, len, span.slot, NONE, true)];
+    while let Some((a, b, slot, parent, first)) = work.pop() {
+        let (id, me) = if b - a == 1 {
+            let leaf = local[a].1;
+            if parent != NONE {
+                leaves.push((leaf, made[parent].0));
+            }
+            (leaf, NONE)
+        } else {
+            let split = a + partition_mid(&mut local[a..b]);
+            let id = slots[slot + b - a - 2];
+            let up = if parent == NONE {
+                NULL_NODE
+            } else {
+                made[parent].0
+            };
+            made.push((
+                id,
+                Node {
+                    allocated: true,
+                    parent: up,
+                    ..Node::EMPTY
+                },
+            ));
+            kids.push([NONE; 2]);
+            let me = made.len() - 1;
+            work.push((split, b, slot + split - a - 1, me, false));
+            work.push((a, split, slot, me, true));
+            (id, me)
+        };
+        if parent == NONE {
+            root = id;
+        } else {
+            let side = usize::from(!first);
+            if side == 0 {
+                made[parent].1.child1 = id;
+            } else {
+                made[parent].1.child2 = id;
+            }
+            kids[parent][side] = me;
+        }
+    }
+    // Children were made after their parents: refit in reverse.
+    for k in (0..made.len()).rev() {
+        let node = made[k].1;
+        let of = |kid: usize, id: u32| {
+            let n = if kid == NONE {
+                &nodes[id as usize]
+            } else {
+                &made[kid].1
+            };
+            (n.aabb, n.height)
+        };
+        let (box1, height1) = of(kids[k][0], node.child1);
+        let (box2, height2) = of(kids[k][1], node.child2);
+        made[k].1.aabb = box1.union(&box2);
+        made[k].1.height = 1 + height1.max(height2);
+    }
+    BuiltSpan { made, leaves, root }
+}
+
+/// The centre of a box, as the rebuild's splits compare it.
+#[inline]
+fn centre_of(b: &Aabb) -> Vec2 {
+    (b.lower + b.upper) * 0.5
+}
+
+/// Reorders `items` (centre, id) so that the first `k` lie below the middle
+/// of their centres' box along its longer axis and returns `k` (in
+/// `1..len`).
+fn partition_mid(items: &mut [(Vec2, u32)]) -> usize {
+    let (mut lo, mut hi) = (Vec2::splat(Real::INFINITY), Vec2::splat(Real::NEG_INFINITY));
+    for &(c, _) in items.iter() {
+        lo = lo.min(c);
+        hi = hi.max(c);
+    }
+    let extent = hi - lo;
+    let axis = usize::from(extent.y > extent.x);
+    let mid = 0.5 * (lo[axis] + hi[axis]);
+    // Branch-free: every item is swapped to the front's end and the end
+    // moves past it only when it lies below (the split's sides are as with
+    // a test per item; random centres would mispredict half those tests).
+    let mut k = 0;
+    for j in 0..items.len() {
+        let below = items[j].0[axis] < mid;
+        items.swap(j, k);
+        k += usize::from(below);
+    }
+    if k == 0 || k == items.len() {
+        // Every centre on one side (all equal): halve by count.
+        k = items.len() / 2;
+    }
+    k
+}
+
 #[cfg(test)]
 pub(crate) mod test_util {
     use janus2d_core::geometry::Aabb;
@@ -1386,6 +1678,85 @@ mod tests {
             format!("{:?}", before.nodes),
             format!("{:?}", batched.nodes)
         );
+    }
+
+    /// Deferred moves (`enlarge_leaf_with_margin`, then
+    /// `finish_enlarged`) give, for a batch of few moves, the very tree of
+    /// immediate ones (`enlarge_proxy_with_margin`, then `rebuild`); for a
+    /// batch of many, a whole rebuild that is sound, answers every query as
+    /// a brute-force scan does, stays shallow, and comes out node for node
+    /// the same on a team of 1, 2 or 4 threads.
+    #[test]
+    fn deferred_moves_match_immediate_ones_and_a_whole_rebuild_any_team() {
+        let mut rng = Lcg(5);
+        let mut deferred = DynamicTree::new();
+        let mut boxes: Vec<Aabb> = (0..3000).map(|_| random_box(&mut rng, 120.0)).collect();
+        let ids: Vec<u32> = boxes
+            .iter()
+            .enumerate()
+            .map(|(i, b)| deferred.create_proxy(*b, i as u32))
+            .collect();
+        let mut items = Vec::new();
+        for round in 0..6 {
+            // Few moves (every 20th box) on even rounds, many (every other
+            // box) on odd ones.
+            let stride = if round % 2 == 0 { 20 } else { 2 };
+            let mut immediate = deferred.clone();
+            let mut moved = 0;
+            for i in (round % stride..boxes.len()).step_by(stride) {
+                let d = Vec2::new(rng.range(-2.0, 2.0), rng.range(-2.0, 2.0));
+                boxes[i] = translate(boxes[i], d);
+                let now = immediate.enlarge_proxy_with_margin(ids[i], boxes[i], 0.1);
+                assert_eq!(
+                    now,
+                    deferred.enlarge_leaf_with_margin(ids[i], boxes[i], 0.1)
+                );
+                moved += usize::from(now);
+            }
+            let bulk = deferred.pending_is_bulk();
+            assert_eq!(bulk, round % 2 == 1, "round {round}: {moved} moved");
+            let on_teams = bulk.then(|| deferred.clone());
+            deferred.finish_enlarged(&mut items, &Team::serial());
+            assert_eq!(deferred.check(), Ok(()), "round {round}");
+            assert!(deferred.pending.is_empty());
+            if bulk {
+                assert!(deferred.height() <= 30, "height {}", deferred.height());
+                #[cfg(feature = "parallel")]
+                for threads in [2, 4] {
+                    let mut tree = on_teams.clone().unwrap();
+                    janus2d_core::parallel::with_threads(threads, |team| {
+                        tree.finish_enlarged(&mut Vec::new(), team);
+                    })
+                    .unwrap();
+                    assert_eq!(
+                        format!("{:?}", tree.nodes),
+                        format!("{:?}", deferred.nodes),
+                        "round {round}, {threads} threads"
+                    );
+                }
+                let _ = on_teams;
+            } else {
+                immediate.rebuild(&mut items);
+                assert_eq!(
+                    format!("{:?}", immediate.nodes),
+                    format!("{:?}", deferred.nodes),
+                    "round {round}"
+                );
+            }
+            for q in 0..50 {
+                let probe = random_box(&mut rng, 120.0).fattened(1.0 + q as Real * 0.1);
+                let mut found = Vec::new();
+                deferred.query(&probe, |u| {
+                    found.push(u);
+                    true
+                });
+                found.sort_unstable();
+                let expected: Vec<u32> = (0..boxes.len() as u32)
+                    .filter(|&i| deferred.fat_aabb(ids[i as usize]).overlaps(&probe))
+                    .collect();
+                assert_eq!(found, expected, "round {round}, query {q}");
+            }
+        }
     }
 
     /// Descending from the seeds reports the same pairs as the full
