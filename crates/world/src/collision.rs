@@ -553,13 +553,16 @@ impl Collision {
     /// it moves fast bodies, reading the shapes and the broadphase) runs,
     /// the shapes' boxes follow the new poses, and then the solved impulses
     /// go back into the contacts (`store`) while the leader moves the
-    /// proxies that left their boxes and rebuilds the tree (`beside`, the
-    /// serial part of the proxy update: it shares no data with the
-    /// contacts). Each on the step's team. Returns what `advance` returned.
+    /// proxies that left their boxes (`beside`, the serial part of the
+    /// proxy update: it shares no data with the contacts) and, when they
+    /// are few, rebuilds the part of the tree they grew. When a quarter of
+    /// the proxies or more moved, the whole tree is rebuilt after the
+    /// store, its spans on the team ([`BroadPhase::finish_moves_on`]).
+    /// Each on the step's team. Returns what `advance` returned.
     ///
     /// ```text
-    /// team:    advance ─ boxes ─┬─ store (blocks of contacts) ─┐
-    /// leader:                   └─ proxy moves, tree rebuild ──┴─ done
+    /// team:    advance ─ boxes ─┬─ store (blocks of contacts) ──────┬─ whole tree (many moved)
+    /// leader:                   └─ proxy moves, part of the tree ───┘
     /// ```
     pub(crate) fn end_step<R>(
         &mut self,
