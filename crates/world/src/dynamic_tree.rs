@@ -384,14 +384,11 @@ impl DynamicTree {
     /// [`enlarge_proxy`](Self::enlarge_proxy) with the proxy's own margin
     /// (as given to [`create_proxy_with_margin`](Self::create_proxy_with_margin)).
     pub fn enlarge_proxy_with_margin(&mut self, id: u32, aabb: Aabb, margin: Real) -> bool {
-        self.check_proxy(id);
-        debug_assert!(aabb.is_valid(), "invalid AABB {aabb:?}");
-        if self.nodes[id as usize].aabb.contains(&aabb) {
-            return false;
+        let moved = self.set_leaf_box(id, aabb, margin);
+        if moved {
+            self.grow_ancestors(id);
         }
-        self.nodes[id as usize].aabb = aabb.fattened(margin);
-        self.grow_ancestors(id);
-        true
+        moved
     }
 
     /// [`enlarge_proxy_with_margin`](Self::enlarge_proxy_with_margin) with
@@ -401,13 +398,22 @@ impl DynamicTree {
     /// ancestors of every listed leaf (or rebuilds the whole tree when
     /// many were listed). Returns whether the leaf moved.
     pub fn enlarge_leaf_with_margin(&mut self, id: u32, aabb: Aabb, margin: Real) -> bool {
+        let moved = self.set_leaf_box(id, aabb, margin);
+        if moved {
+            self.pending.push(id);
+        }
+        moved
+    }
+
+    /// Gives leaf `id` the fat box of `aabb` when `aabb` left its box;
+    /// returns whether it did. The ancestors are left as they were.
+    fn set_leaf_box(&mut self, id: u32, aabb: Aabb, margin: Real) -> bool {
         self.check_proxy(id);
         debug_assert!(aabb.is_valid(), "invalid AABB {aabb:?}");
         if self.nodes[id as usize].aabb.contains(&aabb) {
             return false;
         }
         self.nodes[id as usize].aabb = aabb.fattened(margin);
-        self.pending.push(id);
         true
     }
 
