@@ -43,6 +43,20 @@ const PARALLEL_BUILD: usize = 4096;
 /// entry it will keep.
 const GRAPH_AHEAD: usize = 8;
 
+/// Asks, at the `i`-th of the `touching` contacts, for what the build
+/// reads a few contacts on: the graph entry `GRAPH_AHEAD` contacts on (a
+/// random read by id), and the staged record whose id that will read,
+/// further on. Used by the build's serial and parallel passes alike.
+#[inline]
+fn read_ahead(touching: &[u32], staged: &[StagedContact], graph: &ConstraintGraph, i: usize) {
+    if let Some(&ahead) = touching.get(i + 2 * GRAPH_AHEAD) {
+        janus2d_core::hint::prefetch(&staged[ahead as usize]);
+    }
+    if let Some(&ahead) = touching.get(i + GRAPH_AHEAD) {
+        graph.prefetch(staged[ahead as usize].id);
+    }
+}
+
 /// [`Narrowphase::place_of`] of a contact that is not solved this step.
 const UNSOLVED: LanePlace = LanePlace {
     colour: u8::MAX,
@@ -335,13 +349,7 @@ impl ContactBuilder {
             // that take a colour afresh go through the graph in order.
             let shared = &*graph;
             team.extend_mapped(solved, touching.len(), BLOCK, |i| {
-                // As the serial pass below: the graph entry ahead.
-                if let Some(&ahead) = touching.get(i + 2 * GRAPH_AHEAD) {
-                    janus2d_core::hint::prefetch(&staged[ahead as usize]);
-                }
-                if let Some(&ahead) = touching.get(i + GRAPH_AHEAD) {
-                    shared.prefetch(staged[ahead as usize].id);
-                }
+                read_ahead(touching, staged, shared, i);
                 let k = touching[i] as usize;
                 let record = &staged[k];
                 let mut s = entry(k, record);
@@ -374,14 +382,7 @@ impl ContactBuilder {
                 && ContactSolver::pushes_in_order(handoff.touching.len() + (n - scanned), team);
             let touching = handoff.touching;
             for (i, k) in candidates.enumerate() {
-                // The graph entry a few contacts on (a random read by id),
-                // and the staged record whose id that will read, further on.
-                if let Some(&ahead) = touching.get(i + 2 * GRAPH_AHEAD) {
-                    janus2d_core::hint::prefetch(&staged[ahead as usize]);
-                }
-                if let Some(&ahead) = touching.get(i + GRAPH_AHEAD) {
-                    graph.prefetch(staged[ahead as usize].id);
-                }
+                read_ahead(touching, staged, graph, i);
                 let record = &staged[k];
                 let [sa, sb] = record.still;
                 if (sa && sb) || (k >= scanned && !awake[k].is_solid_touching()) {

@@ -769,12 +769,10 @@ mod tests {
         #![proptest_config(ProptestConfig {
             cases: 2000,
             // A fixed set of cases unless PROPTEST_RNG_SEED asks for another.
-            rng_seed: match ProptestConfig::default().rng_seed {
-                proptest::test_runner::RngSeed::Random => {
-                    proptest::test_runner::RngSeed::Fixed(0x6a61_6e75_7332_6463)
-                }
-                fixed => fixed,
-            },
+            rng_seed: crate::test_support::fixed_unless_asked(
+                ProptestConfig::default().rng_seed,
+                0x6a61_6e75_7332_6463,
+            ),
             ..ProptestConfig::default()
         })]
 

@@ -523,32 +523,21 @@ impl DynamicTree {
             first: true,
         }];
         while let Some(span) = work.pop() {
-            if span.end - span.start <= cut {
+            if span.len() <= cut {
                 spans.push(span);
                 continue;
             }
             let split = span.start + partition_mid(&mut items[span.start..span.end]);
-            let id = slots[span.slot + span.end - span.start - 2];
+            let id = slots[span.root_slot()];
             self.nodes[id as usize] = Node {
                 allocated: true,
                 ..Node::EMPTY
             };
             self.place(id, span.parent, span.first);
             top.push(id);
-            work.push(Span {
-                start: split,
-                end: span.end,
-                slot: span.slot + split - span.start - 1,
-                parent: id,
-                first: false,
-            });
-            work.push(Span {
-                start: span.start,
-                end: split,
-                slot: span.slot,
-                parent: id,
-                first: true,
-            });
+            let [first, second] = span.halves(split, id);
+            work.push(second);
+            work.push(first);
         }
         let built = {
             let (nodes, items, slots) = (&self.nodes, &items[..], &slots[..]);
@@ -1434,6 +1423,41 @@ struct Span {
     first: bool,
 }
 
+impl Span {
+    /// Number of leaves.
+    fn len(&self) -> usize {
+        self.end - self.start
+    }
+
+    /// The internal slot (index into the rebuild's slot list) of the
+    /// span's root: the last of its own.
+    fn root_slot(&self) -> usize {
+        self.slot + self.len() - 2
+    }
+
+    /// The span split at leaf position `split` into its first and second
+    /// halves under `parent` (the span's root): the first half owns the
+    /// span's first slots, the second the next ones.
+    fn halves(&self, split: usize, parent: u32) -> [Span; 2] {
+        [
+            Span {
+                start: self.start,
+                end: split,
+                slot: self.slot,
+                parent,
+                first: true,
+            },
+            Span {
+                start: split,
+                end: self.end,
+                slot: self.slot + split - self.start - 1,
+                parent,
+                first: false,
+            },
+        ]
+    }
+}
+
 /// What [`build_span`] made: the span's internal nodes (slot, node), its
 /// leaves' parents (leaf, parent) and its root (a leaf when the span holds
 /// one).
@@ -1449,6 +1473,7 @@ struct BuiltSpan {
 /// root is left without a parent; the caller hangs it.
 fn build_span(nodes: &[Node], items: &[(Vec2, u32)], slots: &[u32], span: Span) -> BuiltSpan {
     const NONE: usize = usize::MAX;
+    let base = span.start;
     let mut local = items[span.start..span.end].to_vec();
     let len = local.len();
     let mut made: Vec<(u32, Node)> = Vec::with_capacity(len.saturating_sub(1));
@@ -1456,42 +1481,44 @@ fn build_span(nodes: &[Node], items: &[(Vec2, u32)], slots: &[u32], span: Span) 
     let mut kids: Vec<[usize; 2]> = Vec::with_capacity(len.saturating_sub(1));
     let mut leaves = Vec::with_capacity(len);
     let mut root = NULL_NODE;
-    // (range of `local`, its first internal slot, local index of the
-    // parent or NONE, as child1).
-    let mut work: Vec<(usize, usize, usize, usize, bool)> = vec![(0, len, span.slot, NONE, true)];
-    while let Some((a, b, slot, parent, first)) = work.pop() {
-        let (id, me) = if b - a == 1 {
-            let leaf = local[a].1;
+    // Spans still to build, each with its parent's index in `made` (NONE:
+    // the span's own root, hung by the caller).
+    let mut work = vec![(
+        Span {
+            parent: NULL_NODE,
+            ..span
+        },
+        NONE,
+    )];
+    while let Some((part, parent)) = work.pop() {
+        let (id, me) = if part.len() == 1 {
+            let leaf = local[part.start - base].1;
             if parent != NONE {
-                leaves.push((leaf, made[parent].0));
+                leaves.push((leaf, part.parent));
             }
             (leaf, NONE)
         } else {
-            let split = a + partition_mid(&mut local[a..b]);
-            let id = slots[slot + b - a - 2];
-            let up = if parent == NONE {
-                NULL_NODE
-            } else {
-                made[parent].0
-            };
+            let split = part.start + partition_mid(&mut local[part.start - base..part.end - base]);
+            let id = slots[part.root_slot()];
             made.push((
                 id,
                 Node {
                     allocated: true,
-                    parent: up,
+                    parent: part.parent,
                     ..Node::EMPTY
                 },
             ));
             kids.push([NONE; 2]);
             let me = made.len() - 1;
-            work.push((split, b, slot + split - a - 1, me, false));
-            work.push((a, split, slot, me, true));
+            let [first, second] = part.halves(split, id);
+            work.push((second, me));
+            work.push((first, me));
             (id, me)
         };
         if parent == NONE {
             root = id;
         } else {
-            let side = usize::from(!first);
+            let side = usize::from(!part.first);
             if side == 0 {
                 made[parent].1.child1 = id;
             } else {
@@ -1596,11 +1623,22 @@ pub(crate) mod test_util {
     pub(crate) fn translate(b: Aabb, d: Vec2) -> Aabb {
         Aabb::new(b.lower + d, b.upper + d)
     }
+
+    /// The payloads `tree.query` reports for `probe`, sorted.
+    pub(crate) fn sorted_query(tree: &super::DynamicTree, probe: &Aabb) -> Vec<u32> {
+        let mut found = Vec::new();
+        tree.query(probe, |u| {
+            found.push(u);
+            true
+        });
+        found.sort_unstable();
+        found
+    }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::test_util::{Lcg, boxed, random_box, translate};
+    use super::test_util::{Lcg, boxed, random_box, sorted_query, translate};
     use super::*;
 
     /// A tree decoded from crafted bytes may hold any index: the check
@@ -1662,19 +1700,11 @@ mod tests {
             }
             for q in 0..50 {
                 let probe = random_box(&mut rng, 120.0).fattened(1.0 + q as Real * 0.1);
-                let mut a = Vec::new();
-                let mut b = Vec::new();
-                batched.query(&probe, |u| {
-                    a.push(u);
-                    true
-                });
-                inserted.query(&probe, |u| {
-                    b.push(u);
-                    true
-                });
-                a.sort_unstable();
-                b.sort_unstable();
-                assert_eq!(a, b, "round {round}, query {q}");
+                assert_eq!(
+                    sorted_query(&batched, &probe),
+                    sorted_query(&inserted, &probe),
+                    "round {round}, query {q}"
+                );
             }
         }
         let before = batched.clone();
@@ -1751,12 +1781,7 @@ mod tests {
             }
             for q in 0..50 {
                 let probe = random_box(&mut rng, 120.0).fattened(1.0 + q as Real * 0.1);
-                let mut found = Vec::new();
-                deferred.query(&probe, |u| {
-                    found.push(u);
-                    true
-                });
-                found.sort_unstable();
+                let found = sorted_query(&deferred, &probe);
                 let expected: Vec<u32> = (0..boxes.len() as u32)
                     .filter(|&i| deferred.fat_aabb(ids[i as usize]).overlaps(&probe))
                     .collect();
@@ -1870,18 +1895,7 @@ mod tests {
             .map(|k| boxed(-130.0 + 5.3 * k as Real, 45.0 * (k % 5) as Real, 0.8, 0.6))
             .collect();
         let hits = |t: &DynamicTree| -> Vec<Vec<u32>> {
-            probes
-                .iter()
-                .map(|b| {
-                    let mut found = Vec::new();
-                    t.query(b, |u| {
-                        found.push(u);
-                        true
-                    });
-                    found.sort_unstable();
-                    found
-                })
-                .collect()
+            probes.iter().map(|b| sorted_query(t, b)).collect()
         };
         let before = hits(&tree);
         tree.rebuild_all(&mut Vec::new());
@@ -2030,12 +2044,7 @@ mod tests {
         let mut total = 0;
         for _ in 0..50 {
             let q = boxed(rng.range(0.0, 80.0), rng.range(0.0, 80.0), 5.0, 3.0);
-            let mut found = Vec::new();
-            tree.query(&q, |u| {
-                found.push(u);
-                true
-            });
-            found.sort_unstable();
+            let found = sorted_query(&tree, &q);
             let expected: Vec<u32> = (0..boxes.len() as u32)
                 .filter(|&i| boxes[i as usize].fattened(0.25).overlaps(&q))
                 .collect();

@@ -94,3 +94,20 @@ pub use snapshot::Snapshot;
 pub use snapshot::bytes::{SNAPSHOT_MAGIC, SNAPSHOT_VERSION, SnapshotError};
 pub use validate::{Invariant, InvariantError};
 pub use world::{BodyMoveEvent, ExplosionDef, StepEvents, TEAM_MIN_WORK, World, WorldDef};
+
+/// Helpers shared by the crate's property tests.
+#[cfg(test)]
+pub(crate) mod test_support {
+    use proptest::test_runner::RngSeed;
+
+    /// `seed` when `PROPTEST_RNG_SEED` fixed it, else `Fixed(fixed)`: a
+    /// property's cases are the same on every run unless asked otherwise.
+    /// For `proptest!` blocks:
+    /// `rng_seed: fixed_unless_asked(ProptestConfig::default().rng_seed, N)`.
+    pub(crate) fn fixed_unless_asked(seed: RngSeed, fixed: u64) -> RngSeed {
+        match seed {
+            RngSeed::Random => RngSeed::Fixed(fixed),
+            asked => asked,
+        }
+    }
+}
