@@ -31,8 +31,9 @@
 //! bodies, shapes (for reach), contacts (and the links that began or ended
 //! since it last looked) and joints.
 
-use janus2d_core::body::{BodyHandle, BodySet, BodyType};
+use janus2d_core::body::{BodyHandle, BodySet, BodySim, BodyType};
 use janus2d_core::math::Real;
+use janus2d_core::parallel::Team;
 use janus2d_core::union_find::{find, union};
 
 use crate::contacts::{ContactSet, TouchChanges};
@@ -151,6 +152,10 @@ pub(crate) struct SleepInput<'a> {
     /// Bodies that must not fall asleep this step (portal crossings).
     pub(crate) keep_awake: &'a [BodyHandle],
 }
+
+/// Bodies per block of the sleep timers on the team (below two blocks, the
+/// caller runs them alone).
+const TIMER_BLOCK: usize = 1024;
 
 impl Islands {
     /// The id of the island `body` belongs to (read-only, for drawing);
@@ -478,6 +483,7 @@ impl Islands {
         bodies: &mut BodySet,
         contacts: &mut ContactSet,
         joints: &JointSet,
+        team: &Team,
     ) {
         let settings = input.settings;
         let tol2 = settings.linear_threshold * settings.linear_threshold;
@@ -485,23 +491,30 @@ impl Islands {
         if n <= 1 {
             return; // nothing awake
         }
-        // Timers (slot 0 is the static sentinel).
-        for i in 1..n {
-            let st = bodies.states[i];
-            let sim = &mut bodies.sims[i];
-            let tol2 = sim.sleep_threshold.map_or(tol2, |t| t * t);
-            // The shapes' reach (random reads of the shape records) only
-            // where the linear speed leaves the turn to decide.
-            let turn_slow = || {
-                let reach = input.shapes.reach(sim.handle, sim.center);
-                st.w * st.w * reach * reach <= tol2
-            };
-            let slow = st.v.length_squared() <= tol2 && turn_slow();
-            if sim.body_type == BodyType::Dynamic && slow && sim.enable_sleep {
-                sim.sleep_time += input.dt;
-            } else {
-                sim.sleep_time = 0.0;
+        // Timers (slot 0 is the static sentinel), each body on its own:
+        // in blocks on the team.
+        let (sims, states) = (&mut bodies.sims[1..], &bodies.states[1..]);
+        let timers = |first: usize, sims: &mut [BodySim]| {
+            for (sim, st) in sims.iter_mut().zip(&states[first..]) {
+                let tol2 = sim.sleep_threshold.map_or(tol2, |t| t * t);
+                // The shapes' reach (random reads of the shape records)
+                // only where the linear speed leaves the turn to decide.
+                let turn_slow = || {
+                    let reach = input.shapes.reach(sim.handle, sim.center);
+                    st.w * st.w * reach * reach <= tol2
+                };
+                let slow = st.v.length_squared() <= tol2 && turn_slow();
+                if sim.body_type == BodyType::Dynamic && slow && sim.enable_sleep {
+                    sim.sleep_time += input.dt;
+                } else {
+                    sim.sleep_time = 0.0;
+                }
             }
+        };
+        if team.threads() > 1 && sims.len() > TIMER_BLOCK {
+            team.for_each_chunk_mut(sims, TIMER_BLOCK, |b, block| timers(b * TIMER_BLOCK, block));
+        } else {
+            timers(0, sims);
         }
         for &b in input.keep_awake {
             if let Some(i) = dynamic_index(bodies, b) {

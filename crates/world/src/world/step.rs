@@ -357,7 +357,7 @@ impl World {
                 keep_awake: &keep_awake,
             };
             self.islands
-                .update(&input, &mut self.bodies, contacts, &self.joints);
+                .update(&input, &mut self.bodies, contacts, &self.joints, team);
             sp.sleep += lap();
         }
         // Non-finite read-backs reset, the row counts and the threshold
