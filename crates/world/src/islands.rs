@@ -100,8 +100,20 @@ struct Island {
     /// Links removed since the island was built or last split: it may
     /// have fallen apart.
     removed: u32,
+    /// The two bodies of each ended contact counted in `removed`, while
+    /// every removal so far was such a contact and there are at most
+    /// [`MAX_CUTS`] of them (then `cuts.len() == removed`); otherwise the
+    /// list falls short of the count, and a split looks at the whole
+    /// island. Not in snapshots: a decoded island with removals is split
+    /// in full.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    cuts: Vec<[BodyHandle; 2]>,
     asleep: bool,
 }
+
+/// Most ended contacts an island remembers for the split's quick check
+/// ([`Islands::still_whole`]); past it, the split looks at every link.
+const MAX_CUTS: usize = 64;
 
 /// Persistent islands, bodies waiting to sleep, and scratch space.
 ///
@@ -142,6 +154,19 @@ pub(crate) struct Islands {
     /// Scratch of a split: the part of each root position.
     #[cfg_attr(feature = "serde", serde(skip))]
     part_of: Vec<u32>,
+    /// Scratch of the quick check: the search that last reached each body
+    /// slot (two stamps a search, one per end).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    reached: Vec<u32>,
+    /// Scratch of the quick check: the next search's first stamp.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    stamp: u32,
+    /// Scratch of the quick check: the two searches' queues.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    fronts: [Vec<BodyHandle>; 2],
+    /// Splits the quick check answered (for tests).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    quick_wholes: u64,
 }
 
 /// What the sleep update reads besides the bodies it changes.
@@ -191,6 +216,7 @@ impl Islands {
         let island = Island {
             members,
             removed: 0,
+            cuts: Vec::new(),
             asleep: false,
         };
         let id = match self.free.pop() {
@@ -340,6 +366,12 @@ impl Islands {
         let island = &mut self.islands[big as usize];
         island.members.extend(moved.members);
         island.removed = island.removed.saturating_add(moved.removed);
+        if island.cuts.len() + moved.cuts.len() <= MAX_CUTS {
+            island.cuts.extend(moved.cuts);
+        } else {
+            // Too many to check one by one: the next split looks at all.
+            island.cuts.clear();
+        }
         island.asleep = false;
         self.free.push(small);
     }
@@ -387,14 +419,28 @@ impl Islands {
         }
     }
 
+    /// A solid contact between `a` and `b` ended: as
+    /// [`note_removed`](Self::note_removed) of `a`, and the island of `a`
+    /// remembers the pair for the split's quick check.
+    fn note_cut(&mut self, a: BodyHandle, b: BodyHandle) {
+        let id = self.island(a);
+        if id != NONE {
+            let island = &mut self.islands[id as usize];
+            island.removed = island.removed.saturating_add(1);
+            if island.cuts.len() < MAX_CUTS {
+                island.cuts.push([a, b]);
+            }
+        }
+    }
+
     /// Takes the contacts that began and stopped touching during the step
     /// (handed over by the pipeline): links and possible splits.
     pub(crate) fn apply_touch_changes(&mut self, changes: TouchChanges, bodies: &BodySet) {
         for (a, b) in changes.began {
             self.link(a, b, bodies);
         }
-        for (a, _) in changes.ended {
-            self.note_removed(a);
+        for (a, b) in changes.ended {
+            self.note_cut(a, b);
         }
     }
 
@@ -536,7 +582,17 @@ impl Islands {
             }
         }
         if candidate.0 != NONE {
-            self.split(candidate.0, contacts, joints);
+            if self.still_whole(candidate.0, contacts, joints) {
+                // What the split would find: one part, the order kept.
+                #[cfg(debug_assertions)]
+                self.debug_check_whole(candidate.0, contacts, joints);
+                self.quick_wholes += 1;
+                let island = &mut self.islands[candidate.0 as usize];
+                island.removed = 0;
+                island.cuts.clear();
+            } else {
+                self.split(candidate.0, contacts, joints);
+            }
         }
         // The least rested awake member of each island with awake members
         // (sleeping islands are not visited; `min_time` is kept at MAX
@@ -577,6 +633,138 @@ impl Islands {
         }
         self.min_time = min_time;
         self.touched = touched;
+    }
+
+    /// The split's quick check: true when island `id` is surely still in
+    /// one piece, so a split would keep it as it is.
+    ///
+    /// The island was connected when it was built or last split (merges
+    /// join connected islands by a link), and since then every removal was
+    /// an ended contact it remembers (`cuts.len() == removed`; anything
+    /// else, such as a joint removed or a body destroyed, answers false).
+    /// Then it is still connected when the two ends of each remembered
+    /// contact, where both are members, still reach each other: any path
+    /// of old can go round each missing link. Each pair is looked for by
+    /// two searches growing from its ends over the members' solid contacts
+    /// and enabled joints (the links the split reads), a node at a time
+    /// from the smaller front: they meet (joined), or one runs out of
+    /// nodes (a part came off), or the step's budget of visits, an eighth
+    /// of the island, runs out. Only the first answers true; the others
+    /// leave the whole split to find the parts. Either way the result is
+    /// the split's, bit for bit: true is given only where the split would
+    /// find one part and keep the member order.
+    fn still_whole(&mut self, id: u32, contacts: &ContactSet, joints: &JointSet) -> bool {
+        let island = &self.islands[id as usize];
+        if island.cuts.len() != island.removed as usize || island.members.is_empty() {
+            return false;
+        }
+        let mut budget = island.members.len() / 8 + 16;
+        let cuts = std::mem::take(&mut self.islands[id as usize].cuts);
+        let mut whole = true;
+        for &[a, b] in &cuts {
+            let member = |x: BodyHandle| self.island(x) == id;
+            if !(member(a) && member(b)) {
+                continue; // not a link between members: nothing to go round
+            }
+            if !self.reach_each_other(id, [a, b], contacts, joints, &mut budget) {
+                whole = false;
+                break;
+            }
+        }
+        self.islands[id as usize].cuts = cuts;
+        whole
+    }
+
+    /// Debug builds: the whole split, on a copy, keeps island `id` as it
+    /// is (what [`still_whole`](Self::still_whole) answered).
+    #[cfg(debug_assertions)]
+    fn debug_check_whole(&self, id: u32, contacts: &ContactSet, joints: &JointSet) {
+        let mut full = self.clone();
+        full.split(id, contacts, joints);
+        debug_assert_eq!(
+            (
+                full.islands.len(),
+                &full.free,
+                &full.islands[id as usize].members
+            ),
+            (
+                self.islands.len(),
+                &self.free,
+                &self.islands[id as usize].members
+            ),
+            "island {id}: the quick check kept an island the split cuts"
+        );
+    }
+
+    /// The two searches of [`still_whole`](Self::still_whole) from `ends`,
+    /// over members of island `id`: true when they meet within `budget`
+    /// node visits (taken from it).
+    fn reach_each_other(
+        &mut self,
+        id: u32,
+        ends: [BodyHandle; 2],
+        contacts: &ContactSet,
+        joints: &JointSet,
+        budget: &mut usize,
+    ) -> bool {
+        if ends[0] == ends[1] {
+            return true;
+        }
+        if self.reached.len() < self.island_of.len() {
+            self.reached.resize(self.island_of.len(), 0);
+        }
+        if self.stamp == 0 || self.stamp >= u32::MAX - 2 {
+            // First use, or the stamps ran out: no body reached by any.
+            self.reached.fill(0);
+            self.stamp = 1;
+        }
+        let stamps = [self.stamp, self.stamp + 1];
+        self.stamp += 2;
+        let mut fronts = std::mem::take(&mut self.fronts);
+        for (side, front) in fronts.iter_mut().enumerate() {
+            front.clear();
+            front.push(ends[side]);
+            self.reached[ends[side].index as usize] = stamps[side];
+        }
+        let (island_of, reached) = (&self.island_of, &mut self.reached);
+        // Breadth first: each front is a queue read from `heads`.
+        let mut heads = [0usize; 2];
+        let met = 'search: loop {
+            // The smaller front grows by one node (a front that ran out
+            // is a part of its own: the island came apart).
+            let left = |s: usize| fronts[s].len() - heads[s];
+            let side = usize::from(left(1) < left(0));
+            let Some(&body) = fronts[side].get(heads[side]) else {
+                break false;
+            };
+            heads[side] += 1;
+            if *budget == 0 {
+                break false;
+            }
+            *budget -= 1;
+            let joint_others = joints.of_body(body).iter().filter_map(|&j| {
+                joints
+                    .get(j)
+                    .ok()
+                    .filter(|joint| joint.is_enabled())
+                    .and_then(|joint| joint.other_body(body))
+            });
+            for other in contacts.links_of(body).chain(joint_others) {
+                let i = other.index as usize;
+                if island_of.get(i) != Some(&id) {
+                    continue;
+                }
+                if reached[i] == stamps[1 - side] {
+                    break 'search true;
+                }
+                if reached[i] != stamps[side] {
+                    reached[i] = stamps[side];
+                    fronts[side].push(other);
+                }
+            }
+        };
+        self.fronts = fronts;
+        met
     }
 
     /// Splits island `id` into its connected parts over the members' own
@@ -646,6 +834,7 @@ impl Islands {
             let island = &mut self.islands[id as usize];
             island.members = members;
             island.removed = 0;
+            island.cuts.clear();
         } else {
             let mut parts: Vec<Vec<BodyHandle>> = vec![Vec::new(); part_count as usize];
             for (i, &m) in members.iter().enumerate() {
@@ -660,6 +849,7 @@ impl Islands {
                 let island = &mut self.islands[id as usize];
                 island.members = first;
                 island.removed = 0;
+                island.cuts.clear();
             }
             for part in parts {
                 self.new_island(part);
@@ -677,4 +867,88 @@ impl Islands {
 fn dynamic_index(bodies: &BodySet, b: BodyHandle) -> Option<u32> {
     let i = bodies.state_index(b)?;
     (i != 0 && bodies.sims[i as usize].body_type == BodyType::Dynamic).then_some(i)
+}
+
+#[cfg(test)]
+mod tests {
+    use janus2d_core::geometry::shapes::{Circle, Polygon};
+    use janus2d_core::math::{Real, Vec2};
+
+    use crate::{ShapeDef, World, WorldDef};
+    use janus2d_core::body::BodyDef;
+
+    const DT: Real = 1.0 / 60.0;
+
+    /// A row of six touching boxes resting on the ground, and a ball with
+    /// no friction sliding along their tops at 1 m/s: each time it leaves
+    /// a box their contact ends, while the row and the slider are still
+    /// one piece through its next box, until it slides off the row's end.
+    /// The row rests long enough to make the island the split's candidate
+    /// while the slider keeps it awake. The quick check must keep the
+    /// island whole while the slider rides the row (debug builds also run
+    /// the whole split on a copy and compare), and the whole split must
+    /// part them once it has left: then the row sleeps and the slider,
+    /// sliding on along the ground, does not.
+    #[test]
+    fn split_quick_check_keeps_an_island_joined_round_an_ended_contact() {
+        let mut world = World::new(WorldDef::default()).unwrap();
+        let ground = world
+            .create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0)))
+            .unwrap();
+        world
+            .create_shape(ground, &ShapeDef::default(), Polygon::make_box(40.0, 1.0))
+            .unwrap();
+        let row: Vec<_> = (0..6)
+            .map(|i| {
+                let b = world
+                    .create_body(&BodyDef::dynamic(Vec2::new(i as Real, 0.5)))
+                    .unwrap();
+                world
+                    .create_shape(b, &ShapeDef::default(), Polygon::make_box(0.5, 0.5))
+                    .unwrap();
+                b
+            })
+            .collect();
+        let slider = world
+            .create_body(&BodyDef {
+                linear_velocity: Vec2::new(1.0, 0.0),
+                ..BodyDef::dynamic(Vec2::new(0.0, 1.5))
+            })
+            .unwrap();
+        let slippery = ShapeDef {
+            friction: 0.0,
+            ..ShapeDef::default()
+        };
+        world
+            .create_shape(slider, &slippery, Circle::new(Vec2::ZERO, 0.5).unwrap())
+            .unwrap();
+        // Riding the row: four boxes left behind by t = 5 s (each seam
+        // slows the ball a little; it leaves the row at x ≈ 6 by 9 s).
+        for _ in 0..(5.0 / DT) as usize {
+            world.step(DT).unwrap();
+            assert!(
+                !world.is_sleeping(row[0]).unwrap(),
+                "the slider keeps the row awake"
+            );
+            assert_eq!(world.island_id(row[0]), world.island_id(slider));
+        }
+        let quick = world.islands.quick_wholes;
+        assert!(
+            quick >= 3,
+            "the quick check answered {quick} splits, not one a box"
+        );
+        for _ in 0..(8.0 / DT) as usize {
+            world.step(DT).unwrap();
+        }
+        for &b in &row {
+            assert!(
+                world.is_sleeping(b).unwrap(),
+                "the row sleeps once the slider left"
+            );
+        }
+        assert!(!world.is_sleeping(slider).unwrap(), "the slider slides on");
+        assert_ne!(world.island_id(row[0]), world.island_id(slider));
+        let v = world.linear_velocity(slider).unwrap();
+        assert!(v.x > 0.5, "the slider keeps sliding: {v:?}");
+    }
 }
