@@ -35,6 +35,7 @@ use janus2d_core::body::{BodyHandle, BodySet, BodySim, BodyType};
 use janus2d_core::math::Real;
 use janus2d_core::parallel::Team;
 use janus2d_core::union_find::{find, union};
+use smallvec::SmallVec;
 
 use crate::contacts::{ContactSet, TouchChanges};
 use crate::error::WorldError;
@@ -112,8 +113,28 @@ struct Island {
 }
 
 /// Most ended contacts an island remembers for the split's quick check
-/// ([`Islands::still_whole`]); past it, the split looks at every link.
+/// ([`Islands::quick_split`]); past it, the split looks at every link.
 const MAX_CUTS: usize = 64;
+
+/// What the split's quick check found ([`Islands::quick_split`]).
+enum QuickSplit {
+    /// Still one piece: the split would keep the island as it is.
+    Whole,
+    /// These bodies came off as one piece, and the rest is one piece.
+    Piece(Vec<BodyHandle>),
+    /// Not known: the whole split must look.
+    Unknown,
+}
+
+/// How the quick check's two searches ended ([`Islands::search`]).
+enum Search {
+    /// They reached each other.
+    Met,
+    /// Front 0 or 1 ran out of bodies: all it reached is a piece.
+    RanOut(usize),
+    /// The visits' budget ran out first.
+    OutOfBudget,
+}
 
 /// Persistent islands, bodies waiting to sleep, and scratch space.
 ///
@@ -164,9 +185,9 @@ pub(crate) struct Islands {
     /// Scratch of the quick check: the two searches' queues.
     #[cfg_attr(feature = "serde", serde(skip))]
     fronts: [Vec<BodyHandle>; 2],
-    /// Splits the quick check answered (for tests).
+    /// Splits the quick check answered (for tests): whole, one piece off.
     #[cfg_attr(feature = "serde", serde(skip))]
-    quick_wholes: u64,
+    quick_splits: [u64; 2],
 }
 
 /// What the sleep update reads besides the bodies it changes.
@@ -582,17 +603,25 @@ impl Islands {
             }
         }
         if candidate.0 != NONE {
-            if self.still_whole(candidate.0, contacts, joints) {
-                // What the split would find: one part, the order kept.
-                #[cfg(debug_assertions)]
-                self.debug_check_whole(candidate.0, contacts, joints);
-                self.quick_wholes += 1;
-                let island = &mut self.islands[candidate.0 as usize];
-                island.removed = 0;
-                island.cuts.clear();
-            } else {
-                self.split(candidate.0, contacts, joints);
+            let id = candidate.0;
+            #[cfg(debug_assertions)]
+            let before = self.clone();
+            match self.quick_split(id, contacts, joints) {
+                QuickSplit::Whole => {
+                    // What the split would find: one part, the order kept.
+                    self.quick_splits[0] += 1;
+                    let island = &mut self.islands[id as usize];
+                    island.removed = 0;
+                    island.cuts.clear();
+                }
+                QuickSplit::Piece(piece) => {
+                    self.quick_splits[1] += 1;
+                    self.split_off(id, piece);
+                }
+                QuickSplit::Unknown => self.split(id, contacts, joints),
             }
+            #[cfg(debug_assertions)]
+            self.debug_check_split(&before, id, contacts, joints);
         }
         // The least rested awake member of each island with awake members
         // (sleeping islands are not visited; `min_time` is kept at MAX
@@ -635,91 +664,178 @@ impl Islands {
         self.touched = touched;
     }
 
-    /// The split's quick check: true when island `id` is surely still in
-    /// one piece, so a split would keep it as it is.
+    /// The split's quick check: what splitting island `id` would do, found
+    /// from the ends of its ended contacts rather than from all its links.
     ///
     /// The island was connected when it was built or last split (merges
     /// join connected islands by a link), and since then every removal was
     /// an ended contact it remembers (`cuts.len() == removed`; anything
-    /// else, such as a joint removed or a body destroyed, answers false).
-    /// Then it is still connected when the two ends of each remembered
-    /// contact, where both are members, still reach each other: any path
-    /// of old can go round each missing link. Each pair is looked for by
-    /// two searches growing from its ends over the members' solid contacts
-    /// and enabled joints (the links the split reads), a node at a time
-    /// from the smaller front: they meet (joined), or one runs out of
-    /// nodes (a part came off), or the step's budget of visits, an eighth
-    /// of the island, runs out. Only the first answers true; the others
-    /// leave the whole split to find the parts. Either way the result is
-    /// the split's, bit for bit: true is given only where the split would
-    /// find one part and keep the member order.
-    fn still_whole(&mut self, id: u32, contacts: &ContactSet, joints: &JointSet) -> bool {
+    /// else, such as a joint removed or a body destroyed, answers
+    /// [`QuickSplit::Unknown`]). Each remembered contact whose two ends
+    /// are members is looked at in turn: two searches grow from its ends
+    /// over the members' solid contacts and enabled joints (the links the
+    /// split reads), a node at a time from the smaller front, breadth
+    /// first. They meet (still joined round the missing link), or one
+    /// front runs out: all it reached is a piece of its own, kept aside.
+    /// Contacts with an end in that piece are not searched; their other
+    /// ends (the piece's old neighbours) must all reach each other. Then
+    /// the rest is one piece: a path of old between two parts of it either
+    /// goes round each missing link between its members, or through the
+    /// piece, which it enters and leaves at those neighbours. A second
+    /// piece, or the budget of visits (an eighth of the island) running
+    /// out, answers `Unknown`, and the whole split finds the parts.
+    fn quick_split(&mut self, id: u32, contacts: &ContactSet, joints: &JointSet) -> QuickSplit {
         let island = &self.islands[id as usize];
         if island.cuts.len() != island.removed as usize || island.members.is_empty() {
-            return false;
+            return QuickSplit::Unknown;
         }
         let mut budget = island.members.len() / 8 + 16;
+        if self.reached.len() < self.island_of.len() {
+            self.reached.resize(self.island_of.len(), 0);
+        }
+        // Two stamps a search, at most one search a remembered end.
+        let needed = 4 * MAX_CUTS as u32 + 2;
+        if self.stamp == 0 || self.stamp >= u32::MAX - needed {
+            // First use, or the stamps ran out: no body reached by any.
+            self.reached.fill(0);
+            self.stamp = 1;
+        }
         let cuts = std::mem::take(&mut self.islands[id as usize].cuts);
-        let mut whole = true;
+        // The piece kept aside (its stamp and bodies), and its neighbours.
+        let mut aside: Option<(u32, Vec<BodyHandle>)> = None;
+        let mut outer: SmallVec<[BodyHandle; 4]> = SmallVec::new();
+        let mut unknown = false;
         for &[a, b] in &cuts {
-            let member = |x: BodyHandle| self.island(x) == id;
-            if !(member(a) && member(b)) {
+            if self.island(a) != id || self.island(b) != id {
                 continue; // not a link between members: nothing to go round
             }
-            if !self.reach_each_other(id, [a, b], contacts, joints, &mut budget) {
-                whole = false;
-                break;
+            if let Some((stamp, _)) = &aside {
+                let inside = |x: BodyHandle| self.reached[x.index as usize] == *stamp;
+                match (inside(a), inside(b)) {
+                    (true, true) => {}
+                    (true, false) => outer.push(b),
+                    (false, true) => outer.push(a),
+                    (false, false) => {
+                        if !matches!(
+                            self.search(id, [a, b], contacts, joints, &mut budget),
+                            Search::Met
+                        ) {
+                            unknown = true;
+                            break;
+                        }
+                    }
+                }
+                continue;
+            }
+            match self.search(id, [a, b], contacts, joints, &mut budget) {
+                Search::Met => {}
+                Search::RanOut(side) => {
+                    aside = Some(self.last_front(side));
+                    outer.push([a, b][1 - side]);
+                }
+                Search::OutOfBudget => {
+                    unknown = true;
+                    break;
+                }
+            }
+        }
+        // The piece's old neighbours: all in one part of the rest.
+        if !unknown && let Some((&first, others)) = outer.split_first() {
+            for &other in others {
+                if !matches!(
+                    self.search(id, [first, other], contacts, joints, &mut budget),
+                    Search::Met
+                ) {
+                    unknown = true;
+                    break;
+                }
             }
         }
         self.islands[id as usize].cuts = cuts;
-        whole
+        match aside {
+            _ if unknown => QuickSplit::Unknown,
+            Some((_, bodies)) => QuickSplit::Piece(bodies),
+            None => QuickSplit::Whole,
+        }
     }
 
-    /// Debug builds: the whole split, on a copy, keeps island `id` as it
-    /// is (what [`still_whole`](Self::still_whole) answered).
+    /// The stamp and bodies of front `side` of the last search.
+    fn last_front(&self, side: usize) -> (u32, Vec<BodyHandle>) {
+        (self.stamp - 2 + side as u32, self.fronts[side].clone())
+    }
+
+    /// Applies [`QuickSplit::Piece`]: island `id` minus `piece` stays one
+    /// island and `piece` becomes another, as [`split`](Self::split) makes
+    /// them (members in island order, the part holding the first member
+    /// keeps the id).
+    fn split_off(&mut self, id: u32, mut piece: Vec<BodyHandle>) {
+        let stamp = self.reached[piece[0].index as usize];
+        let members = std::mem::take(&mut self.islands[id as usize].members);
+        let position = &self.position;
+        piece.sort_unstable_by_key(|m| position[m.index as usize]);
+        let reached = &self.reached;
+        let rest: Vec<BodyHandle> = members
+            .iter()
+            .copied()
+            .filter(|m| reached[m.index as usize] != stamp)
+            .collect();
+        let (kept, new) = if reached[members[0].index as usize] == stamp {
+            (piece, rest)
+        } else {
+            (rest, piece)
+        };
+        for (k, m) in kept.iter().enumerate() {
+            self.place(*m, id, k);
+        }
+        let island = &mut self.islands[id as usize];
+        island.members = kept;
+        island.removed = 0;
+        island.cuts.clear();
+        self.new_island(new);
+    }
+
+    /// Debug builds: what the whole split makes of island `id` in `before`
+    /// is what the quick one made here.
     #[cfg(debug_assertions)]
-    fn debug_check_whole(&self, id: u32, contacts: &ContactSet, joints: &JointSet) {
-        let mut full = self.clone();
+    fn debug_check_split(&self, before: &Self, id: u32, contacts: &ContactSet, joints: &JointSet) {
+        let mut full = before.clone();
         full.split(id, contacts, joints);
-        debug_assert_eq!(
+        let state = |s: &Self| {
+            let islands: Vec<_> = s
+                .islands
+                .iter()
+                .map(|i| (i.members.clone(), i.removed, i.asleep))
+                .collect();
             (
-                full.islands.len(),
-                &full.free,
-                &full.islands[id as usize].members
-            ),
-            (
-                self.islands.len(),
-                &self.free,
-                &self.islands[id as usize].members
-            ),
-            "island {id}: the quick check kept an island the split cuts"
+                islands,
+                s.free.clone(),
+                s.island_of.clone(),
+                s.position.clone(),
+            )
+        };
+        debug_assert!(
+            state(&full) == state(self),
+            "island {id}: the quick split differs from the whole split"
         );
     }
 
-    /// The two searches of [`still_whole`](Self::still_whole) from `ends`,
-    /// over members of island `id`: true when they meet within `budget`
-    /// node visits (taken from it).
-    fn reach_each_other(
+    /// Two searches over members of island `id`, from `ends[0]` and
+    /// `ends[1]`, within `budget` node visits (taken from it); each marks
+    /// the bodies it reaches with its own stamp and keeps them in its
+    /// front.
+    fn search(
         &mut self,
         id: u32,
         ends: [BodyHandle; 2],
         contacts: &ContactSet,
         joints: &JointSet,
         budget: &mut usize,
-    ) -> bool {
-        if ends[0] == ends[1] {
-            return true;
-        }
-        if self.reached.len() < self.island_of.len() {
-            self.reached.resize(self.island_of.len(), 0);
-        }
-        if self.stamp == 0 || self.stamp >= u32::MAX - 2 {
-            // First use, or the stamps ran out: no body reached by any.
-            self.reached.fill(0);
-            self.stamp = 1;
-        }
+    ) -> Search {
         let stamps = [self.stamp, self.stamp + 1];
         self.stamp += 2;
+        if ends[0] == ends[1] {
+            return Search::Met;
+        }
         let mut fronts = std::mem::take(&mut self.fronts);
         for (side, front) in fronts.iter_mut().enumerate() {
             front.clear();
@@ -729,17 +845,16 @@ impl Islands {
         let (island_of, reached) = (&self.island_of, &mut self.reached);
         // Breadth first: each front is a queue read from `heads`.
         let mut heads = [0usize; 2];
-        let met = 'search: loop {
-            // The smaller front grows by one node (a front that ran out
-            // is a part of its own: the island came apart).
+        let found = 'search: loop {
+            // The smaller front grows by one node.
             let left = |s: usize| fronts[s].len() - heads[s];
             let side = usize::from(left(1) < left(0));
             let Some(&body) = fronts[side].get(heads[side]) else {
-                break false;
+                break Search::RanOut(side);
             };
             heads[side] += 1;
             if *budget == 0 {
-                break false;
+                break Search::OutOfBudget;
             }
             *budget -= 1;
             let joint_others = joints.of_body(body).iter().filter_map(|&j| {
@@ -755,7 +870,7 @@ impl Islands {
                     continue;
                 }
                 if reached[i] == stamps[1 - side] {
-                    break 'search true;
+                    break 'search Search::Met;
                 }
                 if reached[i] != stamps[side] {
                     reached[i] = stamps[side];
@@ -764,7 +879,7 @@ impl Islands {
             }
         };
         self.fronts = fronts;
-        met
+        found
     }
 
     /// Splits island `id` into its connected parts over the members' own
@@ -885,12 +1000,12 @@ mod tests {
     /// one piece through its next box, until it slides off the row's end.
     /// The row rests long enough to make the island the split's candidate
     /// while the slider keeps it awake. The quick check must keep the
-    /// island whole while the slider rides the row (debug builds also run
-    /// the whole split on a copy and compare), and the whole split must
-    /// part them once it has left: then the row sleeps and the slider,
+    /// island whole while the slider rides the row, and take the ball off
+    /// as one piece once it has left (debug builds also run the whole
+    /// split on a copy and compare): then the row sleeps and the ball,
     /// sliding on along the ground, does not.
     #[test]
-    fn split_quick_check_keeps_an_island_joined_round_an_ended_contact() {
+    fn split_quick_check_keeps_a_joined_island_and_takes_off_a_lone_piece() {
         let mut world = World::new(WorldDef::default()).unwrap();
         let ground = world
             .create_body(&BodyDef::fixed(Vec2::new(0.0, -1.0)))
@@ -932,10 +1047,10 @@ mod tests {
             );
             assert_eq!(world.island_id(row[0]), world.island_id(slider));
         }
-        let quick = world.islands.quick_wholes;
+        let [whole, _] = world.islands.quick_splits;
         assert!(
-            quick >= 3,
-            "the quick check answered {quick} splits, not one a box"
+            whole >= 3,
+            "the quick check kept {whole} splits whole, not one a box"
         );
         for _ in 0..(8.0 / DT) as usize {
             world.step(DT).unwrap();
@@ -947,6 +1062,8 @@ mod tests {
             );
         }
         assert!(!world.is_sleeping(slider).unwrap(), "the slider slides on");
+        let [_, pieces] = world.islands.quick_splits;
+        assert_eq!(pieces, 1, "the quick check took the ball off as one piece");
         assert_ne!(world.island_id(row[0]), world.island_id(slider));
         let v = world.linear_velocity(slider).unwrap();
         assert!(v.x > 0.5, "the slider keeps sliding: {v:?}");
