@@ -11,7 +11,9 @@
 //!            threshold) → sleep_time += dt, else 0; keep-awake bodies
 //!            (portal crossings) → 0
 //!   split    the island of the sleepiest body, if it lost links, is split
-//!            into its connected parts (one island per step, as Box2D)
+//!            into its connected parts (one island per step, as Box2D);
+//!            first from the ends of the contacts it lost (still whole,
+//!            or one piece off), else over all its links
 //!   sleep    an island whose every awake member rested long enough: its
 //!            bodies leave the solver arrays (BodySet::sleep), its contacts
 //!            move to the sleeping list (ContactSet::sleep_body)
@@ -147,7 +149,9 @@ enum Search {
 /// body destroyed
 /// sleepiest body's island  → split into its connected parts (one per step,
 ///   has removed > 0           union–find over its solid contacts and
-///                             enabled joints; still whole → order kept)
+///                             enabled joints; still whole → order kept);
+///                             the quick check from the lost contacts'
+///                             ends first (Islands::quick_split)
 /// every member rested      → the island sleeps: bodies and contacts leave
 ///   time_to_sleep             the awake lists
 /// ```
