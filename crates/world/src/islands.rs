@@ -788,14 +788,20 @@ impl Islands {
         } else {
             (rest, piece)
         };
-        for (k, m) in kept.iter().enumerate() {
+        self.keep_part(id, kept);
+        self.new_island(new);
+    }
+
+    /// Island `id` becomes the part `members` (placed in this order), with
+    /// no removals left to look at.
+    fn keep_part(&mut self, id: u32, members: Vec<BodyHandle>) {
+        for (k, m) in members.iter().enumerate() {
             self.place(*m, id, k);
         }
         let island = &mut self.islands[id as usize];
-        island.members = kept;
+        island.members = members;
         island.removed = 0;
         island.cuts.clear();
-        self.new_island(new);
     }
 
     /// Debug builds: what the whole split makes of island `id` in `before`
@@ -962,13 +968,7 @@ impl Islands {
             }
             let mut parts = parts.into_iter();
             if let Some(first) = parts.next() {
-                for (k, m) in first.iter().enumerate() {
-                    self.place(*m, id, k);
-                }
-                let island = &mut self.islands[id as usize];
-                island.members = first;
-                island.removed = 0;
-                island.cuts.clear();
+                self.keep_part(id, first);
             }
             for part in parts {
                 self.new_island(part);
