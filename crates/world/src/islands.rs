@@ -713,31 +713,33 @@ impl Islands {
             if self.island(a) != id || self.island(b) != id {
                 continue; // not a link between members: nothing to go round
             }
-            if let Some((stamp, _)) = &aside {
-                let inside = |x: BodyHandle| self.reached[x.index as usize] == *stamp;
-                match (inside(a), inside(b)) {
-                    (true, true) => {}
-                    (true, false) => outer.push(b),
-                    (false, true) => outer.push(a),
-                    (false, false) => {
-                        if !matches!(
-                            self.search(id, [a, b], contacts, joints, &mut budget),
-                            Search::Met
-                        ) {
-                            unknown = true;
-                            break;
-                        }
-                    }
+            // A contact with an end in the piece aside is not searched:
+            // its other end is one of the piece's old neighbours.
+            let inside = |x: BodyHandle| {
+                aside
+                    .as_ref()
+                    .is_some_and(|(stamp, _)| self.reached[x.index as usize] == *stamp)
+            };
+            match (inside(a), inside(b)) {
+                (true, true) => continue,
+                (true, false) => {
+                    outer.push(b);
+                    continue;
                 }
-                continue;
+                (false, true) => {
+                    outer.push(a);
+                    continue;
+                }
+                (false, false) => {}
             }
             match self.search(id, [a, b], contacts, joints, &mut budget) {
                 Search::Met => {}
-                Search::RanOut(side) => {
-                    aside = Some(self.last_front(side));
+                Search::RanOut(side) if aside.is_none() => {
+                    aside = Some(self.take_front(side));
                     outer.push([a, b][1 - side]);
                 }
-                Search::OutOfBudget => {
+                // A second piece, or the budget gone.
+                _ => {
                     unknown = true;
                     break;
                 }
@@ -763,9 +765,13 @@ impl Islands {
         }
     }
 
-    /// The stamp and bodies of front `side` of the last search.
-    fn last_front(&self, side: usize) -> (u32, Vec<BodyHandle>) {
-        (self.stamp - 2 + side as u32, self.fronts[side].clone())
+    /// The stamp and bodies of front `side` of the last search (the front
+    /// is taken; the next search starts an empty one).
+    fn take_front(&mut self, side: usize) -> (u32, Vec<BodyHandle>) {
+        (
+            self.stamp - 2 + side as u32,
+            std::mem::take(&mut self.fronts[side]),
+        )
     }
 
     /// Applies [`QuickSplit::Piece`]: island `id` minus `piece` stays one
