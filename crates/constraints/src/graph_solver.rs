@@ -100,6 +100,9 @@ impl GraphBatch<'_> {
                 let mut parts = colours.split(&mut refs);
                 for k in 0..slots {
                     let c = if reverse { slots - 1 - k } else { k };
+                    if c < joint_colours {
+                        colours.solve_lanes(c, ctx, states, use_bias, team);
+                    }
                     let joint_part: &mut [Option<&mut crate::Joint>] = if c < joint_colours {
                         &mut *parts[c]
                     } else {
@@ -196,8 +199,9 @@ impl ConstraintBatch for GraphBatch<'_> {
         self.contacts.apply_restitution(ctx, states);
     }
     fn store_impulses(&mut self) {
-        // Joints keep their impulses in place; the pipeline reads the
-        // contacts' back from the solver.
+        // The lanes' impulses go back into their joints; the pipeline
+        // reads the contacts' back from the solver.
+        self.joints.store_impulses();
     }
     fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
         self.contacts.prepare_on(ctx, bodies, team);

@@ -75,6 +75,7 @@ use crate::contact_solver::ContactSolver;
 use crate::joint::Joint;
 use crate::joint_base::is_moving;
 use crate::parts::{PairOf, WRITE_A, WRITE_B};
+use crate::revolute_lanes::{NO_LANE, RevoluteLanes};
 
 /// How many joints ahead a colour's solve asks for the joint record.
 const JOINTS_AHEAD: usize = 2;
@@ -142,6 +143,15 @@ pub struct JointColours {
     /// The colours' plan checked against the contacts' plan: a colour's
     /// joints and contacts then run as one job on the team.
     cross: CrossPlan,
+    /// The revolute joints whose rows are angle rows alone, [`LANES`](crate::lane::LANES)
+    /// at a time per colour ([`crate::revolute_lanes`]), from the batch's
+    /// prepare to its store.
+    lanes: RevoluteLanes,
+    /// The colouring (`generation`) the lanes were built on: lanes of
+    /// another are not used.
+    lanes_generation: u64,
+    /// Every joint one at a time (tests compare the lanes with it).
+    pub(crate) lanes_off: bool,
 }
 
 /// [`JointColours::colour_of`] of a joint that takes no colour.
@@ -348,11 +358,21 @@ impl JointColours {
             self.update(joints, states);
         }
         let (start, list) = (&self.body_start[..], &self.body_joints[..]);
+        let lanes = self.lanes_live().then_some(&self.lanes);
         let body = |s: usize, st: &mut BodyState| {
             // A copy in registers, its velocities written back once.
             let mut local = *st;
             for &e in &list[start[s] as usize..start[s + 1] as usize] {
-                joints[(e >> 1) as usize].warm_start_side(&mut local, e & 1 == 1);
+                let (j, side_b) = ((e >> 1) as usize, e & 1 == 1);
+                // A lane joint's angle rows keep their impulses in its lane.
+                if let (Some(lanes), Joint::Revolute(r)) = (lanes, &joints[j]) {
+                    let lane = lanes.lane_of(j);
+                    if lane != NO_LANE {
+                        r.warm_start_side_with(&mut local, side_b, lanes.impulses(lane));
+                        continue;
+                    }
+                }
+                joints[j].warm_start_side(&mut local, side_b);
             }
             st.v = local.v;
             st.w = local.w;
@@ -465,7 +485,7 @@ impl JointColours {
     /// Solves segment `s` (colour `s`, or the overflow for
     /// `s == colour_count()`) on the caller, in solve order.
     pub(crate) fn solve_segment(
-        &self,
+        &mut self,
         s: usize,
         ctx: &StepContext,
         joints: &mut [Joint],
@@ -475,7 +495,15 @@ impl JointColours {
         let (Some(&start), Some(&end)) = (self.starts.get(s), self.starts.get(s + 1)) else {
             return;
         };
+        let lanes = self.lanes_live();
+        if lanes {
+            self.lanes
+                .solve_colour(s, ctx, states, use_bias, &Team::serial());
+        }
         for p in start as usize..end as usize {
+            if lanes && self.lanes.lane_of(self.order[p] as usize) != NO_LANE {
+                continue;
+            }
             // The joint a few places on: colour order is not storage order.
             if let Some(j) = self
                 .order
@@ -496,12 +524,82 @@ impl JointColours {
     pub(crate) fn take_refs<'j>(&mut self, joints: &'j mut [Joint]) -> Vec<Option<&'j mut Joint>> {
         let mut refs = self.scratch.take();
         refs.resize_with(self.order.len(), || None);
-        for (j, &p) in joints.iter_mut().zip(&self.position) {
-            if p != NONE {
+        let lanes = self.lanes_live();
+        for (i, (j, &p)) in joints.iter_mut().zip(&self.position).enumerate() {
+            if p != NONE && !(lanes && self.lanes.lane_of(i) != NO_LANE) {
                 refs[p as usize] = Some(j);
             }
         }
         refs
+    }
+
+    /// Joints solved in lanes this step (0 outside a step).
+    #[must_use]
+    pub fn lane_joints(&self) -> usize {
+        if self.lanes_live() {
+            self.lanes.joint_count()
+        } else {
+            0
+        }
+    }
+
+    /// Whether this step's lanes are live and built on the current
+    /// colouring.
+    #[inline]
+    fn lanes_live(&self) -> bool {
+        self.lanes.is_live() && self.lanes_generation == self.generation
+    }
+
+    /// Builds the lanes of this step (after the joints' prepare and the
+    /// colouring; [`crate::revolute_lanes`]).
+    pub(crate) fn build_lanes(
+        &mut self,
+        joints: &mut [Joint],
+        ctx: &StepContext,
+        state_count: usize,
+        team: &Team,
+    ) {
+        self.store_lanes(joints);
+        if self.lanes_off {
+            return;
+        }
+        let colours = self.colour_count();
+        let starts = &self.starts;
+        self.lanes.build(
+            joints,
+            (0..colours).map(|c| (starts[c] as usize, starts[c + 1] as usize)),
+            &self.order,
+            &self.writes,
+            ctx,
+            state_count,
+            team,
+        );
+        self.lanes_generation = self.generation;
+    }
+
+    /// One iteration of colour `colour`'s lanes (before the colour's other
+    /// joints and contacts: they share no moving body).
+    pub(crate) fn solve_lanes(
+        &mut self,
+        colour: usize,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        team: &Team,
+    ) {
+        if self.lanes_live() {
+            self.lanes.solve_colour(colour, ctx, states, use_bias, team);
+        }
+    }
+
+    /// Writes the lanes' impulses back into the joints and ends the lanes
+    /// (the batch's store; lanes of an older colouring are dropped).
+    pub(crate) fn store_lanes(&mut self, joints: &mut [Joint]) {
+        if self.lanes_live() {
+            self.lanes.store(joints);
+        } else {
+            self.lanes.store(&mut []);
+        }
     }
 
     /// Keeps the allocation of `refs` for the next stage.
@@ -552,6 +650,7 @@ impl JointColours {
             let mut parts = self.split(&mut refs);
             for s in 0..segments {
                 let s = if reverse { segments - 1 - s } else { s };
+                self.solve_lanes(s, ctx, states, use_bias, team);
                 let part = &mut *parts[s];
                 let per_block = Self::block_len(part.len(), team);
                 if s + 1 == segments || part.len() <= per_block {
@@ -814,6 +913,8 @@ mod tests {
     #[test]
     fn the_warm_start_by_body_is_the_storage_order_warm_start() {
         let (set, mut joints, mut colours, ctx) = prepared(9, 30);
+        // The impulses set below are the joints' own: no lanes hold them.
+        colours.store_lanes(&mut joints);
         for (k, j) in joints.iter_mut().enumerate() {
             let x = k as Real;
             let point = j.tree_point_mut().unwrap();

@@ -43,20 +43,92 @@ use janus2d_core::softness::Softness;
 
 use crate::lane::Lane;
 use crate::parts::{
-    AxisRow, PairMass, PointPart, apply_pair, bounded_sum, cap, clamp_length, row_bound,
-    row_bound_of_k, soft_impulse,
+    AxisRow, MassLanes, PairMass, PairVelocity, PointPart, V2, apply_pair, apply_pair_lanes,
+    bounded_sum_lanes, cap_lanes, clamp_length, clamp_length_lanes, cross_sv_lanes,
+    effective_mass_lanes, row_bound, row_bound_lanes, row_bound_of_k, soft_impulse, solve22_lanes,
 };
 
 /// A row's soft terms: the velocity bias `b` (m/s or rad/s), the mass
-/// scale `s_m` and the impulse scale `s_i` of [`Softness`].
+/// scale `s_m` and the impulse scale `s_i` of [`Softness`]; one row's on
+/// [`Real`], [`LANES`](crate::lane::LANES) rows' on the wide lane type.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Terms {
+pub(crate) struct Terms<L = Real> {
     /// Velocity bias added to `Ċ`.
-    pub(crate) bias: Real,
+    pub(crate) bias: L,
     /// `s_m`, 1 for a rigid row.
-    pub(crate) mass_scale: Real,
+    pub(crate) mass_scale: L,
     /// `s_i`, 0 for a rigid row.
-    pub(crate) impulse_scale: Real,
+    pub(crate) impulse_scale: L,
+}
+
+/// A [`Softness`] lane by lane: its bias rate (1/s), mass scale and
+/// impulse scale.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SoftLanes<L> {
+    pub(crate) bias_rate: L,
+    pub(crate) mass_scale: L,
+    pub(crate) impulse_scale: L,
+}
+
+impl<L: Lane> SoftLanes<L> {
+    /// The same softness in every lane.
+    #[inline(always)]
+    pub(crate) fn splat(softness: Softness) -> Self {
+        SoftLanes {
+            bias_rate: L::splat(softness.bias_rate),
+            mass_scale: L::splat(softness.mass_scale),
+            impulse_scale: L::splat(softness.impulse_scale),
+        }
+    }
+}
+
+impl<L: Lane> Terms<L> {
+    /// A rigid row without position feedback, in every lane.
+    #[inline(always)]
+    pub(crate) fn rigid() -> Self {
+        Terms {
+            bias: L::splat(0.0),
+            mass_scale: L::splat(1.0),
+            impulse_scale: L::splat(0.0),
+        }
+    }
+
+    /// A soft row driving `c` to zero with `softness`, its feedback speed
+    /// `bias_rate · c` capped at `±max_bias` (infinite for a spring, whose
+    /// feedback is its force).
+    #[inline(always)]
+    pub(crate) fn soft_lanes(softness: SoftLanes<L>, c: L, max_bias: L) -> Self {
+        Terms {
+            bias: cap_lanes(softness.bias_rate * c, max_bias),
+            mass_scale: softness.mass_scale,
+            impulse_scale: softness.impulse_scale,
+        }
+    }
+
+    /// A one-sided row `c ≥ 0` (a limit): speculative while apart (the gap
+    /// closes in one step at most: bias `c / h`, rigid), soft when
+    /// violated (only with `use_bias`; rigid in the relax pass), the
+    /// violated row's feedback speed capped at `max_bias`.
+    #[inline(always)]
+    pub(crate) fn limit_lanes(
+        c: L,
+        softness: SoftLanes<L>,
+        inv_h: L,
+        use_bias: bool,
+        max_bias: L,
+    ) -> Self {
+        let violated = if use_bias {
+            Self::soft_lanes(softness, c, max_bias)
+        } else {
+            Self::rigid()
+        };
+        let apart = c.gt(L::splat(0.0));
+        Terms {
+            bias: L::select(apart, c * inv_h, violated.bias),
+            mass_scale: L::select(apart, L::splat(1.0), violated.mass_scale),
+            impulse_scale: L::select(apart, L::splat(0.0), violated.impulse_scale),
+        }
+    }
 }
 
 impl Terms {
@@ -72,11 +144,7 @@ impl Terms {
     /// spring, whose feedback is its force).
     #[inline(always)]
     pub(crate) fn soft(softness: Softness, c: Real, max_bias: Real) -> Terms {
-        Terms {
-            bias: cap(softness.bias_rate * c, max_bias),
-            mass_scale: softness.mass_scale,
-            impulse_scale: softness.impulse_scale,
-        }
+        Terms::soft_lanes(SoftLanes::splat(softness), c, max_bias)
     }
 
     /// An equality row: [`Terms::soft`] with `use_bias`, else rigid (the
@@ -90,9 +158,8 @@ impl Terms {
         }
     }
 
-    /// A one-sided row `c ≥ 0` (a limit): speculative while apart (the gap
-    /// closes in one step at most), soft when violated (only with
-    /// `use_bias`), the violated row's feedback speed capped at `max_bias`.
+    /// A one-sided row `c ≥ 0` (a limit): [`Terms::limit_lanes`] on one
+    /// row.
     #[inline(always)]
     pub(crate) fn limit(
         c: Real,
@@ -101,14 +168,7 @@ impl Terms {
         use_bias: bool,
         max_bias: Real,
     ) -> Terms {
-        if c > 0.0 {
-            Terms {
-                bias: c * inv_h,
-                ..Terms::RIGID
-            }
-        } else {
-            Terms::equality(softness, c, max_bias, use_bias)
-        }
+        Terms::limit_lanes(c, SoftLanes::splat(softness), inv_h, use_bias, max_bias)
     }
 
     /// A velocity row driving `Ċ` to `target` (a motor).
@@ -121,14 +181,15 @@ impl Terms {
     }
 }
 
-/// How a row's accumulated impulse `λ` takes a step `Δλ`.
+/// How a row's accumulated impulse `λ` takes a step `Δλ` (one row's on
+/// [`Real`], lane by lane on the wide lane type).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Bounds {
+pub(crate) enum Bounds<L = Real> {
     /// `λ += Δλ`, unbounded (an equality, a spring).
     Free,
     /// `λ = clamp(λ + Δλ, lower, upper)` (a motor `±h·max`, a limit
     /// `[0, ∞)`, a force-bounded spring); the applied step is the change.
-    Clamp(Real, Real),
+    Clamp(L, L),
 }
 
 impl Bounds {
@@ -140,13 +201,15 @@ impl Bounds {
     pub(crate) fn symmetric(max: Real) -> Bounds {
         Bounds::Clamp(-max, max)
     }
+}
 
+impl<L: Lane> Bounds<L> {
     /// Accumulates `lambda` into `impulse`, its size held within `max`
     /// ([`row_bound`](crate::parts::row_bound)); returns the step to apply.
     #[inline(always)]
-    fn accumulate(self, impulse: &mut Real, lambda: Real, max: Real) -> Real {
+    fn accumulate(self, impulse: &mut L, lambda: L, max: L) -> L {
         match self {
-            Bounds::Free => bounded_sum(impulse, lambda, max),
+            Bounds::Free => bounded_sum_lanes(impulse, lambda, max),
             Bounds::Clamp(lower, upper) => {
                 // The bound folded into the clamp: one clamp per row.
                 let old = *impulse;
@@ -155,6 +218,35 @@ impl Bounds {
             }
         }
     }
+}
+
+/// An angle row `σ (ω_b − ω_a)` (`sign = σ = ±1`) of effective mass
+/// `mass = 1 / (i_a⁻¹ + i_b⁻¹)` on the angular velocities `w = (ω_a, ω_b)`
+/// of bodies of inverse inertias `inv_inertia = (i_a⁻¹, i_b⁻¹)`: the one
+/// definition of the row, for one joint ([`RowSolve::angle`]) and for
+/// [`LANES`](crate::lane::LANES) revolute joints at once
+/// ([`crate::revolute_lanes`]).
+#[inline(always)]
+pub(crate) fn angle_row<L: Lane>(
+    (w_a, w_b): (&mut L, &mut L),
+    (inv_inertia_a, inv_inertia_b): (L, L),
+    sign: Real,
+    mass: L,
+    t: Terms<L>,
+    bounds: Bounds<L>,
+    impulse: &mut L,
+) {
+    let sign = L::splat(sign);
+    let c_dot = sign * (*w_b - *w_a);
+    let lambda = soft_impulse(
+        mass * t.mass_scale,
+        c_dot + t.bias,
+        t.impulse_scale,
+        *impulse,
+    );
+    let step = sign * bounds.accumulate(impulse, lambda, row_bound_lanes(mass));
+    *w_a -= inv_inertia_a * step;
+    *w_b += inv_inertia_b * step;
 }
 
 /// One Gauss–Seidel iteration over a joint's rows: the two bodies' states
@@ -204,16 +296,16 @@ impl RowSolve {
         bounds: Bounds,
         impulse: &mut Real,
     ) {
-        let c_dot = sign * (self.sb.w - self.sa.w);
-        let lambda = soft_impulse(
-            mass * t.mass_scale,
-            c_dot + t.bias,
-            t.impulse_scale,
-            *impulse,
+        let inv_inertia = (self.m.a.inv_inertia, self.m.b.inv_inertia);
+        angle_row(
+            (&mut self.sa.w, &mut self.sb.w),
+            inv_inertia,
+            sign,
+            mass,
+            t,
+            bounds,
+            impulse,
         );
-        let step = sign * bounds.accumulate(impulse, lambda, row_bound(mass));
-        self.sa.w -= self.m.a.inv_inertia * step;
-        self.sb.w += self.m.b.inv_inertia * step;
     }
 
     /// The point block at arms `r_a`, `r_b` (m), its bias a vector;
@@ -256,22 +348,30 @@ impl RowSolve {
         t: PointTerms,
         impulse: &mut Vec2,
     ) {
-        let lambda = self.point_step(r_a, r_b, t, *impulse);
-        *impulse += lambda;
-        apply_pair(&mut self.sa, &mut self.sb, &self.m, r_a, r_b, lambda, 0.0);
+        let mut vel = PairVelocity::of(&self.sa, &self.sb);
+        let mut p = V2::from(*impulse);
+        point_equality_row(
+            &mut vel,
+            &MassLanes::of(&self.m),
+            (r_a.into(), r_b.into()),
+            t,
+            &mut p,
+        );
+        *impulse = p.into();
+        vel.store(&mut self.sa, &mut self.sb);
     }
 
     /// The point block's soft step `Δλ` for the kept impulse `impulse`.
     #[inline(always)]
     fn point_step(&self, r_a: Vec2, r_b: Vec2, t: PointTerms, impulse: Vec2) -> Vec2 {
-        let (sa, sb) = (&self.sa, &self.sb);
-        let c_dot = (sb.v + cross_sv(sb.w, r_b)) - (sa.v + cross_sv(sa.w, r_a));
-        let (k11, k12, k22) = PointPart::effective_mass(&self.m, r_a, r_b);
-        let x = solve22(k11, k12, k22, c_dot + t.bias);
-        Vec2::new(
-            soft_impulse(t.mass_scale, x.x, t.impulse_scale, impulse.x),
-            soft_impulse(t.mass_scale, x.y, t.impulse_scale, impulse.y),
+        point_step_lanes(
+            &PairVelocity::of(&self.sa, &self.sb),
+            &MassLanes::of(&self.m),
+            (r_a.into(), r_b.into()),
+            t,
+            impulse.into(),
         )
+        .into()
     }
 
     /// A linear row and the angle row solved as one 2×2 block (a
@@ -377,20 +477,47 @@ impl RowSolve {
     }
 }
 
-/// A point block's soft terms: the bias is a vector (m/s).
+/// A point block's soft terms: the velocity bias (a vector, m/s), the
+/// mass scale `s_m` and the impulse scale `s_i`; one block's on [`Real`],
+/// lane by lane on the wide lane type.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct PointTerms {
+pub(crate) struct PointTerms<L = Real> {
     /// Velocity bias added to `Ċ`.
-    pub(crate) bias: Vec2,
+    pub(crate) bias: V2<L>,
     /// `s_m`.
-    pub(crate) mass_scale: Real,
+    pub(crate) mass_scale: L,
     /// `s_i`.
-    pub(crate) impulse_scale: Real,
+    pub(crate) impulse_scale: L,
+}
+
+impl<L: Lane> PointTerms<L> {
+    /// An equality block: with `use_bias`, the feedback `bias_rate · c`
+    /// with its length capped at `max_length` (m/s), else rigid.
+    #[inline(always)]
+    pub(crate) fn equality_lanes(
+        softness: SoftLanes<L>,
+        c: V2<L>,
+        max_length: L,
+        use_bias: bool,
+    ) -> Self {
+        if use_bias {
+            PointTerms {
+                bias: clamp_length_lanes(c.scale(softness.bias_rate), max_length),
+                mass_scale: softness.mass_scale,
+                impulse_scale: softness.impulse_scale,
+            }
+        } else {
+            PointTerms {
+                bias: V2::zero(),
+                mass_scale: L::splat(1.0),
+                impulse_scale: L::splat(0.0),
+            }
+        }
+    }
 }
 
 impl PointTerms {
-    /// An equality block: with `use_bias`, the feedback `bias_rate · c`
-    /// with its length capped at `max_length` (m/s), else rigid.
+    /// An equality block ([`PointTerms::equality_lanes`] on one block).
     #[inline(always)]
     pub(crate) fn equality(
         softness: Softness,
@@ -398,30 +525,58 @@ impl PointTerms {
         max_length: Real,
         use_bias: bool,
     ) -> PointTerms {
-        if use_bias {
-            PointTerms {
-                bias: clamp_length(softness.bias_rate * c, max_length),
-                mass_scale: softness.mass_scale,
-                impulse_scale: softness.impulse_scale,
-            }
-        } else {
-            PointTerms {
-                bias: Vec2::ZERO,
-                mass_scale: 1.0,
-                impulse_scale: 0.0,
-            }
-        }
+        PointTerms::equality_lanes(SoftLanes::splat(softness), c.into(), max_length, use_bias)
     }
 
     /// A rigid block whose feedback is `bias_rate · c` (1/s × m), uncapped.
     #[inline(always)]
     pub(crate) fn feedback(bias_rate: Real, c: Vec2) -> PointTerms {
         PointTerms {
-            bias: bias_rate * c,
+            bias: (bias_rate * c).into(),
             mass_scale: 1.0,
             impulse_scale: 0.0,
         }
     }
+}
+
+/// The point block's soft step `Δλ` for the kept impulse `impulse`, lane
+/// by lane: `Ċ = (v_b + ω_b × r_b) − (v_a + ω_a × r_a)`,
+/// `Δλ = −s_m K⁻¹ (Ċ + b) − s_i λ`.
+#[inline(always)]
+pub(crate) fn point_step_lanes<L: Lane>(
+    vel: &PairVelocity<L>,
+    m: &MassLanes<L>,
+    (r_a, r_b): (V2<L>, V2<L>),
+    t: PointTerms<L>,
+    impulse: V2<L>,
+) -> V2<L> {
+    let c_dot = vel
+        .v_b
+        .add(cross_sv_lanes(vel.w_b, r_b))
+        .sub(vel.v_a.add(cross_sv_lanes(vel.w_a, r_a)));
+    let (k11, k12, k22) = effective_mass_lanes(m, r_a, r_b);
+    let x = solve22_lanes(k11, k12, k22, c_dot.add(t.bias));
+    V2::new(
+        soft_impulse(t.mass_scale, x.x, t.impulse_scale, impulse.x),
+        soft_impulse(t.mass_scale, x.y, t.impulse_scale, impulse.y),
+    )
+}
+
+/// The point block of an equality, lane by lane: the soft step, added to
+/// the kept impulse without a bound (held once a step at prepare, see
+/// [`RowSolve::point_equality`]) and applied at the arms. The one
+/// definition for one joint and for [`crate::revolute_lanes`].
+#[inline(always)]
+pub(crate) fn point_equality_row<L: Lane>(
+    vel: &mut PairVelocity<L>,
+    m: &MassLanes<L>,
+    arms: (V2<L>, V2<L>),
+    t: PointTerms<L>,
+    impulse: &mut V2<L>,
+) {
+    let lambda = point_step_lanes(vel, m, arms, t, *impulse);
+    *impulse = impulse.add(lambda);
+    apply_pair_lanes(vel, m, arms.0, arms.1, lambda, L::splat(0.0));
 }
 
 /// One body's share of a joint's warm start: the kept impulses of the

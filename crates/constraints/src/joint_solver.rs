@@ -7,7 +7,8 @@
 //! | warm start     | [`JointColours`]: per moving body, its joints' shares in storage order |
 //! | solve, relax   | [`JointColours`]: the Gauss–Seidel rows colour by colour     |
 //! | late solve     | [`JointForest`]: the point rows of joint trees, exactly      |
-//! | restitution, store | nothing: no joint kind has restitution, impulses stay in the joints |
+//! | restitution    | nothing: no joint kind has restitution                      |
+//! | store          | the lanes' angle impulses back into their joints ([`crate::revolute_lanes`]); every other impulse stays in its joint |
 
 use janus2d_core::body::{BodySet, BodyState};
 use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};
@@ -73,6 +74,8 @@ impl JointBatch<'_> {
         } else {
             self.colours.recolour_if_changed(count, states.len());
         }
+        self.colours
+            .build_lanes(self.joints, ctx, states.len(), team);
     }
 }
 
@@ -105,7 +108,9 @@ impl ConstraintBatch for JointBatch<'_> {
         // No joint kind has restitution rows.
     }
     fn store_impulses(&mut self) {
-        // Joints keep their impulses in place.
+        // The angle rows solved in lanes hand theirs back; every other row
+        // keeps its impulse in its joint.
+        self.colours.store_lanes(self.joints);
     }
     fn prepare_on(&mut self, ctx: &StepContext, bodies: &BodySet, team: &Team) {
         self.prepare_all_on(ctx, bodies, team);

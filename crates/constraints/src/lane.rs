@@ -16,6 +16,9 @@
 //! | [`Lane::at_most`]      | `if x < hi { x } else { hi }`| `min` instruction         |
 //! | comparisons            | `bool`                       | all-ones lane masks       |
 //! | [`Lane::select`]       | `if`                         | blend                     |
+//! | [`Lane::abs`]          | sign bit cleared             | sign bits cleared         |
+//! | [`Lane::flip_sign`]    | `−x`                         | sign bits flipped         |
+//! | [`Lane::sqrt`]         | `sqrt`                       | lane-wise `sqrt`          |
 //!
 //! `at_least` and `at_most` return their argument where `x` is NaN (the
 //! `max` and `min` instructions of SSE do); `−x` differs between the two
@@ -79,6 +82,13 @@ pub trait Lane:
     fn ne(self, other: Self) -> Self::Mask;
     /// `on_true` where `mask` holds, else `on_false`.
     fn select(mask: Self::Mask, on_true: Self, on_false: Self) -> Self;
+    /// `|self|` (the sign bit cleared, NaN included).
+    fn abs(self) -> Self;
+    /// `−self` by its sign bit, as the float's own negation (`−(+0) = −0`,
+    /// where the operator on `Wide` gives `0 − x`).
+    fn flip_sign(self) -> Self;
+    /// `√self` (correctly rounded on either type).
+    fn sqrt(self) -> Self;
     /// Whether `mask` holds in some lane.
     fn any(mask: Self::Mask) -> bool;
     /// Lane `k`'s value (`k = 0` for [`Real`]).
@@ -131,6 +141,18 @@ impl Lane for Real {
     #[inline(always)]
     fn select(mask: bool, on_true: Self, on_false: Self) -> Self {
         if mask { on_true } else { on_false }
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Real::abs(self)
+    }
+    #[inline(always)]
+    fn flip_sign(self) -> Self {
+        -self
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        Real::sqrt(self)
     }
     #[inline(always)]
     fn any(mask: bool) -> bool {
@@ -186,6 +208,18 @@ impl Lane for Wide {
     #[inline(always)]
     fn select(mask: Wide, on_true: Self, on_false: Self) -> Self {
         mask.blend(on_true, on_false)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Wide::abs(self)
+    }
+    #[inline(always)]
+    fn flip_sign(self) -> Self {
+        self ^ Wide::splat(-0.0)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        Wide::sqrt(self)
     }
     #[inline(always)]
     fn any(mask: Wide) -> bool {

@@ -53,6 +53,7 @@ pub mod portal;
 pub mod portal_map;
 pub mod prismatic;
 pub mod revolute;
+pub(crate) mod revolute_lanes;
 pub mod weld;
 pub mod wheel;
 

@@ -30,7 +30,7 @@
 //! every impulse on it vanish without a branch.
 
 use janus2d_core::body::{BodyState, InvMass};
-use janus2d_core::math::{Real, Vec2, cross};
+use janus2d_core::math::{Real, Vec2};
 use janus2d_core::parallel::PlannedStates;
 
 use crate::lane::Lane;
@@ -170,10 +170,194 @@ pub fn apply_pair(
     p: Vec2,
     l: Real,
 ) {
-    sa.v -= m.a.inv_mass * p;
-    sa.w -= m.a.inv_inertia * (cross(r_a, p) + l);
-    sb.v += m.b.inv_mass * p;
-    sb.w += m.b.inv_inertia * (cross(r_b, p) + l);
+    let mut vel = PairVelocity::of(sa, sb);
+    apply_pair_lanes(
+        &mut vel,
+        &MassLanes::of(m),
+        r_a.into(),
+        r_b.into(),
+        p.into(),
+        l,
+    );
+    vel.store(sa, sb);
+}
+
+/// A vector per lane: `x` and `y` on [`Real`] (one vector) or on the wide
+/// lane type ([`LANES`](crate::lane::LANES) vectors). Its operations are
+/// glam's on [`Vec2`], component by component, so a lane computes what the
+/// one-vector form computes, bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct V2<L> {
+    pub(crate) x: L,
+    pub(crate) y: L,
+}
+
+impl<L: Lane> V2<L> {
+    #[inline(always)]
+    pub(crate) fn new(x: L, y: L) -> Self {
+        V2 { x, y }
+    }
+    /// `(0, 0)` in every lane.
+    #[inline(always)]
+    pub(crate) fn zero() -> Self {
+        V2::new(L::splat(0.0), L::splat(0.0))
+    }
+    #[inline(always)]
+    pub(crate) fn add(self, o: Self) -> Self {
+        V2::new(self.x + o.x, self.y + o.y)
+    }
+    #[inline(always)]
+    pub(crate) fn sub(self, o: Self) -> Self {
+        V2::new(self.x - o.x, self.y - o.y)
+    }
+    /// `k · self`.
+    #[inline(always)]
+    pub(crate) fn scale(self, k: L) -> Self {
+        V2::new(k * self.x, k * self.y)
+    }
+    /// `self` where `mask` holds, else `other`.
+    #[inline(always)]
+    pub(crate) fn select(mask: L::Mask, on_true: Self, on_false: Self) -> Self {
+        V2::new(
+            L::select(mask, on_true.x, on_false.x),
+            L::select(mask, on_true.y, on_false.y),
+        )
+    }
+}
+
+impl From<Vec2> for V2<Real> {
+    #[inline(always)]
+    fn from(v: Vec2) -> Self {
+        V2::new(v.x, v.y)
+    }
+}
+
+impl From<V2<Real>> for Vec2 {
+    #[inline(always)]
+    fn from(v: V2<Real>) -> Self {
+        Vec2::new(v.x, v.y)
+    }
+}
+
+/// `a × b`, lane by lane.
+#[inline(always)]
+pub(crate) fn cross_lanes<L: Lane>(a: V2<L>, b: V2<L>) -> L {
+    a.x * b.y - a.y * b.x
+}
+
+/// `s × v = s · perp(v)`, lane by lane.
+#[inline(always)]
+pub(crate) fn cross_sv_lanes<L: Lane>(s: L, v: V2<L>) -> V2<L> {
+    V2::new(s.flip_sign() * v.y, s * v.x)
+}
+
+/// `v` turned by the rotation `(cos, sin)`, lane by lane.
+#[inline(always)]
+pub(crate) fn rotate_lanes<L: Lane>((c, s): (L, L), v: V2<L>) -> V2<L> {
+    V2::new(c * v.x - s * v.y, s * v.x + c * v.y)
+}
+
+/// Two bodies' inverse masses (1/kg) and inertias (1/(kg·m²)) per lane.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct MassLanes<L> {
+    pub(crate) inv_mass_a: L,
+    pub(crate) inv_inertia_a: L,
+    pub(crate) inv_mass_b: L,
+    pub(crate) inv_inertia_b: L,
+}
+
+impl MassLanes<Real> {
+    #[inline(always)]
+    pub(crate) fn of(m: &PairMass) -> Self {
+        MassLanes {
+            inv_mass_a: m.a.inv_mass,
+            inv_inertia_a: m.a.inv_inertia,
+            inv_mass_b: m.b.inv_mass,
+            inv_inertia_b: m.b.inv_inertia,
+        }
+    }
+}
+
+/// Two bodies' velocities per lane: what a point block reads and writes.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PairVelocity<L> {
+    pub(crate) v_a: V2<L>,
+    pub(crate) w_a: L,
+    pub(crate) v_b: V2<L>,
+    pub(crate) w_b: L,
+}
+
+impl PairVelocity<Real> {
+    #[inline(always)]
+    pub(crate) fn of(sa: &BodyState, sb: &BodyState) -> Self {
+        PairVelocity {
+            v_a: sa.v.into(),
+            w_a: sa.w,
+            v_b: sb.v.into(),
+            w_b: sb.w,
+        }
+    }
+
+    #[inline(always)]
+    pub(crate) fn store(&self, sa: &mut BodyState, sb: &mut BodyState) {
+        sa.v = self.v_a.into();
+        sa.w = self.w_a;
+        sb.v = self.v_b.into();
+        sb.w = self.w_b;
+    }
+}
+
+/// [`apply_pair`] lane by lane: the impulse `p` at arms `r_a`, `r_b` (equal
+/// and opposite) plus the angular impulse `l` (positive on b).
+#[inline(always)]
+pub(crate) fn apply_pair_lanes<L: Lane>(
+    vel: &mut PairVelocity<L>,
+    m: &MassLanes<L>,
+    r_a: V2<L>,
+    r_b: V2<L>,
+    p: V2<L>,
+    l: L,
+) {
+    vel.v_a = vel.v_a.sub(p.scale(m.inv_mass_a));
+    vel.w_a -= m.inv_inertia_a * (cross_lanes(r_a, p) + l);
+    vel.v_b = vel.v_b.add(p.scale(m.inv_mass_b));
+    vel.w_b += m.inv_inertia_b * (cross_lanes(r_b, p) + l);
+}
+
+/// A point block's `K = J M⁻¹ Jᵀ` as `(k11, k12, k22)`, lane by lane
+/// ([`PointPart::effective_mass`]).
+#[inline(always)]
+pub(crate) fn effective_mass_lanes<L: Lane>(m: &MassLanes<L>, r_a: V2<L>, r_b: V2<L>) -> (L, L, L) {
+    let (m_a, m_b) = (m.inv_mass_a, m.inv_mass_b);
+    let (i_a, i_b) = (m.inv_inertia_a, m.inv_inertia_b);
+    let k11 = m_a + m_b + r_a.y * r_a.y * i_a + r_b.y * r_b.y * i_b;
+    let k12 = r_a.y.flip_sign() * r_a.x * i_a - r_b.y * r_b.x * i_b;
+    let k22 = m_a + m_b + r_a.x * r_a.x * i_a + r_b.x * r_b.x * i_b;
+    (k11, k12, k22)
+}
+
+/// `K⁻¹ b` of a 2×2 symmetric `K`, lane by lane; zero where `K` is
+/// singular (as [`janus2d_core::math::solve22`], bit for bit).
+#[inline(always)]
+pub(crate) fn solve22_lanes<L: Lane>(k11: L, k12: L, k22: L, b: V2<L>) -> V2<L> {
+    let eps = L::splat(janus2d_core::math::EPSILON);
+    let det = k11 * k22 - k12 * k12;
+    let singular =
+        (eps * (k11.abs() * k22.abs()).at_least(eps)).ge(det.abs()) | det.eq(L::splat(0.0));
+    let inv_det = L::splat(1.0) / det;
+    let x = V2::new(
+        inv_det * (k22 * b.x - k12 * b.y),
+        inv_det * (k11 * b.y - k12 * b.x),
+    );
+    V2::select(singular, V2::zero(), x)
+}
+
+/// [`clamp_length`] lane by lane.
+#[inline(always)]
+pub(crate) fn clamp_length_lanes<L: Lane>(v: V2<L>, max: L) -> V2<L> {
+    let len2 = v.x * v.x + v.y * v.y;
+    let over = len2.gt(max * max);
+    V2::select(over, v.scale(max / len2.sqrt()), v)
 }
 
 /// The lever arm, m, at which an angular correction speed is compared
@@ -203,13 +387,15 @@ pub fn angular_correction_cap(max: Real) -> Real {
 #[inline(always)]
 #[must_use]
 pub fn cap(v: Real, max: Real) -> Real {
-    if v > max {
-        max
-    } else if v < -max {
-        -max
-    } else {
-        v
-    }
+    cap_lanes(v, max)
+}
+
+/// [`cap`] lane by lane: `v` limited to `[−max, max]` (`max > 0`, or
+/// infinite), unchanged inside it.
+#[inline(always)]
+#[must_use]
+pub(crate) fn cap_lanes<L: Lane>(v: L, max: L) -> L {
+    L::select(v.gt(max), max, L::select(v.lt(-max), -max, v))
 }
 
 /// The speed change, m/s (rad/s for an angle row), beyond which no
@@ -235,11 +421,17 @@ pub const ROW_SPEED_BOUND: Real = 4.0e5;
 /// (`m_eff = 0`).
 #[inline(always)]
 pub(crate) fn row_bound(mass: Real) -> Real {
-    if mass > 0.0 {
-        mass * ROW_SPEED_BOUND
-    } else {
-        Real::INFINITY
-    }
+    row_bound_lanes(mass)
+}
+
+/// [`row_bound`] lane by lane.
+#[inline(always)]
+pub(crate) fn row_bound_lanes<L: Lane>(mass: L) -> L {
+    L::select(
+        mass.gt(L::splat(0.0)),
+        mass * L::splat(ROW_SPEED_BOUND),
+        L::splat(Real::INFINITY),
+    )
 }
 
 /// `row_bound` of a row whose `K` is `k` (1/kg or 1/(kg·m²)).
@@ -257,26 +449,23 @@ pub(crate) fn row_bound_of_k(k: Real) -> Real {
 /// bit for bit.
 #[inline(always)]
 pub(crate) fn bounded_sum(impulse: &mut Real, lambda: Real, bound: Real) -> Real {
+    bounded_sum_lanes(impulse, lambda, bound)
+}
+
+/// [`bounded_sum`] lane by lane.
+#[inline(always)]
+pub(crate) fn bounded_sum_lanes<L: Lane>(impulse: &mut L, lambda: L, bound: L) -> L {
     let sum = *impulse + lambda;
-    if sum.abs() <= bound {
-        *impulse = sum;
-        lambda
-    } else {
-        let old = *impulse;
-        *impulse = cap(sum, bound);
-        *impulse - old
-    }
+    let inside = bound.ge(sum.abs());
+    let old = *impulse;
+    *impulse = L::select(inside, sum, cap_lanes(sum, bound));
+    L::select(inside, lambda, *impulse - old)
 }
 
 /// Clamps the length of a bias velocity to `max` (m/s).
 #[inline(always)]
 pub fn clamp_length(v: Vec2, max: Real) -> Vec2 {
-    let len2 = v.length_squared();
-    if len2 > max * max {
-        v * (max / len2.sqrt())
-    } else {
-        v
-    }
+    clamp_length_lanes(v.into(), max).into()
 }
 
 /// Two rows that hold an anchor on body a at an anchor on body b.
@@ -297,10 +486,13 @@ impl PointPart {
     /// Current arms and separation `C` (m) from the states' deltas.
     #[inline(always)]
     pub fn arms(&self, sa: &BodyState, sb: &BodyState) -> (Vec2, Vec2, Vec2) {
-        let r_a = sa.dq.rotate(self.frame_a);
-        let r_b = sb.dq.rotate(self.frame_b);
-        let c = (sb.dp - sa.dp) + (r_b - r_a) + self.delta_center;
-        (r_a, r_b, c)
+        let (r_a, r_b, c) = arms_lanes(
+            (self.frame_a.into(), self.frame_b.into()),
+            self.delta_center.into(),
+            ((sa.dq.c, sa.dq.s), (sb.dq.c, sb.dq.s)),
+            (sa.dp.into(), sb.dp.into()),
+        );
+        (r_a.into(), r_b.into(), c.into())
     }
 
     /// Holds the kept impulse's length within `bound` (N·s), unchanged bit
@@ -314,12 +506,24 @@ impl PointPart {
     /// The 2×2 effective mass `K = J M⁻¹ Jᵀ` as `(k11, k12, k22)`.
     #[inline(always)]
     pub fn effective_mass(m: &PairMass, r_a: Vec2, r_b: Vec2) -> (Real, Real, Real) {
-        let (m_a, m_b, i_a, i_b) = (m.a.inv_mass, m.b.inv_mass, m.a.inv_inertia, m.b.inv_inertia);
-        let k11 = m_a + m_b + r_a.y * r_a.y * i_a + r_b.y * r_b.y * i_b;
-        let k12 = -r_a.y * r_a.x * i_a - r_b.y * r_b.x * i_b;
-        let k22 = m_a + m_b + r_a.x * r_a.x * i_a + r_b.x * r_b.x * i_b;
-        (k11, k12, k22)
+        effective_mass_lanes(&MassLanes::of(m), r_a.into(), r_b.into())
     }
+}
+
+/// [`PointPart::arms`] lane by lane: the arms at the bodies' rotations
+/// since the step began (`dq`) from the frames at its start, and
+/// `C = (dp_b − dp_a) + (r_b − r_a) + Δc`.
+#[inline(always)]
+pub(crate) fn arms_lanes<L: Lane>(
+    (frame_a, frame_b): (V2<L>, V2<L>),
+    delta_center: V2<L>,
+    (dq_a, dq_b): ((L, L), (L, L)),
+    (dp_a, dp_b): (V2<L>, V2<L>),
+) -> (V2<L>, V2<L>, V2<L>) {
+    let r_a = rotate_lanes(dq_a, frame_a);
+    let r_b = rotate_lanes(dq_b, frame_b);
+    let c = dp_b.sub(dp_a).add(r_b.sub(r_a)).add(delta_center);
+    (r_a, r_b, c)
 }
 
 /// One row on the relative angle of two bodies (springs, motors, limits).

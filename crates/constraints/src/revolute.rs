@@ -42,6 +42,7 @@ use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::joint_rows::{Bounds, PointTerms, RowSolve, Terms, WarmSide, point_bound};
 use crate::kind_rows::{KindRows, TreeRows};
 use crate::parts::{AnglePart, PairMass, PointPart, angular_correction_cap};
+use crate::revolute_lanes::{LaneImpulses, RevoluteLane};
 use crate::{JointError, check_motor_speed, check_spring};
 
 /// Everything needed to create a revolute joint.
@@ -431,6 +432,92 @@ impl RevoluteJoint {
         self.def.enable_spring || self.def.enable_motor || self.def.enable_limit
     }
 
+    /// The joint's rows' warm start on one body with the angle rows' kept
+    /// impulse `angle` (N·m·s; its lanes' while they hold them, see
+    /// [`crate::revolute_lanes`]), then the point's.
+    #[inline(always)]
+    fn warm_rows_with(&self, w: &mut WarmSide<'_>, angle: Real, point: Vec2) {
+        w.angle(angle);
+        w.point((self.point.frame_a, self.point.frame_b), point);
+    }
+
+    /// One body's warm start with the impulses its lane holds (see
+    /// [`RevoluteJoint::warm_rows_with`]).
+    #[inline(always)]
+    pub(crate) fn warm_start_side_with(
+        &self,
+        st: &mut BodyState,
+        side_b: bool,
+        impulses: LaneImpulses,
+    ) {
+        let mut w = WarmSide::new(st, self.base.masses, side_b);
+        let [spring, motor, lower, upper] = impulses.angle;
+        let point = impulses.point.unwrap_or(self.point.impulse);
+        self.warm_rows_with(&mut w, spring + motor + lower - upper, point);
+    }
+
+    /// What the joint's angle rows read this step, for a lane
+    /// ([`crate::revolute_lanes`]): only for a joint whose Gauss–Seidel
+    /// rows are angle rows alone (in a tree, solved, not resting); `h` is
+    /// the substep, s.
+    pub(crate) fn lane(&self, h: Real) -> Option<RevoluteLane> {
+        let base = &self.base;
+        // `has_iterative_rows` on the switches the prepare copied (the
+        // definition is boxed apart).
+        let on = self.switches;
+        let angle_rows = on.spring || on.motor || on.limit;
+        if !base.enabled || base.resting || (base.in_tree && !angle_rows) {
+            return None;
+        }
+        let m = &base.masses;
+        Some(RevoluteLane {
+            state: [base.state_a, base.state_b],
+            inv_inertia: [m.a.inv_inertia, m.b.inv_inertia],
+            delta_angle: self.delta_angle,
+            reads_angle: on.spring || on.limit,
+            spring: on.spring && m.a.inv_inertia + m.b.inv_inertia > 0.0,
+            spring_softness: self.spring_softness,
+            target_angle: self.angles.target_angle,
+            motor: on.motor,
+            motor_bias: -self.angles.motor_speed,
+            motor_max: h * self.angles.max_motor_torque,
+            limit: on.limit,
+            lower_angle: self.angles.lower_angle,
+            upper_angle: self.angles.upper_angle,
+            mass: [
+                self.spring.mass,
+                self.motor.mass,
+                self.lower.mass,
+                self.upper.mass,
+            ],
+            impulse: [
+                self.spring.impulse,
+                self.motor.impulse,
+                self.lower.impulse,
+                self.upper.impulse,
+            ],
+            point: !base.in_tree,
+            inv_mass: [m.a.inv_mass, m.b.inv_mass],
+            frames: [self.point.frame_a, self.point.frame_b],
+            delta_center: self.point.delta_center,
+            point_softness: self.point_softness,
+            point_impulse: self.point.impulse,
+        })
+    }
+
+    /// Takes back its impulses from a lane: the angle rows' (spring,
+    /// motor, lower, upper) and the point's where the lane solved it.
+    pub(crate) fn set_lane_impulses(&mut self, impulses: LaneImpulses) {
+        let [spring, motor, lower, upper] = impulses.angle;
+        self.spring.impulse = spring;
+        self.motor.impulse = motor;
+        self.lower.impulse = lower;
+        self.upper.impulse = upper;
+        if let Some(p) = impulses.point {
+            self.point.impulse = p;
+        }
+    }
+
     #[inline(always)]
     fn current_angle(&self, sa: &BodyState, sb: &BodyState) -> Real {
         janus2d_core::math::wrap_angle(self.delta_angle + sa.dq.relative_angle(sb.dq))
@@ -463,8 +550,11 @@ impl KindRows for RevoluteJoint {
     /// rows' sum, then the point at the body's current arm.
     #[inline(always)]
     fn warm_rows(&self, w: &mut WarmSide<'_>) {
-        w.angle(self.spring.impulse + self.motor.impulse + self.lower.impulse - self.upper.impulse);
-        w.point((self.point.frame_a, self.point.frame_b), self.point.impulse);
+        self.warm_rows_with(
+            w,
+            self.spring.impulse + self.motor.impulse + self.lower.impulse - self.upper.impulse,
+            self.point.impulse,
+        );
     }
     /// The joint's rows in Box2D's order: spring, motor, limits, then the
     /// point (unless the tree solves it).

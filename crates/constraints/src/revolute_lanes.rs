@@ -1,0 +1,703 @@
+//! Revolute joints' angle rows, [`LANES`] joints at a time.
+//!
+//! A revolute joint inside a joint tree has its point rows solved exactly
+//! by the tree ([`crate::joint_tree`]); what is left for Gauss–Seidel is
+//! its angle rows: the spring, the motor and the two limits (a ragdoll's
+//! joints run all four). Those rows read and write only the two bodies'
+//! angular velocities and read their rotations, so [`LANES`] joints of one
+//! colour (no moving body twice) run side by side on the wide lane type
+//! with the row arithmetic of [`crate::joint_rows::angle_row`], the same
+//! function the one-joint solve runs.
+//!
+//! ```text
+//! prepare (after the colours)   each colour's eligible joints, in solve order:
+//!                                 colour 0: [j0 j2 j5 … j40] [j44 … pad]   chunk = LANES joints
+//!                                 colour 1: [j1 j4 …]
+//!                               the rest of the colour stays one joint at a time
+//! solve, relax (each colour)    gather ω_a, ω_b and the joint angle per lane
+//!                               (Rot::relative_angle, as one joint computes it),
+//!                               spring, motor, lower, upper on the lanes,
+//!                               scatter ω where the body moves
+//! warm start (per body)         a lane joint's angle impulses read from its lane
+//! store (end of the step)       the lanes' impulses back into the joints
+//! ```
+//!
+//! A row a lane's joint has switched off leaves the lane's velocities and
+//! impulse as they were (selects, not zero steps), and padding lanes are
+//! never written, so each lane's result is bit for bit the one-joint solve
+//! of the same joint: the joints of a colour are independent, and the
+//! order within a colour does not change the state.
+
+use janus2d_core::body::BodyState;
+use janus2d_core::constraint::StepContext;
+use janus2d_core::math::{Real, Vec2, wrap_angle};
+use janus2d_core::parallel::{StatePlan, Team};
+
+use crate::contact_solver::{LaneStates, PLAN_SLOTS};
+use crate::joint::Joint;
+use crate::joint_rows::{Bounds, PointTerms, SoftLanes, Terms, angle_row, point_equality_row};
+use crate::lane::{LANES, Lane, Wide as W};
+use crate::parts::{MassLanes, PairVelocity, V2, angular_correction_cap, arms_lanes};
+use janus2d_core::softness::Softness;
+use wide::CmpNe;
+
+/// Side a of a lane.
+const A: usize = 0;
+/// Side b of a lane.
+const B: usize = 1;
+
+/// No lane: a joint solved one at a time.
+pub(crate) const NO_LANE: u32 = u32::MAX;
+
+/// Fewest chunks of a colour that run on the team (fewer: on the caller).
+const TEAM_CHUNKS: usize = 16;
+
+/// What one revolute joint's angle rows read this step, as its prepare
+/// left them ([`crate::RevoluteJoint::lane`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct RevoluteLane {
+    /// State indices of bodies a and b.
+    pub(crate) state: [u32; 2],
+    /// Inverse inertias of a and b, 1/(kg·m²).
+    pub(crate) inv_inertia: [Real; 2],
+    /// `θ_b − θ_a − θ_ref` at the start of the step, rad.
+    pub(crate) delta_angle: Real,
+    /// The spring or the limits read the joint angle.
+    pub(crate) reads_angle: bool,
+    /// The spring row is solved (switched on, and some body turns).
+    pub(crate) spring: bool,
+    /// The spring's softness.
+    pub(crate) spring_softness: Softness,
+    /// The spring's rest angle, rad.
+    pub(crate) target_angle: Real,
+    /// The motor row is solved.
+    pub(crate) motor: bool,
+    /// The motor's bias, `−speed`, rad/s.
+    pub(crate) motor_bias: Real,
+    /// The motor's largest impulse, `h · max torque`, N·m·s.
+    pub(crate) motor_max: Real,
+    /// The limit rows are solved.
+    pub(crate) limit: bool,
+    /// Lower and upper limits, rad.
+    pub(crate) lower_angle: Real,
+    pub(crate) upper_angle: Real,
+    /// Effective masses of the spring, motor, lower and upper rows, kg·m².
+    pub(crate) mass: [Real; 4],
+    /// Their kept impulses, N·m·s.
+    pub(crate) impulse: [Real; 4],
+    /// The point rows are Gauss–Seidel rows (the joint is in no tree).
+    pub(crate) point: bool,
+    /// Inverse masses of a and b, 1/kg.
+    pub(crate) inv_mass: [Real; 2],
+    /// The anchors from the centres at the step's start, m.
+    pub(crate) frames: [Vec2; 2],
+    /// `c_b − c_a` at the step's start, m.
+    pub(crate) delta_center: Vec2,
+    /// The point rows' softness.
+    pub(crate) point_softness: Softness,
+    /// The point rows' kept impulse, N·s.
+    pub(crate) point_impulse: Vec2,
+}
+
+/// What a lane holds of its joint's impulses: the angle rows' (spring,
+/// motor, lower, upper, N·m·s) and, where the lane solves the point rows,
+/// the point's (N·s).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct LaneImpulses {
+    pub(crate) angle: [Real; 4],
+    pub(crate) point: Option<Vec2>,
+}
+
+/// [`LANES`] joints' angle rows in structure-of-arrays form.
+#[derive(Clone, Debug)]
+struct WideRevolute {
+    /// State index of body a, then b, per lane (0 for padding).
+    state: [[u32; LANES]; 2],
+    /// The joint's storage index per lane.
+    joint: [u32; LANES],
+    /// Lanes in use.
+    len: usize,
+    /// Bit `k`: lane `k`'s body a moves; bit `LANES + k`: its body b.
+    moving: u32,
+    /// Bit `k`: lane `k` reads the joint angle.
+    reads_angle: u32,
+    delta_angle: [Real; LANES],
+    inv_inertia_a: W,
+    inv_inertia_b: W,
+    spring_on: W,
+    spring_softness: SoftLanes<W>,
+    target_angle: W,
+    motor_on: W,
+    motor_bias: W,
+    motor_min: W,
+    motor_max: W,
+    limit_on: W,
+    lower_angle: W,
+    upper_angle: W,
+    /// Spring, motor, lower, upper.
+    mass: [W; 4],
+    impulse: [W; 4],
+    point_on: W,
+    /// Inverse masses and inertias of a and b.
+    masses: MassLanes<W>,
+    frames: (V2<W>, V2<W>),
+    delta_center: V2<W>,
+    point_softness: SoftLanes<W>,
+    point_impulse: V2<W>,
+}
+
+/// All-ones where `on`, else zero: a lane mask of the wide type.
+fn mask(on: [bool; LANES]) -> W {
+    let zero = W::splat(0.0);
+    W::from(on.map(|b| if b { 1.0 } else { 0.0 })).cmp_ne(zero)
+}
+
+impl WideRevolute {
+    /// A chunk of up to [`LANES`] joints (`writes[k]`: which ends of lane
+    /// `k`'s joint move, [`crate::parts::WRITE_A`] and
+    /// [`crate::parts::WRITE_B`]).
+    fn new(lanes: &[(u32, u8, RevoluteLane)]) -> Self {
+        let mut state = [[0; LANES]; 2];
+        let mut joint = [u32::MAX; LANES];
+        let (mut moving, mut reads_angle) = (0, 0);
+        let mut delta_angle = [0.0; LANES];
+        let mut arrays = [[0.0; LANES]; 32];
+        let mut on = [[false; LANES]; 4];
+        for (k, &(j, writes, ref l)) in lanes.iter().enumerate() {
+            state[A][k] = l.state[0];
+            state[B][k] = l.state[1];
+            joint[k] = j;
+            moving |= u32::from(writes & crate::parts::WRITE_A != 0) << k;
+            moving |= u32::from(writes & crate::parts::WRITE_B != 0) << (LANES + k);
+            reads_angle |= u32::from(l.reads_angle) << k;
+            delta_angle[k] = l.delta_angle;
+            on[0][k] = l.spring;
+            on[1][k] = l.motor;
+            on[2][k] = l.limit;
+            on[3][k] = l.point;
+            let values = [
+                l.inv_inertia[0],
+                l.inv_inertia[1],
+                l.spring_softness.bias_rate,
+                l.spring_softness.mass_scale,
+                l.spring_softness.impulse_scale,
+                l.target_angle,
+                l.motor_bias,
+                -l.motor_max,
+                l.motor_max,
+                l.lower_angle,
+                l.upper_angle,
+                l.mass[0],
+                l.mass[1],
+                l.mass[2],
+                l.mass[3],
+                l.impulse[0],
+                l.impulse[1],
+                l.impulse[2],
+                l.impulse[3],
+                l.inv_mass[0],
+                l.inv_mass[1],
+                l.frames[0].x,
+                l.frames[0].y,
+                l.frames[1].x,
+                l.frames[1].y,
+                l.delta_center.x,
+                l.delta_center.y,
+                l.point_softness.bias_rate,
+                l.point_softness.mass_scale,
+                l.point_softness.impulse_scale,
+                l.point_impulse.x,
+                l.point_impulse.y,
+            ];
+            for (array, x) in arrays.iter_mut().zip(values) {
+                array[k] = x;
+            }
+        }
+        let w = |i: usize| W::from(arrays[i]);
+        WideRevolute {
+            state,
+            joint,
+            len: lanes.len(),
+            moving,
+            reads_angle,
+            delta_angle,
+            inv_inertia_a: w(0),
+            inv_inertia_b: w(1),
+            spring_on: mask(on[0]),
+            spring_softness: SoftLanes {
+                bias_rate: w(2),
+                mass_scale: w(3),
+                impulse_scale: w(4),
+            },
+            target_angle: w(5),
+            motor_on: mask(on[1]),
+            motor_bias: w(6),
+            motor_min: w(7),
+            motor_max: w(8),
+            limit_on: mask(on[2]),
+            lower_angle: w(9),
+            upper_angle: w(10),
+            mass: [w(11), w(12), w(13), w(14)],
+            impulse: [w(15), w(16), w(17), w(18)],
+            point_on: mask(on[3]),
+            masses: MassLanes {
+                inv_mass_a: w(19),
+                inv_inertia_a: w(0),
+                inv_mass_b: w(20),
+                inv_inertia_b: w(1),
+            },
+            frames: (V2::new(w(21), w(22)), V2::new(w(23), w(24))),
+            delta_center: V2::new(w(25), w(26)),
+            point_softness: SoftLanes {
+                bias_rate: w(27),
+                mass_scale: w(28),
+                impulse_scale: w(29),
+            },
+            point_impulse: V2::new(w(30), w(31)),
+        }
+    }
+
+    /// One iteration of the lanes' angle rows, in the one-joint order:
+    /// spring, motor, lower, upper.
+    #[inline(always)]
+    fn solve<S: LaneStates>(&mut self, states: &mut S, rows: &LaneContext) {
+        // Per side: v.x, v.y, ω, dp.x, dp.y, dq.c, dq.s.
+        let mut st = [[[0.0; LANES]; 7]; 2];
+        let mut angle = [0.0; LANES];
+        for k in 0..self.len {
+            let sa = states.load(A, k);
+            let sb = states.load(B, k);
+            for (side, s) in [(A, &sa), (B, &sb)] {
+                let values = [s.v.x, s.v.y, s.w, s.dp.x, s.dp.y, s.dq.c, s.dq.s];
+                for (array, x) in st[side].iter_mut().zip(values) {
+                    array[k] = x;
+                }
+            }
+            if self.reads_angle & (1 << k) != 0 {
+                angle[k] = wrap_angle(self.delta_angle[k] + sa.dq.relative_angle(sb.dq));
+            }
+        }
+        let lanes = |side: usize, i: usize| W::from(st[side][i]);
+        let (mut w_a, mut w_b) = (lanes(A, 2), lanes(B, 2));
+        let angle = W::from(angle);
+        let inv_inertia = (self.inv_inertia_a, self.inv_inertia_b);
+        // Each row on copies, kept where the lane's joint solves it.
+        let mut row = |on: W, sign: Real, i: usize, t: Terms<W>, bounds: Bounds<W>| {
+            let (mut a, mut b, mut impulse) = (w_a, w_b, self.impulse[i]);
+            angle_row(
+                (&mut a, &mut b),
+                inv_inertia,
+                sign,
+                self.mass[i],
+                t,
+                bounds,
+                &mut impulse,
+            );
+            w_a = W::select(on, a, w_a);
+            w_b = W::select(on, b, w_b);
+            self.impulse[i] = W::select(on, impulse, self.impulse[i]);
+        };
+        let infinity = W::splat(Real::INFINITY);
+        let spring = Terms::soft_lanes(self.spring_softness, angle - self.target_angle, infinity);
+        row(self.spring_on, 1.0, 0, spring, Bounds::Free);
+        let motor = Terms {
+            bias: self.motor_bias,
+            ..Terms::rigid()
+        };
+        row(
+            self.motor_on,
+            1.0,
+            1,
+            motor,
+            Bounds::Clamp(self.motor_min, self.motor_max),
+        );
+        let one_sided = Bounds::Clamp(W::splat(0.0), infinity);
+        let lower = Terms::limit_lanes(
+            angle - self.lower_angle,
+            rows.limit_softness,
+            rows.inv_h,
+            rows.use_bias,
+            rows.max_bias,
+        );
+        row(self.limit_on, 1.0, 2, lower, one_sided);
+        let upper = Terms::limit_lanes(
+            self.upper_angle - angle,
+            rows.limit_softness,
+            rows.inv_h,
+            rows.use_bias,
+            rows.max_bias,
+        );
+        row(self.limit_on, -1.0, 3, upper, one_sided);
+        // The point rows, where the joint is in no tree.
+        let before = PairVelocity {
+            v_a: V2::new(lanes(A, 0), lanes(A, 1)),
+            w_a,
+            v_b: V2::new(lanes(B, 0), lanes(B, 1)),
+            w_b,
+        };
+        let mut vel = before;
+        if W::any(self.point_on) {
+            let (r_a, r_b, c) = arms_lanes(
+                self.frames,
+                self.delta_center,
+                ((lanes(A, 5), lanes(A, 6)), (lanes(B, 5), lanes(B, 6))),
+                (
+                    V2::new(lanes(A, 3), lanes(A, 4)),
+                    V2::new(lanes(B, 3), lanes(B, 4)),
+                ),
+            );
+            let t =
+                PointTerms::equality_lanes(self.point_softness, c, rows.max_speed, rows.use_bias);
+            let mut impulse = self.point_impulse;
+            point_equality_row(&mut vel, &self.masses, (r_a, r_b), t, &mut impulse);
+            let on = self.point_on;
+            vel = PairVelocity {
+                v_a: V2::select(on, vel.v_a, before.v_a),
+                w_a: W::select(on, vel.w_a, before.w_a),
+                v_b: V2::select(on, vel.v_b, before.v_b),
+                w_b: W::select(on, vel.w_b, before.w_b),
+            };
+            self.point_impulse = V2::select(on, impulse, self.point_impulse);
+        }
+        for k in 0..self.len {
+            if self.moving & (1 << k) != 0 {
+                let v = Vec2::new(vel.v_a.x.lane(k), vel.v_a.y.lane(k));
+                states.store(A, k, v, vel.w_a.lane(k));
+            }
+            if self.moving & (1 << (LANES + k)) != 0 {
+                let v = Vec2::new(vel.v_b.x.lane(k), vel.v_b.y.lane(k));
+                states.store(B, k, v, vel.w_b.lane(k));
+            }
+        }
+    }
+
+    /// Lane `k`'s kept impulses.
+    fn impulses(&self, k: usize) -> LaneImpulses {
+        let point = (self.point_on.lane(k).to_bits() != 0)
+            .then(|| Vec2::new(self.point_impulse.x.lane(k), self.point_impulse.y.lane(k)));
+        LaneImpulses {
+            angle: self.impulse.map(|i| i.lane(k)),
+            point,
+        }
+    }
+}
+
+/// What every lane's rows read from the step.
+struct LaneContext {
+    limit_softness: SoftLanes<W>,
+    inv_h: W,
+    max_bias: W,
+    /// The point rows' largest feedback speed, m/s.
+    max_speed: W,
+    use_bias: bool,
+}
+
+impl LaneContext {
+    fn of(ctx: &StepContext, use_bias: bool) -> Self {
+        LaneContext {
+            limit_softness: SoftLanes::splat(ctx.joint_softness),
+            inv_h: W::splat(ctx.inv_h),
+            max_bias: W::splat(angular_correction_cap(ctx.joint_max_correction_speed)),
+            max_speed: W::splat(ctx.joint_max_correction_speed),
+            use_bias,
+        }
+    }
+}
+
+/// The serial view of a chunk's states: the state slice and the chunk's
+/// indices (only moving ends are stored).
+struct Direct<'s> {
+    states: &'s mut [BodyState],
+    index: [[u32; LANES]; 2],
+}
+
+impl LaneStates for Direct<'_> {
+    #[inline(always)]
+    fn load(&self, side: usize, k: usize) -> BodyState {
+        self.states[self.index[side][k] as usize]
+    }
+    #[inline(always)]
+    fn store(&mut self, side: usize, k: usize, v: Vec2, w: Real) {
+        let s = &mut self.states[self.index[side][k] as usize];
+        s.v = v;
+        s.w = w;
+    }
+}
+
+/// The lane joints of one step, colour by colour (see the module docs).
+/// Live from the joints' prepare to the step's store.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct RevoluteLanes {
+    chunks: Vec<WideRevolute>,
+    /// Where each colour's chunks start; the last entry is the total.
+    starts: Vec<u32>,
+    /// Per joint (storage index): `chunk · LANES + lane`, or [`NO_LANE`].
+    /// Empty while no lanes are live.
+    lane_of: Vec<u32>,
+    /// The chunks' states, one group per colour (verified for a team of
+    /// several threads).
+    plan: StatePlan<PLAN_SLOTS>,
+    /// Scratch: the current colour's lanes before they are packed.
+    pending: Vec<(u32, u8, RevoluteLane)>,
+}
+
+impl RevoluteLanes {
+    /// Joints in lanes.
+    pub(crate) fn joint_count(&self) -> usize {
+        self.chunks.iter().map(|c| c.len).sum()
+    }
+
+    /// Whether lanes are live (built and not yet stored).
+    #[inline]
+    pub(crate) fn is_live(&self) -> bool {
+        !self.lane_of.is_empty()
+    }
+
+    /// The lane of joint `j`, or [`NO_LANE`].
+    #[inline]
+    pub(crate) fn lane_of(&self, j: usize) -> u32 {
+        self.lane_of.get(j).copied().unwrap_or(NO_LANE)
+    }
+
+    /// Builds the lanes: for each colour, its segment of `order` (joint
+    /// storage indices with the ends each writes, `writes`), the revolute
+    /// joints whose Gauss–Seidel rows are angle rows only. Stores lanes
+    /// still live first.
+    pub(crate) fn build(
+        &mut self,
+        joints: &mut [Joint],
+        segments: impl Iterator<Item = (usize, usize)>,
+        order: &[u32],
+        writes: &[u8],
+        ctx: &StepContext,
+        states: usize,
+        team: &Team,
+    ) {
+        self.store(joints);
+        self.chunks.clear();
+        self.starts.clear();
+        self.plan.clear();
+        self.lane_of.clear();
+        self.lane_of.resize(joints.len(), NO_LANE);
+        let mut any = false;
+        for (start, end) in segments {
+            self.starts.push(self.chunks.len() as u32);
+            self.plan.begin_group();
+            self.pending.clear();
+            for p in start..end {
+                // The joint a few places on (solve order is not storage
+                // order).
+                if let Some(ahead) = order.get(p + 4).and_then(|&a| joints.get(a as usize)) {
+                    janus2d_core::hint::prefetch(ahead);
+                }
+                let j = order[p] as usize;
+                if let Joint::Revolute(r) = &joints[j]
+                    && let Some(lane) = r.lane(ctx.h)
+                {
+                    self.pending.push((j as u32, writes[p], lane));
+                }
+            }
+            for group in self.pending.chunks(LANES) {
+                let chunk = WideRevolute::new(group);
+                for (k, &(j, _, _)) in group.iter().enumerate() {
+                    self.lane_of[j as usize] = (self.chunks.len() * LANES + k) as u32;
+                }
+                let mut slots = [0; PLAN_SLOTS];
+                slots[..LANES].copy_from_slice(&chunk.state[A]);
+                slots[LANES..].copy_from_slice(&chunk.state[B]);
+                self.plan.push(slots, chunk.moving);
+                self.chunks.push(chunk);
+                any = true;
+            }
+        }
+        self.starts.push(self.chunks.len() as u32);
+        if !any {
+            self.lane_of.clear();
+            return;
+        }
+        if team.threads() > 1 {
+            let verified = self.plan.verify(states);
+            debug_assert!(verified, "a lane colour holds a moving body twice");
+        }
+    }
+
+    /// One iteration of colour `colour`'s lanes.
+    pub(crate) fn solve_colour(
+        &mut self,
+        colour: usize,
+        ctx: &StepContext,
+        states: &mut [BodyState],
+        use_bias: bool,
+        team: &Team,
+    ) {
+        if !self.is_live() {
+            return;
+        }
+        let (Some(&start), Some(&end)) = (self.starts.get(colour), self.starts.get(colour + 1))
+        else {
+            return;
+        };
+        let chunks = &mut self.chunks[start as usize..end as usize];
+        if chunks.is_empty() {
+            return;
+        }
+        let rows = LaneContext::of(ctx, use_bias);
+        if team.threads() == 1 || chunks.len() < TEAM_CHUNKS {
+            for chunk in chunks.iter_mut() {
+                let mut direct = Direct {
+                    index: chunk.state,
+                    states: &mut *states,
+                };
+                chunk.solve(&mut direct, &rows);
+            }
+            return;
+        }
+        let per_block = chunks.len().div_ceil(4 * team.threads()).max(4);
+        team.for_each_planned(
+            &self.plan,
+            colour,
+            chunks,
+            states,
+            per_block,
+            |chunk, view| chunk.solve(view, &rows),
+        );
+    }
+
+    /// The impulses lane `lane` holds for its joint's warm start.
+    #[inline]
+    pub(crate) fn impulses(&self, lane: u32) -> LaneImpulses {
+        self.chunks[lane as usize / LANES].impulses(lane as usize % LANES)
+    }
+
+    /// Writes the lanes' impulses back into their joints and ends the
+    /// lanes (the end of a step, or before new lanes).
+    pub(crate) fn store(&mut self, joints: &mut [Joint]) {
+        if !self.is_live() {
+            return;
+        }
+        for chunk in &self.chunks {
+            for k in 0..chunk.len {
+                if let Some(Joint::Revolute(r)) = joints.get_mut(chunk.joint[k] as usize) {
+                    r.set_lane_impulses(chunk.impulses(k));
+                }
+            }
+        }
+        self.lane_of.clear();
+        self.chunks.clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use janus2d_core::body::{BodyDef, BodyHandle, BodySet};
+    use janus2d_core::constraint::ConstraintBatch;
+    use janus2d_core::math::{Real, Vec2};
+    use janus2d_core::parallel::Team;
+    use janus2d_core::solver::SolverSettings;
+
+    use crate::joint::Joint;
+    use crate::joint_colour::JointColours;
+    use crate::joint_solver::JointBatch;
+    use crate::joint_tree::JointForest;
+    use crate::revolute::{RevoluteJoint, RevoluteJointDef};
+
+    /// A ring of `n` bodies joined in a loop (no tree: point rows in the
+    /// lanes) and a chain of `n` hanging from a static pin (an anchored
+    /// tree: angle rows only in the lanes); every joint with limits, a
+    /// spring and a motor, as a ragdoll's. Runs three substeps' stages on
+    /// `team` and returns the bits of every velocity and of every joint's
+    /// kept impulses after the store.
+    fn run(lanes_off: bool, team: &Team) -> Vec<u64> {
+        let n = 200;
+        let mut set = BodySet::new();
+        let ground = set.create(&BodyDef::fixed(Vec2::ZERO)).unwrap();
+        let body = |set: &mut BodySet, i: usize, y: Real| -> BodyHandle {
+            let def = BodyDef::dynamic(Vec2::new(i as Real, y))
+                .with_angular_velocity(0.37 * (i % 7) as Real - 1.0);
+            set.create(&def).unwrap()
+        };
+        let ring: Vec<_> = (0..n).map(|i| body(&mut set, i, 0.0)).collect();
+        let chain: Vec<_> = (0..n).map(|i| body(&mut set, i, -5.0)).collect();
+        let hinge = |a, b, k: usize| {
+            let def = RevoluteJointDef::new(a, b, Vec2::new(0.5, 0.02), Vec2::new(-0.5, 0.0))
+                .with_limits(-0.3 - 0.01 * (k % 5) as Real, 0.4)
+                .with_spring(5.0, 0.5)
+                .with_motor(0.0, 0.05 + 0.01 * (k % 3) as Real);
+            Joint::from(RevoluteJoint::new(def))
+        };
+        let mut joints = Vec::new();
+        for i in 0..n {
+            joints.push(hinge(ring[i], ring[(i + 1) % n], i));
+        }
+        joints.push(hinge(ground, chain[0], n));
+        for i in 1..n {
+            joints.push(hinge(chain[i - 1], chain[i], i));
+        }
+        // Some joints with one row kind only.
+        if let Joint::Revolute(r) = &mut joints[3] {
+            r.def.enable_limit = false;
+            r.def.enable_spring = false;
+        }
+        if let Joint::Revolute(r) = &mut joints[n + 5] {
+            r.def.enable_motor = false;
+        }
+        let ctx = SolverSettings::default().context(1.0 / 60.0, Vec2::new(0.0, -10.0));
+        let (mut forest, mut colours) = (JointForest::default(), JointColours::new());
+        colours.lanes_off = lanes_off;
+        let mut batch = JointBatch {
+            joints: &mut joints,
+            forest: &mut forest,
+            colours: &mut colours,
+        };
+        batch.prepare_on(&ctx, &set, team);
+        for flip in [false, true, false] {
+            let states = &mut set.states;
+            batch.warm_start_on(&ctx, states, team);
+            batch.solve_on(&ctx, states, true, flip, team);
+            batch.solve_late_on(&ctx, states, true, team);
+            batch.solve_on(&ctx, states, false, !flip, team);
+        }
+        assert_eq!(
+            batch.colours.lane_joints() == 2 * n,
+            !lanes_off,
+            "every joint in a lane"
+        );
+        batch.store_impulses();
+        assert_eq!(batch.colours.lane_joints(), 0, "the store ends the lanes");
+        let in_tree = joints.iter().filter(|j| j.base().in_tree).count();
+        assert!(
+            in_tree >= n && in_tree < 2 * n,
+            "the chain is a tree, the ring is not"
+        );
+        let bits_of = |x: Real| janus2d_core::math::to_f64(x).to_bits();
+        let mut bits: Vec<u64> = set
+            .states
+            .iter()
+            .flat_map(|s| [s.v.x, s.v.y, s.w])
+            .map(bits_of)
+            .collect();
+        for j in &joints {
+            let Joint::Revolute(r) = j else { continue };
+            let p = r.linear_impulse();
+            for x in [p.x, p.y, r.motor_impulse(), r.constraint_torque()] {
+                bits.push(bits_of(x));
+            }
+        }
+        bits
+    }
+
+    /// The lanes give the one-joint solve's states and impulses bit for
+    /// bit: angle rows alone (tree joints) and angle and point rows
+    /// (a loop), every row kind switched on and off; on the team too.
+    #[test]
+    fn revolute_lanes_match_the_one_joint_solve_bit_for_bit() {
+        let one_at_a_time = run(true, &Team::serial());
+        let lanes = run(false, &Team::serial());
+        assert_eq!(lanes, one_at_a_time);
+        #[cfg(feature = "parallel")]
+        for threads in [2, 4] {
+            let team = janus2d_core::parallel::with_threads(threads, |t| run(false, t)).unwrap();
+            assert_eq!(team, one_at_a_time, "{threads} threads");
+        }
+    }
+}
