@@ -986,7 +986,7 @@ impl LaneStates for PlannedStates<'_, PLAN_SLOTS> {
 /// The lanes' velocities and position deltas on side `side`.
 #[cfg(feature = "f64")]
 #[inline(always)]
-fn load<S: LaneStates>(states: &S, side: usize) -> (Velocity<W>, Delta<W>, ()) {
+pub(crate) fn load<S: LaneStates>(states: &S, side: usize) -> (Velocity<W>, Delta<W>, ()) {
     let mut v_x = [0.0; LANES];
     let mut v_y = [0.0; LANES];
     let mut w = [0.0; LANES];
@@ -1047,9 +1047,25 @@ fn load_velocity<S: LaneStates>(states: &S, side: usize) -> (Velocity<W>, ()) {
 #[cfg(feature = "f64")]
 #[inline(always)]
 fn store<S: LaneStates>(states: &mut S, side: usize, v: &Velocity<W>, _flags: ()) {
+    store_where(states, side, v, (), u32::MAX);
+}
+
+/// Writes the velocities of the lanes whose bit is set in `lanes` back
+/// (bit `k`: lane `k`).
+#[cfg(feature = "f64")]
+#[inline(always)]
+pub(crate) fn store_where<S: LaneStates>(
+    states: &mut S,
+    side: usize,
+    v: &Velocity<W>,
+    _flags: (),
+    lanes: u32,
+) {
     let (v_x, v_y, w) = (v.v_x.to_array(), v.v_y.to_array(), v.w.to_array());
     for k in 0..LANES {
-        states.store(side, k, Vec2::new(v_x[k], v_y[k]), w[k]);
+        if lanes & (1 << k) != 0 {
+            states.store(side, k, Vec2::new(v_x[k], v_y[k]), w[k]);
+        }
     }
 }
 
@@ -1087,7 +1103,7 @@ mod quads {
 
     /// The lanes' velocities and position deltas on side `side`.
     #[inline(always)]
-    pub(super) fn load<S: LaneStates>(states: &S, side: usize) -> (Velocity<W>, Delta<W>, W) {
+    pub(crate) fn load<S: LaneStates>(states: &S, side: usize) -> (Velocity<W>, Delta<W>, W) {
         let [v, d] = quads(states, side, true);
         let (v0, v1) = (f32x4::transpose(v[0]), f32x4::transpose(v[1]));
         let (d0, d1) = (f32x4::transpose(d[0]), f32x4::transpose(d[1]));
@@ -1125,18 +1141,35 @@ mod quads {
     /// per lane, `[v.x, v.y, ω, flags]`, with the flags it read.
     #[inline(always)]
     pub(super) fn store<S: LaneStates>(states: &mut S, side: usize, v: &Velocity<W>, flags: W) {
+        store_where(states, side, v, flags, u32::MAX);
+    }
+
+    /// Writes the velocities of the lanes whose bit is set in `lanes`
+    /// back (bit `k`: lane `k`), by the same transposes.
+    #[inline(always)]
+    pub(crate) fn store_where<S: LaneStates>(
+        states: &mut S,
+        side: usize,
+        v: &Velocity<W>,
+        flags: W,
+        lanes: u32,
+    ) {
         let split = |x: W| -> [f32x4; 2] { bytemuck::cast(x) };
         let (v_x, v_y, w, f) = (split(v.v_x), split(v.v_y), split(v.w), split(flags));
         for half in 0..2 {
             let q = f32x4::transpose([v_x[half], v_y[half], w[half], f[half]]);
             for (i, &q) in q.iter().enumerate() {
-                states.store_head(side, 4 * half + i, q);
+                if lanes & (1 << (4 * half + i)) != 0 {
+                    states.store_head(side, 4 * half + i, q);
+                }
             }
         }
     }
 }
 #[cfg(not(feature = "f64"))]
-use quads::{load, load_velocity, store};
+pub(crate) use quads::{load, store_where};
+#[cfg(not(feature = "f64"))]
+use quads::{load_velocity, store};
 /// The lanes' velocities from the state slice (prepare).
 #[inline(always)]
 fn gather_velocity(states: &[BodyState], index: &[u32; LANES]) -> Velocity<W> {

@@ -357,6 +357,11 @@ pub(crate) fn solve22_lanes<L: Lane>(k11: L, k12: L, k22: L, b: V2<L>) -> V2<L> 
 pub(crate) fn clamp_length_lanes<L: Lane>(v: V2<L>, max: L) -> V2<L> {
     let len2 = v.x * v.x + v.y * v.y;
     let over = len2.gt(max * max);
+    // The root and the division only where some lane is over (on one
+    // vector: only when it is).
+    if !L::any(over) {
+        return v;
+    }
     V2::select(over, v.scale(max / len2.sqrt()), v)
 }
 

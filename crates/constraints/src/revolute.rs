@@ -456,17 +456,20 @@ impl RevoluteJoint {
         self.warm_rows_with(&mut w, spring + motor + lower - upper, point);
     }
 
-    /// What the joint's angle rows read this step, for a lane
-    /// ([`crate::revolute_lanes`]): only for a joint whose Gauss–Seidel
-    /// rows are angle rows alone (in a tree, solved, not resting); `h` is
-    /// the substep, s.
+    /// What the joint's Gauss–Seidel rows read this step, for a lane
+    /// ([`crate::revolute_lanes`]): only for a solved joint (enabled, not
+    /// resting) with angle rows (its point rows too where it is in no
+    /// tree); `h` is the substep, s.
     pub(crate) fn lane(&self, h: Real) -> Option<RevoluteLane> {
         let base = &self.base;
         // `has_iterative_rows` on the switches the prepare copied (the
         // definition is boxed apart).
+        // Only joints with angle rows: a plain hinge's point block alone
+        // runs as fast one at a time (joint_grid: the lanes' gather and
+        // the impulses' round trip cost more than the wide rows saved).
         let on = self.switches;
         let angle_rows = on.spring || on.motor || on.limit;
-        if !base.enabled || base.resting || (base.in_tree && !angle_rows) {
+        if !base.enabled || base.resting || !angle_rows {
             return None;
         }
         let m = &base.masses;

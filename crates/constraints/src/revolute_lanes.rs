@@ -1,24 +1,30 @@
-//! Revolute joints' angle rows, [`LANES`] joints at a time.
+//! Revolute joints with angle rows, [`LANES`] joints at a time.
 //!
-//! A revolute joint inside a joint tree has its point rows solved exactly
-//! by the tree ([`crate::joint_tree`]); what is left for Gauss–Seidel is
-//! its angle rows: the spring, the motor and the two limits (a ragdoll's
-//! joints run all four). Those rows read and write only the two bodies'
-//! angular velocities and read their rotations, so [`LANES`] joints of one
-//! colour (no moving body twice) run side by side on the wide lane type
-//! with the row arithmetic of [`crate::joint_rows::angle_row`], the same
-//! function the one-joint solve runs.
+//! A ragdoll's revolute joints run a spring, a motor and two limits on the
+//! relative angle besides their point block (Box2D's human: all four), and
+//! one at a time they were a third of a ragdoll scene's step (rain). The
+//! joints of one colour share no moving body, so [`LANES`] of them run
+//! side by side on the wide lane type, with the row arithmetic the
+//! one-joint solve runs ([`crate::joint_rows::angle_row`] for each angle
+//! row, [`crate::joint_rows::point_equality_row`] for the point block of a
+//! joint in no tree; a tree joint's point rows stay with the exact tree
+//! solve, [`crate::joint_tree`]).
+//!
+//! A plain hinge (no angle row) stays one joint at a time: its point block
+//! alone ran no faster in lanes (joint_grid: the gather, the build and the
+//! impulses' round trip cost what the wide rows saved).
 //!
 //! ```text
-//! prepare (after the colours)   each colour's eligible joints, in solve order:
+//! prepare (after the colours)   each colour's revolute joints with angle rows, in solve order:
 //!                                 colour 0: [j0 j2 j5 … j40] [j44 … pad]   chunk = LANES joints
 //!                                 colour 1: [j1 j4 …]
 //!                               the rest of the colour stays one joint at a time
-//! solve, relax (each colour)    gather ω_a, ω_b and the joint angle per lane
-//!                               (Rot::relative_angle, as one joint computes it),
-//!                               spring, motor, lower, upper on the lanes,
-//!                               scatter ω where the body moves
-//! warm start (per body)         a lane joint's angle impulses read from its lane
+//! solve, relax (each colour)    gather both states (4×4 transposes in f32), the
+//!                               joint angle per lane (Rot::relative_angle, as one
+//!                               joint computes it); spring, motor, lower, upper,
+//!                               then the point block where the joint is in no
+//!                               tree, on the lanes; scatter v, ω where the body moves
+//! warm start (per body)         a lane joint's impulses read from its lane
 //! store (end of the step)       the lanes' impulses back into the joints
 //! ```
 //!
@@ -30,10 +36,11 @@
 
 use janus2d_core::body::BodyState;
 use janus2d_core::constraint::StepContext;
-use janus2d_core::math::{Real, Vec2, wrap_angle};
+use janus2d_core::math::{Real, Rot, Vec2, wrap_angle};
 use janus2d_core::parallel::{StatePlan, Team};
 
-use crate::contact_solver::{LaneStates, PLAN_SLOTS};
+use crate::contact_row::Velocity;
+use crate::contact_solver::{LaneStates, PLAN_SLOTS, load, store_where};
 use crate::joint::Joint;
 use crate::joint_rows::{Bounds, PointTerms, SoftLanes, Terms, angle_row, point_equality_row};
 use crate::lane::{LANES, Lane, Wide as W};
@@ -261,24 +268,30 @@ impl WideRevolute {
     /// spring, motor, lower, upper.
     #[inline(always)]
     fn solve<S: LaneStates>(&mut self, states: &mut S, rows: &LaneContext) {
-        // Per side: v.x, v.y, ω, dp.x, dp.y, dq.c, dq.s.
-        let mut st = [[[0.0; LANES]; 7]; 2];
+        let (vel_a, delta_a, flags_a) = load(states, A);
+        let (vel_b, delta_b, flags_b) = load(states, B);
+        // The joint angle lane by lane, as one joint reads it.
         let mut angle = [0.0; LANES];
-        for k in 0..self.len {
-            let sa = states.load(A, k);
-            let sb = states.load(B, k);
-            for (side, s) in [(A, &sa), (B, &sb)] {
-                let values = [s.v.x, s.v.y, s.w, s.dp.x, s.dp.y, s.dq.c, s.dq.s];
-                for (array, x) in st[side].iter_mut().zip(values) {
-                    array[k] = x;
+        if self.reads_angle != 0 {
+            let (c_a, s_a) = (delta_a.q_c.to_array(), delta_a.q_s.to_array());
+            let (c_b, s_b) = (delta_b.q_c.to_array(), delta_b.q_s.to_array());
+            for k in 0..LANES {
+                if self.reads_angle & (1 << k) != 0 {
+                    let (q_a, q_b) = (
+                        Rot {
+                            c: c_a[k],
+                            s: s_a[k],
+                        },
+                        Rot {
+                            c: c_b[k],
+                            s: s_b[k],
+                        },
+                    );
+                    angle[k] = wrap_angle(self.delta_angle[k] + q_a.relative_angle(q_b));
                 }
             }
-            if self.reads_angle & (1 << k) != 0 {
-                angle[k] = wrap_angle(self.delta_angle[k] + sa.dq.relative_angle(sb.dq));
-            }
         }
-        let lanes = |side: usize, i: usize| W::from(st[side][i]);
-        let (mut w_a, mut w_b) = (lanes(A, 2), lanes(B, 2));
+        let (mut w_a, mut w_b) = (vel_a.w, vel_b.w);
         let angle = W::from(angle);
         let inv_inertia = (self.inv_inertia_a, self.inv_inertia_b);
         // Each row on copies, kept where the lane's joint solves it.
@@ -330,9 +343,9 @@ impl WideRevolute {
         row(self.limit_on, -1.0, 3, upper, one_sided);
         // The point rows, where the joint is in no tree.
         let before = PairVelocity {
-            v_a: V2::new(lanes(A, 0), lanes(A, 1)),
+            v_a: V2::new(vel_a.v_x, vel_a.v_y),
             w_a,
-            v_b: V2::new(lanes(B, 0), lanes(B, 1)),
+            v_b: V2::new(vel_b.v_x, vel_b.v_y),
             w_b,
         };
         let mut vel = before;
@@ -340,10 +353,10 @@ impl WideRevolute {
             let (r_a, r_b, c) = arms_lanes(
                 self.frames,
                 self.delta_center,
-                ((lanes(A, 5), lanes(A, 6)), (lanes(B, 5), lanes(B, 6))),
+                ((delta_a.q_c, delta_a.q_s), (delta_b.q_c, delta_b.q_s)),
                 (
-                    V2::new(lanes(A, 3), lanes(A, 4)),
-                    V2::new(lanes(B, 3), lanes(B, 4)),
+                    V2::new(delta_a.dp_x, delta_a.dp_y),
+                    V2::new(delta_b.dp_x, delta_b.dp_y),
                 ),
             );
             let t =
@@ -359,16 +372,26 @@ impl WideRevolute {
             };
             self.point_impulse = V2::select(on, impulse, self.point_impulse);
         }
-        for k in 0..self.len {
-            if self.moving & (1 << k) != 0 {
-                let v = Vec2::new(vel.v_a.x.lane(k), vel.v_a.y.lane(k));
-                states.store(A, k, v, vel.w_a.lane(k));
-            }
-            if self.moving & (1 << (LANES + k)) != 0 {
-                let v = Vec2::new(vel.v_b.x.lane(k), vel.v_b.y.lane(k));
-                states.store(B, k, v, vel.w_b.lane(k));
-            }
-        }
+        let side = |v: V2<W>, w: W| Velocity {
+            v_x: v.x,
+            v_y: v.y,
+            w,
+        };
+        let lanes = (1 << LANES) - 1;
+        store_where(
+            states,
+            A,
+            &side(vel.v_a, vel.w_a),
+            flags_a,
+            self.moving & lanes,
+        );
+        store_where(
+            states,
+            B,
+            &side(vel.v_b, vel.w_b),
+            flags_b,
+            (self.moving >> LANES) & lanes,
+        );
     }
 
     /// Lane `k`'s kept impulses.
