@@ -429,6 +429,14 @@ impl JointDef {
 }
 
 impl Joint {
+    /// Whether the joint's Gauss–Seidel rows may run in lanes: a revolute
+    /// joint with angle rows, as its last prepare switched them
+    /// ([`crate::revolute_lanes`]).
+    #[inline]
+    pub(crate) fn lane_candidate(&self) -> bool {
+        matches!(self, Joint::Revolute(r) if r.has_prepared_angle_rows())
+    }
+
     /// The joint of kind `K`, if it is one (`joint.of::<RevoluteJoint>()`).
     #[must_use]
     pub fn of<K: JointOfKind>(&self) -> Option<&K> {

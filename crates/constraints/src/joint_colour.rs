@@ -91,6 +91,10 @@ const ACTIVE: u32 = 4;
 /// not a tree joint without angle rows): it takes a colour.
 const COLOURED: u32 = 8;
 
+/// Key flag: the joint may run in lanes ([`Joint::lane_candidate`]), so
+/// that building the lanes reads no other joint.
+const LANE: u32 = 16;
+
 /// Fewest joints of a colour per block of a stage on the team: a block
 /// costs an atomic claim, and a joint's solve about 20 ns.
 const JOINTS_PER_BLOCK: usize = 64;
@@ -152,6 +156,9 @@ pub struct JointColours {
     lanes_generation: u64,
     /// Every joint one at a time (tests compare the lanes with it).
     pub(crate) lanes_off: bool,
+    /// Coloured joints (overflow aside) that may run in lanes, at the last
+    /// colouring.
+    lane_candidates: usize,
 }
 
 /// [`JointColours::colour_of`] of a joint that takes no colour.
@@ -254,6 +261,7 @@ impl JointColours {
         self.graph.reset(self.built_states);
         // The colour of each joint (COLOURS: overflow), reusing `position`.
         let mut counts = [0u32; COLOURS + 1];
+        let mut lane_candidates = 0;
         self.position.clear();
         self.colour_of.clear();
         for k in keys {
@@ -267,9 +275,13 @@ impl JointColours {
             let b = (flags & u32::from(WRITE_B) != 0).then_some(k[1]);
             let colour = self.graph.assign(a, b).unwrap_or(COLOURS);
             counts[colour] += 1;
+            if colour < COLOURS && flags & LANE != 0 {
+                lane_candidates += 1;
+            }
             self.position.push(colour as u32);
             self.colour_of.push(colour as u8);
         }
+        self.lane_candidates = lane_candidates;
         // Greedy colours are contiguous (colour c is taken only where c − 1
         // is blocked), so this is the number of non-empty colours.
         let used = counts[..COLOURS]
@@ -560,16 +572,17 @@ impl JointColours {
         team: &Team,
     ) {
         self.store_lanes(joints);
-        if self.lanes_off {
+        if self.lanes_off || self.lane_candidates == 0 {
             return;
         }
         let colours = self.colour_count();
-        let starts = &self.starts;
+        let (starts, keys) = (&self.starts, &self.built_keys);
         self.lanes.build(
             joints,
             (0..colours).map(|c| (starts[c] as usize, starts[c + 1] as usize)),
             &self.order,
             &self.writes,
+            |j| keys[j][2] & LANE != 0,
             ctx,
             state_count,
             team,
@@ -691,8 +704,10 @@ fn key_at(j: &Joint, a: u32, b: u32, states: &[BodyState]) -> Key {
         return [0; 3];
     }
     let coloured = if j.has_iterative_rows() { COLOURED } else { 0 };
+    let lane = if j.lane_candidate() { LANE } else { 0 };
     let flags = ACTIVE
         | coloured
+        | lane
         | if is_moving(states, a) {
             u32::from(WRITE_A)
         } else {

@@ -441,6 +441,14 @@ impl RevoluteJoint {
         w.point((self.point.frame_a, self.point.frame_b), point);
     }
 
+    /// Whether the last prepare switched on an angle row (the switches it
+    /// copied; the definition is boxed apart).
+    #[inline]
+    pub(crate) fn has_prepared_angle_rows(&self) -> bool {
+        let on = self.switches;
+        on.spring || on.motor || on.limit
+    }
+
     /// One body's warm start with the impulses its lane holds (see
     /// [`RevoluteJoint::warm_rows_with`]).
     #[inline(always)]
@@ -457,23 +465,13 @@ impl RevoluteJoint {
     }
 
     /// What the joint's Gauss–Seidel rows read this step, for a lane
-    /// ([`crate::revolute_lanes`]): only for a solved joint (enabled, not
-    /// resting) with angle rows (its point rows too where it is in no
-    /// tree); `h` is the substep, s.
-    pub(crate) fn lane(&self, h: Real) -> Option<RevoluteLane> {
+    /// ([`crate::revolute_lanes`]: a solved joint with angle rows, its point
+    /// rows too where it is in no tree); `h` is the substep, s.
+    pub(crate) fn lane(&self, h: Real) -> RevoluteLane {
         let base = &self.base;
-        // `has_iterative_rows` on the switches the prepare copied (the
-        // definition is boxed apart).
-        // Only joints with angle rows: a plain hinge's point block alone
-        // runs as fast one at a time (joint_grid: the lanes' gather and
-        // the impulses' round trip cost more than the wide rows saved).
         let on = self.switches;
-        let angle_rows = on.spring || on.motor || on.limit;
-        if !base.enabled || base.resting || !angle_rows {
-            return None;
-        }
         let m = &base.masses;
-        Some(RevoluteLane {
+        RevoluteLane {
             state: [base.state_a, base.state_b],
             inv_inertia: [m.a.inv_inertia, m.b.inv_inertia],
             delta_angle: self.delta_angle,
@@ -505,7 +503,7 @@ impl RevoluteJoint {
             delta_center: self.point.delta_center,
             point_softness: self.point_softness,
             point_impulse: self.point.impulse,
-        })
+        }
     }
 
     /// Takes back its impulses from a lane: the angle rows' (spring,

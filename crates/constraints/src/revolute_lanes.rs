@@ -160,10 +160,20 @@ fn mask(on: [bool; LANES]) -> W {
 }
 
 impl WideRevolute {
-    /// A chunk of up to [`LANES`] joints (`writes[k]`: which ends of lane
-    /// `k`'s joint move, [`crate::parts::WRITE_A`] and
-    /// [`crate::parts::WRITE_B`]).
-    fn new(lanes: &[(u32, u8, RevoluteLane)]) -> Self {
+    /// A chunk of the joints `entries` names (`(storage index, writes)`:
+    /// which ends of the lane's joint move, [`crate::parts::WRITE_A`] and
+    /// [`crate::parts::WRITE_B`]; index `u32::MAX` for a padding lane),
+    /// from their prepared state; `h` is the substep, s.
+    fn fill(entries: &[(u32, u8)], joints: &[Joint], h: Real) -> Self {
+        let mut lanes: [(u32, u8, RevoluteLane); LANES] = Default::default();
+        let mut len = 0;
+        for &(j, writes) in entries {
+            if let Some(Joint::Revolute(r)) = joints.get(j as usize) {
+                lanes[len] = (j, writes, r.lane(h));
+                len += 1;
+            }
+        }
+        let lanes = &lanes[..len];
         let mut state = [[0; LANES]; 2];
         let mut joint = [u32::MAX; LANES];
         let (mut moving, mut reads_angle) = (0, 0);
@@ -460,8 +470,9 @@ pub(crate) struct RevoluteLanes {
     /// The chunks' states, one group per colour (verified for a team of
     /// several threads).
     plan: StatePlan<PLAN_SLOTS>,
-    /// Scratch: the current colour's lanes before they are packed.
-    pending: Vec<(u32, u8, RevoluteLane)>,
+    /// Scratch of the build: each lane's joint (storage index, or
+    /// `u32::MAX` for padding) and the ends it writes.
+    pending: Vec<(u32, u8)>,
 }
 
 impl RevoluteLanes {
@@ -483,15 +494,19 @@ impl RevoluteLanes {
     }
 
     /// Builds the lanes: for each colour, its segment of `order` (joint
-    /// storage indices with the ends each writes, `writes`), the revolute
-    /// joints whose Gauss–Seidel rows are angle rows only. Stores lanes
-    /// still live first.
+    /// storage indices, with the ends each writes in `writes`), the joints
+    /// `candidate` names (revolute joints with angle rows, solved: read
+    /// from the colouring's keys, so that this pass reads no joint), in
+    /// order, [`LANES`] to a chunk; then the chunks filled from their
+    /// joints on the team. Stores lanes still live first.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn build(
         &mut self,
         joints: &mut [Joint],
         segments: impl Iterator<Item = (usize, usize)>,
         order: &[u32],
         writes: &[u8],
+        candidate: impl Fn(usize) -> bool,
         ctx: &StepContext,
         states: usize,
         team: &Team,
@@ -502,43 +517,47 @@ impl RevoluteLanes {
         self.plan.clear();
         self.lane_of.clear();
         self.lane_of.resize(joints.len(), NO_LANE);
-        let mut any = false;
+        // Which joint each lane takes, colour by colour (each colour's last
+        // chunk padded).
+        let entries = &mut self.pending;
+        entries.clear();
         for (start, end) in segments {
-            self.starts.push(self.chunks.len() as u32);
-            self.plan.begin_group();
-            self.pending.clear();
+            self.starts.push((entries.len() / LANES) as u32);
             for p in start..end {
-                // The joint a few places on (solve order is not storage
-                // order).
-                if let Some(ahead) = order.get(p + 4).and_then(|&a| joints.get(a as usize)) {
-                    janus2d_core::hint::prefetch(ahead);
-                }
                 let j = order[p] as usize;
-                if let Joint::Revolute(r) = &joints[j]
-                    && let Some(lane) = r.lane(ctx.h)
-                {
-                    self.pending.push((j as u32, writes[p], lane));
+                if candidate(j) {
+                    self.lane_of[j] = entries.len() as u32;
+                    entries.push((j as u32, writes[p]));
                 }
             }
-            for group in self.pending.chunks(LANES) {
-                let chunk = WideRevolute::new(group);
-                for (k, &(j, _, _)) in group.iter().enumerate() {
-                    self.lane_of[j as usize] = (self.chunks.len() * LANES + k) as u32;
-                }
-                let mut slots = [0; PLAN_SLOTS];
-                slots[..LANES].copy_from_slice(&chunk.state[A]);
-                slots[LANES..].copy_from_slice(&chunk.state[B]);
-                self.plan.push(slots, chunk.moving);
-                self.chunks.push(chunk);
-                any = true;
+            while !entries.len().is_multiple_of(LANES) {
+                entries.push((u32::MAX, 0));
             }
         }
-        self.starts.push(self.chunks.len() as u32);
-        if !any {
+        let count = entries.len() / LANES;
+        self.starts.push(count as u32);
+        if count == 0 {
             self.lane_of.clear();
             return;
         }
+        self.chunks.resize(count, WideRevolute::fill(&[], &[], 0.0));
+        let (entries, joints, h) = (&*entries, &*joints, ctx.h);
+        team.for_each_chunk_mut(&mut self.chunks, 16, |i, block| {
+            for (k, chunk) in block.iter_mut().enumerate() {
+                let first = (16 * i + k) * LANES;
+                *chunk = WideRevolute::fill(&entries[first..first + LANES], joints, h);
+            }
+        });
         if team.threads() > 1 {
+            for c in 0..self.starts.len() - 1 {
+                self.plan.begin_group();
+                for chunk in &self.chunks[self.starts[c] as usize..self.starts[c + 1] as usize] {
+                    let mut slots = [0; PLAN_SLOTS];
+                    slots[..LANES].copy_from_slice(&chunk.state[A]);
+                    slots[LANES..].copy_from_slice(&chunk.state[B]);
+                    self.plan.push(slots, chunk.moving);
+                }
+            }
             let verified = self.plan.verify(states);
             debug_assert!(verified, "a lane colour holds a moving body twice");
         }
