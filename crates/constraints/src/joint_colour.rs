@@ -369,6 +369,9 @@ impl JointColours {
         if self.position.len() != joints.len() || states.len() != self.built_states {
             self.update(joints, states);
         }
+        if self.lanes_live() {
+            self.lanes.refresh_warm();
+        }
         let (start, list) = (&self.body_start[..], &self.body_joints[..]);
         let lanes = self.lanes_live().then_some(&self.lanes);
         let body = |s: usize, st: &mut BodyState| {
@@ -380,7 +383,7 @@ impl JointColours {
                 if let (Some(lanes), Joint::Revolute(r)) = (lanes, &joints[j]) {
                     let lane = lanes.lane_of(j);
                     if lane != NO_LANE {
-                        r.warm_start_side_with(&mut local, side_b, lanes.impulses(lane));
+                        r.warm_start_side_with(&mut local, side_b, lanes.warm(lane));
                         continue;
                     }
                 }

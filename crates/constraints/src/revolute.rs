@@ -42,7 +42,7 @@ use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::joint_rows::{Bounds, PointTerms, RowSolve, Terms, WarmSide, point_bound};
 use crate::kind_rows::{KindRows, TreeRows};
 use crate::parts::{AnglePart, PairMass, PointPart, angular_correction_cap};
-use crate::revolute_lanes::{LaneImpulses, RevoluteLane};
+use crate::revolute_lanes::{LaneImpulses, LaneWarm, RevoluteLane};
 use crate::{JointError, check_motor_speed, check_spring};
 
 /// Everything needed to create a revolute joint.
@@ -452,16 +452,14 @@ impl RevoluteJoint {
     /// One body's warm start with the impulses its lane holds (see
     /// [`RevoluteJoint::warm_rows_with`]).
     #[inline(always)]
-    pub(crate) fn warm_start_side_with(
-        &self,
-        st: &mut BodyState,
-        side_b: bool,
-        impulses: LaneImpulses,
-    ) {
+    pub(crate) fn warm_start_side_with(&self, st: &mut BodyState, side_b: bool, warm: LaneWarm) {
         let mut w = WarmSide::new(st, self.base.masses, side_b);
-        let [spring, motor, lower, upper] = impulses.angle;
-        let point = impulses.point.unwrap_or(self.point.impulse);
-        self.warm_rows_with(&mut w, spring + motor + lower - upper, point);
+        let point = if warm.has_point {
+            warm.point
+        } else {
+            self.point.impulse
+        };
+        self.warm_rows_with(&mut w, warm.angle, point);
     }
 
     /// What the joint's Gauss–Seidel rows read this step, for a lane

@@ -106,6 +106,15 @@ pub(crate) struct RevoluteLane {
     pub(crate) point_impulse: Vec2,
 }
 
+/// A lane joint's warm start: the angle rows' summed impulse (N·m·s) and
+/// the point's (N·s) where the lane solves the point rows.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct LaneWarm {
+    pub(crate) angle: Real,
+    pub(crate) point: Vec2,
+    pub(crate) has_point: bool,
+}
+
 /// What a lane holds of its joint's impulses: the angle rows' (spring,
 /// motor, lower, upper, N·m·s) and, where the lane solves the point rows,
 /// the point's (N·s).
@@ -473,12 +482,22 @@ pub(crate) struct RevoluteLanes {
     /// Scratch of the build: each lane's joint (storage index, or
     /// `u32::MAX` for padding) and the ends it writes.
     pending: Vec<(u32, u8)>,
+    /// Per lane, what its joint's warm start adds (refreshed before each
+    /// warm start, [`RevoluteLanes::refresh_warm`]): one line read per
+    /// joint and body instead of the chunk's scattered lanes.
+    warm: Vec<LaneWarm>,
 }
 
 impl RevoluteLanes {
+    /// This step's chunks.
+    fn live_chunks(&self) -> &[WideRevolute] {
+        let count = self.starts.last().map_or(0, |&n| n as usize);
+        &self.chunks[..count.min(self.chunks.len())]
+    }
+
     /// Joints in lanes.
     pub(crate) fn joint_count(&self) -> usize {
-        self.chunks.iter().map(|c| c.len).sum()
+        self.live_chunks().iter().map(|c| c.len).sum()
     }
 
     /// Whether lanes are live (built and not yet stored).
@@ -512,7 +531,6 @@ impl RevoluteLanes {
         team: &Team,
     ) {
         self.store(joints);
-        self.chunks.clear();
         self.starts.clear();
         self.plan.clear();
         self.lane_of.clear();
@@ -540,9 +558,12 @@ impl RevoluteLanes {
             self.lane_of.clear();
             return;
         }
-        self.chunks.resize(count, WideRevolute::fill(&[], &[], 0.0));
+        // Chunks are kept from step to step (each is filled whole).
+        if self.chunks.len() < count {
+            self.chunks.resize(count, WideRevolute::fill(&[], &[], 0.0));
+        }
         let (entries, joints, h) = (&*entries, &*joints, ctx.h);
-        team.for_each_chunk_mut(&mut self.chunks, 16, |i, block| {
+        team.for_each_chunk_mut(&mut self.chunks[..count], 16, |i, block| {
             for (k, chunk) in block.iter_mut().enumerate() {
                 let first = (16 * i + k) * LANES;
                 *chunk = WideRevolute::fill(&entries[first..first + LANES], joints, h);
@@ -605,10 +626,35 @@ impl RevoluteLanes {
         );
     }
 
-    /// The impulses lane `lane` holds for its joint's warm start.
+    /// Sums each lane's angle impulses (`spring + motor + lower − upper`,
+    /// as the joint sums its own) and copies its point impulse, for the
+    /// warm start that follows.
+    pub(crate) fn refresh_warm(&mut self) {
+        self.warm.clear();
+        let chunks = &self.chunks[..self.starts.last().map_or(0, |&n| n as usize)];
+        for chunk in chunks {
+            let [spring, motor, lower, upper] = chunk.impulse;
+            let angle = (spring + motor + lower - upper).to_array();
+            let (x, y) = (
+                chunk.point_impulse.x.to_array(),
+                chunk.point_impulse.y.to_array(),
+            );
+            let on = chunk.point_on.to_array();
+            for k in 0..LANES {
+                self.warm.push(LaneWarm {
+                    angle: angle[k],
+                    point: Vec2::new(x[k], y[k]),
+                    has_point: on[k].to_bits() != 0,
+                });
+            }
+        }
+    }
+
+    /// Lane `lane`'s warm start, as the last [`RevoluteLanes::refresh_warm`]
+    /// found it.
     #[inline]
-    pub(crate) fn impulses(&self, lane: u32) -> LaneImpulses {
-        self.chunks[lane as usize / LANES].impulses(lane as usize % LANES)
+    pub(crate) fn warm(&self, lane: u32) -> LaneWarm {
+        self.warm[lane as usize]
     }
 
     /// Writes the lanes' impulses back into their joints and ends the
@@ -617,7 +663,7 @@ impl RevoluteLanes {
         if !self.is_live() {
             return;
         }
-        for chunk in &self.chunks {
+        for chunk in self.live_chunks() {
             for k in 0..chunk.len {
                 if let Some(Joint::Revolute(r)) = joints.get_mut(chunk.joint[k] as usize) {
                     r.set_lane_impulses(chunk.impulses(k));
@@ -625,7 +671,7 @@ impl RevoluteLanes {
             }
         }
         self.lane_of.clear();
-        self.chunks.clear();
+        self.starts.clear();
     }
 }
 
