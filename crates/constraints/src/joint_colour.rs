@@ -549,8 +549,8 @@ impl JointColours {
     }
 
     /// Joints solved in lanes this step (0 outside a step).
-    #[must_use]
-    pub fn lane_joints(&self) -> usize {
+    #[cfg(test)]
+    pub(crate) fn lane_joints(&self) -> usize {
         if self.lanes_live() {
             self.lanes.joint_count()
         } else {

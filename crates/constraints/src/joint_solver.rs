@@ -8,7 +8,7 @@
 //! | solve, relax   | [`JointColours`]: the Gauss–Seidel rows colour by colour     |
 //! | late solve     | [`JointForest`]: the point rows of joint trees, exactly      |
 //! | restitution    | nothing: no joint kind has restitution                      |
-//! | store          | the lanes' angle impulses back into their joints ([`crate::revolute_lanes`]); every other impulse stays in its joint |
+//! | store          | the lanes' impulses back into their joints (`revolute_lanes`); every other impulse stays in its joint |
 
 use janus2d_core::body::{BodySet, BodyState};
 use janus2d_core::constraint::{Constraint, ConstraintBatch, StepContext};

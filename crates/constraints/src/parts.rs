@@ -62,10 +62,11 @@ impl PairMass {
 /// `x = Ċ + b` for a row of effective mass `m = K⁻¹` (module docs).
 /// `impulse_scale` is `s_i`, `accumulated` the accumulated impulse `λ`.
 /// Lane-generic: one row on [`Real`], or [`LANES`](crate::lane::LANES)
-/// rows at once.
+/// rows at once, the same in each lane (the negation by the sign bit,
+/// [`Lane::flip_sign`]).
 #[inline(always)]
 pub fn soft_impulse<L: Lane>(scale: L, x: L, impulse_scale: L, accumulated: L) -> L {
-    -(scale * x) - impulse_scale * accumulated
+    (scale * x).flip_sign() - impulse_scale * accumulated
 }
 
 /// Reads the velocity part of two states.

@@ -496,6 +496,7 @@ impl RevoluteLanes {
     }
 
     /// Joints in lanes.
+    #[cfg(test)]
     pub(crate) fn joint_count(&self) -> usize {
         self.live_chunks().iter().map(|c| c.len).sum()
     }
