@@ -941,9 +941,9 @@ pub(crate) trait LaneStates {
 /// The serial view: the whole state slice and the chunk's state indices.
 /// Lanes on the identity state, on a static or on a kinematic body write
 /// what they read.
-struct Direct<'s> {
-    states: &'s mut [BodyState],
-    index: [[u32; LANES]; 2],
+pub(crate) struct Direct<'s> {
+    pub(crate) states: &'s mut [BodyState],
+    pub(crate) index: [[u32; LANES]; 2],
 }
 
 impl LaneStates for Direct<'_> {

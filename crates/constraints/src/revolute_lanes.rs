@@ -40,7 +40,7 @@ use janus2d_core::math::{Real, Rot, Vec2, wrap_angle};
 use janus2d_core::parallel::{StatePlan, Team};
 
 use crate::contact_row::Velocity;
-use crate::contact_solver::{LaneStates, PLAN_SLOTS, load, store_where};
+use crate::contact_solver::{Direct, LaneStates, PLAN_SLOTS, load, store_where};
 use crate::joint::Joint;
 use crate::joint_rows::{Bounds, PointTerms, SoftLanes, Terms, angle_row, point_equality_row};
 use crate::lane::{LANES, Lane, Wide as W};
@@ -446,26 +446,6 @@ impl LaneContext {
     }
 }
 
-/// The serial view of a chunk's states: the state slice and the chunk's
-/// indices (only moving ends are stored).
-struct Direct<'s> {
-    states: &'s mut [BodyState],
-    index: [[u32; LANES]; 2],
-}
-
-impl LaneStates for Direct<'_> {
-    #[inline(always)]
-    fn load(&self, side: usize, k: usize) -> BodyState {
-        self.states[self.index[side][k] as usize]
-    }
-    #[inline(always)]
-    fn store(&mut self, side: usize, k: usize, v: Vec2, w: Real) {
-        let s = &mut self.states[self.index[side][k] as usize];
-        s.v = v;
-        s.w = w;
-    }
-}
-
 /// The lane joints of one step, colour by colour (see the module docs).
 /// Live from the joints' prepare to the step's store.
 #[derive(Clone, Debug, Default)]
@@ -606,7 +586,9 @@ impl RevoluteLanes {
             return;
         }
         let rows = LaneContext::of(ctx, use_bias);
-        if team.threads() == 1 || chunks.len() < TEAM_CHUNKS {
+        // On the caller: one thread, a short colour, or lanes built for one
+        // thread (no plan: a prepare on another team).
+        if team.threads() == 1 || chunks.len() < TEAM_CHUNKS || colour >= self.plan.group_count() {
             for chunk in chunks.iter_mut() {
                 let mut direct = Direct {
                     index: chunk.state,
