@@ -147,7 +147,7 @@ pub struct JointColours {
     /// The colours' plan checked against the contacts' plan: a colour's
     /// joints and contacts then run as one job on the team.
     cross: CrossPlan,
-    /// The revolute joints whose rows are angle rows alone, [`LANES`](crate::lane::LANES)
+    /// The revolute joints with angle rows, [`LANES`](crate::lane::LANES)
     /// at a time per colour ([`crate::revolute_lanes`]), from the batch's
     /// prepare to its store.
     lanes: RevoluteLanes,

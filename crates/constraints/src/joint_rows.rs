@@ -205,7 +205,7 @@ impl Bounds {
 
 impl<L: Lane> Bounds<L> {
     /// Accumulates `lambda` into `impulse`, its size held within `max`
-    /// ([`row_bound`](crate::parts::row_bound)); returns the step to apply.
+    /// ([`row_bound`]); returns the step to apply.
     #[inline(always)]
     fn accumulate(self, impulse: &mut L, lambda: L, max: L) -> L {
         match self {

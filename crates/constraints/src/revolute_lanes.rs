@@ -59,8 +59,8 @@ pub(crate) const NO_LANE: u32 = u32::MAX;
 /// Fewest chunks of a colour that run on the team (fewer: on the caller).
 const TEAM_CHUNKS: usize = 16;
 
-/// What one revolute joint's angle rows read this step, as its prepare
-/// left them ([`crate::RevoluteJoint::lane`]).
+/// What one revolute joint's Gauss–Seidel rows read this step, as its
+/// prepare left them (`RevoluteJoint::lane`).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct RevoluteLane {
     /// State indices of bodies a and b.
@@ -124,7 +124,9 @@ pub(crate) struct LaneImpulses {
     pub(crate) point: Option<Vec2>,
 }
 
-/// [`LANES`] joints' angle rows in structure-of-arrays form.
+/// [`LANES`] joints' rows in structure-of-arrays form: the angle rows'
+/// settings, masses and impulses, and the point block's (used where
+/// `point_on`).
 #[derive(Clone, Debug)]
 struct WideRevolute {
     /// State index of body a, then b, per lane (0 for padding).
@@ -283,8 +285,9 @@ impl WideRevolute {
         }
     }
 
-    /// One iteration of the lanes' angle rows, in the one-joint order:
-    /// spring, motor, lower, upper.
+    /// One iteration of the lanes' rows, in the one-joint order: spring,
+    /// motor, lower, upper, then the point block where the joint is in no
+    /// tree.
     #[inline(always)]
     fn solve<S: LaneStates>(&mut self, states: &mut S, rows: &LaneContext) {
         let (vel_a, delta_a, flags_a) = load(states, A);
