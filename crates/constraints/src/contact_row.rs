@@ -119,7 +119,6 @@
 //! [`ContactConstraint`]: crate::contact::ContactConstraint
 //! [`LANES`]: crate::lane::LANES
 
-use janus2d_core::body::BodyState;
 use janus2d_core::constraint::StepContext;
 use janus2d_core::math::{Real, Vec2, cross};
 use janus2d_core::softness::Softness;
@@ -169,61 +168,7 @@ const _: () = assert!(MAX_MANIFOLD_POINTS == 2);
 /// them one by one.
 pub const BLOCK_CONDITION: Real = 1000.0;
 
-/// The velocities of one side of the lanes' contacts.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Velocity<L> {
-    /// Linear velocity, x, m/s.
-    pub(crate) v_x: L,
-    /// Linear velocity, y, m/s.
-    pub(crate) v_y: L,
-    /// Angular velocity, rad/s.
-    pub(crate) w: L,
-}
-
-/// The position deltas of one side since the start of the step.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Delta<L> {
-    /// Position delta, x, m.
-    pub(crate) dp_x: L,
-    /// Position delta, y, m.
-    pub(crate) dp_y: L,
-    /// Rotation delta, cosine.
-    pub(crate) q_c: L,
-    /// Rotation delta, sine.
-    pub(crate) q_s: L,
-}
-
-impl Velocity<Real> {
-    /// A state's velocities.
-    #[inline(always)]
-    pub(crate) fn of(s: &BodyState) -> Self {
-        Velocity {
-            v_x: s.v.x,
-            v_y: s.v.y,
-            w: s.w,
-        }
-    }
-
-    /// Writes the velocities into a state.
-    #[inline(always)]
-    pub(crate) fn store(&self, s: &mut BodyState) {
-        s.v = Vec2::new(self.v_x, self.v_y);
-        s.w = self.w;
-    }
-}
-
-impl Delta<Real> {
-    /// A state's position deltas.
-    #[inline(always)]
-    pub(crate) fn of(s: &BodyState) -> Self {
-        Delta {
-            dp_x: s.dp.x,
-            dp_y: s.dp.y,
-            q_c: s.dq.c,
-            q_s: s.dq.s,
-        }
-    }
-}
+pub(crate) use crate::lane::{Delta, Velocity};
 
 /// The rows of one contact (`L = Real`) or of [`LANES`](crate::lane::LANES)
 /// contacts (`L = Wide`, structure of arrays): everything the prepare,

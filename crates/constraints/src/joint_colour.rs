@@ -614,7 +614,7 @@ impl JointColours {
         if self.lanes_live() {
             self.lanes.store(joints);
         } else {
-            self.lanes.store(&mut []);
+            self.lanes.discard();
         }
     }
 

@@ -41,11 +41,11 @@ use janus2d_core::body::{BodyState, InvMass};
 use janus2d_core::math::{Real, Vec2, cross, cross_sv, solve22};
 use janus2d_core::softness::Softness;
 
-use crate::lane::Lane;
+use crate::lane::{Lane, V2, Velocity};
 use crate::parts::{
-    AxisRow, MassLanes, PairMass, PairVelocity, PointPart, V2, apply_pair, apply_pair_lanes,
-    bounded_sum_lanes, cap_lanes, clamp_length, clamp_length_lanes, cross_sv_lanes,
-    effective_mass_lanes, row_bound, row_bound_lanes, row_bound_of_k, soft_impulse, solve22_lanes,
+    AxisRow, MassLanes, PairMass, PointPart, apply_pair, apply_pair_lanes, bounded_sum_lanes,
+    cap_lanes, clamp_length, clamp_length_lanes, cross_sv_lanes, effective_mass_lanes, row_bound,
+    row_bound_lanes, row_bound_of_k, soft_impulse, solve22_lanes,
 };
 
 /// A row's soft terms: the velocity bias `b` (m/s or rad/s), the mass
@@ -348,7 +348,7 @@ impl RowSolve {
         t: PointTerms,
         impulse: &mut Vec2,
     ) {
-        let mut vel = PairVelocity::of(&self.sa, &self.sb);
+        let mut vel = [Velocity::of(&self.sa), Velocity::of(&self.sb)];
         let mut p = V2::from(*impulse);
         point_equality_row(
             &mut vel,
@@ -358,14 +358,15 @@ impl RowSolve {
             &mut p,
         );
         *impulse = p.into();
-        vel.store(&mut self.sa, &mut self.sb);
+        vel[0].store(&mut self.sa);
+        vel[1].store(&mut self.sb);
     }
 
     /// The point block's soft step `Δλ` for the kept impulse `impulse`.
     #[inline(always)]
     fn point_step(&self, r_a: Vec2, r_b: Vec2, t: PointTerms, impulse: Vec2) -> Vec2 {
         point_step_lanes(
-            &PairVelocity::of(&self.sa, &self.sb),
+            &[Velocity::of(&self.sa), Velocity::of(&self.sb)],
             &MassLanes::of(&self.m),
             (r_a.into(), r_b.into()),
             t,
@@ -544,16 +545,16 @@ impl PointTerms {
 /// `Δλ = −s_m K⁻¹ (Ċ + b) − s_i λ`.
 #[inline(always)]
 pub(crate) fn point_step_lanes<L: Lane>(
-    vel: &PairVelocity<L>,
+    [a, b]: &[Velocity<L>; 2],
     m: &MassLanes<L>,
     (r_a, r_b): (V2<L>, V2<L>),
     t: PointTerms<L>,
     impulse: V2<L>,
 ) -> V2<L> {
-    let c_dot = vel
-        .v_b
-        .add(cross_sv_lanes(vel.w_b, r_b))
-        .sub(vel.v_a.add(cross_sv_lanes(vel.w_a, r_a)));
+    let c_dot = b
+        .v()
+        .add(cross_sv_lanes(b.w, r_b))
+        .sub(a.v().add(cross_sv_lanes(a.w, r_a)));
     let (k11, k12, k22) = effective_mass_lanes(m, r_a, r_b);
     let x = solve22_lanes(k11, k12, k22, c_dot.add(t.bias));
     V2::new(
@@ -568,7 +569,7 @@ pub(crate) fn point_step_lanes<L: Lane>(
 /// definition for one joint and for [`crate::revolute_lanes`].
 #[inline(always)]
 pub(crate) fn point_equality_row<L: Lane>(
-    vel: &mut PairVelocity<L>,
+    vel: &mut [Velocity<L>; 2],
     m: &MassLanes<L>,
     arms: (V2<L>, V2<L>),
     t: PointTerms<L>,

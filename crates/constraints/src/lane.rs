@@ -28,7 +28,8 @@
 use std::fmt::Debug;
 use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, Neg, Sub, SubAssign};
 
-use janus2d_core::math::Real;
+use janus2d_core::body::BodyState;
+use janus2d_core::math::{Real, Vec2};
 use wide::{CmpEq, CmpGe, CmpGt, CmpLt, CmpNe};
 
 /// Lanes of [`Wide`].
@@ -232,6 +233,146 @@ impl Lane for Wide {
     #[inline(always)]
     fn set_lane(&mut self, k: usize, x: Real) {
         self.as_array_mut()[k] = x;
+    }
+}
+
+/// A vector per lane: `x` and `y` on [`Real`] (one vector) or on the wide
+/// lane type ([`LANES`](crate::lane::LANES) vectors). Its operations are
+/// glam's on [`Vec2`], component by component, so a lane computes what the
+/// one-vector form computes, bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct V2<L> {
+    pub(crate) x: L,
+    pub(crate) y: L,
+}
+
+impl<L: Lane> V2<L> {
+    #[inline(always)]
+    pub(crate) fn new(x: L, y: L) -> Self {
+        V2 { x, y }
+    }
+    /// `(0, 0)` in every lane.
+    #[inline(always)]
+    pub(crate) fn zero() -> Self {
+        V2::new(L::splat(0.0), L::splat(0.0))
+    }
+    #[inline(always)]
+    pub(crate) fn add(self, o: Self) -> Self {
+        V2::new(self.x + o.x, self.y + o.y)
+    }
+    #[inline(always)]
+    pub(crate) fn sub(self, o: Self) -> Self {
+        V2::new(self.x - o.x, self.y - o.y)
+    }
+    /// `k · self`.
+    #[inline(always)]
+    pub(crate) fn scale(self, k: L) -> Self {
+        V2::new(k * self.x, k * self.y)
+    }
+    /// `self` where `mask` holds, else `other`.
+    #[inline(always)]
+    pub(crate) fn select(mask: L::Mask, on_true: Self, on_false: Self) -> Self {
+        V2::new(
+            L::select(mask, on_true.x, on_false.x),
+            L::select(mask, on_true.y, on_false.y),
+        )
+    }
+}
+
+impl From<Vec2> for V2<Real> {
+    #[inline(always)]
+    fn from(v: Vec2) -> Self {
+        V2::new(v.x, v.y)
+    }
+}
+
+impl From<V2<Real>> for Vec2 {
+    #[inline(always)]
+    fn from(v: V2<Real>) -> Self {
+        Vec2::new(v.x, v.y)
+    }
+}
+
+/// The velocities of one side of a constraint's lanes (of the contact
+/// rows, of a point block): one body's on [`Real`], [`LANES`] bodies' on
+/// [`Wide`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Velocity<L> {
+    /// Linear velocity, x, m/s.
+    pub(crate) v_x: L,
+    /// Linear velocity, y, m/s.
+    pub(crate) v_y: L,
+    /// Angular velocity, rad/s.
+    pub(crate) w: L,
+}
+
+/// The position deltas of one side since the start of the step.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Delta<L> {
+    /// Position delta, x, m.
+    pub(crate) dp_x: L,
+    /// Position delta, y, m.
+    pub(crate) dp_y: L,
+    /// Rotation delta, cosine.
+    pub(crate) q_c: L,
+    /// Rotation delta, sine.
+    pub(crate) q_s: L,
+}
+
+impl Velocity<Real> {
+    /// A state's velocities.
+    #[inline(always)]
+    pub(crate) fn of(s: &BodyState) -> Self {
+        Velocity {
+            v_x: s.v.x,
+            v_y: s.v.y,
+            w: s.w,
+        }
+    }
+
+    /// Writes the velocities into a state.
+    #[inline(always)]
+    pub(crate) fn store(&self, s: &mut BodyState) {
+        s.v = Vec2::new(self.v_x, self.v_y);
+        s.w = self.w;
+    }
+}
+
+impl Delta<Real> {
+    /// A state's position deltas.
+    #[inline(always)]
+    pub(crate) fn of(s: &BodyState) -> Self {
+        Delta {
+            dp_x: s.dp.x,
+            dp_y: s.dp.y,
+            q_c: s.dq.c,
+            q_s: s.dq.s,
+        }
+    }
+}
+
+impl<L: Lane> Velocity<L> {
+    /// The linear velocity as a vector per lane, m/s.
+    #[inline(always)]
+    pub(crate) fn v(&self) -> V2<L> {
+        V2::new(self.v_x, self.v_y)
+    }
+
+    /// Sets the linear velocity, m/s.
+    #[inline(always)]
+    pub(crate) fn set_v(&mut self, v: V2<L>) {
+        self.v_x = v.x;
+        self.v_y = v.y;
+    }
+
+    /// `on_true` where `mask` holds, else `on_false`.
+    #[inline(always)]
+    pub(crate) fn select(mask: L::Mask, on_true: Self, on_false: Self) -> Self {
+        Velocity {
+            v_x: L::select(mask, on_true.v_x, on_false.v_x),
+            v_y: L::select(mask, on_true.v_y, on_false.v_y),
+            w: L::select(mask, on_true.w, on_false.w),
+        }
     }
 }
 

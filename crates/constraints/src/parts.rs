@@ -33,7 +33,7 @@ use janus2d_core::body::{BodyState, InvMass};
 use janus2d_core::math::{Real, Vec2};
 use janus2d_core::parallel::PlannedStates;
 
-use crate::lane::Lane;
+use crate::lane::{Lane, V2, Velocity};
 
 /// The inverse masses of a constraint's two bodies (a, b), loaded at
 /// prepare ([`SolverBody::inv_masses`](janus2d_core::body::SolverBody::inv_masses)):
@@ -171,7 +171,7 @@ pub fn apply_pair(
     p: Vec2,
     l: Real,
 ) {
-    let mut vel = PairVelocity::of(sa, sb);
+    let mut vel = [Velocity::of(sa), Velocity::of(sb)];
     apply_pair_lanes(
         &mut vel,
         &MassLanes::of(m),
@@ -180,64 +180,8 @@ pub fn apply_pair(
         p.into(),
         l,
     );
-    vel.store(sa, sb);
-}
-
-/// A vector per lane: `x` and `y` on [`Real`] (one vector) or on the wide
-/// lane type ([`LANES`](crate::lane::LANES) vectors). Its operations are
-/// glam's on [`Vec2`], component by component, so a lane computes what the
-/// one-vector form computes, bit for bit.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct V2<L> {
-    pub(crate) x: L,
-    pub(crate) y: L,
-}
-
-impl<L: Lane> V2<L> {
-    #[inline(always)]
-    pub(crate) fn new(x: L, y: L) -> Self {
-        V2 { x, y }
-    }
-    /// `(0, 0)` in every lane.
-    #[inline(always)]
-    pub(crate) fn zero() -> Self {
-        V2::new(L::splat(0.0), L::splat(0.0))
-    }
-    #[inline(always)]
-    pub(crate) fn add(self, o: Self) -> Self {
-        V2::new(self.x + o.x, self.y + o.y)
-    }
-    #[inline(always)]
-    pub(crate) fn sub(self, o: Self) -> Self {
-        V2::new(self.x - o.x, self.y - o.y)
-    }
-    /// `k · self`.
-    #[inline(always)]
-    pub(crate) fn scale(self, k: L) -> Self {
-        V2::new(k * self.x, k * self.y)
-    }
-    /// `self` where `mask` holds, else `other`.
-    #[inline(always)]
-    pub(crate) fn select(mask: L::Mask, on_true: Self, on_false: Self) -> Self {
-        V2::new(
-            L::select(mask, on_true.x, on_false.x),
-            L::select(mask, on_true.y, on_false.y),
-        )
-    }
-}
-
-impl From<Vec2> for V2<Real> {
-    #[inline(always)]
-    fn from(v: Vec2) -> Self {
-        V2::new(v.x, v.y)
-    }
-}
-
-impl From<V2<Real>> for Vec2 {
-    #[inline(always)]
-    fn from(v: V2<Real>) -> Self {
-        Vec2::new(v.x, v.y)
-    }
+    vel[0].store(sa);
+    vel[1].store(sb);
 }
 
 /// `a × b`, lane by lane.
@@ -279,50 +223,21 @@ impl MassLanes<Real> {
     }
 }
 
-/// Two bodies' velocities per lane: what a point block reads and writes.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct PairVelocity<L> {
-    pub(crate) v_a: V2<L>,
-    pub(crate) w_a: L,
-    pub(crate) v_b: V2<L>,
-    pub(crate) w_b: L,
-}
-
-impl PairVelocity<Real> {
-    #[inline(always)]
-    pub(crate) fn of(sa: &BodyState, sb: &BodyState) -> Self {
-        PairVelocity {
-            v_a: sa.v.into(),
-            w_a: sa.w,
-            v_b: sb.v.into(),
-            w_b: sb.w,
-        }
-    }
-
-    #[inline(always)]
-    pub(crate) fn store(&self, sa: &mut BodyState, sb: &mut BodyState) {
-        sa.v = self.v_a.into();
-        sa.w = self.w_a;
-        sb.v = self.v_b.into();
-        sb.w = self.w_b;
-    }
-}
-
 /// [`apply_pair`] lane by lane: the impulse `p` at arms `r_a`, `r_b` (equal
 /// and opposite) plus the angular impulse `l` (positive on b).
 #[inline(always)]
 pub(crate) fn apply_pair_lanes<L: Lane>(
-    vel: &mut PairVelocity<L>,
+    [a, b]: &mut [Velocity<L>; 2],
     m: &MassLanes<L>,
     r_a: V2<L>,
     r_b: V2<L>,
     p: V2<L>,
     l: L,
 ) {
-    vel.v_a = vel.v_a.sub(p.scale(m.inv_mass_a));
-    vel.w_a -= m.inv_inertia_a * (cross_lanes(r_a, p) + l);
-    vel.v_b = vel.v_b.add(p.scale(m.inv_mass_b));
-    vel.w_b += m.inv_inertia_b * (cross_lanes(r_b, p) + l);
+    a.set_v(a.v().sub(p.scale(m.inv_mass_a)));
+    a.w -= m.inv_inertia_a * (cross_lanes(r_a, p) + l);
+    b.set_v(b.v().add(p.scale(m.inv_mass_b)));
+    b.w += m.inv_inertia_b * (cross_lanes(r_b, p) + l);
 }
 
 /// A point block's `K = J M⁻¹ Jᵀ` as `(k11, k12, k22)`, lane by lane

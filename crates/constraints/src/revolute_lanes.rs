@@ -39,14 +39,12 @@ use janus2d_core::constraint::StepContext;
 use janus2d_core::math::{Real, Rot, Vec2, wrap_angle};
 use janus2d_core::parallel::{StatePlan, Team};
 
-use crate::contact_row::Velocity;
 use crate::contact_solver::{Direct, LaneStates, PLAN_SLOTS, load, store_where};
 use crate::joint::Joint;
 use crate::joint_rows::{Bounds, PointTerms, SoftLanes, Terms, angle_row, point_equality_row};
-use crate::lane::{LANES, Lane, Wide as W};
-use crate::parts::{MassLanes, PairVelocity, V2, angular_correction_cap, arms_lanes};
+use crate::lane::{LANES, Lane, V2, Velocity, Wide as W};
+use crate::parts::{MassLanes, angular_correction_cap, arms_lanes};
 use janus2d_core::softness::Softness;
-use wide::CmpNe;
 
 /// Side a of a lane.
 const A: usize = 0;
@@ -140,8 +138,6 @@ struct WideRevolute {
     /// Bit `k`: lane `k` reads the joint angle.
     reads_angle: u32,
     delta_angle: [Real; LANES],
-    inv_inertia_a: W,
-    inv_inertia_b: W,
     spring_on: W,
     spring_softness: SoftLanes<W>,
     target_angle: W,
@@ -156,18 +152,13 @@ struct WideRevolute {
     mass: [W; 4],
     impulse: [W; 4],
     point_on: W,
-    /// Inverse masses and inertias of a and b.
+    /// Inverse masses and inertias of a and b (the angle rows read the
+    /// inertias).
     masses: MassLanes<W>,
     frames: (V2<W>, V2<W>),
     delta_center: V2<W>,
     point_softness: SoftLanes<W>,
     point_impulse: V2<W>,
-}
-
-/// All-ones where `on`, else zero: a lane mask of the wide type.
-fn mask(on: [bool; LANES]) -> W {
-    let zero = W::splat(0.0);
-    W::from(on.map(|b| if b { 1.0 } else { 0.0 })).cmp_ne(zero)
 }
 
 impl WideRevolute {
@@ -176,113 +167,97 @@ impl WideRevolute {
     /// [`crate::parts::WRITE_B`]; index `u32::MAX` for a padding lane),
     /// from their prepared state; `h` is the substep, s.
     fn fill(entries: &[(u32, u8)], joints: &[Joint], h: Real) -> Self {
-        let mut lanes: [(u32, u8, RevoluteLane); LANES] = Default::default();
-        let mut len = 0;
-        for &(j, writes) in entries {
-            if let Some(Joint::Revolute(r)) = joints.get(j as usize) {
-                lanes[len] = (j, writes, r.lane(h));
-                len += 1;
-            }
-        }
-        let lanes = &lanes[..len];
-        let mut state = [[0; LANES]; 2];
-        let mut joint = [u32::MAX; LANES];
-        let (mut moving, mut reads_angle) = (0, 0);
-        let mut delta_angle = [0.0; LANES];
-        let mut arrays = [[0.0; LANES]; 32];
-        let mut on = [[false; LANES]; 4];
-        for (k, &(j, writes, ref l)) in lanes.iter().enumerate() {
-            state[A][k] = l.state[0];
-            state[B][k] = l.state[1];
-            joint[k] = j;
-            moving |= u32::from(writes & crate::parts::WRITE_A != 0) << k;
-            moving |= u32::from(writes & crate::parts::WRITE_B != 0) << (LANES + k);
-            reads_angle |= u32::from(l.reads_angle) << k;
-            delta_angle[k] = l.delta_angle;
-            on[0][k] = l.spring;
-            on[1][k] = l.motor;
-            on[2][k] = l.limit;
-            on[3][k] = l.point;
-            let values = [
-                l.inv_inertia[0],
-                l.inv_inertia[1],
-                l.spring_softness.bias_rate,
-                l.spring_softness.mass_scale,
-                l.spring_softness.impulse_scale,
-                l.target_angle,
-                l.motor_bias,
-                -l.motor_max,
-                l.motor_max,
-                l.lower_angle,
-                l.upper_angle,
-                l.mass[0],
-                l.mass[1],
-                l.mass[2],
-                l.mass[3],
-                l.impulse[0],
-                l.impulse[1],
-                l.impulse[2],
-                l.impulse[3],
-                l.inv_mass[0],
-                l.inv_mass[1],
-                l.frames[0].x,
-                l.frames[0].y,
-                l.frames[1].x,
-                l.frames[1].y,
-                l.delta_center.x,
-                l.delta_center.y,
-                l.point_softness.bias_rate,
-                l.point_softness.mass_scale,
-                l.point_softness.impulse_scale,
-                l.point_impulse.x,
-                l.point_impulse.y,
-            ];
-            for (array, x) in arrays.iter_mut().zip(values) {
-                array[k] = x;
-            }
-        }
-        let w = |i: usize| W::from(arrays[i]);
-        WideRevolute {
-            state,
-            joint,
-            len: lanes.len(),
-            moving,
-            reads_angle,
-            delta_angle,
-            inv_inertia_a: w(0),
-            inv_inertia_b: w(1),
-            spring_on: mask(on[0]),
-            spring_softness: SoftLanes {
-                bias_rate: w(2),
-                mass_scale: w(3),
-                impulse_scale: w(4),
-            },
-            target_angle: w(5),
-            motor_on: mask(on[1]),
-            motor_bias: w(6),
-            motor_min: w(7),
-            motor_max: w(8),
-            limit_on: mask(on[2]),
-            lower_angle: w(9),
-            upper_angle: w(10),
-            mass: [w(11), w(12), w(13), w(14)],
-            impulse: [w(15), w(16), w(17), w(18)],
-            point_on: mask(on[3]),
+        let zero = W::splat(0.0);
+        let soft_zero = SoftLanes {
+            bias_rate: zero,
+            mass_scale: zero,
+            impulse_scale: zero,
+        };
+        let mut c = WideRevolute {
+            state: [[0; LANES]; 2],
+            joint: [u32::MAX; LANES],
+            len: 0,
+            moving: 0,
+            reads_angle: 0,
+            delta_angle: [0.0; LANES],
+            spring_on: zero,
+            spring_softness: soft_zero,
+            target_angle: zero,
+            motor_on: zero,
+            motor_bias: zero,
+            motor_min: zero,
+            motor_max: zero,
+            limit_on: zero,
+            lower_angle: zero,
+            upper_angle: zero,
+            mass: [zero; 4],
+            impulse: [zero; 4],
+            point_on: zero,
             masses: MassLanes {
-                inv_mass_a: w(19),
-                inv_inertia_a: w(0),
-                inv_mass_b: w(20),
-                inv_inertia_b: w(1),
+                inv_mass_a: zero,
+                inv_inertia_a: zero,
+                inv_mass_b: zero,
+                inv_inertia_b: zero,
             },
-            frames: (V2::new(w(21), w(22)), V2::new(w(23), w(24))),
-            delta_center: V2::new(w(25), w(26)),
-            point_softness: SoftLanes {
-                bias_rate: w(27),
-                mass_scale: w(28),
-                impulse_scale: w(29),
-            },
-            point_impulse: V2::new(w(30), w(31)),
+            frames: (V2::zero(), V2::zero()),
+            delta_center: V2::zero(),
+            point_softness: soft_zero,
+            point_impulse: V2::zero(),
+        };
+        // All bits set: a lane of a mask that holds.
+        let on = |mask: &mut W, k: usize, yes: bool| {
+            if yes {
+                mask.set_lane(k, Real::from_bits(!0));
+            }
+        };
+        let set_soft = |soft: &mut SoftLanes<W>, k: usize, s: Softness| {
+            soft.bias_rate.set_lane(k, s.bias_rate);
+            soft.mass_scale.set_lane(k, s.mass_scale);
+            soft.impulse_scale.set_lane(k, s.impulse_scale);
+        };
+        let set_v2 = |v: &mut V2<W>, k: usize, x: Vec2| {
+            v.x.set_lane(k, x.x);
+            v.y.set_lane(k, x.y);
+        };
+        for &(j, writes) in entries {
+            let Some(Joint::Revolute(r)) = joints.get(j as usize) else {
+                continue;
+            };
+            let (k, l) = (c.len, r.lane(h));
+            c.len += 1;
+            c.state[A][k] = l.state[0];
+            c.state[B][k] = l.state[1];
+            c.joint[k] = j;
+            c.moving |= u32::from(writes & crate::parts::WRITE_A != 0) << k;
+            c.moving |= u32::from(writes & crate::parts::WRITE_B != 0) << (LANES + k);
+            c.reads_angle |= u32::from(l.reads_angle) << k;
+            c.delta_angle[k] = l.delta_angle;
+            on(&mut c.spring_on, k, l.spring);
+            set_soft(&mut c.spring_softness, k, l.spring_softness);
+            c.target_angle.set_lane(k, l.target_angle);
+            on(&mut c.motor_on, k, l.motor);
+            c.motor_bias.set_lane(k, l.motor_bias);
+            c.motor_min.set_lane(k, -l.motor_max);
+            c.motor_max.set_lane(k, l.motor_max);
+            on(&mut c.limit_on, k, l.limit);
+            c.lower_angle.set_lane(k, l.lower_angle);
+            c.upper_angle.set_lane(k, l.upper_angle);
+            for i in 0..4 {
+                c.mass[i].set_lane(k, l.mass[i]);
+                c.impulse[i].set_lane(k, l.impulse[i]);
+            }
+            on(&mut c.point_on, k, l.point);
+            c.masses.inv_mass_a.set_lane(k, l.inv_mass[0]);
+            c.masses.inv_inertia_a.set_lane(k, l.inv_inertia[0]);
+            c.masses.inv_mass_b.set_lane(k, l.inv_mass[1]);
+            c.masses.inv_inertia_b.set_lane(k, l.inv_inertia[1]);
+            set_v2(&mut c.frames.0, k, l.frames[0]);
+            set_v2(&mut c.frames.1, k, l.frames[1]);
+            set_v2(&mut c.delta_center, k, l.delta_center);
+            set_soft(&mut c.point_softness, k, l.point_softness);
+            set_v2(&mut c.point_impulse, k, l.point_impulse);
         }
+        c
     }
 
     /// One iteration of the lanes' rows, in the one-joint order: spring,
@@ -315,7 +290,7 @@ impl WideRevolute {
         }
         let (mut w_a, mut w_b) = (vel_a.w, vel_b.w);
         let angle = W::from(angle);
-        let inv_inertia = (self.inv_inertia_a, self.inv_inertia_b);
+        let inv_inertia = (self.masses.inv_inertia_a, self.masses.inv_inertia_b);
         // Each row on copies, kept where the lane's joint solves it.
         let mut row = |on: W, sign: Real, i: usize, t: Terms<W>, bounds: Bounds<W>| {
             let (mut a, mut b, mut impulse) = (w_a, w_b, self.impulse[i]);
@@ -364,13 +339,7 @@ impl WideRevolute {
         );
         row(self.limit_on, -1.0, 3, upper, one_sided);
         // The point rows, where the joint is in no tree.
-        let before = PairVelocity {
-            v_a: V2::new(vel_a.v_x, vel_a.v_y),
-            w_a,
-            v_b: V2::new(vel_b.v_x, vel_b.v_y),
-            w_b,
-        };
-        let mut vel = before;
+        let mut vel = [Velocity { w: w_a, ..vel_a }, Velocity { w: w_b, ..vel_b }];
         if W::any(self.point_on) {
             let (r_a, r_b, c) = arms_lanes(
                 self.frames,
@@ -383,37 +352,15 @@ impl WideRevolute {
             );
             let t =
                 PointTerms::equality_lanes(self.point_softness, c, rows.max_speed, rows.use_bias);
-            let mut impulse = self.point_impulse;
-            point_equality_row(&mut vel, &self.masses, (r_a, r_b), t, &mut impulse);
+            let (mut solved, mut impulse) = (vel, self.point_impulse);
+            point_equality_row(&mut solved, &self.masses, (r_a, r_b), t, &mut impulse);
             let on = self.point_on;
-            vel = PairVelocity {
-                v_a: V2::select(on, vel.v_a, before.v_a),
-                w_a: W::select(on, vel.w_a, before.w_a),
-                v_b: V2::select(on, vel.v_b, before.v_b),
-                w_b: W::select(on, vel.w_b, before.w_b),
-            };
+            vel = [0, 1].map(|side| Velocity::select(on, solved[side], vel[side]));
             self.point_impulse = V2::select(on, impulse, self.point_impulse);
         }
-        let side = |v: V2<W>, w: W| Velocity {
-            v_x: v.x,
-            v_y: v.y,
-            w,
-        };
         let lanes = (1 << LANES) - 1;
-        store_where(
-            states,
-            A,
-            &side(vel.v_a, vel.w_a),
-            flags_a,
-            self.moving & lanes,
-        );
-        store_where(
-            states,
-            B,
-            &side(vel.v_b, vel.w_b),
-            flags_b,
-            (self.moving >> LANES) & lanes,
-        );
+        store_where(states, A, &vel[A], flags_a, self.moving & lanes);
+        store_where(states, B, &vel[B], flags_b, (self.moving >> LANES) & lanes);
     }
 
     /// Lane `k`'s kept impulses.
@@ -643,6 +590,13 @@ impl RevoluteLanes {
         self.warm[lane as usize]
     }
 
+    /// Ends the lanes without writing their impulses anywhere (lanes of a
+    /// colouring that is no longer the joints').
+    pub(crate) fn discard(&mut self) {
+        self.lane_of.clear();
+        self.starts.clear();
+    }
+
     /// Writes the lanes' impulses back into their joints and ends the
     /// lanes (the end of a step, or before new lanes).
     pub(crate) fn store(&mut self, joints: &mut [Joint]) {
@@ -656,8 +610,7 @@ impl RevoluteLanes {
                 }
             }
         }
-        self.lane_of.clear();
-        self.starts.clear();
+        self.discard();
     }
 }
 
