@@ -34,6 +34,7 @@ pub mod parallel;
 pub mod slots;
 pub mod softness;
 pub mod solver;
+pub mod team_choice;
 pub mod union_find;
 
 pub use body::{BodyDef, BodyHandle, BodyMass, BodySet, BodyState, BodyType, InvMass, MotionLocks};

@@ -44,6 +44,7 @@ use janus2d_core::constraint::{ConstraintBatch, StepContext};
 use janus2d_core::geometry::Shape;
 use janus2d_core::math::{Real, Rot, Transform, Vec2, cross, vec_is_finite};
 use janus2d_core::solver::{SolverProfile, SolverSettings, solve_step_on};
+use janus2d_core::team_choice::TeamChoice;
 
 use crate::collision::{Collision, CollisionCounters, CollisionEvents};
 use crate::contacts::Contact;
@@ -302,6 +303,11 @@ pub struct World {
         serde(skip, default = "crate::world::step::default_team_min_work")
     )]
     team_min_work: usize,
+    /// Whether the solve runs on the step's team or on the leader alone,
+    /// chosen by timing both now and then ([`TeamChoice`]; not state: the
+    /// result is the same either way, so not serialized).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    solve_team: TeamChoice,
     step_count: u64,
 }
 
@@ -348,6 +354,7 @@ impl World {
             event_work: crate::profile::EventWork::default(),
             profiling_off: false,
             team_min_work: TEAM_MIN_WORK,
+            solve_team: TeamChoice::default(),
             step_count: 0,
         })
     }
@@ -510,6 +517,7 @@ impl World {
             event_work: self.event_work,
             profiling_off: self.profiling_off,
             team_min_work: self.team_min_work,
+            solve_team: self.solve_team.clone(),
             step_count: self.step_count,
         }
     }

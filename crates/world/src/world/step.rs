@@ -264,17 +264,42 @@ impl World {
         } else {
             0
         };
+        // On the team or on the leader alone, whichever the last trial
+        // found faster (`TeamChoice`): the same result either way.
+        let alone = janus2d_core::parallel::Team::serial();
+        let timed = (team.threads() > 1).then(std::time::Instant::now);
+        let work = graph.count() + portals.count();
+        let solve_team = if timed.is_none() || self.solve_team.on_team(work) {
+            team
+        } else {
+            &alone
+        };
         let mut report = if passes > 0 {
             let mut coupled = crate::portal::coupling::CoupledBatches {
                 batches: [&mut graph, &mut portals],
                 passes,
             };
             let mut batches: [&mut dyn ConstraintBatch; 1] = [&mut coupled];
-            solve_step_on(&self.settings, &ctx, &mut self.bodies, &mut batches, team)
+            solve_step_on(
+                &self.settings,
+                &ctx,
+                &mut self.bodies,
+                &mut batches,
+                solve_team,
+            )
         } else {
             let mut batches: [&mut dyn ConstraintBatch; 2] = [&mut graph, &mut portals];
-            solve_step_on(&self.settings, &ctx, &mut self.bodies, &mut batches, team)
+            solve_step_on(
+                &self.settings,
+                &ctx,
+                &mut self.bodies,
+                &mut batches,
+                solve_team,
+            )
         };
+        if let Some(start) = timed {
+            self.solve_team.record(start.elapsed().as_secs_f64());
+        }
         // The solver checks velocities and deltas; a pose they carried out
         // of the world (or to inf) is put back here, before any box is
         // computed from it.
