@@ -242,8 +242,17 @@ impl ContactBuilder {
         let candidates = handoff.touching.iter().map(|&k| k as usize).chain(woken);
         if woke {
             // Woken bodies have new state indices, and woken contacts were not
-            // read by this step's narrowphase: read their bodies again.
+            // read by this step's narrowphase: read their bodies again. A
+            // wake appends states and contacts and moves none, so a contact
+            // the narrowphase staged between two awake bodies (both state
+            // indices set) reads the same states still: only those with a
+            // static, sleeping or woken side are read again (smash wakes
+            // boxes on most steps; this pass read every contact).
             for k in candidates.clone() {
+                let lane = &staged[k].lane;
+                if k < scanned && lane.state_a != 0 && lane.state_b != 0 {
+                    continue;
+                }
                 let c = contacts.awake_mut(k);
                 if c.still == [true, true] {
                     c.still = [
