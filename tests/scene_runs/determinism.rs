@@ -140,9 +140,14 @@ fn benchmark_scene_hashes(steps: usize) -> Vec<u64> {
 
 /// The whole step on the worker team (solver colours, integration, pair
 /// search, proxy boxes, narrowphase): bit-identical for 1, 2 and 4 threads.
+/// The 40 steps hold the solve's first timed trial
+/// (`janus2d::base::team_choice`): two of its steps solve on the leader
+/// alone, the rest on the team, and the state must not show which.
 #[cfg(feature = "parallel")]
 #[test]
 fn benchmark_scenes_are_identical_for_any_thread_count() {
+    use janus2d::base::team_choice::{FIRST_WAIT, TRIAL_STEPS};
+    const { assert!(FIRST_WAIT + TRIAL_STEPS <= 40) };
     let run = |threads: usize| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)

@@ -13,12 +13,14 @@
 //! and keeps the faster:
 //!
 //! ```text
-//! step   0   1   2   3 │ 4 … 3+period │ 0   1   2   3 │ …
-//! runs   T   L   T   L │ the faster   │ T   L   T   L │
-//!        trial (best of two each)      trial again
+//! step   0 … 7 │ 8   9  10  11 │ 12 … 11+period │ T   L   T   L │ …
+//! runs   team  │ T   L   T   L │ the faster     │ trial again   │
+//!              │ trial (best of two each)
 //! ```
 //!
-//! `T` on the team, `L` on the leader. The period doubles (up to
+//! `T` on the team, `L` on the leader. The first [`FIRST_WAIT`] steps run
+//! on the team untimed: a world's first step builds what later steps
+//! keep (colourings, buffers) and would decide the first trial. The period doubles (up to
 //! [`MAX_PERIOD`]) while a trial keeps the same answer by a clear margin
 //! ([`CLEAR_MARGIN`]) and falls back to [`FIRST_PERIOD`] when the answer
 //! changes or is close. A scene that grows or shrinks (bodies raining in,
@@ -30,6 +32,9 @@
 
 /// Steps of a trial: team and leader alternately, two each.
 pub const TRIAL_STEPS: u32 = 4;
+
+/// Steps on the team before the first trial.
+pub const FIRST_WAIT: u32 = 8;
 
 /// Steps between the first trials (and after an answer changed or was
 /// close).
@@ -52,7 +57,7 @@ pub const CLEAR_MARGIN: f64 = 1.15;
 ///
 /// ```
 /// use janus2d_core::team_choice::{TeamChoice, TRIAL_STEPS};
-/// let mut choice = TeamChoice::default();
+/// let mut choice = TeamChoice::starting_trial();
 /// // A trial in which the leader alone is twice as fast…
 /// for _ in 0..TRIAL_STEPS {
 ///     let seconds = if choice.on_team(1000) { 2e-3 } else { 1e-3 };
@@ -62,6 +67,9 @@ pub const CLEAR_MARGIN: f64 = 1.15;
 /// // same.
 /// assert!(!choice.on_team(1100));
 /// ```
+///
+/// (`TeamChoice::default()` would first run [`FIRST_WAIT`] steps on the
+/// team; `starting_trial` begins with a trial.)
 #[derive(Clone, Debug)]
 pub struct TeamChoice {
     /// Steps since the current trial began.
@@ -72,35 +80,49 @@ pub struct TeamChoice {
     best: [f64; 2],
     /// The answer of the last trial: the team is faster.
     team: bool,
-    /// The work when the last trial began.
-    work: usize,
+    /// The work when the last trial began (`None` before the first).
+    work: Option<usize>,
 }
 
 impl Default for TeamChoice {
-    /// Before any trial: the team (the first steps are a trial).
+    /// Before any trial: the team, untimed, for [`FIRST_WAIT`] steps,
+    /// then the first trial.
     fn default() -> Self {
         TeamChoice {
-            clock: 0,
-            period: FIRST_PERIOD,
+            clock: TRIAL_STEPS,
+            period: FIRST_WAIT,
             best: [f64::INFINITY; 2],
             team: true,
-            work: 0,
+            work: None,
         }
     }
 }
 
 impl TeamChoice {
+    /// A choice whose first step begins a trial (the team assumed
+    /// before it).
+    #[must_use]
+    pub fn starting_trial() -> Self {
+        TeamChoice {
+            clock: 0,
+            period: FIRST_PERIOD,
+            ..TeamChoice::default()
+        }
+    }
+
     /// Whether this step's stage, of `work` (any count that grows with
     /// the stage's cost), runs on the team. A work that has moved by more
     /// than [`WORK_DRIFT`] since the last trial begins a trial.
     pub fn on_team(&mut self, work: usize) -> bool {
-        let drift = (work as f64 - self.work as f64).abs();
-        if self.clock >= TRIAL_STEPS && drift > WORK_DRIFT * self.work as f64 {
-            self.clock = 0;
-            self.period = FIRST_PERIOD;
+        if let Some(last) = self.work {
+            let drift = (work as f64 - last as f64).abs();
+            if self.clock >= TRIAL_STEPS && drift > WORK_DRIFT * last as f64 {
+                self.clock = 0;
+                self.period = FIRST_PERIOD;
+            }
         }
         if self.clock == 0 {
-            self.work = work;
+            self.work = Some(work);
         }
         if self.clock < TRIAL_STEPS {
             self.clock.is_multiple_of(2)
@@ -125,7 +147,7 @@ impl TeamChoice {
             let answer = team <= alone;
             let clear = team.max(alone) >= CLEAR_MARGIN * team.min(alone);
             self.period = if answer == self.team && clear {
-                (2 * self.period).min(MAX_PERIOD)
+                (2 * self.period.max(FIRST_PERIOD)).min(MAX_PERIOD)
             } else {
                 FIRST_PERIOD
             };
@@ -165,29 +187,40 @@ mod tests {
     }
 
     #[test]
+    fn the_first_steps_run_on_the_team_untimed() {
+        let mut choice = TeamChoice::default();
+        assert_eq!(choice.steps_to_trial(), FIRST_WAIT);
+        // However slow the team, the first FIRST_WAIT steps are its.
+        assert_eq!(run(&mut choice, FIRST_WAIT, 1.0, 1.0e-3), FIRST_WAIT);
+        assert_eq!(choice.steps_to_trial(), 0);
+        run(&mut choice, TRIAL_STEPS, 1.0, 1.0e-3);
+        assert!(!choice.on_team(1000));
+    }
+
+    #[test]
     fn the_faster_side_runs_every_step_outside_the_trials() {
         let mut choice = TeamChoice::default();
-        // The leader alone is faster: after the first trial only the
+        // The leader alone is faster: after the first wait, only the
         // trials' team steps (two per trial) run on the team.
         let steps = 2000;
-        let on_team = run(&mut choice, steps, 1.5e-3, 1.0e-3);
+        let on_team = run(&mut choice, steps, 1.5e-3, 1.0e-3) - FIRST_WAIT;
         let trials = on_team / 2;
         assert_eq!(on_team % 2, 0);
         // Clear answers double the period: 32, 64, 128, 256, then 512
-        // (the trials begin at steps 0, 36, 104, 236, 496, 1012, 1528).
+        // (the trials begin at steps 8, 44, 112, 244, 504, 1020, 1536).
         assert_eq!(trials, 7, "{trials} trials in {steps} steps");
         assert!(!choice.on_team(1000) || choice.steps_to_trial() == 0);
         // The team faster: all but two steps a trial on the team.
         let mut choice = TeamChoice::default();
         let on_team = run(&mut choice, steps, 1.0e-3, 1.5e-3);
         // (The first trial confirms the team: 64, 128, 256, 512; trials
-        // at 0, 68, 200, 460, 976, 1492.)
+        // at 8, 76, 208, 468, 984, 1500.)
         assert_eq!(steps - on_team, 12, "{} steps alone", steps - on_team);
     }
 
     #[test]
     fn a_close_or_changed_answer_brings_the_next_trial_back_soon() {
-        let mut choice = TeamChoice::default();
+        let mut choice = TeamChoice::starting_trial();
         // The team, as assumed before any trial, and clearly: the period
         // doubles; and again.
         run(&mut choice, TRIAL_STEPS, 1.0e-3, 2.0e-3);
@@ -206,7 +239,7 @@ mod tests {
 
     #[test]
     fn a_scene_that_grows_is_tried_again_at_once() {
-        let mut choice = TeamChoice::default();
+        let mut choice = TeamChoice::starting_trial();
         run(&mut choice, TRIAL_STEPS, 2.0e-3, 1.0e-3);
         assert!(!choice.on_team(1000));
         assert!(choice.steps_to_trial() > 0);
@@ -222,7 +255,7 @@ mod tests {
     fn each_side_keeps_its_best_time_of_the_trial() {
         // One slow team step (a machine hiccup) does not decide a trial:
         // the team's other step is the faster one.
-        let mut choice = TeamChoice::default();
+        let mut choice = TeamChoice::starting_trial();
         let times = [9.0e-3, 1.5e-3, 1.0e-3, 1.5e-3];
         for t in times {
             choice.on_team(1000);
