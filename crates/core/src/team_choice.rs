@@ -20,15 +20,16 @@
 //!
 //! `T` on the team, `L` on the leader. The first [`FIRST_WAIT`] steps run
 //! on the team untimed: a world's first step builds what later steps
-//! keep (colourings, buffers) and would decide the first trial. The period doubles (up to
-//! [`MAX_PERIOD`]) while a trial keeps the same answer by a clear margin
-//! ([`CLEAR_MARGIN`]) and falls back to [`FIRST_PERIOD`] when the answer
-//! changes or is close. A scene that grows or shrinks (bodies raining in,
-//! a pile falling asleep) is tried again at once: when the stage's work
-//! (what the caller counts, the solve's constraints) has moved by more
-//! than [`WORK_DRIFT`] since the last trial. The state is the same bit for bit either way (the
-//! stages give the same results on any team): only time depends on the
-//! choice, so nothing here is state, and a snapshot holds none of it.
+//! keep (colourings, buffers) and would decide the first trial. The
+//! period doubles (up to [`MAX_PERIOD`]) while a trial keeps the same
+//! answer by a clear margin ([`CLEAR_MARGIN`]) and falls back to
+//! [`FIRST_PERIOD`] when the answer changes or is close. A scene that
+//! grows or shrinks (bodies raining in, a pile falling asleep) is tried
+//! again at once: when the stage's work (what the caller counts, the
+//! solve's constraints) has moved by more than [`WORK_DRIFT`] since the
+//! last trial. The state is the same bit for bit either way (the stages
+//! give the same results on any team): only time depends on the choice,
+//! so nothing here is state, and a snapshot holds none of it.
 
 /// Steps of a trial: team and leader alternately, two each.
 pub const TRIAL_STEPS: u32 = 4;

@@ -274,28 +274,18 @@ impl World {
         } else {
             &alone
         };
+        let (settings, bodies) = (&self.settings, &mut self.bodies);
+        let mut solve = |batches: &mut [&mut dyn ConstraintBatch]| {
+            solve_step_on(settings, &ctx, bodies, batches, solve_team)
+        };
         let mut report = if passes > 0 {
             let mut coupled = crate::portal::coupling::CoupledBatches {
                 batches: [&mut graph, &mut portals],
                 passes,
             };
-            let mut batches: [&mut dyn ConstraintBatch; 1] = [&mut coupled];
-            solve_step_on(
-                &self.settings,
-                &ctx,
-                &mut self.bodies,
-                &mut batches,
-                solve_team,
-            )
+            solve(&mut [&mut coupled])
         } else {
-            let mut batches: [&mut dyn ConstraintBatch; 2] = [&mut graph, &mut portals];
-            solve_step_on(
-                &self.settings,
-                &ctx,
-                &mut self.bodies,
-                &mut batches,
-                solve_team,
-            )
+            solve(&mut [&mut graph, &mut portals])
         };
         if let Some(start) = timed {
             self.solve_team.record(start.elapsed().as_secs_f64());
