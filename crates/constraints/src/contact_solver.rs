@@ -650,7 +650,7 @@ impl ContactSolver {
             }
             // A plan that does not hold (it always should: the colouring
             // keeps moving bodies apart) leaves the stages serial.
-            let verified = self.plan.verify(states.len());
+            let verified = self.plan.verify_on(states.len(), team);
             debug_assert!(verified, "a colour holds a moving body twice");
         }
         self.hooked.clear();

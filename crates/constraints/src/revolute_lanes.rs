@@ -510,7 +510,7 @@ impl RevoluteLanes {
                     self.plan.push(slots, chunk.moving);
                 }
             }
-            let verified = self.plan.verify(states);
+            let verified = self.plan.verify_on(states, team);
             debug_assert!(verified, "a lane colour holds a moving body twice");
         }
     }
