@@ -384,14 +384,7 @@ mod tests {
                 object_masses: &objects,
             },
         };
-        batch.prepare_on(&ctx, &set, team);
-        for flip in [false, true, false] {
-            let states = &mut set.states;
-            batch.warm_start_on(&ctx, states, team);
-            batch.solve_on(&ctx, states, true, flip, team);
-            batch.solve_late_on(&ctx, states, true, team);
-            batch.solve_on(&ctx, states, false, !flip, team);
-        }
+        crate::test_support::three_substeps(&mut batch, &ctx, &mut set, team);
         let bits = set
             .states
             .iter()

@@ -63,7 +63,7 @@ pub(crate) struct Terms<L = Real> {
 
 /// A [`Softness`] lane by lane: its bias rate (1/s), mass scale and
 /// impulse scale.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct SoftLanes<L> {
     pub(crate) bias_rate: L,
     pub(crate) mass_scale: L,

@@ -240,7 +240,7 @@ impl Lane for Wide {
 /// lane type ([`LANES`](crate::lane::LANES) vectors). Its operations are
 /// glam's on [`Vec2`], component by component, so a lane computes what the
 /// one-vector form computes, bit for bit.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct V2<L> {
     pub(crate) x: L,
     pub(crate) y: L,

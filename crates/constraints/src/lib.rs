@@ -57,6 +57,33 @@ pub(crate) mod revolute_lanes;
 pub mod weld;
 pub mod wheel;
 
+/// What several modules' tests share.
+#[cfg(test)]
+pub(crate) mod test_support {
+    use janus2d_core::body::BodySet;
+    use janus2d_core::constraint::{ConstraintBatch, StepContext};
+    use janus2d_core::parallel::Team;
+
+    /// Prepares `batch` and runs three substeps' velocity stages on
+    /// `set`'s states, as the solver does (warm start, solve, late pass,
+    /// relax; the sweeps alternating direction).
+    pub(crate) fn three_substeps(
+        batch: &mut dyn ConstraintBatch,
+        ctx: &StepContext,
+        set: &mut BodySet,
+        team: &Team,
+    ) {
+        batch.prepare_on(ctx, set, team);
+        for flip in [false, true, false] {
+            let states = &mut set.states;
+            batch.warm_start_on(ctx, states, team);
+            batch.solve_on(ctx, states, true, flip, team);
+            batch.solve_late_on(ctx, states, true, team);
+            batch.solve_on(ctx, states, false, !flip, team);
+        }
+    }
+}
+
 pub use contact::{ContactConstraint, ContactPointInput};
 pub use contact_solver::{ContactBatch, ContactSolver, ObjectMass, PointImpulse};
 pub use distance::{DistanceJoint, DistanceJointDef};

@@ -203,7 +203,7 @@ pub(crate) fn rotate_lanes<L: Lane>((c, s): (L, L), v: V2<L>) -> V2<L> {
 }
 
 /// Two bodies' inverse masses (1/kg) and inertias (1/(kg·m²)) per lane.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct MassLanes<L> {
     pub(crate) inv_mass_a: L,
     pub(crate) inv_inertia_a: L,

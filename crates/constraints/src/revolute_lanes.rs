@@ -125,7 +125,7 @@ pub(crate) struct LaneImpulses {
 /// [`LANES`] joints' rows in structure-of-arrays form: the angle rows'
 /// settings, masses and impulses, and the point block's (used where
 /// `point_on`).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 struct WideRevolute {
     /// State index of body a, then b, per lane (0 for padding).
     state: [[u32; LANES]; 2],
@@ -167,42 +167,10 @@ impl WideRevolute {
     /// [`crate::parts::WRITE_B`]; index `u32::MAX` for a padding lane),
     /// from their prepared state; `h` is the substep, s.
     fn fill(entries: &[(u32, u8)], joints: &[Joint], h: Real) -> Self {
-        let zero = W::splat(0.0);
-        let soft_zero = SoftLanes {
-            bias_rate: zero,
-            mass_scale: zero,
-            impulse_scale: zero,
-        };
+        // Every lane off and zero; padding lanes name no joint.
         let mut c = WideRevolute {
-            state: [[0; LANES]; 2],
             joint: [u32::MAX; LANES],
-            len: 0,
-            moving: 0,
-            reads_angle: 0,
-            delta_angle: [0.0; LANES],
-            spring_on: zero,
-            spring_softness: soft_zero,
-            target_angle: zero,
-            motor_on: zero,
-            motor_bias: zero,
-            motor_min: zero,
-            motor_max: zero,
-            limit_on: zero,
-            lower_angle: zero,
-            upper_angle: zero,
-            mass: [zero; 4],
-            impulse: [zero; 4],
-            point_on: zero,
-            masses: MassLanes {
-                inv_mass_a: zero,
-                inv_inertia_a: zero,
-                inv_mass_b: zero,
-                inv_inertia_b: zero,
-            },
-            frames: (V2::zero(), V2::zero()),
-            delta_center: V2::zero(),
-            point_softness: soft_zero,
-            point_impulse: V2::zero(),
+            ..WideRevolute::default()
         };
         // All bits set: a lane of a mask that holds.
         let on = |mask: &mut W, k: usize, yes: bool| {
@@ -491,7 +459,7 @@ impl RevoluteLanes {
         }
         // Chunks are kept from step to step (each is filled whole).
         if self.chunks.len() < count {
-            self.chunks.resize(count, WideRevolute::fill(&[], &[], 0.0));
+            self.chunks.resize_with(count, WideRevolute::default);
         }
         let (entries, joints, h) = (&*entries, &*joints, ctx.h);
         team.for_each_chunk_mut(&mut self.chunks[..count], 16, |i, block| {
@@ -676,14 +644,7 @@ mod tests {
             forest: &mut forest,
             colours: &mut colours,
         };
-        batch.prepare_on(&ctx, &set, team);
-        for flip in [false, true, false] {
-            let states = &mut set.states;
-            batch.warm_start_on(&ctx, states, team);
-            batch.solve_on(&ctx, states, true, flip, team);
-            batch.solve_late_on(&ctx, states, true, team);
-            batch.solve_on(&ctx, states, false, !flip, team);
-        }
+        crate::test_support::three_substeps(&mut batch, &ctx, &mut set, team);
         assert_eq!(
             batch.colours.lane_joints() == 2 * n,
             !lanes_off,
