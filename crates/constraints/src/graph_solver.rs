@@ -97,13 +97,13 @@ impl GraphBatch<'_> {
         } else {
             let mut refs = colours.take_refs(joints);
             {
-                let mut parts = colours.split(&mut refs);
+                let mut parts = colours.parts(&mut refs);
                 for k in 0..slots {
                     let c = if reverse { slots - 1 - k } else { k };
                     if c < joint_colours {
                         colours.solve_lanes(c, ctx, states, use_bias, team);
                     }
-                    let joint_part: &mut [Option<&mut crate::Joint>] = if c < joint_colours {
+                    let joint_part: &mut [Option<&mut crate::Joint>] = if colours.has_scalar(c) {
                         &mut *parts[c]
                     } else {
                         &mut []

@@ -159,6 +159,12 @@ pub struct JointColours {
     /// Coloured joints (overflow aside) that may run in lanes, at the last
     /// colouring.
     lane_candidates: usize,
+    /// Per colour, whether a joint of it is solved one at a time beside the
+    /// lanes, while the lanes are live (set by
+    /// [`JointColours::build_lanes`]). A colour with none hands the team no
+    /// joint part, and a stage with none takes no joint references
+    /// (joint_grid: every joint in lanes).
+    scalar_in: Vec<bool>,
 }
 
 /// [`JointColours::colour_of`] of a joint that takes no colour.
@@ -536,8 +542,14 @@ impl JointColours {
     /// The solved joints in solve order, for a stage on the team
     /// ([`JointColours::split`] cuts it by colour; hand it back with
     /// [`JointColours::put_refs`]).
+    ///
+    /// Empty when no colour has a joint solved one at a time
+    /// ([`JointColours::any_scalar`]; cut it with [`JointColours::parts`]).
     pub(crate) fn take_refs<'j>(&mut self, joints: &'j mut [Joint]) -> Vec<Option<&'j mut Joint>> {
         let mut refs = self.scratch.take();
+        if !self.any_scalar() {
+            return refs;
+        }
         refs.resize_with(self.order.len(), || None);
         let lanes = self.lanes_live();
         for (i, (j, &p)) in joints.iter_mut().zip(&self.position).enumerate() {
@@ -591,6 +603,51 @@ impl JointColours {
             team,
         );
         self.lanes_generation = self.generation;
+        let lanes = &self.lanes;
+        self.scalar_in.clear();
+        self.scalar_in.extend((0..colours).map(|c| {
+            self.order[starts[c] as usize..starts[c + 1] as usize]
+                .iter()
+                .any(|&j| lanes.lane_of(j as usize) == NO_LANE)
+        }));
+    }
+
+    /// Whether colour `colour` has a joint solved one at a time (beside
+    /// its lanes, if any): a stage on the team takes it from
+    /// [`JointColours::take_refs`]'s part of the colour. False beyond the
+    /// colours (the overflow is solved by [`JointColours::solve_segment`]).
+    #[inline]
+    pub(crate) fn has_scalar(&self, colour: usize) -> bool {
+        if colour >= self.colour_count() {
+            return false;
+        }
+        if self.lanes_live() {
+            self.scalar_in.get(colour).copied().unwrap_or(true)
+        } else {
+            !self.joints_in(colour).is_empty()
+        }
+    }
+
+    /// Whether any colour has a joint solved one at a time
+    /// ([`JointColours::has_scalar`]): else a stage on the team needs no
+    /// [`JointColours::take_refs`].
+    pub(crate) fn any_scalar(&self) -> bool {
+        (0..self.colour_count()).any(|c| self.has_scalar(c))
+    }
+
+    /// The solved joints' references for a stage on the team, cut by
+    /// colour (`refs` from [`JointColours::take_refs`], or empty parts
+    /// when no colour has a joint solved one at a time).
+    pub(crate) fn parts<'r, 'j>(
+        &self,
+        refs: &'r mut [Option<&'j mut Joint>],
+    ) -> SmallVec<[&'r mut [Option<&'j mut Joint>]; COLOURS + 1]> {
+        if refs.is_empty() {
+            let mut parts = SmallVec::new();
+            parts.resize_with(self.colour_count() + 1, Default::default);
+            return parts;
+        }
+        self.split(refs)
     }
 
     /// One iteration of colour `colour`'s lanes (before the colour's other
@@ -661,15 +718,24 @@ impl JointColours {
             }
             return;
         }
+        // The overflow on the caller: first on a reverse sweep, last on a
+        // forward one.
+        let overflow = segments - 1;
+        if reverse {
+            self.solve_segment(overflow, ctx, joints, states, use_bias);
+        }
         let mut refs = self.take_refs(joints);
         {
-            let mut parts = self.split(&mut refs);
-            for s in 0..segments {
-                let s = if reverse { segments - 1 - s } else { s };
+            let mut parts = self.parts(&mut refs);
+            for k in 0..overflow {
+                let s = if reverse { overflow - 1 - k } else { k };
                 self.solve_lanes(s, ctx, states, use_bias, team);
+                if !self.has_scalar(s) {
+                    continue;
+                }
                 let part = &mut *parts[s];
                 let per_block = Self::block_len(part.len(), team);
-                if s + 1 == segments || part.len() <= per_block {
+                if part.len() <= per_block {
                     let writes = &self.writes[self.starts[s] as usize..];
                     for (j, &w) in part.iter_mut().zip(writes) {
                         let Some(j) = j else { continue };
@@ -686,6 +752,9 @@ impl JointColours {
             }
         }
         self.put_refs(refs);
+        if !reverse {
+            self.solve_segment(overflow, ctx, joints, states, use_bias);
+        }
     }
 }
 
