@@ -376,7 +376,7 @@ impl JointColours {
             self.update(joints, states);
         }
         if self.lanes_live() {
-            self.lanes.refresh_warm();
+            self.lanes.refresh_warm(team);
         }
         let (start, list) = (&self.body_start[..], &self.body_joints[..]);
         let lanes = self.lanes_live().then_some(&self.lanes);
