@@ -811,6 +811,7 @@ fn finalize_bodies(
     fast_bodies: bool,
     report: &mut SolveReport,
     team: &Team,
+    beside: impl FnOnce(),
 ) {
     let finite = |state: &BodyState| {
         vec_is_finite(state.v)
@@ -822,31 +823,35 @@ fn finalize_bodies(
     let any_outside = std::sync::atomic::AtomicBool::new(false);
     let any_fast = std::sync::atomic::AtomicBool::new(false);
     let BodySet { sims, states, .. } = bodies;
-    team.for_each_chunk_pair_mut(sims, states, BODY_BLOCK, |i, sims, states| {
-        clamp_velocity_terms(terms, states, i * BODY_BLOCK);
-        let skip = usize::from(i == 0);
-        let mut outside = false;
-        let mut fast = false;
-        for (sim, state) in sims.iter_mut().zip(states.iter()).skip(skip) {
-            if finite(state) {
-                sim.center = sim.center0 + state.dp;
-                sim.transform.q = state.dq.mul(sim.rotation0).normalize();
-                sim.transform.p = sim.center - sim.transform.q.rotate(sim.local_center);
-                sim.force = Vec2::ZERO;
-                sim.torque = 0.0;
-                fast |= fast_bodies && sim.may_be_fast();
-            } else {
-                any_bad.store(true, std::sync::atomic::Ordering::Relaxed);
+    // A slice of `()` costs no memory (the three-slice form's third).
+    let mut none = vec![(); sims.len()];
+    let finalize =
+        |i: usize, sims: &mut [crate::body::BodySim], states: &mut [BodyState], _: &mut [()]| {
+            clamp_velocity_terms(terms, states, i * BODY_BLOCK);
+            let skip = usize::from(i == 0);
+            let mut outside = false;
+            let mut fast = false;
+            for (sim, state) in sims.iter_mut().zip(states.iter()).skip(skip) {
+                if finite(state) {
+                    sim.center = sim.center0 + state.dp;
+                    sim.transform.q = state.dq.mul(sim.rotation0).normalize();
+                    sim.transform.p = sim.center - sim.transform.q.rotate(sim.local_center);
+                    sim.force = Vec2::ZERO;
+                    sim.torque = 0.0;
+                    fast |= fast_bodies && sim.may_be_fast();
+                } else {
+                    any_bad.store(true, std::sync::atomic::Ordering::Relaxed);
+                }
+                outside |= !sim.pose_within(POSE_LIMIT);
             }
-            outside |= !sim.pose_within(POSE_LIMIT);
-        }
-        if outside {
-            any_outside.store(true, std::sync::atomic::Ordering::Relaxed);
-        }
-        if fast {
-            any_fast.store(true, std::sync::atomic::Ordering::Relaxed);
-        }
-    });
+            if outside {
+                any_outside.store(true, std::sync::atomic::Ordering::Relaxed);
+            }
+            if fast {
+                any_fast.store(true, std::sync::atomic::Ordering::Relaxed);
+            }
+        };
+    team.for_each_chunk_triple_mut_beside(sims, states, &mut none, BODY_BLOCK, finalize, beside);
     report.poses_inside = !any_outside.into_inner();
     report.maybe_fast = any_fast.into_inner();
     if any_bad.into_inner() {
@@ -967,10 +972,15 @@ pub fn solve_step_on(
         }
         report.profile.restitution += clock(&mut t);
     }
-    for &i in &active {
-        batches[i].store_impulses();
-    }
-    finalize_bodies(bodies, &terms, ctx.fast_bodies, &mut report, team);
+    // The batches keep their impulses (joints and lanes only, no body) on
+    // the leader while the team finalizes the bodies (rain at two
+    // threads: the lanes' store was serial while the other thread waited).
+    let store = || {
+        for &i in &active {
+            batches[i].store_impulses();
+        }
+    };
+    finalize_bodies(bodies, &terms, ctx.fast_bodies, &mut report, team, store);
     report.profile.finalize += clock(&mut t);
     report
 }
