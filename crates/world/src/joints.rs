@@ -27,6 +27,7 @@ use janus2d_constraints::{
 use janus2d_core::body::{BodyHandle, BodySet};
 use janus2d_core::handle::{Handle, JointTag};
 use janus2d_core::math::Real;
+use janus2d_core::parallel::Team;
 use janus2d_core::slots::Slots;
 use smallvec::SmallVec;
 
@@ -723,32 +724,33 @@ impl JointSet {
     ///   [`direct_row_count`](Self::direct_row_count));
     /// - the step's joint events (see [`JointEvent`]) are gathered, in
     ///   storage order.
-    pub(crate) fn end_step(&mut self) -> JointStepEnd {
+    ///
+    /// On `team` in blocks of [`END_BLOCK`] joints, the blocks' findings
+    /// joined in storage order (joint_grid at two threads: this pass over
+    /// 3,120 joints was about 3% of the leader's samples, the other thread
+    /// waiting).
+    pub(crate) fn end_step(&mut self, team: &Team) -> JointStepEnd {
+        let n = self.joints.len();
+        if team.threads() == 1 || n < 2 * END_BLOCK {
+            return end_block(&mut self.joints, &self.handles);
+        }
+        let blocks: Vec<std::sync::Mutex<JointStepEnd>> = (0..n.div_ceil(END_BLOCK))
+            .map(|_| Default::default())
+            .collect();
+        let handles = &self.handles[..];
+        team.for_each_chunk_mut(&mut self.joints, END_BLOCK, |b, joints| {
+            let first = b * END_BLOCK;
+            let found = end_block(joints, &handles[first..first + joints.len()]);
+            if let Ok(mut slot) = blocks[b].lock() {
+                *slot = found;
+            }
+        });
         let mut end = JointStepEnd::default();
-        for (k, j) in self.joints.iter_mut().enumerate() {
-            // One read of the kind's impulses serves the finiteness test
-            // and the thresholds.
-            let (mut force, mut torque) = j.read_back();
-            if !(force.x.is_finite() & force.y.is_finite() & torque.is_finite()) {
-                let enabled = j.is_enabled();
-                *j = Joint::new(j.def());
-                j.set_enabled(enabled);
-                (force, torque) = j.read_back();
-            }
-            if j.is_enabled() {
-                end.rows += j.prepared_row_count();
-            }
-            if j.in_tree() {
-                end.direct_rows += j.tree_row_count();
-            }
-            if j.check_thresholds_of(force, torque) {
-                end.events.push(JointEvent {
-                    joint: self.handles[k],
-                    user_data: j.def_base().user_data,
-                    force,
-                    torque,
-                });
-            }
+        for block in blocks {
+            let found = block.into_inner().unwrap_or_default();
+            end.rows += found.rows;
+            end.direct_rows += found.direct_rows;
+            end.events.extend(found.events);
         }
         end
     }
@@ -783,4 +785,38 @@ pub(crate) struct JointStepEnd {
     pub(crate) direct_rows: usize,
     /// The threshold crossings, in storage order.
     pub(crate) events: Vec<JointEvent>,
+}
+
+/// Joints per block of [`JointSet::end_step`] on a team.
+const END_BLOCK: usize = 1024;
+
+/// [`JointSet::end_step`] over `joints` (with their `handles`), in order.
+fn end_block(joints: &mut [Joint], handles: &[JointHandle]) -> JointStepEnd {
+    let mut end = JointStepEnd::default();
+    for (j, &handle) in joints.iter_mut().zip(handles) {
+        // One read of the kind's impulses serves the finiteness test and
+        // the thresholds.
+        let (mut force, mut torque) = j.read_back();
+        if !(force.x.is_finite() & force.y.is_finite() & torque.is_finite()) {
+            let enabled = j.is_enabled();
+            *j = Joint::new(j.def());
+            j.set_enabled(enabled);
+            (force, torque) = j.read_back();
+        }
+        if j.is_enabled() {
+            end.rows += j.prepared_row_count();
+        }
+        if j.in_tree() {
+            end.direct_rows += j.tree_row_count();
+        }
+        if j.check_thresholds_of(force, torque) {
+            end.events.push(JointEvent {
+                joint: handle,
+                user_data: j.def_base().user_data,
+                force,
+                torque,
+            });
+        }
+    }
+    end
 }

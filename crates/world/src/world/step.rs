@@ -377,7 +377,7 @@ impl World {
         }
         // Non-finite read-backs reset, the row counts and the threshold
         // events, in one pass over the joints.
-        let joint_end = self.joints.end_step();
+        let joint_end = self.joints.end_step(team);
         sp.solver = report.profile;
         sp.total = start.elapsed().as_secs_f64();
         self.counters = crate::profile::StepCounters::gather(&crate::profile::CounterSources {
