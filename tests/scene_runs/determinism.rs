@@ -74,24 +74,20 @@ fn contact_scene_hash_is_stable_across_runs() {
 #[test]
 fn small_world_stepped_alone_or_on_the_team_is_identical() {
     let run = |team_min_work: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(2)
-            .build()
-            .unwrap()
-            .install(|| {
-                let def = janus2d_testbed::scenes::shared_settings();
-                let mut pyramid = janus2d_testbed::scenes::large_pyramid(&def, 20);
-                pyramid.world.set_team_min_work(team_min_work);
-                for _ in 0..60 {
-                    pyramid.world.step(1.0 / 60.0).unwrap();
-                }
-                let work = pyramid.world.awake_body_count() + pyramid.world.awake_contact_count();
-                assert!(
-                    work < janus2d::world::TEAM_MIN_WORK,
-                    "pyramid 20 is a small world ({work} work)"
-                );
-                pyramid.world.state_hash()
-            })
+        on_threads(2, || {
+            let def = janus2d_testbed::scenes::shared_settings();
+            let mut pyramid = janus2d_testbed::scenes::large_pyramid(&def, 20);
+            pyramid.world.set_team_min_work(team_min_work);
+            for _ in 0..60 {
+                pyramid.world.step(1.0 / 60.0).unwrap();
+            }
+            let work = pyramid.world.awake_body_count() + pyramid.world.awake_contact_count();
+            assert!(
+                work < janus2d::world::TEAM_MIN_WORK,
+                "pyramid 20 is a small world ({work} work)"
+            );
+            pyramid.world.state_hash()
+        })
     };
     assert_eq!(run(janus2d::world::TEAM_MIN_WORK), run(0));
 }
@@ -101,13 +97,7 @@ fn small_world_stepped_alone_or_on_the_team_is_identical() {
 #[cfg(feature = "parallel")]
 #[test]
 fn contact_scene_is_identical_for_any_thread_count() {
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(contact_scene_hash)
-    };
+    let run = |threads: usize| on_threads(threads, contact_scene_hash);
     let one = run(1);
     assert_eq!(run(2), one);
     assert_eq!(run(4), one);
@@ -148,13 +138,7 @@ fn benchmark_scene_hashes(steps: usize) -> Vec<u64> {
 fn benchmark_scenes_are_identical_for_any_thread_count() {
     use janus2d::base::team_choice::{FIRST_WAIT, TRIAL_STEPS};
     const { assert!(FIRST_WAIT + TRIAL_STEPS <= 40) };
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| benchmark_scene_hashes(40))
-    };
+    let run = |threads: usize| on_threads(threads, || benchmark_scene_hashes(40));
     let one = run(1);
     assert_eq!(run(2), one, "2 threads");
     assert_eq!(run(4), one, "4 threads");
@@ -185,13 +169,7 @@ fn every_joint_kind_is_stable_across_runs() {
 #[cfg(feature = "parallel")]
 #[test]
 fn every_joint_kind_is_identical_for_any_thread_count() {
-    let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(every_joint_kind_hash)
-    };
+    let run = |threads: usize| on_threads(threads, every_joint_kind_hash);
     let one = run(1);
     assert_eq!(run(2), one, "2 threads");
     assert_eq!(run(4), one, "4 threads");
@@ -209,57 +187,53 @@ fn every_joint_kind_is_identical_for_any_thread_count() {
 fn joint_events_are_identical_for_any_thread_count() {
     use janus2d::prelude::*;
     let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| {
-                let mut def = janus2d::world::WorldDef::default();
-                def.sleep.enabled = false;
-                def.gravity = Vec2::new(0.0, -10.0);
-                let mut world = World::new(def).unwrap();
-                for chain in 0..50 {
-                    let x = 3.0 * chain as Real;
-                    let mut above = world
-                        .create_body(&BodyDef::fixed(Vec2::new(x, 0.0)))
+        on_threads(threads, || {
+            let mut def = janus2d::world::WorldDef::default();
+            def.sleep.enabled = false;
+            def.gravity = Vec2::new(0.0, -10.0);
+            let mut world = World::new(def).unwrap();
+            for chain in 0..50 {
+                let x = 3.0 * chain as Real;
+                let mut above = world
+                    .create_body(&BodyDef::fixed(Vec2::new(x, 0.0)))
+                    .unwrap();
+                for link in 0..50 {
+                    let y = -0.5 - link as Real;
+                    let body = world
+                        .create_body(&BodyDef::dynamic(Vec2::new(x, y)).with_mass(1.0, 0.1))
                         .unwrap();
-                    for link in 0..50 {
-                        let y = -0.5 - link as Real;
-                        let body = world
-                            .create_body(&BodyDef::dynamic(Vec2::new(x, y)).with_mass(1.0, 0.1))
-                            .unwrap();
-                        let anchor_above = if link == 0 {
-                            Vec2::ZERO
-                        } else {
-                            Vec2::new(0.0, -0.5)
-                        };
-                        let mut joint =
-                            RevoluteJointDef::new(above, body, anchor_above, Vec2::new(0.0, 0.5));
-                        joint.base.force_threshold = 250.0;
-                        joint.base.user_data = (chain * 50 + link) as u64;
-                        world.create_revolute_joint(&joint).unwrap();
-                        above = body;
-                    }
+                    let anchor_above = if link == 0 {
+                        Vec2::ZERO
+                    } else {
+                        Vec2::new(0.0, -0.5)
+                    };
+                    let mut joint =
+                        RevoluteJointDef::new(above, body, anchor_above, Vec2::new(0.0, 0.5));
+                    joint.base.force_threshold = 250.0;
+                    joint.base.user_data = (chain * 50 + link) as u64;
+                    world.create_revolute_joint(&joint).unwrap();
+                    above = body;
                 }
-                let mut seen = Vec::new();
-                let mut rows = Vec::new();
-                for _ in 0..30 {
-                    world.step(1.0 / 60.0).unwrap();
-                    for e in &world.events().joints {
-                        // (Handles carry their world's owner id: the
-                        // user value names the joint across worlds.)
-                        seen.push((
-                            e.user_data,
-                            e.force.x.to_bits(),
-                            e.force.y.to_bits(),
-                            e.torque.to_bits(),
-                        ));
-                    }
-                    let c = world.counters();
-                    rows.push((c.joint_rows, c.direct_joint_rows));
+            }
+            let mut seen = Vec::new();
+            let mut rows = Vec::new();
+            for _ in 0..30 {
+                world.step(1.0 / 60.0).unwrap();
+                for e in &world.events().joints {
+                    // (Handles carry their world's owner id: the
+                    // user value names the joint across worlds.)
+                    seen.push((
+                        e.user_data,
+                        e.force.x.to_bits(),
+                        e.force.y.to_bits(),
+                        e.torque.to_bits(),
+                    ));
                 }
-                (seen, rows)
-            })
+                let c = world.counters();
+                rows.push((c.joint_rows, c.direct_joint_rows));
+            }
+            (seen, rows)
+        })
     };
     let one = run(1);
     assert!(
@@ -276,4 +250,15 @@ fn joint_events_are_identical_for_any_thread_count() {
             one.0.len()
         );
     }
+}
+
+/// `f` run on a rayon pool of `threads` threads (the world's team is made
+/// from the pool it is stepped on).
+#[cfg(feature = "parallel")]
+fn on_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
 }
