@@ -540,7 +540,7 @@ impl JointColours {
     }
 
     /// The solved joints in solve order, for a stage on the team
-    /// ([`JointColours::split`] cuts it by colour; hand it back with
+    /// ([`JointColours::parts`] cuts it by colour; hand it back with
     /// [`JointColours::put_refs`]).
     ///
     /// Empty when no colour has a joint solved one at a time

@@ -533,6 +533,7 @@ impl RevoluteLanes {
     /// Sums each lane's angle impulses (`spring + motor + lower − upper`,
     /// as the joint sums its own) and copies its point impulse, for the
     /// warm start that follows.
+    ///
     /// On `team` in blocks of [`WARM_BLOCK`] chunks (rain at two threads:
     /// this pass, four times a step, was about 1.7% of the leader's samples
     /// while the other thread waited).
