@@ -233,6 +233,16 @@ macro_rules! joint_kinds {
                 match self { $( Joint::$kind(j) => &j.def.base, )* }
             }
 
+            /// Asks the cache for every line of its boxed definition, a
+            /// few joints before the prepare reads it: a hint only, it
+            /// reads and changes nothing. (A revolute definition spans
+            /// two lines; asking for the first alone left the prepare
+            /// waiting on the second's switches.)
+            #[inline]
+            pub fn prefetch_def(&self) {
+                match self { $( Joint::$kind(j) => janus2d_core::hint::prefetch_all(&*j.def), )* }
+            }
+
             fn def_base_mut(&mut self) -> &mut JointDefBase {
                 match self { $( Joint::$kind(j) => &mut j.def.base, )* }
             }

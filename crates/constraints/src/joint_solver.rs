@@ -52,7 +52,7 @@ impl JointBatch<'_> {
                     // The definition a few joints on, boxed apart: its miss
                     // overlaps this joint's prepare (docs/performance.md).
                     if let Some(ahead) = block.get(i + PREFETCH_AHEAD) {
-                        janus2d_core::hint::prefetch(ahead.def_base());
+                        ahead.prefetch_def();
                     }
                     let j = &mut block[i];
                     if j.is_enabled() {
