@@ -163,7 +163,7 @@ pub struct JointColours {
     /// lanes, while the lanes are live (set by
     /// [`JointColours::build_lanes`]). A colour with none hands the team no
     /// joint part, and a stage with none takes no joint references
-    /// (joint_grid: every joint in lanes).
+    /// (rain: the ragdolls' hinges, every coloured joint in lanes).
     scalar_in: Vec<bool>,
 }
 

@@ -727,7 +727,7 @@ impl JointSet {
     ///
     /// On `team` in blocks of [`END_BLOCK`] joints, the blocks' findings
     /// joined in storage order (joint_grid at two threads: this pass over
-    /// 3,120 joints was about 3% of the leader's samples, the other thread
+    /// 19,800 joints was about 3% of the leader's samples, the other thread
     /// waiting).
     pub(crate) fn end_step(&mut self, team: &Team) -> JointStepEnd {
         let n = self.joints.len();
