@@ -555,11 +555,13 @@ impl RevoluteLanes {
                 has_point: on[k].to_bits() != 0,
             })
         };
-        if team.threads() == 1 || chunks.len() < 2 * WARM_BLOCK {
-            self.warm.extend((0..chunks.len()).map(lanes_of));
+        // Fewer chunks than two blocks: one block, which runs on the caller.
+        let per_block = if chunks.len() < 2 * WARM_BLOCK {
+            chunks.len()
         } else {
-            team.extend_mapped(&mut self.warm, chunks.len(), WARM_BLOCK, lanes_of);
-        }
+            WARM_BLOCK
+        };
+        team.extend_mapped(&mut self.warm, chunks.len(), per_block, lanes_of);
     }
 
     /// Lane `lane`'s warm start, as the last [`RevoluteLanes::refresh_warm`]

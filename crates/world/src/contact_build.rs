@@ -170,20 +170,52 @@ fn kept_colour(s: &SolvedContact, colour: u8) -> u8 {
     }
 }
 
+/// What the build counts of the solved contacts, in the serial pass or
+/// per block of the parallel one.
+#[derive(Clone, Copy, Default)]
+struct Tally {
+    /// Solver rows (two per point).
+    rows: usize,
+    /// Contacts with restitution.
+    bouncy: usize,
+    /// A light pair (`light_pair`, neither body excluded) is met: the
+    /// light clusters are looked for.
+    light: bool,
+}
+
+impl Tally {
+    /// Counts `s`; true when it is the first light pair met (a light body
+    /// against a heavy one, neither in `excluded`).
+    #[inline]
+    fn count(&mut self, s: &SolvedContact, excluded: &[u32]) -> bool {
+        self.rows += 2 * usize::from(s.point_count);
+        self.bouncy += usize::from(s.bouncy);
+        let first_light = !self.light
+            && light_pair(s.moving, s.inv_mass)
+            && !excluded.contains(&s.state[0])
+            && !excluded.contains(&s.state[1]);
+        self.light |= first_light;
+        first_light
+    }
+
+    /// Adds a block's counts.
+    fn add(&mut self, other: Tally) {
+        self.rows += other.rows;
+        self.bouncy += other.bouncy;
+        self.light |= other.light;
+    }
+}
+
 /// What the build's parallel pass finds in one block of the solved
 /// contacts (see `ContactBuilder::build`).
 #[derive(Default)]
 struct BuildPart {
     /// The block's colours (the overflow, for now, for a fresh contact).
     colours: Vec<u8>,
-    /// Solver rows (two per point).
-    rows: usize,
-    /// Contacts with restitution.
-    bouncy: usize,
+    /// The block's counts.
+    tally: Tally,
     /// Contacts whose graph colour was kept.
     kept: usize,
-    /// A light pair (`light_pair`, neither body excluded) is met.
-    light: bool,
     /// Positions in `solved` of the contacts that take a colour afresh.
     fresh: Vec<u32>,
     /// A still pair was met (the block was left unfinished).
@@ -316,7 +348,7 @@ impl ContactBuilder {
         colours.clear();
         let places = &mut self.places;
         places.clear();
-        let (mut rows, mut bouncy, mut any_light) = (0, 0, false);
+        let mut tally = Tally::default();
         // Each solved contact once: its colour (pushed to `colours` and
         // returned), the counters, and whether it is the first contact
         // between a light body and a heavy one with neither body excluded
@@ -324,14 +356,7 @@ impl ContactBuilder {
         let mut take = |s: &SolvedContact, graph: &mut ConstraintGraph| -> (u8, bool) {
             let colour = colour_of(graph, s);
             colours.push(colour);
-            rows += 2 * usize::from(s.point_count);
-            bouncy += usize::from(s.bouncy);
-            let first_light = !any_light
-                && light_pair(s.moving, s.inv_mass)
-                && !excluded.contains(&s.state[0])
-                && !excluded.contains(&s.state[1]);
-            any_light |= first_light;
-            (colour, first_light)
+            (colour, tally.count(s, excluded))
         };
         // Pass 1: the solved contacts, in contact order, each given its
         // colour from the persistent graph, keyed by the bodies' slots (a
@@ -403,11 +428,6 @@ impl ContactBuilder {
             // pass over every contact here was about 4% of the leader's
             // samples in large_pyramid at two threads.)
             let (part_of, light_of) = (&*solved, &*excluded);
-            let is_light = |s: &SolvedContact| {
-                light_pair(s.moving, s.inv_mass)
-                    && !light_of.contains(&s.state[0])
-                    && !light_of.contains(&s.state[1])
-            };
             let parts = team.map_blocks(solved.len().div_ceil(BLOCK), |b| {
                 let first = b * BLOCK;
                 let part = &part_of[first..(first + BLOCK).min(part_of.len())];
@@ -418,9 +438,7 @@ impl ContactBuilder {
                         out.still = true;
                         break;
                     }
-                    out.rows += 2 * usize::from(s.point_count);
-                    out.bouncy += usize::from(s.bouncy);
-                    out.light = out.light || is_light(s);
+                    out.tally.count(s, light_of);
                     if s.kept == NOT_KEPT {
                         out.fresh.push((first + j) as u32);
                         out.colours.push(OVERFLOW);
@@ -444,9 +462,7 @@ impl ContactBuilder {
                 let mut kept = 0;
                 for p in &parts {
                     colours.extend_from_slice(&p.colours);
-                    rows += p.rows;
-                    bouncy += p.bouncy;
-                    any_light |= p.light;
+                    tally.add(p.tally);
                     kept += p.kept;
                 }
                 for &i in parts.iter().flat_map(|p| &p.fresh) {
@@ -525,13 +541,13 @@ impl ContactBuilder {
             pushed = fused;
         }
         graph.sweep();
-        self.had_light = any_light;
+        self.had_light = tally.light;
         // Light clusters (`contact_group`): their contacts go to the overflow
         // this step (keeping their place in the graph), where the solver takes
         // each cluster's contacts as one block.
         let cluster_of = &mut self.cluster_of;
         cluster_of.clear();
-        if any_light {
+        if tally.light {
             self.clusters.assign(
                 bodies.states.len(),
                 solved.len(),
@@ -581,8 +597,8 @@ impl ContactBuilder {
                 place_of[s.index as usize] = place;
             }
         }
-        counters.contact_rows = rows;
-        counters.restitution_contacts = bouncy;
+        counters.contact_rows = tally.rows;
+        counters.restitution_contacts = tally.bouncy;
     }
 
     /// Copies solved impulses back into the contacts (for warm starting);
