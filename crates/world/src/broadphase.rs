@@ -52,7 +52,7 @@ use janus2d_core::geometry::Aabb;
 use janus2d_core::math::{Real, Vec2};
 use janus2d_core::parallel::Team;
 
-pub use crate::dynamic_tree::{DEFAULT_AABB_MARGIN, DynamicTree, NULL_NODE};
+pub use crate::dynamic_tree::{DEFAULT_AABB_MARGIN, DynamicTree, FilterBits, NULL_NODE};
 
 /// [`BroadPhase::update_pairs`] switches from per-proxy queries to one
 /// simultaneous tree descent when at least `1 / BULK_DIVISOR` of the proxies
@@ -194,12 +194,28 @@ impl BroadPhase {
     /// (static proxies: 0). Small shapes take small margins, so that the
     /// fat boxes of a dense pile of them do not overlap far beyond their
     /// neighbours (see [`proxy_margin`]).
+    #[cfg(test)]
     pub fn create_proxy_with_margin(
         &mut self,
         aabb: Aabb,
         payload: u32,
         is_static: bool,
         margin: Real,
+    ) -> u32 {
+        self.create_proxy_filtered(aabb, payload, is_static, margin, FilterBits::ALL)
+    }
+
+    /// [`create_proxy_with_margin`](Self::create_proxy_with_margin) for a
+    /// shape whose collision filter folds to `bits`
+    /// ([`FilterBits::of`]): the pair search skips the proxies it cannot
+    /// pair with.
+    pub fn create_proxy_filtered(
+        &mut self,
+        aabb: Aabb,
+        payload: u32,
+        is_static: bool,
+        margin: Real,
+        bits: FilterBits,
     ) -> u32 {
         let full = self.tree(is_static).margin();
         let margin = if self.uniform_margin {
@@ -229,7 +245,7 @@ impl BroadPhase {
         } else {
             &mut self.dynamic_tree
         };
-        let leaf = tree.create_proxy_with_margin(aabb, id, margin);
+        let leaf = tree.create_proxy_filtered(aabb, id, margin, bits);
         self.proxies[id as usize] = ProxySlot {
             fat: tree.fat_aabb(leaf),
             core: tree.fat_aabb(leaf),
@@ -405,6 +421,18 @@ impl BroadPhase {
         self.proxies.get(proxy as usize).is_some_and(|s| s.alive)
     }
 
+    /// Gives a proxy the filter bits of its shape's new filter (see
+    /// [`FilterBits`]); [`touch_proxy`](Self::touch_proxy) then has its
+    /// pairs found again under it.
+    pub fn set_proxy_bits(&mut self, proxy: u32, bits: FilterBits) {
+        if proxy == NO_PROXY {
+            return;
+        }
+        let slot = self.slot(proxy);
+        self.tree_mut(slot.is_static)
+            .set_proxy_bits(slot.leaf, bits);
+    }
+
     /// Marks a proxy as moved without changing its box, so that the next
     /// [`update_pairs`](Self::update_pairs) reports all its pairs again (for
     /// instance after its collision filter changed).
@@ -451,10 +479,11 @@ impl BroadPhase {
                 continue;
             }
             let tight = tight_of(slot.payload);
+            let bits = self.dynamic_tree.proxy_bits(slot.leaf);
             self.dynamic_tree.destroy_proxy(slot.leaf);
             let leaf = self
                 .dynamic_tree
-                .create_proxy_with_margin(tight, proxy, full);
+                .create_proxy_filtered(tight, proxy, full, bits);
             let s = &mut self.proxies[proxy as usize];
             s.leaf = leaf;
             s.margin = full;
@@ -580,8 +609,13 @@ impl BroadPhase {
             let s = &proxies[p as usize];
             s.alive && s.moved
         });
+        // No two proxies whose filters may pair (the trees' root bits, see
+        // `dynamic_tree`'s *Filter bits*): no pair to look for (a joint
+        // grid whose circles collide with nothing).
+        let searched = self.dynamic_tree.may_pair_within()
+            || self.dynamic_tree.may_pair_across(&self.static_tree);
 
-        if bulk {
+        if bulk && searched {
             // The descents skip node pairs without a moved proxy below
             // either node (only pairs with a moved member are kept).
             for (is_static, marks) in [false, true].into_iter().zip(&mut self.moved_marks) {
@@ -598,11 +632,12 @@ impl BroadPhase {
                 tree.mark_paths(leaves, marks);
             }
         }
-        if team.threads() > 1 && moves.len() >= PARALLEL_MOVES {
+        let parallel = team.threads() > 1 && moves.len() >= PARALLEL_MOVES;
+        if searched && parallel {
             // The filter runs on the threads; the kept pairs come back in
             // block order.
             self.find_pairs_parallel(bulk, &moves, &filter, out, team);
-        } else {
+        } else if searched {
             let mut report = |pa: u32, pb: u32| keep_pair(&filter, out, pa, pb);
             self.find_pairs_serial(bulk, &moves, &mut report);
         }
@@ -653,9 +688,12 @@ impl BroadPhase {
                     }
                     true
                 };
-                self.dynamic_tree.query(&fat, &mut visit);
+                let bits = self.tree(slot.is_static).proxy_bits(slot.leaf);
+                self.dynamic_tree
+                    .query_proxies_filtered(&fat, bits, |_, other| visit(other));
                 if !slot.is_static {
-                    self.static_tree.query(&fat, &mut visit);
+                    self.static_tree
+                        .query_proxies_filtered(&fat, bits, |_, other| visit(other));
                 }
             }
         }
@@ -719,9 +757,10 @@ impl BroadPhase {
                         }
                         true
                     };
-                    dynamic.query(&fat, &mut visit);
+                    let bits = if slot.is_static { fixed } else { dynamic }.proxy_bits(slot.leaf);
+                    dynamic.query_proxies_filtered(&fat, bits, |_, other| visit(other));
                     if !slot.is_static {
-                        fixed.query(&fat, &mut visit);
+                        fixed.query_proxies_filtered(&fat, bits, |_, other| visit(other));
                     }
                 }
                 pairs
@@ -989,6 +1028,80 @@ mod tests {
             assert_eq!(pairs, expected, "{label}, bulk = {bulk}");
             assert_eq!(calls.into_inner(), expected.len(), "{label}, bulk = {bulk}");
         }
+    }
+
+    /// Proxies whose filters refuse each other are not paired, and their
+    /// pairs are not even offered to the caller's filter (the node pairs
+    /// are skipped by their bits); both strategies report exactly the
+    /// overlapping pairs whose bits may pair. A world of mutually refusing
+    /// proxies offers none; one proxy given every category then pairs with
+    /// every proxy it overlaps.
+    #[test]
+    fn refusing_filters_are_never_offered_as_pairs() {
+        let mut rng = Lcg(3);
+        let kinds = [
+            FilterBits::of(1, u64::MAX, 0),
+            FilterBits::of(2, !2, 0),
+            FilterBits::of(4, 1, 0),
+        ];
+        let mut bp = BroadPhase::new();
+        let mut bits_of = std::collections::BTreeMap::new();
+        let ids: Vec<u32> = (0..2000u32)
+            .map(|i| {
+                let bits = kinds[rng.below(3) as usize];
+                bits_of.insert(payload_of(i), bits);
+                bp.create_proxy_filtered(
+                    random_box(&mut rng, 100.0),
+                    payload_of(i),
+                    i % 10 == 0,
+                    Real::INFINITY,
+                    bits,
+                )
+            })
+            .collect();
+        bp.validate();
+        let all = brute_force(&bp, &ids);
+        let expected: Vec<(u32, u32)> = all
+            .iter()
+            .copied()
+            .filter(|(a, b)| bits_of[a].may_pair(bits_of[b]))
+            .collect();
+        assert!(
+            expected.len() > 300 && all.len() > expected.len() + 300,
+            "{} of {}",
+            expected.len(),
+            all.len()
+        );
+        check_both_strategies(&bp, &expected, "mixed filters");
+
+        let mut lonely = BroadPhase::new();
+        let lonely_ids: Vec<u32> = (0..2000u32)
+            .map(|i| {
+                lonely.create_proxy_filtered(
+                    random_box(&mut rng, 100.0),
+                    payload_of(i),
+                    i % 10 == 0,
+                    Real::INFINITY,
+                    kinds[1],
+                )
+            })
+            .collect();
+        assert!(brute_force(&lonely, &lonely_ids).len() > 500);
+        check_both_strategies(&lonely, &[], "refusing filters");
+        let mut pairs = Vec::new();
+        lonely.update_pairs(|_, _| true, &mut pairs, &Team::serial());
+        assert!(pairs.is_empty());
+        // One of them joins every category: its pairs, and only its.
+        let open = lonely_ids[1];
+        lonely.set_proxy_bits(open, FilterBits::ALL);
+        lonely.touch_proxy(open);
+        lonely.validate();
+        let mine: Vec<(u32, u32)> = brute_force(&lonely, &lonely_ids)
+            .into_iter()
+            .filter(|&(a, b)| a == lonely.payload(open) || b == lonely.payload(open))
+            .collect();
+        assert!(!mine.is_empty());
+        check_both_strategies(&lonely, &mine, "one open filter");
     }
 
     /// 2000 random proxies, one in ten static.

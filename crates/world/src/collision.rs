@@ -252,8 +252,9 @@ impl Collision {
             crate::broadphase::NO_PROXY
         } else {
             let margin = proxy_margin(&geometry, self.broadphase.margin());
+            let bits = self.shapes.at(index).def.filter.bits();
             self.broadphase
-                .create_proxy_with_margin(bounded(aabb), index, is_static, margin)
+                .create_proxy_filtered(bounded(aabb), index, is_static, margin, bits)
         };
         self.shapes.at_mut(index).proxy = proxy;
         self.shapes.handle_of(index, self.owner)
@@ -779,12 +780,13 @@ impl Collision {
 
     /// Shape `s`'s box at `xf` and a new proxy for it.
     fn make_proxy(&mut self, s: u32, xf: &Transform, is_static: bool) {
-        let geometry = &self.shapes.at(s).geometry;
-        let aabb = geometry.compute_aabb(xf);
-        let margin = proxy_margin(geometry, self.broadphase.margin());
-        let proxy = self
-            .broadphase
-            .create_proxy_with_margin(bounded(aabb), s, is_static, margin);
+        let shape = self.shapes.at(s);
+        let aabb = shape.geometry.compute_aabb(xf);
+        let margin = proxy_margin(&shape.geometry, self.broadphase.margin());
+        let bits = shape.def.filter.bits();
+        let proxy =
+            self.broadphase
+                .create_proxy_filtered(bounded(aabb), s, is_static, margin, bits);
         let shape = self.shapes.at_mut(s);
         shape.aabb = aabb;
         shape.proxy = proxy;

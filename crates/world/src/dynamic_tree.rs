@@ -63,8 +63,31 @@
 //! | `query`, `query_proxies`             | O(log n + k), iterative, stops when the callback says so |
 //! | `ray_query`                          | the boxes a segment touches (slab test per node)         |
 //! | `for_each_self_pair`, `…_cross_pair` | tree against tree: each overlapping pair once            |
+//! | `create_proxy_filtered`, `set_proxy_bits` | a leaf's [`FilterBits`]; every internal node holds the union of its leaves' |
 //! | `shift_origin`                       | translates every box, tree shape unchanged               |
 //! | `validate`, `height`, `area_ratio`   | invariants and quality, for tests and debugging          |
+//!
+//! # Filter bits
+//!
+//! Every node also carries [`FilterBits`]: a leaf its shape's collision
+//! categories and mask (in 16 bits each), an internal node the
+//! union (bitwise or) of its children's. No two leaves below nodes `X` and
+//! `Y` can pass the category test unless `cat(X) & mask(Y) ≠ 0` and
+//! `cat(Y) & mask(X) ≠ 0`, so the pair descents skip such node pairs
+//! whole, and a subtree whose own bits fail that test against themselves is
+//! not descended into at all:
+//!
+//! ```text
+//!   joint_grid: 10,000 circles, category 2, mask !2   → root: cat 0b10, mask …1101
+//!   root × root: cat & mask = 0                        → no node pair below is visited
+//! ```
+//!
+//! Categories 0–14 keep their own bits; bit 15 stands for all of 15–63
+//! (set when any of them is). A common bit of two full 64-bit filters is
+//! then a common bit of their 16-bit forms, so the test never skips a pair
+//! the full filter would let through; a shape in a positive group (which
+//! collides with its group whatever the masks) takes [`FilterBits::ALL`]
+//! and never prunes.
 
 use janus2d_core::geometry::Aabb;
 use janus2d_core::math::{Real, Vec2};
@@ -155,6 +178,78 @@ impl NodeStack {
     }
 }
 
+/// A node's collision filter in 16 bits for the pair descents (see the
+/// module docs, *Filter bits*): the categories a leaf belongs to and the
+/// categories it collides with, or their unions over an internal node's
+/// leaves. Categories 0–14 keep their bits; bit 15 stands for 15–63.
+///
+/// ```
+/// use janus2d_world::dynamic_tree::FilterBits;
+/// let grid = FilterBits::of(2, !2, 0);
+/// assert!(!grid.may_pair(grid)); // the grid's circles never meet
+/// assert!(grid.may_pair(FilterBits::of(1, u64::MAX, 0)));
+/// // Categories 15–63 share bit 15: a common one is never lost.
+/// assert!(FilterBits::of(1 << 40, 1 << 40, 0).may_pair(FilterBits::of(1 << 40, 1 << 40, 0)));
+/// // A positive group collides whatever the masks: it never prunes.
+/// assert!(FilterBits::of(2, !2, 3).may_pair(FilterBits::of(2, !2, 3)));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct FilterBits {
+    /// Categories: bits 0–14 as they are, bit 15 for any of 15–63.
+    pub category: u16,
+    /// Categories collided with, in the same 16 bits.
+    pub mask: u16,
+}
+
+impl Default for FilterBits {
+    fn default() -> Self {
+        Self::ALL
+    }
+}
+
+impl FilterBits {
+    /// Pairs with anything (a proxy created without a filter).
+    pub const ALL: FilterBits = FilterBits {
+        category: u16::MAX,
+        mask: u16::MAX,
+    };
+
+    /// The bits of a shape's filter: `category_bits`, `mask_bits` and
+    /// `group_index` as in [`Filter`](crate::Filter). A positive group
+    /// overrides the masks, so it gives [`FilterBits::ALL`].
+    #[must_use]
+    pub fn of(category_bits: u64, mask_bits: u64, group_index: i32) -> Self {
+        if group_index > 0 {
+            return Self::ALL;
+        }
+        const LOW: u64 = (1 << 15) - 1;
+        let fold = |x: u64| (x & LOW) as u16 | (u16::from(x > LOW) << 15);
+        FilterBits {
+            category: fold(category_bits),
+            mask: fold(mask_bits),
+        }
+    }
+
+    /// Whether a leaf below `self` and one below `other` may pass each
+    /// other's category test (false: no pair of them can).
+    #[inline(always)]
+    #[must_use]
+    pub fn may_pair(self, other: FilterBits) -> bool {
+        self.category & other.mask != 0 && other.category & self.mask != 0
+    }
+
+    /// The bits of a node over both sets of leaves.
+    #[inline(always)]
+    #[must_use]
+    pub fn union(self, other: FilterBits) -> FilterBits {
+        FilterBits {
+            category: self.category | other.category,
+            mask: self.mask | other.mask,
+        }
+    }
+}
+
 /// One node of the tree: a leaf (a proxy) or an internal node.
 #[derive(Clone, Copy, Debug)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -171,6 +266,10 @@ struct Node {
     user_data: u32,
     /// 0 for a leaf, `1 + max(child heights)` otherwise.
     height: u16,
+    /// A leaf's filter, or the union of the children's (see
+    /// [`FilterBits`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    bits: FilterBits,
     /// False while on the free list.
     allocated: bool,
     /// An internal node whose box [`DynamicTree::enlarge_proxy`] grew (or
@@ -191,6 +290,7 @@ impl Node {
         child2: NULL_NODE,
         user_data: 0,
         height: 0,
+        bits: FilterBits::ALL,
         allocated: false,
         enlarged: false,
     };
@@ -326,6 +426,19 @@ impl DynamicTree {
     /// [`create_proxy`](Self::create_proxy) with a margin of the proxy's
     /// own (metres, `≥ 0`) instead of the tree's.
     pub fn create_proxy_with_margin(&mut self, aabb: Aabb, user_data: u32, margin: Real) -> u32 {
+        self.create_proxy_filtered(aabb, user_data, margin, FilterBits::ALL)
+    }
+
+    /// [`create_proxy_with_margin`](Self::create_proxy_with_margin) for a
+    /// shape with filter bits `bits`: the pair descents skip it where the
+    /// bits say it pairs with nothing there.
+    pub fn create_proxy_filtered(
+        &mut self,
+        aabb: Aabb,
+        user_data: u32,
+        margin: Real,
+        bits: FilterBits,
+    ) -> u32 {
         debug_assert!(aabb.is_valid(), "invalid AABB {aabb:?}");
         let id = self.allocate_node();
         {
@@ -333,10 +446,59 @@ impl DynamicTree {
             node.aabb = aabb.fattened(margin);
             node.user_data = user_data;
             node.height = 0;
+            node.bits = bits;
         }
         self.insert_leaf(id);
         self.proxy_count += 1;
         id
+    }
+
+    /// Gives proxy `id` new filter bits (its shape's filter changed) and
+    /// recomputes its ancestors' unions.
+    pub fn set_proxy_bits(&mut self, id: u32, bits: FilterBits) {
+        self.check_proxy(id);
+        self.nodes[id as usize].bits = bits;
+        let mut index = self.nodes[id as usize].parent;
+        while index != NULL_NODE {
+            let n = self.nodes[index as usize];
+            let union = self.nodes[n.child1 as usize]
+                .bits
+                .union(self.nodes[n.child2 as usize].bits);
+            if union == n.bits {
+                break;
+            }
+            self.nodes[index as usize].bits = union;
+            index = n.parent;
+        }
+    }
+
+    /// The filter bits of proxy `id`.
+    #[inline]
+    #[must_use]
+    pub fn proxy_bits(&self, id: u32) -> FilterBits {
+        self.check_proxy(id);
+        self.nodes[id as usize].bits
+    }
+
+    /// Whether two proxies of this tree may pass each other's category test
+    /// (the root's bits against themselves; false for fewer than two).
+    #[must_use]
+    pub fn may_pair_within(&self) -> bool {
+        self.root != NULL_NODE && {
+            let root = &self.nodes[self.root as usize];
+            !root.is_leaf() && root.bits.may_pair(root.bits)
+        }
+    }
+
+    /// Whether a proxy of this tree and one of `other` may pass each
+    /// other's category test (the roots' bits).
+    #[must_use]
+    pub fn may_pair_across(&self, other: &DynamicTree) -> bool {
+        self.root != NULL_NODE
+            && other.root != NULL_NODE
+            && self.nodes[self.root as usize]
+                .bits
+                .may_pair(other.nodes[other.root as usize].bits)
     }
 
     /// Removes a proxy; its id may be reused by a later
@@ -726,6 +888,35 @@ impl DynamicTree {
         }
     }
 
+    /// [`query_proxies`](Self::query_proxies) for the proxies whose filter
+    /// bits may pair with `bits` (a moved proxy's search for new pairs):
+    /// subtrees whose bits cannot are skipped whole.
+    pub fn query_proxies_filtered<F: FnMut(u32, u32) -> bool>(
+        &self,
+        aabb: &Aabb,
+        bits: FilterBits,
+        mut callback: F,
+    ) {
+        if self.root == NULL_NODE {
+            return;
+        }
+        let mut stack = NodeStack::new(self.root);
+        while let Some(index) = stack.pop() {
+            let node = &self.nodes[index as usize];
+            if !node.bits.may_pair(bits) || !node.aabb.overlaps(aabb) {
+                continue;
+            }
+            if node.is_leaf() {
+                if !callback(index, node.user_data) {
+                    return;
+                }
+            } else {
+                stack.push(node.child2);
+                stack.push(node.child1);
+            }
+        }
+    }
+
     /// Calls `callback(proxy_id, user_data)` for every proxy whose fat box
     /// the segment `origin + s · translation`, `s ∈ [0, max_fraction]`,
     /// touches, in depth-first order, until the callback returns `false`.
@@ -823,6 +1014,9 @@ impl DynamicTree {
                 if node.aabb != n1.aabb.union(&n2.aabb) {
                     return Err(format!("node {index} box is not its children's union"));
                 }
+                if node.bits != n1.bits.union(n2.bits) {
+                    return Err(format!("node {index} bits are not its children's union"));
+                }
                 stack.push(c1);
                 stack.push(c2);
             }
@@ -893,7 +1087,7 @@ impl DynamicTree {
             }
             let na = &self.nodes[a as usize];
             if a == b {
-                if !na.is_leaf() {
+                if !na.is_leaf() && na.bits.may_pair(na.bits) {
                     stack.push((na.child1, na.child2));
                     stack.push((na.child2, na.child2));
                     stack.push((na.child1, na.child1));
@@ -901,7 +1095,7 @@ impl DynamicTree {
                 continue;
             }
             let nb = &self.nodes[b as usize];
-            if !na.aabb.overlaps(&nb.aabb) {
+            if !na.bits.may_pair(nb.bits) || !na.aabb.overlaps(&nb.aabb) {
                 continue;
             }
             Self::descend(na, a, nb, b, stack, &mut f);
@@ -931,7 +1125,7 @@ impl DynamicTree {
             }
             let na = &self.nodes[a as usize];
             let nb = &other.nodes[b as usize];
-            if na.aabb.overlaps(&nb.aabb) {
+            if na.bits.may_pair(nb.bits) && na.aabb.overlaps(&nb.aabb) {
                 Self::descend(na, a, nb, b, stack, &mut f);
             }
         }
@@ -965,7 +1159,7 @@ impl DynamicTree {
             };
             let na = &self.nodes[a as usize];
             if other.is_none() && a == b {
-                if !na.is_leaf() {
+                if !na.is_leaf() && na.bits.may_pair(na.bits) {
                     queue.push_back((na.child1, na.child1));
                     queue.push_back((na.child2, na.child2));
                     queue.push_back((na.child1, na.child2));
@@ -973,7 +1167,7 @@ impl DynamicTree {
                 continue;
             }
             let nb = &b_tree.nodes[b as usize];
-            if !na.aabb.overlaps(&nb.aabb) {
+            if !na.bits.may_pair(nb.bits) || !na.aabb.overlaps(&nb.aabb) {
                 continue;
             }
             match (na.is_leaf(), nb.is_leaf()) {
@@ -1022,7 +1216,7 @@ impl DynamicTree {
             }
             let na = &self.nodes[a as usize];
             if other.is_none() && a == b {
-                if !na.is_leaf() {
+                if !na.is_leaf() && na.bits.may_pair(na.bits) {
                     stack.push((na.child1, na.child2));
                     stack.push((na.child2, na.child2));
                     stack.push((na.child1, na.child1));
@@ -1030,7 +1224,7 @@ impl DynamicTree {
                 continue;
             }
             let nb = &b_tree.nodes[b as usize];
-            if !na.aabb.overlaps(&nb.aabb) {
+            if !na.bits.may_pair(nb.bits) || !na.aabb.overlaps(&nb.aabb) {
                 continue;
             }
             Self::descend(na, a, nb, b, stack, &mut f);
@@ -1158,6 +1352,7 @@ impl DynamicTree {
             return;
         }
         let leaf_aabb = self.nodes[leaf as usize].aabb;
+        let leaf_bits = self.nodes[leaf as usize].bits;
         let sibling = self.find_best_sibling(&leaf_aabb);
         let old_parent = self.nodes[sibling as usize].parent;
         let new_parent = self.allocate_node();
@@ -1169,6 +1364,7 @@ impl DynamicTree {
             p.child2 = leaf;
             p.aabb = sibling_node.aabb.union(&leaf_aabb);
             p.height = sibling_node.height + 1;
+            p.bits = sibling_node.bits.union(leaf_bits);
         }
         self.nodes[sibling as usize].parent = new_parent;
         self.nodes[leaf as usize].parent = new_parent;
@@ -1212,7 +1408,8 @@ impl DynamicTree {
         }
     }
 
-    /// Recomputes box and height of an internal node from its children.
+    /// Recomputes box, height and filter bits of an internal node from its
+    /// children.
     #[inline]
     fn refit(&mut self, index: u32) {
         let n = self.nodes[index as usize];
@@ -1220,21 +1417,26 @@ impl DynamicTree {
         let c2 = &self.nodes[n.child2 as usize];
         let aabb = c1.aabb.union(&c2.aabb);
         let height = 1 + c1.height.max(c2.height);
+        let bits = c1.bits.union(c2.bits);
         let node = &mut self.nodes[index as usize];
         node.aabb = aabb;
         node.height = height;
+        node.bits = bits;
     }
 
     /// Refits and rotates from `index` towards the root, stopping at the
-    /// first node whose box and height come out unchanged (its ancestors are
-    /// then unchanged too).
+    /// first node whose box, height and filter bits come out unchanged (its
+    /// ancestors are then unchanged too).
     fn refit_upwards(&mut self, mut index: u32) {
         while index != NULL_NODE {
             let before = self.nodes[index as usize];
             self.refit(index);
             self.rotate(index);
             let after = &self.nodes[index as usize];
-            if after.aabb == before.aabb && after.height == before.height {
+            if after.aabb == before.aabb
+                && after.height == before.height
+                && after.bits == before.bits
+            {
                 break;
             }
             index = after.parent;
@@ -1536,12 +1738,13 @@ fn build_span(nodes: &[Node], items: &[(Vec2, u32)], slots: &[u32], span: Span) 
             } else {
                 &made[kid].1
             };
-            (n.aabb, n.height)
+            (n.aabb, n.height, n.bits)
         };
-        let (box1, height1) = of(kids[k][0], node.child1);
-        let (box2, height2) = of(kids[k][1], node.child2);
+        let (box1, height1, bits1) = of(kids[k][0], node.child1);
+        let (box2, height2, bits2) = of(kids[k][1], node.child2);
         made[k].1.aabb = box1.union(&box2);
         made[k].1.height = 1 + height1.max(height2);
+        made[k].1.bits = bits1.union(bits2);
     }
     BuiltSpan { made, leaves, root }
 }
@@ -2026,6 +2229,196 @@ mod tests {
             false
         });
         assert_eq!(count, 1);
+    }
+
+    /// Whatever two full filters let collide (`Filter::should_collide`,
+    /// groups included), their 16-bit forms may pair: the descents never
+    /// skip a pair the world would keep. And the forms are exact below
+    /// category 15 without groups.
+    #[test]
+    fn filter_bits_never_refuse_what_the_full_filter_allows() {
+        let mut rng = Lcg(5);
+        let word = |rng: &mut Lcg| {
+            // Mostly low categories, sometimes high ones, sometimes all.
+            let pick = |rng: &mut Lcg| {
+                1u64 << (if rng.below(3) == 0 {
+                    15 + rng.below(49)
+                } else {
+                    rng.below(15)
+                })
+            };
+            match rng.below(6) {
+                0 => u64::MAX,
+                1 => !pick(rng),
+                _ => pick(rng) | pick(rng),
+            }
+        };
+        let (mut allowed, mut refused_exactly) = (0, 0);
+        for _ in 0..20_000 {
+            let group = |rng: &mut Lcg| [0, 0, -1, 1, 2][rng.below(5) as usize];
+            let a = crate::Filter::new(word(&mut rng), word(&mut rng)).with_group(group(&mut rng));
+            let b = crate::Filter::new(word(&mut rng), word(&mut rng)).with_group(group(&mut rng));
+            let may = a.bits().may_pair(b.bits());
+            if a.should_collide(&b) {
+                allowed += 1;
+                assert!(may, "{a:?} and {b:?} collide but their bits refuse");
+            }
+            // Below category 15, without groups: exact.
+            let low = |rng: &mut Lcg| u64::from(rng.next_u32()) & ((1 << 15) - 1);
+            let a = crate::Filter::new(low(&mut rng), low(&mut rng) & low(&mut rng));
+            let b = crate::Filter::new(1 << rng.below(15), low(&mut rng) & low(&mut rng));
+            let exact = a.should_collide(&b);
+            assert_eq!(a.bits().may_pair(b.bits()), exact, "{a:?} {b:?}");
+            refused_exactly += usize::from(!exact);
+        }
+        assert!(
+            allowed > 3000 && refused_exactly > 300,
+            "{allowed} {refused_exactly}"
+        );
+    }
+
+    /// The pair descents and the filtered query skip node pairs by their
+    /// filter bits and still report exactly the overlapping pairs whose
+    /// leaves' bits may pair (brute force over every leaf pair), through
+    /// inserts, removals, a filter change, enlarged moves, the partial and
+    /// the whole-tree rebuild; a tree whose leaves all refuse each other is
+    /// not descended at all.
+    #[test]
+    fn filter_bits_prune_exactly_the_pairs_that_cannot_pass() {
+        let mut rng = Lcg(11);
+        // Categories 1, 2 and 4: 1 meets all, 2 meets 1 only, 4 meets 1 and 4.
+        let filters = [
+            FilterBits::of(1, u64::MAX, 0),
+            FilterBits::of(2, 1, 0),
+            FilterBits::of(4, 5, 0),
+            FilterBits::of(1 << 33, 1 << 33, 0), // bit 15 of the 16: meets itself only
+        ];
+        let mut tree = DynamicTree::new();
+        let mut other = DynamicTree::new();
+        let mut leaves: Vec<(u32, FilterBits)> = Vec::new();
+        for i in 0..1200u32 {
+            let bits = filters[rng.below(4) as usize];
+            let id = tree.create_proxy_filtered(random_box(&mut rng, 50.0), i, 0.1, bits);
+            leaves.push((id, bits));
+        }
+        let mut fixed = Vec::new();
+        for i in 0..300u32 {
+            let bits = filters[rng.below(4) as usize];
+            fixed.push((
+                other.create_proxy_filtered(random_box(&mut rng, 50.0), 5000 + i, 0.0, bits),
+                bits,
+            ));
+        }
+        let brute_self = |tree: &DynamicTree, leaves: &[(u32, FilterBits)]| {
+            let mut want = Vec::new();
+            for (k, &(x, bx)) in leaves.iter().enumerate() {
+                for &(y, by) in &leaves[k + 1..] {
+                    if bx.may_pair(by) && tree.fat_aabb(x).overlaps(&tree.fat_aabb(y)) {
+                        let (ux, uy) = (tree.user_data(x), tree.user_data(y));
+                        want.push((ux.min(uy), ux.max(uy)));
+                    }
+                }
+            }
+            want.sort_unstable();
+            want
+        };
+        let descended = |tree: &DynamicTree| {
+            let mut got = Vec::new();
+            tree.for_each_self_pair(&[], &mut Vec::new(), |x, y| got.push((x.min(y), x.max(y))));
+            got.sort_unstable();
+            got
+        };
+        let check = |tree: &DynamicTree, leaves: &[(u32, FilterBits)]| {
+            tree.validate();
+            let want = brute_self(tree, leaves);
+            assert!(want.len() > 200, "too few pairs: {}", want.len());
+            assert_eq!(descended(tree), want, "self descent");
+            let mut seeded = Vec::new();
+            let mut seeds = Vec::new();
+            tree.pair_seeds(None, 50, &mut seeds);
+            for &seed in &seeds {
+                tree.for_each_pair_from(None, &[], seed, &mut Vec::new(), |x, y| {
+                    seeded.push((x.min(y), x.max(y)));
+                });
+            }
+            seeded.sort_unstable();
+            assert_eq!(seeded, want, "seeded descent");
+            // Each leaf's filtered query finds its partners of the brute force.
+            for &(x, bx) in leaves.iter().step_by(37) {
+                let ux = tree.user_data(x);
+                let mut found = Vec::new();
+                tree.query_proxies_filtered(&tree.fat_aabb(x), bx, |id, u| {
+                    if id != x {
+                        found.push((ux.min(u), ux.max(u)));
+                    }
+                    true
+                });
+                found.sort_unstable();
+                let mine: Vec<_> = want
+                    .iter()
+                    .copied()
+                    .filter(|p| p.0 == ux || p.1 == ux)
+                    .collect();
+                assert_eq!(found, mine, "filtered query of leaf {x}");
+            }
+        };
+        check(&tree, &leaves);
+        // Cross pairs against a second tree.
+        let mut cross = Vec::new();
+        tree.for_each_cross_pair(&other, &[], &[], &mut Vec::new(), |x, y| cross.push((x, y)));
+        cross.sort_unstable();
+        let mut want = Vec::new();
+        for &(x, bx) in &leaves {
+            for &(y, by) in &fixed {
+                if bx.may_pair(by) && tree.fat_aabb(x).overlaps(&other.fat_aabb(y)) {
+                    want.push((tree.user_data(x), other.user_data(y)));
+                }
+            }
+        }
+        want.sort_unstable();
+        assert!(want.len() > 50, "too few cross pairs: {}", want.len());
+        assert_eq!(cross, want, "cross descent");
+        // Removals, a filter change, enlarged moves and both rebuilds.
+        for k in (0..leaves.len()).step_by(9).rev() {
+            tree.destroy_proxy(leaves.remove(k).0);
+        }
+        for k in (0..leaves.len()).step_by(5) {
+            let bits = filters[(k / 5) % 4];
+            tree.set_proxy_bits(leaves[k].0, bits);
+            leaves[k].1 = bits;
+        }
+        check(&tree, &leaves);
+        let mut items = Vec::new();
+        for (round, share) in [(0, 20), (1, 2)] {
+            for &(id, _) in leaves.iter().step_by(share) {
+                let moved = translate(tree.fat_aabb(id), Vec2::new(0.7 + round as Real, -0.4));
+                tree.enlarge_leaf_with_margin(id, moved, 0.1);
+            }
+            tree.finish_enlarged(&mut items, &Team::serial());
+            check(&tree, &leaves);
+        }
+        // Every leaf refuses every other: the root's bits say so, and no
+        // node pair is descended.
+        let mut lonely = DynamicTree::new();
+        for i in 0..500u32 {
+            lonely.create_proxy_filtered(
+                random_box(&mut rng, 10.0),
+                i,
+                0.1,
+                FilterBits::of(2, !2, 0),
+            );
+        }
+        assert!(!lonely.may_pair_within());
+        assert!(descended(&lonely).is_empty());
+        let mut all = lonely.clone();
+        for i in 0..5u32 {
+            all.create_proxy_filtered(random_box(&mut rng, 10.0), 900 + i, 0.1, FilterBits::ALL);
+        }
+        assert!(all.may_pair_within());
+        assert!(
+            !descended(&all).is_empty(),
+            "a shape of every category meets the others"
+        );
     }
 
     #[test]

@@ -79,6 +79,19 @@ impl Filter {
         self
     }
 
+    /// The filter folded for the broadphase's pair search
+    /// ([`FilterBits::of`](crate::dynamic_tree::FilterBits::of)).
+    ///
+    /// ```
+    /// use janus2d_world::Filter;
+    /// let debris = Filter::new(0b100, !0b100);
+    /// assert!(!debris.bits().may_pair(debris.bits()));
+    /// ```
+    #[must_use]
+    pub fn bits(&self) -> crate::dynamic_tree::FilterBits {
+        crate::dynamic_tree::FilterBits::of(self.category_bits, self.mask_bits, self.group_index)
+    }
+
     /// Whether two filters let their shapes collide.
     ///
     /// ```

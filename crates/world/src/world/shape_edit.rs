@@ -33,11 +33,13 @@ impl crate::collision::Collision {
             old
         } else {
             let margin = crate::broadphase::proxy_margin(&geometry, self.broadphase.margin());
-            self.broadphase.create_proxy_with_margin(
+            let bits = self.shapes.at(slot).def.filter.bits();
+            self.broadphase.create_proxy_filtered(
                 crate::broadphase::bounded(aabb),
                 slot,
                 is_static,
                 margin,
+                bits,
             )
         };
         let shape = self.shapes.at_mut(slot);

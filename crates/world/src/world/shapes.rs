@@ -473,7 +473,9 @@ impl World {
         c.contacts.destroy_of_body(body, &mut c.events, |x| {
             x.shape_a == slot || x.shape_b == slot
         });
-        let proxy = c.shapes.at(slot).proxy;
+        let shape = c.shapes.at(slot);
+        let (proxy, bits) = (shape.proxy, shape.def.filter.bits());
+        c.broadphase.set_proxy_bits(proxy, bits);
         c.broadphase.touch_proxy(proxy);
     }
 
