@@ -70,16 +70,20 @@
 //! # Filter bits
 //!
 //! Every node also carries [`FilterBits`]: a leaf its shape's collision
-//! categories and mask (in 16 bits each), an internal node the
-//! union (bitwise or) of its children's. No two leaves below nodes `X` and
-//! `Y` can pass the category test unless `cat(X) & mask(Y) ≠ 0` and
-//! `cat(Y) & mask(X) ≠ 0`, so the pair descents skip such node pairs
-//! whole, and a subtree whose own bits fail that test against themselves is
-//! not descended into at all:
+//! categories and mask (in 16 bits each) and its negative group, an
+//! internal node the union (bitwise or) of its children's bits and the
+//! group they share (0 when they differ). No two leaves below nodes `X` and
+//! `Y` can pass the filter unless `cat(X) & mask(Y) ≠ 0` and
+//! `cat(Y) & mask(X) ≠ 0`, nor when every leaf below both is in one
+//! negative group, so the pair descents skip such node pairs whole, and a
+//! subtree whose own bits fail that test against themselves is not
+//! descended into at all:
 //!
 //! ```text
 //!   joint_grid: 10,000 circles, category 2, mask !2   → root: cat 0b10, mask …1101
 //!   root × root: cat & mask = 0                        → no node pair below is visited
+//!   rain: a ragdoll's 11 bodies in group −k            → a subtree of one ragdoll
+//!                                                        is not descended into
 //! ```
 //!
 //! Categories 0–14 keep their own bits; bit 15 stands for all of 15–63
@@ -181,7 +185,8 @@ impl NodeStack {
 /// A node's collision filter in 16 bits for the pair descents (see the
 /// module docs, *Filter bits*): the categories a leaf belongs to and the
 /// categories it collides with, or their unions over an internal node's
-/// leaves. Categories 0–14 keep their bits; bit 15 stands for 15–63.
+/// leaves. Categories 0–14 keep their bits; bit 15 stands for 15–63. A
+/// negative group shared by every leaf below refuses all of their pairs.
 ///
 /// ```
 /// use janus2d_world::dynamic_tree::FilterBits;
@@ -192,6 +197,11 @@ impl NodeStack {
 /// assert!(FilterBits::of(1 << 40, 1 << 40, 0).may_pair(FilterBits::of(1 << 40, 1 << 40, 0)));
 /// // A positive group collides whatever the masks: it never prunes.
 /// assert!(FilterBits::of(2, !2, 3).may_pair(FilterBits::of(2, !2, 3)));
+/// // One negative group never collides; two different ones may.
+/// let (limb, other) = (FilterBits::of(2, 3, -4), FilterBits::of(2, 3, -5));
+/// assert!(!limb.may_pair(limb));
+/// assert!(limb.may_pair(other) && !limb.union(limb).may_pair(limb));
+/// assert!(limb.union(other).may_pair(limb));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -200,6 +210,9 @@ pub struct FilterBits {
     pub category: u16,
     /// Categories collided with, in the same 16 bits.
     pub mask: u16,
+    /// The negative group every leaf below shares (0: none, or mixed):
+    /// shapes of one negative group never collide.
+    pub group: i32,
 }
 
 impl Default for FilterBits {
@@ -213,6 +226,7 @@ impl FilterBits {
     pub const ALL: FilterBits = FilterBits {
         category: u16::MAX,
         mask: u16::MAX,
+        group: 0,
     };
 
     /// The bits of a shape's filter: `category_bits`, `mask_bits` and
@@ -228,24 +242,34 @@ impl FilterBits {
         FilterBits {
             category: fold(category_bits),
             mask: fold(mask_bits),
+            group: group_index,
         }
     }
 
     /// Whether a leaf below `self` and one below `other` may pass each
-    /// other's category test (false: no pair of them can).
+    /// other's filter (false: no pair of them can: their categories and
+    /// masks miss, or all of them share one negative group).
     #[inline(always)]
     #[must_use]
     pub fn may_pair(self, other: FilterBits) -> bool {
-        self.category & other.mask != 0 && other.category & self.mask != 0
+        (self.group == 0 || self.group != other.group)
+            && self.category & other.mask != 0
+            && other.category & self.mask != 0
     }
 
-    /// The bits of a node over both sets of leaves.
+    /// The bits of a node over both sets of leaves (the group kept only
+    /// when both share it).
     #[inline(always)]
     #[must_use]
     pub fn union(self, other: FilterBits) -> FilterBits {
         FilterBits {
             category: self.category | other.category,
             mask: self.mask | other.mask,
+            group: if self.group == other.group {
+                self.group
+            } else {
+                0
+            },
         }
     }
 }
@@ -2292,18 +2316,19 @@ mod tests {
             FilterBits::of(2, 1, 0),
             FilterBits::of(4, 5, 0),
             FilterBits::of(1 << 33, 1 << 33, 0), // bit 15 of the 16: meets itself only
+            FilterBits::of(1, u64::MAX, -7),     // meets all but its own group
         ];
         let mut tree = DynamicTree::new();
         let mut other = DynamicTree::new();
         let mut leaves: Vec<(u32, FilterBits)> = Vec::new();
         for i in 0..1200u32 {
-            let bits = filters[rng.below(4) as usize];
+            let bits = filters[rng.below(5) as usize];
             let id = tree.create_proxy_filtered(random_box(&mut rng, 50.0), i, 0.1, bits);
             leaves.push((id, bits));
         }
         let mut fixed = Vec::new();
         for i in 0..300u32 {
-            let bits = filters[rng.below(4) as usize];
+            let bits = filters[rng.below(5) as usize];
             fixed.push((
                 other.create_proxy_filtered(random_box(&mut rng, 50.0), 5000 + i, 0.0, bits),
                 bits,
@@ -2383,7 +2408,7 @@ mod tests {
             tree.destroy_proxy(leaves.remove(k).0);
         }
         for k in (0..leaves.len()).step_by(5) {
-            let bits = filters[(k / 5) % 4];
+            let bits = filters[(k / 5) % 5];
             tree.set_proxy_bits(leaves[k].0, bits);
             leaves[k].1 = bits;
         }
