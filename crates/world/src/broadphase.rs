@@ -425,7 +425,7 @@ impl BroadPhase {
     /// [`FilterBits`]); [`touch_proxy`](Self::touch_proxy) then has its
     /// pairs found again under it.
     pub fn set_proxy_bits(&mut self, proxy: u32, bits: FilterBits) {
-        if proxy == NO_PROXY {
+        if !self.is_live(proxy) {
             return;
         }
         let slot = self.slot(proxy);

@@ -153,6 +153,17 @@ impl Collision {
         !self.contacts.awake().is_empty()
     }
 
+    /// Gives every shape's proxy the filter bits of its shape's filter
+    /// again (a world decoded from a snapshot's bytes, whose trees carry
+    /// none: see [`crate::dynamic_tree::FilterBits`]).
+    #[cfg(feature = "serde")]
+    pub(crate) fn refresh_filter_bits(&mut self) {
+        let (shapes, broadphase) = (&mut self.shapes, &mut self.broadphase);
+        for shape in shapes.entries_mut().iter().filter_map(|(_, s)| s.as_ref()) {
+            broadphase.set_proxy_bits(shape.proxy, shape.def.filter.bits());
+        }
+    }
+
     /// The hand-off to contact building (after [`Collision::collide`]).
     #[inline]
     pub(crate) fn contact_handoff(&mut self) -> ContactHandoff<'_> {
@@ -851,6 +862,38 @@ mod tests {
             c.broadphase.fat_aabb(proxy),
             c.broadphase.proxy_margin(proxy),
         )
+    }
+
+    /// A world decoded from a snapshot's bytes, whose trees carry no
+    /// filter bits, takes its shapes' again: 40 overlapping boxes of a
+    /// category that refuses itself leave nothing to search, and the
+    /// tree's unions hold.
+    #[cfg(feature = "serde")]
+    #[test]
+    fn decoded_snapshots_take_their_shapes_filter_bits_again() {
+        let mut world = World::new(WorldDef::default()).unwrap();
+        let refusing = ShapeDef {
+            filter: crate::Filter::new(2, !2),
+            ..ShapeDef::default()
+        };
+        for i in 0..40 {
+            let b = world
+                .create_body(&BodyDef::dynamic(Vec2::new(0.3 * i as Real, 0.0)))
+                .unwrap();
+            world
+                .create_shape(b, &refusing, Polygon::make_box(0.5, 0.5))
+                .unwrap();
+        }
+        world.step(1.0 / 60.0).unwrap();
+        let tree = |w: &World| w.collision.broadphase.dynamic_tree().clone();
+        assert!(!tree(&world).may_pair_within());
+        let bytes = world.snapshot().to_bytes();
+        let decoded = crate::Snapshot::from_bytes(&bytes).unwrap().to_world();
+        tree(&decoded).validate();
+        // (Without the refresh every node decodes to `FilterBits::ALL`,
+        // which pairs with anything.)
+        assert!(!tree(&decoded).may_pair_within(), "bits set again");
+        assert_eq!(world.state_hash(), decoded.state_hash());
     }
 
     fn body_with_box(world: &mut World, x: Real, half: Real) -> BodyHandle {

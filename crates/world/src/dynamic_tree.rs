@@ -291,8 +291,10 @@ struct Node {
     /// 0 for a leaf, `1 + max(child heights)` otherwise.
     height: u16,
     /// A leaf's filter, or the union of the children's (see
-    /// [`FilterBits`]).
-    #[cfg_attr(feature = "serde", serde(default))]
+    /// [`FilterBits`]). Not in snapshots' bytes: a decoded tree starts
+    /// with [`FilterBits::ALL`] everywhere (consistent, prunes nothing)
+    /// and the world sets each proxy's bits from its shape's filter again.
+    #[cfg_attr(feature = "serde", serde(skip))]
     bits: FilterBits,
     /// False while on the free list.
     allocated: bool,
@@ -891,14 +893,23 @@ impl DynamicTree {
 
     /// Like [`query`](Self::query) but the callback receives
     /// `(proxy_id, user_data)`.
-    pub fn query_proxies<F: FnMut(u32, u32) -> bool>(&self, aabb: &Aabb, mut callback: F) {
+    pub fn query_proxies<F: FnMut(u32, u32) -> bool>(&self, aabb: &Aabb, callback: F) {
+        self.walk(|node| node.aabb.overlaps(aabb), callback);
+    }
+
+    /// The depth-first walk behind the queries: descends into the nodes
+    /// `enter` accepts and calls `callback(proxy_id, user_data)` for each
+    /// accepted leaf, until it returns `false`. Iterative, with a stack on
+    /// the call stack.
+    #[inline(always)]
+    fn walk<F: FnMut(u32, u32) -> bool>(&self, enter: impl Fn(&Node) -> bool, mut callback: F) {
         if self.root == NULL_NODE {
             return;
         }
         let mut stack = NodeStack::new(self.root);
         while let Some(index) = stack.pop() {
             let node = &self.nodes[index as usize];
-            if !node.aabb.overlaps(aabb) {
+            if !enter(node) {
                 continue;
             }
             if node.is_leaf() {
@@ -919,26 +930,12 @@ impl DynamicTree {
         &self,
         aabb: &Aabb,
         bits: FilterBits,
-        mut callback: F,
+        callback: F,
     ) {
-        if self.root == NULL_NODE {
-            return;
-        }
-        let mut stack = NodeStack::new(self.root);
-        while let Some(index) = stack.pop() {
-            let node = &self.nodes[index as usize];
-            if !node.bits.may_pair(bits) || !node.aabb.overlaps(aabb) {
-                continue;
-            }
-            if node.is_leaf() {
-                if !callback(index, node.user_data) {
-                    return;
-                }
-            } else {
-                stack.push(node.child2);
-                stack.push(node.child1);
-            }
-        }
+        self.walk(
+            |node| node.bits.may_pair(bits) && node.aabb.overlaps(aabb),
+            callback,
+        );
     }
 
     /// Calls `callback(proxy_id, user_data)` for every proxy whose fat box
@@ -952,26 +949,12 @@ impl DynamicTree {
         origin: Vec2,
         translation: Vec2,
         max_fraction: Real,
-        mut callback: F,
+        callback: F,
     ) {
-        if self.root == NULL_NODE {
-            return;
-        }
-        let mut stack = NodeStack::new(self.root);
-        while let Some(index) = stack.pop() {
-            let node = &self.nodes[index as usize];
-            if !segment_touches_box(origin, translation, max_fraction, &node.aabb) {
-                continue;
-            }
-            if node.is_leaf() {
-                if !callback(index, node.user_data) {
-                    return;
-                }
-            } else {
-                stack.push(node.child2);
-                stack.push(node.child1);
-            }
-        }
+        self.walk(
+            |node| segment_touches_box(origin, translation, max_fraction, &node.aabb),
+            callback,
+        );
     }
 
     /// Translates every box by `-new_origin` (for large worlds: makes

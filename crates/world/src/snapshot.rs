@@ -292,9 +292,11 @@ pub mod bytes {
             if fnv(payload) != word(16) {
                 return Err(SnapshotError::Checksum);
             }
-            let world: World =
+            let mut world: World =
                 postcard::from_bytes(payload).map_err(|e| SnapshotError::Decode(e.to_string()))?;
             world.validate().map_err(SnapshotError::Invalid)?;
+            // The trees' filter bits are not in the bytes: from the shapes.
+            world.collision.refresh_filter_bits();
             Ok(Snapshot {
                 world: Box::new(world),
             })
