@@ -205,10 +205,11 @@ impl BroadPhase {
         self.create_proxy_filtered(aabb, payload, is_static, margin, FilterBits::ALL)
     }
 
-    /// [`create_proxy_with_margin`](Self::create_proxy_with_margin) for a
-    /// shape whose collision filter folds to `bits`
-    /// ([`FilterBits::of`]): the pair search skips the proxies it cannot
-    /// pair with.
+    /// Adds a proxy for the tight box `aabb` with the given payload, whose
+    /// fat boxes grow the tight box by `margin` metres (at most the tree's
+    /// margin; static proxies: 0), for a shape whose collision filter
+    /// gives `bits` ([`FilterBits::of`]): the pair search skips the
+    /// proxies it cannot pair with. The new proxy counts as moved.
     pub fn create_proxy_filtered(
         &mut self,
         aabb: Aabb,

@@ -79,7 +79,7 @@ impl Filter {
         self
     }
 
-    /// The filter folded for the broadphase's pair search
+    /// The filter in the 16-bit form of the broadphase's pair search
     /// ([`FilterBits::of`](crate::dynamic_tree::FilterBits::of)).
     ///
     /// ```
