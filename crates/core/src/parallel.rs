@@ -393,15 +393,33 @@ impl Team<'_> {
         beside: impl FnOnce(),
     ) {
         let mut none = vec![(); items.len()];
-        let mut none_too = vec![(); items.len()];
-        self.for_each_chunk_triple_mut_beside(
+        self.for_each_chunk_pair_mut_beside(
             items,
             &mut none,
-            &mut none_too,
             len,
-            |i, chunk, _, _| f(i, chunk),
+            |i, chunk, _| f(i, chunk),
             beside,
         );
+    }
+
+    /// `f(i, block)` for the blocks of `items` of `len` items each, as
+    /// [`Team::for_each_chunk_mut`] runs them, the results in block order
+    /// ([`Team::map_blocks`] for work that changes its items).
+    pub fn map_chunks_mut<T: Send, R: Send>(
+        &self,
+        items: &mut [T],
+        len: usize,
+        f: impl Fn(usize, &mut [T]) -> R + Sync,
+    ) -> Vec<R> {
+        // One block of items and one result slot per job block: the
+        // two-slice form's proof of disjoint blocks covers both.
+        let mut blocks: Vec<&mut [T]> = items.chunks_mut(len.max(1)).collect();
+        let mut found: Vec<Option<R>> = blocks.iter().map(|_| None).collect();
+        self.for_each_chunk_pair_mut(&mut blocks, &mut found, 1, |i, block, slot| {
+            slot[0] = Some(f(i, &mut *block[0]));
+        });
+        // (Every block ran: none is `None`.)
+        found.into_iter().flatten().collect()
     }
 
     /// [`Team::for_each_chunk_mut`] over two slices of the same length at
@@ -418,6 +436,25 @@ impl Team<'_> {
         len: usize,
         f: impl Fn(usize, &mut [A], &mut [B]) + Sync,
     ) {
+        self.for_each_chunk_pair_mut_beside(a, b, len, f, || {});
+    }
+
+    /// [`Team::for_each_chunk_pair_mut`] with `beside`, serial work of the
+    /// caller's that shares no data with `a` and `b`, run first on the
+    /// leader while the other threads start on the blocks (on a serial
+    /// team, before the blocks).
+    ///
+    /// # Panics
+    ///
+    /// When the slices' lengths differ (a bug of the caller, not input).
+    pub fn for_each_chunk_pair_mut_beside<A: Send, B: Send>(
+        &self,
+        a: &mut [A],
+        b: &mut [B],
+        len: usize,
+        f: impl Fn(usize, &mut [A], &mut [B]) + Sync,
+        beside: impl FnOnce(),
+    ) {
         // A slice of `()` costs no memory.
         let mut none = vec![(); a.len()];
         self.for_each_chunk_triple_mut_beside(
@@ -426,7 +463,7 @@ impl Team<'_> {
             &mut none,
             len,
             |i, ca, cb, _| f(i, ca, cb),
-            || {},
+            beside,
         );
     }
 
@@ -1112,6 +1149,35 @@ mod tests {
         let seen = std::sync::Mutex::new(Vec::new());
         Team::serial().run(5, &|i| seen.lock().unwrap().push(i));
         assert_eq!(*seen.lock().unwrap(), vec![0, 1, 2, 3, 4]);
+    }
+
+    /// `map_chunks_mut` changes every item once and returns each block's
+    /// result in block order, on any team (a serial one too).
+    #[test]
+    fn mapped_mutable_blocks_come_back_in_block_order() {
+        let check = |team: &Team| {
+            let mut items: Vec<u32> = (0..1000).collect();
+            let sums = team.map_chunks_mut(&mut items, 64, |b, block| {
+                block.iter_mut().for_each(|x| *x *= 2);
+                (b, block.iter().map(|&x| u64::from(x)).sum::<u64>())
+            });
+            assert_eq!(sums.len(), 16);
+            for (k, &(b, sum)) in sums.iter().enumerate() {
+                let first = 64 * k as u64;
+                let last = (first + 64).min(1000);
+                assert_eq!((b, sum), (k, (first..last).map(|x| 2 * x).sum::<u64>()));
+            }
+            assert!(items.iter().enumerate().all(|(i, &x)| x == 2 * i as u32));
+        };
+        check(&Team::serial());
+        #[cfg(feature = "parallel")]
+        for threads in [2, 3, 4] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| with_team(|team| check(team)));
+        }
     }
 
     /// Every block of a job runs exactly once, for any team size and any

@@ -823,35 +823,32 @@ fn finalize_bodies(
     let any_outside = std::sync::atomic::AtomicBool::new(false);
     let any_fast = std::sync::atomic::AtomicBool::new(false);
     let BodySet { sims, states, .. } = bodies;
-    // A slice of `()` costs no memory (the three-slice form's third).
-    let mut none = vec![(); sims.len()];
-    let finalize =
-        |i: usize, sims: &mut [crate::body::BodySim], states: &mut [BodyState], _: &mut [()]| {
-            clamp_velocity_terms(terms, states, i * BODY_BLOCK);
-            let skip = usize::from(i == 0);
-            let mut outside = false;
-            let mut fast = false;
-            for (sim, state) in sims.iter_mut().zip(states.iter()).skip(skip) {
-                if finite(state) {
-                    sim.center = sim.center0 + state.dp;
-                    sim.transform.q = state.dq.mul(sim.rotation0).normalize();
-                    sim.transform.p = sim.center - sim.transform.q.rotate(sim.local_center);
-                    sim.force = Vec2::ZERO;
-                    sim.torque = 0.0;
-                    fast |= fast_bodies && sim.may_be_fast();
-                } else {
-                    any_bad.store(true, std::sync::atomic::Ordering::Relaxed);
-                }
-                outside |= !sim.pose_within(POSE_LIMIT);
+    let finalize = |i: usize, sims: &mut [crate::body::BodySim], states: &mut [BodyState]| {
+        clamp_velocity_terms(terms, states, i * BODY_BLOCK);
+        let skip = usize::from(i == 0);
+        let mut outside = false;
+        let mut fast = false;
+        for (sim, state) in sims.iter_mut().zip(states.iter()).skip(skip) {
+            if finite(state) {
+                sim.center = sim.center0 + state.dp;
+                sim.transform.q = state.dq.mul(sim.rotation0).normalize();
+                sim.transform.p = sim.center - sim.transform.q.rotate(sim.local_center);
+                sim.force = Vec2::ZERO;
+                sim.torque = 0.0;
+                fast |= fast_bodies && sim.may_be_fast();
+            } else {
+                any_bad.store(true, std::sync::atomic::Ordering::Relaxed);
             }
-            if outside {
-                any_outside.store(true, std::sync::atomic::Ordering::Relaxed);
-            }
-            if fast {
-                any_fast.store(true, std::sync::atomic::Ordering::Relaxed);
-            }
-        };
-    team.for_each_chunk_triple_mut_beside(sims, states, &mut none, BODY_BLOCK, finalize, beside);
+            outside |= !sim.pose_within(POSE_LIMIT);
+        }
+        if outside {
+            any_outside.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+        if fast {
+            any_fast.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+    };
+    team.for_each_chunk_pair_mut_beside(sims, states, BODY_BLOCK, finalize, beside);
     report.poses_inside = !any_outside.into_inner();
     report.maybe_fast = any_fast.into_inner();
     if any_bad.into_inner() {

@@ -734,20 +734,13 @@ impl JointSet {
         if team.threads() == 1 || n < 2 * END_BLOCK {
             return end_block(&mut self.joints, &self.handles);
         }
-        let blocks: Vec<std::sync::Mutex<JointStepEnd>> = (0..n.div_ceil(END_BLOCK))
-            .map(|_| Default::default())
-            .collect();
         let handles = &self.handles[..];
-        team.for_each_chunk_mut(&mut self.joints, END_BLOCK, |b, joints| {
+        let blocks = team.map_chunks_mut(&mut self.joints, END_BLOCK, |b, joints| {
             let first = b * END_BLOCK;
-            let found = end_block(joints, &handles[first..first + joints.len()]);
-            if let Ok(mut slot) = blocks[b].lock() {
-                *slot = found;
-            }
+            end_block(joints, &handles[first..first + joints.len()])
         });
         let mut end = JointStepEnd::default();
-        for block in blocks {
-            let found = block.into_inner().unwrap_or_default();
+        for found in blocks {
             end.rows += found.rows;
             end.direct_rows += found.direct_rows;
             end.events.extend(found.events);
