@@ -113,6 +113,12 @@ pub struct BroadPhase {
     static_tree: DynamicTree,
     proxies: Vec<ProxySlot>,
     free_proxies: Vec<u32>,
+    /// The proxies moved since the last pair update, in the order they
+    /// moved. Nothing reads the order: the pair update marks and queries
+    /// each and sorts what it finds, and the tree's growth is a union. So
+    /// the proxy update may fill it in any order (by body on one thread,
+    /// by shape slot on a team), and a snapshot writes it sorted.
+    #[cfg_attr(feature = "serde", serde(with = "crate::serde_maps::sorted_ids"))]
     move_buffer: Vec<u32>,
     /// Scratch stack of the simultaneous tree descent.
     pair_stack: Vec<(u32, u32)>,

@@ -613,7 +613,9 @@ impl Collision {
     /// static or asleep ones too, so where most shapes do not move (a
     /// level's static geometry, a sleeping pile) the pass by body, whose
     /// cost follows the moving bodies alone, is cheaper. Both move the
-    /// proxies in the same order.
+    /// same proxies to the same boxes; only the order differs, and the
+    /// tree and the pairs do not depend on it (see
+    /// [`Collision::update_boxes`]).
     fn boxes_by_slot(team: &Team, bodies: &BodySet, shapes: &ShapeStore) -> bool {
         let moving = bodies.moving_count();
         team.threads() > 1 && moving >= 1024 && 2 * moving >= shapes.len()
@@ -671,14 +673,18 @@ impl Collision {
     /// on the team, shape slots in blocks:  each live shape of a moving body:
     ///                                        tight box from its body's pose
     ///                                        keeps its boxes? (read only)
-    /// here, in order:                      the shapes whose proxies move,
-    ///                                      sorted by (body state index, place
-    ///                                      in the body's shape list), moved
+    /// here, in slot order:                 the shapes whose proxies move, moved
     /// ```
     ///
-    /// The moves keep the order of the pass by body
-    /// ([`Collision::update_proxies_by_body`]), so the tree and its move
-    /// buffer are the same on any thread count. Before (stop 54), the team
+    /// The moves come in shape slot order, not in the order of the pass
+    /// by body ([`Collision::update_proxies_by_body`]), and the tree comes
+    /// out the same: a moved leaf's box does not depend on the others, its
+    /// ancestors grow to the union of their moved leaves' boxes, and the
+    /// rebuild that follows reads the tree, not the order of the moves.
+    /// The move buffer holds the same proxies in another order; the pair
+    /// update sorts it, and a snapshot writes it sorted. (Until stop 63
+    /// the moves were sorted into body order, a sort on the leader while
+    /// the team stored the impulses.) Before (stop 54), the team
     /// computed the boxes by body and the leader then wrote every shape's
     /// box and asked every proxy in body order: on many_pyramids (22,000
     /// bodies, two threads) that loop alone took 1.2–1.5 ms a step, more
@@ -690,58 +696,53 @@ impl Collision {
         bodies: &BodySet,
         dt: Real,
         team: &Team,
-    ) -> Vec<(u32, usize, u32)> {
+    ) -> Vec<(u32, u32)> {
         const BLOCK: usize = 512;
         let entries = shapes.entries_mut();
-        let mut moves = vec![false; entries.len()];
-        {
-            team.for_each_chunk_pair_mut(entries, &mut moves, BLOCK, |_, block, flags| {
-                for ((_, entry), flag) in block.iter_mut().zip(flags) {
-                    let Some(shape) = entry else { continue };
-                    let i = bodies.state_index(shape.body).unwrap_or(0) as usize;
-                    if i == 0 {
-                        // Static, asleep or disabled: not moved.
-                        continue;
-                    }
-                    let tight = shape.geometry.compute_aabb(&bodies.sims[i].transform);
-                    shape.aabb = tight;
-                    *flag = !broadphase.keeps_boxes(
-                        shape.proxy,
-                        bounded(tight),
-                        dt * bodies.states[i].v,
-                    );
+        // Per shape slot: its body's state index when its proxy moves, else 0.
+        let mut moves = vec![0u32; entries.len()];
+        team.for_each_chunk_pair_mut(entries, &mut moves, BLOCK, |_, block, moving| {
+            for ((_, entry), moving) in block.iter_mut().zip(moving) {
+                let Some(shape) = entry else { continue };
+                let i = bodies.state_index(shape.body).unwrap_or(0);
+                if i == 0 {
+                    // Static, asleep or disabled: not moved.
+                    continue;
                 }
-            });
-        }
-        // (state index, place in the body's shape list, shape slot).
-        let mut order: Vec<(u32, usize, u32)> = Vec::new();
-        for (s, _) in moves.iter().enumerate().filter(|(_, m)| **m) {
-            let s = s as u32;
-            let body = shapes.at(s).body;
-            let i = bodies.state_index(body).unwrap_or(0);
-            let place = shapes
-                .of_body(body)
-                .iter()
-                .position(|&x| x == s)
-                .unwrap_or(0);
-            order.push((i, place, s));
-        }
-        order.sort_unstable();
-        order
+                let tight = shape
+                    .geometry
+                    .compute_aabb(&bodies.sims[i as usize].transform);
+                shape.aabb = tight;
+                if !broadphase.keeps_boxes(
+                    shape.proxy,
+                    bounded(tight),
+                    dt * bodies.states[i as usize].v,
+                ) {
+                    *moving = i;
+                }
+            }
+        });
+        // (body state index, shape slot), in slot order.
+        moves
+            .iter()
+            .enumerate()
+            .filter(|&(_, &i)| i != 0)
+            .map(|(s, &i)| (i, s as u32))
+            .collect()
     }
 
     /// Moves the proxies [`Collision::update_boxes`] listed (`order`: body
-    /// state index, place in the body's shape list, shape slot), then
-    /// rebuilds the movable proxies' tree; returns the number moved.
+    /// state index, shape slot), then rebuilds the movable proxies' tree;
+    /// returns the number moved.
     fn move_proxies(
-        order: &[(u32, usize, u32)],
+        order: &[(u32, u32)],
         shapes: &ShapeStore,
         broadphase: &mut BroadPhase,
         bodies: &BodySet,
         dt: Real,
     ) -> usize {
         let mut moved = 0;
-        for &(i, _, s) in order {
+        for &(i, s) in order {
             let shape = shapes.at(s);
             let sweep = dt * bodies.states[i as usize].v;
             if broadphase.move_proxy_in_batch_swept(shape.proxy, bounded(shape.aabb), sweep) {

@@ -61,3 +61,25 @@ pub(crate) mod sorted_map {
         Ok(sorted.into_iter().collect())
     }
 }
+
+/// Serde for a list whose order carries no meaning (the broadphase's move
+/// buffer): written sorted, so that a snapshot's bytes do not depend on
+/// the order the step happened to fill it in (the proxy update by shape
+/// slot on a team, by body on one thread). Read as written: the same
+/// format as a plain sequence.
+#[cfg(feature = "serde")]
+pub(crate) mod sorted_ids {
+    /// Writes the ids in increasing order.
+    pub(crate) fn serialize<S: serde::Serializer>(ids: &[u32], s: S) -> Result<S::Ok, S::Error> {
+        let mut sorted = ids.to_vec();
+        sorted.sort_unstable();
+        serde::Serialize::serialize(&sorted, s)
+    }
+
+    /// Reads ids written by [`serialize`] (or by a plain sequence).
+    pub(crate) fn deserialize<'de, D: serde::Deserializer<'de>>(
+        d: D,
+    ) -> Result<Vec<u32>, D::Error> {
+        serde::Deserialize::deserialize(d)
+    }
+}
