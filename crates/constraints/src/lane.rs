@@ -376,9 +376,147 @@ impl<L: Lane> Velocity<L> {
     }
 }
 
+/// [`solver_atan2`](janus2d_core::math::solver_atan2) lane by lane, bit
+/// for bit. In the f32 build: the same polynomial and reductions in the
+/// same order, its branches as selects, and `copysign` as the sign bit of
+/// `y` on the magnitude; a lane where `max(|x|, |y|)` is zero or not
+/// finite takes the scalar function, as the scalar function takes the
+/// library's there. In the f64 build: the scalar function on each lane.
+#[must_use]
+pub(crate) fn atan2_lanes(y: Wide, x: Wide) -> Wide {
+    #[cfg(feature = "f64")]
+    {
+        let (ys, xs) = (y.to_array(), x.to_array());
+        Wide::from(std::array::from_fn::<Real, LANES, _>(|k| {
+            janus2d_core::math::solver_atan2(ys[k], xs[k])
+        }))
+    }
+    #[cfg(not(feature = "f64"))]
+    {
+        use core::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+        use janus2d_core::math::atan2_terms::{C0, C1, C2, C3, C4, TAN_PI_8};
+        let s = Wide::splat;
+        let (ax, ay) = (Lane::abs(x), Lane::abs(y));
+        let steep = Lane::gt(ay, ax);
+        let (lo, hi) = (Wide::select(steep, ax, ay), Wide::select(steep, ay, ax));
+        let past_eighth = Lane::gt(lo, s(TAN_PI_8) * hi);
+        let num = Wide::select(past_eighth, lo - hi, lo);
+        let den = Wide::select(past_eighth, lo + hi, hi);
+        let u = num / den;
+        let z = u * u;
+        let z2 = z * z;
+        let p = (s(C0) + s(C1) * z) + z2 * ((s(C2) + s(C3) * z) + z2 * s(C4));
+        let mut a = p * u;
+        a = Wide::select(past_eighth, a + s(FRAC_PI_4), a);
+        a = Wide::select(steep, s(FRAC_PI_2) - a, a);
+        a = Wide::select(Lane::lt(x, s(0.0)), s(PI) - a, a);
+        let sign = s(-0.0);
+        let mut out = Lane::abs(a) | (y & sign);
+        let usual = Lane::gt(hi, s(0.0)) & Lane::lt(hi, s(Real::INFINITY));
+        if !usual.all() {
+            let (ys, xs, fine) = (y.to_array(), x.to_array(), usual.move_mask());
+            for k in 0..LANES {
+                if fine & (1 << k) == 0 {
+                    out.set_lane(k, janus2d_core::math::solver_atan2(ys[k], xs[k]));
+                }
+            }
+        }
+        out
+    }
+}
+
+/// [`wrap_angle`](janus2d_core::math::wrap_angle) lane by lane, bit for
+/// bit: lanes within `(−π, π)` as they are (its common path), the others
+/// through the scalar function.
+#[must_use]
+pub(crate) fn wrap_angle_lanes(x: Wide) -> Wide {
+    let within = Lane::lt(Lane::abs(x), Wide::splat(janus2d_core::math::PI));
+    if within.all() {
+        return x;
+    }
+    let mut out = x;
+    for k in 0..LANES {
+        if within.lane(k).to_bits() == 0 {
+            out.set_lane(k, janus2d_core::math::wrap_angle(x.lane(k)));
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The lane versions of `solver_atan2` and `wrap_angle` give the
+    /// scalar functions' bits on every lane: random pairs of every size
+    /// and sign, the axes and diagonals, signed zeros, infinities and NaN,
+    /// and angles around ±π and far past them.
+    #[test]
+    fn angle_lanes_match_the_scalar_functions_bit_for_bit() {
+        use janus2d_core::math::{solver_atan2, wrap_angle};
+        let mut seed = 0x2545_f491_u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            ((seed >> 33) as f64 / (1u64 << 31) as f64 * 2.0 - 1.0) as Real
+        };
+        let specials: [Real; 12] = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            1e-30,
+            -1e-30,
+            1e30,
+            Real::INFINITY,
+            Real::NEG_INFINITY,
+            Real::NAN,
+            0.414_213_57,
+            -0.707_106_77,
+        ];
+        let mut pairs = Vec::new();
+        for &y in &specials {
+            for &x in &specials {
+                pairs.push((y, x));
+            }
+        }
+        for _ in 0..20_000 {
+            let scale = [1e-3, 1.0, 1e3][pairs.len() % 3];
+            pairs.push((scale * next(), scale * next()));
+        }
+        for block in pairs.chunks(LANES) {
+            let mut ys = [0.0; LANES];
+            let mut xs = [1.0; LANES];
+            for (k, &(y, x)) in block.iter().enumerate() {
+                (ys[k], xs[k]) = (y, x);
+            }
+            let got = atan2_lanes(Wide::from(ys), Wide::from(xs)).to_array();
+            for k in 0..LANES {
+                let want = solver_atan2(ys[k], xs[k]);
+                assert!(
+                    got[k].to_bits() == want.to_bits() || (got[k].is_nan() && want.is_nan()),
+                    "atan2({}, {}): {} against {want}",
+                    ys[k],
+                    xs[k],
+                    got[k]
+                );
+            }
+            // Angles from −4π to 4π, most within (−π, π).
+            let angles: [Real; LANES] = std::array::from_fn(|k| ys[k] * 4.0 + xs[k] * 0.1);
+            let wrapped = wrap_angle_lanes(Wide::from(angles)).to_array();
+            for k in 0..LANES {
+                let want = wrap_angle(angles[k]);
+                assert!(
+                    wrapped[k].to_bits() == want.to_bits()
+                        || (want.is_nan() && wrapped[k].is_nan()),
+                    "wrap({}): {} against {want}",
+                    angles[k],
+                    wrapped[k]
+                );
+            }
+        }
+    }
 
     /// Each operation gives the same value on `Real` as lane by lane on
     /// `Wide`, NaN included.

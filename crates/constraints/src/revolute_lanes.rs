@@ -36,13 +36,13 @@
 
 use janus2d_core::body::BodyState;
 use janus2d_core::constraint::StepContext;
-use janus2d_core::math::{Real, Rot, Vec2, wrap_angle};
+use janus2d_core::math::{Real, Vec2};
 use janus2d_core::parallel::{StatePlan, Team};
 
 use crate::contact_solver::{Direct, LaneStates, PLAN_SLOTS, load, store_where};
 use crate::joint::Joint;
 use crate::joint_rows::{Bounds, PointTerms, SoftLanes, Terms, angle_row, point_equality_row};
-use crate::lane::{LANES, Lane, V2, Velocity, Wide as W};
+use crate::lane::{LANES, Lane, V2, Velocity, Wide as W, atan2_lanes, wrap_angle_lanes};
 use crate::parts::{MassLanes, angular_correction_cap, arms_lanes};
 use janus2d_core::softness::Softness;
 
@@ -137,7 +137,7 @@ struct WideRevolute {
     moving: u32,
     /// Bit `k`: lane `k` reads the joint angle.
     reads_angle: u32,
-    delta_angle: [Real; LANES],
+    delta_angle: W,
     spring_on: W,
     spring_softness: SoftLanes<W>,
     target_angle: W,
@@ -201,7 +201,7 @@ impl WideRevolute {
             c.moving |= u32::from(writes & crate::parts::WRITE_A != 0) << k;
             c.moving |= u32::from(writes & crate::parts::WRITE_B != 0) << (LANES + k);
             c.reads_angle |= u32::from(l.reads_angle) << k;
-            c.delta_angle[k] = l.delta_angle;
+            c.delta_angle.set_lane(k, l.delta_angle);
             on(&mut c.spring_on, k, l.spring);
             set_soft(&mut c.spring_softness, k, l.spring_softness);
             c.target_angle.set_lane(k, l.target_angle);
@@ -236,29 +236,20 @@ impl WideRevolute {
     fn solve<S: LaneStates>(&mut self, states: &mut S, rows: &LaneContext) {
         let (vel_a, delta_a, flags_a) = load(states, A);
         let (vel_b, delta_b, flags_b) = load(states, B);
-        // The joint angle lane by lane, as one joint reads it.
-        let mut angle = [0.0; LANES];
-        if self.reads_angle != 0 {
-            let (c_a, s_a) = (delta_a.q_c.to_array(), delta_a.q_s.to_array());
-            let (c_b, s_b) = (delta_b.q_c.to_array(), delta_b.q_s.to_array());
-            for k in 0..LANES {
-                if self.reads_angle & (1 << k) != 0 {
-                    let (q_a, q_b) = (
-                        Rot {
-                            c: c_a[k],
-                            s: s_a[k],
-                        },
-                        Rot {
-                            c: c_b[k],
-                            s: s_b[k],
-                        },
-                    );
-                    angle[k] = wrap_angle(self.delta_angle[k] + q_a.relative_angle(q_b));
-                }
-            }
-        }
+        // The joint angle on every lane, with the arithmetic of one joint's
+        // read (`Rot::relative_angle`, `wrap_angle`; lane versions that
+        // agree bit for bit): q = q_a⁻¹ q_b, θ = wrap(Δθ + atan2(q_s, q_c)).
+        // Only the spring and the limits read it, and where they are off
+        // their rows are selected away. (One joint at a time, the angle
+        // was a third of this solve in rain.)
+        let angle = if self.reads_angle != 0 {
+            let q_c = delta_a.q_c * delta_b.q_c + delta_a.q_s * delta_b.q_s;
+            let q_s = delta_a.q_c * delta_b.q_s - delta_a.q_s * delta_b.q_c;
+            wrap_angle_lanes(self.delta_angle + atan2_lanes(q_s, q_c))
+        } else {
+            W::splat(0.0)
+        };
         let (mut w_a, mut w_b) = (vel_a.w, vel_b.w);
-        let angle = W::from(angle);
         let inv_inertia = (self.masses.inv_inertia_a, self.masses.inv_inertia_b);
         // Each row on copies, kept where the lane's joint solves it.
         let mut row = |on: W, sign: Real, i: usize, t: Terms<W>, bounds: Bounds<W>| {

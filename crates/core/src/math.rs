@@ -484,15 +484,8 @@ pub fn solver_atan2(y: Real, x: Real) -> Real {
     }
     #[cfg(not(feature = "f64"))]
     {
+        use atan2_terms::{C0, C1, C2, C3, C4, TAN_PI_8};
         use core::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
-        /// tan(π/8).
-        const TAN_PI_8: f32 = 0.414_213_57;
-        // Coefficients of u^(2k+1), k = 0..4 (dimensionless).
-        const C0: f32 = 0.999_999_9;
-        const C1: f32 = -0.333_322_05;
-        const C2: f32 = 0.199_619_65;
-        const C3: f32 = -0.137_548_06;
-        const C4: f32 = 0.077_345_36;
         let (ax, ay) = (x.abs(), y.abs());
         let steep = ay > ax;
         let (lo, hi) = if steep { (ax, ay) } else { (ay, ax) };
@@ -522,6 +515,25 @@ pub fn solver_atan2(y: Real, x: Real) -> Real {
         }
         a.copysign(y)
     }
+}
+
+/// The constants of [`solver_atan2`]'s f32 polynomial, for a version of
+/// it over other number types that must agree with it bit for bit (the
+/// revolute joints' lanes, `janus2d_constraints`).
+#[cfg(not(feature = "f64"))]
+pub mod atan2_terms {
+    /// tan(π/8): past it, the argument is reduced by π/4.
+    pub const TAN_PI_8: f32 = 0.414_213_57;
+    /// Coefficient of u (dimensionless).
+    pub const C0: f32 = 0.999_999_9;
+    /// Coefficient of u³.
+    pub const C1: f32 = -0.333_322_05;
+    /// Coefficient of u⁵.
+    pub const C2: f32 = 0.199_619_65;
+    /// Coefficient of u⁷.
+    pub const C3: f32 = -0.137_548_06;
+    /// Coefficient of u⁹.
+    pub const C4: f32 = 0.077_345_36;
 }
 
 #[cfg(test)]
