@@ -382,6 +382,7 @@ impl<L: Lane> Velocity<L> {
 /// `y` on the magnitude; a lane where `max(|x|, |y|)` is zero or not
 /// finite takes the scalar function, as the scalar function takes the
 /// library's there. In the f64 build: the scalar function on each lane.
+#[inline(always)]
 #[must_use]
 pub(crate) fn atan2_lanes(y: Wide, x: Wide) -> Wide {
     #[cfg(feature = "f64")]
@@ -414,26 +415,46 @@ pub(crate) fn atan2_lanes(y: Wide, x: Wide) -> Wide {
         let mut out = Lane::abs(a) | (y & sign);
         let usual = Lane::gt(hi, s(0.0)) & Lane::lt(hi, s(Real::INFINITY));
         if !usual.all() {
-            let (ys, xs, fine) = (y.to_array(), x.to_array(), usual.move_mask());
-            for k in 0..LANES {
-                if fine & (1 << k) == 0 {
-                    out.set_lane(k, janus2d_core::math::solver_atan2(ys[k], xs[k]));
-                }
-            }
+            out = atan2_unusual_lanes(y, x, out, usual.move_mask());
         }
         out
     }
 }
 
+/// `out` with the lanes not in `usual` (bit `k`: lane `k`) replaced by
+/// the scalar function's answer (kept out of line: no unit rotation gets
+/// here).
+#[cfg(not(feature = "f64"))]
+#[cold]
+#[inline(never)]
+fn atan2_unusual_lanes(y: Wide, x: Wide, mut out: Wide, usual: i32) -> Wide {
+    let (ys, xs) = (y.to_array(), x.to_array());
+    for k in 0..LANES {
+        if usual & (1 << k) == 0 {
+            out.set_lane(k, janus2d_core::math::solver_atan2(ys[k], xs[k]));
+        }
+    }
+    out
+}
+
 /// [`wrap_angle`](janus2d_core::math::wrap_angle) lane by lane, bit for
 /// bit: lanes within `(−π, π)` as they are (its common path), the others
 /// through the scalar function.
+#[inline(always)]
 #[must_use]
 pub(crate) fn wrap_angle_lanes(x: Wide) -> Wide {
     let within = Lane::lt(Lane::abs(x), Wide::splat(janus2d_core::math::PI));
     if within.all() {
         return x;
     }
+    wrap_unusual_lanes(x, within)
+}
+
+/// `x` with the lanes outside `(−π, π)` (not in `within`) wrapped by the
+/// scalar function (out of line: a joint angle rarely gets here).
+#[cold]
+#[inline(never)]
+fn wrap_unusual_lanes(x: Wide, within: Wide) -> Wide {
     let mut out = x;
     for k in 0..LANES {
         if within.lane(k).to_bits() == 0 {
