@@ -593,16 +593,20 @@ impl Islands {
             }
         }
         // The sleepiest body whose island may have split: split that one.
+        // (The body's own fields first: its island is a random read, and
+        // in a scene in motion hardly any body is sleepy enough.)
         let mut candidate = (NONE, 0.0 as Real);
-        for i in 1..n {
-            let sim = &bodies.sims[i];
-            let id = self.island(sim.handle);
-            if sim.body_type == BodyType::Dynamic
-                && id != NONE
-                && self.islands[id as usize].removed > 0
-                && sim.sleep_time >= settings.time_to_sleep
+        let mut any_rested = false;
+        for sim in &bodies.sims[1..n] {
+            any_rested |= sim.sleep_time >= settings.time_to_sleep;
+            let sleepiest = sim.sleep_time >= settings.time_to_sleep
                 && sim.sleep_time > candidate.1
-            {
+                && sim.body_type == BodyType::Dynamic;
+            if !sleepiest {
+                continue;
+            }
+            let id = self.island(sim.handle);
+            if id != NONE && self.islands[id as usize].removed > 0 {
                 candidate = (id, sim.sleep_time);
             }
         }
@@ -626,6 +630,12 @@ impl Islands {
             }
             #[cfg(debug_assertions)]
             self.debug_check_split(&before, id, contacts, joints);
+        }
+        // An island sleeps when its least rested member has rested long
+        // enough: with no awake body rested that long, none does (a scene
+        // in motion skips the pass and its island lookups).
+        if !any_rested {
+            return;
         }
         // The least rested awake member of each island with awake members
         // (sleeping islands are not visited; `min_time` is kept at MAX
