@@ -20,8 +20,9 @@
 //!                                 colour 1: [j1 j4 …]
 //!                               the rest of the colour stays one joint at a time
 //! solve, relax (each colour)    gather both states (4×4 transposes in f32), the
-//!                               joint angle per lane (Rot::relative_angle, as one
-//!                               joint computes it); spring, motor, lower, upper,
+//!                               joint angles on the lanes (atan2_lanes and
+//!                               wrap_angle_lanes: bit for bit what one joint's
+//!                               Rot::relative_angle reads); spring, motor, lower, upper,
 //!                               then the point block where the joint is in no
 //!                               tree, on the lanes; scatter v, ω where the body moves
 //! warm start (per body)         a lane joint's impulses read from its lane
@@ -464,6 +465,13 @@ impl RevoluteLanes {
         team.for_each_chunk_mut(&mut self.chunks[..count], 16, |i, block| {
             for (k, chunk) in block.iter_mut().enumerate() {
                 let first = (16 * i + k) * LANES;
+                // The next chunk's joints (colour order is not storage
+                // order: each is a random read of several lines).
+                for &(j, _) in entries.get(first + LANES..first + 2 * LANES).unwrap_or(&[]) {
+                    if let Some(joint) = joints.get(j as usize) {
+                        janus2d_core::hint::prefetch_all(joint);
+                    }
+                }
                 WideRevolute::fill(chunk, &entries[first..first + LANES], joints, h);
             }
         });
@@ -581,7 +589,17 @@ impl RevoluteLanes {
         if !self.is_live() {
             return;
         }
-        for chunk in self.live_chunks() {
+        let chunks = self.live_chunks();
+        for (c, chunk) in chunks.iter().enumerate() {
+            // The next chunk's joints (random reads, as in the fill).
+            for &j in chunks
+                .get(c + 1)
+                .map_or(&[][..], |next| &next.joint[..next.len])
+            {
+                if let Some(joint) = joints.get(j as usize) {
+                    janus2d_core::hint::prefetch_all(joint);
+                }
+            }
             for k in 0..chunk.len {
                 if let Some(Joint::Revolute(r)) = joints.get_mut(chunk.joint[k] as usize) {
                     r.set_lane_impulses(chunk.impulses(k));
