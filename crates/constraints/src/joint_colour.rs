@@ -376,7 +376,7 @@ impl JointColours {
             self.update(joints, states);
         }
         if self.lanes_live() {
-            self.lanes.refresh_warm(team);
+            self.lanes.refresh_warm(joints, team);
         }
         let (start, list) = (&self.body_start[..], &self.body_joints[..]);
         let lanes = self.lanes_live().then_some(&self.lanes);
@@ -385,11 +385,12 @@ impl JointColours {
             let mut local = *st;
             for &e in &list[start[s] as usize..start[s + 1] as usize] {
                 let (j, side_b) = ((e >> 1) as usize, e & 1 == 1);
-                // A lane joint's angle rows keep their impulses in its lane.
-                if let (Some(lanes), Joint::Revolute(r)) = (lanes, &joints[j]) {
+                // A lane joint's angle rows keep their impulses in its lane,
+                // which has gathered all its warm start reads.
+                if let Some(lanes) = lanes {
                     let lane = lanes.lane_of(j);
                     if lane != NO_LANE {
-                        r.warm_start_side_with(&mut local, side_b, lanes.warm(lane));
+                        lanes.warm(lane).warm_start_side(&mut local, side_b);
                         continue;
                     }
                 }

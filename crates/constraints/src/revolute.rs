@@ -42,7 +42,7 @@ use crate::joint_def::{JointDefBase, KindDef, LimitsMut, MotorMut, SpringMut};
 use crate::joint_rows::{Bounds, PointTerms, RowSolve, Terms, WarmSide, point_bound};
 use crate::kind_rows::{KindRows, TreeRows};
 use crate::parts::{AnglePart, PairMass, PointPart, angular_correction_cap};
-use crate::revolute_lanes::{LaneImpulses, LaneWarm, RevoluteLane};
+use crate::revolute_lanes::{LaneImpulses, RevoluteLane};
 use crate::{JointError, check_motor_speed, check_spring};
 
 /// Everything needed to create a revolute joint.
@@ -319,6 +319,16 @@ impl Switches {
 /// by the mass ratio `ρ = min((m_a⁻¹ + m_b⁻¹) / min(m_a⁻¹, m_b⁻¹), ρ_max)`
 /// (`ρ_max` when one body is static). Used by the solve and reported by
 /// `rows()`, so both see the same rows.
+/// A revolute joint's warm start on one body: the angle rows' summed kept
+/// impulse `angle` (N·m·s), then the point's `point` (N·s) at the body's
+/// current arm from `frames` (the anchors' arms at the step's start). The
+/// one joint's warm start and its lane's ([`LaneWarm`]) both run it.
+#[inline(always)]
+pub(crate) fn warm_rows_at(w: &mut WarmSide<'_>, frames: (Vec2, Vec2), angle: Real, point: Vec2) {
+    w.angle(angle);
+    w.point(frames, point);
+}
+
 fn point_softness(def: &RevoluteJointDef, ctx: &StepContext, m: &PairMass) -> Softness {
     def.base.rigid_softness(ctx, m.a.inv_mass, m.b.inv_mass)
 }
@@ -432,34 +442,12 @@ impl RevoluteJoint {
         self.def.enable_spring || self.def.enable_motor || self.def.enable_limit
     }
 
-    /// The joint's rows' warm start on one body with the angle rows' kept
-    /// impulse `angle` (N·m·s; its lanes' while they hold them, see
-    /// [`crate::revolute_lanes`]), then the point's.
-    #[inline(always)]
-    fn warm_rows_with(&self, w: &mut WarmSide<'_>, angle: Real, point: Vec2) {
-        w.angle(angle);
-        w.point((self.point.frame_a, self.point.frame_b), point);
-    }
-
     /// Whether the last prepare switched on an angle row (the switches it
     /// copied; the definition is boxed apart).
     #[inline]
     pub(crate) fn has_prepared_angle_rows(&self) -> bool {
         let on = self.switches;
         on.spring || on.motor || on.limit
-    }
-
-    /// One body's warm start with the impulses its lane holds (see
-    /// [`RevoluteJoint::warm_rows_with`]).
-    #[inline(always)]
-    pub(crate) fn warm_start_side_with(&self, st: &mut BodyState, side_b: bool, warm: LaneWarm) {
-        let mut w = WarmSide::new(st, self.base.masses, side_b);
-        let point = if warm.has_point {
-            warm.point
-        } else {
-            self.point.impulse
-        };
-        self.warm_rows_with(&mut w, warm.angle, point);
     }
 
     /// What the joint's Gauss–Seidel rows read this step, for a lane
@@ -549,8 +537,9 @@ impl KindRows for RevoluteJoint {
     /// rows' sum, then the point at the body's current arm.
     #[inline(always)]
     fn warm_rows(&self, w: &mut WarmSide<'_>) {
-        self.warm_rows_with(
+        warm_rows_at(
             w,
+            (self.point.frame_a, self.point.frame_b),
             self.spring.impulse + self.motor.impulse + self.lower.impulse - self.upper.impulse,
             self.point.impulse,
         );

@@ -35,16 +35,18 @@
 //! of the same joint: the joints of a colour are independent, and the
 //! order within a colour does not change the state.
 
-use janus2d_core::body::BodyState;
+use janus2d_core::body::{BodyState, InvMass};
 use janus2d_core::constraint::StepContext;
 use janus2d_core::math::{Real, Vec2};
 use janus2d_core::parallel::{StatePlan, Team};
 
 use crate::contact_solver::{Direct, LaneStates, PLAN_SLOTS, load, store_where};
 use crate::joint::Joint;
-use crate::joint_rows::{Bounds, PointTerms, SoftLanes, Terms, angle_row, point_equality_row};
+use crate::joint_rows::{
+    Bounds, PointTerms, SoftLanes, Terms, WarmSide, angle_row, point_equality_row,
+};
 use crate::lane::{LANES, Lane, V2, Velocity, Wide as W, atan2_lanes, wrap_angle_lanes};
-use crate::parts::{MassLanes, angular_correction_cap, arms_lanes};
+use crate::parts::{MassLanes, PairMass, angular_correction_cap, arms_lanes};
 use janus2d_core::softness::Softness;
 
 /// Side a of a lane.
@@ -105,13 +107,31 @@ pub(crate) struct RevoluteLane {
     pub(crate) point_impulse: Vec2,
 }
 
-/// A lane joint's warm start: the angle rows' summed impulse (N·m·s) and
-/// the point's (N·s) where the lane solves the point rows.
+/// What a lane joint's warm start reads, gathered once a substep
+/// ([`RevoluteLanes::refresh_warm`]) so that the warm start, body by body,
+/// reads no joint record (a random read of three lines per joint and
+/// side in a ragdoll scene).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct LaneWarm {
-    pub(crate) angle: Real,
-    pub(crate) point: Vec2,
-    pub(crate) has_point: bool,
+    /// The angle rows' summed kept impulse, N·m·s.
+    angle: Real,
+    /// The point's kept impulse, N·s: the lane's where it solves the point
+    /// rows, else the joint's (which its tree solve keeps).
+    point: Vec2,
+    /// The two bodies' inverse masses, as the joint loaded them.
+    masses: PairMass,
+    /// The anchors' arms from the centres at the step's start, m.
+    frames: (Vec2, Vec2),
+}
+
+impl LaneWarm {
+    /// Body `st`'s share (`side_b`: body b, else a) of the joint's warm
+    /// start: the arithmetic of one joint's ([`crate::revolute::warm_rows_at`]).
+    #[inline(always)]
+    pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
+        let mut w = WarmSide::new(st, self.masses, side_b);
+        crate::revolute::warm_rows_at(&mut w, self.frames, self.angle, self.point);
+    }
 }
 
 /// What a lane holds of its joint's impulses: the angle rows' (spring,
@@ -541,22 +561,55 @@ impl RevoluteLanes {
     /// On `team` in blocks of [`WARM_BLOCK`] chunks (rain at two threads:
     /// this pass, four times a step, was about 1.7% of the leader's samples
     /// while the other thread waited).
-    pub(crate) fn refresh_warm(&mut self, team: &Team) {
+    pub(crate) fn refresh_warm(&mut self, joints: &[Joint], team: &Team) {
         self.warm.clear();
         let chunks = &self.chunks[..self.starts.last().map_or(0, |&n| n as usize)];
         let lanes_of = |c: usize| -> [LaneWarm; LANES] {
             let chunk = &chunks[c];
+            // The next chunk's tree joints, whose point impulses are read
+            // from their records (random reads).
+            if let Some(next) = chunks.get(c + 1) {
+                for k in 0..next.len {
+                    if next.point_on.lane(k).to_bits() == 0
+                        && let Some(j) = joints.get(next.joint[k] as usize)
+                    {
+                        janus2d_core::hint::prefetch(j);
+                    }
+                }
+            }
             let [spring, motor, lower, upper] = chunk.impulse;
             let angle = (spring + motor + lower - upper).to_array();
-            let (x, y) = (
-                chunk.point_impulse.x.to_array(),
-                chunk.point_impulse.y.to_array(),
-            );
-            let on = chunk.point_on.to_array();
-            std::array::from_fn(|k| LaneWarm {
-                angle: angle[k],
-                point: Vec2::new(x[k], y[k]),
-                has_point: on[k].to_bits() != 0,
+            let m = &chunk.masses;
+            std::array::from_fn(|k| {
+                if k >= chunk.len {
+                    return LaneWarm::default();
+                }
+                let point = if chunk.point_on.lane(k).to_bits() != 0 {
+                    Vec2::new(chunk.point_impulse.x.lane(k), chunk.point_impulse.y.lane(k))
+                } else {
+                    match joints.get(chunk.joint[k] as usize) {
+                        Some(Joint::Revolute(r)) => r.point.impulse,
+                        _ => Vec2::ZERO,
+                    }
+                };
+                LaneWarm {
+                    angle: angle[k],
+                    point,
+                    masses: PairMass {
+                        a: InvMass {
+                            inv_mass: m.inv_mass_a.lane(k),
+                            inv_inertia: m.inv_inertia_a.lane(k),
+                        },
+                        b: InvMass {
+                            inv_mass: m.inv_mass_b.lane(k),
+                            inv_inertia: m.inv_inertia_b.lane(k),
+                        },
+                    },
+                    frames: (
+                        Vec2::new(chunk.frames.0.x.lane(k), chunk.frames.0.y.lane(k)),
+                        Vec2::new(chunk.frames.1.x.lane(k), chunk.frames.1.y.lane(k)),
+                    ),
+                }
             })
         };
         // Fewer chunks than two blocks: one block, which runs on the caller.
