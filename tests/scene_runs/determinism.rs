@@ -200,6 +200,46 @@ fn benchmark_snapshots_are_identical_for_any_thread_count() {
     }
 }
 
+/// A world restored from a snapshot continues as the original does, its
+/// broadphase tree included: washer (most proxies move, so most steps
+/// refit the tree and one in `TREE_REBUILD_PERIOD` rebuilds it) saved at
+/// step 13 and decoded, then both stepped 20 more (past two rebuild
+/// steps): the same snapshot bytes. A choice between refit and rebuild
+/// kept outside the snapshot would give the restored world another tree.
+#[cfg(feature = "serde")]
+#[test]
+fn a_restored_world_continues_with_the_original_tree() {
+    const { assert!(janus2d::world::dynamic_tree::TREE_REBUILD_PERIOD <= 10) };
+    let desc = janus2d_testbed::benchmarks::by_name("washer").expect("a benchmark scene");
+    let mut original = janus2d_testbed::janus::Janus::new(&desc)
+        .expect("scene builds")
+        .world;
+    let dt = desc.settings.dt as janus2d::prelude::Real;
+    for _ in 0..13 {
+        original.step(dt).unwrap();
+    }
+    let bytes = original.snapshot().to_bytes();
+    let mut restored = janus2d::world::Snapshot::from_bytes(&bytes)
+        .expect("a snapshot's bytes")
+        .to_world();
+    for _ in 0..20 {
+        original.step(dt).unwrap();
+        restored.step(dt).unwrap();
+    }
+    let (a, b) = (
+        original.snapshot().to_bytes(),
+        restored.snapshot().to_bytes(),
+    );
+    let first = a.iter().zip(&b).skip(24).position(|(x, y)| x != y);
+    assert!(
+        a == b,
+        "{} bytes against {}, first payload difference at {:?}",
+        b.len(),
+        a.len(),
+        first.map(|p| p + 24)
+    );
+}
+
 /// The testbed's every-joint-kind scene
 /// ([`janus2d_testbed::support::every_joint_kind_world`]: 512 joints, so
 /// the joint prepare and colours take their blocked paths on the team),

@@ -52,7 +52,9 @@ use janus2d_core::geometry::Aabb;
 use janus2d_core::math::{Real, Vec2};
 use janus2d_core::parallel::Team;
 
-pub use crate::dynamic_tree::{DEFAULT_AABB_MARGIN, DynamicTree, FilterBits, NULL_NODE};
+pub use crate::dynamic_tree::{
+    BulkFinish, DEFAULT_AABB_MARGIN, DynamicTree, FilterBits, NULL_NODE,
+};
 
 /// [`BroadPhase::update_pairs`] switches from per-proxy queries to one
 /// simultaneous tree descent when at least `1 / BULK_DIVISOR` of the proxies
@@ -410,8 +412,14 @@ impl BroadPhase {
     /// [`finish_moves`](Self::finish_moves) with a whole-tree rebuild's
     /// spans built on `team`; the tree is the same for any team.
     pub fn finish_moves_on(&mut self, team: &Team) {
+        self.finish_moves_with(team, BulkFinish::Rebuild);
+    }
+
+    /// [`finish_moves_on`](Self::finish_moves_on), a batch of many moves
+    /// finished as `bulk` says (rebuilt, or refitted in its shape).
+    pub fn finish_moves_with(&mut self, team: &Team, bulk: BulkFinish) {
         self.dynamic_tree
-            .finish_enlarged(&mut self.rebuild_items, team);
+            .finish_enlarged_with(&mut self.rebuild_items, team, bulk);
     }
 
     /// Whether the batch so far moved enough proxies for

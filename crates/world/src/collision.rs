@@ -28,9 +28,10 @@ use janus2d_core::geometry::Shape;
 use janus2d_core::math::{Real, Transform, Vec2};
 use janus2d_core::parallel::Team;
 
-use crate::broadphase::BroadPhase;
+use crate::broadphase::{BroadPhase, BulkFinish};
 pub use crate::contacts::CollisionEvents;
 use crate::contacts::{Contact, ContactPointData, ContactSet};
+use crate::dynamic_tree::TREE_REBUILD_PERIOD;
 use crate::hooks::Hooks;
 use crate::joints::NoCollide;
 use crate::shapes::{ShapeData, ShapeDef, ShapeHandle, ShapeStore};
@@ -579,6 +580,7 @@ impl Collision {
     pub(crate) fn end_step<R>(
         &mut self,
         bodies: &mut BodySet,
+        step: u64,
         dt: Real,
         store: impl FnOnce(&mut ContactSet, &Team, &mut dyn FnMut()),
         advance: impl FnOnce(&mut BodySet, &ShapeStore, &BroadPhase, &Team) -> R,
@@ -598,9 +600,15 @@ impl Collision {
                 || moved = Self::update_proxies_by_body(shapes, broadphase, bodies, dt);
             store(&mut self.contacts, team, &mut beside);
         }
-        // A batch of many moves left the whole tree to rebuild: its spans
-        // on the team, now that the store is done.
-        self.broadphase.finish_moves_on(team);
+        // A batch of many moves left the whole tree to finish: rebuilt (its
+        // spans on the team, now that the store is done) on every
+        // TREE_REBUILD_PERIOD-th step, refitted in its shape on the others.
+        let bulk = if step.is_multiple_of(TREE_REBUILD_PERIOD) {
+            BulkFinish::Rebuild
+        } else {
+            BulkFinish::Refit
+        };
+        self.broadphase.finish_moves_with(team, bulk);
         self.counters.proxies_moved = moved;
         out
     }

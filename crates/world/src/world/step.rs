@@ -311,6 +311,7 @@ impl World {
             let (builder, solver) = (&self.contact_builder, &self.contact_solver);
             let continuous_time = self.collision.end_step(
                 &mut self.bodies,
+                self.step_count,
                 dt,
                 |contacts, team, beside| builder.store_impulses(contacts, solver, team, beside),
                 |bodies, shapes, broadphase, team| {
