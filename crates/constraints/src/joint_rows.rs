@@ -607,6 +607,17 @@ impl<'s> WarmSide<'s> {
         }
     }
 
+    /// A revolute joint's share: the angle rows' summed kept impulse
+    /// `angle` (N·m·s), then the point's `p` (N·s) at the body's current
+    /// arm from `frames` (the anchors' arms at the step's start). One
+    /// joint's warm start and its lane's (`revolute_lanes::LaneWarm`) both
+    /// run it.
+    #[inline(always)]
+    pub(crate) fn hinge(&mut self, angle: Real, frames: (Vec2, Vec2), p: Vec2) {
+        self.angle(angle);
+        self.point(frames, p);
+    }
+
     /// A kept impulse `λ` along a linear row stored at the last solve.
     #[inline(always)]
     pub(crate) fn linear(&mut self, row: &AxisRow, lambda: Real) {

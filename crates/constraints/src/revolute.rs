@@ -319,16 +319,6 @@ impl Switches {
 /// by the mass ratio `ρ = min((m_a⁻¹ + m_b⁻¹) / min(m_a⁻¹, m_b⁻¹), ρ_max)`
 /// (`ρ_max` when one body is static). Used by the solve and reported by
 /// `rows()`, so both see the same rows.
-/// A revolute joint's warm start on one body: the angle rows' summed kept
-/// impulse `angle` (N·m·s), then the point's `point` (N·s) at the body's
-/// current arm from `frames` (the anchors' arms at the step's start). The
-/// one joint's warm start and its lane's ([`LaneWarm`]) both run it.
-#[inline(always)]
-pub(crate) fn warm_rows_at(w: &mut WarmSide<'_>, frames: (Vec2, Vec2), angle: Real, point: Vec2) {
-    w.angle(angle);
-    w.point(frames, point);
-}
-
 fn point_softness(def: &RevoluteJointDef, ctx: &StepContext, m: &PairMass) -> Softness {
     def.base.rigid_softness(ctx, m.a.inv_mass, m.b.inv_mass)
 }
@@ -537,10 +527,9 @@ impl KindRows for RevoluteJoint {
     /// rows' sum, then the point at the body's current arm.
     #[inline(always)]
     fn warm_rows(&self, w: &mut WarmSide<'_>) {
-        warm_rows_at(
-            w,
-            (self.point.frame_a, self.point.frame_b),
+        w.hinge(
             self.spring.impulse + self.motor.impulse + self.lower.impulse - self.upper.impulse,
+            (self.point.frame_a, self.point.frame_b),
             self.point.impulse,
         );
     }

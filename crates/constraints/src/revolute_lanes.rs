@@ -126,11 +126,10 @@ pub(crate) struct LaneWarm {
 
 impl LaneWarm {
     /// Body `st`'s share (`side_b`: body b, else a) of the joint's warm
-    /// start: the arithmetic of one joint's ([`crate::revolute::warm_rows_at`]).
+    /// start: the arithmetic of one joint's ([`WarmSide::hinge`]).
     #[inline(always)]
     pub(crate) fn warm_start_side(&self, st: &mut BodyState, side_b: bool) {
-        let mut w = WarmSide::new(st, self.masses, side_b);
-        crate::revolute::warm_rows_at(&mut w, self.frames, self.angle, self.point);
+        WarmSide::new(st, self.masses, side_b).hinge(self.angle, self.frames, self.point);
     }
 }
 
