@@ -187,15 +187,7 @@ fn benchmark_snapshots_are_identical_for_any_thread_count() {
     for threads in [2, 4] {
         let other = on_threads(threads, bytes);
         for (k, (a, b)) in one.iter().zip(&other).enumerate() {
-            // (Bytes 16..24 are the payload's checksum.)
-            let first = a.iter().zip(b).skip(24).position(|(x, y)| x != y);
-            assert!(
-                a == b,
-                "scene {k}, {threads} threads: {} bytes against {}, first payload difference at {:?}",
-                b.len(),
-                a.len(),
-                first.map(|p| p + 24)
-            );
+            assert_same_bytes(a, b, &format!("scene {k}, {threads} threads"));
         }
     }
 }
@@ -226,14 +218,22 @@ fn a_restored_world_continues_with_the_original_tree() {
         original.step(dt).unwrap();
         restored.step(dt).unwrap();
     }
-    let (a, b) = (
-        original.snapshot().to_bytes(),
-        restored.snapshot().to_bytes(),
+    assert_same_bytes(
+        &original.snapshot().to_bytes(),
+        &restored.snapshot().to_bytes(),
+        "restored",
     );
-    let first = a.iter().zip(&b).skip(24).position(|(x, y)| x != y);
+}
+
+/// Asserts two snapshots' bytes are the same, naming the first payload
+/// byte that differs (bytes 16..24 of the header are the payload's
+/// checksum, so they differ whenever the payload does).
+#[cfg(feature = "serde")]
+fn assert_same_bytes(a: &[u8], b: &[u8], what: &str) {
+    let first = a.iter().zip(b).skip(24).position(|(x, y)| x != y);
     assert!(
         a == b,
-        "{} bytes against {}, first payload difference at {:?}",
+        "{what}: {} bytes against {}, first payload difference at {:?}",
         b.len(),
         a.len(),
         first.map(|p| p + 24)

@@ -1938,6 +1938,26 @@ pub(crate) mod test_util {
     }
 
     /// The payloads `tree.query` reports for `probe`, sorted.
+    /// `count` random boxes within `size` (the `q`-th fattened by
+    /// `1 + q·grow`) queried in `tree`: each finds exactly the leaves of
+    /// `ids` (leaf `i` is `ids[i]`, payload `i`) whose fat boxes overlap it.
+    pub(crate) fn queries_match_brute_force(
+        tree: &super::DynamicTree,
+        ids: &[u32],
+        rng: &mut Lcg,
+        (count, size, grow): (usize, Real, Real),
+        round: usize,
+    ) {
+        for q in 0..count {
+            let probe = random_box(rng, size).fattened(1.0 + q as Real * grow);
+            let found = sorted_query(tree, &probe);
+            let expected: Vec<u32> = (0..ids.len() as u32)
+                .filter(|&i| tree.fat_aabb(ids[i as usize]).overlaps(&probe))
+                .collect();
+            assert_eq!(found, expected, "round {round}, query {q}");
+        }
+    }
+
     pub(crate) fn sorted_query(tree: &super::DynamicTree, probe: &Aabb) -> Vec<u32> {
         let mut found = Vec::new();
         tree.query(probe, |u| {
@@ -1951,7 +1971,9 @@ pub(crate) mod test_util {
 
 #[cfg(test)]
 mod tests {
-    use super::test_util::{Lcg, boxed, random_box, sorted_query, translate};
+    use super::test_util::{
+        Lcg, boxed, queries_match_brute_force, random_box, sorted_query, translate,
+    };
     use super::*;
 
     /// A tree decoded from crafted bytes may hold any index: the check
@@ -2068,14 +2090,7 @@ mod tests {
             if finish == BulkFinish::Refit {
                 assert_eq!(shape(&tree), before, "round {round}: the shape kept");
             }
-            for q in 0..40 {
-                let probe = random_box(&mut rng, 110.0).fattened(1.0 + q as Real * 0.2);
-                let found = sorted_query(&tree, &probe);
-                let expected: Vec<u32> = (0..boxes.len() as u32)
-                    .filter(|&i| tree.fat_aabb(ids[i as usize]).overlaps(&probe))
-                    .collect();
-                assert_eq!(found, expected, "round {round}, query {q}");
-            }
+            queries_match_brute_force(&tree, &ids, &mut rng, (40, 110.0, 0.2), round);
         }
     }
 
@@ -2145,14 +2160,7 @@ mod tests {
                     "round {round}"
                 );
             }
-            for q in 0..50 {
-                let probe = random_box(&mut rng, 120.0).fattened(1.0 + q as Real * 0.1);
-                let found = sorted_query(&deferred, &probe);
-                let expected: Vec<u32> = (0..boxes.len() as u32)
-                    .filter(|&i| deferred.fat_aabb(ids[i as usize]).overlaps(&probe))
-                    .collect();
-                assert_eq!(found, expected, "round {round}, query {q}");
-            }
+            queries_match_brute_force(&deferred, &ids, &mut rng, (50, 120.0, 0.1), round);
         }
     }
 
