@@ -569,13 +569,15 @@ impl Collision {
     /// proxies that left their boxes (`beside`, the serial part of the
     /// proxy update: it shares no data with the contacts) and, when they
     /// are few, rebuilds the part of the tree they grew. When a quarter of
-    /// the proxies or more moved, the whole tree is rebuilt after the
-    /// store, its spans on the team ([`BroadPhase::finish_moves_on`]).
+    /// the proxies or more moved, the whole tree is finished after the
+    /// store: on a step whose count `step` is a multiple of
+    /// [`TREE_REBUILD_PERIOD`] rebuilt, its spans on the team, on the
+    /// others refitted in its shape ([`BroadPhase::finish_moves_with`]).
     /// Each on the step's team. Returns what `advance` returned.
     ///
     /// ```text
-    /// team:    advance ─ boxes ─┬─ store (blocks of contacts) ──────┬─ whole tree (many moved)
-    /// leader:                   └─ proxy moves, part of the tree ───┘
+    /// team:    advance ─ boxes ─┬─ store (blocks of contacts) ──────┬─ whole tree (many moved):
+    /// leader:                   └─ proxy moves, part of the tree ───┘  rebuilt 1 step in 8, else refitted
     /// ```
     pub(crate) fn end_step<R>(
         &mut self,

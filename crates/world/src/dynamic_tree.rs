@@ -58,7 +58,7 @@
 //! | `create_proxy`, `destroy_proxy`      | O(log n); ids are node indices, stable until destroyed   |
 //! | `move_proxy`                         | one `contains` test; re-insert only when it fails        |
 //! | `enlarge_proxy`, then `rebuild`      | a batch of moves: ancestors only grow and are marked; one partial top-down rebuild of the marked nodes (as Box2D v3) |
-//! | `enlarge_leaf_with_margin`, then `finish_enlarged` | the same with the ancestors' growth deferred to the batch's end; a batch that moved a quarter of the proxies or more rebuilds the whole tree from its leaves instead, its spans on a team |
+//! | `enlarge_leaf_with_margin`, then `finish_enlarged` | the same with the ancestors' growth deferred to the batch's end; a batch that moved a quarter of the proxies or more rebuilds the whole tree from its leaves instead, its spans on a team, or (`finish_enlarged_with`, [`BulkFinish::Refit`]) refits every internal box in the tree's shape |
 //! | insert / remove a leaf               | best sibling by perimeter, then refit and rotate upwards |
 //! | `query`, `query_proxies`             | O(log n + k), iterative, stops when the callback says so |
 //! | `ray_query`                          | the boxes a segment touches (slab test per node)         |
@@ -123,9 +123,9 @@ pub const FULL_REBUILD_DIVISOR: usize = 4;
 /// more) rebuild the whole tree comes once in this many; the others refit
 /// the tree in its shape ([`BulkFinish`]; the world chooses at the end of
 /// its step). A refit costs about a third of a rebuild, and the shape a
-/// rebuild gave stays good for a few steps of motion. `perf` samples of janus2d alone, one thread, the tree's
-/// rebuild or refit, the marks and the pair search together, every step
-/// rebuilt → one in eight: rain 6,471 → 3,489, joint_grid 1,415 → 448,
+/// rebuild gave stays good for a few steps of motion. `perf` samples of
+/// janus2d alone, one thread, the tree's rebuild or refit, the marks and
+/// the pair search together, every step rebuilt → one in eight: rain 6,471 → 3,489, joint_grid 1,415 → 448,
 /// spinner 6,744 → 6,098, washer 7,656 → 6,550, tumbler 2,553 → 2,195,
 /// smash 2,781 → 2,259 (the pair search itself within 3%). A period, not
 /// a measure of the tree's looseness, so that the choice depends on the
