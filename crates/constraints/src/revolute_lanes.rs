@@ -25,7 +25,9 @@
 //!                               Rot::relative_angle reads); spring, motor, lower, upper,
 //!                               then the point block where the joint is in no
 //!                               tree, on the lanes; scatter v, ω where the body moves
-//! warm start (per body)         a lane joint's impulses read from its lane
+//! warm start (per body)         a lane joint's impulses, masses and arms read from
+//!                               its lane's warm record (gathered once a substep),
+//!                               not from the joint
 //! store (end of the step)       the lanes' impulses back into the joints
 //! ```
 //!

@@ -406,17 +406,12 @@ impl BroadPhase {
     /// whole when many moved ([`DynamicTree::finish_enlarged`]), on the
     /// caller.
     pub fn finish_moves(&mut self) {
-        self.finish_moves_on(&Team::serial());
+        self.finish_moves_with(&Team::serial(), BulkFinish::Rebuild);
     }
 
-    /// [`finish_moves`](Self::finish_moves) with a whole-tree rebuild's
-    /// spans built on `team`; the tree is the same for any team.
-    pub fn finish_moves_on(&mut self, team: &Team) {
-        self.finish_moves_with(team, BulkFinish::Rebuild);
-    }
-
-    /// [`finish_moves_on`](Self::finish_moves_on), a batch of many moves
-    /// finished as `bulk` says (rebuilt, or refitted in its shape).
+    /// [`finish_moves`](Self::finish_moves), a batch of many moves finished
+    /// as `bulk` says: rebuilt, its spans on `team` (the tree is the same
+    /// for any team), or refitted in its shape.
     pub fn finish_moves_with(&mut self, team: &Team, bulk: BulkFinish) {
         self.dynamic_tree
             .finish_enlarged_with(&mut self.rebuild_items, team, bulk);

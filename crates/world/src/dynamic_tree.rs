@@ -695,6 +695,9 @@ impl DynamicTree {
     /// filter bits), children before parents: every box again exactly the
     /// union of its children's, the shape kept.
     fn refit_all(&mut self) {
+        if self.root == NULL_NODE {
+            return;
+        }
         let mut order = std::mem::take(&mut self.refit_order);
         order.clear();
         let mut stack = NodeStack::new(self.root);
