@@ -389,10 +389,18 @@ pub struct DynamicTree {
     /// between batches (so never in a snapshot).
     #[cfg_attr(feature = "serde", serde(skip))]
     pending: Vec<u32>,
-    /// Scratch of [`DynamicTree::refit_all`]: the internal nodes, parents
-    /// before children.
+    /// The internal nodes in an order that puts children before parents,
+    /// for [`DynamicTree::refit_all`]; valid while `refit_order_ready`.
+    /// Derived from the links, so not in a snapshot.
     #[cfg_attr(feature = "serde", serde(skip))]
     refit_order: Vec<u32>,
+    /// Whether `refit_order` lists the internal nodes of the tree as it
+    /// is. Every change to a link clears it; a whole rebuild sets it with
+    /// its internal slots in ascending order (each span's root after its
+    /// children's), and the first refit after any other change sets it
+    /// from a walk of the tree.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    refit_order_ready: bool,
 }
 
 impl Default for DynamicTree {
@@ -422,6 +430,7 @@ impl DynamicTree {
             margin,
             pending: Vec::new(),
             refit_order: Vec::new(),
+            refit_order_ready: false,
         }
     }
 
@@ -694,26 +703,36 @@ impl DynamicTree {
     /// Recomputes every internal node from its children (boxes, heights,
     /// filter bits), children before parents: every box again exactly the
     /// union of its children's, the shape kept.
+    ///
+    /// The order is kept from one refit to the next while no link
+    /// changes: after a whole rebuild it is the internal slots ascending
+    /// (read from memory in order), otherwise a walk from the root
+    /// reversed, made once. Any order with children first gives the same
+    /// boxes.
     fn refit_all(&mut self) {
         if self.root == NULL_NODE {
             return;
         }
         let mut order = std::mem::take(&mut self.refit_order);
-        order.clear();
-        let mut stack = NodeStack::new(self.root);
-        while let Some(index) = stack.pop() {
-            let node = &self.nodes[index as usize];
-            if node.is_leaf() {
-                continue;
+        if !self.refit_order_ready {
+            order.clear();
+            let mut stack = NodeStack::new(self.root);
+            while let Some(index) = stack.pop() {
+                let node = &self.nodes[index as usize];
+                if node.is_leaf() {
+                    continue;
+                }
+                order.push(index);
+                stack.push(node.child1);
+                stack.push(node.child2);
             }
-            order.push(index);
-            stack.push(node.child1);
-            stack.push(node.child2);
+            order.reverse();
         }
-        for &index in order.iter().rev() {
+        for &index in &order {
             self.refit(index);
         }
         self.refit_order = order;
+        self.refit_order_ready = true;
     }
 
     /// Grows the ancestors of leaf `id` to cover its box, marking them.
@@ -760,7 +779,11 @@ impl DynamicTree {
     /// ```
     fn rebuild_from_leaves(&mut self, items: &mut Vec<(Vec2, u32)>, team: &Team) {
         items.clear();
-        let mut slots = Vec::with_capacity(self.proxy_count as usize);
+        // The internal slots in node order: the next refits' order, kept
+        // below.
+        let mut slots = std::mem::take(&mut self.refit_order);
+        slots.clear();
+        self.refit_order_ready = false;
         let nodes = &self.nodes[..];
         if team.threads() == 1 || nodes.len() < 2 * SCAN_BLOCK {
             scan_nodes(nodes, 0, items, &mut slots);
@@ -783,6 +806,7 @@ impl DynamicTree {
         }
         let n = items.len();
         if n == 0 {
+            self.refit_order = slots;
             return;
         }
         debug_assert_eq!(slots.len() + 1, n, "a full tree has n - 1 internal nodes");
@@ -830,11 +854,17 @@ impl DynamicTree {
         for &id in top.iter().rev() {
             self.refit(id);
         }
+        // Each span's root slot follows its children's: ascending, the
+        // internal slots put children first (the refits' order until a
+        // link changes).
+        self.refit_order = slots;
+        self.refit_order_ready = true;
     }
 
     /// Hangs `id` under `parent` as its first or second child (or makes it
     /// the root when `parent` is [`NULL_NODE`]).
     fn place(&mut self, id: u32, parent: u32, first: bool) {
+        self.refit_order_ready = false;
         self.nodes[id as usize].parent = parent;
         if parent == NULL_NODE {
             self.root = id;
@@ -880,6 +910,7 @@ impl DynamicTree {
     /// the items with their boxes' centres and joins them again top down
     /// under a new root.
     fn rejoin(&mut self, items: &mut Vec<(Vec2, u32)>, whole: bool) {
+        self.refit_order_ready = false;
         let mut stack = NodeStack::new(self.root);
         while let Some(index) = stack.pop() {
             let node = self.nodes[index as usize];
@@ -909,6 +940,7 @@ impl DynamicTree {
     /// root. The centres travel with the ids, so each split reads one
     /// contiguous array rather than every item's node.
     fn build_top_down(&mut self, items: &mut [(Vec2, u32)]) -> u32 {
+        self.refit_order_ready = false;
         if items.len() == 1 {
             return items[0].1;
         }
@@ -1362,6 +1394,7 @@ impl DynamicTree {
     }
 
     fn allocate_node(&mut self) -> u32 {
+        self.refit_order_ready = false;
         if self.free_list != NULL_NODE {
             let id = self.free_list;
             let node = &mut self.nodes[id as usize];
@@ -1385,6 +1418,7 @@ impl DynamicTree {
     }
 
     fn free_node(&mut self, id: u32) {
+        self.refit_order_ready = false;
         self.nodes[id as usize] = Node {
             parent: self.free_list,
             ..Node::EMPTY
@@ -1439,6 +1473,7 @@ impl DynamicTree {
     }
 
     fn insert_leaf(&mut self, leaf: u32) {
+        self.refit_order_ready = false;
         if self.root == NULL_NODE {
             self.root = leaf;
             self.nodes[leaf as usize].parent = NULL_NODE;
@@ -1471,6 +1506,7 @@ impl DynamicTree {
     }
 
     fn remove_leaf(&mut self, leaf: u32) {
+        self.refit_order_ready = false;
         if leaf == self.root {
             self.root = NULL_NODE;
             return;
@@ -1492,6 +1528,7 @@ impl DynamicTree {
 
     #[inline]
     fn replace_child(&mut self, parent: u32, old: u32, new: u32) {
+        self.refit_order_ready = false;
         let p = &mut self.nodes[parent as usize];
         if p.child1 == old {
             p.child1 = new;
@@ -2058,13 +2095,17 @@ mod tests {
     /// node's parent and children as they were) and leaves it sound: each
     /// internal box exactly its children's union, heights and bits right
     /// (`check`), and every query answered as a brute-force scan answers
-    /// it; a rebuild after a few refits is sound too.
+    /// it; a rebuild after a few refits is sound too. The refits' kept
+    /// order is exercised each way: from a walk (the first rounds), from a
+    /// whole rebuild's slots (after round 3), and again from a walk after
+    /// proxies were destroyed and created (round 5), each reused once
+    /// more.
     #[test]
     fn refitted_bulk_batches_keep_the_shape_and_answer_queries() {
         let mut rng = Lcg(11);
         let mut tree = DynamicTree::new();
         let mut boxes: Vec<Aabb> = (0..2000).map(|_| random_box(&mut rng, 100.0)).collect();
-        let ids: Vec<u32> = boxes
+        let mut ids: Vec<u32> = boxes
             .iter()
             .enumerate()
             .map(|(i, b)| tree.create_proxy(*b, i as u32))
@@ -2075,17 +2116,24 @@ mod tests {
                 .map(|n| (n.parent, n.child1, n.child2))
                 .collect()
         };
-        for round in 0..4 {
+        for round in 0..8 {
+            if round == 5 {
+                // Links change: every tenth proxy out and in again.
+                for i in (0..boxes.len()).step_by(10) {
+                    tree.destroy_proxy(ids[i]);
+                    ids[i] = tree.create_proxy(boxes[i], i as u32);
+                }
+            }
             for (i, b) in boxes.iter_mut().enumerate() {
                 let d = Vec2::new(rng.range(-3.0, 3.0), rng.range(-3.0, 3.0));
                 *b = translate(*b, d);
                 tree.enlarge_leaf_with_margin(ids[i], *b, 0.1);
             }
             assert!(tree.pending_is_bulk(), "round {round}");
-            let finish = if round < 3 {
-                BulkFinish::Refit
-            } else {
+            let finish = if round == 3 || round == 7 {
                 BulkFinish::Rebuild
+            } else {
+                BulkFinish::Refit
             };
             let before = shape(&tree);
             tree.finish_enlarged_with(&mut Vec::new(), &Team::serial(), finish);
