@@ -583,7 +583,8 @@ fn first_impact(
             .union(&geometry.compute_aabb(&xf2));
         let centroid = geometry.centroid();
         let (c1, c2) = (xf1.apply(centroid), xf2.apply(centroid));
-        let shape_min = shape_extent(geometry, centroid).min_extent;
+        // Read only against a chain segment or at a touch at the start.
+        let shape_min = || shape_extent(geometry, centroid).min_extent;
         candidates.clear();
         bp.static_tree().query(&swept, |proxy| {
             candidates.push(bp.payload(proxy));
@@ -640,7 +641,7 @@ fn first_impact(
                 let p2 = xf.apply(chain.segment.point2);
                 let n = xf.q.rotate(chain.normal());
                 let (o1, o2) = ((c1 - p1).dot(n), (c2 - p1).dot(n));
-                if o2 > 0.0 || o1 == o2 || o1 < -HUG_FRACTION * shape_min {
+                if o2 > 0.0 || o1 == o2 || o1 < -HUG_FRACTION * shape_min() {
                     continue; // ends in front, or started well behind
                 }
                 let e = p2 - p1;
@@ -678,7 +679,7 @@ fn first_impact(
                 // Touching at the start: a small disc at the centroid
                 // still must not pass (Box2D's fallback).
                 let mut small = ShapeProxy::point(centroid);
-                small.radius = 0.25 * shape_min;
+                small.radius = 0.25 * shape_min();
                 *toi_calls += 1;
                 let out = time_of_impact(&other_proxy, &other_sweep, &small, sweep, best);
                 if out.fraction > 0.0 && out.fraction < best && usable(out.state) {
