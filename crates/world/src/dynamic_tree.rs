@@ -1176,11 +1176,33 @@ impl DynamicTree {
     /// walked up to the first node already marked, so the cost is the
     /// number of marked nodes. The pair descents take these marks to skip
     /// node pairs with no marked leaf on either side.
-    pub(crate) fn mark_paths(&self, leaves: impl Iterator<Item = u32>, marks: &mut Vec<bool>) {
+    ///
+    /// When a quarter of the proxies or more are listed and the refits'
+    /// order is kept (see [`DynamicTree::refit_all`]), the internal marks
+    /// are made in that order instead, each node's from its children's:
+    /// the same marks, from one pass in memory order rather than a walk of
+    /// parent links from each leaf.
+    pub(crate) fn mark_paths(
+        &self,
+        leaves: impl Iterator<Item = u32> + Clone,
+        marks: &mut Vec<bool>,
+    ) {
         marks.clear();
         marks.resize(self.nodes.len(), false);
+        let mut count = 0;
+        for leaf in leaves.clone() {
+            marks[leaf as usize] = true;
+            count += 1;
+        }
+        if self.refit_order_ready && count * FULL_REBUILD_DIVISOR >= self.proxy_count as usize {
+            for &index in &self.refit_order {
+                let node = &self.nodes[index as usize];
+                marks[index as usize] = marks[node.child1 as usize] || marks[node.child2 as usize];
+            }
+            return;
+        }
         for leaf in leaves {
-            let mut index = leaf;
+            let mut index = self.nodes[leaf as usize].parent;
             while index != NULL_NODE && !marks[index as usize] {
                 marks[index as usize] = true;
                 index = self.nodes[index as usize].parent;
@@ -2142,6 +2164,41 @@ mod tests {
                 assert_eq!(shape(&tree), before, "round {round}: the shape kept");
             }
             queries_match_brute_force(&tree, &ids, &mut rng, (40, 110.0, 0.2), round);
+        }
+    }
+
+    /// The marks of a bulk batch made in the refits' kept order are the
+    /// marks of walking each listed leaf's path: after a refit (the order
+    /// from a walk of the tree) and after a whole rebuild (the order from
+    /// its slots), for every second and every third leaf listed.
+    #[test]
+    fn marks_in_the_refit_order_are_the_walked_paths() {
+        let mut rng = Lcg(23);
+        let mut tree = DynamicTree::new();
+        let mut boxes: Vec<Aabb> = (0..3000).map(|_| random_box(&mut rng, 100.0)).collect();
+        let ids: Vec<u32> = boxes
+            .iter()
+            .enumerate()
+            .map(|(i, b)| tree.create_proxy(*b, i as u32))
+            .collect();
+        for finish in [BulkFinish::Refit, BulkFinish::Rebuild] {
+            for (i, b) in boxes.iter_mut().enumerate() {
+                *b = translate(*b, Vec2::new(rng.range(-3.0, 3.0), rng.range(-3.0, 3.0)));
+                tree.enlarge_leaf_with_margin(ids[i], *b, 0.1);
+            }
+            tree.finish_enlarged_with(&mut Vec::new(), &Team::serial(), finish);
+            assert!(tree.refit_order_ready, "{finish:?}: the order kept");
+            let mut walked_tree = tree.clone();
+            walked_tree.refit_order_ready = false;
+            for stride in [2, 3] {
+                let listed = ids.iter().copied().step_by(stride);
+                let (mut ordered, mut walked) = (Vec::new(), Vec::new());
+                tree.mark_paths(listed.clone(), &mut ordered);
+                walked_tree.mark_paths(listed, &mut walked);
+                assert_eq!(ordered, walked, "{finish:?}, every {stride}th leaf");
+                let count = ordered.iter().filter(|&&m| m).count();
+                assert!(count > ids.len() / stride, "{finish:?}: {count} marks");
+            }
         }
     }
 
