@@ -1221,32 +1221,13 @@ impl DynamicTree {
         &self,
         marks: &[bool],
         stack: &mut Vec<(u32, u32)>,
-        mut f: F,
+        f: F,
     ) {
         stack.clear();
         if self.root == NULL_NODE {
             return;
         }
-        stack.push((self.root, self.root));
-        while let Some((a, b)) = stack.pop() {
-            if !(marked(marks, a) || marked(marks, b)) {
-                continue;
-            }
-            let na = &self.nodes[a as usize];
-            if a == b {
-                if !na.is_leaf() && na.bits.may_pair(na.bits) {
-                    stack.push((na.child1, na.child2));
-                    stack.push((na.child2, na.child2));
-                    stack.push((na.child1, na.child1));
-                }
-                continue;
-            }
-            let nb = &self.nodes[b as usize];
-            if !na.bits.may_pair(nb.bits) || !na.aabb.overlaps(&nb.aabb) {
-                continue;
-            }
-            Self::descend(na, a, nb, b, stack, &mut f);
-        }
+        self.for_each_pair_from(None, marks, (self.root, self.root), stack, f);
     }
 
     /// Calls `f(user_self, user_other)` for every pair of a proxy of `self`
@@ -1259,23 +1240,14 @@ impl DynamicTree {
         marks: &[bool],
         other_marks: &[bool],
         stack: &mut Vec<(u32, u32)>,
-        mut f: F,
+        f: F,
     ) {
         stack.clear();
         if self.root == NULL_NODE || other.root == NULL_NODE {
             return;
         }
-        stack.push((self.root, other.root));
-        while let Some((a, b)) = stack.pop() {
-            if !(marked(marks, a) || marked(other_marks, b)) {
-                continue;
-            }
-            let na = &self.nodes[a as usize];
-            let nb = &other.nodes[b as usize];
-            if na.bits.may_pair(nb.bits) && na.aabb.overlaps(&nb.aabb) {
-                Self::descend(na, a, nb, b, stack, &mut f);
-            }
-        }
+        let seed = (self.root, other.root);
+        self.for_each_pair_from(Some((other, other_marks)), marks, seed, stack, f);
     }
 
     /// Starting points of the simultaneous descent that
@@ -1344,7 +1316,14 @@ impl DynamicTree {
     /// The descent of [`DynamicTree::for_each_self_pair`] (`other: None`)
     /// or [`DynamicTree::for_each_cross_pair`] from one seed of
     /// [`DynamicTree::pair_seeds`].
-    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
+    ///
+    /// A node pair goes on the stack only once it has passed its test (a
+    /// mark on either side, filters that may pair, boxes that overlap; for
+    /// a node against itself, its mark and its own filter): the two
+    /// children of a split node are read and tested together, so their
+    /// loads overlap, and a pair that fails is never pushed. The pairs
+    /// that pass are pushed in the order they always were, so the leaf
+    /// pairs are reported in the order of testing after popping.
     pub(crate) fn for_each_pair_from<F: FnMut(u32, u32)>(
         &self,
         other: Option<(&DynamicTree, &[bool])>,
@@ -1354,56 +1333,78 @@ impl DynamicTree {
         mut f: F,
     ) {
         let (b_tree, b_marks) = other.unwrap_or((self, marks));
-        let other = other.map(|(tree, _)| tree);
+        let within = other.is_none();
+        let a_nodes = &self.nodes[..];
+        let b_nodes = &b_tree.nodes[..];
+        // The test of a pair of distinct nodes (or of two trees' nodes).
+        let passes = |na: &Node, a: u32, nb: &Node, b: u32| {
+            (marked(marks, a) || marked(b_marks, b))
+                && na.bits.may_pair(nb.bits)
+                && na.aabb.overlaps(&nb.aabb)
+        };
+        // A node against itself: worth descending when marked, internal,
+        // and its leaves' filters may pair among themselves.
+        let passes_alone =
+            |n: &Node, i: u32| marked(marks, i) && !n.is_leaf() && n.bits.may_pair(n.bits);
         stack.clear();
+        let (a, b) = seed;
+        let seed_passes = if within && a == b {
+            passes_alone(&a_nodes[a as usize], a)
+        } else {
+            passes(&a_nodes[a as usize], a, &b_nodes[b as usize], b)
+        };
+        if !seed_passes {
+            return;
+        }
         stack.push(seed);
         while let Some((a, b)) = stack.pop() {
-            if !(marked(marks, a) || marked(b_marks, b)) {
-                continue;
-            }
-            let na = &self.nodes[a as usize];
-            if other.is_none() && a == b {
-                if !na.is_leaf() && na.bits.may_pair(na.bits) {
-                    stack.push((na.child1, na.child2));
-                    stack.push((na.child2, na.child2));
-                    stack.push((na.child1, na.child1));
+            let na = &a_nodes[a as usize];
+            if within && a == b {
+                // (Internal: tested before it was pushed.)
+                let (c1, c2) = (na.child1, na.child2);
+                let (n1, n2) = (&a_nodes[c1 as usize], &a_nodes[c2 as usize]);
+                if passes(n1, c1, n2, c2) {
+                    stack.push((c1, c2));
+                }
+                if passes_alone(n2, c2) {
+                    stack.push((c2, c2));
+                }
+                if passes_alone(n1, c1) {
+                    stack.push((c1, c1));
                 }
                 continue;
             }
-            let nb = &b_tree.nodes[b as usize];
-            if !na.bits.may_pair(nb.bits) || !na.aabb.overlaps(&nb.aabb) {
-                continue;
+            let nb = &b_nodes[b as usize];
+            let split_a = match (na.is_leaf(), nb.is_leaf()) {
+                (true, true) => {
+                    f(na.user_data, nb.user_data);
+                    continue;
+                }
+                (false, true) => true,
+                (true, false) => false,
+                (false, false) => na.aabb.perimeter() >= nb.aabb.perimeter(),
+            };
+            if split_a {
+                let (c1, c2) = (na.child1, na.child2);
+                let (n1, n2) = (&a_nodes[c1 as usize], &a_nodes[c2 as usize]);
+                let (keep1, keep2) = (passes(n1, c1, nb, b), passes(n2, c2, nb, b));
+                if keep2 {
+                    stack.push((c2, b));
+                }
+                if keep1 {
+                    stack.push((c1, b));
+                }
+            } else {
+                let (c1, c2) = (nb.child1, nb.child2);
+                let (n1, n2) = (&b_nodes[c1 as usize], &b_nodes[c2 as usize]);
+                let (keep1, keep2) = (passes(na, a, n1, c1), passes(na, a, n2, c2));
+                if keep2 {
+                    stack.push((a, c2));
+                }
+                if keep1 {
+                    stack.push((a, c1));
+                }
             }
-            Self::descend(na, a, nb, b, stack, &mut f);
-        }
-    }
-
-    /// One step of a simultaneous descent of two overlapping nodes: report
-    /// two leaves, otherwise split the larger internal node.
-    #[inline(always)]
-    fn descend<F: FnMut(u32, u32)>(
-        na: &Node,
-        a: u32,
-        nb: &Node,
-        b: u32,
-        stack: &mut Vec<(u32, u32)>,
-        f: &mut F,
-    ) {
-        let split_a = match (na.is_leaf(), nb.is_leaf()) {
-            (true, true) => {
-                f(na.user_data, nb.user_data);
-                return;
-            }
-            (false, true) => true,
-            (true, false) => false,
-            (false, false) => na.aabb.perimeter() >= nb.aabb.perimeter(),
-        };
-        if split_a {
-            stack.push((na.child2, b));
-            stack.push((na.child1, b));
-        } else {
-            stack.push((a, nb.child2));
-            stack.push((a, nb.child1));
         }
     }
 
