@@ -341,6 +341,11 @@ impl Narrowphase {
                 NARROW_BLOCK,
                 |_, cs, ss, rs| {
                     for i in 0..cs.len() {
+                        // The contact records further on, whole: their
+                        // stream is what the loads below waited on.
+                        if let Some(far) = cs.get(i + CONTACTS_AHEAD) {
+                            janus2d_core::hint::prefetch_all(far);
+                        }
                         // The shapes a few contacts on: a contact's two
                         // shape records are random loads (docs/performance.md).
                         if let Some(ahead) = cs.get(i + SHAPES_AHEAD) {
@@ -432,6 +437,11 @@ impl Narrowphase {
 
 /// How many contacts ahead the narrowphase asks for the shape records.
 const SHAPES_AHEAD: usize = 4;
+
+/// How many contacts ahead the narrowphase asks for the contact records
+/// themselves (beyond [`SHAPES_AHEAD`], whose fields it reads to ask for
+/// the shapes).
+const CONTACTS_AHEAD: usize = 12;
 
 /// Phase 1 of the narrowphase for one contact, on the contact alone: the
 /// new manifold (impulses carried over by feature id), the aperture
