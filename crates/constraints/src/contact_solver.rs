@@ -369,18 +369,13 @@ impl ContactSolver {
     /// the one of pushing them in order; with the `parallel` feature and
     /// more than one thread the [`PUSH_BLOCK`]s are filled at once on
     /// `team`, each reading its contacts in order into chunks of its own.
-    pub fn push_all<'l, F>(
-        &mut self,
-        colours: &[u8],
-        lane: F,
-        places: &mut Vec<LanePlace>,
-        team: &Team,
-    ) where
-        F: Fn(usize) -> (&'l ContactLane, u32, [u32; 2]) + Sync,
+    pub fn push_all<F>(&mut self, colours: &[u8], lane: F, places: &mut Vec<LanePlace>, team: &Team)
+    where
+        F: Fn(usize) -> (ContactLane, u32, [u32; 2]) + Sync,
     {
         let push = |solver: &mut Self, colour: u8, i: usize| {
             let (lane, index, cluster) = lane(i);
-            solver.push_with(colour, lane, index, cluster)
+            solver.push_with(colour, &lane, index, cluster)
         };
         places.clear();
         if self.colours.len() < COLOURS {
@@ -414,7 +409,7 @@ impl ContactSolver {
         for (i, &colour) in colours.iter().enumerate() {
             if colour >= OVERFLOW {
                 let (lane, index, cluster) = lane(i);
-                places[i] = self.push_overflow(lane, index, cluster);
+                places[i] = self.push_overflow(&lane, index, cluster);
             } else {
                 counts[i / PUSH_BLOCK][colour as usize] += 1;
             }
@@ -797,11 +792,7 @@ struct PushBlock<'a> {
 impl PushBlock<'_> {
     /// Pushes the block's contacts (`colours[j]`, `lane(j)` for the j-th)
     /// into its chunks in order; the overflow's were placed already.
-    fn fill<'l>(
-        &mut self,
-        colours: &[u8],
-        lane: impl Fn(usize) -> (&'l ContactLane, u32, [u32; 2]),
-    ) {
+    fn fill(&mut self, colours: &[u8], lane: impl Fn(usize) -> (ContactLane, u32, [u32; 2])) {
         let mut pushed = [0usize; COLOURS];
         for (j, (place, &colour)) in self.places.iter_mut().zip(colours).enumerate() {
             if colour >= OVERFLOW {
@@ -820,7 +811,7 @@ impl PushBlock<'_> {
                 }
             }
             let (lane, index, _) = lane(j);
-            chunks[at].push(lane, lane.point_count.min(MAX_MANIFOLD_POINTS), index);
+            chunks[at].push(&lane, lane.point_count.min(MAX_MANIFOLD_POINTS), index);
             *place = LanePlace {
                 colour,
                 lane: lane_k as u8,
@@ -1501,7 +1492,7 @@ mod tests {
         let mut places = Vec::new();
         solver.push_all(
             &colours,
-            |i| (&lanes[i], i as u32, lanes[i].cluster),
+            |i| (lanes[i], i as u32, lanes[i].cluster),
             &mut places,
             team,
         );

@@ -62,12 +62,12 @@ pub(crate) struct Collision {
 }
 
 /// What the collision stage hands to contact building after the
-/// narrowphase: the staged manifolds, with the contact set and the
+/// narrowphase: the touching list, with the contact set and the
 /// counters that building writes (the one plain hand-off between the
 /// collision side and the solver side).
 pub(crate) struct ContactHandoff<'a> {
-    /// The narrowphase's staged manifolds and touching list.
-    pub(crate) staged: crate::narrowphase::Handoff<'a>,
+    /// The narrowphase's touching list.
+    pub(crate) narrow: crate::narrowphase::Handoff<'a>,
     /// The persistent contacts.
     pub(crate) contacts: &'a mut ContactSet,
     /// The step's counters (building adds its rows).
@@ -169,7 +169,7 @@ impl Collision {
     #[inline]
     pub(crate) fn contact_handoff(&mut self) -> ContactHandoff<'_> {
         ContactHandoff {
-            staged: self.narrowphase.handoff(),
+            narrow: self.narrowphase.handoff(),
             contacts: &mut self.contacts,
             counters: &mut self.counters,
         }

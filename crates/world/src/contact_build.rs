@@ -2,7 +2,8 @@
 //! narrowphase.
 //!
 //! ```text
-//! narrowphase ──Handoff { touching, scanned, staged lanes }──▶ build
+//! narrowphase ──Handoff { touching, scanned }──▶ build (each lane read
+//!                                                 from its contact)
 //!   pass 1   the contacts the solve takes (pre-solve hook, still bodies,
 //!            portal copies), their graph keys and light-pair flags;
 //!            each keeps its colour in the persistent ConstraintGraph
@@ -15,8 +16,8 @@
 //!
 //! Where the solver pushes in contact order
 //! (`ContactSolver::pushes_in_order`) and there was no light pair
-//! last step, pass 1 also pushes each contact as it goes, while its staged
-//! lane is in cache; the chunks are those the push would fill, in the same
+//! last step, pass 1 also pushes each contact as it goes, while its
+//! record is in cache; the chunks are those the push would fill, in the same
 //! order.
 //!
 //! The builder owns what lives from step to step on the solver side: the
@@ -27,13 +28,14 @@ use janus2d_constraints::ObjectMass;
 use janus2d_constraints::contact_group::{Clusters, ContactBodies, NO_CLUSTER, light_pair};
 use janus2d_constraints::contact_solver::{ContactSolver, LanePlace, OVERFLOW, PointImpulse};
 use janus2d_core::body::{BodyHandle, BodySet};
+use janus2d_core::contact_input::{ContactLane, ContactPointInput};
 use janus2d_core::graph::{ConstraintGraph, NO_BODY};
 use janus2d_core::math::{Real, Vec2};
 use janus2d_core::parallel::Team;
 
 use crate::collision::ContactHandoff;
-use crate::contacts::ContactSet;
-use crate::narrowphase::{PreSolve, PreSolveFn, StagedContact, solve_body, stage};
+use crate::contacts::{Contact, ContactSet};
+use crate::narrowphase::{PreSolve, PreSolveFn, solve_body};
 
 /// Touching contacts from which constraint building's first pass runs on
 /// threads (below, the tasks cost more than the pass).
@@ -45,15 +47,66 @@ const GRAPH_AHEAD: usize = 8;
 
 /// Asks, at the `i`-th of the `touching` contacts, for what the build
 /// reads a few contacts on: the graph entry `GRAPH_AHEAD` contacts on (a
-/// random read by id), and the staged record whose id that will read,
-/// further on. Used by the build's serial and parallel passes alike.
+/// random read by id), and the contact record (whole) whose id that will
+/// read, further on. Used by the build's serial and parallel passes alike.
 #[inline]
-fn read_ahead(touching: &[u32], staged: &[StagedContact], graph: &ConstraintGraph, i: usize) {
+fn read_ahead(touching: &[u32], awake: &[Contact], graph: &ConstraintGraph, i: usize) {
     if let Some(&ahead) = touching.get(i + 2 * GRAPH_AHEAD) {
-        janus2d_core::hint::prefetch(&staged[ahead as usize]);
+        janus2d_core::hint::prefetch_all(&awake[ahead as usize]);
     }
     if let Some(&ahead) = touching.get(i + GRAPH_AHEAD) {
-        graph.prefetch(staged[ahead as usize].id);
+        graph.prefetch(awake[ahead as usize].id);
+    }
+}
+
+/// What constraint building reads of one awake contact ([`lane_of`]): its
+/// lane (the solver's input, state indices and inverse masses included)
+/// and whether each body read as still.
+#[derive(Clone, Copy, Debug)]
+struct ContactRead {
+    /// The solver's lane data (`contact_index` is set at push).
+    pub(crate) lane: ContactLane,
+    /// The contact's id (its key in the constraint graph).
+    pub(crate) id: u32,
+    /// [`Contact::still`].
+    pub(crate) still: [bool; 2],
+}
+
+/// A contact's lane and stillness as the solve takes them, read from the
+/// contact where the narrowphase left it (an earlier design copied this
+/// out in the narrowphase, 160 bytes a contact written and read back).
+#[inline]
+fn lane_of(c: &Contact) -> ContactRead {
+    let mut points = [ContactPointInput::default(); 2];
+    for (input, p) in points.iter_mut().zip(&c.points[..c.point_count]) {
+        *input = ContactPointInput {
+            anchor_a: p.anchor_a,
+            anchor_b: p.anchor_b,
+            separation: p.separation,
+            normal_impulse: p.normal_impulse,
+            tangent_impulse: p.tangent_impulse,
+        };
+    }
+    let [(state_a, [m_a, i_a]), (state_b, [m_b, i_b])] = c.solve_bodies;
+    ContactRead {
+        lane: ContactLane {
+            body_a: c.body_a,
+            body_b: c.body_b,
+            state_a,
+            state_b,
+            inv_masses: [m_a, i_a, m_b, i_b],
+            normal: c.normal,
+            points,
+            point_count: c.point_count,
+            friction: c.friction,
+            restitution: c.restitution,
+            tangent_speed: c.tangent_speed,
+            rolling_resistance: c.rolling_resistance,
+            contact_index: 0,
+            cluster: [NO_CLUSTER; 2],
+        },
+        id: c.id,
+        still: c.still,
     }
 }
 
@@ -114,6 +167,10 @@ fn not_kept() -> u8 {
 #[derive(Clone, Debug, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub(crate) struct ContactBuilder {
+    /// The lanes a pre-solve hook changed this step, by solved position
+    /// (empty without a hook; scratch).
+    #[cfg_attr(feature = "serde", serde(skip))]
+    hooked: Vec<ContactLane>,
     /// The contacts solved this step, in contact order.
     solved: Vec<SolvedContact>,
     /// Their colours, in the same order (the solver's `push_all` input).
@@ -267,20 +324,20 @@ impl ContactBuilder {
         team: &Team,
     ) {
         let ContactHandoff {
-            staged: handoff,
+            narrow: handoff,
             contacts,
             counters,
         } = from;
         let solved = &mut self.solved;
-        let staged = handoff.staged;
+        // Lanes a pre-solve hook changed, by solved position (only with a
+        // hook: the push reads the rest from the contacts).
+        let hooked = &mut self.hooked;
+        hooked.clear();
         // The contacts to look at: those the narrowphase found touching, then
         // any woken (appended) since.
         let n = contacts.awake().len();
         let scanned = handoff.scanned.min(n);
         let woken = scanned..n;
-        if staged.len() < n {
-            staged.resize(n, StagedContact::default());
-        }
         // A light pair with a body a motor turns or a portal object's body
         // makes no cluster: every cluster it marks touches that body and is
         // blocked (`Clusters::assign`), so without another light pair the
@@ -303,13 +360,13 @@ impl ContactBuilder {
             // Woken bodies have new state indices, and woken contacts were not
             // read by this step's narrowphase: read their bodies again. A
             // wake appends states and contacts and moves none, so a contact
-            // the narrowphase staged between two awake bodies (both state
+            // the narrowphase read between two awake bodies (both state
             // indices set) reads the same states still: only those with a
             // static, sleeping or woken side are read again (smash wakes
             // boxes on most steps; this pass read every contact).
             for k in candidates.clone() {
-                let lane = &staged[k].lane;
-                if k < scanned && lane.state_a != 0 && lane.state_b != 0 {
+                let [(state_a, _), (state_b, _)] = contacts.awake()[k].solve_bodies;
+                if k < scanned && state_a != 0 && state_b != 0 {
                     continue;
                 }
                 let c = contacts.awake_mut(k);
@@ -323,12 +380,6 @@ impl ContactBuilder {
                     solve_body(&bodies.solver_body(c.body_a)),
                     solve_body(&bodies.solver_body(c.body_b)),
                 ];
-                staged[k] = stage(c);
-            }
-        } else {
-            // Contacts woken after the narrowphase were not staged by it.
-            for k in scanned..n {
-                staged[k] = stage(&contacts.awake()[k]);
             }
         }
         // The state index of a body (0: static or asleep) and whether the
@@ -366,7 +417,7 @@ impl ContactBuilder {
         let awake = contacts.awake();
         solved.clear();
         let key = |moving: bool, body: BodyHandle| if moving { body.index } else { NO_BODY };
-        let entry = |k: usize, record: &StagedContact| {
+        let entry = |k: usize, record: &ContactRead| {
             let lane = &record.lane;
             let [m_a, i_a, m_b, i_b] = lane.inv_masses;
             let (ia, moving_a) = state_of((lane.state_a, [m_a, i_a]));
@@ -397,7 +448,6 @@ impl ContactBuilder {
             && handoff.touching.len() >= PARALLEL_BUILD;
         let mut pushed = false;
         if parallel {
-            let staged = &*staged;
             // Written in place: each block of `solved` from its own
             // contacts. A contact whose bodies are both still is marked and
             // dropped after (phase 1 leaves none in `touching`, so the drop
@@ -410,9 +460,9 @@ impl ContactBuilder {
             // that take a colour afresh go through the graph in order.
             let shared = &*graph;
             team.extend_mapped(solved, touching.len(), BLOCK, |i| {
-                read_ahead(touching, staged, shared, i);
+                read_ahead(touching, awake, shared, i);
                 let k = touching[i] as usize;
-                let record = &staged[k];
+                let record = &lane_of(&awake[k]);
                 let mut s = entry(k, record);
                 if record.still == [true, true] {
                     s.index = STILL;
@@ -472,7 +522,7 @@ impl ContactBuilder {
             }
         } else {
             // Serial: each contact is also pushed into its colour's chunk
-            // here, while its staged record is in cache (read once, not
+            // here, while its record is in cache (read once, not
             // again by `push_all` below), unless a light pair could put it
             // in a cluster (then all go through `push_all` after the
             // clusters are known). Last step's clusters predict this
@@ -483,8 +533,8 @@ impl ContactBuilder {
                 && ContactSolver::pushes_in_order(handoff.touching.len() + (n - scanned), team);
             let touching = handoff.touching;
             for (i, k) in candidates.enumerate() {
-                read_ahead(touching, staged, graph, i);
-                let record = &staged[k];
+                read_ahead(touching, awake, graph, i);
+                let mut record = lane_of(&awake[k]);
                 let [sa, sb] = record.still;
                 if (sa && sb) || (k >= scanned && !awake[k].is_solid_touching()) {
                     continue;
@@ -523,10 +573,10 @@ impl ContactBuilder {
                     if !hook(&mut view) {
                         continue;
                     }
-                    view.apply_to(&mut staged[k].lane);
+                    view.apply_to(&mut record.lane);
+                    hooked.push(record.lane);
                 }
-                let record = &staged[k];
-                let s = entry(k, record);
+                let s = entry(k, &record);
                 let (colour, first_light) = take(&s, graph);
                 if first_light && fused {
                     fused = false;
@@ -575,13 +625,18 @@ impl ContactBuilder {
         }
         // Pass 2 (unless pass 1 pushed them): each contact into its colour,
         // in contact order.
-        let (solved, staged) = (&*solved, &*staged);
+        let (solved, hooked) = (&*solved, &*hooked);
         if !pushed {
             solver.push_all(
                 colours,
                 |i| {
                     let s = &solved[i];
-                    (&staged[s.index as usize].lane, s.index, s.cluster)
+                    // (With a hook every solved contact's lane is listed.)
+                    let lane = hooked
+                        .get(i)
+                        .copied()
+                        .unwrap_or_else(|| lane_of(&awake[s.index as usize]).lane);
+                    (lane, s.index, s.cluster)
                 },
                 places,
                 team,

@@ -15,7 +15,7 @@
 //! | [`debug_draw`]   | the [`DebugDraw`] trait, draw flags and colours, the drawing walk |
 //! | `continuous`     | continuous collision: fast bodies swept to their time of impact |
 //! | `contacts`       | the contact life cycle; awake and sleeping contacts, body → contacts |
-//! | `narrowphase`    | manifolds of awake contacts, staged for the solve         |
+//! | `narrowphase`    | manifolds of awake contacts, updated in place             |
 //! | `contact_build`  | contact constraints from the narrowphase's hand-off (colours, clusters, lanes) |
 //! | `collision`      | the collision stage: shapes + broadphase + contacts + events |
 //! | `broadphase`     | pair finding over two dynamic trees                      |

@@ -1,5 +1,5 @@
-//! The narrowphase: new manifolds for the awake contacts, staged for the
-//! solve while each is in cache.
+//! The narrowphase: new manifolds for the awake contacts, updated in
+//! place.
 //!
 //! ```text
 //! phase 1 (parallel with `parallel`)   each awake contact alone, in place:
@@ -22,16 +22,17 @@
 //! phase 2 (contact order)    destroy separated, move asleep ones to the
 //!                            sleeping list, begin/end events, list
 //!                            bodies to wake
-//! hand-off                   the touching contacts and their staged
-//!                            lanes ([`Handoff`]) go to constraint building
-//!                            (`crate::contact_build`, the solver side)
+//! hand-off                   the touching contacts' awake positions
+//!                            ([`Handoff`]) go to constraint building
+//!                            (`crate::contact_build`, the solver side),
+//!                            which reads their lanes from the contacts
 //! ```
 //!
 //! Phase 1 results do not depend on the thread count, since each contact
 //! is computed alone; phase 2 runs in list order.
 
 use janus2d_core::body::{BodyHandle, BodySet, BodyType};
-use janus2d_core::contact_input::{ContactLane, ContactPointInput, NO_CLUSTER};
+use janus2d_core::contact_input::ContactLane;
 use janus2d_core::geometry::{Aabb, Manifold, collide_with_clearance};
 use janus2d_core::math::{Real, Rot, Transform, Vec2};
 use janus2d_core::parallel::Team;
@@ -102,7 +103,7 @@ pub type PreSolveFn = Box<dyn FnMut(&mut PreSolve) -> bool + Send>;
 
 impl PreSolve {
     /// Writes the view's material (as the type docs say: non-finite
-    /// changes ignored, values clamped) into a staged lane.
+    /// changes ignored, values clamped) into a lane.
     pub(crate) fn apply_to(&self, lane: &mut ContactLane) {
         use janus2d_core::limits::{MAX_FRICTION, MAX_RESTITUTION, MAX_SPEED};
         let keep = |new: Real, old: Real, lo: Real, hi: Real| {
@@ -164,102 +165,15 @@ pub(crate) struct Narrowphase {
     /// Number of awake contacts when the last run ended; contacts woken
     /// after it are appended beyond.
     scanned: usize,
-    /// What the solve takes of each awake contact, by awake position,
-    /// written by phase 1 while the contact is in cache (valid where the
-    /// contact touches solidly). Constraint building reads these compact
-    /// records instead of the contacts themselves (about half their size).
-    #[cfg_attr(feature = "serde", serde(skip))]
-    staged: Vec<StagedContact>,
 }
 
 /// What the narrowphase hands constraint building: the contacts it found
-/// touching and their staged records.
+/// touching (constraint building reads their lanes from the contacts).
 pub(crate) struct Handoff<'a> {
     /// Awake positions of the contacts that touch solidly, contact order.
     pub(crate) touching: &'a [u32],
     /// Awake contacts when the narrowphase ended (later ones were woken).
     pub(crate) scanned: usize,
-    /// The staged record of each awake contact, by awake position.
-    pub(crate) staged: &'a mut Vec<StagedContact>,
-}
-
-/// What constraint building needs of one awake contact: its lane (the
-/// solver's input, state indices and inverse masses included) and whether
-/// each body read as still.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct StagedContact {
-    /// The solver's lane data (`contact_index` is set at push).
-    pub(crate) lane: ContactLane,
-    /// The contact's id (its key in the constraint graph).
-    pub(crate) id: u32,
-    /// [`Contact::still`] when staged.
-    pub(crate) still: [bool; 2],
-}
-
-impl Default for StagedContact {
-    fn default() -> Self {
-        Self {
-            lane: empty_lane(),
-            id: u32::MAX,
-            still: [true, true],
-        }
-    }
-}
-
-/// A lane with no points (the filler of unstaged records).
-fn empty_lane() -> ContactLane {
-    ContactLane {
-        body_a: BodyHandle::new(u32::MAX, 0, 0),
-        body_b: BodyHandle::new(u32::MAX, 0, 0),
-        state_a: 0,
-        state_b: 0,
-        inv_masses: [0.0; 4],
-        normal: Vec2::ZERO,
-        points: [ContactPointInput::default(); 2],
-        point_count: 0,
-        friction: 0.0,
-        restitution: 0.0,
-        tangent_speed: 0.0,
-        rolling_resistance: 0.0,
-        contact_index: 0,
-        cluster: [NO_CLUSTER; 2],
-    }
-}
-
-/// Stages a contact: its lane and stillness as the solve takes them.
-#[inline]
-pub(crate) fn stage(c: &Contact) -> StagedContact {
-    let mut points = [ContactPointInput::default(); 2];
-    for (input, p) in points.iter_mut().zip(&c.points[..c.point_count]) {
-        *input = ContactPointInput {
-            anchor_a: p.anchor_a,
-            anchor_b: p.anchor_b,
-            separation: p.separation,
-            normal_impulse: p.normal_impulse,
-            tangent_impulse: p.tangent_impulse,
-        };
-    }
-    let [(state_a, [m_a, i_a]), (state_b, [m_b, i_b])] = c.solve_bodies;
-    StagedContact {
-        lane: ContactLane {
-            body_a: c.body_a,
-            body_b: c.body_b,
-            state_a,
-            state_b,
-            inv_masses: [m_a, i_a, m_b, i_b],
-            normal: c.normal,
-            points,
-            point_count: c.point_count,
-            friction: c.friction,
-            restitution: c.restitution,
-            tangent_speed: c.tangent_speed,
-            rolling_resistance: c.rolling_resistance,
-            contact_index: 0,
-            cluster: [NO_CLUSTER; 2],
-        },
-        id: c.id,
-        still: c.still,
-    }
 }
 
 /// Contacts per block of the narrowphase on the team.
@@ -278,11 +192,10 @@ pub(crate) struct NarrowphaseInput<'a> {
 
 impl Narrowphase {
     /// The hand-off to constraint building (after [`Narrowphase::run`]).
-    pub(crate) fn handoff(&mut self) -> Handoff<'_> {
+    pub(crate) fn handoff(&self) -> Handoff<'_> {
         Handoff {
             touching: &self.touching,
             scanned: self.scanned,
-            staged: &mut self.staged,
         }
     }
 
@@ -316,30 +229,18 @@ impl Narrowphase {
     ) {
         let mut results = std::mem::take(&mut self.results);
         results.clear();
-        let staged = &mut self.staged;
         let n = contacts.awake().len();
-        if staged.len() < n {
-            staged.resize(n, StagedContact::default());
-        }
         {
-            let compute = |(c, s): (&mut Contact, &mut StagedContact)| {
-                let update = update_in_place(c, input);
-                if let ContactUpdate::Updated { solid: true, .. } = update {
-                    *s = stage(c);
-                }
-                update
-            };
             let awake = contacts.awake_slice_mut();
             // Each contact's result is written in its place, in blocks on
             // the team (`beside` runs first on the leader, or alone before
             // the blocks on a serial team).
             results.resize(n, ContactUpdate::Asleep);
-            team.for_each_chunk_triple_mut_beside(
+            team.for_each_chunk_pair_mut_beside(
                 awake,
-                &mut staged[..n],
                 &mut results[..],
                 NARROW_BLOCK,
-                |_, cs, ss, rs| {
+                |_, cs, rs| {
                     for i in 0..cs.len() {
                         // The contact records further on, whole: their
                         // stream is what the loads below waited on.
@@ -356,7 +257,7 @@ impl Narrowphase {
                             input.bodies.prefetch_hinted(hint_a);
                             input.bodies.prefetch_hinted(hint_b);
                         }
-                        rs[i] = compute((&mut cs[i], &mut ss[i]));
+                        rs[i] = update_in_place(&mut cs[i], input);
                     }
                 },
                 beside,
@@ -381,16 +282,13 @@ impl Narrowphase {
                     // brings it back. (Contacts found between bodies
                     // created asleep come here; the rest go when a body
                     // falls asleep.)
-                    // The last awake contact moves to k: so does its
-                    // record (k's own is not read again).
-                    staged[k] = staged[contacts.awake().len() - 1];
+                    // (The last awake contact moves to k.)
                     contacts.sleep_awake_at(k);
                     results.swap_remove(k);
                     continue;
                 }
                 ContactUpdate::Separated => {
-                    // The last awake contact moves to k: so does its record.
-                    staged[k] = staged[contacts.awake().len() - 1];
+                    // (The last awake contact moves to k.)
                     contacts.destroy_awake_at(k, events);
                     results.swap_remove(k);
                     continue;
@@ -409,7 +307,6 @@ impl Narrowphase {
                 wake.push(other);
                 // Woken before the solve: it moves this step.
                 c.still = [false, false];
-                staged[k].still = [false, false];
             }
             if touching {
                 touching_count += 1;
