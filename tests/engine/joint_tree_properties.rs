@@ -22,7 +22,7 @@
 //! worst error as a fraction of its bound.
 
 use janus2d_constraints::joint_tree::{
-    VELOCITY_CORRECTION_SPEED, heavy_spring_inv_mass, spring_inv_mass,
+    HEAVY_SPRING_FACTOR, VELOCITY_CORRECTION_SPEED, heavy_spring_inv_mass, spring_inv_mass,
 };
 use janus2d_constraints::revolute::{RevoluteJoint, RevoluteJointDef};
 use janus2d_constraints::{Joint, JointForest};
@@ -198,10 +198,12 @@ pub(super) fn spring_ks(before: &[ConstraintRows]) -> (Vec<[[f64; 3]; 3]>, f64) 
             // Held by a fixed end: a joint with one moving body.
             let anchored = members().any(|((_, b), _)| b.len() < 2);
             let heavy = if anchored {
+                // (The tests' steps: 1/60 s in 4 substeps, the factor's own.)
                 heavy_spring_inv_mass(
                     members()
                         .flat_map(|((r, _), _)| r.rows.iter().flat_map(|row| row.jacobian.iter()))
                         .map(|e| e.inv_mass),
+                    HEAVY_SPRING_FACTOR,
                 )
             } else {
                 0.0

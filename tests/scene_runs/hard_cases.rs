@@ -475,6 +475,20 @@ fn mass_ratio_chain_1000_to_1_keeps_joints_within_1_cm() {
     assert_case(hard::mass_ratio_chain(20, 1000.0));
 }
 
+/// The 1000:1 chain at 2 substeps (half the default cost): every joint
+/// within 1 cm over the 10 s. With the heavy springs' cap at 300× (as at 4
+/// substeps) it diverged from about 6 s (5.4 m gaps, 212 m/s); the cap
+/// scaled by the substep (`joint_tree::heavy_spring_factor`, 75×) holds
+/// it to 0.7 mm, and 2,000:1 and 5,000:1 too (they diverged as well).
+#[test]
+fn mass_ratio_chain_1000_to_1_holds_its_joints_at_2_substeps() {
+    for ratio in [1000.0, 5000.0] {
+        let mut case = hard::mass_ratio_chain(20, ratio);
+        case.desc.settings.substeps = 2;
+        assert_case(case);
+    }
+}
+
 /// The 20-link chain at 10,000:1: every joint within 1 cm. Measured 0.2
 /// mm with the springs built on 300 times a link's mass
 /// (`joint_tree::HEAVY_SPRING_FACTOR`); on the links' own it diverged

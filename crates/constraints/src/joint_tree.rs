@@ -89,8 +89,9 @@
 //! In a tree held by a fixed end whose moving bodies' masses span more
 //! than [`HEAVY_TREE_RATIO`], every `K_j` in `Γ_j` (and in the held term `Γ_j
 //! λ_j`) is instead taken with every moving body as heavy as the tree's
-//! heaviest, or [`HEAVY_SPRING_FACTOR`] times its lightest if less
-//! ([`heavy_spring_inv_mass`], [`spring_inv_mass`]: `1/m → 1/m̃`,
+//! heaviest, or [`heavy_spring_factor`] times its lightest if less
+//! (300 at the default substep, less for a longer one;
+//! [`heavy_spring_inv_mass`], [`spring_inv_mass`]: `1/m → 1/m̃`,
 //! `1/I → (m / m̃) / I`). The springs are then stiff on the scale of the
 //! load they carry, as the contact groups build theirs on the heaviest
 //! body's mass (`janus2d_constraints::contact_group`); the Jacobians,
@@ -1307,6 +1308,34 @@ pub const HEAVY_TREE_RATIO: Real = 10.0;
 /// joints within 2.1 mm (`mass_ratio_sweep`).
 pub const HEAVY_SPRING_FACTOR: Real = 300.0;
 
+/// The substep (s) at which [`HEAVY_SPRING_FACTOR`] was measured: steps of
+/// 1/60 s in 4 substeps.
+pub const HEAVY_SPRING_SUBSTEP: Real = 1.0 / 240.0;
+
+/// The stiffening cap of a heavy tree's springs for a substep of `h`
+/// seconds (dimensionless): [`HEAVY_SPRING_FACTOR`] up to
+/// [`HEAVY_SPRING_SUBSTEP`], and `HEAVY_SPRING_FACTOR (h₀ / h)²` for a
+/// longer substep.
+///
+/// The directly solved joints' spring has a fixed frequency `ω` (the
+/// direct joint hertz, 500 Hz); built on a mass `f` times a light body's,
+/// it pulls that body at `ω √f`. Scaling `f` by `(h₀ / h)²` keeps `ω √f h`,
+/// the light body's spring phase per substep, where it was measured
+/// stable. At 2 substeps (75×) the 20-link chain with a 1,000:1 end holds
+/// its joints within 0.7 mm; at 300× it diverged there (5.4 m gaps, from
+/// about 6 s), as did 2,000:1 and 5,000:1.
+#[must_use]
+pub fn heavy_spring_factor(h: Real) -> Real {
+    // (A substep within rounding of h₀, as 1/60 s in 4, takes the factor
+    // as it is.)
+    if h <= HEAVY_SPRING_SUBSTEP * 1.001 {
+        HEAVY_SPRING_FACTOR
+    } else {
+        let r = HEAVY_SPRING_SUBSTEP / h;
+        HEAVY_SPRING_FACTOR * r * r
+    }
+}
+
 /// The masses a joint's spring is built on: its own, or, in an anchored
 /// tree whose masses span more than [`HEAVY_TREE_RATIO`], every moving body as heavy
 /// as the tree's spring mass (see [`spring_inv_mass`]). The soft row's
@@ -1350,10 +1379,10 @@ pub fn spring_inv_mass(inv_mass: Real, inv_inertia: Real, heavy: Real) -> (Real,
 /// The inverse mass (1/kg) a tree's joint springs are built on, from its
 /// moving bodies' inverse masses: where the heaviest is more than
 /// [`HEAVY_TREE_RATIO`] times the lightest, the heaviest body's mass or
-/// [`HEAVY_SPRING_FACTOR`] times the lightest's, whichever is less; 0
-/// (each joint's own masses) otherwise.
+/// `factor` times the lightest's ([`heavy_spring_factor`] of the
+/// substep), whichever is less; 0 (each joint's own masses) otherwise.
 #[must_use]
-pub fn heavy_spring_inv_mass(inv_masses: impl IntoIterator<Item = Real>) -> Real {
+pub fn heavy_spring_inv_mass(inv_masses: impl IntoIterator<Item = Real>, factor: Real) -> Real {
     let (mut lightest, mut heaviest) = (0.0 as Real, Real::MAX);
     for inv in inv_masses {
         if inv > 0.0 {
@@ -1362,19 +1391,20 @@ pub fn heavy_spring_inv_mass(inv_masses: impl IntoIterator<Item = Real>) -> Real
         }
     }
     if heaviest < Real::MAX && lightest > HEAVY_TREE_RATIO * heaviest {
-        heaviest.max(lightest / HEAVY_SPRING_FACTOR)
+        heaviest.max(lightest / factor)
     } else {
         0.0
     }
 }
 
 /// [`heavy_spring_inv_mass`] of a tree's moving bodies, read from its
-/// joints' loaded masses.
-fn heavy_inv_mass(tree: &[TreeJoint], joints: &[Joint]) -> Real {
-    heavy_spring_inv_mass(tree.iter().flat_map(|tj| {
+/// joints' loaded masses, for a substep of `h` seconds.
+fn heavy_inv_mass(tree: &[TreeJoint], joints: &[Joint], h: f64) -> Real {
+    let inv_masses = tree.iter().flat_map(|tj| {
         let m = joints[tj.index as usize].base().masses;
         [m.a.inv_mass, m.b.inv_mass]
-    }))
+    });
+    heavy_spring_inv_mass(inv_masses, heavy_spring_factor(h as Real))
 }
 
 /// Largest position-feedback speed of one tree joint that goes into the
@@ -1491,7 +1521,7 @@ fn solve_tree(tree: &mut Tree<'_>, joints: &[Joint], states: &[BodyState], param
         // Free trees (ragdolls, vehicles) keep their joints' own springs,
         // as they keep the whole feedback in their velocities.
         heavy_inv_mass: if anchored {
-            heavy_inv_mass(tree.joints, joints)
+            heavy_inv_mass(tree.joints, joints, params.h)
         } else {
             0.0
         },
