@@ -65,11 +65,11 @@ fn read_ahead(touching: &[u32], awake: &[Contact], graph: &ConstraintGraph, i: u
 #[derive(Clone, Copy, Debug)]
 struct ContactRead {
     /// The solver's lane data (`contact_index` is set at push).
-    pub(crate) lane: ContactLane,
+    lane: ContactLane,
     /// The contact's id (its key in the constraint graph).
-    pub(crate) id: u32,
+    id: u32,
     /// [`Contact::still`].
-    pub(crate) still: [bool; 2],
+    still: [bool; 2],
 }
 
 /// A contact's lane and stillness as the solve takes them, read from the
