@@ -1384,6 +1384,8 @@ impl DynamicTree {
                 (true, false) => false,
                 (false, false) => na.aabb.perimeter() >= nb.aabb.perimeter(),
             };
+            // (The two branches mirror each other; one written with
+            // closures over the side measured 7% slower in washer.)
             if split_a {
                 let (c1, c2) = (na.child1, na.child2);
                 let (n1, n2) = (&a_nodes[c1 as usize], &a_nodes[c2 as usize]);
