@@ -109,6 +109,18 @@ pub(crate) struct RevoluteLane {
     pub(crate) point_impulse: Vec2,
 }
 
+/// Asks for the records of joints `ids` (whole) ahead of their reads:
+/// lanes go in colour order, not storage order, so each is a random read
+/// of several lines. A hint only.
+#[inline]
+fn prefetch_joints(joints: &[Joint], ids: impl Iterator<Item = u32>) {
+    for j in ids {
+        if let Some(joint) = joints.get(j as usize) {
+            janus2d_core::hint::prefetch_all(joint);
+        }
+    }
+}
+
 /// What a lane joint's warm start reads, gathered once a substep
 /// ([`RevoluteLanes::refresh_warm`]) so that the warm start, body by body,
 /// reads no joint record (a random read of three lines per joint and
@@ -488,11 +500,8 @@ impl RevoluteLanes {
                 let first = (16 * i + k) * LANES;
                 // The next chunk's joints (colour order is not storage
                 // order: each is a random read of several lines).
-                for &(j, _) in entries.get(first + LANES..first + 2 * LANES).unwrap_or(&[]) {
-                    if let Some(joint) = joints.get(j as usize) {
-                        janus2d_core::hint::prefetch_all(joint);
-                    }
-                }
+                let next = entries.get(first + LANES..first + 2 * LANES);
+                prefetch_joints(joints, next.unwrap_or(&[]).iter().map(|&(j, _)| j));
                 WideRevolute::fill(chunk, &entries[first..first + LANES], joints, h);
             }
         });
@@ -646,14 +655,8 @@ impl RevoluteLanes {
         let chunks = self.live_chunks();
         for (c, chunk) in chunks.iter().enumerate() {
             // The next chunk's joints (random reads, as in the fill).
-            for &j in chunks
-                .get(c + 1)
-                .map_or(&[][..], |next| &next.joint[..next.len])
-            {
-                if let Some(joint) = joints.get(j as usize) {
-                    janus2d_core::hint::prefetch_all(joint);
-                }
-            }
+            let next = chunks.get(c + 1).map_or(&[][..], |n| &n.joint[..n.len]);
+            prefetch_joints(joints, next.iter().copied());
             for k in 0..chunk.len {
                 if let Some(Joint::Revolute(r)) = joints.get_mut(chunk.joint[k] as usize) {
                     r.set_lane_impulses(chunk.impulses(k));

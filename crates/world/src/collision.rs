@@ -662,7 +662,8 @@ impl Collision {
 
     /// Ends the batch of proxy moves here, beside the impulse store, when
     /// it moved few proxies; a batch of many is left for
-    /// [`Collision::end_step`] to rebuild the whole tree on the team.
+    /// [`Collision::end_step`] to finish the whole tree (rebuilt on the
+    /// team, or refitted).
     fn finish_few_moves(broadphase: &mut BroadPhase) {
         if !broadphase.moves_are_bulk() {
             broadphase.finish_moves();
