@@ -395,9 +395,24 @@ impl ContactSolver {
         // the chunks are those the pushes in order make.
         let n = colours.len();
         let blocks = n.div_ceil(PUSH_BLOCK);
+        // Each block's count per colour on the team, and whether it has
+        // overflow contacts (a serial count was 1.2% of the leader's
+        // samples in large_pyramid at two threads).
+        let tallies = team.map_blocks(blocks, |b| {
+            let mut count = [0u32; COLOURS];
+            let mut overflow = false;
+            for &colour in &colours[b * PUSH_BLOCK..((b + 1) * PUSH_BLOCK).min(n)] {
+                if colour >= OVERFLOW {
+                    overflow = true;
+                } else {
+                    count[colour as usize] += 1;
+                }
+            }
+            (count, overflow)
+        });
         let mut counts = std::mem::take(&mut self.block_counts);
         counts.clear();
-        counts.resize(blocks, [0; COLOURS]);
+        counts.extend(tallies.iter().map(|&(count, _)| count));
         places.resize(
             n,
             LanePlace {
@@ -406,12 +421,19 @@ impl ContactSolver {
                 chunk: 0,
             },
         );
-        for (i, &colour) in colours.iter().enumerate() {
-            if colour >= OVERFLOW {
-                let (lane, index, cluster) = lane(i);
-                places[i] = self.push_overflow(&lane, index, cluster);
-            } else {
-                counts[i / PUSH_BLOCK][colour as usize] += 1;
+        // The overflow's pushes in contact order, on the caller.
+        for (b, _) in tallies.iter().enumerate().filter(|(_, t)| t.1) {
+            let first = b * PUSH_BLOCK;
+            for (i, &colour) in colours
+                .iter()
+                .enumerate()
+                .take((first + PUSH_BLOCK).min(n))
+                .skip(first)
+            {
+                if colour >= OVERFLOW {
+                    let (lane, index, cluster) = lane(i);
+                    places[i] = self.push_overflow(&lane, index, cluster);
+                }
             }
         }
         self.len += n;
@@ -623,26 +645,41 @@ impl ContactSolver {
         team: &Team,
     ) {
         let states = &bodies.states[..];
+        self.plan.clear();
+        let planned = team.threads() > 1;
         for chunks in &mut self.colours {
             chunks.seal();
             let per_block = block_len(team, chunks.len());
-            team.for_each_chunk_mut(chunks, per_block, |_, block| {
-                for chunk in block {
-                    chunk.prepare(ctx, states);
-                }
-            });
-        }
-        self.plan.clear();
-        if team.threads() > 1 {
-            for chunks in &self.colours {
-                self.plan.begin_group();
-                for chunk in chunks.iter() {
-                    let mut slots = [0; PLAN_SLOTS];
-                    slots[..LANES].copy_from_slice(&chunk.state_a);
-                    slots[LANES..].copy_from_slice(&chunk.state_b);
-                    self.plan.push(slots, chunk.moving);
-                }
+            if planned {
+                // Each chunk's item of the state plan (its colour a group)
+                // written beside its prepare, on the team (a serial pass
+                // after it was 1.2% of the leader's samples in
+                // large_pyramid at two threads).
+                let (slots, writes) = self.plan.push_group(chunks.len());
+                team.for_each_chunk_triple_mut_beside(
+                    chunks,
+                    slots,
+                    writes,
+                    per_block,
+                    |_, block, slots, writes| {
+                        for ((chunk, slots), writes) in block.iter_mut().zip(slots).zip(writes) {
+                            chunk.prepare(ctx, states);
+                            slots[..LANES].copy_from_slice(&chunk.state_a);
+                            slots[LANES..].copy_from_slice(&chunk.state_b);
+                            *writes = chunk.moving;
+                        }
+                    },
+                    || {},
+                );
+            } else {
+                team.for_each_chunk_mut(chunks, per_block, |_, block| {
+                    for chunk in block {
+                        chunk.prepare(ctx, states);
+                    }
+                });
             }
+        }
+        if planned {
             // A plan that does not hold (it always should: the colouring
             // keeps moving bodies apart) leaves the stages serial.
             let verified = self.plan.verify_on(states.len(), team);
@@ -810,8 +847,13 @@ impl PushBlock<'_> {
                     janus2d_core::hint::prefetch_all(next);
                 }
             }
-            let (lane, index, _) = lane(j);
-            chunks[at].push(&lane, lane.point_count.min(MAX_MANIFOLD_POINTS), index);
+            // Read in place: moved out of the tuple, the lane was copied
+            // through a call to `memcpy` whose stores the push's loads
+            // then waited on (many_pyramids at two threads: 5% of the
+            // step).
+            let read = lane(j);
+            let lane = &read.0;
+            chunks[at].push(lane, lane.point_count.min(MAX_MANIFOLD_POINTS), read.1);
             *place = LanePlace {
                 colour,
                 lane: lane_k as u8,

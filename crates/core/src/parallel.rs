@@ -592,6 +592,18 @@ impl<const N: usize> StatePlan<N> {
         self.verified = None;
     }
 
+    /// Adds a group of `count` items whose state indices and write masks
+    /// the caller fills in the slices returned (all zero until then), so
+    /// that a team can fill them in blocks; the same plan as `count`
+    /// [`StatePlan::push`]es after [`StatePlan::begin_group`].
+    pub fn push_group(&mut self, count: usize) -> (&mut [[u32; N]], &mut [u32]) {
+        self.begin_group();
+        let start = self.slots.len();
+        self.slots.resize(start + count, [0; N]);
+        self.writes.resize(start + count, 0);
+        (&mut self.slots[start..], &mut self.writes[start..])
+    }
+
     /// Number of groups.
     #[must_use]
     pub fn group_count(&self) -> usize {

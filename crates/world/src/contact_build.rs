@@ -110,12 +110,19 @@ fn lane_of(c: &Contact) -> ContactRead {
     }
 }
 
-/// [`Narrowphase::place_of`] of a contact that is not solved this step.
-const UNSOLVED: LanePlace = LanePlace {
-    colour: u8::MAX,
-    lane: 0,
-    chunk: 0,
-};
+/// One block of the solved contacts for the threads' impulse store: the
+/// awake contacts it may write (from `first` on) and its solved contacts
+/// with their places.
+struct StorePart<'a> {
+    /// The awake contacts from `first` to the next block's first solved one.
+    contacts: &'a mut [Contact],
+    /// Awake index of `contacts[0]`.
+    first: usize,
+    /// The block's solved contacts, in contact order.
+    solved: &'a [SolvedContact],
+    /// Their places (as long as `solved` or longer).
+    places: &'a [LanePlace],
+}
 
 /// A contact the solve takes this step, as the build's first pass found it.
 #[derive(Clone, Copy, Debug)]
@@ -178,10 +185,10 @@ pub(crate) struct ContactBuilder {
     /// Where the solver put each solved contact, in `solved` order.
     #[cfg_attr(feature = "serde", serde(skip))]
     places: Vec<LanePlace>,
-    /// The same by awake position ([`UNSOLVED`] for a contact the solve
-    /// does not take), for storing the impulses back in contact order.
+    /// The awake contacts' count when `solved` and `places` were made
+    /// (the threads' store checks that the list is the same).
     #[cfg_attr(feature = "serde", serde(skip))]
-    place_of: Vec<LanePlace>,
+    built_for: usize,
     /// The persistent colours of the solved contacts (kept in snapshots:
     /// the colours are part of the state a step continues from).
     graph: ConstraintGraph,
@@ -286,12 +293,6 @@ impl ContactBuilder {
         self.graph
             .check()
             .map_err(|e| format!("constraint graph: {e}"))
-    }
-
-    /// Whether a place holds a solved contact.
-    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
-    pub(crate) fn is_solved(place: &LanePlace) -> bool {
-        *place != UNSOLVED
     }
 }
 
@@ -642,25 +643,15 @@ impl ContactBuilder {
                 team,
             );
         }
-        // By contact, for storing the impulses on the threads (one thread
-        // stores by the solver's order and needs none of it).
-        let place_of = &mut self.place_of;
-        place_of.clear();
-        if team.threads() > 1 {
-            place_of.resize(n, UNSOLVED);
-            for (s, &place) in solved.iter().zip(places.iter()) {
-                place_of[s.index as usize] = place;
-            }
-        }
+        self.built_for = n;
         counters.contact_rows = tally.rows;
         counters.restitution_contacts = tally.bouncy;
     }
 
-    /// Copies solved impulses back into the contacts (for warm starting);
-    /// `places` is where the solver holds each awake contact's impulses
-    /// (`place_of`). Touches only the contacts: `beside` (the proxy moves
-    /// and the tree rebuild, `Collision::end_step`) runs on the leader
-    /// while the team stores, or first on one thread.
+    /// Copies solved impulses back into the contacts (for warm starting).
+    /// Touches only the contacts: `beside` (the proxy moves and the tree
+    /// rebuild, `Collision::end_step`) runs on the leader while the team
+    /// stores, or first on one thread.
     pub(crate) fn store_impulses(
         &self,
         contacts: &mut ContactSet,
@@ -668,7 +659,6 @@ impl ContactBuilder {
         team: &Team,
         beside: &mut dyn FnMut(),
     ) {
-        let places = &self.place_of[..];
         // A non-finite impulse (a solve that blew up) is not kept for warm
         // starting: the contact starts cold next step instead of carrying
         // NaN into it.
@@ -679,20 +669,50 @@ impl ContactBuilder {
             p.total_normal_impulse = finite(impulse.total_normal);
             p.total_tangent_impulse = finite(impulse.total_tangent);
         };
-        if team.threads() > 1 && places.len() > 4096 && places.len() == contacts.awake().len() {
-            // On the team, in contact order: each contact written once, in
-            // place, reading its lanes from the chunks. (On one thread the
-            // scatter below measured faster: 6.8% of many_pyramids' samples
-            // against 10.2% for this gather.)
+        let (solved, places) = (&self.solved[..], &self.places[..]);
+        let n = contacts.awake().len();
+        if team.threads() > 1 && n > 4096 && self.built_for == n && places.len() == solved.len() {
+            // On the team, in contact order: each solved contact written
+            // once, in place, reading its lanes from the chunks. `solved`
+            // is in contact order, so each block of it writes only the
+            // contacts from its first one's to the next block's first one's
+            // (the serial pass that spread the places over every awake
+            // contact first was 1.3% of the leader's samples in
+            // large_pyramid at two threads). (On one thread the scatter
+            // below measured faster: 6.8% of many_pyramids' samples against
+            // 10.2% for this gather.)
             const BLOCK: usize = 1024;
+            let mut parts = Vec::with_capacity(solved.len().div_ceil(BLOCK));
+            let mut rest = contacts.awake_slice_mut();
+            let mut first = 0;
+            for (b, block) in solved.chunks(BLOCK).enumerate() {
+                let end = solved
+                    .get((b + 1) * BLOCK)
+                    .map_or(first + rest.len(), |s| s.index as usize);
+                let (mine, tail) = std::mem::take(&mut rest).split_at_mut(end - first);
+                parts.push(StorePart {
+                    contacts: mine,
+                    first,
+                    solved: block,
+                    places: &places[b * BLOCK..],
+                });
+                rest = tail;
+                first = end;
+            }
             team.for_each_chunk_mut_beside(
-                contacts.awake_slice_mut(),
-                BLOCK,
-                |i, block| {
-                    for (c, place) in block.iter_mut().zip(&places[i * BLOCK..]) {
-                        if Self::is_solved(place) {
-                            for k in 0..c.point_count {
-                                keep(&mut c.points[k], solver.point_impulse_at(*place, k));
+                &mut parts,
+                1,
+                |_, parts| {
+                    for part in parts {
+                        for (s, place) in part.solved.iter().zip(part.places) {
+                            let c = (s.index as usize)
+                                .checked_sub(part.first)
+                                .and_then(|i| part.contacts.get_mut(i));
+                            debug_assert!(c.is_some(), "solved contacts out of contact order");
+                            if let Some(c) = c {
+                                for k in 0..c.point_count {
+                                    keep(&mut c.points[k], solver.point_impulse_at(*place, k));
+                                }
                             }
                         }
                     }
