@@ -689,7 +689,10 @@ impl ContactBuilder {
                 let end = solved
                     .get((b + 1) * BLOCK)
                     .map_or(first + rest.len(), |s| s.index as usize);
-                let (mine, tail) = std::mem::take(&mut rest).split_at_mut(end - first);
+                // (Clamped: out of contact order, a block writes nothing
+                // rather than panic; the debug check below names it.)
+                let len = end.saturating_sub(first).min(rest.len());
+                let (mine, tail) = std::mem::take(&mut rest).split_at_mut(len);
                 parts.push(StorePart {
                     contacts: mine,
                     first,
@@ -697,7 +700,7 @@ impl ContactBuilder {
                     places: &places[b * BLOCK..],
                 });
                 rest = tail;
-                first = end;
+                first += len;
             }
             team.for_each_chunk_mut_beside(
                 &mut parts,
