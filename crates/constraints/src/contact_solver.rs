@@ -658,7 +658,7 @@ impl ContactSolver {
                 // written beside its prepare, on the team (a serial pass
                 // after it was 1.2% of the leader's samples in
                 // large_pyramid at two threads).
-                let (slots, writes) = self.plan.push_group(chunks.len());
+                let (slots, writes) = self.plan.push_groups([chunks.len()]);
                 team.for_each_chunk_triple_mut_beside(
                     chunks,
                     slots,
@@ -667,9 +667,8 @@ impl ContactSolver {
                     |_, block, slots, writes| {
                         for ((chunk, slots), writes) in block.iter_mut().zip(slots).zip(writes) {
                             chunk.prepare(ctx, states);
-                            slots[..LANES].copy_from_slice(&chunk.state_a);
-                            slots[LANES..].copy_from_slice(&chunk.state_b);
-                            *writes = chunk.moving;
+                            (*slots, *writes) =
+                                (plan_slots(&chunk.state_a, &chunk.state_b), chunk.moving);
                         }
                     },
                     || {},
@@ -1004,6 +1003,16 @@ impl LaneStates for Direct<'_> {
 
 /// Slots per chunk in the parallel stages' plan: both bodies of every lane.
 pub(crate) const PLAN_SLOTS: usize = 2 * LANES;
+
+/// A chunk's item of a state plan: its lanes' states on side a, then on
+/// side b.
+#[inline]
+pub(crate) fn plan_slots(a: &[u32; LANES], b: &[u32; LANES]) -> [u32; PLAN_SLOTS] {
+    let mut slots = [0; PLAN_SLOTS];
+    slots[..LANES].copy_from_slice(a);
+    slots[LANES..].copy_from_slice(b);
+    slots
+}
 
 /// The parallel view: the chunk's slots of the verified plan (slot `k`:
 /// body a of lane `k`, slot `LANES + k`: body b); only moving bodies are

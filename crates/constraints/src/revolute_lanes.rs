@@ -42,7 +42,7 @@ use janus2d_core::constraint::StepContext;
 use janus2d_core::math::{Real, Vec2};
 use janus2d_core::parallel::{StatePlan, Team};
 
-use crate::contact_solver::{Direct, LaneStates, PLAN_SLOTS, load, store_where};
+use crate::contact_solver::{Direct, LaneStates, PLAN_SLOTS, load, plan_slots, store_where};
 use crate::joint::Joint;
 use crate::joint_rows::{
     Bounds, PointTerms, SoftLanes, Terms, WarmSide, angle_row, point_equality_row,
@@ -495,28 +495,44 @@ impl RevoluteLanes {
             self.chunks.resize_with(count, WideRevolute::default);
         }
         let (entries, joints, h) = (&*entries, &*joints, ctx.h);
-        team.for_each_chunk_mut(&mut self.chunks[..count], 16, |i, block| {
-            for (k, chunk) in block.iter_mut().enumerate() {
-                let first = (16 * i + k) * LANES;
-                // The next chunk's joints (colour order is not storage
-                // order: each is a random read of several lines).
-                let next = entries.get(first + LANES..first + 2 * LANES);
-                prefetch_joints(joints, next.unwrap_or(&[]).iter().map(|&(j, _)| j));
-                WideRevolute::fill(chunk, &entries[first..first + LANES], joints, h);
-            }
-        });
+        let fill = |c: usize, chunk: &mut WideRevolute| {
+            let first = c * LANES;
+            // The next chunk's joints (colour order is not storage order:
+            // each is a random read of several lines).
+            let next = entries.get(first + LANES..first + 2 * LANES);
+            prefetch_joints(joints, next.unwrap_or(&[]).iter().map(|&(j, _)| j));
+            WideRevolute::fill(chunk, &entries[first..first + LANES], joints, h);
+        };
+        let chunks = &mut self.chunks[..count];
         if team.threads() > 1 {
-            for c in 0..self.starts.len() - 1 {
-                self.plan.begin_group();
-                for chunk in &self.chunks[self.starts[c] as usize..self.starts[c + 1] as usize] {
-                    let mut slots = [0; PLAN_SLOTS];
-                    slots[..LANES].copy_from_slice(&chunk.state[A]);
-                    slots[LANES..].copy_from_slice(&chunk.state[B]);
-                    self.plan.push(slots, chunk.moving);
-                }
-            }
+            // Each chunk's item of the state plan (a group per colour, in
+            // chunk order) written beside its fill, on the team.
+            let colours = self.starts.windows(2).map(|s| (s[1] - s[0]) as usize);
+            let (slots, writes) = self.plan.push_groups(colours);
+            team.for_each_chunk_triple_mut_beside(
+                chunks,
+                slots,
+                writes,
+                16,
+                |i, block, slots, writes| {
+                    for (k, ((chunk, slots), writes)) in
+                        block.iter_mut().zip(slots).zip(writes).enumerate()
+                    {
+                        fill(16 * i + k, chunk);
+                        (*slots, *writes) =
+                            (plan_slots(&chunk.state[A], &chunk.state[B]), chunk.moving);
+                    }
+                },
+                || {},
+            );
             let verified = self.plan.verify_on(states, team);
             debug_assert!(verified, "a lane colour holds a moving body twice");
+        } else {
+            team.for_each_chunk_mut(chunks, 16, |i, block| {
+                for (k, chunk) in block.iter_mut().enumerate() {
+                    fill(16 * i + k, chunk);
+                }
+            });
         }
     }
 
@@ -627,15 +643,15 @@ impl RevoluteLanes {
         };
         // Fewer chunks than two blocks: one block, which runs on the caller.
         let per_block = if chunks.len() < 2 * WARM_BLOCK {
-            chunks.len()
+            chunks.len().max(1)
         } else {
             WARM_BLOCK
         };
         // (Kept entries are overwritten whole.)
         self.warm.resize(chunks.len(), [LaneWarm::default(); LANES]);
-        team.for_each_chunk_mut(&mut self.warm, per_block.max(1), |b, block| {
+        team.for_each_chunk_mut(&mut self.warm, per_block, |b, block| {
             for (j, out) in block.iter_mut().enumerate() {
-                fill(b * per_block.max(1) + j, out);
+                fill(b * per_block + j, out);
             }
         });
     }

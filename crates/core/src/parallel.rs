@@ -592,15 +592,24 @@ impl<const N: usize> StatePlan<N> {
         self.verified = None;
     }
 
-    /// Adds a group of `count` items whose state indices and write masks
-    /// the caller fills in the slices returned (all zero until then), so
-    /// that a team can fill them in blocks; the same plan as `count`
-    /// [`StatePlan::push`]es after [`StatePlan::begin_group`].
-    pub fn push_group(&mut self, count: usize) -> (&mut [[u32; N]], &mut [u32]) {
-        self.begin_group();
+    /// Adds groups of `counts` items each, whose state indices and write
+    /// masks the caller fills in the slices returned (every new item, in
+    /// group order; all zero until then), so that a team can fill them in
+    /// blocks: the same plan as, per group, [`StatePlan::begin_group`] and
+    /// its items' [`StatePlan::push`]es.
+    pub fn push_groups(
+        &mut self,
+        counts: impl IntoIterator<Item = usize>,
+    ) -> (&mut [[u32; N]], &mut [u32]) {
         let start = self.slots.len();
-        self.slots.resize(start + count, [0; N]);
-        self.writes.resize(start + count, 0);
+        let mut end = start;
+        for count in counts {
+            self.group_start.push(end);
+            end += count;
+        }
+        self.slots.resize(end, [0; N]);
+        self.writes.resize(end, 0);
+        self.verified = None;
         (&mut self.slots[start..], &mut self.writes[start..])
     }
 

@@ -120,7 +120,7 @@ struct StorePart<'a> {
     first: usize,
     /// The block's solved contacts, in contact order.
     solved: &'a [SolvedContact],
-    /// Their places (as long as `solved` or longer).
+    /// Their places.
     places: &'a [LanePlace],
 }
 
@@ -697,7 +697,7 @@ impl ContactBuilder {
                     contacts: mine,
                     first,
                     solved: block,
-                    places: &places[b * BLOCK..],
+                    places: &places[b * BLOCK..b * BLOCK + block.len()],
                 });
                 rest = tail;
                 first += len;
